@@ -1,0 +1,253 @@
+// turtle.cpp — the 3D turtle (ABOP ch. 1.5, 2.2) building skeleton chains (skeleton.md).
+#include "core/turtle.h"
+
+#include <chrono>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+#include "lsystem/expr.h"
+
+namespace sylva {
+
+namespace {
+
+using glm::dvec3;
+
+struct TurtleState {
+  dvec3 position{0, 0, 0};
+  dvec3 heading{0, 1, 0};
+  dvec3 left{-1, 0, 0};
+  dvec3 up{0, 0, 1};
+  double radius = 0.05;
+  uint32_t material = 0;
+  double tropism_e = 0;
+  int64_t chain = -1;          // chain the turtle stands on, or -1
+  int64_t joint = -1;          // joint index within that chain
+  bool branch_pending = false; // set by '[': the next F starts a new chain
+};
+
+struct PendingJoint {
+  uint32_t chain;
+  Joint joint;
+};
+
+struct TurtleFailure {
+  std::string message;
+};
+
+// Keeps the frame orthonormal and right-handed after a rotation (cheap Gram–Schmidt).
+void orthonormalize(TurtleState& t) {
+  t.heading = glm::normalize(t.heading);
+  t.left = glm::normalize(t.left - glm::dot(t.left, t.heading) * t.heading);
+  t.up = glm::cross(t.heading, t.left);
+}
+
+// Rotates the pair (a, b) in their plane by `angle_deg`, turning a toward b.
+void rotate_pair(dvec3& a, dvec3& b, double angle_deg) {
+  const double c = lsys::cos_deg(angle_deg), s = lsys::sin_deg(angle_deg);
+  const dvec3 a2 = a * c + b * s;
+  const dvec3 b2 = b * c - a * s;
+  a = a2;
+  b = b2;
+}
+
+// Rodrigues rotation of v about unit axis k by angle (radians).
+dvec3 rotate_about(const dvec3& v, const dvec3& k, double angle_rad) {
+  const double c = std::cos(angle_rad), s = std::sin(angle_rad);
+  return v * c + glm::cross(k, v) * s + k * glm::dot(k, v) * (1 - c);
+}
+
+}  // namespace
+
+lsys::Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g, TurtleStats* stats) {
+  using namespace lsys;
+  auto t0 = std::chrono::steady_clock::now();
+  const TurtleDefaults& d = g.turtle;
+  const dvec3 tropism(d.tropism[0], d.tropism[1], d.tropism[2]);
+  TurtleState t;
+  t.radius = d.width;
+  t.tropism_e = d.has_tropism ? d.tropism_e : 0.0;
+  std::vector<TurtleState> stack;
+  std::vector<PendingJoint> joints;
+  std::vector<uint32_t> chain_joint_count;
+  std::vector<std::optional<ChainParent>> chain_parent;
+  uint64_t zero_moves = 0;
+  const size_t n = word.size();
+  size_t i = 0;
+  try {
+    for (; i < n; ++i) {
+      const Module& m = word.modules[i];
+      const double* p = word.params_of(m);
+      const bool has = m.param_count > 0;
+      switch (m.symbol) {
+        case kSymF: {
+          const double len = has ? p[0] : d.step;
+          if (len == 0) {
+            ++zero_moves;
+            break;
+          }
+          const bool start_chain = t.chain < 0 || t.branch_pending ||
+                                   t.joint + 1 != static_cast<int64_t>(chain_joint_count[t.chain]);
+          if (start_chain) {
+            if (chain_joint_count.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many chains"};
+            std::optional<ChainParent> parent;
+            if (t.chain >= 0) parent = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
+            const uint32_t c = static_cast<uint32_t>(chain_joint_count.size());
+            chain_joint_count.push_back(1);
+            chain_parent.push_back(parent);
+            joints.push_back({c, Joint{{t.position.x, t.position.y, t.position.z}, t.radius, t.material}});
+            t.chain = c;
+            t.joint = 0;
+            t.branch_pending = false;
+          }
+          t.position += t.heading * len;
+          if (!std::isfinite(t.position.x) || !std::isfinite(t.position.y) || !std::isfinite(t.position.z))
+            throw TurtleFailure{"the turtle's position is no longer finite"};
+          if (chain_joint_count[t.chain] == 0xFFFFFFFFu) throw TurtleFailure{"a chain has too many joints"};
+          joints.push_back({static_cast<uint32_t>(t.chain),
+                            Joint{{t.position.x, t.position.y, t.position.z}, t.radius, t.material}});
+          ++chain_joint_count[t.chain];
+          ++t.joint;
+          if (t.tropism_e != 0.0) {
+            // ABOP 2.2: rotate the frame about H × T by e·|H × T|.
+            const dvec3 axis = glm::cross(t.heading, tropism);
+            const double len_axis = glm::length(axis);
+            if (len_axis > 1e-12) {
+              const dvec3 k = axis / len_axis;
+              const double alpha = t.tropism_e * len_axis;
+              t.heading = rotate_about(t.heading, k, alpha);
+              t.left = rotate_about(t.left, k, alpha);
+              orthonormalize(t);
+            }
+          }
+          break;
+        }
+        case kSymf: {
+          const double len = has ? p[0] : d.step;
+          if (len == 0) ++zero_moves;
+          t.position += t.heading * len;
+          if (!std::isfinite(t.position.x) || !std::isfinite(t.position.y) || !std::isfinite(t.position.z))
+            throw TurtleFailure{"the turtle's position is no longer finite"};
+          t.chain = -1;
+          t.joint = -1;
+          t.branch_pending = false;
+          break;
+        }
+        case kSymTurnLeft: rotate_pair(t.heading, t.left, has ? p[0] : d.angle_deg); orthonormalize(t); break;
+        case kSymTurnRight: rotate_pair(t.heading, t.left, -(has ? p[0] : d.angle_deg)); orthonormalize(t); break;
+        case kSymPitchDown: {
+          // & turns H toward −U: rotate (H, −U) pair.
+          dvec3 down = -t.up;
+          rotate_pair(t.heading, down, has ? p[0] : d.angle_deg);
+          t.up = -down;
+          orthonormalize(t);
+          break;
+        }
+        case kSymPitchUp: rotate_pair(t.heading, t.up, has ? p[0] : d.angle_deg); orthonormalize(t); break;
+        case kSymRollLeft: rotate_pair(t.up, t.left, has ? p[0] : d.angle_deg); orthonormalize(t); break;
+        case kSymRollRight: rotate_pair(t.up, t.left, -(has ? p[0] : d.angle_deg)); orthonormalize(t); break;
+        case kSymTurnAround:
+          t.heading = -t.heading;
+          t.left = -t.left;
+          break;
+        case kSymLevel: {
+          // ABOP 2.2: L = (V × H) / |V × H|, U = H × L, with V = +Y.
+          const dvec3 v(0, 1, 0);
+          const dvec3 c = glm::cross(v, t.heading);
+          const double len = glm::length(c);
+          if (len > 1e-9) {
+            t.left = c / len;
+            t.up = glm::cross(t.heading, t.left);
+          }
+          break;
+        }
+        case kSymPush:
+          stack.push_back(t);
+          t.branch_pending = true;
+          break;
+        case kSymPop:
+          if (stack.empty()) throw TurtleFailure{"']' without matching '['"};
+          t = stack.back();
+          stack.pop_back();
+          break;
+        case kSymWidth:
+          if (has) t.radius = p[0];
+          else t.radius *= d.width_decrement;
+          if (!(t.radius >= 0) || !std::isfinite(t.radius)) throw TurtleFailure{"the radius must be finite and not negative"};
+          break;
+        case kSymMaterial:
+          if (has) {
+            if (!(p[0] >= 0) || p[0] != std::floor(p[0]) || p[0] > 4294967295.0)
+              throw TurtleFailure{"a material index must be a non-negative integer"};
+            t.material = static_cast<uint32_t>(p[0]);
+          } else {
+            if (t.material == 0xFFFFFFFFu) throw TurtleFailure{"material index overflow"};
+            ++t.material;
+          }
+          break;
+        case kSymTropism:
+          if (!has) throw TurtleFailure{"@T needs the susceptibility: @T(e)"};
+          t.tropism_e = p[0];
+          break;
+        default:
+          break;  // carried through, ignored by the turtle
+      }
+    }
+  } catch (const TurtleFailure& f) {
+    Word one;
+    const Module& m = word.modules[i];
+    one.modules.push_back(Module{m.symbol, m.param_count, 0});
+    one.params.assign(word.params_of(m), word.params_of(m) + m.param_count);
+    return g.error_at({}, "turtle: " + f.message + " at module " + std::to_string(i) + " (" +
+                              print_word(one, g.symbols) + ") of the interpreted word");
+  }
+
+  // Flatten: chains' joints were interleaved in creation order; a counting sort by chain
+  // keeps each chain's joints in order and makes every chain one contiguous range.
+  Skeleton sk;
+  sk.chains.resize(chain_joint_count.size());
+  uint32_t offset = 0;
+  for (size_t c = 0; c < chain_joint_count.size(); ++c) {
+    sk.chains[c] = Chain{offset, 0, chain_parent[c]};
+    offset += chain_joint_count[c];
+  }
+  sk.joints.resize(joints.size());
+  for (const PendingJoint& pj : joints) {
+    Chain& c = sk.chains[pj.chain];
+    sk.joints[c.first_joint + c.joint_count++] = pj.joint;
+  }
+  if (stats) {
+    stats->zero_length_moves = zero_moves;
+    stats->modules_read = n;
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  return sk;
+}
+
+lsys::Expected<GrowResult> grow(const lsys::Grammar& g, const lsys::DeriveOptions& options,
+                                const std::string& grammar_path, const std::map<std::string, double>& defines) {
+  auto t0 = std::chrono::steady_clock::now();
+  GrowResult r;
+  auto word = lsys::derive(g, options, &r.derive);
+  if (!word) return word.error();
+  r.modules = word->size();
+  const lsys::Word* turtle_word = &*word;
+  lsys::Expected<lsys::Word> interpreted = lsys::Word{};
+  if (!g.homomorphism.empty()) {
+    interpreted = lsys::interpret(g, *word, options, &r.interpret);
+    if (!interpreted) return interpreted.error();
+    turtle_word = &*interpreted;
+  }
+  auto sk = build_skeleton(*turtle_word, g, &r.turtle);
+  if (!sk) return sk.error();
+  r.skeleton = std::move(*sk);
+  r.skeleton.source.grammar = grammar_path;
+  r.skeleton.source.seed = options.seed.value_or(g.seed);
+  r.skeleton.source.steps = options.steps.value_or(g.steps);
+  r.skeleton.source.defines = defines;
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+}  // namespace sylva

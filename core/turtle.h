@@ -1,0 +1,53 @@
+// turtle.h — the 3D turtle of grammar.md that turns a derived word into a Skeleton.
+//
+// Frame: the turtle starts at the origin with heading H = +Y, left L = −X, up U = +Z
+// (right-handed, H × L = U). Angles in degrees; the grammar's header gives the defaults
+// (angle, step, width as a radius, width decrement, tropism). Chains are built exactly as
+// skeleton.md says: the first F (and the first F after f) starts a root chain; the first
+// F after '[' starts a chain attached to the joint the turtle stands on; after ']' the
+// turtle continues its chain if its joint is still that chain's last, else branches.
+// Tropism (ABOP 2.2) bends H toward T by e·|H × T| after every F. Zero-length moves make
+// no joint and are counted.
+//
+// Errors (a Diagnostic naming the module and its index in the word): a position that is
+// no longer finite, a negative radius, a material that is not a non-negative integer,
+// ']' without '['. Nothing recurses: the branch stack is an explicit array.
+#pragma once
+
+#include <cstdint>
+
+#include "core/skeleton.h"
+#include "lsystem/derive.h"
+#include "lsystem/grammar.h"
+
+namespace sylva {
+
+struct TurtleStats {
+  uint64_t zero_length_moves = 0;  // F/f with length 0: no joint made
+  uint64_t modules_read = 0;
+  double seconds = 0;
+};
+
+// Interprets `word` (the interpreted word: homomorphism already applied) with the turtle
+// settings of `grammar`.
+lsys::Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& grammar,
+                                        TurtleStats* stats = nullptr);
+
+// Everything `sylva grow` does: derive, interpret, build the skeleton, record the source.
+struct GrowResult {
+  Skeleton skeleton;
+  uint64_t modules = 0;  // modules in the derived word
+  lsys::DeriveStats derive;
+  lsys::InterpretStats interpret;
+  TurtleStats turtle;
+  double seconds = 0;    // total
+};
+
+// Grows `grammar` (already parsed with its define overrides). `grammar_path` and
+// `defines` are recorded in skeleton.source; seed and steps come from options or the
+// grammar.
+lsys::Expected<GrowResult> grow(const lsys::Grammar& grammar, const lsys::DeriveOptions& options,
+                                const std::string& grammar_path,
+                                const std::map<std::string, double>& defines);
+
+}  // namespace sylva

@@ -1,0 +1,453 @@
+// derive.cpp — the derivation engine (see derive.h for the contract).
+//
+// Hot loop design: words are flat arrays of 8-byte records; rules are looked up by
+// symbol id; a symbol whose first production is context-free, unconditional and
+// deterministic with constant arguments is rewritten by copying a prebuilt word (ABOP
+// 1.24a runs entirely on this path); bracket partners are precomputed once per step for
+// context-sensitive grammars so context search never rescans a branch; nothing recurses
+// over the word.
+#include "lsystem/derive.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace sylva::lsys {
+
+namespace {
+
+constexpr uint64_t kAxiomKeyBase = 0xA7104D5EEDULL;
+constexpr uint64_t kHomomorphismStreamBase = 0x40000000ULL;
+constexpr uint32_t kNoMatch = 0xFFFFFFFFu;
+constexpr size_t kMaxParams = 0xFFFFFFF0u;
+
+struct DeriveFailure {
+  SourceLoc loc;
+  std::string message;
+};
+
+std::string module_text(const Word& w, size_t i, const SymbolTable& symbols) {
+  Word one;
+  const Module& m = w.modules[i];
+  one.modules.push_back(Module{m.symbol, m.param_count, 0});
+  one.params.assign(w.params_of(m), w.params_of(m) + m.param_count);
+  return print_word(one, symbols);
+}
+
+// Rewrites one word into another by one set of productions (the grammar's productions
+// for a derivation step, or its homomorphism for one interpretation pass).
+class Rewriter {
+ public:
+  Rewriter(const Grammar& g, const std::vector<Production>& productions,
+           const std::vector<std::vector<uint32_t>>& by_symbol, uint64_t seed, uint64_t max_modules)
+      : g_(g), productions_(productions), by_symbol_(by_symbol), seed_(seed), max_modules_(max_modules) {
+    uint32_t slots = 0;
+    for (const Production& p : productions_) slots = std::max(slots, p.slot_count);
+    slots_.assign(slots + 1, 0.0);
+    direct_.assign(by_symbol_.size(), nullptr);
+    for (size_t s = 0; s < by_symbol_.size(); ++s) {
+      if (by_symbol_[s].empty()) continue;
+      const Production& p = productions_[by_symbol_[s][0]];
+      if (!p.has_context() && p.condition.kind == Expr::Kind::kNone &&
+          p.probability.kind == Expr::Kind::kNone && p.successor.all_constant)
+        direct_[s] = &p;
+    }
+    for (const Production& p : productions_) uses_context_ |= p.has_context();
+  }
+
+  // Rewrites `in` into `out` (cleared first). `stream` distinguishes steps/passes in the
+  // random streams. With `active_in`, only modules flagged there are rewritten (the
+  // others are copied) and `active_out` flags the modules produced by a production.
+  void rewrite(const Word& in, Word& out, uint64_t stream, const std::vector<uint8_t>* active_in,
+               std::vector<uint8_t>* active_out) {
+    in_ = &in;
+    out_ = &out;
+    const bool keyed = !in.lineage.empty();
+    if (uses_context_) compute_brackets(in);
+    const size_t n = in.size();
+    for (size_t i = 0; i < n; ++i) {
+      const Module& m = in.modules[i];
+      const Production* chosen = nullptr;
+      Rng rng;
+      if ((!active_in || (*active_in)[i]) && !by_symbol_[m.symbol].empty()) {
+        const Production* direct = direct_[m.symbol];
+        if (direct && direct->predecessor.arity == m.param_count) {
+          chosen = direct;
+        } else {
+          if (keyed) rng = Rng(mix_pair(mix_pair(seed_, in.lineage[i]), stream));
+          chosen = choose(i, m, rng);
+        }
+      }
+      if (!chosen) {
+        copy_module(in, i, out);
+        if (active_out) active_out->push_back(0);
+        continue;
+      }
+      apply(*chosen, i, rng, keyed);
+      if (active_out) active_out->resize(out.size(), 1);
+    }
+  }
+
+  // Index of the module whose production failed, for messages.
+  size_t current = 0;
+  const Production* current_production = nullptr;
+
+ private:
+  void copy_module(const Word& in, size_t i, Word& out) {
+    const Module& m = in.modules[i];
+    if (out.modules.size() + 1 > max_modules_) too_many();
+    if (out.params.size() > kMaxParams) too_many_params();
+    out.modules.push_back(Module{m.symbol, m.param_count, static_cast<uint32_t>(out.params.size())});
+    if (m.param_count) out.params.insert(out.params.end(), in.params.begin() + m.param_begin,
+                                         in.params.begin() + m.param_begin + m.param_count);
+    if (!in.lineage.empty()) out.lineage.push_back(in.lineage[i]);
+  }
+
+  [[noreturn]] void too_many() {
+    throw DeriveFailure{{}, "the word exceeds --max-modules (" + std::to_string(max_modules_) +
+                                " modules); raise --max-modules or lower the derivation length"};
+  }
+  [[noreturn]] void too_many_params() {
+    throw DeriveFailure{{}, "the word holds more than 4 billion parameters"};
+  }
+
+  void bind(const PatternModule& pm, const Module& m) {
+    const double* p = in_->params_of(m);
+    for (uint16_t k = 0; k < pm.arity; ++k) slots_[pm.first_slot + k] = p[k];
+  }
+
+  void compute_brackets(const Word& w) {
+    const size_t n = w.size();
+    match_.assign(n, kNoMatch);
+    open_.clear();
+    for (size_t i = 0; i < n; ++i) {
+      SymbolId s = w.modules[i].symbol;
+      if (s == kSymPush) {
+        open_.push_back(static_cast<uint32_t>(i));
+      } else if (s == kSymPop && !open_.empty()) {
+        match_[open_.back()] = static_cast<uint32_t>(i);
+        match_[i] = open_.back();
+        open_.pop_back();
+      }
+    }
+  }
+
+  bool ignored(SymbolId s) const { return g_.ignored[s] != 0; }
+
+  // ABOP 1.8: going left, skip completed branches ("[...]" before us) and climb out of
+  // the branch we are in (its "["), so the context is the module below on the path.
+  bool match_left(const Production& p, size_t i) {
+    const Word& w = *in_;
+    int64_t j = static_cast<int64_t>(i) - 1;
+    for (int64_t k = static_cast<int64_t>(p.left_context.size()) - 1; k >= 0;) {
+      if (j < 0) return false;
+      const Module& m = w.modules[j];
+      if (m.symbol == kSymPop) {
+        if (match_[j] == kNoMatch) return false;
+        j = static_cast<int64_t>(match_[j]) - 1;
+        continue;
+      }
+      if (m.symbol == kSymPush || ignored(m.symbol)) {
+        --j;
+        continue;
+      }
+      const PatternModule& pm = p.left_context[k];
+      if (m.symbol != pm.symbol || m.param_count != pm.arity) return false;
+      bind(pm, m);
+      --k;
+      --j;
+    }
+    return true;
+  }
+
+  // ABOP 1.8: going right, skip whole branches the pattern does not enter; '[' in the
+  // pattern enters a branch, ']' in the pattern skips the rest of the current branch;
+  // the end of the current branch ends the context.
+  bool match_right(const Production& p, size_t i) {
+    const Word& w = *in_;
+    const size_t n = w.size();
+    size_t j = i + 1;
+    entered_.clear();
+    for (size_t k = 0; k < p.right_context.size();) {
+      const PatternModule& pm = p.right_context[k];
+      while (j < n && ignored(w.modules[j].symbol)) ++j;
+      if (j >= n) return false;
+      const Module& m = w.modules[j];
+      if (pm.symbol == kSymPush) {
+        if (m.symbol != kSymPush) return false;
+        entered_.push_back(static_cast<uint32_t>(j));
+        ++j;
+        ++k;
+        continue;
+      }
+      if (pm.symbol == kSymPop) {
+        size_t close;
+        if (!entered_.empty()) {
+          close = match_[entered_.back()];
+          entered_.pop_back();
+        } else {
+          close = j;
+          while (close < n && w.modules[close].symbol != kSymPop) {
+            if (w.modules[close].symbol == kSymPush) {
+              if (match_[close] == kNoMatch) return false;
+              close = match_[close];
+            }
+            ++close;
+          }
+        }
+        if (close >= n) return false;
+        j = close + 1;
+        ++k;
+        continue;
+      }
+      if (m.symbol == kSymPush) {
+        if (match_[j] == kNoMatch) return false;
+        j = match_[j] + 1;
+        continue;
+      }
+      if (m.symbol == kSymPop) return false;
+      if (m.symbol != pm.symbol || m.param_count != pm.arity) return false;
+      bind(pm, m);
+      ++j;
+      ++k;
+    }
+    return true;
+  }
+
+  // Binds the predecessor and contexts of `p` at module i; false if they do not match.
+  bool matches(const Production& p, size_t i, const Module& m) {
+    bind(p.predecessor, m);
+    if (!p.left_context.empty() && !match_left(p, i)) return false;
+    if (!p.right_context.empty() && !match_right(p, i)) return false;
+    return true;
+  }
+
+  const Production* choose(size_t i, const Module& m, Rng& rng) {
+    current = i;
+    const std::vector<uint32_t>& rules = by_symbol_[m.symbol];
+    bool arity_seen = false;
+    candidates_.clear();
+    double total = 0;
+    for (uint32_t r : rules) {
+      const Production& p = productions_[r];
+      if (p.predecessor.arity != m.param_count) continue;
+      arity_seen = true;
+      if (!matches(p, i, m)) continue;
+      current_production = &p;
+      if (p.condition.kind != Expr::Kind::kNone && g_.program.eval(p.condition, slots_.data(), &rng) == 0.0)
+        continue;
+      if (p.probability.kind == Expr::Kind::kNone) {
+        if (candidates_.empty()) return &p;  // first candidate is deterministic: apply it
+        continue;                            // deterministic ones after stochastic: ignored
+      }
+      double w = g_.program.eval(p.probability, slots_.data(), &rng);
+      if (w < 0) throw DeriveFailure{p.probability.loc, "a probability must not be negative (it is " + std::to_string(w) + ")"};
+      candidates_.push_back({&p, w});
+      total += w;
+    }
+    if (!arity_seen) {
+      const Production& p = productions_[rules[0]];
+      current_production = &p;
+      throw DeriveFailure{p.loc, "parameter count: module has " + std::to_string(m.param_count) +
+                                     (m.param_count == 1 ? " parameter" : " parameters") +
+                                     " but the production expects " + std::to_string(p.predecessor.arity)};
+    }
+    if (candidates_.empty() || total <= 0) return nullptr;
+    double u = rng.next_double() * total;
+    const Production* pick = candidates_.back().first;
+    for (const auto& [prod, w] : candidates_) {
+      if (u < w) {
+        pick = prod;
+        break;
+      }
+      u -= w;
+    }
+    // Rebind the chosen production's parameters (later candidates overwrote the slots).
+    matches(*pick, i, m);
+    return pick;
+  }
+
+  void apply(const Production& p, size_t i, Rng& rng, bool keyed) {
+    Word& out = *out_;
+    const Successor& s = p.successor;
+    if (out.modules.size() + s.modules.size() > max_modules_) too_many();
+    if (out.params.size() > kMaxParams) too_many_params();
+    const size_t first_new = out.modules.size();
+    if (s.all_constant) {
+      const uint32_t base = static_cast<uint32_t>(out.params.size());
+      for (const Module& pm : s.prebuilt.modules)
+        out.modules.push_back(Module{pm.symbol, pm.param_count, pm.param_begin + base});
+      out.params.insert(out.params.end(), s.prebuilt.params.begin(), s.prebuilt.params.end());
+    } else {
+      // Slots were bound by choose() (the direct path only takes constant successors).
+      current = i;
+      current_production = &p;
+      for (const SuccessorModule& sm : s.modules) {
+        out.modules.push_back(Module{sm.symbol, sm.arg_count, static_cast<uint32_t>(out.params.size())});
+        for (uint16_t k = 0; k < sm.arg_count; ++k)
+          out.params.push_back(g_.program.eval(s.args[sm.first_arg + k], slots_.data(), &rng));
+      }
+    }
+    if (keyed) {
+      const uint64_t key = in_->lineage[i];
+      for (size_t j = first_new; j < out.modules.size(); ++j)
+        out.lineage.push_back(mix_pair(key, j - first_new + 1));
+    }
+  }
+
+  const Grammar& g_;
+  const std::vector<Production>& productions_;
+  const std::vector<std::vector<uint32_t>>& by_symbol_;
+  uint64_t seed_;
+  uint64_t max_modules_;
+  bool uses_context_ = false;
+  const Word* in_ = nullptr;
+  Word* out_ = nullptr;
+  std::vector<double> slots_;
+  std::vector<const Production*> direct_;
+  std::vector<uint32_t> match_;
+  std::vector<uint32_t> open_;
+  std::vector<uint32_t> entered_;
+  std::vector<std::pair<const Production*, double>> candidates_;
+};
+
+// Removes, for each %, the rest of its branch up to (not including) the closing ']'.
+void apply_cut(Word& w) {
+  const size_t n = w.size();
+  const bool keyed = !w.lineage.empty();
+  size_t out = 0, out_param = 0;
+  for (size_t i = 0; i < n;) {
+    if (w.modules[i].symbol == kSymCut) {
+      int depth = 0;
+      size_t j = i + 1;
+      for (; j < n; ++j) {
+        SymbolId s = w.modules[j].symbol;
+        if (s == kSymPush) ++depth;
+        else if (s == kSymPop && depth-- == 0) break;
+      }
+      i = j;
+      continue;
+    }
+    Module m = w.modules[i];
+    for (uint16_t k = 0; k < m.param_count; ++k) w.params[out_param + k] = w.params[m.param_begin + k];
+    m.param_begin = static_cast<uint32_t>(out_param);
+    out_param += m.param_count;
+    w.modules[out] = m;
+    if (keyed) w.lineage[out] = w.lineage[i];
+    ++out;
+    ++i;
+  }
+  w.modules.resize(out);
+  w.params.resize(out_param);
+  if (keyed) w.lineage.resize(out);
+}
+
+Diagnostic failure_diagnostic(const Grammar& g, const Word& in, const Rewriter& r, const std::string& message,
+                              SourceLoc loc, const char* what, int64_t step) {
+  std::string text = message;
+  if (r.current_production) {
+    const Production& p = *r.current_production;
+    text += ", in production " + (p.label.empty() ? std::string() : p.label + " ") + "'" + p.text + "' (line " +
+            std::to_string(p.loc.line) + ")";
+    if (r.current < in.size()) text += " rewriting module " + module_text(in, r.current, g.symbols);
+    text += std::string(" at ") + what + " " + std::to_string(step);
+    if (loc.line == 0) loc = p.loc;
+  }
+  return g.error_at(loc, text);
+}
+
+void reserve_for_growth(Word& out, size_t in_size, double growth, uint64_t max_modules) {
+  double want = static_cast<double>(in_size) * growth * 1.05 + 16;
+  size_t cap = static_cast<size_t>(std::min<double>(want, static_cast<double>(max_modules) + 1));
+  if (out.modules.capacity() < cap) out.modules.reserve(cap);
+}
+
+}  // namespace
+
+Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStats* stats) {
+  auto t0 = std::chrono::steady_clock::now();
+  const int64_t steps = options.steps.value_or(g.steps);
+  const uint64_t seed = options.seed.value_or(g.seed);
+  if (g.axiom.size() > options.max_modules)
+    return g.error_at(g.axiom_loc, "the axiom exceeds --max-modules");
+  Word cur = g.axiom;
+  if (g.uses_random) {
+    cur.lineage.resize(cur.size());
+    for (size_t i = 0; i < cur.size(); ++i) cur.lineage[i] = mix_pair(kAxiomKeyBase, i);
+  }
+  if (g.uses_cut) apply_cut(cur);
+  Word next;
+  Rewriter rewriter(g, g.productions, g.productions_by_symbol, seed, options.max_modules);
+  uint64_t peak = cur.capacity_bytes();
+  double growth = 2.0;
+  int64_t step = 0;
+  try {
+    for (step = 1; step <= steps; ++step) {
+      next.clear();
+      reserve_for_growth(next, cur.size(), growth, options.max_modules);
+      if (g.uses_random) next.lineage.reserve(next.modules.capacity());
+      rewriter.current_production = nullptr;
+      rewriter.rewrite(cur, next, static_cast<uint64_t>(step), nullptr, nullptr);
+      if (g.uses_cut) apply_cut(next);
+      peak = std::max<uint64_t>(peak, cur.capacity_bytes() + next.capacity_bytes());
+      growth = cur.size() ? std::max(1.0, static_cast<double>(next.size()) / static_cast<double>(cur.size())) : 2.0;
+      std::swap(cur, next);
+    }
+  } catch (const DeriveFailure& f) {
+    return failure_diagnostic(g, cur, rewriter, f.message, f.loc, "step", step);
+  } catch (const EvalError& e) {
+    return failure_diagnostic(g, cur, rewriter, e.message, e.loc, "step", step);
+  } catch (const std::bad_alloc&) {
+    return g.error_at({}, "out of memory at step " + std::to_string(step) + "; lower --max-modules or the derivation length");
+  }
+  if (stats) {
+    stats->steps = steps;
+    stats->modules = cur.size();
+    stats->peak_bytes = peak;
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  return cur;
+}
+
+Expected<Word> interpret(const Grammar& g, const Word& word, const DeriveOptions& options, InterpretStats* stats) {
+  Word cur = word;
+  if (g.homomorphism.empty()) return cur;
+  const uint64_t seed = options.seed.value_or(g.seed);
+  if (g.uses_random && cur.lineage.size() != cur.size()) {
+    cur.lineage.resize(cur.size());
+    for (size_t i = 0; i < cur.size(); ++i) cur.lineage[i] = mix_pair(kAxiomKeyBase, i);
+  }
+  Word next;
+  std::vector<uint8_t> active(cur.size(), 1), next_active;
+  Rewriter rewriter(g, g.homomorphism, g.homomorphism_by_symbol, seed, options.max_modules);
+  int depth = 0;
+  try {
+    for (depth = 1; depth <= g.max_depth; ++depth) {
+      next.clear();
+      next_active.clear();
+      rewriter.current_production = nullptr;
+      rewriter.rewrite(cur, next, kHomomorphismStreamBase + static_cast<uint64_t>(depth), &active, &next_active);
+      bool changed = std::find(next_active.begin(), next_active.end(), 1) != next_active.end();
+      std::swap(cur, next);
+      std::swap(active, next_active);
+      if (!changed) break;
+    }
+  } catch (const DeriveFailure& f) {
+    return failure_diagnostic(g, cur, rewriter, f.message, f.loc, "interpretation depth", depth);
+  } catch (const EvalError& e) {
+    return failure_diagnostic(g, cur, rewriter, e.message, e.loc, "interpretation depth", depth);
+  }
+  if (stats) {
+    stats->depth = std::min(depth, g.max_depth);
+    // Modules produced by the last pass that still have a production: left unexpanded.
+    uint64_t left = 0;
+    for (size_t i = 0; i < cur.size(); ++i)
+      if (active[i] && !g.homomorphism_by_symbol[cur.modules[i].symbol].empty()) ++left;
+    stats->still_expandable = depth > g.max_depth ? left : 0;
+  }
+  cur.lineage.clear();
+  cur.lineage.shrink_to_fit();
+  return cur;
+}
+
+}  // namespace sylva::lsys

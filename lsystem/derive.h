@@ -1,0 +1,57 @@
+// derive.h — parallel rewriting of a word by a compiled grammar (grammar.md).
+//
+// derive() applies the grammar's productions `steps` times to the axiom. Every module is
+// rewritten in parallel using the word before the step as context; a module with no
+// applicable production is copied unchanged. Cut (%) removes the rest of its branch
+// after each step. The interpretation (homomorphism) productions are applied separately
+// by interpret(), producing the word the turtle reads without changing the derived word.
+//
+// Stable random streams: each module carries a 64-bit lineage key. Axiom modules are keyed
+// by position; a module produced at successor position j of a production applied to a
+// module with key K gets key mix(K, j + 1); a module copied unchanged keeps its key. All
+// draws for one module at one step (stochastic choice, rand/uniform/gauss in conditions
+// and arguments) come from a stream seeded by (seed, key, step). So editing a rule or a
+// #define that changes one branch leaves every other branch's random numbers — and so its
+// geometry — bit-identical. Keys are stored only when the grammar draws random numbers.
+//
+// Errors (Diagnostic): division by zero, NaN/infinity, negative probabilities and
+// parameter-count mismatches name the production and the module; a word that would
+// exceed max_modules stops the derivation before the memory is taken.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+
+#include "lsystem/grammar.h"
+
+namespace sylva::lsys {
+
+struct DeriveOptions {
+  std::optional<int64_t> steps;     // overrides `derivation length:`
+  std::optional<uint64_t> seed;     // overrides `seed:`
+  uint64_t max_modules = 50'000'000;
+};
+
+struct DeriveStats {
+  int64_t steps = 0;           // steps performed
+  uint64_t modules = 0;        // modules in the result
+  uint64_t peak_bytes = 0;     // most bytes held by word buffers at any one time
+  double seconds = 0;
+};
+
+// Derives the grammar's word. `stats` (optional) receives counts and the time taken.
+Expected<Word> derive(const Grammar& grammar, const DeriveOptions& options = {},
+                      DeriveStats* stats = nullptr);
+
+struct InterpretStats {
+  int depth = 0;                 // homomorphism passes performed
+  uint64_t still_expandable = 0; // modules left unexpanded at the depth limit
+};
+
+// Applies the homomorphism (interpretation) productions recursively, up to the grammar's
+// maximum depth, giving the word the turtle reads. Returns a copy of `word` when the
+// grammar has no homomorphism.
+Expected<Word> interpret(const Grammar& grammar, const Word& word, const DeriveOptions& options = {},
+                         InterpretStats* stats = nullptr);
+
+}  // namespace sylva::lsys

@@ -1,0 +1,162 @@
+// expr.cpp — the bytecode machine for grammar expressions (see expr.h).
+#include "lsystem/expr.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace sylva::lsys {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kRadPerDeg = kPi / 180.0;
+
+const FuncInfo kFuncs[] = {
+    {"sin", 1, false},   {"cos", 1, false},   {"tan", 1, false},   {"asin", 1, false},
+    {"acos", 1, false},  {"atan", 1, false},  {"atan2", 2, false}, {"sqrt", 1, false},
+    {"exp", 1, false},   {"log", 1, false},   {"pow", 2, false},   {"abs", 1, false},
+    {"floor", 1, false}, {"ceil", 1, false},  {"min", 2, false},   {"max", 2, false},
+    {"clamp", 3, false}, {"rand", 0, true},   {"uniform", 2, true}, {"gauss", 2, true},
+};
+
+// Reduces degrees to a quadrant q (0..3) and a remainder in [-45, 45] degrees.
+void reduce_degrees(double degrees, int* quadrant, double* rem_rad) {
+  double r = std::fmod(degrees, 360.0);  // exact
+  if (r < 0) r += 360.0;
+  double q = std::nearbyint(r / 90.0);
+  *rem_rad = (r - q * 90.0) * kRadPerDeg;
+  *quadrant = static_cast<int>(q) & 3;
+}
+
+[[noreturn]] void fail(SourceLoc loc, std::string message) {
+  throw EvalError{loc, std::move(message)};
+}
+}  // namespace
+
+double sin_deg(double degrees) {
+  int q;
+  double a;
+  reduce_degrees(degrees, &q, &a);
+  switch (q) {
+    case 0: return std::sin(a);
+    case 1: return std::cos(a);
+    case 2: return -std::sin(a);
+    default: return -std::cos(a);
+  }
+}
+
+double cos_deg(double degrees) {
+  int q;
+  double a;
+  reduce_degrees(degrees, &q, &a);
+  switch (q) {
+    case 0: return std::cos(a);
+    case 1: return -std::sin(a);
+    case 2: return -std::cos(a);
+    default: return std::sin(a);
+  }
+}
+
+const FuncInfo& func_info(Func f) { return kFuncs[static_cast<int>(f)]; }
+
+bool find_func(const std::string& name, Func* f) {
+  for (size_t i = 0; i < std::size(kFuncs); ++i) {
+    if (name == kFuncs[i].name) {
+      *f = static_cast<Func>(i);
+      return true;
+    }
+  }
+  return false;
+}
+
+double Program::run(const Expr& e, const double* slots, Rng* rng) const {
+  // Expressions are shallow (the parser bounds nesting), so a fixed stack suffices; the
+  // compiler checks the depth it needs against kMaxStack.
+  constexpr int kMaxStack = 512;
+  double stack[kMaxStack];
+  int sp = 0;
+  const Instr* code_ptr = code.data();
+  for (uint32_t pc = e.begin; pc < e.end; ++pc) {
+    const Instr& in = code_ptr[pc];
+    auto check = [&](double v) {
+      if (!std::isfinite(v)) fail(locs[pc], "result is not finite (NaN or infinity)");
+      return v;
+    };
+    switch (in.op) {
+      case Op::kConst: stack[sp++] = consts[in.arg]; break;
+      case Op::kSlot: stack[sp++] = slots[in.arg]; break;
+      case Op::kAdd: --sp; stack[sp - 1] = check(stack[sp - 1] + stack[sp]); break;
+      case Op::kSub: --sp; stack[sp - 1] = check(stack[sp - 1] - stack[sp]); break;
+      case Op::kMul: --sp; stack[sp - 1] = check(stack[sp - 1] * stack[sp]); break;
+      case Op::kDiv:
+        --sp;
+        if (stack[sp] == 0.0) fail(locs[pc], "division by zero");
+        stack[sp - 1] = check(stack[sp - 1] / stack[sp]);
+        break;
+      case Op::kPow: --sp; stack[sp - 1] = check(std::pow(stack[sp - 1], stack[sp])); break;
+      case Op::kNeg: stack[sp - 1] = -stack[sp - 1]; break;
+      case Op::kNot: stack[sp - 1] = stack[sp - 1] == 0.0 ? 1.0 : 0.0; break;
+      case Op::kLt: --sp; stack[sp - 1] = stack[sp - 1] < stack[sp]; break;
+      case Op::kLe: --sp; stack[sp - 1] = stack[sp - 1] <= stack[sp]; break;
+      case Op::kGt: --sp; stack[sp - 1] = stack[sp - 1] > stack[sp]; break;
+      case Op::kGe: --sp; stack[sp - 1] = stack[sp - 1] >= stack[sp]; break;
+      case Op::kEq: --sp; stack[sp - 1] = stack[sp - 1] == stack[sp]; break;
+      case Op::kNe: --sp; stack[sp - 1] = stack[sp - 1] != stack[sp]; break;
+      case Op::kAndJump:
+        if (stack[--sp] == 0.0) {
+          stack[sp++] = 0.0;
+          pc = in.arg - 1;
+        }
+        break;
+      case Op::kOrJump:
+        if (stack[--sp] != 0.0) {
+          stack[sp++] = 1.0;
+          pc = in.arg - 1;
+        }
+        break;
+      case Op::kBool: stack[sp - 1] = stack[sp - 1] != 0.0 ? 1.0 : 0.0; break;
+      case Op::kCall: {
+        double r = 0;
+        double* a = nullptr;
+        int arity = func_info(in.fn).arity;
+        sp -= arity;
+        a = stack + sp;
+        switch (in.fn) {
+          case Func::kSin: r = sin_deg(a[0]); break;
+          case Func::kCos: r = cos_deg(a[0]); break;
+          case Func::kTan: {
+            double c = cos_deg(a[0]);
+            if (c == 0.0) fail(locs[pc], "tan of an odd multiple of 90 degrees is not finite");
+            r = sin_deg(a[0]) / c;
+            break;
+          }
+          case Func::kAsin: r = std::asin(a[0]) / kRadPerDeg; break;
+          case Func::kAcos: r = std::acos(a[0]) / kRadPerDeg; break;
+          case Func::kAtan: r = std::atan(a[0]) / kRadPerDeg; break;
+          case Func::kAtan2: r = std::atan2(a[0], a[1]) / kRadPerDeg; break;
+          case Func::kSqrt: r = std::sqrt(a[0]); break;
+          case Func::kExp: r = std::exp(a[0]); break;
+          case Func::kLog: r = std::log(a[0]); break;
+          case Func::kPow: r = std::pow(a[0], a[1]); break;
+          case Func::kAbs: r = std::fabs(a[0]); break;
+          case Func::kFloor: r = std::floor(a[0]); break;
+          case Func::kCeil: r = std::ceil(a[0]); break;
+          case Func::kMin: r = std::min(a[0], a[1]); break;
+          case Func::kMax: r = std::max(a[0], a[1]); break;
+          case Func::kClamp:
+            if (a[1] > a[2]) fail(locs[pc], "clamp(x, lo, hi) needs lo <= hi");
+            r = std::clamp(a[0], a[1], a[2]);
+            break;
+          case Func::kRand: r = rng->next_double(); break;
+          case Func::kUniform: r = a[0] + (a[1] - a[0]) * rng->next_double(); break;
+          case Func::kGauss: r = a[0] + a[1] * rng->next_gauss(); break;
+        }
+        stack[sp++] = check(r);
+        break;
+      }
+    }
+  }
+  return stack[sp - 1];
+}
+
+}  // namespace sylva::lsys

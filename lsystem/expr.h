@@ -1,0 +1,96 @@
+// expr.h — the expression language of grammar.md, compiled once to bytecode.
+//
+// Expressions (arguments, conditions, probabilities, directive values) are parsed once
+// and compiled into one flat instruction array per grammar; evaluation is a small stack
+// machine over doubles. Constants are folded at compile time (defines are constants),
+// and the two commonest shapes — a constant and a bare formal parameter — never touch
+// the machine. Every arithmetic result is checked: a NaN or infinity, or a division by
+// zero, raises EvalError with the source place of the operation.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "lsystem/diagnostic.h"
+#include "lsystem/random.h"
+
+namespace sylva::lsys {
+
+enum class Op : uint8_t {
+  kConst,       // push consts[arg]
+  kSlot,        // push slots[arg]
+  kAdd, kSub, kMul, kDiv, kPow, kNeg, kNot,
+  kLt, kLe, kGt, kGe, kEq, kNe,
+  kAndJump,     // pop a; if a == 0 { push 0; pc = arg } (short-circuit &&)
+  kOrJump,      // pop a; if a != 0 { push 1; pc = arg } (short-circuit ||)
+  kBool,        // replace top by (top != 0)
+  kCall,        // call function `fn` (arity known per function)
+};
+
+enum class Func : uint8_t {
+  kSin, kCos, kTan, kAsin, kAcos, kAtan, kAtan2, kSqrt, kExp, kLog, kPow, kAbs,
+  kFloor, kCeil, kMin, kMax, kClamp, kRand, kUniform, kGauss
+};
+
+struct Instr {
+  Op op;
+  Func fn;        // for kCall
+  uint16_t pad = 0;
+  uint32_t arg;   // constant index, slot index or jump target
+};
+
+// A compiled expression: a constant, a slot read, or a range of the shared program.
+struct Expr {
+  enum class Kind : uint8_t { kNone, kConst, kSlot, kProgram };
+  Kind kind = Kind::kNone;
+  bool uses_random = false;
+  uint32_t slot = 0;      // kSlot
+  uint32_t begin = 0;     // kProgram: first instruction
+  uint32_t end = 0;       // kProgram: one past the last
+  double value = 0;       // kConst
+  SourceLoc loc;          // where the expression starts
+};
+
+// Raised by evaluation: where the failing operation is written, and what went wrong.
+struct EvalError {
+  SourceLoc loc;
+  std::string message;
+};
+
+// All compiled code of one grammar.
+struct Program {
+  std::vector<Instr> code;
+  std::vector<double> consts;
+  std::vector<SourceLoc> locs;  // parallel to code: the place of each operation
+
+  // Evaluates `e` with formal parameters `slots` and random stream `rng` (only touched
+  // by rand/uniform/gauss). Throws EvalError on division by zero or a non-finite result.
+  double eval(const Expr& e, const double* slots, Rng* rng) const {
+    switch (e.kind) {
+      case Expr::Kind::kConst: return e.value;
+      case Expr::Kind::kSlot: return slots[e.slot];
+      default: return run(e, slots, rng);
+    }
+  }
+
+ private:
+  double run(const Expr& e, const double* slots, Rng* rng) const;
+};
+
+// Trigonometry in degrees, exact at multiples of 90° (sin_deg(180) == 0, not 1.2e-16),
+// so ABOP's right-angle grammars give exact coordinates.
+double sin_deg(double degrees);
+double cos_deg(double degrees);
+
+// Name, arity and whether it draws random numbers, for each Func.
+struct FuncInfo {
+  const char* name;
+  int arity;
+  bool random;
+};
+const FuncInfo& func_info(Func f);
+// Looks a function up by name; false if there is none.
+bool find_func(const std::string& name, Func* f);
+
+}  // namespace sylva::lsys

@@ -1,0 +1,125 @@
+// grammar.h — a parsed and compiled grammar (grammar.md), ready to derive.
+//
+// parse_grammar() reads .lsys text once: it checks UTF-8, strips comments, joins
+// continuation lines, evaluates #defines (with overrides) and header directives,
+// tokenises module strings with the declared multi-character names, and compiles every
+// expression to bytecode (expr.h). Nothing is re-parsed during derivation.
+// Errors: the first problem found, as a Diagnostic with file, line and column.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "lsystem/diagnostic.h"
+#include "lsystem/expr.h"
+#include "lsystem/word.h"
+
+namespace sylva::lsys {
+
+// A module in a context pattern or predecessor: symbol, arity, and the slot of its first
+// formal parameter in the production's slot array.
+struct PatternModule {
+  SymbolId symbol;
+  uint16_t arity;
+  uint32_t first_slot;
+};
+
+// A module of a successor: symbol and the range of its argument expressions.
+struct SuccessorModule {
+  SymbolId symbol;
+  uint16_t arg_count;
+  uint32_t first_arg;  // index into Successor::args
+};
+
+struct Successor {
+  std::vector<SuccessorModule> modules;
+  std::vector<Expr> args;
+  bool all_constant = true;  // every argument is a constant: `prebuilt` holds the result
+  Word prebuilt;             // the successor as a word (only when all_constant)
+};
+
+struct Production {
+  SourceLoc loc;            // where the production starts
+  std::string label;        // "p1", or empty
+  std::string text;         // the production as written (for messages)
+  PatternModule predecessor;
+  std::vector<PatternModule> left_context;   // in reading order
+  std::vector<PatternModule> right_context;  // may contain [ and ]
+  uint32_t slot_count = 0;                   // formal parameters in all patterns
+  Expr condition;                            // kind kNone: always
+  Expr probability;                          // kind kNone: not stochastic
+  Successor successor;
+  bool has_context() const { return !left_context.empty() || !right_context.empty(); }
+};
+
+// Turtle settings from the header (grammar.md "Header directives").
+struct TurtleDefaults {
+  double angle_deg = 90;
+  double width = 0.05;  // initial radius in metres
+  double width_decrement = 0.7;
+  double step = 1;
+  bool has_tropism = false;
+  double tropism[3] = {0, 0, 0};
+  double tropism_e = 0;
+};
+
+// A #define after overrides.
+struct Define {
+  std::string name;
+  double value;
+  SourceLoc loc;
+  bool overridden = false;
+};
+
+struct Grammar {
+  std::string file;                          // as given, for messages
+  std::shared_ptr<const std::string> text;   // the source, for caret lines
+  SymbolTable symbols;
+  std::vector<Define> defines;
+  TurtleDefaults turtle;
+  uint64_t seed = 1;
+  int64_t steps = 1;
+  int max_depth = 16;        // homomorphism recursion limit
+  Word axiom;
+  SourceLoc axiom_loc;
+  Program program;           // all compiled expressions
+  std::vector<Production> productions;
+  std::vector<Production> homomorphism;
+  std::vector<uint8_t> ignored;  // by symbol id: skipped when matching context
+  // Index lists by predecessor symbol, in file order.
+  std::vector<std::vector<uint32_t>> productions_by_symbol;
+  std::vector<std::vector<uint32_t>> homomorphism_by_symbol;
+  bool uses_random = false;   // any stochastic production or random function
+  bool uses_context = false;  // any production with left or right context
+  bool uses_cut = false;      // % appears in a successor or the axiom
+
+  // The physical source line `line` (1-based) without its newline, for messages.
+  std::string source_line(uint32_t line) const;
+  // A Diagnostic at `loc` in this grammar's file.
+  Diagnostic error_at(SourceLoc loc, std::string message) const;
+};
+
+struct ParseOptions {
+  // -D overrides: replace the value of a #define. A name the grammar does not define
+  // is an error (a typo must not be ignored silently).
+  std::map<std::string, double> define_overrides;
+};
+
+// Parses and compiles grammar text. `file` names the grammar in messages.
+Expected<Grammar> parse_grammar(std::string_view text, std::string file,
+                                const ParseOptions& options = {});
+
+// Reads and parses a grammar file; an unreadable file is an error naming the path.
+Expected<Grammar> load_grammar(const std::string& path, const ParseOptions& options = {});
+
+// Parses a word as `sylva derive` prints it (constant arguments only), with the
+// grammar's symbols (declared multi-character names). Used for round-trip checks and
+// by tools that read words back.
+Expected<Word> parse_word(std::string_view text, Grammar& grammar);
+
+}  // namespace sylva::lsys

@@ -1,0 +1,1199 @@
+// parser.cpp — reads .lsys text (grammar.md) into a compiled Grammar.
+//
+// Pipeline: validate UTF-8 → blank out /* */ comments (keeping line/column) → join
+// continuation lines into logical lines that remember each byte's place → classify each
+// line (comment, #define, directive, section, production) → module declarations and
+// defines first, then directives, then productions, so declaration order is free except
+// among defines. Expressions compile straight to bytecode (expr.h); an expression that
+// reads no formal parameter and draws no random number is evaluated once and stored as a
+// constant. Recursion is bounded (kMaxNesting) so hostile input cannot overflow the stack.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <unordered_map>
+
+#include "lsystem/grammar.h"
+
+namespace sylva::lsys {
+
+namespace {
+
+constexpr int kMaxNesting = 128;     // parentheses / unary operators / calls
+constexpr int kMaxEvalStack = 512;   // must match Program::run
+constexpr int64_t kMaxSteps = 1000000;
+constexpr int kMaxDepthLimit = 1000;
+
+struct ParseFailure {
+  SourceLoc loc;
+  std::string message;
+};
+
+[[noreturn]] void fail(SourceLoc loc, std::string message) {
+  throw ParseFailure{loc, std::move(message)};
+}
+
+// One logical line (continuations joined) with the source place of every byte; locs has
+// one extra entry for the position just past the end.
+struct LogicalLine {
+  std::string text;
+  std::vector<SourceLoc> locs;
+};
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+bool is_ident_start(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
+}
+bool is_ident_char(char c) { return is_ident_start(c) || (c >= '0' && c <= '9'); }
+bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+std::string quote_char(char c) {
+  if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+    char buf[8];
+    std::snprintf(buf, sizeof buf, "0x%02x", static_cast<unsigned char>(c));
+    return buf;
+  }
+  return std::string("'") + c + "'";
+}
+
+// Checks UTF-8 and NUL bytes; returns the place of the first problem.
+void validate_text(std::string_view text) {
+  uint32_t line = 1, col = 1;
+  size_t i = 0;
+  while (i < text.size()) {
+    unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c == 0) fail({line, col}, "binary file: NUL byte in grammar text");
+    size_t len = 1;
+    if (c >= 0x80) {
+      uint32_t cp = 0;
+      if ((c >> 5) == 0x6) len = 2, cp = c & 0x1f;
+      else if ((c >> 4) == 0xE) len = 3, cp = c & 0x0f;
+      else if ((c >> 3) == 0x1E) len = 4, cp = c & 0x07;
+      else fail({line, col}, "invalid UTF-8 (is this a binary file?)");
+      if (i + len > text.size()) fail({line, col}, "invalid UTF-8 (truncated sequence)");
+      for (size_t k = 1; k < len; ++k) {
+        unsigned char cc = static_cast<unsigned char>(text[i + k]);
+        if ((cc >> 6) != 0x2) fail({line, col}, "invalid UTF-8 (is this a binary file?)");
+        cp = (cp << 6) | (cc & 0x3f);
+      }
+      bool overlong = (len == 2 && cp < 0x80) || (len == 3 && cp < 0x800) ||
+                      (len == 4 && cp < 0x10000);
+      if (overlong || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
+        fail({line, col}, "invalid UTF-8 (is this a binary file?)");
+    }
+    if (c == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      col += static_cast<uint32_t>(len);
+    }
+    i += len;
+  }
+}
+
+// Replaces /* ... */ comments by spaces, keeping newlines (so places do not move).
+std::string blank_comments(std::string_view text) {
+  std::string out(text);
+  uint32_t line = 1, col = 1;
+  for (size_t i = 0; i < out.size(); ++i) {
+    if (out[i] == '/' && i + 1 < out.size() && out[i + 1] == '*') {
+      SourceLoc start{line, col};
+      size_t j = i + 2;
+      while (j + 1 < out.size() && !(out[j] == '*' && out[j + 1] == '/')) ++j;
+      if (j + 1 >= out.size()) fail(start, "unterminated comment: '/*' has no '*/'");
+      for (size_t k = i; k < j + 2; ++k) {
+        if (out[k] == '\n') {
+          ++line;
+          col = 1;
+        } else {
+          out[k] = ' ';
+          ++col;
+        }
+      }
+      i = j + 1;
+      continue;
+    }
+    if (out[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return out;
+}
+
+// True if `s` (after leading spaces) is a '#' line that is not #define / #ignore.
+bool is_comment_line(std::string_view s) {
+  size_t i = 0;
+  while (i < s.size() && is_space(s[i])) ++i;
+  if (i >= s.size() || s[i] != '#') return false;
+  std::string_view rest = s.substr(i + 1);
+  auto starts_word = [&](std::string_view w) {
+    return rest.substr(0, w.size()) == w &&
+           (rest.size() == w.size() || !is_ident_char(rest[w.size()]));
+  };
+  return !(starts_word("define") || starts_word("ignore"));
+}
+
+std::vector<LogicalLine> logical_lines(const std::string& text) {
+  std::vector<LogicalLine> lines;
+  size_t pos = 0;
+  uint32_t line_no = 0;
+  LogicalLine current;
+  bool continuing = false;
+  while (pos <= text.size()) {
+    size_t nl = text.find('\n', pos);
+    if (nl == std::string::npos) nl = text.size();
+    ++line_no;
+    std::string_view phys(text.data() + pos, nl - pos);
+    if (!phys.empty() && phys.back() == '\r') phys.remove_suffix(1);
+    if (!continuing && is_comment_line(phys)) {
+      pos = nl + 1;
+      continue;
+    }
+    size_t keep = phys.size();
+    while (keep > 0 && is_space(phys[keep - 1])) --keep;
+    bool continues = keep > 0 && phys[keep - 1] == '\\';
+    size_t take = continues ? keep - 1 : phys.size();
+    for (size_t k = 0; k < take; ++k) {
+      current.text += phys[k];
+      current.locs.push_back({line_no, static_cast<uint32_t>(k + 1)});
+    }
+    if (continues && nl < text.size()) {
+      continuing = true;
+    } else {
+      current.locs.push_back({line_no, static_cast<uint32_t>(take + 1)});
+      lines.push_back(std::move(current));
+      current = LogicalLine{};
+      continuing = false;
+    }
+    pos = nl + 1;
+  }
+  return lines;
+}
+
+// A view of part of a logical line: [pos, end).
+struct Cursor {
+  const LogicalLine* line;
+  size_t pos;
+  size_t end;
+
+  SourceLoc loc() const { return line->locs[std::min(pos, line->text.size())]; }
+  SourceLoc loc_at(size_t p) const { return line->locs[std::min(p, line->text.size())]; }
+  bool at_end() const { return pos >= end; }
+  char peek(size_t ahead = 0) const {
+    return pos + ahead < end ? line->text[pos + ahead] : '\0';
+  }
+  void skip_spaces() {
+    while (pos < end && is_space(line->text[pos])) ++pos;
+  }
+  std::string_view rest() const { return std::string_view(line->text).substr(pos, end - pos); }
+  Cursor sub(size_t b, size_t e) const { return Cursor{line, b, e}; }
+};
+
+// Finds `token` in [c.pos, c.end) outside parentheses; returns npos if absent.
+size_t find_top_level(const Cursor& c, std::string_view token) {
+  int depth = 0;
+  const std::string& t = c.line->text;
+  for (size_t i = c.pos; i < c.end; ++i) {
+    char ch = t[i];
+    if (ch == '(') ++depth;
+    else if (ch == ')') depth = std::max(0, depth - 1);
+    else if (depth == 0 && i + token.size() <= c.end && t.compare(i, token.size(), token) == 0)
+      return i;
+  }
+  return std::string::npos;
+}
+
+// Formal parameter names in scope for one production.
+using Scope = std::unordered_map<std::string, uint32_t>;
+
+class Parser {
+ public:
+  Parser(Grammar& g, const ParseOptions& options) : g_(g), options_(options) {}
+
+  void parse(const std::string& text);
+  Word parse_word_line(const LogicalLine& line);
+
+ private:
+  // ---- expressions ----
+  struct ExprBuild {
+    uint32_t begin;
+    bool uses_slot = false;
+    bool uses_random = false;
+    int depth = 0;      // current simulated stack depth
+    int max_depth = 0;
+    int nesting = 0;
+  };
+  Expr compile_expression(Cursor& c, const Scope* scope, bool allow_random = true);
+  void emit(ExprBuild& b, Op op, uint32_t arg, SourceLoc loc, int stack_change,
+            Func fn = Func::kSin);
+  void parse_or(Cursor& c, ExprBuild& b, const Scope* scope);
+  void parse_and(Cursor& c, ExprBuild& b, const Scope* scope);
+  void parse_equality(Cursor& c, ExprBuild& b, const Scope* scope);
+  void parse_relational(Cursor& c, ExprBuild& b, const Scope* scope);
+  void parse_additive(Cursor& c, ExprBuild& b, const Scope* scope);
+  void parse_multiplicative(Cursor& c, ExprBuild& b, const Scope* scope);
+  void parse_unary(Cursor& c, ExprBuild& b, const Scope* scope);
+  void parse_power(Cursor& c, ExprBuild& b, const Scope* scope);
+  void parse_primary(Cursor& c, ExprBuild& b, const Scope* scope);
+  double parse_number(Cursor& c);
+  double constant_expression(Cursor c, const char* what);
+
+  // ---- module strings ----
+  struct ParsedModule {
+    SymbolId symbol;
+    SourceLoc loc;
+    std::vector<Cursor> args;  // argument texts (split at top-level commas)
+  };
+  std::vector<ParsedModule> parse_modules(Cursor c, const char* what);
+  std::string module_name_at(Cursor& c);
+  void check_brackets(const std::vector<ParsedModule>& ms, const char* what);
+  Successor compile_successor(Cursor c, const Scope& scope, const char* what);
+  Word evaluate_constant_word(const Successor& s);
+  std::vector<PatternModule> compile_pattern(Cursor c, Scope& scope, const char* what);
+
+  // ---- lines ----
+  void parse_define(const LogicalLine& line);
+  bool try_directive(const LogicalLine& line);
+  void parse_production(const LogicalLine& line, bool homomorphism);
+  void declare_modules(Cursor c);
+  void set_ignore(Cursor c);
+
+  Grammar& g_;
+  const ParseOptions& options_;
+  std::unordered_map<std::string, double> define_values_;
+  bool have_axiom_ = false;
+  Rng header_rng_{mix_pair(0x5EED, 1)};
+};
+
+// ---------------------------------------------------------------- expressions
+
+void Parser::emit(ExprBuild& b, Op op, uint32_t arg, SourceLoc loc, int stack_change, Func fn) {
+  g_.program.code.push_back(Instr{op, fn, 0, arg});
+  g_.program.locs.push_back(loc);
+  b.depth += stack_change;
+  b.max_depth = std::max(b.max_depth, b.depth);
+}
+
+Expr Parser::compile_expression(Cursor& c, const Scope* scope, bool allow_random) {
+  c.skip_spaces();
+  SourceLoc start = c.loc();
+  ExprBuild b;
+  b.begin = static_cast<uint32_t>(g_.program.code.size());
+  if (c.at_end() || c.peek() == ',' || c.peek() == ')')
+    fail(start, "expected an expression");
+  parse_or(c, b, scope);
+  if (b.max_depth > kMaxEvalStack) fail(start, "expression nested too deeply");
+  if (b.uses_random && !allow_random)
+    fail(start, "random functions are not allowed here");
+  Expr e;
+  e.loc = start;
+  e.uses_random = b.uses_random;
+  const uint32_t end = static_cast<uint32_t>(g_.program.code.size());
+  if (end - b.begin == 1 && g_.program.code[b.begin].op == Op::kSlot) {
+    e.kind = Expr::Kind::kSlot;
+    e.slot = g_.program.code[b.begin].arg;
+  } else if (!b.uses_slot && !b.uses_random) {
+    // Fold: evaluate once now; errors (1/0, sqrt(-1)) are reported at their operator.
+    Expr run{Expr::Kind::kProgram, false, 0, b.begin, end, 0, start};
+    try {
+      e.value = g_.program.eval(run, nullptr, nullptr);
+    } catch (const EvalError& err) {
+      fail(err.loc, err.message);
+    }
+    e.kind = Expr::Kind::kConst;
+  } else {
+    e.kind = Expr::Kind::kProgram;
+    e.begin = b.begin;
+    e.end = end;
+    return e;
+  }
+  g_.program.code.resize(b.begin);
+  g_.program.locs.resize(b.begin);
+  return e;
+}
+
+void Parser::parse_or(Cursor& c, ExprBuild& b, const Scope* scope) {
+  parse_and(c, b, scope);
+  for (;;) {
+    c.skip_spaces();
+    if (!(c.peek() == '|' && c.peek(1) == '|')) {
+      if (c.peek() == '|') fail(c.loc(), "expected '||' ('|' alone is not an operator)");
+      return;
+    }
+    SourceLoc loc = c.loc();
+    c.pos += 2;
+    size_t jump = g_.program.code.size();
+    emit(b, Op::kOrJump, 0, loc, -1);
+    parse_and(c, b, scope);
+    emit(b, Op::kBool, 0, loc, 0);
+    g_.program.code[jump].arg = static_cast<uint32_t>(g_.program.code.size());
+  }
+}
+
+void Parser::parse_and(Cursor& c, ExprBuild& b, const Scope* scope) {
+  parse_equality(c, b, scope);
+  for (;;) {
+    c.skip_spaces();
+    if (!(c.peek() == '&' && c.peek(1) == '&')) {
+      if (c.peek() == '&') fail(c.loc(), "expected '&&' ('&' alone is not an operator)");
+      return;
+    }
+    SourceLoc loc = c.loc();
+    c.pos += 2;
+    size_t jump = g_.program.code.size();
+    emit(b, Op::kAndJump, 0, loc, -1);
+    parse_equality(c, b, scope);
+    emit(b, Op::kBool, 0, loc, 0);
+    g_.program.code[jump].arg = static_cast<uint32_t>(g_.program.code.size());
+  }
+}
+
+void Parser::parse_equality(Cursor& c, ExprBuild& b, const Scope* scope) {
+  parse_relational(c, b, scope);
+  for (;;) {
+    c.skip_spaces();
+    Op op;
+    if (c.peek() == '=' && c.peek(1) == '=') op = Op::kEq;
+    else if (c.peek() == '!' && c.peek(1) == '=') op = Op::kNe;
+    else if (c.peek() == '=') fail(c.loc(), "expected '==' to compare ('=' alone is not an operator)");
+    else return;
+    SourceLoc loc = c.loc();
+    c.pos += 2;
+    parse_relational(c, b, scope);
+    emit(b, op, 0, loc, -1);
+  }
+}
+
+void Parser::parse_relational(Cursor& c, ExprBuild& b, const Scope* scope) {
+  parse_additive(c, b, scope);
+  for (;;) {
+    c.skip_spaces();
+    Op op;
+    size_t len = 1;
+    if (c.peek() == '<') op = c.peek(1) == '=' ? (len = 2, Op::kLe) : Op::kLt;
+    else if (c.peek() == '>') op = c.peek(1) == '=' ? (len = 2, Op::kGe) : Op::kGt;
+    else return;
+    SourceLoc loc = c.loc();
+    c.pos += len;
+    parse_additive(c, b, scope);
+    emit(b, op, 0, loc, -1);
+  }
+}
+
+void Parser::parse_additive(Cursor& c, ExprBuild& b, const Scope* scope) {
+  parse_multiplicative(c, b, scope);
+  for (;;) {
+    c.skip_spaces();
+    char ch = c.peek();
+    if (ch != '+' && ch != '-') return;
+    SourceLoc loc = c.loc();
+    ++c.pos;
+    parse_multiplicative(c, b, scope);
+    emit(b, ch == '+' ? Op::kAdd : Op::kSub, 0, loc, -1);
+  }
+}
+
+void Parser::parse_multiplicative(Cursor& c, ExprBuild& b, const Scope* scope) {
+  parse_unary(c, b, scope);
+  for (;;) {
+    c.skip_spaces();
+    char ch = c.peek();
+    if (ch != '*' && ch != '/') return;
+    SourceLoc loc = c.loc();
+    ++c.pos;
+    parse_unary(c, b, scope);
+    emit(b, ch == '*' ? Op::kMul : Op::kDiv, 0, loc, -1);
+  }
+}
+
+void Parser::parse_unary(Cursor& c, ExprBuild& b, const Scope* scope) {
+  c.skip_spaces();
+  char ch = c.peek();
+  if ((ch == '-' || ch == '+' || ch == '!') && !(ch == '!' && c.peek(1) == '=')) {
+    SourceLoc loc = c.loc();
+    if (++b.nesting > kMaxNesting) fail(loc, "expression nested too deeply");
+    ++c.pos;
+    parse_unary(c, b, scope);
+    --b.nesting;
+    if (ch == '-') emit(b, Op::kNeg, 0, loc, 0);
+    else if (ch == '!') emit(b, Op::kNot, 0, loc, 0);
+    return;
+  }
+  parse_power(c, b, scope);
+}
+
+void Parser::parse_power(Cursor& c, ExprBuild& b, const Scope* scope) {
+  parse_primary(c, b, scope);
+  c.skip_spaces();
+  if (c.peek() == '^') {
+    SourceLoc loc = c.loc();
+    if (++b.nesting > kMaxNesting) fail(loc, "expression nested too deeply");
+    ++c.pos;
+    parse_unary(c, b, scope);  // right-associative; 2^-1 allowed
+    --b.nesting;
+    emit(b, Op::kPow, 0, loc, -1);
+  }
+}
+
+double Parser::parse_number(Cursor& c) {
+  SourceLoc loc = c.loc();
+  size_t start = c.pos;
+  while (is_digit(c.peek())) ++c.pos;
+  if (c.peek() == '.') {
+    ++c.pos;
+    while (is_digit(c.peek())) ++c.pos;
+  }
+  if ((c.peek() == 'e' || c.peek() == 'E') &&
+      (is_digit(c.peek(1)) || ((c.peek(1) == '-' || c.peek(1) == '+') && is_digit(c.peek(2))))) {
+    c.pos += 2;
+    while (is_digit(c.peek())) ++c.pos;
+  }
+  const char* first = c.line->text.data() + start;
+  const char* last = c.line->text.data() + c.pos;
+  if (first + 1 == last && *first == '.') fail(loc, "expected a number after '.'");
+  double value = 0;
+  auto [ptr, ec] = std::from_chars(first, last, value);
+  if (ec == std::errc::result_out_of_range)
+    fail(loc, "number out of range: '" + std::string(first, last) + "'");
+  if (ec != std::errc() || ptr != last) fail(loc, "malformed number '" + std::string(first, last) + "'");
+  if (is_ident_start(c.peek()))
+    fail(c.loc(), "unexpected " + quote_char(c.peek()) + " after a number");
+  return value;
+}
+
+void Parser::parse_primary(Cursor& c, ExprBuild& b, const Scope* scope) {
+  c.skip_spaces();
+  SourceLoc loc = c.loc();
+  char ch = c.peek();
+  if (c.at_end()) fail(loc, "expected an expression");
+  if (is_digit(ch) || (ch == '.' && is_digit(c.peek(1)))) {
+    double v = parse_number(c);
+    g_.program.consts.push_back(v);
+    emit(b, Op::kConst, static_cast<uint32_t>(g_.program.consts.size() - 1), loc, +1);
+    return;
+  }
+  if (ch == '(') {
+    if (++b.nesting > kMaxNesting) fail(loc, "expression nested too deeply");
+    ++c.pos;
+    parse_or(c, b, scope);
+    c.skip_spaces();
+    if (c.peek() != ')') fail(c.loc(), "expected ')' to close the '(' at column " +
+                                           std::to_string(loc.column));
+    ++c.pos;
+    --b.nesting;
+    return;
+  }
+  if (is_ident_start(ch)) {
+    size_t start = c.pos;
+    while (is_ident_char(c.peek())) ++c.pos;
+    std::string name = c.line->text.substr(start, c.pos - start);
+    size_t after = c.pos;
+    c.skip_spaces();
+    if (c.peek() == '(') {
+      Func fn;
+      if (!find_func(name, &fn)) fail(loc, "unknown function '" + name + "'");
+      if (++b.nesting > kMaxNesting) fail(loc, "expression nested too deeply");
+      ++c.pos;
+      int args = 0;
+      c.skip_spaces();
+      if (c.peek() == ')') {
+        ++c.pos;
+      } else {
+        for (;;) {
+          parse_or(c, b, scope);
+          ++args;
+          c.skip_spaces();
+          if (c.peek() == ',') {
+            ++c.pos;
+            continue;
+          }
+          if (c.peek() == ')') {
+            ++c.pos;
+            break;
+          }
+          fail(c.loc(), "expected ',' or ')' in the arguments of '" + name + "'");
+        }
+      }
+      --b.nesting;
+      const FuncInfo& info = func_info(fn);
+      if (args != info.arity)
+        fail(loc, "function '" + name + "' expects " + std::to_string(info.arity) +
+                      (info.arity == 1 ? " argument" : " arguments") + ", got " +
+                      std::to_string(args));
+      if (info.random) b.uses_random = true;
+      emit(b, Op::kCall, 0, loc, 1 - args, fn);
+      return;
+    }
+    c.pos = after;
+    if (scope) {
+      auto it = scope->find(name);
+      if (it != scope->end()) {
+        b.uses_slot = true;
+        emit(b, Op::kSlot, it->second, loc, +1);
+        return;
+      }
+    }
+    double value;
+    auto it = define_values_.find(name);
+    if (it != define_values_.end()) {
+      value = it->second;
+    } else if (name == "pi") {
+      value = 3.14159265358979323846;
+    } else {
+      Func fn;
+      if (find_func(name, &fn)) fail(loc, "function '" + name + "' needs arguments: " + name + "(...)");
+      fail(loc, "unknown name '" + name + "'");
+    }
+    g_.program.consts.push_back(value);
+    emit(b, Op::kConst, static_cast<uint32_t>(g_.program.consts.size() - 1), loc, +1);
+    return;
+  }
+  if (ch == ')') fail(loc, "unexpected ')'");
+  fail(loc, "expected an expression, found " + quote_char(ch));
+}
+
+// Compiles an expression that must use no formal parameters and evaluates it.
+double Parser::constant_expression(Cursor c, const char* what) {
+  c.skip_spaces();
+  if (c.at_end()) fail(c.loc(), std::string("expected a value for ") + what);
+  Expr e = compile_expression(c, nullptr);
+  c.skip_spaces();
+  if (!c.at_end()) fail(c.loc(), "unexpected " + quote_char(c.peek()) + " after the value of " + what);
+  if (e.kind == Expr::Kind::kConst) return e.value;
+  // Random draws in a header value come from the header stream.
+  try {
+    double v = g_.program.eval(e, nullptr, &header_rng_);
+    return v;
+  } catch (const EvalError& err) {
+    fail(err.loc, err.message);
+  }
+}
+
+// ---------------------------------------------------------------- module strings
+
+std::string Parser::module_name_at(Cursor& c) {
+  size_t n = g_.symbols.module_name_length(c.rest());
+  std::string name = c.line->text.substr(c.pos, n);
+  c.pos += n;
+  return name;
+}
+
+std::vector<Parser::ParsedModule> Parser::parse_modules(Cursor c, const char* what) {
+  std::vector<ParsedModule> out;
+  for (;;) {
+    c.skip_spaces();
+    if (c.at_end()) break;
+    char ch = c.peek();
+    SourceLoc loc = c.loc();
+    if (ch == '(') {
+      if (!out.empty() && c.pos > 0 && is_space(c.line->text[c.pos - 1]))
+        fail(loc, "unexpected '(' (no space is allowed between a module name and its arguments)");
+      fail(loc, std::string("unexpected '(' in ") + what);
+    }
+    if (ch == ')' || ch == ',' || ch == ':')
+      fail(loc, "unexpected " + quote_char(ch) + " in " + what);
+    std::string name = module_name_at(c);
+    bool ok = true;
+    SymbolId id = g_.symbols.intern(name, &ok);
+    if (!ok) fail(loc, "too many different module names (more than 65535)");
+    ParsedModule m{id, loc, {}};
+    if (c.peek() == '(') {
+      SourceLoc open = c.loc();
+      ++c.pos;
+      // Split the argument list at top-level commas.
+      size_t arg_start = c.pos;
+      int depth = 0;
+      bool closed = false;
+      while (!c.at_end()) {
+        char a = c.peek();
+        if (a == '(') {
+          ++depth;
+        } else if (a == ')') {
+          if (depth == 0) {
+            m.args.push_back(c.sub(arg_start, c.pos));
+            ++c.pos;
+            closed = true;
+            break;
+          }
+          --depth;
+        } else if (a == ',' && depth == 0) {
+          m.args.push_back(c.sub(arg_start, c.pos));
+          arg_start = c.pos + 1;
+        }
+        ++c.pos;
+      }
+      if (!closed) fail(open, "'(' is never closed: expected ')'");
+      if (m.args.size() > 65535) fail(open, "too many arguments (more than 65535)");
+    }
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+void Parser::check_brackets(const std::vector<ParsedModule>& ms, const char* what) {
+  std::vector<SourceLoc> open;
+  for (const ParsedModule& m : ms) {
+    if (m.symbol == kSymPush) {
+      open.push_back(m.loc);
+    } else if (m.symbol == kSymPop) {
+      if (open.empty()) fail(m.loc, std::string("unbalanced brackets in ") + what + ": ']' without matching '['");
+      open.pop_back();
+    }
+  }
+  if (!open.empty())
+    fail(open.back(), std::string("unbalanced brackets in ") + what + ": '[' is never closed");
+}
+
+Successor Parser::compile_successor(Cursor c, const Scope& scope, const char* what) {
+  std::vector<ParsedModule> ms = parse_modules(c, what);
+  check_brackets(ms, what);
+  Successor s;
+  for (ParsedModule& m : ms) {
+    if ((m.symbol == kSymPush || m.symbol == kSymPop) && !m.args.empty())
+      fail(m.loc, "brackets take no arguments");
+    SuccessorModule sm{m.symbol, static_cast<uint16_t>(m.args.size()),
+                       static_cast<uint32_t>(s.args.size())};
+    for (Cursor& a : m.args) {
+      Expr e = compile_expression(a, &scope);
+      a.skip_spaces();
+      if (!a.at_end()) fail(a.loc(), "unexpected " + quote_char(a.peek()) + " in an argument");
+      if (e.kind != Expr::Kind::kConst) s.all_constant = false;
+      s.args.push_back(e);
+    }
+    if (m.symbol == kSymCut) g_.uses_cut = true;
+    s.modules.push_back(sm);
+  }
+  if (s.all_constant) s.prebuilt = evaluate_constant_word(s);
+  return s;
+}
+
+Word Parser::evaluate_constant_word(const Successor& s) {
+  Word w;
+  for (const SuccessorModule& sm : s.modules) {
+    w.modules.push_back(Module{sm.symbol, sm.arg_count, static_cast<uint32_t>(w.params.size())});
+    for (uint32_t k = 0; k < sm.arg_count; ++k) {
+      const Expr& e = s.args[sm.first_arg + k];
+      double v = e.kind == Expr::Kind::kConst ? e.value : 0.0;
+      if (e.kind != Expr::Kind::kConst) {
+        try {
+          v = g_.program.eval(e, nullptr, &header_rng_);
+        } catch (const EvalError& err) {
+          fail(err.loc, err.message);
+        }
+      }
+      w.params.push_back(v);
+    }
+  }
+  return w;
+}
+
+std::vector<PatternModule> Parser::compile_pattern(Cursor c, Scope& scope, const char* what) {
+  std::vector<ParsedModule> ms = parse_modules(c, what);
+  std::vector<PatternModule> out;
+  for (ParsedModule& m : ms) {
+    if ((m.symbol == kSymPush || m.symbol == kSymPop) && !m.args.empty())
+      fail(m.loc, "brackets take no arguments");
+    PatternModule pm{m.symbol, static_cast<uint16_t>(m.args.size()), 0};
+    pm.first_slot = static_cast<uint32_t>(scope.size());
+    for (Cursor& a : m.args) {
+      a.skip_spaces();
+      SourceLoc loc = a.loc();
+      if (a.at_end()) fail(loc, "expected a parameter name");
+      size_t start = a.pos;
+      if (!is_ident_start(a.peek())) fail(loc, std::string("expected a parameter name in ") + what + ", found " + quote_char(a.peek()));
+      while (is_ident_char(a.peek())) ++a.pos;
+      std::string name = a.line->text.substr(start, a.pos - start);
+      a.skip_spaces();
+      if (!a.at_end()) fail(a.loc(), "expected ',' or ')' after parameter '" + name + "'");
+      if (scope.count(name)) fail(loc, "formal parameter '" + name + "' is declared twice");
+      if (define_values_.count(name))
+        fail(loc, "formal parameter '" + name + "' hides the #define of the same name");
+      uint32_t slot = static_cast<uint32_t>(scope.size());
+      scope.emplace(name, slot);
+    }
+    out.push_back(pm);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------- lines
+
+void Parser::parse_define(const LogicalLine& line) {
+  Cursor c{&line, 0, line.text.size()};
+  c.skip_spaces();
+  c.pos += 7;  // "#define"
+  c.skip_spaces();
+  SourceLoc loc = c.loc();
+  if (!is_ident_start(c.peek())) fail(loc, "#define needs a name: '#define NAME value'");
+  size_t start = c.pos;
+  while (is_ident_char(c.peek())) ++c.pos;
+  std::string name = line.text.substr(start, c.pos - start);
+  Func fn;
+  if (name == "pi" || find_func(name, &fn))
+    fail(loc, "#define cannot redefine the built-in '" + name + "'");
+  for (const Define& d : g_.defines)
+    if (d.name == name) fail(loc, "'" + name + "' is defined twice (first at line " + std::to_string(d.loc.line) + ")");
+  Define d{name, 0, loc, false};
+  auto ov = options_.define_overrides.find(name);
+  c.skip_spaces();
+  if (c.at_end()) fail(c.loc(), "#define " + name + " needs a value");
+  if (ov != options_.define_overrides.end()) {
+    d.value = ov->second;
+    d.overridden = true;
+  } else {
+    d.value = constant_expression(c, ("#define " + name).c_str());
+  }
+  define_values_[name] = d.value;
+  g_.defines.push_back(d);
+}
+
+void Parser::declare_modules(Cursor c) {
+  for (;;) {
+    c.skip_spaces();
+    if (c.at_end()) break;
+    SourceLoc loc = c.loc();
+    size_t start = c.pos;
+    while (!c.at_end() && !is_space(c.peek())) ++c.pos;
+    std::string name = c.line->text.substr(start, c.pos - start);
+    if (is_digit(name[0]))
+      fail(loc, "invalid module name '" + name + "': it must not start with a digit");
+    for (char ch : name)
+      if (ch == '(' || ch == ')' || ch == ',' || ch == ':' || ch == '[' || ch == ']' || ch == '<' || ch == '>')
+        fail(loc, "invalid module name '" + name + "': it must not contain " + quote_char(ch));
+    g_.symbols.declare_multichar(name);
+    bool ok = true;
+    g_.symbols.intern(name, &ok);
+    if (!ok) fail(loc, "too many different module names (more than 65535)");
+  }
+}
+
+void Parser::set_ignore(Cursor c) {
+  std::vector<ParsedModule> ms = parse_modules(c, "the ignore list");
+  for (const ParsedModule& m : ms) {
+    if (!m.args.empty()) fail(m.loc, "the ignore list takes module names without parameters");
+    if (m.symbol == kSymPush || m.symbol == kSymPop)
+      fail(m.loc, "brackets cannot be ignored: they delimit branches");
+    if (g_.ignored.size() <= m.symbol) g_.ignored.resize(m.symbol + 1u, 0);
+    g_.ignored[m.symbol] = 1;
+  }
+}
+
+// Directives: name -> kind. Returns false if the line is not a directive.
+bool Parser::try_directive(const LogicalLine& line) {
+  static const char* const kNames[] = {
+      "module", "ignore", "angle", "width decrement", "width", "step", "tropism", "seed",
+      "derivation length", "steps", "axiom", "\xCF\x89" /* ω */, "maximum depth"};
+  Cursor c{&line, 0, line.text.size()};
+  c.skip_spaces();
+  std::string_view rest = c.rest();
+  for (const char* name : kNames) {
+    size_t n = std::strlen(name);
+    if (rest.substr(0, n) != name) continue;
+    size_t p = n;
+    while (p < rest.size() && is_space(rest[p])) ++p;
+    if (p >= rest.size() || rest[p] != ':') continue;
+    Cursor value = c.sub(c.pos + p + 1, line.text.size());
+    std::string d = name;
+    SourceLoc loc = c.loc();
+    if (d == "module") {
+      // handled in the first pass
+    } else if (d == "ignore") {
+      set_ignore(value);
+    } else if (d == "angle") {
+      g_.turtle.angle_deg = constant_expression(value, "angle");
+    } else if (d == "width decrement") {
+      g_.turtle.width_decrement = constant_expression(value, "width decrement");
+    } else if (d == "width") {
+      double w = constant_expression(value, "width");
+      if (w < 0) fail(loc, "width must not be negative");
+      g_.turtle.width = w;
+    } else if (d == "step") {
+      g_.turtle.step = constant_expression(value, "step");
+    } else if (d == "tropism") {
+      // Four values separated by commas or spaces: T.x T.y T.z e.
+      std::vector<Cursor> parts;
+      if (find_top_level(value, ",") != std::string::npos) {
+        size_t s = value.pos;
+        for (;;) {
+          Cursor rem = value.sub(s, value.end);
+          size_t comma = find_top_level(rem, ",");
+          if (comma == std::string::npos) {
+            parts.push_back(rem);
+            break;
+          }
+          parts.push_back(value.sub(s, comma));
+          s = comma + 1;
+        }
+      } else {
+        Cursor v = value;
+        for (;;) {
+          v.skip_spaces();
+          if (v.at_end()) break;
+          size_t s = v.pos;
+          int depth = 0;
+          while (!v.at_end() && (depth > 0 || !is_space(v.peek()))) {
+            if (v.peek() == '(') ++depth;
+            if (v.peek() == ')') --depth;
+            ++v.pos;
+          }
+          parts.push_back(value.sub(s, v.pos));
+        }
+      }
+      if (parts.size() != 4) fail(value.loc(), "tropism needs four values: x y z e");
+      for (int k = 0; k < 3; ++k) g_.turtle.tropism[k] = constant_expression(parts[k], "tropism");
+      g_.turtle.tropism_e = constant_expression(parts[3], "tropism");
+      g_.turtle.has_tropism = true;
+    } else if (d == "seed") {
+      Cursor v = value;
+      v.skip_spaces();
+      std::string_view t = v.rest();
+      while (!t.empty() && is_space(t.back())) t.remove_suffix(1);
+      bool plain = !t.empty() && std::all_of(t.begin(), t.end(), is_digit);
+      if (plain) {
+        uint64_t s = 0;
+        auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), s);
+        if (ec != std::errc() || ptr != t.data() + t.size())
+          fail(v.loc(), "seed out of range: it must be an integer from 0 to 18446744073709551615");
+        g_.seed = s;
+      } else {
+        double s = constant_expression(value, "seed");
+        if (s < 0 || s != std::floor(s) || s > 9007199254740992.0)
+          fail(v.loc(), "seed must be a non-negative integer");
+        g_.seed = static_cast<uint64_t>(s);
+      }
+    } else if (d == "derivation length" || d == "steps") {
+      double n = constant_expression(value, "derivation length");
+      if (n < 0 || n != std::floor(n)) fail(value.loc(), "derivation length must be a non-negative integer");
+      if (n > kMaxSteps) fail(value.loc(), "derivation length is out of range (at most 1000000)");
+      g_.steps = static_cast<int64_t>(n);
+    } else if (d == "maximum depth") {
+      double n = constant_expression(value, "maximum depth");
+      if (n < 0 || n != std::floor(n) || n > kMaxDepthLimit)
+        fail(value.loc(), "maximum depth must be an integer from 0 to 1000");
+      g_.max_depth = static_cast<int>(n);
+    } else {  // axiom / ω
+      if (have_axiom_) fail(loc, "the axiom is given twice");
+      have_axiom_ = true;
+      Successor s = compile_successor(value, Scope{}, "the axiom");
+      g_.axiom = s.all_constant ? std::move(s.prebuilt) : evaluate_constant_word(s);
+      g_.axiom_loc = loc;
+      if (g_.axiom.size() == 0) fail(value.loc(), "the axiom is empty");
+    }
+    return true;
+  }
+  return false;
+}
+
+void Parser::parse_production(const LogicalLine& line, bool homomorphism) {
+  Cursor all{&line, 0, line.text.size()};
+  all.skip_spaces();
+  Production p;
+  p.loc = all.loc();
+  {
+    std::string_view t = all.rest();
+    while (!t.empty() && is_space(t.back())) t.remove_suffix(1);
+    p.text = std::string(t);
+  }
+  size_t arrow = find_top_level(all, "->");
+  if (arrow == std::string::npos) fail(all.loc(), "expected '->'");
+  size_t arrow_len = 2;
+  // "-->" is the arrow too, unless the '-' is the whole predecessor ("- -> +", "--> +").
+  if (arrow > all.pos && line.text[arrow - 1] == '-') {
+    Cursor before = all.sub(all.pos, arrow - 1);
+    before.skip_spaces();
+    if (!before.at_end()) {
+      --arrow;
+      arrow_len = 3;
+    }
+  }
+  Cursor left = all.sub(all.pos, arrow);
+  Cursor right = all.sub(arrow + arrow_len, line.text.size());
+
+  // Label "p<digits>:".
+  left.skip_spaces();
+  {
+    size_t q = left.pos;
+    while (q < left.end && is_ident_char(line.text[q])) ++q;
+    size_t r = q;
+    while (r < left.end && is_space(line.text[r])) ++r;
+    if (q - left.pos >= 2 && r < left.end && line.text[r] == ':') {
+      std::string word = line.text.substr(left.pos, q - left.pos);
+      bool is_label = word[0] == 'p' && std::all_of(word.begin() + 1, word.end(), is_digit);
+      SymbolId dummy;
+      bool is_module = g_.symbols.find(word, &dummy) && g_.symbols.match_multichar(word) == word.size();
+      if (is_label) {
+        p.label = word;
+        left.pos = r + 1;
+      } else if (!is_module) {
+        fail(left.loc(), "label '" + word + "' must be 'p' followed by digits, as in 'p1:'");
+      }
+    }
+  }
+  // Condition after the first top-level ':'.
+  size_t colon = find_top_level(left, ":");
+  Cursor context = left;
+  Cursor cond_text = left;
+  bool has_condition = false;
+  if (colon != std::string::npos) {
+    context.end = colon;
+    cond_text = left.sub(colon + 1, left.end);
+    cond_text.skip_spaces();
+    if (cond_text.at_end()) fail(cond_text.loc(), "expected a condition after ':' (use '*' for always)");
+    std::string_view ct = cond_text.rest();
+    while (!ct.empty() && is_space(ct.back())) ct.remove_suffix(1);
+    has_condition = ct != "*";
+  }
+  // Context split at top-level '<' and '>'.
+  size_t lt = find_top_level(context, "<");
+  size_t gt = find_top_level(context, ">");
+  if (lt != std::string::npos && gt != std::string::npos && gt < lt)
+    fail(context.loc_at(gt), "the right context '>' must come after the left context '<'");
+  Cursor lctx = context.sub(context.pos, lt == std::string::npos ? context.pos : lt);
+  Cursor pred = context.sub(lt == std::string::npos ? context.pos : lt + 1,
+                            gt == std::string::npos ? context.end : gt);
+  Cursor rctx = context.sub(gt == std::string::npos ? context.end : gt + 1, context.end);
+  if (lt != std::string::npos) {
+    Cursor t = lctx;
+    t.skip_spaces();
+    if (t.at_end()) fail(context.loc_at(lt), "expected a left context before '<'");
+    if (find_top_level(context.sub(lt + 1, context.end), "<") != std::string::npos)
+      fail(context.loc_at(find_top_level(context.sub(lt + 1, context.end), "<")), "a production has at most one '<'");
+  }
+  if (gt != std::string::npos) {
+    Cursor t = rctx;
+    t.skip_spaces();
+    if (t.at_end()) fail(context.loc_at(gt), "expected a right context after '>'");
+  }
+  Scope scope;
+  {
+    Cursor t = pred;
+    t.skip_spaces();
+    if (t.at_end()) fail(t.loc(), "expected a predecessor module before '->'");
+    std::vector<PatternModule> pm = compile_pattern(pred, scope, "the predecessor");
+    if (pm.size() != 1)
+      fail(t.loc(), "the predecessor must be one module (use '<' and '>' for context)");
+    if (pm[0].symbol == kSymPush || pm[0].symbol == kSymPop)
+      fail(t.loc(), "brackets cannot be rewritten");
+    p.predecessor = pm[0];
+  }
+  p.left_context = compile_pattern(lctx, scope, "the left context");
+  for (const PatternModule& m : p.left_context)
+    if (m.symbol == kSymPush || m.symbol == kSymPop)
+      fail(lctx.loc(), "brackets are not allowed in a left context");
+  p.right_context = compile_pattern(rctx, scope, "the right context");
+  p.slot_count = static_cast<uint32_t>(scope.size());
+  if (p.has_context()) g_.uses_context = true;
+
+  // Condition.
+  if (has_condition) {
+    Cursor c = cond_text;
+    p.condition = compile_expression(c, &scope);
+    c.skip_spaces();
+    if (!c.at_end()) fail(c.loc(), "unexpected " + quote_char(c.peek()) + " in the condition");
+    if (p.condition.uses_random) g_.uses_random = true;
+  }
+
+  // Successor and probability.
+  size_t pcolon = find_top_level(right, ":");
+  Cursor succ = right;
+  if (pcolon != std::string::npos) {
+    succ.end = pcolon;
+    Cursor prob = right.sub(pcolon + 1, right.end);
+    prob.skip_spaces();
+    if (prob.at_end()) fail(prob.loc(), "expected a probability after ':'");
+    p.probability = compile_expression(prob, &scope);
+    prob.skip_spaces();
+    if (!prob.at_end()) fail(prob.loc(), "unexpected " + quote_char(prob.peek()) + " in the probability");
+    if (p.probability.kind == Expr::Kind::kConst && p.probability.value < 0)
+      fail(p.probability.loc, "a probability must not be negative");
+    g_.uses_random = true;
+  }
+  p.successor = compile_successor(succ, scope, "the successor");
+  for (const Expr& e : p.successor.args)
+    if (e.uses_random) g_.uses_random = true;
+  (homomorphism ? g_.homomorphism : g_.productions).push_back(std::move(p));
+}
+
+enum class LineKind { kBlank, kDefine, kModule, kSection, kOther };
+
+LineKind classify(const LogicalLine& line) {
+  size_t i = 0;
+  const std::string& t = line.text;
+  while (i < t.size() && is_space(t[i])) ++i;
+  if (i == t.size()) return LineKind::kBlank;
+  std::string_view rest(t.data() + i, t.size() - i);
+  if (rest.substr(0, 7) == "#define" && (rest.size() == 7 || !is_ident_char(rest[7])))
+    return LineKind::kDefine;
+  auto keyword = [&](std::string_view w) {
+    if (rest.substr(0, w.size()) != w) return false;
+    size_t p = w.size();
+    while (p < rest.size() && is_space(rest[p])) ++p;
+    return p < rest.size() && rest[p] == ':';
+  };
+  if (keyword("module")) return LineKind::kModule;
+  return LineKind::kOther;
+}
+
+void Parser::parse(const std::string& text) {
+  validate_text(text);
+  std::string clean = blank_comments(text);
+  size_t bom = clean.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+  if (bom) clean.replace(0, 3, "   ");
+  std::vector<LogicalLine> lines = logical_lines(clean);
+
+  // Pass 1: module declarations (they change how every module string is tokenised).
+  for (const LogicalLine& line : lines) {
+    if (classify(line) != LineKind::kModule) continue;
+    Cursor c{&line, 0, line.text.size()};
+    size_t colon = line.text.find(':');
+    declare_modules(c.sub(colon + 1, line.text.size()));
+  }
+  // Pass 2: defines, in file order.
+  for (const LogicalLine& line : lines)
+    if (classify(line) == LineKind::kDefine) parse_define(line);
+  for (const auto& [name, value] : options_.define_overrides) {
+    if (!define_values_.count(name))
+      fail({0, 0}, "-D " + name + ": the grammar has no '#define " + name + "'");
+  }
+  // Pass 3: directives, sections and productions.
+  bool homomorphism = false;
+  for (const LogicalLine& line : lines) {
+    LineKind kind = classify(line);
+    if (kind != LineKind::kOther) continue;
+    Cursor c{&line, 0, line.text.size()};
+    c.skip_spaces();
+    std::string_view rest = c.rest();
+    while (!rest.empty() && is_space(rest.back())) rest.remove_suffix(1);
+    if (rest.substr(0, 7) == "#ignore") {
+      Cursor v = c.sub(c.pos + 7, line.text.size());
+      v.skip_spaces();
+      if (v.peek() == ':') ++v.pos;
+      set_ignore(v);
+      continue;
+    }
+    auto section = [&](std::string_view name) {
+      if (rest.substr(0, name.size()) != name) return false;
+      std::string_view after = rest.substr(name.size());
+      size_t k = 0;
+      while (k < after.size() && is_space(after[k])) ++k;
+      if (k >= after.size() || after[k] != ':') return false;
+      ++k;
+      while (k < after.size() && is_space(after[k])) ++k;
+      if (k != after.size())
+        fail(c.loc_at(c.pos + name.size() + k), "unexpected text after '" + std::string(name) + ":'");
+      return true;
+    };
+    if (section("productions")) {
+      homomorphism = false;
+      continue;
+    }
+    if (section("homomorphism") || section("interpretation")) {
+      homomorphism = true;
+      continue;
+    }
+    if (find_top_level(c, "->") != std::string::npos) {
+      parse_production(line, homomorphism);
+      continue;
+    }
+    if (try_directive(line)) continue;
+    // "name words:" that is no known directive.
+    size_t k = 0;
+    while (k < rest.size() && (is_ident_char(rest[k]) || rest[k] == ' ')) ++k;
+    if (k > 0 && k < rest.size() && rest[k] == ':' && is_ident_start(rest[0])) {
+      std::string name(rest.substr(0, k));
+      while (!name.empty() && name.back() == ' ') name.pop_back();
+      fail(c.loc(), "unknown directive '" + name + "'");
+    }
+    if (rest[0] == '#')
+      fail(c.loc(), "unknown directive '" + std::string(rest.substr(0, rest.find_first_of(" \t:"))) + "'");
+    fail(c.loc(), "expected a production 'predecessor -> successor' or a directive 'name: value'");
+  }
+  if (!have_axiom_) fail({1, 1}, "no axiom: the grammar needs a line 'axiom: <modules>'");
+
+  // Index productions by predecessor symbol; size per-symbol tables.
+  const size_t nsym = g_.symbols.size();
+  g_.ignored.resize(nsym, 0);
+  g_.productions_by_symbol.assign(nsym, {});
+  g_.homomorphism_by_symbol.assign(nsym, {});
+  for (uint32_t i = 0; i < g_.productions.size(); ++i)
+    g_.productions_by_symbol[g_.productions[i].predecessor.symbol].push_back(i);
+  for (uint32_t i = 0; i < g_.homomorphism.size(); ++i)
+    g_.homomorphism_by_symbol[g_.homomorphism[i].predecessor.symbol].push_back(i);
+  for (size_t i = 0; i < g_.axiom.size(); ++i)
+    if (g_.axiom.modules[i].symbol == kSymCut) g_.uses_cut = true;
+}
+
+Word Parser::parse_word_line(const LogicalLine& line) {
+  Successor s = compile_successor(Cursor{&line, 0, line.text.size()}, Scope{}, "the word");
+  return s.all_constant ? std::move(s.prebuilt) : evaluate_constant_word(s);
+}
+
+}  // namespace
+
+std::string Grammar::source_line(uint32_t line) const {
+  if (!text || line == 0) return {};
+  size_t pos = 0;
+  for (uint32_t l = 1; l < line; ++l) {
+    pos = text->find('\n', pos);
+    if (pos == std::string::npos) return {};
+    ++pos;
+  }
+  size_t end = text->find('\n', pos);
+  std::string s = text->substr(pos, end == std::string::npos ? std::string::npos : end - pos);
+  if (!s.empty() && s.back() == '\r') s.pop_back();
+  return s;
+}
+
+Diagnostic Grammar::error_at(SourceLoc loc, std::string message) const {
+  return Diagnostic{file, loc, std::move(message), source_line(loc.line)};
+}
+
+Expected<Grammar> parse_grammar(std::string_view text, std::string file, const ParseOptions& options) {
+  Grammar g;
+  g.file = std::move(file);
+  g.text = std::make_shared<const std::string>(text);
+  try {
+    Parser parser(g, options);
+    parser.parse(*g.text);
+  } catch (const ParseFailure& f) {
+    return g.error_at(f.loc, f.message);
+  }
+  return g;
+}
+
+Expected<Grammar> load_grammar(const std::string& path, const ParseOptions& options) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Diagnostic{path, {}, std::string("cannot read the grammar: ") + std::strerror(errno), {}};
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) return Diagnostic{path, {}, "cannot read the grammar: read error", {}};
+  return parse_grammar(ss.str(), path, options);
+}
+
+Expected<Word> parse_word(std::string_view text, Grammar& grammar) {
+  LogicalLine line;
+  line.text = std::string(text);
+  for (size_t i = 0; i <= text.size(); ++i) line.locs.push_back({1, static_cast<uint32_t>(i + 1)});
+  try {
+    if (line.text.find('\n') != std::string::npos) fail({1, static_cast<uint32_t>(line.text.find('\n') + 1)}, "a word is one line");
+    validate_text(text);
+    ParseOptions none;
+    Parser parser(grammar, none);
+    Word w = parser.parse_word_line(line);
+    const size_t nsym = grammar.symbols.size();  // the word may name new modules
+    grammar.ignored.resize(nsym, 0);
+    grammar.productions_by_symbol.resize(nsym);
+    grammar.homomorphism_by_symbol.resize(nsym);
+    return w;
+  } catch (const ParseFailure& f) {
+    return Diagnostic{"<word>", f.loc, f.message, std::string(text)};
+  }
+}
+
+}  // namespace sylva::lsys

@@ -1,0 +1,96 @@
+// word.h — symbols and words: the data an L-system derivation works on.
+//
+// A word is a flat array of compact module records (symbol id, parameter count, offset
+// into one shared parameter array), never strings or per-module heap objects: a module
+// without parameters costs 8 bytes. Lineage keys (for stable random streams) are stored
+// only when the grammar draws random numbers.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+namespace sylva::lsys {
+
+using SymbolId = uint16_t;
+
+// Symbols the turtle and the derivation give a meaning to. Every SymbolTable registers
+// them first, in this order, so their ids are these constants in every grammar.
+enum BuiltinSymbol : SymbolId {
+  kSymF = 0,        // F   move and draw
+  kSymf,            // f   move without drawing
+  kSymTurnLeft,     // +   rotate about U, H toward L
+  kSymTurnRight,    // -
+  kSymPitchDown,    // &   rotate about L, H toward -U
+  kSymPitchUp,      // ^
+  kSymRollLeft,     // \   rotate about H, U toward L
+  kSymRollRight,    // /
+  kSymTurnAround,   // |
+  kSymLevel,        // $
+  kSymPush,         // [
+  kSymPop,          // ]
+  kSymWidth,        // !
+  kSymMaterial,     // '
+  kSymCut,          // %
+  kSymTropism,      // @T
+  kBuiltinSymbolCount
+};
+
+// Module names <-> ids. Names are one UTF-8 character unless declared with `module:`
+// (or the built-in @T); tokenisation takes the longest declared name at each place.
+class SymbolTable {
+ public:
+  SymbolTable();
+  // Id of `name`, registering it if new. Returns false in `ok` past 65535 symbols.
+  SymbolId intern(std::string_view name, bool* ok = nullptr);
+  // Id of `name` if it is known.
+  bool find(std::string_view name, SymbolId* id) const;
+  const std::string& name(SymbolId id) const { return names_[id]; }
+  size_t size() const { return names_.size(); }
+  // Declares a multi-character name for longest-match tokenisation.
+  void declare_multichar(std::string_view name);
+  // Length in bytes of the longest declared multi-character name that `text` starts
+  // with, or 0 when none does.
+  size_t match_multichar(std::string_view text) const;
+  // Length in bytes of the module name that `text` starts with: the longest declared
+  // multi-character name, else one UTF-8 character. Precondition: text not empty.
+  size_t module_name_length(std::string_view text) const;
+
+ private:
+  std::vector<std::string> names_;
+  std::unordered_map<std::string, SymbolId> ids_;
+  std::vector<std::string> multichar_;  // sorted by length, longest first
+};
+
+// One module of a word: 8 bytes.
+struct Module {
+  SymbolId symbol;
+  uint16_t param_count;
+  uint32_t param_begin;  // index of the first parameter in Word::params
+};
+
+struct Word {
+  std::vector<Module> modules;
+  std::vector<double> params;
+  // Lineage key of each module (parallel to modules), or empty when the grammar draws
+  // no random numbers. See derive.cpp for how keys are made.
+  std::vector<uint64_t> lineage;
+
+  size_t size() const { return modules.size(); }
+  const double* params_of(const Module& m) const { return params.data() + m.param_begin; }
+  // Bytes held by the arrays (capacity, not size): what a word really costs.
+  size_t capacity_bytes() const;
+  void clear();
+};
+
+// Prints a word as grammar.md "Printing a word" says: modules without separators,
+// arguments in shortest round-trip decimal, a space after a module only where the next
+// module would otherwise merge with it when read back.
+std::string print_word(const Word& word, const SymbolTable& symbols);
+
+// Appends the shortest decimal text that reads back as exactly `value`.
+void append_shortest_double(std::string& out, double value);
+
+}  // namespace sylva::lsys
