@@ -347,12 +347,12 @@ Diagnostic failure_diagnostic(const Grammar& g, const Word& in, const Rewriter& 
   std::string text = message;
   if (r.current_production) {
     const Production& p = *r.current_production;
-    text += ", in production " + (p.label.empty() ? std::string() : p.label + " ") + "'" + p.text + "' (line " +
+    text += ", in production '" + p.text + "' (line " +
             std::to_string(p.loc.line) + ")";
     if (r.current < in.size()) text += " rewriting module " + module_text(in, r.current, g.symbols);
-    text += std::string(" at ") + what + " " + std::to_string(step);
     if (loc.line == 0) loc = p.loc;
   }
+  text += std::string(" at ") + what + " " + std::to_string(step);
   return g.error_at(loc, text);
 }
 

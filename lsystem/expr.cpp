@@ -33,15 +33,16 @@ void reduce_degrees(double degrees, int* quadrant, double* rem_rad) {
 }
 }  // namespace
 
+// "+ 0.0" turns a -0 from the quadrant sign into +0: sin(180) prints as 0, not -0.
 double sin_deg(double degrees) {
   int q;
   double a;
   reduce_degrees(degrees, &q, &a);
   switch (q) {
-    case 0: return std::sin(a);
-    case 1: return std::cos(a);
-    case 2: return -std::sin(a);
-    default: return -std::cos(a);
+    case 0: return std::sin(a) + 0.0;
+    case 1: return std::cos(a) + 0.0;
+    case 2: return -std::sin(a) + 0.0;
+    default: return -std::cos(a) + 0.0;
   }
 }
 
@@ -50,10 +51,10 @@ double cos_deg(double degrees) {
   double a;
   reduce_degrees(degrees, &q, &a);
   switch (q) {
-    case 0: return std::cos(a);
-    case 1: return -std::sin(a);
-    case 2: return -std::cos(a);
-    default: return std::sin(a);
+    case 0: return std::cos(a) + 0.0;
+    case 1: return -std::sin(a) + 0.0;
+    case 2: return -std::cos(a) + 0.0;
+    default: return std::sin(a) + 0.0;
   }
 }
 
@@ -127,7 +128,7 @@ double Program::run(const Expr& e, const double* slots, Rng* rng) const {
           case Func::kTan: {
             double c = cos_deg(a[0]);
             if (c == 0.0) fail(locs[pc], "tan of an odd multiple of 90 degrees is not finite");
-            r = sin_deg(a[0]) / c;
+            r = sin_deg(a[0]) / c + 0.0;
             break;
           }
           case Func::kAsin: r = std::asin(a[0]) / kRadPerDeg; break;

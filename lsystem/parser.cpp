@@ -799,6 +799,7 @@ bool Parser::try_directive(const LogicalLine& line) {
     while (p < rest.size() && is_space(rest[p])) ++p;
     if (p >= rest.size() || rest[p] != ':') continue;
     Cursor value = c.sub(c.pos + p + 1, line.text.size());
+    value.skip_spaces();
     std::string d = name;
     SourceLoc loc = c.loc();
     if (d == "module") {
