@@ -65,7 +65,7 @@ class CapturingReporter : public benchmark::ConsoleReporter {
   void ReportRuns(const std::vector<Run>& runs) override {
     for (const Run& r : runs) {
       if (r.run_type == Run::RT_Iteration || r.aggregate_name == "median")
-        seconds_[r.benchmark_name()] = r.GetAdjustedRealTime() / 1e9;  // time unit: ns
+        seconds_[r.benchmark_name()] = r.GetAdjustedRealTime() / benchmark::GetTimeUnitMultiplier(r.time_unit);
     }
     ConsoleReporter::ReportRuns(runs);
   }
@@ -125,7 +125,7 @@ int run_bench(const std::vector<std::string>& args) {
   {
     auto g = load("abop_1_31a_context.lsys");
     if (!g) return kInputError;
-    int64_t n = quick ? 30 : 120;
+    int64_t n = steps_to_reach(*g, target_b, 400);
     cases.push_back({"derive/c_abop_1_31a", "abop_1_31a_context.lsys", n, std::move(*g)});
   }
   for (Case& c : cases) {

@@ -43,9 +43,15 @@ void orthonormalize(TurtleState& t) {
   t.up = glm::cross(t.heading, t.left);
 }
 
-// Rotates the pair (a, b) in their plane by `angle_deg`, turning a toward b.
-void rotate_pair(dvec3& a, dvec3& b, double angle_deg) {
-  const double c = lsys::cos_deg(angle_deg), s = lsys::sin_deg(angle_deg);
+// Cosine and sine of a turn: the grammar's default angle is computed once.
+struct Turn {
+  double c, s;
+};
+Turn turn_of(double angle_deg) { return {lsys::cos_deg(angle_deg), lsys::sin_deg(angle_deg)}; }
+
+// Rotates the pair (a, b) in their plane by a turn, turning a toward b.
+void rotate_pair(dvec3& a, dvec3& b, Turn t) {
+  const double c = t.c, s = t.s;
   const dvec3 a2 = a * c + b * s;
   const dvec3 b2 = b * c - a * s;
   a = a2;
@@ -74,6 +80,24 @@ lsys::Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Gram
   std::vector<std::optional<ChainParent>> chain_parent;
   uint64_t zero_moves = 0;
   const size_t n = word.size();
+  const Turn default_turn = turn_of(d.angle_deg);
+  const Turn default_turn_back = turn_of(-d.angle_deg);
+  auto turn = [&](const Module& m, const double* p, bool negate) {
+    if (m.param_count == 0) return negate ? default_turn_back : default_turn;
+    return turn_of(negate ? -p[0] : p[0]);
+  };
+  // Rotations keep the frame orthonormal up to rounding; re-orthonormalise every 16 of
+  // them (and after tropism) so drift stays at the level of one rounding error.
+  unsigned rotations = 0;
+  auto rotated = [&](TurtleState& s) {
+    if ((++rotations & 15u) == 0) orthonormalize(s);
+    else s.up = glm::cross(s.heading, s.left);
+  };
+  {
+    size_t moves = 0;
+    for (const Module& m : word.modules) moves += m.symbol == kSymF;
+    joints.reserve(moves + moves / 4);
+  }
   size_t i = 0;
   try {
     for (; i < n; ++i) {
@@ -134,19 +158,20 @@ lsys::Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Gram
           t.branch_pending = false;
           break;
         }
-        case kSymTurnLeft: rotate_pair(t.heading, t.left, has ? p[0] : d.angle_deg); orthonormalize(t); break;
-        case kSymTurnRight: rotate_pair(t.heading, t.left, -(has ? p[0] : d.angle_deg)); orthonormalize(t); break;
-        case kSymPitchDown: {
-          // & turns H toward −U: rotate (H, −U) pair.
-          dvec3 down = -t.up;
-          rotate_pair(t.heading, down, has ? p[0] : d.angle_deg);
-          t.up = -down;
-          orthonormalize(t);
+        case kSymTurnLeft: rotate_pair(t.heading, t.left, turn(m, p, false)); rotated(t); break;
+        case kSymTurnRight: rotate_pair(t.heading, t.left, turn(m, p, true)); rotated(t); break;
+        case kSymPitchDown: rotate_pair(t.heading, t.up, turn(m, p, true)); rotated(t); break;  // H toward −U
+        case kSymPitchUp: rotate_pair(t.heading, t.up, turn(m, p, false)); rotated(t); break;
+        case kSymRollLeft: {  // U toward L; H is unchanged, so recompute L from U and H
+          rotate_pair(t.up, t.left, turn(m, p, false));
+          if ((++rotations & 15u) == 0) orthonormalize(t);
           break;
         }
-        case kSymPitchUp: rotate_pair(t.heading, t.up, has ? p[0] : d.angle_deg); orthonormalize(t); break;
-        case kSymRollLeft: rotate_pair(t.up, t.left, has ? p[0] : d.angle_deg); orthonormalize(t); break;
-        case kSymRollRight: rotate_pair(t.up, t.left, -(has ? p[0] : d.angle_deg)); orthonormalize(t); break;
+        case kSymRollRight: {
+          rotate_pair(t.up, t.left, turn(m, p, true));
+          if ((++rotations & 15u) == 0) orthonormalize(t);
+          break;
+        }
         case kSymTurnAround:
           t.heading = -t.heading;
           t.left = -t.left;

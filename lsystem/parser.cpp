@@ -159,6 +159,8 @@ std::vector<LogicalLine> logical_lines(const std::string& text) {
     while (keep > 0 && is_space(phys[keep - 1])) --keep;
     bool continues = keep > 0 && phys[keep - 1] == '\\';
     size_t take = continues ? keep - 1 : phys.size();
+    current.text.reserve(current.text.size() + take);
+    current.locs.reserve(current.locs.size() + take + 1);
     for (size_t k = 0; k < take; ++k) {
       current.text += phys[k];
       current.locs.push_back({line_no, static_cast<uint32_t>(k + 1)});
@@ -251,7 +253,7 @@ class Parser {
     std::vector<Cursor> args;  // argument texts (split at top-level commas)
   };
   std::vector<ParsedModule> parse_modules(Cursor c, const char* what);
-  std::string module_name_at(Cursor& c);
+  std::string_view module_name_at(Cursor& c);
   void check_brackets(const std::vector<ParsedModule>& ms, const char* what);
   Successor compile_successor(Cursor c, const Scope& scope, const char* what);
   Word evaluate_constant_word(const Successor& s);
@@ -577,9 +579,9 @@ double Parser::constant_expression(Cursor c, const char* what) {
 
 // ---------------------------------------------------------------- module strings
 
-std::string Parser::module_name_at(Cursor& c) {
+std::string_view Parser::module_name_at(Cursor& c) {
   size_t n = g_.symbols.module_name_length(c.rest());
-  std::string name = c.line->text.substr(c.pos, n);
+  std::string_view name = std::string_view(c.line->text).substr(c.pos, n);
   c.pos += n;
   return name;
 }
@@ -598,7 +600,7 @@ std::vector<Parser::ParsedModule> Parser::parse_modules(Cursor c, const char* wh
     }
     if (ch == ')' || ch == ',' || ch == ':')
       fail(loc, "unexpected " + quote_char(ch) + " in " + what);
-    std::string name = module_name_at(c);
+    std::string_view name = module_name_at(c);
     bool ok = true;
     SymbolId id = g_.symbols.intern(name, &ok);
     if (!ok) fail(loc, "too many different module names (more than 65535)");

@@ -23,11 +23,17 @@ size_t utf8_length(unsigned char lead) {
 }  // namespace
 
 SymbolTable::SymbolTable() {
+  std::fill(std::begin(ascii_ids_), std::end(ascii_ids_), -1);
   for (const char* name : kBuiltinNames) intern(name);
   declare_multichar("@T");
 }
 
 SymbolId SymbolTable::intern(std::string_view name, bool* ok) {
+  const bool ascii = name.size() == 1 && static_cast<unsigned char>(name[0]) < 128;
+  if (ascii && ascii_ids_[static_cast<unsigned char>(name[0])] >= 0) {
+    if (ok) *ok = true;
+    return static_cast<SymbolId>(ascii_ids_[static_cast<unsigned char>(name[0])]);
+  }
   auto it = ids_.find(std::string(name));
   if (it != ids_.end()) {
     if (ok) *ok = true;
@@ -40,6 +46,7 @@ SymbolId SymbolTable::intern(std::string_view name, bool* ok) {
   SymbolId id = static_cast<SymbolId>(names_.size());
   names_.emplace_back(name);
   ids_.emplace(std::string(name), id);
+  if (ascii) ascii_ids_[static_cast<unsigned char>(name[0])] = id;
   if (ok) *ok = true;
   return id;
 }
@@ -54,11 +61,13 @@ bool SymbolTable::find(std::string_view name, SymbolId* id) const {
 void SymbolTable::declare_multichar(std::string_view name) {
   if (std::find(multichar_.begin(), multichar_.end(), name) != multichar_.end()) return;
   multichar_.emplace_back(name);
+  if (!name.empty()) multichar_first_byte_[static_cast<unsigned char>(name[0])] = true;
   std::stable_sort(multichar_.begin(), multichar_.end(),
                    [](const std::string& a, const std::string& b) { return a.size() > b.size(); });
 }
 
 size_t SymbolTable::match_multichar(std::string_view text) const {
+  if (text.empty() || !multichar_first_byte_[static_cast<unsigned char>(text[0])]) return 0;
   for (const std::string& name : multichar_)
     if (text.substr(0, name.size()) == name) return name.size();
   return 0;

@@ -62,6 +62,8 @@ class SymbolTable {
   std::vector<std::string> names_;
   std::unordered_map<std::string, SymbolId> ids_;
   std::vector<std::string> multichar_;  // sorted by length, longest first
+  int32_t ascii_ids_[128];               // id of each one-byte name, or -1: the fast path
+  bool multichar_first_byte_[256] = {};  // bytes that start some multi-character name
 };
 
 // One module of a word: 8 bytes.

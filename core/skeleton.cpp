@@ -1,0 +1,555 @@
+// skeleton.cpp — the skeleton's invariants and its file format, sylva-skeleton version 1
+// (../shared/spec/skeleton.md).
+//
+// The reader checks the file against the schema value by value and reports the first
+// problem at the place of the offending value, naming the chain and joint; anything it
+// accepts also passes validate_skeleton, so later stages never re-check a file.
+#include "core/skeleton.h"
+
+#include <cassert>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <initializer_list>
+#include <limits>
+#include <utility>
+
+#include "core/file_io.h"
+#include "core/json.h"
+
+namespace sylva {
+namespace {
+
+constexpr std::string_view kFormatName = "sylva-skeleton";
+constexpr uint64_t kFormatVersion = 1;
+// Chain and joint indices are uint32 in memory, so are counts of chains and joints.
+constexpr uint64_t kMaxCount = std::numeric_limits<uint32_t>::max();
+constexpr const char* kJointFieldNames[5] = {"x", "y", "z", "radius", "material"};
+
+// A double as a message shows it: shortest round-trip form, non-finite values by name.
+std::string number_for_message(double value) {
+  if (std::isnan(value)) return "NaN";
+  if (std::isinf(value)) return value > 0 ? "Infinity" : "-Infinity";
+  char buffer[32];
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  assert(error == std::errc());
+  return std::string(buffer, end);
+}
+
+std::string chain_place(size_t chain) { return "chain " + std::to_string(chain); }
+
+std::string joint_place(size_t chain, size_t joint) {
+  return "chain " + std::to_string(chain) + ", joint " + std::to_string(joint);
+}
+
+std::string count_of(uint64_t count, const char* singular, const char* plural) {
+  return std::to_string(count) + " " + (count == 1 ? singular : plural);
+}
+
+// What a JSON value is, for the "got ..." of a message.
+std::string describe(const JsonValue& value) {
+  switch (value.kind) {
+    case JsonValue::Kind::Number: {
+      std::string text = value.text.substr(0, 40) + (value.text.size() > 40 ? "..." : "");
+      if (!std::isfinite(value.number) && value.text != "NaN" && value.text != "Infinity" &&
+          value.text != "-Infinity") {
+        text += " (out of range of a double)";
+      }
+      return text;
+    }
+    case JsonValue::Kind::String: return "the string " + json_excerpt(value.text);
+    case JsonValue::Kind::Array:
+      return "an array of " + count_of(value.elements.size(), "element", "elements");
+    case JsonValue::Kind::Bool: return value.boolean ? "true" : "false";
+    default: return value.kind_name();
+  }
+}
+
+// `"a", "b" or "c"` for messages listing the keys an object may have.
+std::string key_list(std::initializer_list<std::string_view> keys) {
+  std::string out;
+  size_t i = 0;
+  for (const std::string_view key : keys) {
+    if (i > 0) out += i + 1 == keys.size() ? " or " : ", ";
+    append_json_string(out, key);
+    ++i;
+  }
+  return out;
+}
+
+// Why a joint breaks the invariants, or nullopt if it does not.
+std::optional<std::string> joint_problem(const Joint& joint) {
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!std::isfinite(joint.position_m[axis])) {
+      return std::string(kJointFieldNames[axis]) + " is " +
+             number_for_message(joint.position_m[axis]) + "; positions must be finite";
+    }
+  }
+  if (!std::isfinite(joint.radius_m)) {
+    return "radius is " + number_for_message(joint.radius_m) + "; radii must be finite";
+  }
+  if (joint.radius_m < 0) {
+    return "radius " + number_for_message(joint.radius_m) + " is negative; radii must be >= 0";
+  }
+  return std::nullopt;
+}
+
+// Reads a parsed sylva-skeleton document; the first problem found stops it.
+class SkeletonReader {
+ public:
+  explicit SkeletonReader(std::string_view file) : file_(file) {}
+
+  SkeletonReadResult read(std::string_view text);
+
+ private:
+  bool fail(uint32_t line, uint32_t column, std::string message) {
+    error_ = SkeletonError{file_, line, column, std::move(message)};
+    return false;
+  }
+  bool fail(const JsonValue& where, std::string message) {
+    return fail(where.line, where.column, std::move(message));
+  }
+
+  // "<prefix>: <message>", or just the message at the top level.
+  static std::string prefixed(std::string_view prefix, const std::string& message) {
+    return prefix.empty() ? message : std::string(prefix) + ": " + message;
+  }
+
+  // Every key of `object` is one of `allowed`: a typo is an error, never ignored.
+  bool check_keys(const JsonValue& object, std::initializer_list<std::string_view> allowed,
+                  std::string_view prefix);
+  // The member `key` of `object`; an error (located at the object) if it is absent.
+  const JsonValue* require(const JsonValue& object, std::string_view key, std::string_view prefix);
+
+  bool read_format_and_version(const JsonValue& root);
+  bool read_source(const JsonValue& value, SkeletonSource& source);
+  bool read_chains(const JsonValue& value, Skeleton& skeleton);
+  bool read_chain(size_t index, const JsonValue& value, Skeleton& skeleton);
+  bool read_parent(size_t index, const JsonValue& value, const Skeleton& skeleton, Chain& chain);
+  bool read_joint(size_t chain, size_t index, const JsonValue& value, Joint& joint);
+
+  std::string file_;
+  std::optional<SkeletonError> error_;
+};
+
+SkeletonReadResult SkeletonReader::read(std::string_view text) {
+  // Non-finite numbers are let through the JSON layer so that the schema check below
+  // can say which chain and joint holds them.
+  JsonParseOptions options;
+  options.allow_non_finite_numbers = true;
+  JsonParseResult parsed = parse_json(text, options);
+  if (parsed.error) {
+    return {std::nullopt,
+            SkeletonError{file_, parsed.error->line, parsed.error->column, parsed.error->message}};
+  }
+  const JsonValue& root = *parsed.value;
+  Skeleton skeleton;
+  const bool ok = [&] {
+    if (!root.is_object()) {
+      return fail(root, std::string("a skeleton file holds a JSON object, found ") + describe(root));
+    }
+    if (!read_format_and_version(root)) return false;
+    if (!check_keys(root, {"format", "version", "source", "chains"}, "")) return false;
+    if (const JsonValue* source = root.find("source")) {
+      if (!read_source(*source, skeleton.source)) return false;
+    }
+    const JsonValue* chains = require(root, "chains", "");
+    return chains != nullptr && read_chains(*chains, skeleton);
+  }();
+  if (!ok) return {std::nullopt, std::move(error_)};
+  assert(!validate_skeleton(skeleton) && "the reader accepted a skeleton that breaks an invariant");
+  return {std::move(skeleton), std::nullopt};
+}
+
+bool SkeletonReader::check_keys(const JsonValue& object,
+                                std::initializer_list<std::string_view> allowed,
+                                std::string_view prefix) {
+  for (const JsonMember& member : object.members) {
+    bool known = false;
+    for (const std::string_view key : allowed) known = known || member.key.name == key;
+    if (!known) {
+      return fail(member.key.line, member.key.column,
+                  prefixed(prefix, "unknown key " + json_excerpt(member.key.name) +
+                                       (prefix.empty() ? " at the top level" : "") +
+                                       "; expected " + key_list(allowed)));
+    }
+  }
+  return true;
+}
+
+const JsonValue* SkeletonReader::require(const JsonValue& object, std::string_view key,
+                                         std::string_view prefix) {
+  const JsonValue* value = object.find(key);
+  if (value == nullptr) {
+    std::string quoted;
+    append_json_string(quoted, key);
+    fail(object, prefixed(prefix, "missing required key " + quoted));
+  }
+  return value;
+}
+
+// Format and version come first: a file of another kind should be named as such, not
+// reported as a list of unknown keys.
+bool SkeletonReader::read_format_and_version(const JsonValue& root) {
+  const JsonValue* format = root.find("format");
+  if (format != nullptr) {
+    if (!format->is_string()) {
+      return fail(*format, "format must be the string \"sylva-skeleton\", got " + describe(*format));
+    }
+    if (format->text != kFormatName) {
+      return fail(*format, "unknown format " + json_excerpt(format->text) +
+                               "; this reader reads \"sylva-skeleton\"");
+    }
+  }
+  const JsonValue* version = root.find("version");
+  if (version != nullptr) {
+    const std::optional<uint64_t> number = version->as_uint64();
+    if (!number) return fail(*version, "version must be an integer, got " + describe(*version));
+    if (*number != kFormatVersion) {
+      return fail(*version, "unsupported version " + version->text + " of \"sylva-skeleton\"; " +
+                                "this reader reads version " + std::to_string(kFormatVersion));
+    }
+  }
+  if (format == nullptr) {
+    return fail(root, "missing required key \"format\" (a skeleton file starts with "
+                      "\"format\": \"sylva-skeleton\")");
+  }
+  if (version == nullptr) {
+    require(root, "version", "");  // records the error
+    return false;
+  }
+  return true;
+}
+
+bool SkeletonReader::read_source(const JsonValue& value, SkeletonSource& source) {
+  const char* prefix = "source";
+  if (!value.is_object()) {
+    return fail(value, "source must be an object {\"grammar\", \"seed\", \"steps\", \"defines\"}, got " +
+                           describe(value));
+  }
+  if (!check_keys(value, {"grammar", "seed", "steps", "defines"}, prefix)) return false;
+  const JsonValue* grammar = require(value, "grammar", prefix);
+  const JsonValue* seed = grammar ? require(value, "seed", prefix) : nullptr;
+  const JsonValue* steps = seed ? require(value, "steps", prefix) : nullptr;
+  const JsonValue* defines = steps ? require(value, "defines", prefix) : nullptr;
+  if (defines == nullptr) return false;
+
+  if (!grammar->is_string()) {
+    return fail(*grammar, "source: grammar must be a string, got " + describe(*grammar));
+  }
+  source.grammar = grammar->text;
+
+  const std::optional<uint64_t> seed_value = seed->as_uint64();  // exact, never via double
+  if (!seed_value) {
+    return fail(*seed, "source: seed must be an integer from 0 to 18446744073709551615, got " +
+                           describe(*seed));
+  }
+  source.seed = *seed_value;
+
+  const std::optional<uint64_t> steps_value = steps->as_uint64();
+  if (!steps_value || *steps_value > uint64_t{std::numeric_limits<int64_t>::max()}) {
+    return fail(*steps, "source: steps must be an integer from 0 to 9223372036854775807, got " +
+                            describe(*steps));
+  }
+  source.steps = static_cast<int64_t>(*steps_value);
+
+  if (!defines->is_object()) {
+    return fail(*defines, "source: defines must be an object of name: number, got " + describe(*defines));
+  }
+  for (const JsonMember& define : defines->members) {
+    if (define.key.name.empty()) {
+      return fail(define.key.line, define.key.column, "source: a define name must not be empty");
+    }
+    if (!define.value.is_number() || !std::isfinite(define.value.number)) {
+      return fail(define.value, "source: define " + json_excerpt(define.key.name) +
+                                    " must be a finite number, got " + describe(define.value));
+    }
+    source.defines.emplace(define.key.name, define.value.number);  // keys are unique
+  }
+  return true;
+}
+
+bool SkeletonReader::read_chains(const JsonValue& value, Skeleton& skeleton) {
+  if (!value.is_array()) return fail(value, "chains must be an array, got " + describe(value));
+  if (value.elements.size() > kMaxCount) {
+    return fail(value, "too many chains; a skeleton holds at most 4294967295");
+  }
+  skeleton.chains.reserve(value.elements.size());
+  for (size_t c = 0; c < value.elements.size(); ++c) {
+    if (!read_chain(c, value.elements[c], skeleton)) return false;
+  }
+  return true;
+}
+
+bool SkeletonReader::read_chain(size_t index, const JsonValue& value, Skeleton& skeleton) {
+  const std::string prefix = chain_place(index);
+  if (!value.is_object()) {
+    return fail(value, prefix + " must be an object {\"parent\": ..., \"joints\": [...]}, got " +
+                           describe(value));
+  }
+  if (!check_keys(value, {"parent", "joints"}, prefix)) return false;
+  const JsonValue* parent = require(value, "parent", prefix);
+  const JsonValue* joints = parent ? require(value, "joints", prefix) : nullptr;
+  if (joints == nullptr) return false;
+
+  Chain chain{};
+  if (!read_parent(index, *parent, skeleton, chain)) return false;
+
+  if (!joints->is_array()) {
+    return fail(*joints, prefix + ": joints must be an array of [x, y, z, radius, material], got " +
+                             describe(*joints));
+  }
+  if (joints->elements.empty()) {
+    return fail(*joints, prefix + " has no joints; a chain needs at least one");
+  }
+  if (skeleton.joints.size() + joints->elements.size() > kMaxCount) {
+    return fail(*joints, prefix + ": too many joints; a skeleton holds at most 4294967295");
+  }
+  chain.first_joint = static_cast<uint32_t>(skeleton.joints.size());
+  chain.joint_count = static_cast<uint32_t>(joints->elements.size());
+  for (size_t j = 0; j < joints->elements.size(); ++j) {
+    Joint joint{};
+    if (!read_joint(index, j, joints->elements[j], joint)) return false;
+    skeleton.joints.push_back(joint);
+  }
+  skeleton.chains.push_back(chain);
+  return true;
+}
+
+bool SkeletonReader::read_parent(size_t index, const JsonValue& value, const Skeleton& skeleton,
+                                 Chain& chain) {
+  const std::string prefix = chain_place(index);
+  if (value.is_null()) return true;  // a root chain
+  if (!value.is_array() || value.elements.size() != 2) {
+    return fail(value, prefix + ": parent must be null or [chain index, joint index], got " +
+                           describe(value));
+  }
+  const JsonValue& chain_value = value.elements[0];
+  const JsonValue& joint_value = value.elements[1];
+  const std::optional<uint64_t> parent_chain = chain_value.as_uint64();
+  if (!parent_chain || *parent_chain > kMaxCount) {
+    return fail(chain_value, prefix + ": parent chain index must be an integer from 0 to " +
+                                 "4294967295, got " + describe(chain_value));
+  }
+  const std::optional<uint64_t> parent_joint = joint_value.as_uint64();
+  if (!parent_joint || *parent_joint > kMaxCount) {
+    return fail(joint_value, prefix + ": parent joint index must be an integer from 0 to " +
+                                 "4294967295, got " + describe(joint_value));
+  }
+  const std::string shown =
+      "[" + std::to_string(*parent_chain) + ", " + std::to_string(*parent_joint) + "]";
+  if (*parent_chain >= index) {
+    return fail(chain_value, prefix + ": parent " + shown + " refers to chain " +
+                                 std::to_string(*parent_chain) + ", which does not come before " +
+                                 prefix + " (parents come before their children)");
+  }
+  const uint32_t parent_joint_count = skeleton.chains[*parent_chain].joint_count;
+  if (*parent_joint >= parent_joint_count) {
+    return fail(joint_value, prefix + ": parent " + shown + " refers to joint " +
+                                 std::to_string(*parent_joint) + " of chain " +
+                                 std::to_string(*parent_chain) + ", which has " +
+                                 count_of(parent_joint_count, "joint", "joints"));
+  }
+  chain.parent = ChainParent{static_cast<uint32_t>(*parent_chain), static_cast<uint32_t>(*parent_joint)};
+  return true;
+}
+
+bool SkeletonReader::read_joint(size_t chain, size_t index, const JsonValue& value, Joint& joint) {
+  const std::string prefix = joint_place(chain, index);
+  if (!value.is_array() || value.elements.size() != 5) {
+    return fail(value, prefix + ": a joint must be an array of 5 numbers [x, y, z, radius, " +
+                           "material], got " + describe(value));
+  }
+  double numbers[4];
+  for (int k = 0; k < 4; ++k) {
+    const JsonValue& element = value.elements[static_cast<size_t>(k)];
+    const std::string name = kJointFieldNames[k];
+    if (!element.is_number()) {
+      return fail(element, prefix + ": " + name + " must be a number, got " + describe(element));
+    }
+    if (!std::isfinite(element.number)) {
+      return fail(element, prefix + ": " + name + " must be a finite number, got " + describe(element));
+    }
+    numbers[k] = element.number;
+  }
+  if (numbers[3] < 0) {
+    return fail(value.elements[3], prefix + ": radius " + value.elements[3].text +
+                                       " is negative; radii must be >= 0");
+  }
+  const JsonValue& material = value.elements[4];
+  const std::optional<uint64_t> material_index = material.as_uint64();
+  if (!material_index || *material_index > kMaxCount) {
+    return fail(material, prefix + ": material must be an integer from 0 to 4294967295, got " +
+                              describe(material));
+  }
+  joint = Joint{{numbers[0], numbers[1], numbers[2]}, numbers[3], static_cast<uint32_t>(*material_index)};
+  return true;
+}
+
+}  // namespace
+
+uint64_t Skeleton::segment_count() const {
+  uint64_t segments = 0;
+  for (const Chain& chain : chains) {
+    if (chain.joint_count > 0) segments += chain.joint_count - 1;
+  }
+  return segments;
+}
+
+std::string SkeletonError::format() const {
+  std::string out = file;
+  if (line != 0) {
+    if (!out.empty()) out += ':';
+    out += std::to_string(line);
+    if (column != 0) {
+      out += ':';
+      out += std::to_string(column);
+    }
+  }
+  if (!out.empty()) out += ": ";
+  return out + "error: " + message;
+}
+
+std::optional<SkeletonError> validate_skeleton(const Skeleton& skeleton) {
+  auto error = [](std::string message) { return SkeletonError{"", 0, 0, std::move(message)}; };
+  if (skeleton.chains.size() > kMaxCount) {
+    return error("too many chains (" + std::to_string(skeleton.chains.size()) + "); at most 4294967295");
+  }
+  if (skeleton.joints.size() > kMaxCount) {
+    return error("too many joints (" + std::to_string(skeleton.joints.size()) + "); at most 4294967295");
+  }
+
+  uint64_t next_free_joint = 0;  // ranges must be disjoint and in chain order
+  for (size_t c = 0; c < skeleton.chains.size(); ++c) {
+    const Chain& chain = skeleton.chains[c];
+    if (chain.joint_count == 0) return error(chain_place(c) + " has no joints; a chain needs at least one");
+    const uint64_t end = uint64_t{chain.first_joint} + chain.joint_count;
+    if (end > skeleton.joints.size()) {
+      return error(chain_place(c) + ": joints " + std::to_string(chain.first_joint) + " to " +
+                   std::to_string(end - 1) + " run past the end of the joint array (" +
+                   count_of(skeleton.joints.size(), "joint", "joints") + ")");
+    }
+    if (chain.first_joint < next_free_joint) {
+      return error(chain_place(c) + ": joints start at " + std::to_string(chain.first_joint) +
+                   ", inside an earlier chain's range; ranges must be disjoint and in chain order");
+    }
+    next_free_joint = end;
+    if (chain.parent) {
+      const ChainParent& parent = *chain.parent;
+      if (parent.chain >= c) {
+        return error(chain_place(c) + ": parent chain " + std::to_string(parent.chain) +
+                     " does not come before it (parents come before their children)");
+      }
+      const uint32_t parent_joint_count = skeleton.chains[parent.chain].joint_count;
+      if (parent.joint >= parent_joint_count) {
+        return error(chain_place(c) + ": parent joint " + std::to_string(parent.joint) +
+                     " is past the end of chain " + std::to_string(parent.chain) + " (" +
+                     count_of(parent_joint_count, "joint", "joints") + ")");
+      }
+    }
+    for (uint32_t j = 0; j < chain.joint_count; ++j) {
+      if (auto problem = joint_problem(skeleton.joints[chain.first_joint + j])) {
+        return error(joint_place(c, j) + ": " + *problem);
+      }
+    }
+  }
+
+  // Joints between or after the chains' ranges belong to no chain; stages that scan the
+  // flat array still see them, so they must be finite too.
+  size_t next = 0;
+  auto check_unowned = [&](size_t end) -> std::optional<SkeletonError> {
+    for (; next < end; ++next) {
+      if (auto problem = joint_problem(skeleton.joints[next])) {
+        return error("joint " + std::to_string(next) + " (in no chain): " + *problem);
+      }
+    }
+    return std::nullopt;
+  };
+  for (const Chain& chain : skeleton.chains) {
+    if (auto problem = check_unowned(chain.first_joint)) return problem;
+    next = chain.first_joint + size_t{chain.joint_count};
+  }
+  if (auto problem = check_unowned(skeleton.joints.size())) return problem;
+
+  if (skeleton.source.steps < 0) {
+    return error("source: steps is " + std::to_string(skeleton.source.steps) + "; must be >= 0");
+  }
+  for (const auto& [name, value] : skeleton.source.defines) {
+    if (name.empty()) return error("source: a define name must not be empty");
+    if (!std::isfinite(value)) {
+      return error("source: define " + json_excerpt(name) + " is " + number_for_message(value) +
+                   "; defines must be finite");
+    }
+  }
+  return std::nullopt;
+}
+
+std::string write_skeleton_json(const Skeleton& skeleton) {
+  assert(!validate_skeleton(skeleton) &&
+         "write_skeleton_json: the skeleton breaks an invariant; see validate_skeleton");
+  const SkeletonSource& source = skeleton.source;
+  std::string out;
+  out.reserve(256 + skeleton.chains.size() * 48 + skeleton.joints.size() * 56);
+  out += "{\n  \"format\": ";
+  append_json_string(out, kFormatName);
+  out += ",\n  \"version\": ";
+  append_json_uint64(out, kFormatVersion);
+  out += ",\n  \"source\": {\"grammar\": ";
+  append_json_string(out, source.grammar);
+  out += ", \"seed\": ";
+  append_json_uint64(out, source.seed);
+  out += ", \"steps\": ";
+  append_json_int64(out, source.steps);
+  out += ", \"defines\": {";
+  bool first_define = true;
+  for (const auto& [name, value] : source.defines) {  // std::map: sorted by name
+    if (!first_define) out += ", ";
+    first_define = false;
+    append_json_string(out, name);
+    out += ": ";
+    append_json_number(out, value);
+  }
+  out += "}},\n  \"chains\": [";
+  if (!skeleton.chains.empty()) out += '\n';
+  for (size_t c = 0; c < skeleton.chains.size(); ++c) {
+    const Chain& chain = skeleton.chains[c];
+    out += "    {\"parent\": ";
+    if (chain.parent) {
+      out += '[';
+      append_json_uint64(out, chain.parent->chain);
+      out += ',';
+      append_json_uint64(out, chain.parent->joint);
+      out += ']';
+    } else {
+      out += "null";
+    }
+    out += ", \"joints\": [";
+    for (uint32_t j = 0; j < chain.joint_count; ++j) {
+      const Joint& joint = skeleton.joints[chain.first_joint + j];
+      out += j == 0 ? "[" : ",[";
+      for (const double coordinate : joint.position_m) {
+        append_json_number(out, coordinate);
+        out += ',';
+      }
+      append_json_number(out, joint.radius_m);
+      out += ',';
+      append_json_uint64(out, joint.material);
+      out += ']';
+    }
+    out += c + 1 < skeleton.chains.size() ? "]},\n" : "]}\n";
+  }
+  out += skeleton.chains.empty() ? "]\n}\n" : "  ]\n}\n";
+  return out;
+}
+
+SkeletonReadResult read_skeleton_json(std::string_view text, std::string_view file) {
+  return SkeletonReader(file).read(text);
+}
+
+SkeletonReadResult read_skeleton_file(const std::string& path) {
+  FileReadResult file = read_text_file(path);
+  if (file.error) return {std::nullopt, SkeletonError{path, 0, 0, file.error->message}};
+  return read_skeleton_json(*file.contents, path);
+}
+
+}  // namespace sylva

@@ -1,0 +1,26 @@
+// `sylva bench lsystem`: the benchmark runs end to end and prints its summary table.
+// (A smoke test on small sizes: speed targets live in the benchmark, never in tests.)
+#include <gtest/gtest.h>
+
+#include "tests/app/process.h"
+
+namespace {
+
+TEST(BenchLsystem, QuickRunPrintsEveryCaseAndTheMemcpyBandwidth) {
+  auto r = run_process({SYLVA_BINARY, "bench", "lsystem", "--quick", "--benchmark_min_time=0.001"},
+                       SYLVA_SOURCE_DIR, 240);
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* expected : {"memcpy bandwidth:", "derive/a_abop_1_24a", "derive/b_honda_2_6",
+                               "derive/c_abop_1_31a", "turtle/a_abop_1_24a", "turtle/b_honda_2_6",
+                               "Mmodules/s", "Msegments/s"})
+    EXPECT_NE(r.out.find(expected), std::string::npos) << expected << "\n" << r.out;
+}
+
+TEST(BenchLsystem, AnUnknownBenchmarkIsAUsageError) {
+  auto r = run_process({SYLVA_BINARY, "bench", "nope"}, SYLVA_SOURCE_DIR);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("unknown benchmark 'nope'"), std::string::npos) << r.err;
+}
+
+}  // namespace
