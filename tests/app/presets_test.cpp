@@ -1,0 +1,146 @@
+// presets_test.cpp — the bundled plants, presets/*.lsys, pinned.
+//
+// Each preset is grown with `sylva grow` at its own default seed and steps, as a user
+// would from the repository root, and its segment count must equal the number measured
+// when the preset was made: any change to a preset, to the grammar engine or to the
+// turtle that alters a plant shows up here, by name. If a change is meant to alter a
+// plant, look at it (scripts/view_skeleton.py), then update the pinned number.
+// The paper 000 plants must also stay within 15% of the segment counts of the paper's
+// Table 1, and every preset must open with the comment block that says what it models,
+// where it comes from and which knobs to turn.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "process.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Preset {
+  const char* name;             // file stem under presets/
+  uint64_t segments;            // pinned: measured at the preset's default seed and steps
+  std::optional<double> paper;  // paper 000 Table 1 segment count, for the paper's plants
+};
+
+// Printed by gtest in failure messages and test names.
+void PrintTo(const Preset& p, std::ostream* os) { *os << p.name; }
+
+const Preset kPresets[] = {
+    // ABOP classics (Prusinkiewicz & Lindenmayer 1990), typed from the book.
+    {"abop_1_24a", 3125, std::nullopt},
+    {"abop_1_24b", 3125, std::nullopt},
+    {"abop_1_24c", 4096, std::nullopt},
+    {"abop_1_24d", 4118, std::nullopt},
+    {"abop_1_24e", 4118, std::nullopt},
+    {"abop_1_24f", 992, std::nullopt},
+    {"abop_1_25_bush", 7743, std::nullopt},
+    {"abop_1_27_stochastic", 885, std::nullopt},
+    {"abop_1_31a_context", 2501, std::nullopt},
+    {"abop_2_6_honda", 1023, std::nullopt},
+    {"abop_2_8_ternary", 1457, std::nullopt},
+    // The plants of paper 000, modelled for sylva; Table 1 gives their segment counts.
+    {"saguaro", 30, 30},
+    {"aloe_vera", 229, 229},
+    {"elm", 1769, 1833},
+    {"coconut_palm", 3626, 3713},
+    {"pine", 17468, 16997},
+    // A small cactus for the dancing-cacti scene (paper 000, Figure 8).
+    {"cactus", 25, std::nullopt},
+};
+
+fs::path presets_dir() { return fs::path(SYLVA_SOURCE_DIR) / "presets"; }
+
+// The number before " segments" in grow's summary line, or nullopt.
+std::optional<uint64_t> segments_in_summary(const std::string& out) {
+  std::smatch m;
+  static const std::regex kSegments(R"((\d+) segments\b)");
+  if (!std::regex_search(out, m, kSegments)) return std::nullopt;
+  return std::stoull(m[1].str());
+}
+
+class PresetTest : public ::testing::TestWithParam<Preset> {};
+
+TEST_P(PresetTest, GrowsWithThePinnedSegmentCount) {
+  const Preset& p = GetParam();
+  TempDir dir;
+  const std::string relative = "presets/" + std::string(p.name) + ".lsys";
+  const std::string output = dir.file(std::string(p.name) + ".skel.json");
+
+  ProcessResult r = run_sylva({"grow", relative, "-o", output}, SYLVA_SOURCE_DIR, 120);
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_TRUE(fs::exists(output) && fs::file_size(output) > 0) << output;
+
+  std::optional<uint64_t> segments = segments_in_summary(r.out);
+  ASSERT_TRUE(segments.has_value()) << "no segment count in grow's summary:\n" << r.out;
+  EXPECT_EQ(*segments, p.segments)
+      << relative << " changed: look at the plant, then update the pinned count.\n" << r.out;
+
+  if (p.paper) {
+    const double low = 0.85 * *p.paper, high = 1.15 * *p.paper;
+    EXPECT_GE(static_cast<double>(*segments), low) << relative << " vs Table 1: " << *p.paper;
+    EXPECT_LE(static_cast<double>(*segments), high) << relative << " vs Table 1: " << *p.paper;
+  }
+}
+
+// A comment line: '#' that is not a directive (#define, #ignore), or a /* comment.
+bool is_comment_line(const std::string& line) {
+  size_t i = line.find_first_not_of(" \t");
+  if (i == std::string::npos) return false;
+  if (line.compare(i, 2, "/*") == 0) return true;
+  if (line[i] != '#') return false;
+  return line.compare(i, 7, "#define") != 0 && line.compare(i, 7, "#ignore") != 0;
+}
+
+TEST_P(PresetTest, OpensWithACommentBlockNamingSourceAndKnobs) {
+  const Preset& p = GetParam();
+  const fs::path path = presets_dir() / (std::string(p.name) + ".lsys");
+  const std::string text = read_file(path);
+
+  // The first line is a comment, and the block before the first directive or
+  // production says where the plant comes from and lists its knobs.
+  const std::string first_line = text.substr(0, text.find('\n'));
+  EXPECT_TRUE(is_comment_line(first_line)) << path << " starts with: " << first_line;
+
+  std::string block;
+  size_t start = 0;
+  while (start < text.size()) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    const std::string line = text.substr(start, end - start);
+    if (!line.empty() && !is_comment_line(line)) break;
+    block += line + "\n";
+    start = end + 1;
+  }
+  EXPECT_NE(block.find("Source:"), std::string::npos) << path << ": no 'Source:' in\n" << block;
+  EXPECT_NE(block.find("Knobs"), std::string::npos) << path << ": no 'Knobs' in\n" << block;
+}
+
+INSTANTIATE_TEST_SUITE_P(Bundled, PresetTest, ::testing::ValuesIn(kPresets),
+                         [](const ::testing::TestParamInfo<Preset>& info) {
+                           return std::string(info.param.name);
+                         });
+
+// A preset added to presets/ without a pinned count would go untested.
+TEST(Presets, EveryPresetFileIsPinned) {
+  std::vector<std::string> pinned;
+  for (const Preset& p : kPresets) pinned.push_back(std::string(p.name) + ".lsys");
+  for (const std::string& name : list_dir(presets_dir())) {
+    if (fs::path(name).extension() != ".lsys") continue;
+    EXPECT_NE(std::find(pinned.begin(), pinned.end(), name), pinned.end())
+        << "presets/" << name << " has no pinned segment count in presets_test.cpp";
+  }
+  for (const std::string& name : pinned)
+    EXPECT_TRUE(fs::exists(presets_dir() / name)) << "presets/" << name << " is missing";
+}
+
+}  // namespace
