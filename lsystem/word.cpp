@@ -73,6 +73,12 @@ size_t SymbolTable::match_multichar(std::string_view text) const {
   return 0;
 }
 
+bool SymbolTable::has_longer_multichar(std::string_view name) const {
+  for (const std::string& m : multichar_)
+    if (m.size() > name.size() && std::string_view(m).substr(0, name.size()) == name) return true;
+  return false;
+}
+
 size_t SymbolTable::module_name_length(std::string_view text) const {
   assert(!text.empty());
   size_t n = match_multichar(text);
@@ -98,6 +104,13 @@ void append_shortest_double(std::string& out, double value) {
 }
 
 std::string print_word(const Word& word, const SymbolTable& symbols) {
+  // A space is needed after a module without parameters only if its name is a proper
+  // prefix of some declared multi-character name (else no reader could merge it).
+  std::vector<uint8_t> may_merge(symbols.size(), 0);
+  for (size_t id = 0; id < symbols.size(); ++id) {
+    const std::string& name = symbols.name(static_cast<SymbolId>(id));
+    may_merge[id] = symbols.has_longer_multichar(name);
+  }
   std::string out;
   out.reserve(word.size() * 2);
   const size_t n = word.size();
@@ -113,7 +126,7 @@ std::string print_word(const Word& word, const SymbolTable& symbols) {
         append_shortest_double(out, p[k]);
       }
       out += ')';
-    } else if (i + 1 < n) {
+    } else if (i + 1 < n && may_merge[m.symbol]) {
       // Would the reader take a longer name here? Look ahead over the next names.
       std::string ahead = name;
       for (size_t j = i + 1; j < n && ahead.size() < name.size() + 64; ++j) {

@@ -54,6 +54,8 @@ class SymbolTable {
   // Length in bytes of the longest declared multi-character name that `text` starts
   // with, or 0 when none does.
   size_t match_multichar(std::string_view text) const;
+  // True if some declared multi-character name is longer than `name` and starts with it.
+  bool has_longer_multichar(std::string_view name) const;
   // Length in bytes of the module name that `text` starts with: the longest declared
   // multi-character name, else one UTF-8 character. Precondition: text not empty.
   size_t module_name_length(std::string_view text) const;
