@@ -234,6 +234,8 @@ class Parser {
   Expr compile_expression(Cursor& c, const Scope* scope, bool allow_random = true);
   void emit(ExprBuild& b, Op op, uint32_t arg, SourceLoc loc, int stack_change,
             Func fn = Func::kSin);
+  void parse_logical(Cursor& c, ExprBuild& b, const Scope* scope, char symbol, Op jump_op,
+                     void (Parser::*operand)(Cursor&, ExprBuild&, const Scope*));
   void parse_or(Cursor& c, ExprBuild& b, const Scope* scope);
   void parse_and(Cursor& c, ExprBuild& b, const Scope* scope);
   void parse_equality(Cursor& c, ExprBuild& b, const Scope* scope);
@@ -320,40 +322,34 @@ Expr Parser::compile_expression(Cursor& c, const Scope* scope, bool allow_random
   return e;
 }
 
-void Parser::parse_or(Cursor& c, ExprBuild& b, const Scope* scope) {
-  parse_and(c, b, scope);
+// `||` and `&&` share one shape: operands joined by a doubled character, compiled with a
+// short-circuit jump so the right operand is not evaluated when the left decides.
+void Parser::parse_logical(Cursor& c, ExprBuild& b, const Scope* scope, char symbol, Op jump_op,
+                           void (Parser::*operand)(Cursor&, ExprBuild&, const Scope*)) {
+  (this->*operand)(c, b, scope);
   for (;;) {
     c.skip_spaces();
-    if (!(c.peek() == '|' && c.peek(1) == '|')) {
-      if (c.peek() == '|') fail(c.loc(), "expected '||' ('|' alone is not an operator)");
+    if (!(c.peek() == symbol && c.peek(1) == symbol)) {
+      if (c.peek() == symbol)
+        fail(c.loc(), std::string("expected '") + symbol + symbol + "' ('" + symbol + "' alone is not an operator)");
       return;
     }
     SourceLoc loc = c.loc();
     c.pos += 2;
     size_t jump = g_.program.code.size();
-    emit(b, Op::kOrJump, 0, loc, -1);
-    parse_and(c, b, scope);
+    emit(b, jump_op, 0, loc, -1);
+    (this->*operand)(c, b, scope);
     emit(b, Op::kBool, 0, loc, 0);
     g_.program.code[jump].arg = static_cast<uint32_t>(g_.program.code.size());
   }
 }
 
+void Parser::parse_or(Cursor& c, ExprBuild& b, const Scope* scope) {
+  parse_logical(c, b, scope, '|', Op::kOrJump, &Parser::parse_and);
+}
+
 void Parser::parse_and(Cursor& c, ExprBuild& b, const Scope* scope) {
-  parse_equality(c, b, scope);
-  for (;;) {
-    c.skip_spaces();
-    if (!(c.peek() == '&' && c.peek(1) == '&')) {
-      if (c.peek() == '&') fail(c.loc(), "expected '&&' ('&' alone is not an operator)");
-      return;
-    }
-    SourceLoc loc = c.loc();
-    c.pos += 2;
-    size_t jump = g_.program.code.size();
-    emit(b, Op::kAndJump, 0, loc, -1);
-    parse_equality(c, b, scope);
-    emit(b, Op::kBool, 0, loc, 0);
-    g_.program.code[jump].arg = static_cast<uint32_t>(g_.program.code.size());
-  }
+  parse_logical(c, b, scope, '&', Op::kAndJump, &Parser::parse_equality);
 }
 
 void Parser::parse_equality(Cursor& c, ExprBuild& b, const Scope* scope) {
