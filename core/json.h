@@ -13,7 +13,9 @@
 // code points from the start of the line, a tab being one column. A leading UTF-8 byte
 // order mark is skipped (RFC 8259 section 8.1 allows it) and not counted.
 //
-// Memory: a value is about 100 bytes, so a DOM is a few times larger than its text.
+// Memory: a value takes about 100 bytes (plus its text beyond 15 bytes), so a DOM is
+// 10-50 times the size of compact JSON text: a skeleton joint, six values, costs under
+// 1 KB while its file is read.
 #pragma once
 
 #include <cstdint>
