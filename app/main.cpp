@@ -9,8 +9,8 @@
 
 namespace {
 
-void print_help() {
-  std::cout << "usage: sylva SUBCOMMAND [ARGS...]\n\n"
+void print_help(std::ostream& out) {
+  out << "usage: sylva SUBCOMMAND [ARGS...]\n\n"
                "sylva grows plants from L-system grammars (The Algorithmic Beauty of Plants, cpfg).\n\n"
                "subcommands:\n"
                "  derive GRAMMAR [-n STEPS] [--seed S] [-D NAME=VALUE]...   print the derived word\n"
@@ -27,14 +27,15 @@ int main(int argc, char** argv) {
   using namespace sylva::cli;
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) {
-    print_help();
+    std::cerr << "sylva: error: missing SUBCOMMAND\n\n";
+    print_help(std::cerr);
     return kUsageError;
   }
   const std::string sub = args[0];
   args.erase(args.begin());
   try {
     if (sub == "-h" || sub == "--help" || sub == "help") {
-      print_help();
+      print_help(std::cout);
       return kOk;
     }
     if (sub == "derive") return run_derive(args);

@@ -347,8 +347,8 @@ Diagnostic failure_diagnostic(const Grammar& g, const Word& in, const Rewriter& 
   std::string text = message;
   if (r.current_production) {
     const Production& p = *r.current_production;
-    text += ", in production '" + p.text + "' (line " +
-            std::to_string(p.loc.line) + ")";
+    text += ", in production '" + p.text + "' at " + std::to_string(p.loc.line) + ":" +
+            std::to_string(p.loc.column);
     if (r.current < in.size()) text += " rewriting module " + module_text(in, r.current, g.symbols);
     if (loc.line == 0) loc = p.loc;
   }

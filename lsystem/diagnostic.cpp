@@ -7,7 +7,7 @@ std::string Diagnostic::format() const {
   std::string out = file;
   if (loc.line) out += ":" + std::to_string(loc.line) + ":" + std::to_string(loc.column);
   out += ": error: " + message + "\n";
-  if (loc.line && !source_line.empty()) {
+  if (loc.line) {
     // Long lines (a 10 MB axiom) are shown around the column only.
     constexpr size_t kWindow = 160;
     size_t col = loc.column ? loc.column - 1 : 0;

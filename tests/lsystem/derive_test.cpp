@@ -48,7 +48,7 @@ TEST(Derive, ParameterCountMismatchNamesTheProductionAndModule) {
   EXPECT_NE(w.error().message.find("A(1)"), std::string::npos);
   // A production of another arity for the same symbol makes it a legitimate identity.
   EXPECT_EQ(derive_text("axiom: A(1)A\nA -> B\n"), "<error: parameter count: module has 1 parameter but the "
-                                                  "production expects 0, in production 'A -> B' (line 2) rewriting "
+                                                  "production expects 0, in production 'A -> B' at 2:1 rewriting "
                                                   "module A(1) at step 1>");
   EXPECT_EQ(derive_text("axiom: A(1)A\nA -> B\nA(x) : x > 5 -> C\n"), "A(1)B");
 }
