@@ -252,7 +252,15 @@ class Rewriter {
                                      (m.param_count == 1 ? " parameter" : " parameters") +
                                      " but the production expects " + std::to_string(p.predecessor.arity)};
     }
-    if (candidates_.empty() || total <= 0) return nullptr;
+    if (candidates_.empty()) return nullptr;
+    if (total <= 0) {
+      // Normalising weights that sum to 0 is a division by zero: every matching
+      // production was switched off at once, which is almost surely a mistake.
+      const Production& first = *candidates_.front().first;
+      current_production = &first;
+      throw DeriveFailure{first.probability.loc,
+                          "the probabilities of the matching productions sum to 0 (nothing to choose from)"};
+    }
     double u = rng.next_double() * total;
     const Production* pick = candidates_.back().first;
     for (const auto& [prod, w] : candidates_) {

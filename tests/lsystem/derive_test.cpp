@@ -122,6 +122,15 @@ TEST(Stochastic, WeightsAreNormalisedAndZeroWeightsNeverChosen) {
   EXPECT_NEAR(counts[b] / 2000.0, 0.75, 0.05);
 }
 
+TEST(Stochastic, ProbabilitiesThatAllSumToZeroAreAnError) {
+  auto g = parse_ok("axiom: A\nA -> B : 0\nA -> C : 0\n");
+  auto w = derive(g, steps(1));
+  ASSERT_FALSE(w.ok());
+  EXPECT_EQ(w.error().loc.line, 2u);
+  EXPECT_EQ(w.error().loc.column, 10u);
+  EXPECT_NE(w.error().message.find("sum to 0"), std::string::npos);
+}
+
 TEST(Stochastic, ADeterministicFirstCandidateIsAppliedAndLaterOnesAreIgnored) {
   EXPECT_EQ(derive_text("axiom: AAAA\nA -> B\nA -> C : 0.5\n"), "BBBB");
   // After a stochastic candidate, a deterministic one is not a candidate.
