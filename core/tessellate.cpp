@@ -1,0 +1,143 @@
+// tessellate.cpp — frusta to triangle meshes (see tessellate.h).
+#include "core/tessellate.h"
+
+#include <cmath>
+#include <glm/geometric.hpp>
+
+namespace sylva {
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586;
+
+// Unit radial direction at raw angle `u_raw` (turns) in the frustum's axis frame.
+glm::dvec3 radial_at(const AxisFrame& frame, double u_raw) {
+  return std::cos(kTwoPi * u_raw) * frame.e0 + std::sin(kTwoPi * u_raw) * frame.e1;
+}
+
+// Point of the surface at raw angle u_raw and parameter v in [0,1] between the cuts.
+glm::dvec3 surface_point(const FrustumShape& s, const glm::dvec3& radial, double v) {
+  const double y_lower = generator_crossing_y(s, s.lower, radial);
+  const double y_upper = generator_crossing_y(s, s.upper, radial);
+  const double y = y_lower + v * (y_upper - y_lower);
+  return s.base + y * s.axis + s.radius_at(y) * radial;
+}
+
+// Centre of a cap: where the cap plane crosses the axis.
+glm::dvec3 plane_axis_point(const FrustumShape& s, const Plane& p) {
+  const double y = (p.offset - glm::dot(p.normal, s.base)) / glm::dot(p.normal, s.axis);
+  return s.base + y * s.axis;
+}
+
+}  // namespace
+
+size_t TriangleMesh::memory_bytes() const {
+  return positions.capacity() * sizeof(glm::dvec3) + normals.capacity() * sizeof(glm::dvec3) +
+         uvs.capacity() * sizeof(glm::dvec2) + indices.capacity() * sizeof(uint32_t) +
+         triangle_frustum.capacity() * sizeof(uint32_t);
+}
+
+int tessellation_columns(const TessellateOptions& o) {
+  if (o.segments_around > 0) return std::max(3, o.segments_around);
+  return 8 << std::max(0, o.level);
+}
+
+int tessellation_rows(const TessellateOptions& o) { return 1 << std::max(0, o.level); }
+
+TriangleMesh tessellate(const SkinnedSkeleton& skinned, const TessellateOptions& o) {
+  const int n = tessellation_columns(o), k = tessellation_rows(o);
+  TriangleMesh mesh;
+  const size_t per_frustum_vertices = static_cast<size_t>(n + 1) * (k + 1) + 2 * (n + 2);
+  mesh.positions.reserve(skinned.frusta.size() * per_frustum_vertices);
+  mesh.normals.reserve(mesh.positions.capacity());
+  mesh.uvs.reserve(mesh.positions.capacity());
+  mesh.indices.reserve(skinned.frusta.size() * static_cast<size_t>(n) * (2 * k + 2) * 3);
+
+  // Top-row points of each frustum, reused as the bottom row of the frustum above it
+  // when the two share their cut plane: the mesh is watertight by construction.
+  std::vector<std::vector<glm::dvec3>> top_rows(skinned.frusta.size());
+  std::vector<glm::dvec3> radials(static_cast<size_t>(n) + 1);
+  for (size_t f = 0; f < skinned.frusta.size(); ++f) {
+    const Frustum& fr = skinned.frusta[f];
+    const FrustumShape& s = fr.shape;
+    const AxisFrame frame = axis_frame(s.axis);
+    const uint32_t first = static_cast<uint32_t>(mesh.positions.size());
+    const double twist_turns_per_m = fr.twist_rad_per_m / kTwoPi;
+    const Frustum* below = fr.parent >= 0 ? &skinned.frusta[static_cast<size_t>(fr.parent)] : nullptr;
+    const bool shares_cut = below && below->chain == fr.chain && below->kind == FrustumKind::segment &&
+                            fr.kind == FrustumKind::segment && below->shape.upper.normal == s.lower.normal &&
+                            below->shape.upper.offset == s.lower.offset &&
+                            !top_rows[static_cast<size_t>(fr.parent)].empty();
+    // One generator line per column: through the shared cut point, or at texture u = i/n
+    // on the lower cut (texture u = raw − u_offset + twist·v_m, so raw = u + u_offset − …).
+    for (int i = 0; i <= n; ++i) {
+      glm::dvec3 radial = radial_at(frame, static_cast<double>(i) / n + fr.u_offset - twist_turns_per_m * fr.v_lower_m);
+      if (shares_cut) {
+        const glm::dvec3 w = top_rows[static_cast<size_t>(fr.parent)][static_cast<size_t>(i)] - s.base;
+        const glm::dvec3 perp = w - glm::dot(w, s.axis) * s.axis;
+        const double len = glm::length(perp);
+        if (len > 1e-12 * (s.length + s.radius0)) radial = perp / len;
+      }
+      radials[static_cast<size_t>(i)] = radial;
+    }
+    radials[static_cast<size_t>(n)] = radials[0];
+    for (int j = 0; j <= k; ++j) {
+      const double v = static_cast<double>(j) / k;
+      const double v_m = fr.v_lower_m + v * (fr.v_upper_m - fr.v_lower_m);
+      for (int i = 0; i <= n; ++i) {
+        glm::dvec3 p = surface_point(s, radials[static_cast<size_t>(i)], v);
+        if (j == 0 && shares_cut) p = top_rows[static_cast<size_t>(fr.parent)][static_cast<size_t>(i)];
+        mesh.positions.push_back(p);
+        mesh.normals.push_back(surface_normal(fr, p, o.normals));
+        mesh.uvs.push_back({static_cast<double>(i) / n, v_m});
+      }
+    }
+    top_rows[f].assign(mesh.positions.end() - (n + 1), mesh.positions.end());
+    if (shares_cut) {
+      top_rows[static_cast<size_t>(fr.parent)].clear();  // no longer needed
+      top_rows[static_cast<size_t>(fr.parent)].shrink_to_fit();
+    }
+    auto vertex = [&](int i, int j) { return first + static_cast<uint32_t>(j * (n + 1) + i); };
+    const bool tip_lower = s.radius0 == 0, tip_upper = s.radius1 == 0;
+    for (int j = 0; j < k; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const uint32_t a = vertex(i, j), b = vertex(i + 1, j), c = vertex(i + 1, j + 1), d = vertex(i, j + 1);
+        // Counter-clockwise seen from outside: u grows counter-clockwise about the axis.
+        if (!(j == 0 && tip_lower)) {
+          mesh.indices.insert(mesh.indices.end(), {a, b, c});
+          mesh.triangle_frustum.push_back(static_cast<uint32_t>(f));
+        }
+        if (!(j == k - 1 && tip_upper)) {
+          mesh.indices.insert(mesh.indices.end(), {a, c, d});
+          mesh.triangle_frustum.push_back(static_cast<uint32_t>(f));
+        }
+      }
+    }
+    if (!o.caps) continue;
+    auto cap = [&](const Plane& plane, int row, bool lower) {
+      const uint32_t centre = static_cast<uint32_t>(mesh.positions.size());
+      const glm::dvec3 normal = lower ? -plane.normal : plane.normal;
+      mesh.positions.push_back(plane_axis_point(s, plane));
+      mesh.normals.push_back(normal);
+      mesh.uvs.push_back({0.0, lower ? fr.v_lower_m : fr.v_upper_m});
+      // Rim vertices again, with the cap's flat normal.
+      const uint32_t rim = static_cast<uint32_t>(mesh.positions.size());
+      for (int i = 0; i <= n; ++i) {
+        mesh.positions.push_back(mesh.positions[vertex(i, row)]);
+        mesh.normals.push_back(normal);
+        mesh.uvs.push_back(mesh.uvs[vertex(i, row)]);
+      }
+      for (int i = 0; i < n; ++i) {
+        const uint32_t a = rim + static_cast<uint32_t>(i), b = rim + static_cast<uint32_t>(i + 1);
+        if (lower) mesh.indices.insert(mesh.indices.end(), {centre, b, a});
+        else mesh.indices.insert(mesh.indices.end(), {centre, a, b});
+        mesh.triangle_frustum.push_back(static_cast<uint32_t>(f));
+      }
+    };
+    if (s.cap_lower && !tip_lower) cap(s.lower, 0, true);
+    if (s.cap_upper && !tip_upper) cap(s.upper, k, false);
+  }
+  return mesh;
+}
+
+}  // namespace sylva
