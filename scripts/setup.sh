@@ -8,21 +8,34 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # The design card's libraries; later stages link them (render, GUI, export).
   libglm-dev libglfw3-dev libimgui-dev libopenimageio-dev libtinygltf-dev
+  # The Python module (built for /usr/bin/python3) and its tests.
+  python3 python3-dev pybind11-dev python3-numpy python3-pytest
 )
+# Node.js runs the Khronos glTF validator; any npm already on the machine will do.
+command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
 
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 
-if [ ${#missing[@]} -eq 0 ]; then
-  echo "setup: all ${#packages[@]} packages already installed"
-  exit 0
-fi
-
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-echo "setup: installing ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} Debian packages already installed"
+else
+  echo "setup: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# The Khronos glTF validator (npm), pinned, installed inside the repo (git-ignored).
+validator_version=2.0.0-dev.3.10
+tools="$(cd "$(dirname "$0")/.." && pwd)/.tools/node"
+if [ ! -f "$tools/node_modules/gltf-validator/package.json" ] || \
+   ! grep -q "\"version\": \"$validator_version\"" "$tools/node_modules/gltf-validator/package.json"; then
+  echo "setup: installing gltf-validator@$validator_version into .tools/node"
+  mkdir -p "$tools"
+  npm install --silent --no-audit --no-fund --prefix "$tools" "gltf-validator@$validator_version"
+fi
