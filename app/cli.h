@@ -41,5 +41,6 @@ std::optional<uint64_t> parse_u64(const std::string& text);
 int run_derive(const std::vector<std::string>& args);
 int run_grow(const std::vector<std::string>& args);
 int run_bench(const std::vector<std::string>& args);
+int run_render(const std::vector<std::string>& args);
 
 }  // namespace sylva::cli

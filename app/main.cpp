@@ -16,6 +16,7 @@ void print_help(std::ostream& out) {
                "  derive GRAMMAR [-n STEPS] [--seed S] [-D NAME=VALUE]...   print the derived word\n"
                "  grow   GRAMMAR [-n STEPS] [--seed S] [-D ...] -o FILE.skel.json\n"
                "                                      write the skeleton and print a summary\n"
+               "  render INPUT -o IMAGE [--backend auto|gl|cpu] [--aov ...]   render to PNG/EXR\n"
                "  bench  lsystem [--quick]            derivation and turtle benchmarks\n\n"
                "'sylva SUBCOMMAND --help' describes every flag.\n"
                "Exit status: 0 success, 1 bad input, 2 usage error, 3 internal error.\n";
@@ -41,6 +42,7 @@ int main(int argc, char** argv) {
     if (sub == "derive") return run_derive(args);
     if (sub == "grow") return run_grow(args);
     if (sub == "bench") return run_bench(args);
+    if (sub == "render") return run_render(args);
     std::cerr << "sylva: error: unknown subcommand '" << sub << "' (see 'sylva --help')\n";
     return kUsageError;
   } catch (const UsageError& e) {

@@ -1,0 +1,392 @@
+// render_cpu.cpp — the CPU reference ray caster (see render_cpu.h for the shading model).
+#include "core/render_cpu.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <glm/geometric.hpp>
+#include <limits>
+#include <mutex>
+#include <numbers>
+#include <stdexcept>
+#include <thread>
+
+namespace sylva {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr uint32_t kTile = 32;
+constexpr double kSpecular = 0.04;   // k_s: a dielectric's reflectance at normal incidence
+constexpr double kShininess = 40;    // s
+constexpr double kPi = std::numbers::pi;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// splitmix64 (Steele et al. 2014): a counter-based stream, so every pixel sample draws the
+// same numbers whatever thread renders it.
+struct Rng {
+  uint64_t state;
+  double next() {
+    uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return static_cast<double>(z >> 11) * 0x1.0p-53;
+  }
+};
+
+glm::dvec3 material_albedo(const ScenePlant& plant, uint32_t material) {
+  if (material == 0 && plant.bark.albedo_rgb) return *plant.bark.albedo_rgb;
+  constexpr uint32_t n = sizeof kMaterialAlbedo / sizeof kMaterialAlbedo[0];
+  const double* a = kMaterialAlbedo[std::min(material, n - 1)];
+  return {a[0], a[1], a[2]};
+}
+
+// The camera's orthonormal frame and the image plane's half extents at distance 1.
+struct CameraFrame {
+  glm::dvec3 eye, forward, right, up;
+  double half_height, half_width;
+  double width, height;
+};
+
+CameraFrame camera_frame(const Scene& scene) {
+  CameraFrame f;
+  f.eye = scene.camera.eye;
+  f.forward = glm::normalize(scene.camera.target - scene.camera.eye);
+  f.right = glm::normalize(glm::cross(f.forward, scene.camera.up));
+  f.up = glm::cross(f.right, f.forward);
+  f.width = scene.width;
+  f.height = scene.height;
+  f.half_height = std::tan(0.5 * scene.camera.fov_y_deg * kPi / 180);
+  f.half_width = f.half_height * f.width / f.height;
+  return f;
+}
+
+Ray frame_ray(const CameraFrame& f, double x, double y) {
+  const double sx = (2 * x / f.width - 1) * f.half_width;
+  const double sy = (1 - 2 * y / f.height) * f.half_height;
+  return {f.eye, f.forward + sx * f.right + sy * f.up};
+}
+
+// A unit direction toward the sun: its centre for a point sun, else uniform over the disc
+// (uniform in solid angle: cos θ uniform in [cos α, 1]).
+glm::dvec3 sun_sample(const Sun& sun, const glm::dvec3& sun_direction, double cos_alpha, const AxisFrame& frame, Rng& rng) {
+  if (sun.angular_radius_deg <= 0) return sun_direction;
+  const double cos_t = 1 - rng.next() * (1 - cos_alpha);
+  const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
+  const double phi = 2 * kPi * rng.next();
+  return glm::normalize(cos_t * sun_direction +
+                        sin_t * (std::cos(phi) * frame.e0 + std::sin(phi) * frame.e1));
+}
+
+// What one primary sample saw (the trace pass's output, the shade pass's input).
+struct PrimaryHit {
+  Ray ray;
+  double t = kInf;           // plant hit; kInf: none
+  uint32_t frustum = 0;
+  glm::dvec3 geometric_normal{0, 0, 0};
+  double ground_t = kInf;    // ground hit; kInf: none
+  uint64_t rng_state = 0;
+};
+
+class Renderer {
+ public:
+  Renderer(const Scene& scene, const SceneGeometry& geometry, const RenderOptions& options)
+      : scene_(scene), geometry_(geometry), options_(options), frame_(camera_frame(scene)),
+        frusta_(geometry.frusta), sun_direction_(glm::normalize(scene.sun.direction)),
+        sun_frame_(axis_frame(sun_direction_)),
+        cos_alpha_(std::cos(scene.sun.angular_radius_deg * kPi / 180)),
+        sun_on_(scene.sun.radiance.x > 0 || scene.sun.radiance.y > 0 || scene.sun.radiance.z > 0) {}
+
+  // Renders tile `index` into `image`; adds its thread time to *trace_s and *shade_s.
+  void render_tile(uint32_t index, RenderImage& image, double* trace_s, double* shade_s,
+                   uint64_t* shadow_rays) {
+    const uint32_t tiles_x = (scene_.width + kTile - 1) / kTile;
+    const uint32_t x0 = (index % tiles_x) * kTile, y0 = (index / tiles_x) * kTile;
+    const uint32_t x1 = std::min(x0 + kTile, scene_.width), y1 = std::min(y0 + kTile, scene_.height);
+    const uint32_t spp = std::max(1u, options_.spp);
+    const uint32_t grid_x = static_cast<uint32_t>(std::ceil(std::sqrt(static_cast<double>(spp))));
+    const uint32_t grid_y = (spp + grid_x - 1) / grid_x;
+    PrimaryHit hits[kTile * kTile];
+    glm::dvec3 sum[kTile * kTile];
+    for (auto& s : sum) s = glm::dvec3(0);
+    for (uint32_t sample = 0; sample < spp; ++sample) {
+      Clock::time_point start = Clock::now();
+      for (uint32_t y = y0; y < y1; ++y)
+        for (uint32_t x = x0; x < x1; ++x) {
+          PrimaryHit& h = hits[(y - y0) * kTile + (x - x0)];
+          Rng rng{(static_cast<uint64_t>(y) * scene_.width + x) * 0x100000001B3ull + sample * 0x9E37ull};
+          double sx = 0.5, sy = 0.5;
+          if (spp > 1) {
+            sx = ((sample % grid_x) + rng.next()) / grid_x;
+            sy = ((sample / grid_x) + rng.next()) / grid_y;
+          }
+          trace(frame_ray(frame_, x + sx, y + sy), h);
+          h.rng_state = rng.state;
+        }
+      *trace_s += seconds_since(start);
+      start = Clock::now();
+      for (uint32_t y = y0; y < y1; ++y)
+        for (uint32_t x = x0; x < x1; ++x) {
+          const uint32_t k = (y - y0) * kTile + (x - x0);
+          sum[k] += shade(hits[k], shadow_rays);
+        }
+      *shade_s += seconds_since(start);
+    }
+    for (uint32_t y = y0; y < y1; ++y)
+      for (uint32_t x = x0; x < x1; ++x) {
+        const glm::dvec3 c = sum[(y - y0) * kTile + (x - x0)] / static_cast<double>(spp);
+        float* px = &image.beauty[(static_cast<size_t>(y) * scene_.width + x) * 4];
+        px[0] = static_cast<float>(c.r), px[1] = static_cast<float>(c.g), px[2] = static_cast<float>(c.b);
+        px[3] = 1;
+        if (options_.aovs) write_aovs(image, x, y, spp == 1 ? &hits[(y - y0) * kTile + (x - x0)] : nullptr);
+      }
+  }
+
+ private:
+  void trace(const Ray& ray, PrimaryHit& h) {
+    h.ray = ray;
+    BvhHit hit = intersect_nearest(geometry_.bvh, frusta_, ray, 0, kInf);
+    h.t = hit.hit_any() ? hit.hit.t : kInf;
+    h.frustum = hit.frustum;
+    h.geometric_normal = hit.hit.normal;
+    h.ground_t = kInf;
+    if (ray.direction.y < 0 && ray.origin.y > scene_.ground.height) {
+      double t = (scene_.ground.height - ray.origin.y) / ray.direction.y;
+      if (t < h.t) h.ground_t = t;
+    }
+  }
+
+  // Sun visibility from `p` (offset along the geometric normal `n_geometric`).
+  double sun_visibility(const glm::dvec3& p, const glm::dvec3& n_geometric, const glm::dvec3& l,
+                        uint64_t* shadow_rays) {
+    const double scale = std::max({1.0, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    Ray shadow{p + (1e-7 * scale) * n_geometric, l};
+    ++*shadow_rays;
+    // The ground cannot shadow anything above it; only plants cast shadows.
+    return intersect_any(geometry_.bvh, frusta_, shadow, 0, kInf) ? 0.0 : 1.0;
+  }
+
+  glm::dvec3 lit(const glm::dvec3& albedo, const glm::dvec3& n, const glm::dvec3& n_geometric,
+                 const glm::dvec3& p, const glm::dvec3& view, bool specular, Rng& rng,
+                 uint64_t* shadow_rays) {
+    glm::dvec3 colour = albedo * scene_.sky * (0.5 * (1 + n.y));
+    if (!sun_on_) return colour;
+    const glm::dvec3 l = sun_sample(scene_.sun, sun_direction_, cos_alpha_, sun_frame_, rng);
+    const double n_dot_l = glm::dot(n, l);
+    if (n_dot_l <= 0 || glm::dot(n_geometric, l) <= 0) return colour;
+    const double visibility = sun_visibility(p, n_geometric, l, shadow_rays);
+    if (visibility == 0) return colour;
+    glm::dvec3 brdf = albedo / kPi;
+    if (specular) {
+      const glm::dvec3 h = glm::normalize(l + view);
+      brdf += glm::dvec3(kSpecular * (kShininess + 8) / (8 * kPi) *
+                         std::pow(std::max(0.0, glm::dot(n, h)), kShininess));
+    }
+    return colour + brdf * scene_.sun.radiance * (n_dot_l * visibility);
+  }
+
+  glm::dvec3 shade(const PrimaryHit& h, uint64_t* shadow_rays) {
+    Rng rng{h.rng_state};
+    const glm::dvec3 view = -glm::normalize(h.ray.direction);
+    if (h.ground_t < kInf) {
+      const glm::dvec3 p = h.ray.origin + h.ground_t * h.ray.direction;
+      const glm::dvec3 up(0, 1, 0);
+      return lit(scene_.ground.albedo, up, up, p, view, false, rng, shadow_rays);
+    }
+    if (h.t == kInf) return scene_.sky;
+    const Frustum& f = frusta_[h.frustum];
+    const glm::dvec3 p = h.ray.origin + h.t * h.ray.direction;
+    glm::dvec3 n = surface_normal(f, p, NormalMode::interpolated);
+    glm::dvec3 ng = h.geometric_normal;
+    if (glm::dot(ng, view) < 0) ng = -ng;   // seen from inside: light the side we see
+    if (glm::dot(n, view) < 0) n = -n;
+    const ScenePlant& plant = scene_.plants[geometry_.plant_of_frustum[h.frustum]];
+    return lit(material_albedo(plant, f.material), n, ng, p, view, true, rng, shadow_rays);
+  }
+
+  void write_aovs(RenderImage& image, uint32_t x, uint32_t y, const PrimaryHit* centre_hit) {
+    PrimaryHit local;
+    if (!centre_hit) {
+      trace(frame_ray(frame_, x + 0.5, y + 0.5), local);
+      centre_hit = &local;
+    }
+    const PrimaryHit& h = *centre_hit;
+    const size_t pixel = static_cast<size_t>(y) * scene_.width + x;
+    const bool hit = h.t < kInf;
+    glm::dvec3 n(0), p(0);
+    SurfaceUV uv;
+    const Frustum* f = hit ? &frusta_[h.frustum] : nullptr;
+    if (hit) {
+      p = h.ray.origin + h.t * h.ray.direction;
+      n = surface_normal(*f, p, NormalMode::interpolated);
+      if (glm::dot(n, h.ray.direction) > 0) n = -n;
+    }
+    if (!image.depth.empty())
+      image.depth[pixel] = hit ? static_cast<float>(h.t * glm::length(h.ray.direction))
+                               : std::numeric_limits<float>::infinity();
+    if (!image.normal.empty())
+      for (int k = 0; k < 3; ++k) image.normal[pixel * 3 + k] = static_cast<float>(n[k]);
+    if (!image.uv.empty()) {
+      if (hit) uv = surface_uv(*f, p);
+      image.uv[pixel * 2 + 0] = hit ? static_cast<float>(uv.u) : 0.0f;
+      image.uv[pixel * 2 + 1] = hit ? static_cast<float>(uv.v_m) : 0.0f;
+    }
+    if (!image.id.empty()) {
+      image.id[pixel * 3 + 0] = hit ? static_cast<float>(geometry_.plant_of_frustum[h.frustum]) : -1.0f;
+      image.id[pixel * 3 + 1] = hit ? static_cast<float>(f->chain) : -1.0f;
+      image.id[pixel * 3 + 2] = hit ? static_cast<float>(f->segment) : -1.0f;
+    }
+  }
+
+  const Scene& scene_;
+  const SceneGeometry& geometry_;
+  const RenderOptions& options_;
+  const CameraFrame frame_;
+  std::span<const Frustum> frusta_;
+  const glm::dvec3 sun_direction_;
+  const AxisFrame sun_frame_;
+  const double cos_alpha_;
+  const bool sun_on_;
+};
+
+void draw_progress(uint32_t done, uint32_t total, double elapsed_s) {
+  constexpr int kWidth = 40;
+  const int filled = static_cast<int>(kWidth * static_cast<double>(done) / total);
+  char bar[kWidth + 1];
+  for (int i = 0; i < kWidth; ++i) bar[i] = i < filled ? '#' : '.';
+  bar[kWidth] = 0;
+  std::fprintf(stderr, "\rsylva render: [%s] %3d%% %.1f s", bar, static_cast<int>(100.0 * done / total),
+               elapsed_s);
+  std::fflush(stderr);
+}
+
+}  // namespace
+
+Skeleton place_plant(const ScenePlant& plant) {
+  Skeleton sk = *plant.skeleton;
+  const double angle = plant.rotate_y_deg * kPi / 180;
+  const double c = std::cos(angle), s = std::sin(angle);
+  for (Joint& j : sk.joints) {
+    const double x = plant.scale * j.position_m[0], y = plant.scale * j.position_m[1],
+                 z = plant.scale * j.position_m[2];
+    // R_y: x' = c x + s z, z' = −s x + c z (right-handed, counter-clockwise seen from +Y).
+    j.position_m[0] = plant.position.x + c * x + s * z;
+    j.position_m[1] = plant.position.y + y;
+    j.position_m[2] = plant.position.z - s * x + c * z;
+    j.radius_m *= plant.scale;
+  }
+  return sk;
+}
+
+SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin,
+                                   std::vector<RenderPass>* passes) {
+  SceneGeometry g;
+  Clock::time_point start = Clock::now();
+  for (uint32_t p = 0; p < scene.plants.size(); ++p) {
+    SkinnedSkeleton skinned = skin_skeleton(place_plant(scene.plants[p]), skin);
+    g.frusta.insert(g.frusta.end(), skinned.frusta.begin(), skinned.frusta.end());
+    g.plant_of_frustum.insert(g.plant_of_frustum.end(), skinned.frusta.size(), p);
+  }
+  if (passes)
+    passes->push_back({"skin", seconds_since(start),
+                       std::to_string(scene.plants.size()) + " plants, " + std::to_string(g.frusta.size()) + " frusta"});
+  start = Clock::now();
+  g.bvh = build_bvh(g.frusta);
+  if (passes)
+    passes->push_back({"bvh build", seconds_since(start),
+                       std::to_string(g.bvh.nodes.size()) + " nodes, depth " + std::to_string(g.bvh.depth)});
+  return g;
+}
+
+Ray camera_ray(const Scene& scene, double x, double y) { return frame_ray(camera_frame(scene), x, y); }
+
+RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
+  RenderResult result;
+  for (const ScenePlant& plant : scene.plants)
+    if (!plant.skeleton) throw std::logic_error("render_cpu: a plant has no skeleton (call grow_scene_plants)");
+  SceneGeometry geometry = build_scene_geometry(scene, options.skin, &result.passes);
+  result.frusta = geometry.frusta.size();
+
+  RenderImage& image = result.image;
+  image.width = scene.width;
+  image.height = scene.height;
+  const size_t pixels = static_cast<size_t>(scene.width) * scene.height;
+  image.beauty.assign(pixels * 4, 0.0f);
+  if (options.aovs & kAovDepth) image.depth.assign(pixels, 0.0f);
+  if (options.aovs & kAovNormal) image.normal.assign(pixels * 3, 0.0f);
+  if (options.aovs & kAovUv) image.uv.assign(pixels * 2, 0.0f);
+  if (options.aovs & kAovId) image.id.assign(pixels * 3, 0.0f);
+
+  const uint32_t tiles_x = (scene.width + kTile - 1) / kTile;
+  const uint32_t tiles_y = (scene.height + kTile - 1) / kTile;
+  const uint32_t tiles = tiles_x * tiles_y;
+  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  threads = std::min<unsigned>(threads, tiles);
+
+  Renderer renderer(scene, geometry, options);
+  std::atomic<uint32_t> next_tile{0}, done_tiles{0};
+  std::mutex totals_mutex;
+  double trace_s = 0, shade_s = 0;
+  uint64_t shadow_rays = 0;
+  auto worker = [&] {
+    double my_trace = 0, my_shade = 0;
+    uint64_t my_shadow = 0;
+    for (;;) {
+      if (options.cancel && options.cancel->load(std::memory_order_relaxed)) break;
+      const uint32_t tile = next_tile.fetch_add(1, std::memory_order_relaxed);
+      if (tile >= tiles) break;
+      renderer.render_tile(tile, image, &my_trace, &my_shade, &my_shadow);
+      done_tiles.fetch_add(1, std::memory_order_release);
+    }
+    std::lock_guard lock(totals_mutex);
+    trace_s += my_trace;
+    shade_s += my_shade;
+    shadow_rays += my_shadow;
+  };
+
+  const Clock::time_point start = Clock::now();
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
+  if (options.progress) {
+    // This thread draws the bar; the workers render.
+    pool.emplace_back(worker);
+    bool drawn = false;
+    while (done_tiles.load(std::memory_order_acquire) < tiles &&
+           !(options.cancel && options.cancel->load())) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      const double elapsed = seconds_since(start);
+      if (elapsed > 1.0) draw_progress(done_tiles.load(), tiles, elapsed), drawn = true;
+    }
+    for (std::thread& t : pool) t.join();
+    if (drawn) {
+      draw_progress(done_tiles.load(), tiles, seconds_since(start));
+      std::fputc('\n', stderr);
+    }
+  } else {
+    worker();
+    for (std::thread& t : pool) t.join();
+  }
+  const double wall = seconds_since(start);
+  result.cancelled = done_tiles.load() < tiles;
+  result.primary_rays = pixels * std::max(1u, options.spp);
+  result.shadow_rays = shadow_rays;
+  result.passes.push_back({"trace + shade (wall)", wall,
+                           std::to_string(threads) + " threads, " + std::to_string(tiles) + " tiles of 32x32"});
+  result.passes.push_back({"trace (thread time)", trace_s,
+                           std::to_string(result.primary_rays) + " primary rays, " +
+                               std::to_string(options.spp) + " spp"});
+  result.passes.push_back({"shade (thread time)", shade_s,
+                           std::to_string(shadow_rays) + (scene.sun.angular_radius_deg > 0 ? " soft" : " hard") +
+                               " shadow rays"});
+  return result;
+}
+
+}  // namespace sylva

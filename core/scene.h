@@ -1,0 +1,132 @@
+// scene.h — the scene of ../shared/spec/scene.md: camera, image size, sun, sky, ground,
+// fog and plants, read from a `.scene.json` file or made around one skeleton.
+//
+// Units: metres, Y up, angles in degrees where the name says _deg. Colours are linear RGB.
+// Every key but `plants` is optional (the defaults below are those of scene.md's
+// example); a key the reader does not know is an error naming the key, the file and the
+// key's line and column, so a typo never silently changes a picture.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/skeleton.h"
+
+namespace sylva {
+
+// Pinhole camera; pixel (i, j), j downward, is sampled through (i + 0.5, j + 0.5).
+struct Camera {
+  glm::dvec3 eye{6, 3, 6};
+  glm::dvec3 target{0, 2, 0};
+  glm::dvec3 up{0, 1, 0};
+  double fov_y_deg = 40;  // full vertical field of view, (0, 180)
+};
+
+// The sun: a disc light. angular_radius_deg 0 is a point sun (hard shadows).
+struct Sun {
+  glm::dvec3 direction{0.4, 1.0, 0.2};  // toward the sun, need not be unit (stored unit)
+  double angular_radius_deg = 0.27;
+  glm::dvec3 radiance{3, 3, 2.8};       // irradiance at normal incidence, linear RGB
+};
+
+struct Ground {
+  double height = 0;                    // the plane y = height
+  glm::dvec3 albedo{0.35, 0.3, 0.25};
+};
+
+// Participating media. Parsed and kept; not rendered yet.
+struct Fog {
+  double sigma_s = 0.05;         // scattering coefficient, 1/m
+  double sigma_a = 0.005;        // absorption coefficient, 1/m
+  double g = 0.6;                // Henyey–Greenstein asymmetry, (-1, 1)
+  double height_falloff = 0.0;   // 1/m
+};
+
+// The bark of a plant. albedo is a texture path or a constant colour.
+struct Bark {
+  std::optional<std::string> albedo_texture;  // resolved against the scene file's folder
+  std::optional<glm::dvec3> albedo_rgb;       // constant albedo of material 0 (wood)
+  std::optional<std::string> height_texture;  // relief height map (resolved path)
+  double relief_depth_m = 0.02;
+  double u_repeat = 1;           // texture repeats around the stem
+  double v_per_metre = 1;        // texture repeats per metre of arc length
+};
+
+// One plant: a grammar grown with seed/steps/defines, or a ready skeleton, placed by
+// p_world = position + R_y(rotate_y_deg) · (scale · p).
+struct ScenePlant {
+  std::string grammar;                     // resolved path (empty if `skeleton` is given)
+  std::optional<uint64_t> seed;            // overrides the grammar's seed
+  std::optional<int64_t> steps;            // overrides the derivation length
+  std::map<std::string, double> defines;   // -D overrides
+  std::optional<Skeleton> skeleton;        // set by default_scene_for (no grammar to grow)
+  glm::dvec3 position{0, 0, 0};
+  double rotate_y_deg = 0;
+  double scale = 1;
+  Bark bark;
+};
+
+struct Scene {
+  Camera camera;
+  uint32_t width = 1024;
+  uint32_t height = 768;
+  Sun sun;
+  glm::dvec3 sky{0.25, 0.3, 0.4};  // uniform sky radiance, linear RGB
+  Ground ground;
+  std::optional<Fog> fog;          // none: no fog pass
+  std::vector<ScenePlant> plants;
+};
+
+// "file:line:column: error: message" (place omitted where unknown).
+struct SceneError {
+  std::string file;
+  uint32_t line = 0;
+  uint32_t column = 0;
+  std::string message;
+  std::string format() const;
+};
+
+struct SceneReadResult {
+  std::optional<Scene> scene;
+  std::optional<SceneError> error;
+};
+
+// Parses scene JSON. `file` names it in messages; relative paths in it (grammar,
+// textures) are resolved against `base_dir` (the scene file's folder; "" = as written).
+SceneReadResult parse_scene_json(std::string_view text, std::string_view file,
+                                 const std::string& base_dir);
+
+// Reads and parses a scene file; paths in it are relative to its folder.
+SceneReadResult read_scene_file(const std::string& path);
+
+// Axis-aligned bounds of a skeleton's joints grown by their radii (metres).
+struct SkeletonBounds {
+  glm::dvec3 lo{0, 0, 0};
+  glm::dvec3 hi{0, 0, 0};
+};
+SkeletonBounds skeleton_bounds(const Skeleton& skeleton);
+
+// Camera framing a box for an image of width × height: a 3/4 view from the front right,
+// 12° above the box centre's horizon (azimuth 35° from +Z toward +X), fov_y 35°, far
+// enough that the box's bounding sphere fits the narrower field of view with 8% margin.
+Camera framing_camera(const glm::dvec3& lo, const glm::dvec3& hi, uint32_t width,
+                      uint32_t height);
+
+// The scene a bare grammar or skeleton is rendered in (scene.md): the plant at the
+// origin, the sun from (0.5, 1, 0.3), no fog, the ground at the skeleton's lowest point
+// (or 0 if higher), and framing_camera around the skeleton's bounds.
+Scene default_scene_for(const Skeleton& skeleton, uint32_t width = 1024, uint32_t height = 768);
+
+// Grows every plant of `scene` that has no skeleton yet from its grammar (with its seed,
+// steps and defines) and stores the skeleton in the plant, untransformed. Returns the
+// first error as the full diagnostic text (grammar file, line, column, caret), or
+// nullopt when every plant has a skeleton.
+std::optional<std::string> grow_scene_plants(Scene& scene, uint64_t max_modules = 50'000'000);
+
+}  // namespace sylva

@@ -1,0 +1,141 @@
+// scene_test.cpp — scene.md's scene files: every key read, defaults, and located errors.
+#include "core/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <glm/geometric.hpp>
+
+namespace sylva {
+namespace {
+
+const char* const kExample = R"({
+  "format": "sylva-scene", "version": 1,
+  "camera": {"eye": [6, 3, 6], "target": [0, 2, 0], "up": [0, 1, 0], "fov_y_deg": 40},
+  "image": {"width": 640, "height": 480},
+  "sun": {"direction": [0, 2, 0], "angular_radius_deg": 0.27, "radiance": [3, 3, 2.8]},
+  "sky": [0.25, 0.3, 0.4],
+  "ground": {"height": -1, "albedo": [0.35, 0.3, 0.25]},
+  "fog": {"sigma_s": 0.05, "sigma_a": 0.005, "g": 0.6, "height_falloff": 0.0},
+  "plants": [
+    {"grammar": "presets/saguaro.lsys", "seed": 3, "steps": 6, "defines": {"N": 5},
+     "position": [1, 0, 2], "rotate_y_deg": 90, "scale": 2,
+     "bark": {"albedo": "textures/bark.png", "height": "textures/bark_height.png",
+              "relief_depth": 0.02, "u_repeat": 2, "v_per_metre": 1}}
+  ]
+})";
+
+SceneError expect_error(std::string_view text) {
+  SceneReadResult r = parse_scene_json(text, "s.scene.json", "");
+  EXPECT_FALSE(r.scene.has_value());
+  EXPECT_TRUE(r.error.has_value());
+  return r.error.value_or(SceneError{});
+}
+
+TEST(Scene, ReadsEveryKeyOfTheSpecExample) {
+  SceneReadResult r = parse_scene_json(kExample, "dir/a.scene.json", "dir");
+  ASSERT_TRUE(r.scene) << r.error->format();
+  const Scene& s = *r.scene;
+  EXPECT_EQ(s.camera.eye, glm::dvec3(6, 3, 6));
+  EXPECT_EQ(s.camera.target, glm::dvec3(0, 2, 0));
+  EXPECT_EQ(s.camera.fov_y_deg, 40);
+  EXPECT_EQ(s.width, 640u);
+  EXPECT_EQ(s.height, 480u);
+  EXPECT_EQ(s.sun.direction, glm::dvec3(0, 1, 0));  // stored unit
+  EXPECT_EQ(s.sun.angular_radius_deg, 0.27);
+  EXPECT_EQ(s.sun.radiance, glm::dvec3(3, 3, 2.8));
+  EXPECT_EQ(s.sky, glm::dvec3(0.25, 0.3, 0.4));
+  EXPECT_EQ(s.ground.height, -1);
+  ASSERT_TRUE(s.fog);
+  EXPECT_EQ(s.fog->g, 0.6);
+  ASSERT_EQ(s.plants.size(), 1u);
+  const ScenePlant& p = s.plants[0];
+  EXPECT_EQ(p.grammar, "dir/presets/saguaro.lsys");  // relative to the scene file
+  EXPECT_EQ(p.seed, 3u);
+  EXPECT_EQ(p.steps, 6);
+  EXPECT_EQ(p.defines.at("N"), 5);
+  EXPECT_EQ(p.position, glm::dvec3(1, 0, 2));
+  EXPECT_EQ(p.rotate_y_deg, 90);
+  EXPECT_EQ(p.scale, 2);
+  EXPECT_EQ(p.bark.albedo_texture, "dir/textures/bark.png");
+  EXPECT_EQ(p.bark.height_texture, "dir/textures/bark_height.png");
+  EXPECT_EQ(p.bark.u_repeat, 2);
+}
+
+TEST(Scene, OnlyPlantsIsRequiredAndTheRestDefaults) {
+  SceneReadResult r = parse_scene_json(R"({"plants": [{"grammar": "g.lsys"}]})", "s", "");
+  ASSERT_TRUE(r.scene) << r.error->format();
+  EXPECT_EQ(r.scene->width, 1024u);
+  EXPECT_EQ(r.scene->height, 768u);
+  EXPECT_FALSE(r.scene->fog);  // no fog key, no fog pass
+  EXPECT_NEAR(glm::length(r.scene->sun.direction), 1.0, 1e-15);
+  EXPECT_EQ(r.scene->plants[0].scale, 1);
+  EXPECT_FALSE(r.scene->plants[0].seed);
+}
+
+TEST(Scene, UnknownTopLevelKeyNamesKeyFileLineAndColumn) {
+  SceneError e = expect_error("{\"plants\": [],\n  \"camra\": {}}");
+  EXPECT_EQ(e.line, 2u);
+  EXPECT_EQ(e.column, 3u);
+  EXPECT_NE(e.message.find("\"camra\""), std::string::npos) << e.message;
+  EXPECT_EQ(e.format().rfind("s.scene.json:2:3: error: unknown key \"camra\"", 0), 0u) << e.format();
+}
+
+TEST(Scene, UnknownNestedKeyIsLocatedAtTheKey) {
+  SceneError e = expect_error("{\"plants\": [{\"grammar\": \"g.lsys\",\n    \"bark\": {\"u_repeet\": 2}}]}");
+  EXPECT_EQ(e.line, 2u);
+  EXPECT_EQ(e.column, 14u);
+  EXPECT_NE(e.message.find("u_repeet"), std::string::npos);
+  EXPECT_NE(e.message.find("plants[0].bark"), std::string::npos) << e.message;
+}
+
+TEST(Scene, MissingPlantsIsAnError) {
+  SceneError e = expect_error("{\"sky\": [1, 1, 1]}");
+  EXPECT_NE(e.message.find("plants"), std::string::npos);
+}
+
+TEST(Scene, WrongTypesAndRangesAreLocated) {
+  SceneError e = expect_error("{\"plants\": [],\n \"camera\": {\"fov_y_deg\": 180}}");
+  EXPECT_EQ(e.line, 2u);
+  EXPECT_EQ(e.column, 26u);
+  e = expect_error("{\"plants\": [], \"image\": {\"width\": 1.5}}");
+  EXPECT_NE(e.message.find("image.width"), std::string::npos);
+  e = expect_error("{\"plants\": [], \"sky\": [1, 2]}");
+  EXPECT_NE(e.message.find("sky"), std::string::npos);
+  e = expect_error("{\"plants\": [{\"seed\": 1}]}");
+  EXPECT_NE(e.message.find("grammar"), std::string::npos);
+  e = expect_error("{\"plants\": [], \"camera\": {\"eye\": [0, 1, 0], \"target\": [0, 5, 0]}}");
+  EXPECT_NE(e.message.find("parallel"), std::string::npos);
+  e = expect_error("{\"plants\": [], \"version\": 2}");
+  EXPECT_NE(e.message.find("version"), std::string::npos);
+}
+
+TEST(Scene, MalformedJsonIsLocated) {
+  SceneError e = expect_error("{\"plants\": [],\n}");
+  EXPECT_EQ(e.line, 1u);  // the trailing comma
+  EXPECT_EQ(e.column, 14u);
+}
+
+TEST(Scene, DefaultSceneFramesTheSkeletonFromAThreeQuarterView) {
+  Skeleton sk;
+  sk.joints = {{{0, 0, 0}, 0.3, 0}, {{0, 6, 0}, 0.3, 0}};
+  sk.chains = {{0, 2, std::nullopt}};
+  Scene s = default_scene_for(sk, 320, 240);
+  EXPECT_EQ(s.width, 320u);
+  ASSERT_EQ(s.plants.size(), 1u);
+  EXPECT_TRUE(s.plants[0].skeleton);
+  EXPECT_FALSE(s.fog);
+  EXPECT_NEAR(glm::dot(s.sun.direction, glm::normalize(glm::dvec3(0.5, 1, 0.3))), 1.0, 1e-15);
+  EXPECT_EQ(s.ground.height, 0);
+  EXPECT_NEAR(s.camera.target.y, 3, 1e-12);  // the box centre
+  EXPECT_GT(s.camera.eye.x, 0);              // front right, above
+  EXPECT_GT(s.camera.eye.z, s.camera.eye.x);
+  EXPECT_GT(s.camera.eye.y, s.camera.target.y);
+  // The bounding sphere fits the vertical field of view.
+  double d = glm::length(s.camera.eye - s.camera.target);
+  double r = 0.5 * glm::length(glm::dvec3(0.6, 6.6, 0.6));
+  EXPECT_LT(r / d, std::sin(0.5 * s.camera.fov_y_deg * 3.14159265358979 / 180));
+}
+
+}  // namespace
+}  // namespace sylva
