@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The README's first command: install dependencies (Debian 12), build sylva (release),
-# and grow the bundled saguaro and elm presets, printing their summaries.
+# grow the bundled saguaro and elm presets (printing their summaries), and render the
+# saguaro with the CPU ray caster to out/saguaro.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -11,4 +12,5 @@ mkdir -p out
 for plant in saguaro elm; do
   build/release/app/sylva grow "presets/$plant.lsys" -o "out/$plant.skel.json"
 done
-echo "skeletons written to out/ (see docs/ for the file format and the other presets)"
+build/release/app/sylva render presets/saguaro.lsys -o out/saguaro.png --width 800 --height 600 --spp 4
+echo "skeletons and out/saguaro.png written to out/ (see docs/ for the formats and the other presets)"
