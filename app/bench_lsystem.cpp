@@ -82,14 +82,19 @@ class CapturingReporter : public benchmark::ConsoleReporter {
 
 int run_bench(const std::vector<std::string>& args) {
   if (args.empty() || args[0] == "-h" || args[0] == "--help") {
-    std::cout << "usage: sylva bench lsystem [--quick] [--presets DIR] [Google Benchmark flags]\n\n"
+    std::cout << "usage: sylva bench lsystem [--quick] [--presets DIR] [Google Benchmark flags]\n"
+                 "       sylva bench raycast [PRESET] [--width W --height H] [--csv FILE] [--quick]\n\n"
                  "Derivation throughput (modules produced per second, one thread) for ABOP 1.24a,\n"
                  "Honda's tree (ABOP 2.6) and ABOP 1.31a; turtle segments per second; peak bytes\n"
                  "per module; memcpy bandwidth in the same run. --quick uses small sizes (a smoke\n"
-                 "test, not a measurement).\n";
+                 "test, not a measurement).\n"
+                 "raycast: primary rays per second on a preset (default pine, 1024x768), sylva's BVH\n"
+                 "and analytic frusta against Embree user geometry, round curves and tessellated\n"
+                 "meshes, on one thread and all threads, with depth error and bytes per segment.\n";
     return args.empty() ? kUsageError : kOk;
   }
-  if (args[0] != "lsystem") throw UsageError{"unknown benchmark '" + args[0] + "' (available: lsystem)"};
+  if (args[0] == "raycast") return run_bench_raycast(args);
+  if (args[0] != "lsystem") throw UsageError{"unknown benchmark '" + args[0] + "' (available: lsystem, raycast)"};
   bool quick = false;
   std::string presets = SYLVA_PRESETS_DIR;
   std::vector<std::string> gb_args = {"sylva-bench"};

@@ -41,6 +41,9 @@ std::optional<uint64_t> parse_u64(const std::string& text);
 int run_derive(const std::vector<std::string>& args);
 int run_grow(const std::vector<std::string>& args);
 int run_bench(const std::vector<std::string>& args);
+// `sylva bench raycast` (bench_raycast.cpp), dispatched by run_bench.
+int run_bench_raycast(const std::vector<std::string>& args);
 int run_render(const std::vector<std::string>& args);
+int run_export(const std::vector<std::string>& args);
 
 }  // namespace sylva::cli

@@ -4,7 +4,9 @@
 #include <cstdio>
 #include <iostream>
 #include <limits>
+#include <sstream>
 
+#include "app/batch.h"
 #include "app/cli.h"
 #include "core/file_io.h"
 #include "core/turtle.h"
@@ -37,35 +39,11 @@ void print_grow_help() {
                "(sylva-skeleton JSON) atomically; prints one summary line: modules, chains,\n"
                "segments, bounding box, time.\n\n"
                "  -o, --output FILE      the skeleton file to write\n"
+               "      --seed A..B        a batch: every seed from A to B, in parallel on all cores;\n"
+               "                         -o must then hold {seed} (out/elm_{seed}.skel.json), its\n"
+               "                         folder is created; a failed seed is named on stderr,\n"
+               "                         the others are still written, and the exit status is 1\n"
             << kGrammarFlags;
-}
-
-// Loads the grammar with its -D overrides; prints the diagnostic on failure.
-std::optional<lsys::Grammar> load(const GrammarArgs& a, int* exit_code) {
-  lsys::ParseOptions po;
-  po.define_overrides = a.defines;
-  auto g = lsys::load_grammar(a.grammar, po);
-  if (!g) {
-    const lsys::Diagnostic& d = g.error();
-    // A -D naming no #define is a usage error, not a grammar error.
-    if (d.loc.line == 0 && d.message.rfind("-D ", 0) == 0) {
-      std::cerr << "sylva: error: " << d.message << "\n";
-      *exit_code = kUsageError;
-    } else {
-      std::cerr << d.format();
-      *exit_code = kInputError;
-    }
-    return std::nullopt;
-  }
-  return std::move(*g);
-}
-
-lsys::DeriveOptions derive_options(const GrammarArgs& a) {
-  lsys::DeriveOptions o;
-  o.steps = a.steps;
-  o.seed = a.seed;
-  o.max_modules = a.max_modules;
-  return o;
 }
 
 std::string format_number(double v) {
@@ -83,9 +61,9 @@ int run_derive(const std::vector<std::string>& args) {
     return kOk;
   }
   int code = kOk;
-  auto g = load(a, &code);
+  auto g = load_grammar_for(a, &code);
   if (!g) return code;
-  auto word = lsys::derive(*g, derive_options(a));
+  auto word = lsys::derive(*g, derive_options_for(a));
   if (!word) {
     std::cerr << word.error().format();
     return kInputError;
@@ -97,28 +75,31 @@ int run_derive(const std::vector<std::string>& args) {
   return kOk;
 }
 
-int run_grow(const std::vector<std::string>& args) {
-  GrammarArgs a = parse_grammar_args(args, true);
-  if (a.help) {
-    print_grow_help();
-    return kOk;
-  }
-  int code = kOk;
-  auto g = load(a, &code);
-  if (!g) return code;
-  auto result = grow(*g, derive_options(a), a.grammar, a.defines);
+namespace {
+
+// Grows one plant and writes it to `output`: the text grow prints on failure (a
+// diagnostic) or, on success, its summary line and any warning.
+struct GrowOutcome {
+  std::optional<std::string> error;  // as printed on stderr, ending in a newline
+  std::string warning;               // stderr text, may be empty
+  std::string summary;               // the stdout summary line, without newline
+};
+
+GrowOutcome grow_to_file(const lsys::Grammar& g, const GrammarArgs& a, const std::string& output) {
+  GrowOutcome out;
+  auto result = grow(g, derive_options_for(a), a.grammar, a.defines);
   if (!result) {
-    std::cerr << result.error().format();
-    return kInputError;
+    out.error = result.error().format();
+    return out;
   }
   const Skeleton& sk = result->skeleton;
   if (result->interpret.still_expandable)
-    std::cerr << a.grammar << ": warning: the interpretation stopped at maximum depth " << g->max_depth
-              << " with " << result->interpret.still_expandable << " modules still expandable\n";
+    out.warning = a.grammar + ": warning: the interpretation stopped at maximum depth " + std::to_string(g.max_depth) +
+                  " with " + std::to_string(result->interpret.still_expandable) + " modules still expandable\n";
   std::string json = write_skeleton_json(sk);
-  if (auto err = write_file_atomically(a.output, json)) {
-    std::cerr << err->format() << "\n";
-    return kInputError;
+  if (auto err = write_file_atomically(output, json)) {
+    out.error = err->format() + "\n";
+    return out;
   }
   double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
   if (!sk.joints.empty()) {
@@ -129,12 +110,56 @@ int run_grow(const std::vector<std::string>& args) {
         hi[k] = std::max(hi[k], j.position_m[k] + j.radius_m);
       }
   }
-  std::cout << a.grammar << ": " << result->modules << " modules, " << sk.chains.size() << " chains, "
-            << sk.segment_count() << " segments, bbox [" << format_number(lo[0]) << "," << format_number(lo[1])
-            << "," << format_number(lo[2]) << "]..[" << format_number(hi[0]) << "," << format_number(hi[1]) << ","
-            << format_number(hi[2]) << "] m, " << format_number(result->seconds * 1e3) << " ms";
-  if (result->turtle.zero_length_moves) std::cout << ", " << result->turtle.zero_length_moves << " zero-length moves";
-  std::cout << "\n";
+  std::ostringstream line;
+  line << a.grammar << ": " << result->modules << " modules, " << sk.chains.size() << " chains, "
+       << sk.segment_count() << " segments, bbox [" << format_number(lo[0]) << "," << format_number(lo[1]) << ","
+       << format_number(lo[2]) << "]..[" << format_number(hi[0]) << "," << format_number(hi[1]) << ","
+       << format_number(hi[2]) << "] m, " << format_number(result->seconds * 1e3) << " ms";
+  if (result->turtle.zero_length_moves) line << ", " << result->turtle.zero_length_moves << " zero-length moves";
+  out.summary = line.str();
+  return out;
+}
+
+}  // namespace
+
+int run_grow(const std::vector<std::string>& raw_args) {
+  std::vector<std::string> args = raw_args;
+  const std::optional<SeedRange> range = take_seed_range(args, grammar_value_flags());
+  GrammarArgs a = parse_grammar_args(args, true);
+  if (a.help) {
+    print_grow_help();
+    return kOk;
+  }
+  if (range && !has_seed_placeholder(a.output))
+    throw UsageError{"--seed " + std::to_string(range->first) + ".." + std::to_string(range->last) +
+                     " writes one file per seed: -o must hold {seed}, e.g. -o out/plant_{seed}.skel.json"};
+  int code = kOk;
+  auto g = load_grammar_for(a, &code);
+  if (!g) return code;
+  if (range) {
+    if (auto err = create_parent_folder(expand_seed_pattern(a.output, range->first))) {
+      std::cerr << *err << "\n";
+      return kInputError;
+    }
+    return run_seed_batch("grow", *range, [&](uint64_t seed) {
+      GrammarArgs one = a;
+      one.seed = seed;
+      GrowOutcome o = grow_to_file(*g, one, expand_seed_pattern(a.output, seed));
+      SeedTaskResult r;
+      r.error = o.error;
+      r.summary = o.summary;
+      r.warning = o.warning;
+      return r;
+    });
+  }
+  GrowOutcome o = grow_to_file(*g, a, has_seed_placeholder(a.output) && a.seed
+                                          ? expand_seed_pattern(a.output, *a.seed) : a.output);
+  std::cerr << o.warning;
+  if (o.error) {
+    std::cerr << *o.error;
+    return kInputError;
+  }
+  std::cout << o.summary << "\n";
   return kOk;
 }
 

@@ -17,6 +17,7 @@ void print_help(std::ostream& out) {
                "  grow   GRAMMAR [-n STEPS] [--seed S] [-D ...] -o FILE.skel.json\n"
                "                                      write the skeleton and print a summary\n"
                "  render INPUT -o IMAGE [--backend auto|gl|cpu] [--aov ...]   render to PNG/EXR\n"
+               "  export INPUT -o FILE.gltf|FILE.glb [--mesh]   glTF 2.0 with the skeleton in extras\n"
                "  bench  lsystem [--quick]            derivation and turtle benchmarks\n\n"
                "'sylva SUBCOMMAND --help' describes every flag.\n"
                "Exit status: 0 success, 1 bad input, 2 usage error, 3 internal error.\n";
@@ -43,6 +44,7 @@ int main(int argc, char** argv) {
     if (sub == "grow") return run_grow(args);
     if (sub == "bench") return run_bench(args);
     if (sub == "render") return run_render(args);
+    if (sub == "export") return run_export(args);
     std::cerr << "sylva: error: unknown subcommand '" << sub << "' (see 'sylva --help')\n";
     return kUsageError;
   } catch (const UsageError& e) {

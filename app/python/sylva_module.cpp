@@ -1,0 +1,641 @@
+// sylva_module.cpp — the `sylva` Python module (issue 5, sec. 2): grammars, growth,
+// skeletons as zero-copy numpy views, glTF export and the CPU renderer.
+//
+// Boundaries, as everywhere in sylva: errors are values in C++ and become Python
+// exceptions here, each with a readable message (GrammarError carries file, line and
+// column). Seeds cross as Python ints converted straight to uint64 — never through a
+// float. Derivation, export and rendering run with the GIL released; the objects they
+// read are immutable from Python (a Skeleton has no setters), so views stay valid.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "app/python/sylva_python.h"
+#include "core/file_io.h"
+#include "core/gltf_export.h"
+#include "core/skeleton.h"
+#include "core/turtle.h"
+#include "lsystem/derive.h"
+#include "lsystem/grammar.h"
+
+namespace py = pybind11;
+using namespace pybind11::literals;
+
+namespace sylva::python {
+
+namespace {
+
+// Exception types created at import (heap types owned by the module; never freed).
+PyObject* g_grammar_error = nullptr;
+PyObject* g_skeleton_error = nullptr;
+
+// Raises `type(text)` with file/line/column/source_line attributes (None where the
+// place is unknown).
+void set_located_error(PyObject* type, const std::string& text, const std::string& message,
+                       const std::string& file, uint32_t line, uint32_t column, const std::string& source_line) {
+  py::object exc = py::reinterpret_borrow<py::object>(type)(text);
+  exc.attr("file") = file.empty() ? py::object(py::none()) : py::object(py::str(file));
+  exc.attr("line") = line ? py::object(py::int_(line)) : py::object(py::none());
+  exc.attr("column") = line ? py::object(py::int_(column)) : py::object(py::none());
+  exc.attr("message") = py::str(message);
+  exc.attr("source_line") = py::str(source_line);
+  PyErr_SetObject(type, exc.ptr());
+}
+
+// Strips the trailing newline of a formatted diagnostic (str(e) should not end in one).
+std::string chomp(std::string text) {
+  while (!text.empty() && text.back() == '\n') text.pop_back();
+  return text;
+}
+
+// Raises OSError from a FileError (FileNotFoundError etc. by errno, as open() would).
+[[noreturn]] void throw_file_error(const FileError& error) {
+  if (error.error_number != 0) {
+    py::object exc = py::reinterpret_borrow<py::object>(PyExc_OSError)(error.error_number, error.format(),
+                                                                        error.path);
+    PyErr_SetObject(reinterpret_cast<PyObject*>(Py_TYPE(exc.ptr())), exc.ptr());
+  } else {
+    PyErr_SetString(PyExc_OSError, error.format().c_str());
+  }
+  throw py::error_already_set();
+}
+
+// `os.fspath(path)` as the caller wrote it (kept verbatim: it is recorded in files).
+std::string path_string(const std::filesystem::path& path) { return path.string(); }
+
+}  // namespace
+
+GrammarFailure::GrammarFailure(lsys::Diagnostic d)
+    : std::runtime_error(d.message), diagnostic(std::move(d)) {}
+
+SkeletonFailure::SkeletonFailure(SkeletonError e)
+    : std::runtime_error(e.message), error(std::move(e)) {}
+
+std::optional<uint64_t> seed_from_python(const py::object& value) {
+  if (value.is_none()) return std::nullopt;
+  if (PyBool_Check(value.ptr()) || PyFloat_Check(value.ptr()))
+    throw py::type_error("seed must be an int in [0, 2**64 - 1], not " +
+                         std::string(Py_TYPE(value.ptr())->tp_name));
+  // __index__ accepts int and numpy integers, rejects floats and strings (TypeError).
+  py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  if (!index) throw py::error_already_set();
+  const unsigned long long seed = PyLong_AsUnsignedLongLong(index.ptr());
+  if (seed == static_cast<unsigned long long>(-1) && PyErr_Occurred()) {
+    PyErr_Clear();
+    PyErr_SetString(PyExc_OverflowError,
+                    ("seed must be an int in [0, 2**64 - 1], got " + py::str(index).cast<std::string>()).c_str());
+    throw py::error_already_set();
+  }
+  return static_cast<uint64_t>(seed);
+}
+
+std::optional<int64_t> steps_from_python(const py::object& value) {
+  if (value.is_none()) return std::nullopt;
+  if (PyBool_Check(value.ptr()) || PyFloat_Check(value.ptr()))
+    throw py::type_error("steps must be an int >= 0, not " + std::string(Py_TYPE(value.ptr())->tp_name));
+  py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  if (!index) throw py::error_already_set();
+  int overflow = 0;
+  const long long steps = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (steps == -1 && PyErr_Occurred()) throw py::error_already_set();
+  if (overflow != 0 || steps < 0)
+    throw py::value_error("steps must be an int >= 0, got " + py::str(index).cast<std::string>());
+  return static_cast<int64_t>(steps);
+}
+
+std::map<std::string, double> defines_from_python(const py::object& value) {
+  std::map<std::string, double> defines;
+  if (value.is_none()) return defines;
+  if (!PyDict_Check(value.ptr())) throw py::type_error("defines must be a dict {name: number}");
+  for (auto item : py::reinterpret_borrow<py::dict>(value)) {
+    if (!PyUnicode_Check(item.first.ptr())) throw py::type_error("defines: every name must be a str");
+    const std::string name = item.first.cast<std::string>();
+    const double number = PyFloat_AsDouble(item.second.ptr());
+    if (number == -1.0 && PyErr_Occurred()) {
+      PyErr_Clear();
+      throw py::type_error("defines['" + name + "'] must be a number");
+    }
+    if (!std::isfinite(number)) throw py::value_error("defines['" + name + "'] must be finite");
+    defines[name] = number;
+  }
+  return defines;
+}
+
+// ---------------------------------------------------------------------------------------
+// Grammar
+
+PyGrammar::PyGrammar(std::string grammar_text, std::string grammar_file)
+    : text(std::move(grammar_text)), file(std::move(grammar_file)) {
+  auto parsed_grammar = lsys::parse_grammar(text, file);
+  if (!parsed_grammar) throw GrammarFailure(parsed_grammar.error());
+  parsed = std::make_shared<const lsys::Grammar>(std::move(*parsed_grammar));
+}
+
+PyGrammar PyGrammar::from_file(const std::string& path) {
+  FileReadResult read = read_text_file(path);
+  if (read.error) throw_file_error(*read.error);
+  return PyGrammar(std::move(*read.contents), path);
+}
+
+std::shared_ptr<const lsys::Grammar> PyGrammar::with_defines(const std::map<std::string, double>& defines) const {
+  if (defines.empty()) return parsed;
+  lsys::ParseOptions options;
+  options.define_overrides = defines;
+  auto reparsed = lsys::parse_grammar(text, file, options);
+  if (!reparsed) throw GrammarFailure(reparsed.error());
+  return std::make_shared<const lsys::Grammar>(std::move(*reparsed));
+}
+
+namespace {
+
+lsys::DeriveOptions derive_options(const py::object& steps, const py::object& seed, uint64_t max_modules) {
+  lsys::DeriveOptions options;
+  options.steps = steps_from_python(steps);
+  options.seed = seed_from_python(seed);
+  if (max_modules == 0) throw py::value_error("max_modules must be > 0");
+  options.max_modules = max_modules;
+  return options;
+}
+
+Skeleton grammar_grow(const PyGrammar& self, const py::object& steps, const py::object& seed,
+                      const py::object& defines_object, uint64_t max_modules) {
+  const lsys::DeriveOptions options = derive_options(steps, seed, max_modules);
+  const std::map<std::string, double> defines = defines_from_python(defines_object);
+  std::optional<lsys::Diagnostic> failure;
+  std::optional<GrowResult> result;
+  uint64_t still_expandable = 0;
+  int max_depth = 0;
+  {
+    py::gil_scoped_release release;
+    try {
+      std::shared_ptr<const lsys::Grammar> grammar = self.with_defines(defines);
+      auto grown = grow(*grammar, options, self.file, defines);
+      if (grown) {
+        still_expandable = grown->interpret.still_expandable;
+        max_depth = grammar->max_depth;
+        result = std::move(*grown);
+      } else {
+        failure = grown.error();
+      }
+    } catch (const GrammarFailure& e) {
+      failure = e.diagnostic;
+    }
+  }
+  if (failure) throw GrammarFailure(*failure);
+  if (still_expandable != 0) {
+    const std::string message = self.file + ": the interpretation stopped at maximum depth " +
+                                std::to_string(max_depth) + " with " + std::to_string(still_expandable) +
+                                " modules still expandable";
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, message.c_str(), 1) != 0) throw py::error_already_set();
+  }
+  return std::move(result->skeleton);
+}
+
+std::string grammar_derive(const PyGrammar& self, const py::object& steps, const py::object& seed,
+                           const py::object& defines_object, uint64_t max_modules) {
+  const lsys::DeriveOptions options = derive_options(steps, seed, max_modules);
+  const std::map<std::string, double> defines = defines_from_python(defines_object);
+  std::optional<lsys::Diagnostic> failure;
+  std::string text;
+  {
+    py::gil_scoped_release release;
+    try {
+      std::shared_ptr<const lsys::Grammar> grammar = self.with_defines(defines);
+      auto word = lsys::derive(*grammar, options);
+      if (word)
+        text = lsys::print_word(*word, grammar->symbols);
+      else
+        failure = word.error();
+    } catch (const GrammarFailure& e) {
+      failure = e.diagnostic;
+    }
+  }
+  if (failure) throw GrammarFailure(*failure);
+  return text;
+}
+
+py::dict defines_dict(const std::map<std::string, double>& defines) {
+  py::dict d;
+  for (const auto& [name, value] : defines) d[py::str(name)] = value;
+  return d;
+}
+
+// ---------------------------------------------------------------------------------------
+// Skeleton
+
+// The chains as numpy records (see the `chains` docstring).
+struct ChainRecord {
+  int32_t first_joint;
+  int32_t joint_count;
+  int32_t parent_chain;  // -1: a root chain
+  int32_t parent_joint;  // joint index within the parent chain; -1 for a root chain
+};
+
+int32_t checked_index(uint64_t value, const char* what) {
+  if (value > static_cast<uint64_t>(std::numeric_limits<int32_t>::max()))
+    throw py::value_error(std::string("the skeleton has too many ") + what + " for int32 indices");
+  return static_cast<int32_t>(value);
+}
+
+// A read-only view of a member of every Joint (stride sizeof(Joint)) that keeps `owner`
+// alive through the array's base.
+template <class T>
+py::array joint_view(const py::object& owner, const Skeleton& skeleton, const T* first, std::vector<py::ssize_t> shape,
+                     std::vector<py::ssize_t> strides) {
+  py::array view = skeleton.joints.empty()
+                       ? py::array(py::dtype::of<T>(), shape, strides)
+                       : py::array(py::dtype::of<T>(), shape, strides, first, owner);
+  view.attr("setflags")("write"_a = false);
+  return view;
+}
+
+py::array skeleton_positions(const py::object& self) {
+  const Skeleton& sk = self.cast<const Skeleton&>();
+  const auto n = static_cast<py::ssize_t>(sk.joints.size());
+  const double* first = sk.joints.empty() ? nullptr : &sk.joints[0].position_m[0];
+  return joint_view(self, sk, first, {n, 3}, {static_cast<py::ssize_t>(sizeof(Joint)), sizeof(double)});
+}
+
+py::array skeleton_radii(const py::object& self) {
+  const Skeleton& sk = self.cast<const Skeleton&>();
+  const auto n = static_cast<py::ssize_t>(sk.joints.size());
+  const double* first = sk.joints.empty() ? nullptr : &sk.joints[0].radius_m;
+  return joint_view(self, sk, first, {n}, {static_cast<py::ssize_t>(sizeof(Joint))});
+}
+
+py::array skeleton_materials(const py::object& self) {
+  const Skeleton& sk = self.cast<const Skeleton&>();
+  const auto n = static_cast<py::ssize_t>(sk.joints.size());
+  const uint32_t* first = sk.joints.empty() ? nullptr : &sk.joints[0].material;
+  return joint_view(self, sk, first, {n}, {static_cast<py::ssize_t>(sizeof(Joint))});
+}
+
+py::array_t<int32_t> skeleton_segments(const Skeleton& sk) {
+  const auto count = static_cast<py::ssize_t>(sk.segment_count());
+  checked_index(sk.joints.size(), "joints");
+  py::array_t<int32_t> segments({count, py::ssize_t{2}});
+  auto out = segments.mutable_unchecked<2>();
+  py::ssize_t s = 0;
+  for (const Chain& chain : sk.chains) {
+    for (uint32_t k = 1; k < chain.joint_count; ++k, ++s) {
+      uint32_t start = chain.first_joint + k - 1;
+      // A branch's first segment starts at the joint it grows from, so the segments
+      // form one connected tree per root chain (the joints are at the same place).
+      if (k == 1 && chain.parent) start = sk.chains[chain.parent->chain].first_joint + chain.parent->joint;
+      out(s, 0) = static_cast<int32_t>(start);
+      out(s, 1) = static_cast<int32_t>(chain.first_joint + k);
+    }
+  }
+  return segments;
+}
+
+py::array_t<ChainRecord> skeleton_chains(const Skeleton& sk) {
+  checked_index(sk.joints.size(), "joints");
+  checked_index(sk.chains.size(), "chains");
+  py::array_t<ChainRecord> chains(static_cast<py::ssize_t>(sk.chains.size()));
+  auto out = chains.mutable_unchecked<1>();
+  for (size_t c = 0; c < sk.chains.size(); ++c) {
+    const Chain& chain = sk.chains[c];
+    ChainRecord& r = out(static_cast<py::ssize_t>(c));
+    r.first_joint = static_cast<int32_t>(chain.first_joint);
+    r.joint_count = static_cast<int32_t>(chain.joint_count);
+    r.parent_chain = chain.parent ? static_cast<int32_t>(chain.parent->chain) : -1;
+    r.parent_joint = chain.parent ? static_cast<int32_t>(chain.parent->joint) : -1;
+  }
+  return chains;
+}
+
+Skeleton skeleton_from_json(const std::string& text, const std::string& file) {
+  SkeletonReadResult read = read_skeleton_json(text, file);
+  if (!read.skeleton) throw SkeletonFailure(read.error.value_or(SkeletonError{file, 0, 0, "unreadable skeleton"}));
+  return std::move(*read.skeleton);
+}
+
+Skeleton skeleton_from_file(const std::filesystem::path& path_in) {
+  const std::string path = path_string(path_in);
+  FileReadResult read = read_text_file(path);
+  if (read.error) throw_file_error(*read.error);
+  return skeleton_from_json(*read.contents, path);
+}
+
+void skeleton_save(const Skeleton& sk, const std::filesystem::path& path) {
+  const std::string json = write_skeleton_json(sk);
+  std::optional<FileError> error;
+  {
+    py::gil_scoped_release release;
+    error = write_file_atomically(path_string(path), json);
+  }
+  if (error) throw_file_error(*error);
+}
+
+std::string skeleton_repr(const Skeleton& sk) {
+  std::string name = sk.source.grammar.empty() ? "" : std::filesystem::path(sk.source.grammar).filename().string() + " ";
+  return "<sylva.Skeleton " + name + "seed=" + std::to_string(sk.source.seed) + " steps=" +
+         std::to_string(sk.source.steps) + ": " + std::to_string(sk.chains.size()) + " chains, " +
+         std::to_string(sk.joints.size()) + " joints, " + std::to_string(sk.segment_count()) + " segments>";
+}
+
+// ---------------------------------------------------------------------------------------
+// glTF export
+
+std::string plant_name(const Skeleton& sk) {
+  std::string stem = std::filesystem::path(sk.source.grammar).stem().string();
+  if (stem.empty() || stem.front() == '<') stem = "plant";
+  return stem;
+}
+
+// A Skeleton or a sequence of Skeletons.
+std::vector<const Skeleton*> skeleton_list(const py::object& plants) {
+  std::vector<const Skeleton*> list;
+  if (py::isinstance<Skeleton>(plants)) {
+    list.push_back(&plants.cast<const Skeleton&>());
+    return list;
+  }
+  if (!py::isinstance<py::sequence>(plants) || py::isinstance<py::str>(plants))
+    throw py::type_error("plants must be a sylva.Skeleton or a sequence of them");
+  for (auto item : py::reinterpret_borrow<py::sequence>(plants)) {
+    if (!py::isinstance<Skeleton>(item)) throw py::type_error("plants must be a sylva.Skeleton or a sequence of them");
+    list.push_back(&item.cast<const Skeleton&>());
+  }
+  return list;
+}
+
+// A per-plant argument: None, or a sequence of exactly `count` items.
+py::sequence per_plant(const py::object& value, size_t count, const char* name) {
+  if (!py::isinstance<py::sequence>(value) || py::isinstance<py::str>(value))
+    throw py::type_error(std::string(name) + " must be a sequence with one entry per plant");
+  py::sequence seq = py::reinterpret_borrow<py::sequence>(value);
+  if (seq.size() != count)
+    throw py::value_error(std::string(name) + " has " + std::to_string(seq.size()) + " entries for " +
+                          std::to_string(count) + " plants");
+  return seq;
+}
+
+void python_export_gltf(const py::object& plants, const std::filesystem::path& path, bool mesh, int segments_around,
+                        bool instancing, const py::object& names, const py::object& positions,
+                        const py::object& rotate_y_deg, const py::object& scales) {
+  const std::vector<const Skeleton*> skeletons = skeleton_list(plants);
+  if (skeletons.empty()) throw py::value_error("export_gltf needs at least one plant");
+  if (segments_around < 3) throw py::value_error("segments_around must be >= 3");
+  std::vector<GltfPlant> gltf_plants(skeletons.size());
+  for (size_t i = 0; i < skeletons.size(); ++i) {
+    gltf_plants[i].skeleton = *skeletons[i];
+    gltf_plants[i].name = plant_name(*skeletons[i]);
+  }
+  if (!names.is_none()) {
+    py::sequence seq = per_plant(names, skeletons.size(), "names");
+    for (size_t i = 0; i < skeletons.size(); ++i) gltf_plants[i].name = seq[i].cast<std::string>();
+  }
+  if (!positions.is_none()) {
+    py::sequence seq = per_plant(positions, skeletons.size(), "positions");
+    for (size_t i = 0; i < skeletons.size(); ++i) {
+      auto p = seq[i].cast<std::vector<double>>();
+      if (p.size() != 3) throw py::value_error("positions: every entry must be (x, y, z) in metres");
+      for (int k = 0; k < 3; ++k) gltf_plants[i].position_m[k] = p[static_cast<size_t>(k)];
+    }
+  }
+  if (!rotate_y_deg.is_none()) {
+    py::sequence seq = per_plant(rotate_y_deg, skeletons.size(), "rotate_y_deg");
+    for (size_t i = 0; i < skeletons.size(); ++i) gltf_plants[i].rotate_y_deg = seq[i].cast<double>();
+  }
+  if (!scales.is_none()) {
+    py::sequence seq = per_plant(scales, skeletons.size(), "scales");
+    for (size_t i = 0; i < skeletons.size(); ++i) gltf_plants[i].scale = seq[i].cast<double>();
+  }
+  GltfExportOptions options;
+  options.mesh = mesh;
+  options.segments_around = segments_around;
+  options.instancing = instancing;
+  std::optional<std::string> error;
+  {
+    py::gil_scoped_release release;
+    error = export_gltf(gltf_plants, path_string(path), options);
+  }
+  if (error) throw std::runtime_error(*error);
+}
+
+
+const char* const kModuleDoc = R"doc(sylva: procedural plants from L-systems, scripted from Python.
+
+A grammar (.lsys text) is derived into a word, the turtle turns the word into a
+skeleton (chains of joints: position and radius in metres, Y up, material index), and
+the skeleton exports to glTF 2.0 or renders on the CPU:
+
+    import sylva
+    g = sylva.Grammar.from_file("presets/elm.lsys")    # or sylva.Grammar(text)
+    sk = g.grow(seed=7, steps=6)                        # keyword-only knobs
+    print(sk.positions.shape, sk.radii.max())           # zero-copy numpy views
+    sylva.export_gltf(sk, "elm.glb", mesh=True)
+
+Classes: Grammar, Skeleton. Functions: export_gltf, render (the CPU ray caster).
+Errors: GrammarError (a ValueError with .file, .line, .column),
+SkeletonError (a ValueError, same attributes); file problems raise OSError.
+Seeds are ints in [0, 2**64 - 1], carried exactly (never through a float).
+Growing, deriving, exporting and rendering release the GIL, so threads run in parallel.
+)doc";
+
+}  // namespace
+
+void bind_module(py::module_& m) {
+  m.doc() = kModuleDoc;
+  PYBIND11_NUMPY_DTYPE(ChainRecord, first_joint, joint_count, parent_chain, parent_joint);
+  m.attr("__version__") = "0.1.0";
+
+  // --- exceptions -----------------------------------------------------------------------
+  g_grammar_error = PyErr_NewExceptionWithDoc(
+      "sylva.GrammarError",
+      "A grammar that cannot be parsed or derived, or a define the grammar does not have.\n\n"
+      "A ValueError. str(e) is the full diagnostic: 'file:line:column: error: message', the\n"
+      "source line and a caret. Attributes: file (str), line and column (1-based ints; None\n"
+      "when the problem has no place in the text, e.g. an unknown define name), message\n"
+      "(str, without the place), source_line (str).",
+      PyExc_ValueError, nullptr);
+  g_skeleton_error = PyErr_NewExceptionWithDoc(
+      "sylva.SkeletonError",
+      "A skeleton file or JSON text that is not a valid sylva-skeleton version 1 document.\n\n"
+      "A ValueError with attributes file, line, column (None where unknown) and message.",
+      PyExc_ValueError, nullptr);
+  if (!g_grammar_error || !g_skeleton_error) throw py::error_already_set();
+  for (PyObject* type : {g_grammar_error, g_skeleton_error}) {
+    py::object t = py::reinterpret_borrow<py::object>(type);
+    t.attr("file") = py::none();
+    t.attr("line") = py::none();
+    t.attr("column") = py::none();
+    t.attr("message") = "";
+    t.attr("source_line") = "";
+  }
+  m.attr("GrammarError") = py::reinterpret_borrow<py::object>(g_grammar_error);
+  m.attr("SkeletonError") = py::reinterpret_borrow<py::object>(g_skeleton_error);
+
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const GrammarFailure& e) {
+      const lsys::Diagnostic& d = e.diagnostic;
+      // A -D name the grammar lacks has no place: the message alone reads best.
+      const std::string text = d.loc.line == 0 ? d.file + ": error: " + d.message : chomp(d.format());
+      set_located_error(g_grammar_error, text, d.message, d.file, d.loc.line, d.loc.column, d.source_line);
+    } catch (const SkeletonFailure& e) {
+      const SkeletonError& s = e.error;
+      set_located_error(g_skeleton_error, s.format(), s.message, s.file, s.line, s.column, "");
+    }
+  });
+
+  // Both classes are registered before any method so signatures name them (sylva.Skeleton).
+  py::class_<PyGrammar> grammar_class(m, "Grammar", R"doc(A parsed L-system grammar (.lsys text), ready to derive and grow.
+
+Grammar(text, *, file="<string>") parses text; Grammar.from_file(path) reads a file.
+Parse errors raise GrammarError with the file, line and column. The text is kept:
+grow()/derive() with `defines` re-parse it with those #define overrides (they are
+applied at parse time, exactly as `sylva grow -D NAME=VALUE` does).
+A Grammar is immutable and may be used from several threads at once.)doc");
+  py::class_<Skeleton> skeleton_class(m, "Skeleton", R"doc(A plant skeleton: chains of joints (metres, Y up), as sylva-skeleton JSON describes.
+
+Immutable. Array properties are numpy arrays:
+  positions (J, 3) float64, radii (J,) float64, materials (J,) uint32 — read-only
+      zero-copy views of the joints; each keeps the Skeleton alive.
+  segments (S, 2) int32 — joint index pairs (start, end), one per segment.
+  chains (C,) structured int32 records (first_joint, joint_count, parent_chain,
+      parent_joint); parent_chain = parent_joint = -1 for a root chain.
+Chain c owns joints[first_joint : first_joint + joint_count].
+Make one with Grammar.grow(), Skeleton.from_file() or Skeleton.from_json().)doc");
+
+  // --- Grammar --------------------------------------------------------------------------
+  grammar_class.def(py::init([](std::string text, std::string file) { return PyGrammar(std::move(text), std::move(file)); }),
+           "text"_a, py::kw_only(), "file"_a = "<string>",
+           "Parses grammar text. `file` names it in error messages and in the skeleton's source.")
+      .def_static(
+          "from_file", [](const std::filesystem::path& path) { return PyGrammar::from_file(path_string(path)); },
+          "path"_a,
+          "Reads and parses a grammar file (str or os.PathLike). The path is recorded, as given,\n"
+          "in grown skeletons. A missing file raises FileNotFoundError; bad text GrammarError.")
+      .def_property_readonly("text", [](const PyGrammar& g) { return g.text; }, "The grammar's source text.")
+      .def_property_readonly("file", [](const PyGrammar& g) { return g.file; },
+                             "The file name used in messages and recorded in skeletons.")
+      .def_property_readonly(
+          "defines",
+          [](const PyGrammar& g) {
+            py::dict d;
+            for (const lsys::Define& def : g.parsed->defines) d[py::str(def.name)] = def.value;
+            return d;
+          },
+          "The grammar's #defines as {name: value} (values as written in the file).")
+      .def_property_readonly("seed", [](const PyGrammar& g) { return g.parsed->seed; },
+                             "The default seed (the grammar's `seed:` line, else 1).")
+      .def_property_readonly("steps", [](const PyGrammar& g) { return g.parsed->steps; },
+                             "The default number of derivation steps (`derivation length:`).");
+  {
+    // steps/seed/defines are converted by hand (exact uint64 seeds, numpy integers), so
+    // pybind11 would show them as `object`: the signatures are written out instead.
+    py::options signatures;
+    signatures.disable_function_signatures();
+    grammar_class.def("grow", &grammar_grow, py::kw_only(), "steps"_a = py::none(), "seed"_a = py::none(),
+           "defines"_a = py::none(), "max_modules"_a = uint64_t{50'000'000},
+           R"doc(grow(self, *, steps: int | None = None, seed: int | None = None, defines: dict[str, float] | None = None, max_modules: int = 50000000) -> sylva.Skeleton
+
+Derives the grammar and builds its skeleton with the turtle (what `sylva grow` does).
+
+Keyword-only:
+  steps        derivation steps (int >= 0; default: the grammar's `derivation length:`)
+  seed         random seed, an int in [0, 2**64 - 1] (default: the grammar's `seed:`)
+  defines      {name: number} overriding #defines; a name the grammar lacks is a
+               GrammarError (line and column None)
+  max_modules  stop with GrammarError if a word would exceed this many modules
+Returns a Skeleton whose JSON equals `sylva grow` output byte for byte. The GIL is
+released while growing. A RuntimeWarning reports an interpretation cut at max depth.)doc");
+    grammar_class.def("derive", &grammar_derive, py::kw_only(), "steps"_a = py::none(), "seed"_a = py::none(),
+           "defines"_a = py::none(), "max_modules"_a = uint64_t{50'000'000},
+           "derive(self, *, steps: int | None = None, seed: int | None = None, defines: dict[str, float] | None = None, "
+           "max_modules: int = 50000000) -> str\n\n"
+           "Derives the grammar's word and returns it as `sylva derive` prints it (without the\n"
+           "final newline). Same keyword-only knobs as grow(); the GIL is released.");
+  }
+  grammar_class.def("__repr__", [](const PyGrammar& g) {
+        return "<sylva.Grammar " + g.file + ": " + std::to_string(g.parsed->productions.size()) + " productions, " +
+               std::to_string(g.parsed->defines.size()) + " defines>";
+      });
+
+  // --- Skeleton -------------------------------------------------------------------------
+  skeleton_class
+      .def_static("from_file", &skeleton_from_file, "path"_a,
+                  "Reads a .skel.json file. Invalid content raises SkeletonError naming chain, joint,\n"
+                  "line and column; an unreadable file raises OSError.")
+      .def_static("from_json", &skeleton_from_json, "text"_a, "file"_a = "<string>",
+                  "Parses sylva-skeleton JSON text (`file` only names it in errors).")
+      .def("to_json", &write_skeleton_json,
+           "The sylva-skeleton JSON text, byte-identical to what `sylva grow -o` writes.")
+      .def("save", &skeleton_save, "path"_a,
+           "Writes to_json() to `path` atomically (readers never see a partial file).")
+      .def_property_readonly("positions", &skeleton_positions,
+                             "(J, 3) float64 joint positions in metres, Y up. Read-only view, no copy.")
+      .def_property_readonly("radii", &skeleton_radii, "(J,) float64 joint radii in metres (0 is a tip). Read-only view.")
+      .def_property_readonly("materials", &skeleton_materials,
+                             "(J,) uint32 material index of the segment ending at each joint. Read-only view.")
+      .def_property_readonly(
+          "segments", &skeleton_segments,
+          "(S, 2) int32 joint index pairs (start, end), chain by chain, one per segment.\n"
+          "Within a chain a segment joins consecutive joints; a branch's first segment starts\n"
+          "at its parent joint instead of the branch's own first joint (same position), so\n"
+          "the segments form one connected tree per root. A new array on every access.")
+      .def_property_readonly(
+          "chains", &skeleton_chains,
+          "(C,) numpy structured array, fields first_joint, joint_count, parent_chain,\n"
+          "parent_joint (int32; parents -1 for a root chain). Parents come before children.\n"
+          "E.g. sk.chains['parent_chain'], or for c in sk.chains: c['first_joint'].")
+      .def_property_readonly("joint_count", [](const Skeleton& sk) { return sk.joints.size(); }, "Number of joints J.")
+      .def_property_readonly("chain_count", [](const Skeleton& sk) { return sk.chains.size(); }, "Number of chains C.")
+      .def_property_readonly("segment_count", &Skeleton::segment_count, "Number of segments S = sum(joint_count - 1).")
+      .def_property_readonly("grammar", [](const Skeleton& sk) { return sk.source.grammar; },
+                             "The grammar path it was grown from, as given (source.grammar).")
+      .def_property_readonly("seed", [](const Skeleton& sk) { return sk.source.seed; },
+                             "The 64-bit seed it was grown with (an exact int).")
+      .def_property_readonly("steps", [](const Skeleton& sk) { return sk.source.steps; }, "The derivation steps.")
+      .def_property_readonly("defines", [](const Skeleton& sk) { return defines_dict(sk.source.defines); },
+                             "The #define overrides it was grown with, {name: value}.")
+      .def("__repr__", &skeleton_repr)
+      .def(py::pickle([](const Skeleton& sk) { return write_skeleton_json(sk); },
+                      [](const std::string& json) { return skeleton_from_json(json, "<pickle>"); }));
+
+  // --- functions ------------------------------------------------------------------------
+  py::options signatures;  // per-plant arguments are any sequences: the signature is written out
+  signatures.disable_function_signatures();
+  m.def("export_gltf", &python_export_gltf, "plants"_a, "path"_a, py::kw_only(), "mesh"_a = false,
+        "segments_around"_a = 8, "instancing"_a = false, "names"_a = py::none(), "positions"_a = py::none(),
+        "rotate_y_deg"_a = py::none(), "scales"_a = py::none(),
+        R"doc(export_gltf(plants: Skeleton | Sequence[Skeleton], path: str | os.PathLike, *, mesh: bool = False, segments_around: int = 8, instancing: bool = False, names: Sequence[str] | None = None, positions: Sequence[tuple[float, float, float]] | None = None, rotate_y_deg: Sequence[float] | None = None, scales: Sequence[float] | None = None) -> None
+
+Writes plants to a glTF 2.0 file, binary (.glb) or JSON (.gltf) by extension.
+
+plants: a Skeleton or a sequence of Skeletons, one node each, carrying the skeleton
+as a LINES mesh and the exact skeleton document in the node's extras["sylva"].
+Keyword-only:
+  mesh             also write the skinned frusta as a triangle mesh with a bark material
+  segments_around  columns around each frustum of that mesh (>= 3)
+  instancing       repeated identical plants as EXT_mesh_gpu_instancing
+  names            node names (default: the grammar file's stem, e.g. "elm")
+  positions        per plant (x, y, z) node translation in metres
+  rotate_y_deg     per plant rotation about +Y in degrees
+  scales           per plant uniform scale
+The file is written atomically; a failure raises RuntimeError with the reason. The GIL
+is released while writing.)doc");
+  signatures.enable_function_signatures();
+
+  bind_render(m);
+}
+
+}  // namespace sylva::python
+
+PYBIND11_MODULE(sylva, m) { sylva::python::bind_module(m); }

@@ -1,0 +1,62 @@
+// sylva_python.h — shared pieces of the `sylva` Python module's translation units.
+//
+// C++ failures cross to Python as the exception types below, translated once (in
+// sylva_module.cpp) into sylva.GrammarError / sylva.SkeletonError with file, line and
+// column attributes. Argument converters keep Python ints exact (seeds are uint64).
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "core/skeleton.h"
+#include "lsystem/diagnostic.h"
+#include "lsystem/grammar.h"
+
+namespace sylva::python {
+
+// Thrown for a grammar problem; becomes sylva.GrammarError.
+struct GrammarFailure : std::runtime_error {
+  explicit GrammarFailure(lsys::Diagnostic d);
+  lsys::Diagnostic diagnostic;
+};
+
+// Thrown for an invalid skeleton document; becomes sylva.SkeletonError.
+struct SkeletonFailure : std::runtime_error {
+  explicit SkeletonFailure(SkeletonError e);
+  SkeletonError error;
+};
+
+// The Python Grammar: the source text (re-parsed when defines are given, since -D
+// overrides apply at parse time) and the grammar parsed without overrides.
+struct PyGrammar {
+  PyGrammar(std::string grammar_text, std::string grammar_file);  // throws GrammarFailure
+  static PyGrammar from_file(const std::string& path);            // OSError / GrammarFailure
+
+  // The grammar with `defines` applied (the shared parse when there are none). Safe
+  // without the GIL.
+  std::shared_ptr<const lsys::Grammar> with_defines(const std::map<std::string, double>& defines) const;
+
+  std::string text;
+  std::string file;
+  std::shared_ptr<const lsys::Grammar> parsed;
+};
+
+// None → nullopt; an int (or numpy integer) in [0, 2**64 - 1] → exactly that value.
+// bool/float → TypeError; out of range → OverflowError.
+std::optional<uint64_t> seed_from_python(const pybind11::object& value);
+// None → nullopt; an int >= 0 → its value; negative → ValueError.
+std::optional<int64_t> steps_from_python(const pybind11::object& value);
+// None → {}; a dict {str: number} → the override map (non-finite values: ValueError).
+std::map<std::string, double> defines_from_python(const pybind11::object& value);
+
+// Adds everything to the module (sylva_module.cpp) and sylva.render (python_render.cpp).
+void bind_module(pybind11::module_& m);
+void bind_render(pybind11::module_& m);
+
+}  // namespace sylva::python

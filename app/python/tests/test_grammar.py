@@ -1,0 +1,109 @@
+"""sylva.Grammar: parsing text and files, errors as GrammarError, derive()."""
+import pathlib
+import subprocess
+
+import pytest
+
+import sylva
+
+SIMPLE = """\
+#define ANGLE 30
+angle: ANGLE
+derivation length: 2
+axiom: F
+F -> F[+F]F[-F]F
+"""
+
+
+def test_grammar_from_text_keeps_text_file_name_and_defaults():
+    g = sylva.Grammar(SIMPLE, file="simple.lsys")
+    assert g.text == SIMPLE
+    assert g.file == "simple.lsys"
+    assert g.defines == {"ANGLE": 30.0}
+    assert g.steps == 2
+    assert g.seed == 1
+    assert "simple.lsys" in repr(g)
+
+
+def test_grammar_from_text_names_it_string_by_default():
+    assert sylva.Grammar(SIMPLE).file == "<string>"
+
+
+def test_grammar_from_file_accepts_str_and_pathlike():
+    a = sylva.Grammar.from_file("presets/elm.lsys")
+    b = sylva.Grammar.from_file(pathlib.Path("presets/elm.lsys"))
+    assert a.file == b.file == "presets/elm.lsys"
+    assert a.text == pathlib.Path("presets/elm.lsys").read_text()
+    assert "LIMBS" in a.defines
+
+
+def test_grammar_from_missing_file_raises_file_not_found():
+    with pytest.raises(FileNotFoundError) as info:
+        sylva.Grammar.from_file("presets/no_such_plant.lsys")
+    assert "no_such_plant.lsys" in str(info.value)
+
+
+def test_grammar_error_is_a_value_error_with_file_line_and_column():
+    bad = "axiom: F\nF -> F[+F\n"
+    with pytest.raises(sylva.GrammarError) as info:
+        sylva.Grammar(bad, file="bad.lsys")
+    e = info.value
+    assert isinstance(e, ValueError)
+    assert (e.file, e.line, e.column) == ("bad.lsys", 2, 7)
+    assert e.message == "unbalanced brackets in the successor: '[' is never closed"
+    assert e.source_line == "F -> F[+F"
+    # str() is the CLI's diagnostic: located first line, source line, caret.
+    assert str(e).splitlines() == ["bad.lsys:2:7: error: " + e.message, "F -> F[+F", "      ^"]
+
+
+def test_unknown_define_is_a_grammar_error_without_a_place():
+    g = sylva.Grammar(SIMPLE, file="simple.lsys")
+    with pytest.raises(sylva.GrammarError) as info:
+        g.grow(defines={"ANGEL": 10})
+    assert info.value.line is None and info.value.column is None
+    assert info.value.file == "simple.lsys"
+    assert "ANGEL" in str(info.value)
+
+
+def test_defines_must_be_numbers_keyed_by_name():
+    g = sylva.Grammar(SIMPLE)
+    with pytest.raises(TypeError):
+        g.grow(defines={"ANGLE": "thirty"})
+    with pytest.raises(TypeError):
+        g.grow(defines={1: 2})
+    with pytest.raises(ValueError):
+        g.grow(defines={"ANGLE": float("nan")})
+
+
+def test_knobs_are_keyword_only():
+    g = sylva.Grammar(SIMPLE)
+    with pytest.raises(TypeError):
+        g.grow(3)  # steps must be named
+    with pytest.raises(TypeError):
+        g.derive(3)
+
+
+def test_derive_returns_the_printed_word():
+    g = sylva.Grammar("axiom: A\nA -> AB\nB -> A\n")
+    assert g.derive(steps=0) == "A"
+    assert g.derive(steps=4) == "ABAABABA"
+
+
+def test_derive_errors_are_grammar_errors():
+    g = sylva.Grammar("axiom: A(0)\nA(x) -> A(1/x)\n", file="div.lsys")
+    with pytest.raises(sylva.GrammarError) as info:
+        g.derive(steps=1)
+    assert info.value.file == "div.lsys"
+
+
+def test_max_modules_stops_runaway_growth_with_grammar_error():
+    g = sylva.Grammar("axiom: A\nA -> AA\n")
+    with pytest.raises(sylva.GrammarError):
+        g.derive(steps=20, max_modules=1000)
+
+
+def test_derive_equals_cli_derive(sylva_binary):
+    g = sylva.Grammar.from_file("presets/abop_1_24a.lsys")
+    cli = subprocess.run([sylva_binary, "derive", "presets/abop_1_24a.lsys", "-n", "3"],
+                         capture_output=True, check=True).stdout.decode()
+    assert g.derive(steps=3) + "\n" == cli

@@ -1,0 +1,31 @@
+"""sylva.render: the CPU ray caster on a skeleton's default scene, as numpy."""
+import numpy as np
+import pytest
+
+import sylva
+
+
+@pytest.fixture(scope="module")
+def saguaro():
+    return sylva.Grammar.from_file("presets/saguaro.lsys").grow(seed=5)
+
+
+def test_render_returns_height_width_rgba_float32(saguaro):
+    img = sylva.render(saguaro, width=48, height=32)
+    assert img.shape == (32, 48, 4) and img.dtype == np.float32
+    assert np.isfinite(img).all()
+    np.testing.assert_array_equal(img[..., 3], 1.0)
+    assert img[..., :3].std() > 0  # a plant, ground and sky: not one flat colour
+
+
+def test_render_is_the_same_for_any_thread_count(saguaro):
+    a = sylva.render(saguaro, width=40, height=30, threads=1)
+    b = sylva.render(saguaro, width=40, height=30, threads=2)
+    np.testing.assert_array_equal(a, b)
+
+
+def test_render_rejects_unknown_backends_and_empty_images(saguaro):
+    with pytest.raises(ValueError):
+        sylva.render(saguaro, backend="vulkan")
+    with pytest.raises(ValueError):
+        sylva.render(saguaro, width=0, height=10)
