@@ -6,9 +6,12 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <glm/common.hpp>
 #include <iostream>
+#include <limits>
 
 #include "app/cli.h"
+#include "core/gltf_export.h"
 #include "core/image_io.h"
 #include "core/render_cpu.h"
 #include "core/scene.h"
@@ -31,8 +34,9 @@ void print_render_help() {
       << "usage: sylva render INPUT -o IMAGE [--backend auto|gl|cpu] [--width W --height H]\n"
          "                    [--aov depth,normal,uv,id] [--spp N] [--verbose]\n"
          "                    [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n\n"
-         "Renders INPUT — a .scene.json scene, a .lsys grammar or a .skel.json skeleton (the\n"
-         "last two in a default scene: the plant at the origin, the sun from (0.5, 1, 0.3), a\n"
+         "Renders INPUT — a .scene.json scene, a .lsys grammar, a .skel.json skeleton or a .glb/.gltf\n"
+         "written by `sylva export` (its skeletons are read back from node extras) (all but\n"
+         "the scene in a default scene: the plant at the origin, the sun from (0.5, 1, 0.3), a\n"
          "camera framing it) — to IMAGE, written atomically. The format follows IMAGE's\n"
          "extension: .png (8-bit sRGB), .exr (linear half, AOVs as extra channels), or any\n"
          "format OpenImageIO writes. For a non-EXR IMAGE each AOV goes to its own EXR next to\n"
@@ -172,9 +176,9 @@ int run_render(const std::vector<std::string>& args) {
   const std::string& input = a.grammar.grammar;
   const std::string& output = a.grammar.output;
   const bool is_scene = ends_with(input, ".scene.json"), is_skeleton = ends_with(input, ".skel.json"),
-             is_grammar = ends_with(input, ".lsys");
-  if (!is_scene && !is_skeleton && !is_grammar)
-    throw UsageError{"INPUT '" + input + "' must end in .lsys, .skel.json or .scene.json"};
+             is_grammar = ends_with(input, ".lsys"), is_gltf = ends_with(input, ".glb") || ends_with(input, ".gltf");
+  if (!is_scene && !is_skeleton && !is_grammar && !is_gltf)
+    throw UsageError{"INPUT '" + input + "' must end in .lsys, .skel.json, .scene.json, .glb or .gltf"};
   if (a.grammar_flags && !is_grammar)
     throw UsageError{"-n, --seed, -D and --max-modules apply to a .lsys grammar only"};
   if (a.backend == "gl")
@@ -203,6 +207,34 @@ int run_render(const std::vector<std::string>& args) {
       return kInputError;
     }
     passes.push_back({"grow", seconds_since(start), std::to_string(scene.plants.size()) + " plants"});
+  } else if (is_gltf) {
+    // A file written by `sylva export`: its skeletons come back exactly from node extras.
+    GltfImportResult imported = import_gltf_skeletons(input);
+    if (imported.error) {
+      std::cerr << *imported.error << "\n";
+      return kInputError;
+    }
+    const uint32_t width = a.width.value_or(1024), height = a.height.value_or(768);
+    scene = default_scene_for(imported.plants.front().skeleton, width, height);
+    scene.plants.clear();
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+    double lowest = 0;
+    for (GltfPlant& p : imported.plants) {
+      ScenePlant plant;
+      plant.skeleton = std::move(p.skeleton);
+      plant.position = {p.position_m[0], p.position_m[1], p.position_m[2]};
+      plant.rotate_y_deg = p.rotate_y_deg;
+      plant.scale = p.scale;
+      const Skeleton placed = place_plant(plant);
+      const SkeletonBounds b = skeleton_bounds(placed);
+      lo = glm::min(lo, b.lo);
+      hi = glm::max(hi, b.hi);
+      for (const Joint& j : placed.joints) lowest = std::min(lowest, j.position_m[1]);
+      scene.plants.push_back(std::move(plant));
+    }
+    scene.ground.height = lowest;
+    scene.camera = framing_camera(lo, hi, width, height);
+    passes.push_back({"read glTF", seconds_since(start), std::to_string(scene.plants.size()) + " plants"});
   } else {
     Skeleton skeleton;
     if (is_skeleton) {

@@ -77,6 +77,8 @@ std::optional<FileError> write_image_atomically(const std::string& path, uint32_
     if (channel_names[c] == "Z") spec.z_channel = static_cast<int>(c);
   spec.attribute("oiio:ColorSpace", srgb ? "sRGB" : "Linear");
   spec.attribute("Software", "sylva");
+  // A fixed date keeps images byte-identical for identical input (OpenEXR writes capDate).
+  spec.attribute("DateTime", "1970:01:01 00:00:00");
   if (lower_extension(path) == ".exr") spec.attribute("compression", "zip");
 
   const std::string temp = temporary_path_for(path);

@@ -119,6 +119,31 @@ TEST(ExportCli, TheSkeletonSurvivesTheRoundTripExactly) {
   EXPECT_EQ(sylva::import_gltf_skeletons(dir.file("b.gltf")).plants[0].name, "abop_1_27_stochastic");
 }
 
+TEST(ExportCli, RenderingTheExportedFileGivesTheSameDepthImageAsTheGrammar) {
+  TempDir dir;
+  const std::string saguaro = kSource + "/presets/saguaro.lsys";
+  expect_ok(run_sylva({"export", saguaro, "-o", dir.file("saguaro.glb"), "--mesh"}));
+  for (const char* input : {"glb", "lsys"}) {
+    const std::string in = std::string(input) == "glb" ? dir.file("saguaro.glb") : saguaro;
+    expect_ok(run_sylva({"render", in, "--backend", "cpu", "-o", dir.file(std::string("from_") + input + ".exr"),
+                         "--aov", "depth", "--width", "96", "--height", "72"}));
+  }
+  // Images are written reproducibly (fixed metadata), so equal pixels mean equal files.
+  const std::string from_glb = read_file(dir.path() / "from_glb.exr");
+  EXPECT_FALSE(from_glb.empty());
+  EXPECT_TRUE(from_glb == read_file(dir.path() / "from_lsys.exr"));
+}
+
+TEST(ExportCli, RenderingAGltfWithoutSylvaExtrasIsAClearError) {
+  TempDir dir;
+  const std::string plain = dir.write("plain.gltf", R"({"asset":{"version":"2.0"},"nodes":[{"name":"x"}]})");
+  ProcessResult r = run_sylva({"render", plain, "--backend", "cpu", "-o", dir.file("x.png")});
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  EXPECT_EQ(r.exit_code, 1) << describe(r);
+  EXPECT_NE(r.err.find("plain.gltf"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "x.png"));
+}
+
 TEST(ExportCli, UsageErrorsExitTwoAndInputErrorsExitOne) {
   TempDir dir;
   const std::string skel = dir.file("p.skel.json");
