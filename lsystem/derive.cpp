@@ -379,6 +379,18 @@ Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStat
   if (g.axiom.size() > options.max_modules)
     return g.error_at(g.axiom_loc, "the axiom exceeds --max-modules");
   Word cur = g.axiom;
+  if (g.axiom_successor) {
+    // The axiom draws random numbers: evaluate its arguments from this seed's stream.
+    Rng rng = axiom_rng(seed);
+    size_t k = 0;
+    try {
+      for (const SuccessorModule& sm : g.axiom_successor->modules)
+        for (uint16_t a = 0; a < sm.arg_count; ++a)
+          cur.params[k++] = g.program.eval(g.axiom_successor->args[sm.first_arg + a], nullptr, &rng);
+    } catch (const EvalError& e) {
+      return g.error_at(e.loc, e.message + " (in the axiom)");
+    }
+  }
   if (g.uses_random) {
     cur.lineage.resize(cur.size());
     for (size_t i = 0; i < cur.size(); ++i) cur.lineage[i] = mix_pair(kAxiomKeyBase, i);

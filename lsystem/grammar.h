@@ -85,8 +85,11 @@ struct Grammar {
   uint64_t seed = 1;
   int64_t steps = 1;
   int max_depth = 16;        // homomorphism recursion limit
-  Word axiom;
+  Word axiom;                 // the start word (random arguments: drawn with `seed`)
   SourceLoc axiom_loc;
+  // Set when the axiom draws random numbers (`axiom: F(uniform(1,2))`): derive() then
+  // evaluates it again from the effective seed's axiom stream (see axiom_rng).
+  std::optional<Successor> axiom_successor;
   Program program;           // all compiled expressions
   std::vector<Production> productions;
   std::vector<Production> homomorphism;
@@ -103,6 +106,9 @@ struct Grammar {
   // A Diagnostic at `loc` in this grammar's file.
   Diagnostic error_at(SourceLoc loc, std::string message) const;
 };
+
+// The random stream of the axiom's arguments for a given seed.
+inline Rng axiom_rng(uint64_t seed) { return Rng(mix_pair(seed, 0xA710A5EEDULL)); }
 
 struct ParseOptions {
   // -D overrides: replace the value of a #define. A name the grammar does not define

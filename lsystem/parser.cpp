@@ -272,7 +272,6 @@ class Parser {
   const ParseOptions& options_;
   std::unordered_map<std::string, double> define_values_;
   bool have_axiom_ = false;
-  Rng header_rng_{mix_pair(0x5EED, 1)};
 };
 
 // ---------------------------------------------------------------- expressions
@@ -556,21 +555,20 @@ void Parser::parse_primary(Cursor& c, ExprBuild& b, const Scope* scope) {
   fail(loc, "expected an expression, found " + quote_char(ch));
 }
 
-// Compiles an expression that must use no formal parameters and evaluates it.
+// Compiles an expression that must use no formal parameters and no random numbers, and
+// returns its value. Header values are evaluated once, before any seed is known, so a
+// random draw there could not follow the seed: it is an error (draw in the axiom or a
+// production instead).
 double Parser::constant_expression(Cursor c, const char* what) {
   c.skip_spaces();
   if (c.at_end()) fail(c.loc(), std::string("expected a value for ") + what);
   Expr e = compile_expression(c, nullptr);
   c.skip_spaces();
   if (!c.at_end()) fail(c.loc(), "unexpected " + quote_char(c.peek()) + " after the value of " + what);
-  if (e.kind == Expr::Kind::kConst) return e.value;
-  // Random draws in a header value come from the header stream.
-  try {
-    double v = g_.program.eval(e, nullptr, &header_rng_);
-    return v;
-  } catch (const EvalError& err) {
-    fail(err.loc, err.message);
-  }
+  if (e.kind != Expr::Kind::kConst)
+    fail(e.loc, std::string("random functions are not allowed in ") + what +
+                    " (it is evaluated before the seed is known); draw them in the axiom or a production");
+  return e.value;
 }
 
 // ---------------------------------------------------------------- module strings
@@ -673,14 +671,17 @@ Successor Parser::compile_successor(Cursor c, const Scope& scope, const char* wh
 
 Word Parser::evaluate_constant_word(const Successor& s) {
   Word w;
+  Rng rng = axiom_rng(g_.seed);
   for (const SuccessorModule& sm : s.modules) {
     w.modules.push_back(Module{sm.symbol, sm.arg_count, static_cast<uint32_t>(w.params.size())});
     for (uint32_t k = 0; k < sm.arg_count; ++k) {
       const Expr& e = s.args[sm.first_arg + k];
+      // Random arguments (only the axiom has them) are drawn by derive() from the seed's
+      // stream; here they hold the value of the grammar's default seed.
       double v = e.kind == Expr::Kind::kConst ? e.value : 0.0;
       if (e.kind != Expr::Kind::kConst) {
         try {
-          v = g_.program.eval(e, nullptr, &header_rng_);
+          v = g_.program.eval(e, nullptr, &rng);
         } catch (const EvalError& err) {
           fail(err.loc, err.message);
         }
@@ -880,7 +881,13 @@ bool Parser::try_directive(const LogicalLine& line) {
       if (have_axiom_) fail(loc, "the axiom is given twice");
       have_axiom_ = true;
       Successor s = compile_successor(value, Scope{}, "the axiom");
-      g_.axiom = s.all_constant ? std::move(s.prebuilt) : evaluate_constant_word(s);
+      if (!s.all_constant) {
+        g_.axiom = evaluate_constant_word(s);
+        g_.axiom_successor = std::move(s);
+        g_.uses_random = true;
+      } else {
+        g_.axiom = std::move(s.prebuilt);
+      }
       g_.axiom_loc = loc;
       if (g_.axiom.size() == 0) fail(value.loc(), "the axiom is empty");
     }

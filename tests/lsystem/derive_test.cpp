@@ -147,6 +147,28 @@ TEST(Stochastic, TheSameSeedGivesTheSameWordAndAnotherSeedAnother) {
   EXPECT_NE(a, derive_text(g, other));
 }
 
+TEST(Stochastic, RandomAxiomArgumentsFollowTheSeed) {
+  const char* g = "axiom: X(uniform(0, 360))Y(rand())\n";
+  std::string a = derive_text(g, steps(0));
+  EXPECT_EQ(a, derive_text(g, steps(0)));
+  DeriveOptions other = steps(0);
+  other.seed = 2;
+  std::string b = derive_text(g, other);
+  EXPECT_NE(a, b);
+  // Two draws of one axiom are different numbers (one stream, not one draw each).
+  auto gr = parse_ok(g);
+  auto w = derive(gr, steps(0));
+  EXPECT_NE(w->params[0] / 360.0, w->params[1]);
+}
+
+TEST(Stochastic, RandomFunctionsInHeaderValuesAreAnError) {
+  Diagnostic d = testing::parse_error("#define A rand()\naxiom: F\n");
+  EXPECT_EQ(d.loc.line, 1u);
+  EXPECT_EQ(d.loc.column, 11u);
+  EXPECT_NE(d.message.find("random functions are not allowed"), std::string::npos);
+  EXPECT_NE(testing::parse_error("angle: uniform(1, 2)\naxiom: F\n").message.find("not allowed"), std::string::npos);
+}
+
 TEST(Stochastic, GaussDrawsHaveTheRequestedMeanAndSpread) {
   std::string axiom(4000, 'A');
   auto g = parse_ok("axiom: " + axiom + "\nA -> X(gauss(10, 2))\n");
