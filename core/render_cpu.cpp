@@ -153,7 +153,7 @@ class Renderer {
  private:
   void trace(const Ray& ray, PrimaryHit& h) {
     h.ray = ray;
-    BvhHit hit = intersect_nearest(geometry_.bvh, frusta_, ray, 0, kInf);
+    BvhHit hit = geometry_.accel->nearest(ray, 0, kInf);
     h.t = hit.hit_any() ? hit.hit.t : kInf;
     h.frustum = hit.frustum;
     h.geometric_normal = hit.hit.normal;
@@ -171,7 +171,7 @@ class Renderer {
     Ray shadow{p + (1e-7 * scale) * n_geometric, l};
     ++*shadow_rays;
     // The ground cannot shadow anything above it; only plants cast shadows.
-    return intersect_any(geometry_.bvh, frusta_, shadow, 0, kInf) ? 0.0 : 1.0;
+    return geometry_.accel->any(shadow, 0, kInf) ? 0.0 : 1.0;
   }
 
   glm::dvec3 lit(const glm::dvec3& albedo, const glm::dvec3& n, const glm::dvec3& n_geometric,
@@ -299,10 +299,10 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin,
     passes->push_back({"skin", seconds_since(start),
                        std::to_string(scene.plants.size()) + " plants, " + std::to_string(g.frusta.size()) + " frusta"});
   start = Clock::now();
-  g.bvh = build_bvh(g.frusta);
+  g.accel = std::make_unique<FrustumAccel>(g.frusta);
   if (passes)
-    passes->push_back({"bvh build", seconds_since(start),
-                       std::to_string(g.bvh.nodes.size()) + " nodes, depth " + std::to_string(g.bvh.depth)});
+    passes->push_back({"accel build", seconds_since(start),
+                       "Embree, " + std::to_string(g.accel->memory_bytes() / 1024) + " KiB"});
   return g;
 }
 

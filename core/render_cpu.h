@@ -1,5 +1,5 @@
 // render_cpu.h — the CPU reference ray caster (issue 3, sec. 2): one ray per sample
-// through a pinhole camera, conical frusta (skin.h) found through a BVH (bvh.h) and
+// through a pinhole camera, conical frusta (skin.h) found through Embree (frustum_accel.h) and
 // intersected exactly (ray_frustum.h), shaded under the scene's sun and sky over a
 // ground plane. The GPU ray caster must match it.
 //
@@ -35,9 +35,11 @@
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <memory>
 #include <vector>
 
 #include "core/bvh.h"
+#include "core/frustum_accel.h"
 #include "core/scene.h"
 #include "core/skin.h"
 
@@ -95,11 +97,11 @@ struct RenderResult {
 };
 
 // World-space geometry of a scene: every plant's skeleton transformed (position,
-// rotate_y_deg, scale) and skinned, one BVH over all frusta.
+// rotate_y_deg, scale) and skinned, one acceleration structure over all frusta.
 struct SceneGeometry {
   std::vector<Frustum> frusta;
   std::vector<uint32_t> plant_of_frustum;  // plant index of each frustum
-  Bvh bvh;
+  std::unique_ptr<FrustumAccel> accel;     // Embree user geometry over `frusta`
 };
 
 // The skeleton of `plant` placed in the world: p' = position + R_y(rotate_y_deg)·(scale·p),

@@ -1,9 +1,11 @@
 // bvh_test.cpp — the BVH finds exactly what testing every frustum finds.
 #include "core/bvh.h"
+#include "core/frustum_accel.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <glm/geometric.hpp>
 #include <limits>
 #include <random>
@@ -37,14 +39,13 @@ Skeleton random_skeleton(uint32_t seed, int chains, int joints_per_chain, double
   return sk;
 }
 
-void expect_bvh_matches_brute_force(const Skeleton& sk, uint32_t seed, double offset) {
-  SkinnedSkeleton skinned = skin_skeleton(sk);
-  ASSERT_GT(skinned.frusta.size(), 50u);
-  std::span<const Frustum> frusta(skinned.frusta);
-  Bvh bvh = build_bvh(frusta);
-  ASSERT_FALSE(bvh.nodes.empty());
-  EXPECT_LT(bvh.depth, kBvhStackSize);
+// Nearest and any-hit queries of one acceleration structure over `frusta`.
+struct Queries {
+  std::function<BvhHit(const Ray&, double, double)> nearest;
+  std::function<bool(const Ray&, double, double)> any;
+};
 
+void expect_matches_brute_force(std::span<const Frustum> frusta, const Queries& q, uint32_t seed, double offset) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
   const double inf = std::numeric_limits<double>::infinity();
@@ -62,17 +63,57 @@ void expect_bvh_matches_brute_force(const Skeleton& sk, uint32_t seed, double of
       FrustumHit h = intersect_frustum(ray, frusta[f].shape, 0, inf);
       if (h.hit() && (!best.hit() || h.t < best.t)) best = h, best_index = f;
     }
-    BvhHit got = intersect_nearest(bvh, frusta, ray, 0, inf);
+    BvhHit got = q.nearest(ray, 0, inf);
     ASSERT_EQ(got.hit_any(), best.hit()) << "ray " << r;
-    EXPECT_EQ(intersect_any(bvh, frusta, ray, 0, inf), best.hit()) << "ray " << r;
+    EXPECT_EQ(q.any(ray, 0, inf), best.hit()) << "ray " << r;
     if (!best.hit()) continue;
     ++hits;
     EXPECT_EQ(got.hit.t, best.t) << "ray " << r;
     EXPECT_EQ(got.frustum, best_index) << "ray " << r;
     // A shadow query that stops short of the nearest hit sees nothing.
-    EXPECT_FALSE(intersect_any(bvh, frusta, ray, 0, best.t * 0.999)) << "ray " << r;
+    EXPECT_FALSE(q.any(ray, 0, best.t * 0.999)) << "ray " << r;
   }
   EXPECT_GT(hits, 400);  // the rays aim at the plants, so many hit
+}
+
+void expect_bvh_matches_brute_force(const Skeleton& sk, uint32_t seed, double offset) {
+  SkinnedSkeleton skinned = skin_skeleton(sk);
+  ASSERT_GT(skinned.frusta.size(), 50u);
+  std::span<const Frustum> frusta(skinned.frusta);
+  Bvh bvh = build_bvh(frusta);
+  ASSERT_FALSE(bvh.nodes.empty());
+  EXPECT_LT(bvh.depth, kBvhStackSize);
+  expect_matches_brute_force(
+      frusta,
+      {[&](const Ray& r, double a, double b) { return intersect_nearest(bvh, frusta, r, a, b); },
+       [&](const Ray& r, double a, double b) { return intersect_any(bvh, frusta, r, a, b); }},
+      seed, offset);
+}
+
+void expect_accel_matches_brute_force(const Skeleton& sk, uint32_t seed, double offset) {
+  SkinnedSkeleton skinned = skin_skeleton(sk);
+  std::span<const Frustum> frusta(skinned.frusta);
+  FrustumAccel accel(frusta);
+  EXPECT_GT(accel.memory_bytes(), 0u);
+  expect_matches_brute_force(
+      frusta,
+      {[&](const Ray& r, double a, double b) { return accel.nearest(r, a, b); },
+       [&](const Ray& r, double a, double b) { return accel.any(r, a, b); }},
+      seed, offset);
+}
+
+TEST(FrustumAccel, EmbreeFindsExactlyWhatTestingEveryFrustumFinds) {
+  expect_accel_matches_brute_force(random_skeleton(7, 40, 6, 0), 11, 0);
+}
+
+TEST(FrustumAccel, EmbreeStaysExactFarFromTheOrigin) {
+  expect_accel_matches_brute_force(random_skeleton(8, 40, 6, 1e6), 12, 1e6);
+}
+
+TEST(FrustumAccel, AnEmptySceneHitsNothing) {
+  FrustumAccel accel(std::span<const Frustum>{});
+  EXPECT_FALSE(accel.nearest(Ray{{0, 0, 0}, {0, 1, 0}}, 0, 1e9).hit_any());
+  EXPECT_FALSE(accel.any(Ray{{0, 0, 0}, {0, 1, 0}}, 0, 1e9));
 }
 
 TEST(Bvh, NodesAreThirtyTwoBytes) { EXPECT_EQ(sizeof(BvhNode), 32u); }
