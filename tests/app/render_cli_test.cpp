@@ -106,7 +106,7 @@ TEST(RenderCli, SceneFileRendersItsPlantsRelativeToTheScene) {
   ASSERT_TRUE(in);
   EXPECT_EQ(in->spec().width, 48);
   // --verbose lists the passes.
-  for (const char* pass : {"skin", "bvh build", "trace", "shade", "write"})
+  for (const char* pass : {"skin", "accel build", "trace", "shade", "write"})
     EXPECT_NE(r.err.find(pass), std::string::npos) << pass << "\n" << describe(r);
 }
 
