@@ -143,29 +143,8 @@ void append_skeleton_document(std::string& out, const Skeleton& sk) {
   }
   out += "}},\"chains\":[";
   for (size_t c = 0; c < sk.chains.size(); ++c) {
-    const Chain& chain = sk.chains[c];
     if (c) out += ',';
-    out += "{\"parent\":";
-    if (chain.parent) {
-      out += '[';
-      append_json_uint64(out, chain.parent->chain);
-      out += ',';
-      append_json_uint64(out, chain.parent->joint);
-      out += ']';
-    } else {
-      out += "null";
-    }
-    out += ",\"joints\":[";
-    for (uint32_t j = 0; j < chain.joint_count; ++j) {
-      const Joint& joint = sk.joints[chain.first_joint + j];
-      if (j) out += ',';
-      const double v[4] = {joint.position_m[0], joint.position_m[1], joint.position_m[2], joint.radius_m};
-      out += '[';
-      for (double x : v) append_json_number(out, x), out += ',';
-      append_json_uint64(out, joint.material);
-      out += ']';
-    }
-    out += "]}";
+    append_chain_json(out, sk, c, true);
   }
   out += ']';
 }

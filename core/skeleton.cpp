@@ -484,6 +484,34 @@ std::optional<SkeletonError> validate_skeleton(const Skeleton& skeleton) {
   return std::nullopt;
 }
 
+void append_chain_json(std::string& out, const Skeleton& skeleton, size_t c, bool compact) {
+  const Chain& chain = skeleton.chains[c];
+  out += compact ? "{\"parent\":" : "{\"parent\": ";
+  if (chain.parent) {
+    out += '[';
+    append_json_uint64(out, chain.parent->chain);
+    out += ',';
+    append_json_uint64(out, chain.parent->joint);
+    out += ']';
+  } else {
+    out += "null";
+  }
+  out += compact ? ",\"joints\":[" : ", \"joints\": [";
+  for (uint32_t j = 0; j < chain.joint_count; ++j) {
+    const Joint& joint = skeleton.joints[chain.first_joint + j];
+    out += j == 0 ? "[" : ",[";
+    for (const double coordinate : joint.position_m) {
+      append_json_number(out, coordinate);
+      out += ',';
+    }
+    append_json_number(out, joint.radius_m);
+    out += ',';
+    append_json_uint64(out, joint.material);
+    out += ']';
+  }
+  out += "]}";
+}
+
 std::string write_skeleton_json(const Skeleton& skeleton) {
   assert(!validate_skeleton(skeleton) &&
          "write_skeleton_json: the skeleton breaks an invariant; see validate_skeleton");
@@ -512,31 +540,9 @@ std::string write_skeleton_json(const Skeleton& skeleton) {
   out += "}},\n  \"chains\": [";
   if (!skeleton.chains.empty()) out += '\n';
   for (size_t c = 0; c < skeleton.chains.size(); ++c) {
-    const Chain& chain = skeleton.chains[c];
-    out += "    {\"parent\": ";
-    if (chain.parent) {
-      out += '[';
-      append_json_uint64(out, chain.parent->chain);
-      out += ',';
-      append_json_uint64(out, chain.parent->joint);
-      out += ']';
-    } else {
-      out += "null";
-    }
-    out += ", \"joints\": [";
-    for (uint32_t j = 0; j < chain.joint_count; ++j) {
-      const Joint& joint = skeleton.joints[chain.first_joint + j];
-      out += j == 0 ? "[" : ",[";
-      for (const double coordinate : joint.position_m) {
-        append_json_number(out, coordinate);
-        out += ',';
-      }
-      append_json_number(out, joint.radius_m);
-      out += ',';
-      append_json_uint64(out, joint.material);
-      out += ']';
-    }
-    out += c + 1 < skeleton.chains.size() ? "]},\n" : "]}\n";
+    out += "    ";
+    append_chain_json(out, skeleton, c, false);
+    out += c + 1 < skeleton.chains.size() ? ",\n" : "\n";
   }
   out += skeleton.chains.empty() ? "]\n}\n" : "  ]\n}\n";
   return out;

@@ -79,6 +79,12 @@ std::optional<SkeletonError> validate_skeleton(const Skeleton& skeleton);
 // form that reads back to the same double (std::to_chars), "\n" line endings.
 std::string write_skeleton_json(const Skeleton& skeleton);
 
+// Appends chain `c` as the skeleton document writes it —
+// {"parent": [chain,joint] | null, "joints": [[x,y,z,radius,material],...]} — with the
+// same numbers; `compact` drops the spaces after ':' and ',' (for embedding, e.g. in
+// glTF extras). One writer for every place a chain is serialised.
+void append_chain_json(std::string& out, const Skeleton& skeleton, size_t c, bool compact);
+
 // Result of reading a skeleton file: the skeleton, or the first error found.
 struct SkeletonReadResult {
   std::optional<Skeleton> skeleton;
