@@ -26,8 +26,18 @@ struct QueryContext {
   double t_min;
   double t_best;
   BvhHit best;
-  bool any_only;
 };
+
+// A fresh query for `ray` over `frusta` in (t_min, t_max).
+QueryContext start_query(const Frustum* frusta, const Ray& ray, double t_min, double t_max) {
+  QueryContext q{};
+  rtcInitIntersectContext(&q.embree);
+  q.frusta = frusta;
+  q.ray = ray;
+  q.t_min = t_min;
+  q.t_best = t_max;
+  return q;
+}
 
 struct GeometryData {
   const Frustum* frusta;
@@ -152,13 +162,7 @@ FrustumAccel::~FrustumAccel() {
 }
 
 BvhHit FrustumAccel::nearest(const Ray& ray, double t_min, double t_max) const {
-  QueryContext q{};
-  rtcInitIntersectContext(&q.embree);
-  q.frusta = impl_->data.frusta;
-  q.ray = ray;
-  q.t_min = t_min;
-  q.t_best = t_max;
-  q.any_only = false;
+  QueryContext q = start_query(impl_->data.frusta, ray, t_min, t_max);
   RTCRayHit rh{};
   rh.ray = impl_->embree_ray(ray, t_min, t_max);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -167,13 +171,7 @@ BvhHit FrustumAccel::nearest(const Ray& ray, double t_min, double t_max) const {
 }
 
 bool FrustumAccel::any(const Ray& ray, double t_min, double t_max) const {
-  QueryContext q{};
-  rtcInitIntersectContext(&q.embree);
-  q.frusta = impl_->data.frusta;
-  q.ray = ray;
-  q.t_min = t_min;
-  q.t_best = t_max;
-  q.any_only = true;
+  QueryContext q = start_query(impl_->data.frusta, ray, t_min, t_max);
   RTCRay r = impl_->embree_ray(ray, t_min, t_max);
   rtcOccluded1(impl_->scene, &q.embree, &r);
   return q.best.hit_any();
