@@ -30,6 +30,8 @@
 #include <vector>
 
 #include "app/cli.h"
+#include "core/bvh.h"
+#include "core/frustum_accel.h"
 #include "core/render_cpu.h"
 #include "core/scene.h"
 #include "core/tessellate.h"

@@ -1,6 +1,8 @@
 // render_cpu.cpp — the CPU reference ray caster (see render_cpu.h for the shading model).
 #include "core/render_cpu.h"
 
+#include "core/frustum_tracer.h"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -89,9 +91,7 @@ glm::dvec3 sun_sample(const Sun& sun, const glm::dvec3& sun_direction, double co
 // What one primary sample saw (the trace pass's output, the shade pass's input).
 struct PrimaryHit {
   Ray ray;
-  double t = kInf;           // plant hit; kInf: none
-  uint32_t frustum = 0;
-  glm::dvec3 geometric_normal{0, 0, 0};
+  SurfaceHit surface;        // plant hit (surface.hit() false: none)
   double ground_t = kInf;    // ground hit; kInf: none
   uint64_t rng_state = 0;
 };
@@ -100,7 +100,7 @@ class Renderer {
  public:
   Renderer(const Scene& scene, const SceneGeometry& geometry, const RenderOptions& options)
       : scene_(scene), geometry_(geometry), options_(options), frame_(camera_frame(scene)),
-        frusta_(geometry.frusta), sun_direction_(glm::normalize(scene.sun.direction)),
+        tracer_(*geometry.tracer), sun_direction_(glm::normalize(scene.sun.direction)),
         sun_frame_(axis_frame(sun_direction_)),
         cos_alpha_(std::cos(scene.sun.angular_radius_deg * kPi / 180)),
         sun_on_(scene.sun.radiance.x > 0 || scene.sun.radiance.y > 0 || scene.sun.radiance.z > 0) {}
@@ -153,14 +153,11 @@ class Renderer {
  private:
   void trace(const Ray& ray, PrimaryHit& h) {
     h.ray = ray;
-    BvhHit hit = geometry_.accel->nearest(ray, 0, kInf);
-    h.t = hit.hit_any() ? hit.hit.t : kInf;
-    h.frustum = hit.frustum;
-    h.geometric_normal = hit.hit.normal;
+    h.surface = tracer_.nearest(ray, 0, kInf);
     h.ground_t = kInf;
     if (ray.direction.y < 0 && ray.origin.y > scene_.ground.height) {
       double t = (scene_.ground.height - ray.origin.y) / ray.direction.y;
-      if (t < h.t) h.ground_t = t;
+      if (t < h.surface.t) h.ground_t = t;
     }
   }
 
@@ -171,7 +168,7 @@ class Renderer {
     Ray shadow{p + (1e-7 * scale) * n_geometric, l};
     ++*shadow_rays;
     // The ground cannot shadow anything above it; only plants cast shadows.
-    return geometry_.accel->any(shadow, 0, kInf) ? 0.0 : 1.0;
+    return tracer_.any(shadow, 0, kInf) ? 0.0 : 1.0;
   }
 
   glm::dvec3 lit(const glm::dvec3& albedo, const glm::dvec3& n, const glm::dvec3& n_geometric,
@@ -201,15 +198,14 @@ class Renderer {
       const glm::dvec3 up(0, 1, 0);
       return lit(scene_.ground.albedo, up, up, p, view, false, rng, shadow_rays);
     }
-    if (h.t == kInf) return scene_.sky;
-    const Frustum& f = frusta_[h.frustum];
-    const glm::dvec3 p = h.ray.origin + h.t * h.ray.direction;
-    glm::dvec3 n = surface_normal(f, p, NormalMode::interpolated);
-    glm::dvec3 ng = h.geometric_normal;
+    const SurfaceHit& s = h.surface;
+    if (!s.hit()) return scene_.sky;
+    glm::dvec3 n = s.shading_normal;
+    glm::dvec3 ng = s.geometric_normal;
     if (glm::dot(ng, view) < 0) ng = -ng;   // seen from inside: light the side we see
     if (glm::dot(n, view) < 0) n = -n;
-    const ScenePlant& plant = scene_.plants[geometry_.plant_of_frustum[h.frustum]];
-    return lit(material_albedo(plant, f.material), n, ng, p, view, true, rng, shadow_rays);
+    const ScenePlant& plant = scene_.plants[s.plant];
+    return lit(material_albedo(plant, s.material), n, ng, s.position, view, true, rng, shadow_rays);
   }
 
   void write_aovs(RenderImage& image, uint32_t x, uint32_t y, const PrimaryHit* centre_hit) {
@@ -218,31 +214,27 @@ class Renderer {
       trace(frame_ray(frame_, x + 0.5, y + 0.5), local);
       centre_hit = &local;
     }
-    const PrimaryHit& h = *centre_hit;
+    const SurfaceHit& s = centre_hit->surface;
     const size_t pixel = static_cast<size_t>(y) * scene_.width + x;
-    const bool hit = h.t < kInf;
-    glm::dvec3 n(0), p(0);
-    SurfaceUV uv;
-    const Frustum* f = hit ? &frusta_[h.frustum] : nullptr;
+    const bool hit = s.hit();
+    glm::dvec3 n(0);
     if (hit) {
-      p = h.ray.origin + h.t * h.ray.direction;
-      n = surface_normal(*f, p, NormalMode::interpolated);
-      if (glm::dot(n, h.ray.direction) > 0) n = -n;
+      n = s.shading_normal;
+      if (glm::dot(n, centre_hit->ray.direction) > 0) n = -n;
     }
     if (!image.depth.empty())
-      image.depth[pixel] = hit ? static_cast<float>(h.t * glm::length(h.ray.direction))
+      image.depth[pixel] = hit ? static_cast<float>(s.t * glm::length(centre_hit->ray.direction))
                                : std::numeric_limits<float>::infinity();
     if (!image.normal.empty())
       for (int k = 0; k < 3; ++k) image.normal[pixel * 3 + k] = static_cast<float>(n[k]);
     if (!image.uv.empty()) {
-      if (hit) uv = surface_uv(*f, p);
-      image.uv[pixel * 2 + 0] = hit ? static_cast<float>(uv.u) : 0.0f;
-      image.uv[pixel * 2 + 1] = hit ? static_cast<float>(uv.v_m) : 0.0f;
+      image.uv[pixel * 2 + 0] = hit ? static_cast<float>(s.u) : 0.0f;
+      image.uv[pixel * 2 + 1] = hit ? static_cast<float>(s.v_m) : 0.0f;
     }
     if (!image.id.empty()) {
-      image.id[pixel * 3 + 0] = hit ? static_cast<float>(geometry_.plant_of_frustum[h.frustum]) : -1.0f;
-      image.id[pixel * 3 + 1] = hit ? static_cast<float>(f->chain) : -1.0f;
-      image.id[pixel * 3 + 2] = hit ? static_cast<float>(f->segment) : -1.0f;
+      image.id[pixel * 3 + 0] = hit ? static_cast<float>(s.plant) : -1.0f;
+      image.id[pixel * 3 + 1] = hit ? static_cast<float>(s.chain) : -1.0f;
+      image.id[pixel * 3 + 2] = hit ? static_cast<float>(s.segment) : -1.0f;
     }
   }
 
@@ -250,7 +242,7 @@ class Renderer {
   const SceneGeometry& geometry_;
   const RenderOptions& options_;
   const CameraFrame frame_;
-  std::span<const Frustum> frusta_;
+  const SceneTracer& tracer_;
   const glm::dvec3 sun_direction_;
   const AxisFrame sun_frame_;
   const double cos_alpha_;
@@ -287,7 +279,7 @@ Skeleton place_plant(const ScenePlant& plant) {
 }
 
 SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin,
-                                   std::vector<RenderPass>* passes) {
+                                   const GeometryOptions& options, std::vector<RenderPass>* passes) {
   SceneGeometry g;
   Clock::time_point start = Clock::now();
   for (uint32_t p = 0; p < scene.plants.size(); ++p) {
@@ -299,10 +291,16 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin,
     passes->push_back({"skin", seconds_since(start),
                        std::to_string(scene.plants.size()) + " plants, " + std::to_string(g.frusta.size()) + " frusta"});
   start = Clock::now();
-  g.accel = std::make_unique<FrustumAccel>(g.frusta);
+  switch (options.kind) {
+    case GeometryKind::frusta:
+      g.tracer = std::make_unique<FrustumTracer>(g.frusta, g.plant_of_frustum);
+      break;
+    case GeometryKind::mesh:
+      throw std::logic_error("build_scene_geometry: mesh geometry is not built yet");
+  }
   if (passes)
     passes->push_back({"accel build", seconds_since(start),
-                       "Embree, " + std::to_string(g.accel->memory_bytes() / 1024) + " KiB"});
+                       g.tracer->describe() + ", " + std::to_string(g.tracer->memory_bytes() / 1024) + " KiB"});
   return g;
 }
 
@@ -312,7 +310,7 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   RenderResult result;
   for (const ScenePlant& plant : scene.plants)
     if (!plant.skeleton) throw std::logic_error("render_cpu: a plant has no skeleton (call grow_scene_plants)");
-  SceneGeometry geometry = build_scene_geometry(scene, options.skin, &result.passes);
+  SceneGeometry geometry = build_scene_geometry(scene, options.skin, options.geometry, &result.passes);
   result.frusta = geometry.frusta.size();
 
   RenderImage& image = result.image;

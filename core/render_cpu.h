@@ -38,10 +38,9 @@
 #include <memory>
 #include <vector>
 
-#include "core/bvh.h"
-#include "core/frustum_accel.h"
 #include "core/scene.h"
 #include "core/skin.h"
+#include "core/surface.h"
 
 namespace sylva {
 
@@ -61,6 +60,20 @@ inline constexpr double kMaterialAlbedo[][3] = {
     {0.85, 0.75, 0.35},  // 3 flowers, fruit
 };
 
+// Which geometry stands for the plants (issue 3: the analytic frusta are the reference,
+// the tessellated meshes the polygon baseline).
+enum class GeometryKind : uint8_t {
+  frusta,  // analytic conical frusta (frustum_tracer.h), relief-mapped where asked
+  mesh,    // the frusta tessellated at GS level mesh_level (tessellate.h), in Embree
+};
+
+struct GeometryOptions {
+  GeometryKind kind = GeometryKind::frusta;
+  int mesh_level = 2;   // m: 16·4^m triangles per segment
+  bool cull = true;     // leave out plants that can affect no pixel (outside the view
+                        // frustum and casting no shadow into it)
+};
+
 struct RenderOptions {
   uint32_t spp = 1;                             // samples per pixel, >= 1
   uint32_t aovs = 0;                            // AovFlags
@@ -68,6 +81,7 @@ struct RenderOptions {
   const std::atomic<bool>* cancel = nullptr;    // set (e.g. by SIGINT) to stop early
   bool progress = false;                        // progress bar on stderr after 1 s
   SkinOptions skin;                             // how plants are skinned
+  GeometryOptions geometry;                     // what stands for the plants
 };
 
 // Float images, row-major from the top-left pixel, channels interleaved.
@@ -97,11 +111,12 @@ struct RenderResult {
 };
 
 // World-space geometry of a scene: every plant's skeleton transformed (position,
-// rotate_y_deg, scale) and skinned, one acceleration structure over all frusta.
+// rotate_y_deg, scale) and skinned, and what the renderer traces: the frusta themselves
+// or a mesh made from them (GeometryOptions).
 struct SceneGeometry {
   std::vector<Frustum> frusta;
   std::vector<uint32_t> plant_of_frustum;  // plant index of each frustum
-  std::unique_ptr<FrustumAccel> accel;     // Embree user geometry over `frusta`
+  std::unique_ptr<SceneTracer> tracer;     // over `frusta` (or a mesh made from them)
 };
 
 // The skeleton of `plant` placed in the world: p' = position + R_y(rotate_y_deg)·(scale·p),
@@ -110,6 +125,7 @@ Skeleton place_plant(const ScenePlant& plant);
 
 // Skins and indexes every plant (each plant's skeleton must be set: grow_scene_plants).
 SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin,
+                                   const GeometryOptions& geometry = {},
                                    std::vector<RenderPass>* passes = nullptr);
 
 // The primary ray through continuous pixel position (x, y) in [0, width] × [0, height]
