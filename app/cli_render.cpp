@@ -6,18 +6,13 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
-#include <glm/common.hpp>
 #include <iostream>
-#include <limits>
 
 #include "app/cli.h"
-#include "core/gltf_export.h"
+#include "app/render_input.h"
 #include "core/image_io.h"
 #include "core/render_cpu.h"
 #include "core/scene.h"
-#include "core/turtle.h"
-#include "lsystem/derive.h"
-#include "lsystem/grammar.h"
 
 namespace sylva::cli {
 
@@ -70,10 +65,6 @@ struct RenderArgs {
   bool verbose = false;
   bool grammar_flags = false;  // -n, --seed, -D or --max-modules given
 };
-
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
 
 uint32_t parse_size(const std::string& flag, const std::string& v, uint32_t max) {
   auto n = parse_u64(v);
@@ -175,11 +166,9 @@ int run_render(const std::vector<std::string>& args) {
   }
   const std::string& input = a.grammar.grammar;
   const std::string& output = a.grammar.output;
-  const bool is_scene = ends_with(input, ".scene.json"), is_skeleton = ends_with(input, ".skel.json"),
-             is_grammar = ends_with(input, ".lsys"), is_gltf = ends_with(input, ".glb") || ends_with(input, ".gltf");
-  if (!is_scene && !is_skeleton && !is_grammar && !is_gltf)
+  if (!is_render_input(input))
     throw UsageError{"INPUT '" + input + "' must end in .lsys, .skel.json, .scene.json, .glb or .gltf"};
-  if (a.grammar_flags && !is_grammar)
+  if (a.grammar_flags && !is_grammar_input(input))
     throw UsageError{"-n, --seed, -D and --max-modules apply to a .lsys grammar only"};
   if (a.backend == "gl")
     throw UsageError{"--backend gl: the OpenGL backend is not available yet (use --backend cpu or auto)"};
@@ -190,90 +179,10 @@ int run_render(const std::vector<std::string>& args) {
   SigintGuard sigint;
   g_interrupted.store(false);
   std::vector<RenderPass> passes;
+  auto loaded = load_render_input(a.grammar, a.width, a.height, passes);
+  if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
+  Scene scene = std::move(std::get<Scene>(loaded));
   auto start = std::chrono::steady_clock::now();
-  Scene scene;
-  if (is_scene) {
-    SceneReadResult read = read_scene_file(input);
-    if (read.error) {
-      std::cerr << read.error->format() << "\n";
-      return kInputError;
-    }
-    scene = std::move(*read.scene);
-    passes.push_back({"read scene", seconds_since(start), ""});
-    start = std::chrono::steady_clock::now();
-    if (auto error = grow_scene_plants(scene, a.grammar.max_modules)) {
-      std::cerr << *error;
-      if (!error->empty() && error->back() != '\n') std::cerr << "\n";
-      return kInputError;
-    }
-    passes.push_back({"grow", seconds_since(start), std::to_string(scene.plants.size()) + " plants"});
-  } else if (is_gltf) {
-    // A file written by `sylva export`: its skeletons come back exactly from node extras.
-    GltfImportResult imported = import_gltf_skeletons(input);
-    if (imported.error) {
-      std::cerr << *imported.error << "\n";
-      return kInputError;
-    }
-    const uint32_t width = a.width.value_or(1024), height = a.height.value_or(768);
-    scene = default_scene_for(imported.plants.front().skeleton, width, height);
-    scene.plants.clear();
-    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
-    double lowest = 0;
-    for (GltfPlant& p : imported.plants) {
-      ScenePlant plant;
-      plant.skeleton = std::move(p.skeleton);
-      plant.position = {p.position_m[0], p.position_m[1], p.position_m[2]};
-      plant.rotate_y_deg = p.rotate_y_deg;
-      plant.scale = p.scale;
-      const Skeleton placed = place_plant(plant);
-      const SkeletonBounds b = skeleton_bounds(placed);
-      lo = glm::min(lo, b.lo);
-      hi = glm::max(hi, b.hi);
-      for (const Joint& j : placed.joints) lowest = std::min(lowest, j.position_m[1]);
-      scene.plants.push_back(std::move(plant));
-    }
-    scene.ground.height = lowest;
-    scene.camera = framing_camera(lo, hi, width, height);
-    passes.push_back({"read glTF", seconds_since(start), std::to_string(scene.plants.size()) + " plants"});
-  } else {
-    Skeleton skeleton;
-    if (is_skeleton) {
-      SkeletonReadResult read = read_skeleton_file(input);
-      if (read.error) {
-        std::cerr << read.error->format() << "\n";
-        return kInputError;
-      }
-      skeleton = std::move(*read.skeleton);
-      passes.push_back({"read skeleton", seconds_since(start), ""});
-    } else {
-      lsys::ParseOptions po;
-      po.define_overrides = a.grammar.defines;
-      auto g = lsys::load_grammar(input, po);
-      if (!g) {
-        const lsys::Diagnostic& d = g.error();
-        if (d.loc.line == 0 && d.message.rfind("-D ", 0) == 0) {
-          std::cerr << "sylva render: error: " << d.message << "\n";
-          return kUsageError;
-        }
-        std::cerr << d.format();
-        return kInputError;
-      }
-      lsys::DeriveOptions o;
-      o.steps = a.grammar.steps;
-      o.seed = a.grammar.seed;
-      o.max_modules = a.grammar.max_modules;
-      auto grown = grow(*g, o, input, a.grammar.defines);
-      if (!grown) {
-        std::cerr << grown.error().format();
-        return kInputError;
-      }
-      skeleton = std::move(grown->skeleton);
-      passes.push_back({"grow", seconds_since(start), std::to_string(grown->modules) + " modules"});
-    }
-    scene = default_scene_for(skeleton, a.width.value_or(1024), a.height.value_or(768));
-  }
-  if (a.width) scene.width = *a.width;
-  if (a.height) scene.height = *a.height;
 
   RenderOptions options;
   options.spp = a.spp;

@@ -11,6 +11,7 @@ packages=(
   libglm-dev libglfw3-dev libimgui-dev libopenimageio-dev libtinygltf-dev
   # The Python module (built for /usr/bin/python3) and its tests.
   python3 python3-dev pybind11-dev python3-numpy python3-pytest
+  fonts-dejavu-core  # the text of the benchmarks' plots (core/plot.h)
 )
 # Node.js runs the Khronos glTF validator; any npm already on the machine will do.
 command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
