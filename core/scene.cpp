@@ -260,17 +260,26 @@ Camera framing_camera(const glm::dvec3& lo, const glm::dvec3& hi, uint32_t width
   Camera c;
   c.fov_y_deg = 35;
   const glm::dvec3 centre = 0.5 * (lo + hi);
-  const double radius = std::max(0.5 * glm::length(hi - lo), 1e-3);
   const double deg = std::numbers::pi / 180;
   const double elevation = 12 * deg, azimuth = 35 * deg;
   const glm::dvec3 toward_eye(std::cos(elevation) * std::sin(azimuth), std::sin(elevation),
                               std::cos(elevation) * std::cos(azimuth));
-  // Half angle of the narrower field of view; the sphere fits when sin(half) = r / d.
-  const double half_y = 0.5 * c.fov_y_deg * deg;
+  const glm::dvec3 right = glm::normalize(glm::cross(-toward_eye, glm::dvec3(0, 1, 0)));
+  const glm::dvec3 up = glm::cross(right, -toward_eye);
+  // The box's 8 corners fit the field of view with 8% margin: a corner q (relative to
+  // the centre) at camera distance d − q·w is inside when |q·right| <= kx·(d − q·w) and
+  // |q·up| <= ky·(d − q·w), so d is the largest of q·w + |q·right|/kx, q·w + |q·up|/ky.
   const double aspect = static_cast<double>(width) / std::max<uint32_t>(height, 1);
-  const double half_x = std::atan(std::tan(half_y) * aspect);
-  const double half = std::min(half_y, half_x);
-  const double distance = 1.08 * radius / std::sin(half);
+  const double ky = std::tan(0.5 * c.fov_y_deg * deg) / 1.08, kx = ky * aspect;
+  const double size = std::max(glm::length(hi - lo), 1e-3);
+  double distance = 0;
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+    const glm::dvec3 q = corner - centre;
+    const double along = glm::dot(q, toward_eye);
+    distance = std::max({distance, along + std::abs(glm::dot(q, right)) / kx,
+                         along + std::abs(glm::dot(q, up)) / ky, along + 0.05 * size});
+  }
   c.target = centre;
   c.eye = centre + distance * toward_eye;
   c.up = {0, 1, 0};

@@ -131,10 +131,22 @@ TEST(Scene, DefaultSceneFramesTheSkeletonFromAThreeQuarterView) {
   EXPECT_GT(s.camera.eye.x, 0);              // front right, above
   EXPECT_GT(s.camera.eye.z, s.camera.eye.x);
   EXPECT_GT(s.camera.eye.y, s.camera.target.y);
-  // The bounding sphere fits the vertical field of view.
-  double d = glm::length(s.camera.eye - s.camera.target);
-  double r = 0.5 * glm::length(glm::dvec3(0.6, 6.6, 0.6));
-  EXPECT_LT(r / d, std::sin(0.5 * s.camera.fov_y_deg * 3.14159265358979 / 180));
+  // Every corner of the bounds (joints grown by radii) projects inside the image, and the
+  // tightest one touches the 8% margin: the plant fills the frame.
+  const glm::dvec3 lo(-0.3, -0.3, -0.3), hi(0.3, 6.3, 0.3);
+  const glm::dvec3 fwd = glm::normalize(s.camera.target - s.camera.eye);
+  const glm::dvec3 right = glm::normalize(glm::cross(fwd, s.camera.up)), up = glm::cross(right, fwd);
+  const double ty = std::tan(0.5 * s.camera.fov_y_deg * 3.14159265358979 / 180), tx = ty * 320 / 240;
+  double fill = 0;
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec3 c((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+    const glm::dvec3 q = c - s.camera.eye;
+    const double z = glm::dot(q, fwd);
+    ASSERT_GT(z, 0);
+    fill = std::max({fill, std::abs(glm::dot(q, right)) / (z * tx), std::abs(glm::dot(q, up)) / (z * ty)});
+  }
+  EXPECT_LE(fill, 1 / 1.08 + 1e-9);
+  EXPECT_GT(fill, 1 / 1.08 - 1e-9);
 }
 
 }  // namespace
