@@ -7,7 +7,10 @@
 //   embree-user      Embree user geometry: Embree's BVH calling the same intersect_frustum
 //   embree-curves    Embree's native round linear curves on the same skeleton (cones with
 //                    spheres at the joints: a different surface at the joints)
-//   embree-mesh-mN   Embree triangles: the frusta tessellated at GS level N (tessellate.h)
+//   embree-mesh-mN   Embree triangles: the frusta tessellated at GS level N (tessellate.h),
+//                    traced as the renderer traces them (MeshTracer, mesh_accel.h: the hit
+//                    recomputed and described in double); bytes: the mesh's arrays plus
+//                    Embree's structure
 // For each: rays per second on 1 thread and on all threads, the depth error against the
 // analytic reference (sylva-bvh: hit/miss disagreement and RMS distance error over pixels
 // both hit, relative to the scene's size), and bytes per segment of the structure.
@@ -32,6 +35,7 @@
 #include "app/cli.h"
 #include "core/bvh.h"
 #include "core/frustum_accel.h"
+#include "core/mesh_accel.h"
 #include "core/render_cpu.h"
 #include "core/scene.h"
 #include "core/tessellate.h"
@@ -269,27 +273,26 @@ int run_bench_raycast(const std::vector<std::string>& args) {
     rtcAttachGeometry(s, geom);
     rtcReleaseGeometry(geom);
   });
+  rtcReleaseDevice(device);
   SkinnedSkeleton skinned;
   skinned.frusta = geometry.frusta;
   for (int m = 0; m <= max_level; ++m) {
     TessellateOptions o;
     o.level = m;
-    TriangleMesh mesh = tessellate(skinned, o);
-    run_embree("embree-mesh-m" + std::to_string(m), [&](RTCScene s) {
-      RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-      auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                            3 * sizeof(float), mesh.positions.size()));
-      for (size_t i = 0; i < mesh.positions.size(); ++i)
-        for (int k = 0; k < 3; ++k) v[3 * i + k] = static_cast<float>(mesh.positions[i][k]);
-      auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                 3 * sizeof(unsigned), mesh.triangle_count()));
-      std::copy(mesh.indices.begin(), mesh.indices.end(), idx);
-      rtcCommitGeometry(geom);
-      rtcAttachGeometry(s, geom);
-      rtcReleaseGeometry(geom);
-    });
+    const MeshTracer mesh(tessellate(skinned, o), geometry.frusta, geometry.plant_of_frustum, m);
+    MethodResult r{"embree-mesh-m" + std::to_string(m)};
+    auto trace = [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        const SurfaceHit h = mesh.nearest(rays[i], 0, std::numeric_limits<double>::infinity());
+        depth[i] = h.hit() ? h.t * glm::length(rays[i].direction) : std::numeric_limits<double>::infinity();
+      }
+    };
+    r.rays_per_s_1 = static_cast<double>(rays.size()) / time_trace(rays.size(), 1, repeats, trace);
+    r.rays_per_s_all = static_cast<double>(rays.size()) / time_trace(rays.size(), all, repeats, trace);
+    compare(reference, depth, scale, r);
+    r.bytes_per_segment = static_cast<double>(mesh.memory_bytes()) / static_cast<double>(segments);
+    results.push_back(r);
   }
-  rtcReleaseDevice(device);
 
   std::printf("%-16s %14s %14s %12s %14s %12s\n", "method", "Mrays/s 1 thr", "Mrays/s all", "hit/miss",
               "depth RMS", "B/segment");

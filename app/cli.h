@@ -43,6 +43,8 @@ int run_grow(const std::vector<std::string>& args);
 int run_bench(const std::vector<std::string>& args);
 // `sylva bench raycast` (bench_raycast.cpp), dispatched by run_bench.
 int run_bench_raycast(const std::vector<std::string>& args);
+// `sylva bench geometry` (bench_geometry.cpp), dispatched by run_bench.
+int run_bench_geometry(const std::vector<std::string>& args);
 int run_render(const std::vector<std::string>& args);
 int run_export(const std::vector<std::string>& args);
 

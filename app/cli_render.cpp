@@ -1,5 +1,6 @@
 // cli_render.cpp — `sylva render` (cli.md, scene.md): a scene, grammar or skeleton to an
-// image through the CPU ray caster (the OpenGL backend comes with the next issue).
+// image through the OpenGL ray caster (render_gl.h, on a headless EGL context) or the CPU
+// ray caster (render_cpu.h), as --backend says.
 #include <signal.h>
 #include <unistd.h>
 
@@ -11,7 +12,9 @@
 #include "app/cli.h"
 #include "app/render_input.h"
 #include "core/image_io.h"
+#include "core/gl_context.h"
 #include "core/render_cpu.h"
+#include "core/render_gl.h"
 #include "core/scene.h"
 
 namespace sylva::cli {
@@ -28,6 +31,7 @@ void print_render_help() {
   std::cout
       << "usage: sylva render INPUT -o IMAGE [--backend auto|gl|cpu] [--width W --height H]\n"
          "                    [--aov depth,normal,uv,id] [--spp N] [--verbose]\n"
+         "                    [--geometry frusta|mesh] [--mesh-level M]\n"
          "                    [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n\n"
          "Renders INPUT — a .scene.json scene, a .lsys grammar, a .skel.json skeleton or a .glb/.gltf\n"
          "written by `sylva export` (its skeletons are read back from node extras) (all but\n"
@@ -37,8 +41,10 @@ void print_render_help() {
          "format OpenImageIO writes. For a non-EXR IMAGE each AOV goes to its own EXR next to\n"
          "it: IMAGE without its extension + .depth.exr, .normal.exr, .uv.exr, .id.exr.\n\n"
          "  -o, --output IMAGE     the image to write\n"
-         "      --backend B        auto (default: OpenGL, falling back to the CPU), gl, cpu;\n"
-         "                         only the CPU ray caster exists in this version\n"
+         "      --backend B        auto (default): OpenGL on a window-less EGL context (the GPU,\n"
+         "                         or Mesa's llvmpipe without one), else the CPU ray caster,\n"
+         "                         saying why; gl: OpenGL or exit 1 saying why; cpu: the CPU\n"
+         "                         reference (bark textures and relief are CPU-only for now)\n"
          "      --width W          image width in pixels (default: the scene's, else 1024)\n"
          "      --height H         image height in pixels (default: the scene's, else 768)\n"
          "      --aov LIST         extra outputs, comma-separated: depth (channel Z, distance\n"
@@ -46,6 +52,12 @@ void print_render_help() {
          "                         uv (U V), id (id.plant id.chain id.segment)\n"
          "      --spp N            samples per pixel, stratified (default 1: pixel centres)\n"
          "      --verbose          list the passes that ran and what each cost\n"
+         "      --geometry G       what stands for the plants: frusta (default: the exact\n"
+         "                         conical frusta) or mesh (the polygon baseline: the frusta\n"
+         "                         tessellated, displaced by bark height maps where a scene\n"
+         "                         gives them)\n"
+         "      --mesh-level M     the mesh's subdivision level, 0 to 6: 16·4^M triangles per\n"
+         "                         segment (default 2)\n"
          "grammar input only:\n"
          "  -n, --steps N          derivation steps (overrides 'derivation length:')\n"
          "      --seed S           random seed, an integer from 0 to 2^64-1\n"
@@ -63,6 +75,7 @@ struct RenderArgs {
   uint32_t aovs = 0;
   uint32_t spp = 1;
   bool verbose = false;
+  GeometryOptions geometry;
   bool grammar_flags = false;  // -n, --seed, -D or --max-modules given
 };
 
@@ -113,6 +126,16 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
         if (comma == std::string::npos) break;
         start = comma + 1;
       }
+    } else if (a == "--geometry") {
+      const std::string g = value();
+      if (g == "frusta") out.geometry.kind = GeometryKind::frusta;
+      else if (g == "mesh") out.geometry.kind = GeometryKind::mesh;
+      else throw UsageError{"--geometry " + g + ": expected frusta or mesh"};
+    } else if (a == "--mesh-level") {
+      const std::string v = value();
+      auto n = parse_u64(v);
+      if (!n || *n > 6) throw UsageError{"--mesh-level " + v + ": expected an integer from 0 to 6"};
+      out.geometry.mesh_level = static_cast<int>(*n);
     } else if (a == "--verbose" || a == "-v") {
       out.verbose = true;
     } else {
@@ -170,9 +193,6 @@ int run_render(const std::vector<std::string>& args) {
     throw UsageError{"INPUT '" + input + "' must end in .lsys, .skel.json, .scene.json, .glb or .gltf"};
   if (a.grammar_flags && !is_grammar_input(input))
     throw UsageError{"-n, --seed, -D and --max-modules apply to a .lsys grammar only"};
-  if (a.backend == "gl")
-    throw UsageError{"--backend gl: the OpenGL backend is not available yet (use --backend cpu or auto)"};
-  if (a.backend == "auto") std::cerr << "sylva render: OpenGL backend not available yet; using the CPU ray caster\n";
   if (!can_write_image_format(output))
     throw UsageError{"-o " + output + ": OpenImageIO cannot write this format (use .png, .exr, ...)"};
 
@@ -187,9 +207,43 @@ int run_render(const std::vector<std::string>& args) {
   RenderOptions options;
   options.spp = a.spp;
   options.aovs = a.aovs;
+  options.geometry = a.geometry;
   options.cancel = &g_interrupted;
   options.progress = ::isatty(STDERR_FILENO) == 1;
-  RenderResult result = render_cpu(scene, options);
+  // The backend (cli.md): gl, or for auto OpenGL where a context can be made and the scene
+  // needs nothing the GL backend lacks; otherwise the CPU, saying why.
+  std::string backend_name = "CPU ray caster";
+  std::optional<RenderResult> gl_result;
+  if (a.backend != "cpu") {
+    std::string why_not;
+    const char* fallback = "OpenGL unavailable";
+    if (auto unsupported = gl_unsupported(scene, options)) {
+      why_not = *unsupported;
+      fallback = "the OpenGL backend cannot draw this";
+    } else {
+      const auto context_start = std::chrono::steady_clock::now();
+      GlContextResult context = create_headless_gl_context();
+      if (!context.context) {
+        why_not = context.error;
+      } else {
+        passes.push_back({"gl context", seconds_since(context_start), context.context->info().describe()});
+        try {
+          gl_result = render_gl(scene, options);
+          backend_name = "OpenGL ray caster (" + context.context->info().renderer + ")";
+        } catch (const GlError& e) {
+          why_not = e.what();
+        }
+      }
+    }
+    if (!gl_result) {
+      if (a.backend == "gl") {
+        std::cerr << "sylva render: --backend gl: " << why_not << "\n";
+        return kInputError;
+      }
+      std::cerr << "sylva render: " << fallback << " (" << why_not << "); using the CPU ray caster\n";
+    }
+  }
+  RenderResult result = gl_result ? std::move(*gl_result) : render_cpu(scene, options);
   if (result.cancelled || g_interrupted.load()) {
     std::cerr << "sylva render: interrupted; nothing written\n";
     return kInterrupted;
@@ -207,7 +261,7 @@ int run_render(const std::vector<std::string>& args) {
   passes.push_back({"write", seconds_since(start), files});
 
   if (a.verbose) {
-    std::cerr << "sylva render: " << scene.width << "x" << scene.height << ", " << a.spp << " spp, CPU ray caster"
+    std::cerr << "sylva render: " << scene.width << "x" << scene.height << ", " << a.spp << " spp, " << backend_name
               << (scene.fog ? "; fog is parsed but not rendered in this version" : "") << "\n";
     for (const RenderPass& p : passes) {
       char line[256];

@@ -22,28 +22,37 @@ constexpr float kInfF = std::numeric_limits<float>::infinity();
 struct QueryContext {
   RTCIntersectContext embree;
   const Frustum* frusta;
+  const double* custom_shell;  // nullptr: no custom frusta
+  const CustomFrustumIntersector* custom;
+  CustomHitDetail* detail;     // the caller's, for custom hits (nullptr: not wanted)
   Ray ray;
   double t_min;
   double t_best;
   BvhHit best;
 };
 
-// A fresh query for `ray` over `frusta` in (t_min, t_max).
-QueryContext start_query(const Frustum* frusta, const Ray& ray, double t_min, double t_max) {
+struct GeometryData {
+  const Frustum* frusta;
+  const double* custom_shell;  // per frustum, or nullptr
+  const CustomFrustumIntersector* custom;
+  glm::dvec3 centre;
+  double pad;
+};
+
+// A fresh query for `ray` in (t_min, t_max).
+QueryContext start_query(const GeometryData& data, const Ray& ray, double t_min, double t_max,
+                         CustomHitDetail* detail) {
   QueryContext q{};
   rtcInitIntersectContext(&q.embree);
-  q.frusta = frusta;
+  q.frusta = data.frusta;
+  q.custom_shell = data.custom_shell;
+  q.custom = data.custom;
+  q.detail = detail;
   q.ray = ray;
   q.t_min = t_min;
   q.t_best = t_max;
   return q;
 }
-
-struct GeometryData {
-  const Frustum* frusta;
-  glm::dvec3 centre;
-  double pad;
-};
 
 // Smallest float >= v (and largest <= v for round_down).
 float round_up(double v) {
@@ -57,7 +66,12 @@ float round_down(double v) {
 
 void bounds_callback(const RTCBoundsFunctionArguments* args) {
   const auto* data = static_cast<const GeometryData*>(args->geometryUserPtr);
-  const Aabb b = frustum_bounds(data->frusta[args->primID].shape);
+  FrustumShape shape = data->frusta[args->primID].shape;
+  if (data->custom_shell && data->custom_shell[args->primID] > 0) {
+    shape.radius0 += data->custom_shell[args->primID];
+    shape.radius1 += data->custom_shell[args->primID];
+  }
+  const Aabb b = frustum_bounds(shape);
   const glm::dvec3 lo = b.lo - data->centre - glm::dvec3(data->pad);
   const glm::dvec3 hi = b.hi - data->centre + glm::dvec3(data->pad);
   RTCBounds* o = args->bounds_o;
@@ -67,7 +81,9 @@ void bounds_callback(const RTCBoundsFunctionArguments* args) {
 
 // Tests one candidate with the exact double ray; records it if nearer.
 bool test_candidate(QueryContext* q, unsigned prim) {
-  FrustumHit h = intersect_frustum(q->ray, q->frusta[prim].shape, q->t_min, q->t_best);
+  FrustumHit h = q->custom_shell && q->custom_shell[prim] > 0
+                     ? q->custom->intersect(prim, q->ray, q->t_min, q->t_best, q->detail)
+                     : intersect_frustum(q->ray, q->frusta[prim].shape, q->t_min, q->t_best);
   if (!h.hit()) return false;
   q->t_best = h.t;
   q->best.hit = h;
@@ -124,19 +140,27 @@ struct FrustumAccel::Impl {
   }
 };
 
-FrustumAccel::FrustumAccel(std::span<const Frustum> frusta) : impl_(std::make_unique<Impl>()) {
+FrustumAccel::FrustumAccel(std::span<const Frustum> frusta, CustomFrusta custom)
+    : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.device = rtcNewDevice(nullptr);
   if (!m.device) throw std::runtime_error("Embree: cannot create a device");
   rtcSetDeviceMemoryMonitorFunction(m.device, &Impl::monitor, &m);
   // Centre and a padding that covers float rounding of rays far across the scene.
   glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
-  for (const Frustum& f : frusta) {
-    const Aabb b = frustum_bounds(f.shape);
+  const bool has_custom = !custom.shell_m.empty() && custom.intersector;
+  if (has_custom && custom.shell_m.size() != frusta.size())
+    throw std::invalid_argument("FrustumAccel: custom.shell_m must have one entry per frustum");
+  for (size_t i = 0; i < frusta.size(); ++i) {
+    FrustumShape shape = frusta[i].shape;
+    if (has_custom && custom.shell_m[i] > 0) shape.radius0 += custom.shell_m[i], shape.radius1 += custom.shell_m[i];
+    const Aabb b = frustum_bounds(shape);
     lo = glm::min(lo, b.lo);
     hi = glm::max(hi, b.hi);
   }
   m.data.frusta = frusta.data();
+  m.data.custom_shell = has_custom ? custom.shell_m.data() : nullptr;
+  m.data.custom = has_custom ? custom.intersector : nullptr;
   m.data.centre = frusta.empty() ? glm::dvec3(0) : 0.5 * (lo + hi);
   m.data.pad = frusta.empty() ? 0 : 1e-6 * glm::length(hi - lo);
   m.scene = rtcNewScene(m.device);
@@ -161,8 +185,8 @@ FrustumAccel::~FrustumAccel() {
   if (impl_->device) rtcReleaseDevice(impl_->device);
 }
 
-BvhHit FrustumAccel::nearest(const Ray& ray, double t_min, double t_max) const {
-  QueryContext q = start_query(impl_->data.frusta, ray, t_min, t_max);
+BvhHit FrustumAccel::nearest(const Ray& ray, double t_min, double t_max, CustomHitDetail* detail) const {
+  QueryContext q = start_query(impl_->data, ray, t_min, t_max, detail);
   RTCRayHit rh{};
   rh.ray = impl_->embree_ray(ray, t_min, t_max);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -171,7 +195,7 @@ BvhHit FrustumAccel::nearest(const Ray& ray, double t_min, double t_max) const {
 }
 
 bool FrustumAccel::any(const Ray& ray, double t_min, double t_max) const {
-  QueryContext q = start_query(impl_->data.frusta, ray, t_min, t_max);
+  QueryContext q = start_query(impl_->data, ray, t_min, t_max, nullptr);
   RTCRay r = impl_->embree_ray(ray, t_min, t_max);
   rtcOccluded1(impl_->scene, &q.embree, &r);
   return q.best.hit_any();

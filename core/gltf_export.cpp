@@ -11,9 +11,11 @@
 // independent second reader.
 //
 // Buffer layout: one buffer; one tightly packed bufferView per accessor, each starting
-// at a multiple of 4 bytes. Floats are little-endian IEEE 754 (as the machine's).
+// at a multiple of 4 bytes, then (.glb only) one bufferView per embedded image. Floats
+// are little-endian IEEE 754 (as the machine's).
 #include "core/gltf_export.h"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -25,8 +27,14 @@
 #include <string_view>
 #include <utility>
 
+#include <OpenImageIO/imageio.h>
+
+#include <glm/geometric.hpp>
+
 #include "core/file_io.h"
 #include "core/json.h"
+#include "core/materials.h"
+#include "core/normal_map.h"
 #include "core/skin.h"
 #include "core/tessellate.h"
 
@@ -41,6 +49,9 @@ constexpr int kTargetArrayBuffer = 34962;
 constexpr int kTargetElementArrayBuffer = 34963;
 constexpr int kModeLines = 1;
 constexpr int kModeTriangles = 4;
+constexpr int kFilterLinear = 9729;
+constexpr int kFilterLinearMipmapLinear = 9987;
+constexpr int kWrapRepeat = 10497;
 constexpr uint32_t kGlbMagic = 0x46546C67;      // "glTF"
 constexpr uint32_t kGlbChunkJson = 0x4E4F534A;  // "JSON"
 constexpr uint32_t kGlbChunkBin = 0x004E4942;   // "BIN\0"
@@ -93,6 +104,9 @@ class BufferBuilder {
     accessors_.push_back(std::move(a));
     return accessors_.size() - 1;
   }
+
+  // Appends raw bytes (an image) as a bufferView without target; returns the view index.
+  size_t add_bytes(std::string_view data) { return add_view(data.data(), data.size(), 0); }
 
   const std::string& bytes() const { return bytes_; }
   const std::vector<BufferView>& views() const { return views_; }
@@ -245,10 +259,216 @@ std::optional<std::string> check_plant(const GltfPlant& p, size_t index) {
   if (!std::isfinite(p.rotate_y_deg)) return which + ": rotate_y_deg is not finite";
   if (!std::isfinite(p.scale) || p.scale <= 0) return which + ": the scale must be a finite number > 0";
   if (auto err = validate_skeleton(p.skeleton)) return which + ": " + err->message;
+  if (!std::isfinite(p.bark.u_repeat) || p.bark.u_repeat <= 0) return which + ": bark u_repeat must be a finite number > 0";
+  if (!std::isfinite(p.bark.v_per_metre) || p.bark.v_per_metre <= 0)
+    return which + ": bark v_per_metre must be a finite number > 0";
+  if (!std::isfinite(p.bark.relief_depth_m) || p.bark.relief_depth_m < 0)
+    return which + ": bark relief_depth must be a finite number >= 0";
   return std::nullopt;
 }
 
+// An image embedded in the file.
+struct EmbeddedImage {
+  std::string bytes;
+  const char* mime = "image/png";
+};
+
+// Reads a bark albedo texture to embed it byte for byte: glTF takes PNG or JPEG only.
+std::optional<std::string> read_albedo_image(const std::string& path, EmbeddedImage* out) {
+  FileReadResult file = read_text_file(path);
+  if (!file.contents)
+    return path + ": error: cannot read the bark albedo texture: " +
+           (file.error ? file.error->message : std::string("unreadable"));
+  const std::string& bytes = *file.contents;
+  if (bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) out->mime = "image/png";
+  else if (bytes.compare(0, 3, "\xFF\xD8\xFF") == 0) out->mime = "image/jpeg";
+  else return path + ": error: the bark albedo texture must be a PNG or JPEG file to be embedded in glTF";
+  // The header must decode too (a viewer, and the validator, read it).
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    const std::string why = OIIO::geterror();
+    return path + ": error: the bark albedo texture is not a readable image" + (why.empty() ? "" : ": " + why);
+  }
+  out->bytes = bytes;
+  return std::nullopt;
+}
+
+// Identifies a bark for grouping identical plants (instancing).
+std::string bark_key(const Bark& b) {
+  std::string key = "albedo:";
+  if (b.albedo_texture) key += "file:" + *b.albedo_texture;
+  if (b.albedo_rgb) append_vec(key, *b.albedo_rgb);
+  key += "\nheight:" + b.height_texture.value_or("") + "\n";
+  for (double v : {b.relief_depth_m, b.u_repeat, b.v_per_metre}) append_json_number(key, v), key += ',';
+  return key;
+}
+
+// The material of index `material` of a plant with bark `bark` (gltf_export.h).
+std::string material_json(uint32_t material, const Bark& bark, std::optional<size_t> albedo_texture,
+                          std::optional<size_t> normal_texture, double r_ref_m) {
+  std::string m = "{\"name\":\"sylva_material_" + std::to_string(material) + "\",\"pbrMetallicRoughness\":{";
+  if (albedo_texture) {
+    m += "\"baseColorFactor\":[1,1,1,1],\"baseColorTexture\":{\"index\":" + std::to_string(*albedo_texture) + "},";
+  } else {
+    const double* rgb = default_material_albedo(material);
+    const glm::dvec3 colour = material == 0 && bark.albedo_rgb ? *bark.albedo_rgb : glm::dvec3(rgb[0], rgb[1], rgb[2]);
+    m += "\"baseColorFactor\":[";
+    for (int k = 0; k < 3; ++k) append_json_number(m, colour[k]), m += ',';
+    m += "1],";
+  }
+  m += "\"metallicFactor\":0,\"roughnessFactor\":0.9}";
+  if (normal_texture) m += ",\"normalTexture\":{\"index\":" + std::to_string(*normal_texture) + "}";
+  m += ",\"extras\":{\"sylva\":{\"material_index\":" + std::to_string(material);
+  if (bark.albedo_texture) {
+    m += ",\"albedo\":";
+    append_json_string(m, *bark.albedo_texture);
+  } else if (bark.albedo_rgb) {
+    m += ",\"albedo\":";
+    append_vec(m, *bark.albedo_rgb);
+  }
+  if (bark.height_texture) {
+    m += ",\"height\":";
+    append_json_string(m, *bark.height_texture);
+  }
+  m += ",\"relief_depth_m\":";
+  append_json_number(m, bark.relief_depth_m);
+  m += ",\"u_repeat\":";
+  append_json_number(m, bark.u_repeat);
+  m += ",\"v_per_metre\":";
+  append_json_number(m, bark.v_per_metre);
+  if (normal_texture) {
+    m += ",\"r_ref_m\":";
+    append_json_number(m, r_ref_m);
+  }
+  m += ",\"texcoord_0\":\"s = u * u_repeat with u in turns around the axis, t = v_m * v_per_metre with v_m the "
+       "arc length in metres\"}}}";
+  return m;
+}
+
+double median_segment_radius(const SkinnedSkeleton& skinned) {
+  std::vector<double> radii;
+  for (const Frustum& f : skinned.frusta)
+    if (f.kind == FrustumKind::segment && (f.shape.radius0 > 0 || f.shape.radius1 > 0))
+      radii.push_back(0.5 * (f.shape.radius0 + f.shape.radius1));
+  if (radii.empty()) return 0;
+  const size_t mid = radii.size() / 2;
+  std::nth_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(mid), radii.end());
+  if (radii.size() % 2 == 1) return radii[mid];
+  const double upper = radii[mid];
+  return 0.5 * (*std::max_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(mid)) + upper);
+}
+
+// Per vertex of `tm`: TANGENT (gltf_export.h) as 4 floats, xyz unit in float.
+std::vector<float> vertex_tangents(const TriangleMesh& tm, const SkinnedSkeleton& skinned) {
+  // Each vertex belongs to one frustum (tessellate.h makes every frustum's own vertices).
+  std::vector<int64_t> frustum_of(tm.positions.size(), -1);
+  for (size_t t = 0; t < tm.triangle_count(); ++t)
+    for (int c = 0; c < 3; ++c) frustum_of[tm.indices[3 * t + static_cast<size_t>(c)]] = tm.triangle_frustum[t];
+  std::vector<float> tangents;
+  tangents.reserve(tm.positions.size() * 4);
+  for (size_t v = 0; v < tm.positions.size(); ++v) {
+    const glm::dvec3 n = tm.normals[v];
+    const glm::dvec3 axis = frustum_of[v] >= 0 ? skinned.frusta[static_cast<size_t>(frustum_of[v])].shape.axis
+                                               : glm::dvec3(0, 1, 0);
+    glm::dvec3 t = glm::cross(axis, n);  // u grows counter-clockwise about the axis
+    // On a cap (normal ∥ axis) any direction ⊥ the normal will do.
+    if (glm::length(t) < 1e-6) t = axis_frame(glm::normalize(n)).e0;
+    t = glm::normalize(t);
+    // cross(N, T)·w must point toward decreasing t, i.e. against the axis.
+    const float w = glm::dot(glm::cross(n, t), axis) > 0 ? -1.0f : 1.0f;
+    float f[3] = {static_cast<float>(t.x), static_cast<float>(t.y), static_cast<float>(t.z)};
+    const float len = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    tangents.insert(tangents.end(), {f[0] / len, f[1] / len, f[2] / len, w});
+  }
+  return tangents;
+}
+
+// Everything the materials of one export refer to, read and baked once.
+class MaterialTable {
+ public:
+  // Reads every texture the plants' barks name (before anything is written).
+  std::optional<std::string> load(const std::vector<GltfPlant>& plants) {
+    for (const GltfPlant& p : plants) {
+      if (p.bark.albedo_texture && !albedo_files_.count(*p.bark.albedo_texture)) {
+        EmbeddedImage image;
+        if (auto err = read_albedo_image(*p.bark.albedo_texture, &image)) return err;
+        albedo_files_.emplace(*p.bark.albedo_texture, std::move(image));
+      }
+      if (p.bark.height_texture && !height_files_.count(*p.bark.height_texture)) {
+        HeightMapReadResult r = read_height_map(*p.bark.height_texture);
+        if (!r.map) return r.error.value_or(*p.bark.height_texture + ": error: unreadable height map");
+        height_files_.emplace(*p.bark.height_texture, std::move(*r.map));
+      }
+    }
+    return std::nullopt;
+  }
+
+  // The normal map texture of `bark` at radius r_ref_m (baked on first use), or nothing
+  // when the bark has no height map or the plant no radius.
+  std::optional<size_t> normal_texture(const Bark& bark, double r_ref_m, std::string* error) {
+    if (!bark.height_texture || !(r_ref_m > 0)) return std::nullopt;
+    std::string key = "normal:" + *bark.height_texture + "\n";
+    for (double v : {r_ref_m, bark.u_repeat, bark.v_per_metre, bark.relief_depth_m}) append_json_number(key, v), key += ',';
+    if (auto it = image_of_.find(key); it != image_of_.end()) return it->second;
+    const HeightMap& map = height_files_.at(*bark.height_texture);
+    const NormalMapMetric metric =
+        bark_normal_map_metric(map.width, map.height, r_ref_m, bark.u_repeat, bark.v_per_metre, bark.relief_depth_m);
+    std::optional<std::string> png =
+        encode_png_in_memory(map.width, map.height, 3, encode_normals_rgb8(bake_tangent_normals(map, metric)));
+    if (!png) {
+      *error = *bark.height_texture + ": error: cannot encode the normal map baked from this height map as PNG";
+      return std::nullopt;
+    }
+    return add_image(key, {std::move(*png), "image/png"});
+  }
+
+  std::optional<size_t> albedo_texture(const Bark& bark) {
+    if (!bark.albedo_texture) return std::nullopt;
+    const std::string key = "albedo:" + *bark.albedo_texture;
+    if (auto it = image_of_.find(key); it != image_of_.end()) return it->second;
+    return add_image(key, albedo_files_.at(*bark.albedo_texture));
+  }
+
+  // The index of a material, written once however many plants use it.
+  size_t material(const std::string& json) {
+    auto [it, inserted] = material_of_.emplace(json, materials_.size());
+    if (inserted) materials_.push_back(json);
+    return it->second;
+  }
+
+  const std::vector<std::string>& materials() const { return materials_; }
+  const std::vector<EmbeddedImage>& images() const { return images_; }  // texture i = image i
+
+ private:
+  size_t add_image(const std::string& key, EmbeddedImage image) {
+    images_.push_back(std::move(image));
+    image_of_.emplace(key, images_.size() - 1);
+    return images_.size() - 1;
+  }
+
+  std::map<std::string, EmbeddedImage> albedo_files_;
+  std::map<std::string, HeightMap> height_files_;
+  std::map<std::string, size_t> image_of_;
+  std::vector<EmbeddedImage> images_;
+  std::map<std::string, size_t> material_of_;
+  std::vector<std::string> materials_;
+};
+
 }  // namespace
+
+std::optional<std::string> check_bark_textures(const Bark& bark) {
+  if (bark.albedo_texture) {
+    EmbeddedImage image;
+    if (auto err = read_albedo_image(*bark.albedo_texture, &image)) return err;
+  }
+  if (bark.height_texture) {
+    HeightMapReadResult r = read_height_map(*bark.height_texture);
+    if (!r.map) return r.error.value_or(*bark.height_texture + ": error: unreadable height map");
+  }
+  return std::nullopt;
+}
+
+double bark_reference_radius_m(const Skeleton& skeleton) { return median_segment_radius(skin_skeleton(skeleton)); }
 
 std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, const std::string& path,
                                        const GltfExportOptions& options) {
@@ -260,13 +480,19 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
     return path + ": error: segments around must be an integer from 3 to 4096";
   for (size_t i = 0; i < plants.size(); ++i)
     if (auto err = check_plant(plants[i], i)) return path + ": error: " + *err;
+  MaterialTable table;
+  if (options.mesh)
+    if (auto err = table.load(plants)) return err;
 
-  // Group identical skeletons when instancing (compared by their exact serialization).
+  // Group identical skeletons when instancing (compared by their exact serialization,
+  // and by their barks when those shape the mesh).
   std::vector<PlantGroup> groups;
   if (options.instancing) {
     std::map<std::string, size_t> group_of;
     for (size_t i = 0; i < plants.size(); ++i) {
-      auto [it, inserted] = group_of.emplace(write_skeleton_json(plants[i].skeleton), groups.size());
+      std::string key = write_skeleton_json(plants[i].skeleton);
+      if (options.mesh) key += bark_key(plants[i].bark);
+      auto [it, inserted] = group_of.emplace(std::move(key), groups.size());
       if (inserted) groups.emplace_back();
       groups[it->second].plants.push_back(i);
     }
@@ -276,7 +502,7 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
 
   BufferBuilder buffer;
   std::vector<std::string> meshes, nodes;
-  bool any_bark = false, any_instancing = false;
+  bool any_instancing = false;
   for (const PlantGroup& group : groups) {
     const GltfPlant& plant = plants[group.plants.front()];
     const Skeleton& sk = plant.skeleton;
@@ -313,6 +539,13 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
       to.segments_around = options.segments_around;
       const TriangleMesh tm = tessellate(skinned, to);
       if (!tm.indices.empty()) {
+        const Bark& bark = plant.bark;
+        const double r_ref_m = median_segment_radius(skinned);
+        std::string error;
+        const std::optional<size_t> normal_texture = table.normal_texture(bark, r_ref_m, &error);
+        if (!error.empty()) return error;
+        const std::optional<size_t> albedo_texture = table.albedo_texture(bark);
+
         std::vector<float> positions, normals, texcoords;
         positions.reserve(tm.positions.size() * 3);
         normals.reserve(tm.normals.size() * 3);
@@ -326,16 +559,28 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
           normals.insert(normals.end(), {f[0] / len, f[1] / len, f[2] / len});
         }
         for (const glm::dvec2& uv : tm.uvs)
-          texcoords.insert(texcoords.end(), {static_cast<float>(uv.x), static_cast<float>(uv.y * kGltfTexcoordVPerMetre)});
-        const size_t pos = buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer);
-        const size_t nrm = buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer);
-        const size_t tex = buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer);
-        const size_t idx = buffer.add_indices(tm.indices);
-        if (!primitives.empty()) primitives += ',';
-        primitives += "{\"attributes\":{\"POSITION\":" + std::to_string(pos) + ",\"NORMAL\":" + std::to_string(nrm) +
-                      ",\"TEXCOORD_0\":" + std::to_string(tex) + "},\"indices\":" + std::to_string(idx) +
-                      ",\"material\":0,\"mode\":" + std::to_string(kModeTriangles) + "}";
-        any_bark = true;
+          texcoords.insert(texcoords.end(),
+                           {static_cast<float>(uv.x * bark.u_repeat), static_cast<float>(uv.y * bark.v_per_metre)});
+        std::string attributes = "{\"POSITION\":" + std::to_string(buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer)) +
+                                 ",\"NORMAL\":" + std::to_string(buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer));
+        if (normal_texture)
+          attributes += ",\"TANGENT\":" +
+                        std::to_string(buffer.add_floats(vertex_tangents(tm, skinned), 4, "VEC4", kTargetArrayBuffer));
+        attributes += ",\"TEXCOORD_0\":" + std::to_string(buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer)) + "}";
+
+        // One primitive per material index, in increasing order.
+        std::map<uint32_t, std::vector<uint32_t>> triangles_of;
+        for (size_t t = 0; t < tm.triangle_count(); ++t) {
+          std::vector<uint32_t>& list = triangles_of[skinned.frusta[tm.triangle_frustum[t]].material];
+          list.insert(list.end(), tm.indices.begin() + static_cast<std::ptrdiff_t>(3 * t),
+                      tm.indices.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
+        }
+        for (const auto& [material, indices] : triangles_of) {
+          const size_t m = table.material(material_json(material, bark, albedo_texture, normal_texture, r_ref_m));
+          if (!primitives.empty()) primitives += ',';
+          primitives += "{\"attributes\":" + attributes + ",\"indices\":" + std::to_string(buffer.add_indices(indices)) +
+                        ",\"material\":" + std::to_string(m) + ",\"mode\":" + std::to_string(kModeTriangles) + "}";
+        }
       }
     }
 
@@ -406,16 +651,28 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
     for (size_t i = 0; i < meshes.size(); ++i) json += (i ? "," : "") + meshes[i];
     json += ']';
   }
-  if (any_bark) {
-    // Bark: a constant albedo until textures are baked; the relief parameters a sylva
-    // renderer needs (scene.md "bark") and the UV convention travel in the extras.
-    json += ",\"materials\":[{\"name\":\"bark\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[";
-    for (int k = 0; k < 3; ++k) append_json_number(json, kGltfBarkAlbedo[k]), json += ',';
-    json += "1],\"metallicFactor\":0,\"roughnessFactor\":0.9},\"extras\":{\"sylva\":{\"relief_depth_m\":0.02,"
-            "\"u_repeat\":1,\"v_per_metre\":1,\"texcoord_0\":\"u in turns around the axis, v = arc length in "
-            "metres times texcoord_v_per_metre\",\"texcoord_v_per_metre\":";
-    append_json_number(json, kGltfTexcoordVPerMetre);
-    json += "}}}]";
+  if (!table.materials().empty()) {
+    json += ",\"materials\":[";
+    for (size_t i = 0; i < table.materials().size(); ++i) json += (i ? "," : "") + table.materials()[i];
+    json += ']';
+  }
+  if (!table.images().empty()) {
+    // Texture i shows image i; one sampler: linear, mipmapped, repeating (the bark tiles).
+    json += ",\"samplers\":[{\"magFilter\":" + std::to_string(kFilterLinear) +
+            ",\"minFilter\":" + std::to_string(kFilterLinearMipmapLinear) + ",\"wrapS\":" + std::to_string(kWrapRepeat) +
+            ",\"wrapT\":" + std::to_string(kWrapRepeat) + "}],\"textures\":[";
+    for (size_t i = 0; i < table.images().size(); ++i)
+      json += std::string(i ? "," : "") + "{\"sampler\":0,\"source\":" + std::to_string(i) + "}";
+    json += "],\"images\":[";
+    for (size_t i = 0; i < table.images().size(); ++i) {
+      const EmbeddedImage& image = table.images()[i];
+      if (i) json += ',';
+      if (glb)
+        json += "{\"bufferView\":" + std::to_string(buffer.add_bytes(image.bytes)) + ",\"mimeType\":\"" + image.mime + "\"}";
+      else
+        json += "{\"uri\":\"data:" + std::string(image.mime) + ";base64," + base64(image.bytes) + "\"}";
+    }
+    json += ']';
   }
   const std::string& bin = buffer.bytes();
   if (!buffer.accessors().empty()) {

@@ -8,10 +8,44 @@
 //     version, source with grammar, seed as a *string* (64-bit exact), steps, defines;
 //     chains with parents and joints) plus, per segment, the skinning data a renderer
 //     needs (cutting plane normals and u offset);
-//   - optionally (`mesh`) a second, TRIANGLES primitive of the same mesh (so instancing
-//     covers it too): the tessellated frusta (tessellate.h) with NORMAL and TEXCOORD_0 =
-//     (u in turns, v_m · kGltfTexcoordVPerMetre), and material 0 "bark" (constant albedo;
-//     relief parameters and the UV convention in the material's extras.sylva).
+//   - optionally (`mesh`) further TRIANGLES primitives of the same mesh (so instancing
+//     covers them too): the tessellated frusta (tessellate.h), one primitive per material
+//     index that occurs in the plant (triangles grouped by their frustum's material),
+//     all sharing one set of vertex attributes — POSITION, NORMAL, TEXCOORD_0 and, when
+//     the bark has a height map, TANGENT — and one material each (below).
+//
+// Bark and materials (with `mesh`; without it the bark is ignored and no texture read).
+// A plant's `bark` (scene.h, scene.md) covers every segment of the plant, whatever its
+// material index:
+//   - TEXCOORD_0 = (u · u_repeat, v_m · v_per_metre): u in turns around the axis, v_m the
+//     arc length in metres (skin.h) — the texture repeats as in the renderer. (The
+//     defaults u_repeat = v_per_metre = 1 give the raw (u, v_m).)
+//   - material "sylva_material_<k>" per material index k used, pbrMetallicRoughness with
+//     metallic 0, roughness 0.9. With a bark albedo texture: baseColorTexture = that
+//     image, embedded byte for byte (a bufferView in .glb, a data URI in .gltf; PNG or
+//     JPEG only, as glTF requires), baseColorFactor 1. Without: baseColorFactor = the
+//     linear colour default_material_albedo(k) (materials.h), a bark albedo colour
+//     replacing material 0's.
+//   - with a bark height map: normalTexture = a tangent-space normal map baked from it
+//     (normal_map.h, 8-bit RGB PNG, glTF's "+X right, +Y up in the image" convention,
+//     i.e. X toward increasing s, Y toward decreasing t). glTF cannot follow a radius
+//     that changes along the plant, so one texel is measured at r_ref = the plant's
+//     median segment radius (a segment's radius: the mean of its two end radii): around,
+//     2π·r_ref/(u_repeat·width) metres; along, 1/(v_per_metre·height); relief depth
+//     relief_depth_m. Thinner and thicker segments get proportionally weaker and
+//     stronger relief around the stem than the renderer's. TANGENT (vec4): xyz the unit
+//     direction of increasing s (axis × normal, the circumferential direction), w = ±1
+//     chosen so that cross(NORMAL, TANGENT.xyz)·w points toward decreasing t, as the
+//     map's +Y does (w = −1 on the lateral surface, where u grows counter-clockwise
+//     about the axis). The flat caps carry a tangent ⊥ their normal and the texture's
+//     rim coordinates; their relief is not meaningful.
+//   - the material's extras.sylva holds the raw relief parameters: "material_index",
+//     "albedo" (path as given, or [r, g, b]) and "height" (path as given) when the bark
+//     has them, "relief_depth_m", "u_repeat", "v_per_metre", "r_ref_m" (with a height
+//     map), and "texcoord_0", the UV convention in words.
+//   Identical materials and images are written once. A missing or unreadable texture,
+//   or an albedo that is neither PNG nor JPEG, is an error naming the file, and nothing
+//   is written.
 //
 // Layout of node extras.sylva (all numbers shortest round-trip decimals):
 //   "format", "version", "source" {grammar, seed (decimal string), steps, defines},
@@ -31,14 +65,10 @@
 #include <string>
 #include <vector>
 
+#include "core/scene.h"
 #include "core/skeleton.h"
 
 namespace sylva {
-
-// TEXCOORD_0.v = arc length in metres times this (one texture repeat per metre).
-inline constexpr double kGltfTexcoordVPerMetre = 1.0;
-// Linear RGB base colour of the bark material until bark textures are baked.
-inline constexpr double kGltfBarkAlbedo[3] = {0.30, 0.22, 0.15};
 
 // One plant placed in the file.
 struct GltfPlant {
@@ -47,12 +77,14 @@ struct GltfPlant {
   double position_m[3] = {0, 0, 0};  // node translation
   double rotate_y_deg = 0;      // node rotation about +Y
   double scale = 1;             // node uniform scale
+  Bark bark = {};               // textures and relief of the mesh (used with `mesh` only)
 };
 
 struct GltfExportOptions {
   bool mesh = false;            // also write the tessellated frusta as a triangle mesh
   int segments_around = 8;      // columns around each frustum for the mesh (>= 3)
-  bool instancing = false;      // repeated identical plants (equal skeletons) as one node
+  bool instancing = false;      // repeated identical plants (equal skeletons and, with
+                                // `mesh`, equal barks) as one node
                                 // with EXT_mesh_gpu_instancing (listed in extensionsUsed)
 };
 
@@ -60,6 +92,17 @@ struct GltfExportOptions {
 // nothing on success; an existing file is left untouched on failure.
 std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, const std::string& path,
                                        const GltfExportOptions& options = {});
+
+// Checks that the bark's textures can be embedded: the albedo (if a texture) is a
+// readable PNG or JPEG, the height map (if any) a readable image. Returns an error
+// naming the file, or nothing. export_gltf checks the same; a front end calls this once
+// before a batch.
+std::optional<std::string> check_bark_textures(const Bark& bark);
+
+// r_ref of the baked normal map: the median over the skinned segments (knuckles left
+// out) of the mean of their two end radii, segments of radius 0 at both ends left out;
+// 0 when there is none.
+double bark_reference_radius_m(const Skeleton& skeleton);
 
 // Reads the sylva skeletons back from a glTF file's node extras (for `sylva render
 // plant.glb`). A file without sylva extras is an error naming the file, not a crash.

@@ -1,7 +1,10 @@
 // render_cpu.cpp — the CPU reference ray caster (see render_cpu.h for the shading model).
 #include "core/render_cpu.h"
 
+#include "core/culling.h"
 #include "core/frustum_tracer.h"
+#include "core/mesh_accel.h"
+#include "core/texture.h"
 
 #include <unistd.h>
 
@@ -98,12 +101,20 @@ struct PrimaryHit {
 
 class Renderer {
  public:
-  Renderer(const Scene& scene, const SceneGeometry& geometry, const RenderOptions& options)
+  Renderer(const Scene& scene, const SceneGeometry& geometry, const RenderOptions& options,
+           const SceneTextures* textures)
       : scene_(scene), geometry_(geometry), options_(options), frame_(camera_frame(scene)),
         tracer_(*geometry.tracer), sun_direction_(glm::normalize(scene.sun.direction)),
         sun_frame_(axis_frame(sun_direction_)),
         cos_alpha_(std::cos(scene.sun.angular_radius_deg * kPi / 180)),
-        sun_on_(scene.sun.radiance.x > 0 || scene.sun.radiance.y > 0 || scene.sun.radiance.z > 0) {}
+        sun_on_(scene.sun.radiance.x > 0 || scene.sun.radiance.y > 0 || scene.sun.radiance.z > 0),
+        textures_(textures) {
+    // Ray differentials: frame_ray is affine in (x, y), so the neighbouring sample's
+    // direction is the direction plus a constant; one pixel / sqrt(spp) (texture.h).
+    const double step = 1 / std::sqrt(static_cast<double>(std::max(1u, options.spp)));
+    direction_dx_ = (step * 2 * frame_.half_width / frame_.width) * frame_.right;
+    direction_dy_ = (-step * 2 * frame_.half_height / frame_.height) * frame_.up;
+  }
 
   // Renders tile `index` into `image`; adds its thread time to *trace_s and *shade_s.
   void render_tile(uint32_t index, RenderImage& image, double* trace_s, double* shade_s,
@@ -161,11 +172,12 @@ class Renderer {
     }
   }
 
-  // Sun visibility from `p` (offset along the geometric normal `n_geometric`).
+  // Sun visibility from `p` (offset along the geometric normal `n_geometric`, by at least
+  // `offset_m`).
   double sun_visibility(const glm::dvec3& p, const glm::dvec3& n_geometric, const glm::dvec3& l,
-                        uint64_t* shadow_rays) {
+                        uint64_t* shadow_rays, double offset_m) {
     const double scale = std::max({1.0, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-    Ray shadow{p + (1e-7 * scale) * n_geometric, l};
+    Ray shadow{p + std::max(1e-7 * scale, offset_m) * n_geometric, l};
     ++*shadow_rays;
     // The ground cannot shadow anything above it; only plants cast shadows.
     return tracer_.any(shadow, 0, kInf) ? 0.0 : 1.0;
@@ -173,13 +185,13 @@ class Renderer {
 
   glm::dvec3 lit(const glm::dvec3& albedo, const glm::dvec3& n, const glm::dvec3& n_geometric,
                  const glm::dvec3& p, const glm::dvec3& view, bool specular, Rng& rng,
-                 uint64_t* shadow_rays) {
+                 uint64_t* shadow_rays, double shadow_offset_m = 0) {
     glm::dvec3 colour = albedo * scene_.sky * (0.5 * (1 + n.y));
     if (!sun_on_) return colour;
     const glm::dvec3 l = sun_sample(scene_.sun, sun_direction_, cos_alpha_, sun_frame_, rng);
     const double n_dot_l = glm::dot(n, l);
     if (n_dot_l <= 0 || glm::dot(n_geometric, l) <= 0) return colour;
-    const double visibility = sun_visibility(p, n_geometric, l, shadow_rays);
+    const double visibility = sun_visibility(p, n_geometric, l, shadow_rays, shadow_offset_m);
     if (visibility == 0) return colour;
     glm::dvec3 brdf = albedo / kPi;
     if (specular) {
@@ -205,7 +217,19 @@ class Renderer {
     if (glm::dot(ng, view) < 0) ng = -ng;   // seen from inside: light the side we see
     if (glm::dot(n, view) < 0) n = -n;
     const ScenePlant& plant = scene_.plants[s.plant];
-    return lit(material_albedo(plant, s.material), n, ng, s.position, view, true, rng, shadow_rays);
+    glm::dvec3 albedo;
+    if (textures_ && textures_->has_albedo(s.plant)) {
+      const UvFootprint footprint = uv_footprint(s, {h.ray.origin, h.ray.direction + direction_dx_},
+                                                 {h.ray.origin, h.ray.direction + direction_dy_});
+      albedo = textures_->albedo(s.plant, s.u, s.v_m, footprint);
+    } else {
+      albedo = material_albedo(plant, s.material);
+    }
+    // A relief hit's shadow ray starts a pixel footprint above it (render_cpu.h).
+    const bool relief = textures_ && options_.geometry.relief && textures_->has_height(s.plant) &&
+                        plant.bark.relief_depth_m > 0;
+    const double shadow_offset_m = relief ? s.t * glm::length(direction_dy_) : 0.0;
+    return lit(albedo, n, ng, s.position, view, true, rng, shadow_rays, shadow_offset_m);
   }
 
   void write_aovs(RenderImage& image, uint32_t x, uint32_t y, const PrimaryHit* centre_hit) {
@@ -247,6 +271,8 @@ class Renderer {
   const AxisFrame sun_frame_;
   const double cos_alpha_;
   const bool sun_on_;
+  const SceneTextures* textures_;  // bark albedo textures; nullptr: none
+  glm::dvec3 direction_dx_{0}, direction_dy_{0};  // ray differentials' direction offsets
 };
 
 void draw_progress(uint32_t done, uint32_t total, double elapsed_s) {
@@ -278,25 +304,167 @@ Skeleton place_plant(const ScenePlant& plant) {
   return sk;
 }
 
-SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin,
-                                   const GeometryOptions& options, std::vector<RenderPass>* passes) {
+namespace {
+
+// Per vertex of `mesh` (tessellated from `frusta`): the relief shell's thickness at the
+// vertex over the bark's depth — relief.h's min(d, max_depth_per_radius·r) at each end of
+// the vertex's frustum, linear between — so that GS+R lifts a twig or needle no more
+// than the relief marcher's shell does.
+std::vector<double> displacement_scale(const TriangleMesh& mesh, std::span<const Frustum> frusta, double depth_m,
+                                       double max_depth_per_radius) {
+  std::vector<double> scale(mesh.positions.size(), 1.0);
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const FrustumShape& shape = frusta[mesh.triangle_frustum[t]].shape;
+    const ShellDepths d = relief_shell_depths(shape, depth_m, max_depth_per_radius);
+    if (d.lower_m == depth_m && d.upper_m == depth_m) continue;  // thick enough: the full depth
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t v = mesh.indices[3 * t + c];
+      const double y = std::clamp(glm::dot(mesh.positions[v] - shape.base, shape.axis) / shape.length, 0.0, 1.0);
+      scale[v] = (d.lower_m + (d.upper_m - d.lower_m) * y) / depth_m;
+    }
+  }
+  return scale;
+}
+
+}  // namespace
+
+HeightFn height_function_for(const SceneTextures& textures, uint32_t plant) {
+  if (!textures.has_height(plant)) return {};
+  const ReliefMap map = textures.relief_map(plant);
+  if (!(map.depth_m > 0)) return {};  // as the relief: no depth, nothing to displace
+  return [map](double u, double v_m) {
+    const double h = map.field->height(u * map.u_repeat, v_m * map.v_per_metre);
+    return map.depth_m * std::clamp(h, 0.0, 1.0);  // clamped as the relief marcher does
+  };
+}
+
+namespace {
+
+// The relief of the frusta tracer (relief.h): every plant whose bark has a height map and
+// a relief depth > 0, when options.relief. Textures come from `textures`, else are opened
+// into g.own_textures. Adds the "relief" pass: its plants, or "none" (no marching).
+SceneRelief scene_relief(const Scene& scene, const GeometryOptions& options, const SceneTextures* textures,
+                         SceneGeometry& g, std::vector<RenderPass>* passes) {
+  SceneRelief relief;
+  relief.options = options.relief_options;
+  const Clock::time_point start = Clock::now();
+  std::vector<char> skinned(scene.plants.size(), 0);  // culled plants have no frusta
+  for (uint32_t p : g.plant_of_frustum) skinned[p] = 1;
+  std::vector<uint32_t> plants;
+  for (uint32_t p = 0; p < scene.plants.size(); ++p)
+    if (options.relief && skinned[p] && scene.plants[p].bark.height_texture && scene.plants[p].bark.relief_depth_m > 0)
+      plants.push_back(p);
+  if (!plants.empty() && !textures) {
+    SceneTextures::OpenResult opened = SceneTextures::open(scene);
+    if (opened.error) throw std::runtime_error(*opened.error);
+    g.own_textures = std::move(opened.textures);
+    textures = g.own_textures.get();
+  }
+  if (!plants.empty()) {
+    relief.plants.resize(scene.plants.size());
+    for (uint32_t p : plants) relief.plants[p] = textures->relief_map(p);
+  }
+  if (passes) {
+    const ReliefOptions& o = relief.options;
+    passes->push_back({"relief", seconds_since(start),
+                       plants.empty() ? std::string("none")
+                                      : std::to_string(plants.size()) + (plants.size() == 1 ? " plant, " : " plants, ") +
+                                            std::to_string(o.linear_steps) +
+                                            " linear + " + std::to_string(o.bisection_steps) + " bisection steps, v " +
+                                            (o.exact_v ? "exact" : "linear")});
+  }
+  return relief;
+}
+
+}  // namespace
+
+SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, const GeometryOptions& options,
+                                   std::vector<RenderPass>* passes, const SceneTextures* textures) {
   SceneGeometry g;
-  Clock::time_point start = Clock::now();
+  const bool mesh = options.kind == GeometryKind::mesh;
+  TessellateOptions tessellation;
+  tessellation.level = options.mesh_level;
+  // Height maps for GS+R: the caller's textures, else opened here for as long as needed.
+  bool any_height = false;
+  for (const ScenePlant& plant : scene.plants) any_height = any_height || plant.bark.height_texture.has_value();
+  std::unique_ptr<SceneTextures> own_textures;
+  if (mesh && options.displace && any_height && !textures) {
+    SceneTextures::OpenResult opened = SceneTextures::open(scene);
+    if (opened.error) throw std::runtime_error(*opened.error);
+    own_textures = std::move(opened.textures);
+    textures = own_textures.get();
+  }
+  const ViewFrustum view = view_frustum(scene);
+  double cull_s = 0, skin_s = 0, tessellate_s = 0, displace_s = 0;
+  uint32_t culled = 0, displaced = 0;
+  TriangleMesh triangles;
   for (uint32_t p = 0; p < scene.plants.size(); ++p) {
-    SkinnedSkeleton skinned = skin_skeleton(place_plant(scene.plants[p]), skin);
+    const ScenePlant& plant = scene.plants[p];
+    Clock::time_point start = Clock::now();
+    Skeleton placed = place_plant(plant);
+    skin_s += seconds_since(start);
+    if (options.cull) {
+      start = Clock::now();
+      // A relief or displacement reaches out to relief_depth_m beyond the frusta.
+      const double relief_m = plant.bark.height_texture ? std::max(0.0, plant.bark.relief_depth_m) : 0.0;
+      const bool out = plant_is_culled(scene, view, plant_box(placed, skin, relief_m));
+      cull_s += seconds_since(start);
+      if (out) {
+        ++culled;
+        continue;
+      }
+    }
+    start = Clock::now();
+    const SkinnedSkeleton skinned = skin_skeleton(placed, skin);
+    const uint32_t first_frustum = static_cast<uint32_t>(g.frusta.size());
     g.frusta.insert(g.frusta.end(), skinned.frusta.begin(), skinned.frusta.end());
     g.plant_of_frustum.insert(g.plant_of_frustum.end(), skinned.frusta.size(), p);
+    skin_s += seconds_since(start);
+    if (!mesh) continue;
+    start = Clock::now();
+    TriangleMesh part = tessellate(skinned, tessellation);
+    tessellate_s += seconds_since(start);
+    if (HeightFn height = options.displace && textures ? height_function_for(*textures, p) : HeightFn{}) {
+      start = Clock::now();
+      part = displace(part, height,
+                      displacement_scale(part, skinned.frusta, plant.bark.relief_depth_m,
+                                         options.relief_options.max_depth_per_radius));
+      displace_s += seconds_since(start);
+      ++displaced;
+    }
+    start = Clock::now();
+    if (triangles.positions.empty()) {  // the first plant's mesh is taken, not copied
+      for (uint32_t& f : part.triangle_frustum) f += first_frustum;
+      triangles = std::move(part);
+    } else {
+      append_mesh(triangles, part, first_frustum);
+    }
+    tessellate_s += seconds_since(start);
   }
+  const std::string plants = std::to_string(scene.plants.size());
+  if (passes && options.cull)
+    passes->push_back({"culling", cull_s, std::to_string(culled) + " of " + plants + " plants culled"});
   if (passes)
-    passes->push_back({"skin", seconds_since(start),
-                       std::to_string(scene.plants.size()) + " plants, " + std::to_string(g.frusta.size()) + " frusta"});
-  start = Clock::now();
+    passes->push_back({"skin", skin_s,
+                       std::to_string(scene.plants.size() - culled) + " plants, " + std::to_string(g.frusta.size()) +
+                           " frusta"});
+  if (passes && mesh)
+    passes->push_back({"tessellate", tessellate_s,
+                       std::to_string(triangles.triangle_count()) + " triangles, GS " +
+                           std::to_string(options.mesh_level) + ", " + std::to_string(triangles.memory_bytes() / 1024) +
+                           " KiB"});
+  if (passes && displaced > 0)
+    passes->push_back({"displace", displace_s, std::to_string(displaced) + " plants by their height maps"});
+  Clock::time_point start = Clock::now();
   switch (options.kind) {
     case GeometryKind::frusta:
-      g.tracer = std::make_unique<FrustumTracer>(g.frusta, g.plant_of_frustum);
+      g.tracer = std::make_unique<FrustumTracer>(g.frusta, g.plant_of_frustum,
+                                                 scene_relief(scene, options, textures, g, passes));
       break;
     case GeometryKind::mesh:
-      throw std::logic_error("build_scene_geometry: mesh geometry is not built yet");
+      g.tracer = std::make_unique<MeshTracer>(std::move(triangles), g.frusta, g.plant_of_frustum, options.mesh_level,
+                                              displaced > 0);
+      break;
   }
   if (passes)
     passes->push_back({"accel build", seconds_since(start),
@@ -310,8 +478,26 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   RenderResult result;
   for (const ScenePlant& plant : scene.plants)
     if (!plant.skeleton) throw std::logic_error("render_cpu: a plant has no skeleton (call grow_scene_plants)");
-  SceneGeometry geometry = build_scene_geometry(scene, options.skin, options.geometry, &result.passes);
+  // Bark textures: opened once, for the shading and for the relief or displacement.
+  std::unique_ptr<SceneTextures> textures;
+  if (std::any_of(scene.plants.begin(), scene.plants.end(), [](const ScenePlant& p) {
+        return p.bark.albedo_texture || p.bark.height_texture;
+      })) {
+    const Clock::time_point start = Clock::now();
+    SceneTextures::OpenResult opened = SceneTextures::open(scene);
+    if (opened.error) throw std::runtime_error(*opened.error);
+    textures = std::move(opened.textures);
+    result.passes.push_back({"textures", seconds_since(start), std::to_string(textures->file_count()) + " files"});
+  }
+  // The relief's shading normal is filtered over a pixel's footprint (relief.h): the
+  // angle between neighbouring samples' rays at the image centre.
+  GeometryOptions geometry_options = options.geometry;
+  geometry_options.relief_options.pixel_spread_rad =
+      2 * std::tan(0.5 * scene.camera.fov_y_deg * kPi / 180) / scene.height /
+      std::sqrt(static_cast<double>(std::max(1u, options.spp)));
+  SceneGeometry geometry = build_scene_geometry(scene, options.skin, geometry_options, &result.passes, textures.get());
   result.frusta = geometry.frusta.size();
+  result.geometry_bytes = geometry.tracer->memory_bytes();
 
   RenderImage& image = result.image;
   image.width = scene.width;
@@ -329,7 +515,7 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   threads = std::min<unsigned>(threads, tiles);
 
-  Renderer renderer(scene, geometry, options);
+  Renderer renderer(scene, geometry, options, textures.get());
   std::atomic<uint32_t> next_tile{0}, done_tiles{0};
   std::mutex totals_mutex;
   double trace_s = 0, shade_s = 0;

@@ -15,7 +15,17 @@
 // converge with --spp). The ground (y = ground.height, normal +Y, no specular) is shaded
 // the same way, with the plants' shadows. A ray that hits nothing sees L_sky.
 // Plant albedo comes from the material index (kMaterialAlbedo); bark.albedo given as a
-// colour replaces material 0 (wood). Normals: the C0-interpolated normal of eq. 8.
+// colour replaces material 0 (wood); bark.albedo given as a texture covers every segment
+// of its plant whatever its material (texture.h: mipmapped lookup, sRGB decoded after
+// filtering), filtered over the footprint of the ray differentials through the
+// neighbouring pixel positions, one pixel step / sqrt(spp) away (texture.h uv_footprint).
+// Normals: the C0-interpolated normal of eq. 8; on a relief-mapped plant (bark.height,
+// GeometryOptions::relief) the relief surface of relief.h with its perturbed normal,
+// filtered over the pixel's footprint (ReliefOptions::pixel_spread_rad, set here from the
+// camera: 2·tan(fov_y/2)/height/sqrt(spp)). A relief hit's shadow ray starts one pixel
+// footprint (t·|∂direction/∂y|) above it along its geometric normal, instead of the usual
+// 1e-7·scale: relief roughness below a pixel is shaded through the filtered normal and
+// must not also shadow itself from the finest-level geometry (which aliases to speckles).
 //
 // Outputs: beauty RGBA (linear; A = 1 everywhere, the sky is part of the picture) and, on
 // request, AOVs of the plant surface seen through each pixel's centre: depth (Euclidean
@@ -38,11 +48,16 @@
 #include <memory>
 #include <vector>
 
+#include "core/materials.h"  // kMaterialAlbedo: default albedo by material index
+#include "core/relief.h"
 #include "core/scene.h"
 #include "core/skin.h"
 #include "core/surface.h"
+#include "core/tessellate.h"
 
 namespace sylva {
+
+class SceneTextures;  // texture.h
 
 // Which AOVs to compute (bit flags).
 enum AovFlags : uint32_t {
@@ -50,14 +65,6 @@ enum AovFlags : uint32_t {
   kAovNormal = 1u << 1,  // N.X N.Y N.Z
   kAovUv = 1u << 2,      // U V
   kAovId = 1u << 3,      // id.plant id.chain id.segment
-};
-
-// Default albedo by material index (materials past the table reuse its last entry).
-inline constexpr double kMaterialAlbedo[][3] = {
-    {0.30, 0.20, 0.12},  // 0 wood, bark
-    {0.16, 0.34, 0.10},  // 1 leaves, needles, cactus skin
-    {0.22, 0.40, 0.16},  // 2 succulent skin
-    {0.85, 0.75, 0.35},  // 3 flowers, fruit
 };
 
 // Which geometry stands for the plants (issue 3: the analytic frusta are the reference,
@@ -71,7 +78,12 @@ struct GeometryOptions {
   GeometryKind kind = GeometryKind::frusta;
   int mesh_level = 2;   // m: 16·4^m triangles per segment
   bool cull = true;     // leave out plants that can affect no pixel (outside the view
-                        // frustum and casting no shadow into it)
+                        // frustum and casting no shadow into it; culling.h)
+  bool displace = true; // mesh: displace each plant's mesh by its height map where it has
+                        // one (the paper's GS+R; tessellate.h displace)
+  bool relief = true;   // frusta: relief-map every plant whose bark has a height map and a
+                        // relief_depth > 0 (relief.h, paper sec. 3); no height map, no marching
+  ReliefOptions relief_options;  // how the relief marcher samples
 };
 
 struct RenderOptions {
@@ -106,6 +118,7 @@ struct RenderResult {
   std::vector<RenderPass> passes;
   bool cancelled = false;     // stopped by options.cancel: the image is incomplete
   uint64_t frusta = 0;
+  uint64_t geometry_bytes = 0;  // what the traced geometry holds (SceneTracer::memory_bytes)
   uint64_t primary_rays = 0;
   uint64_t shadow_rays = 0;
 };
@@ -116,6 +129,8 @@ struct RenderResult {
 struct SceneGeometry {
   std::vector<Frustum> frusta;
   std::vector<uint32_t> plant_of_frustum;  // plant index of each frustum
+  std::shared_ptr<const SceneTextures> own_textures;  // opened here when the caller gave
+                                                      // none and the relief needs them
   std::unique_ptr<SceneTracer> tracer;     // over `frusta` (or a mesh made from them)
 };
 
@@ -123,10 +138,24 @@ struct SceneGeometry {
 // radii scaled. Precondition: plant.skeleton is set.
 Skeleton place_plant(const ScenePlant& plant);
 
-// Skins and indexes every plant (each plant's skeleton must be set: grow_scene_plants).
+// Skins and indexes every plant (each plant's skeleton must be set: grow_scene_plants)
+// that geometry.cull does not leave out (culling.h; a culled plant has no frusta, its
+// index stays valid), then builds the tracer: the frusta, or their GS mesh at
+// geometry.mesh_level in Embree (mesh_accel.h), displaced where geometry.displace and the
+// plant has a height map (as deep as the relief shell is thick: relief.h's
+// max_depth_per_radius thins it on twigs and needles). `textures` supplies the height maps; null: they are opened here
+// when a displaced mesh needs them (std::runtime_error naming the file if one cannot be).
+// Passes: "culling" (when on), "skin", "tessellate" and "displace" (mesh), "accel build".
 SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin,
                                    const GeometryOptions& geometry = {},
-                                   std::vector<RenderPass>* passes = nullptr);
+                                   std::vector<RenderPass>* passes = nullptr,
+                                   const SceneTextures* textures = nullptr);
+
+// The displacement of plant `plant`'s mesh: d·H(u·u_repeat, v_m·v_per_metre) metres with
+// H its height map in [0, 1] (texture.h: bilinear, finest MIP level, periodic; the field
+// the relief marcher reads) and d its bark's relief_depth_m; an empty function when the
+// plant has no height map or no depth. The function reads `textures`, which must outlive it.
+HeightFn height_function_for(const SceneTextures& textures, uint32_t plant);
 
 // The primary ray through continuous pixel position (x, y) in [0, width] × [0, height]
 // (y downward); pixel (i, j)'s centre is (i + 0.5, j + 0.5). The direction is not unit.

@@ -11,6 +11,7 @@
 
 #include "core/file_io.h"
 #include "core/json.h"
+#include "core/texture.h"
 #include "core/turtle.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
@@ -127,15 +128,38 @@ Sun read_sun(const JsonValue& v) {
   return s;
 }
 
+// A texture named by member `key` of `object` must exist and open in OpenImageIO, so a
+// missing or broken image is reported at its key, before anything is grown or rendered.
+void check_texture(const JsonValue& object, std::string_view key, const std::string& path,
+                   const std::string& what) {
+  const JsonMember* member = nullptr;
+  for (const JsonMember& m : object.members)
+    if (m.key.name == key) member = &m;
+  const uint32_t line = member ? member->key.line : object.line;
+  const uint32_t column = member ? member->key.column : object.column;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw Located{line, column, what + ": no such image file '" + path + "'"};
+  if (auto reason = image_open_error(path))
+    throw Located{line, column, what + ": cannot open image '" + path + "': " + *reason};
+}
+
 Bark read_bark(const JsonValue& v, const std::string& base_dir, std::string_view what) {
   expect_object(v, what);
   check_keys(v, what, {"albedo", "height", "relief_depth", "u_repeat", "v_per_metre"});
   Bark b;
   if (auto* x = v.find("albedo")) {
-    if (x->is_array()) b.albedo_rgb = colour(*x, "bark.albedo");
-    else b.albedo_texture = path_relative_to(base_dir, *x, "bark.albedo");
+    if (x->is_array()) {
+      b.albedo_rgb = colour(*x, "bark.albedo");
+    } else {
+      b.albedo_texture = path_relative_to(base_dir, *x, "bark.albedo");
+      check_texture(v, "albedo", *b.albedo_texture, std::string(what) + ".albedo");
+    }
   }
-  if (auto* x = v.find("height")) b.height_texture = path_relative_to(base_dir, *x, "bark.height");
+  if (auto* x = v.find("height")) {
+    b.height_texture = path_relative_to(base_dir, *x, "bark.height");
+    check_texture(v, "height", *b.height_texture, std::string(what) + ".height");
+  }
   if (auto* x = v.find("relief_depth")) b.relief_depth_m = number_in(*x, "bark.relief_depth", 0, 1e3, false, false);
   if (auto* x = v.find("u_repeat")) b.u_repeat = number_in(*x, "bark.u_repeat", 0, 1e6, true, false);
   if (auto* x = v.find("v_per_metre")) b.v_per_metre = number_in(*x, "bark.v_per_metre", 0, 1e6, true, false);

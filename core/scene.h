@@ -48,7 +48,9 @@ struct Fog {
   double height_falloff = 0.0;   // 1/m
 };
 
-// The bark of a plant. albedo is a texture path or a constant colour.
+// The bark of a plant. albedo is a texture path or a constant colour. Texture paths are
+// checked when the scene is read: a file that does not exist or that OpenImageIO cannot
+// open is an error at its key. Textures: texture.h; relief: relief.h.
 struct Bark {
   std::optional<std::string> albedo_texture;  // resolved against the scene file's folder
   std::optional<glm::dvec3> albedo_rgb;       // constant albedo of material 0 (wood)

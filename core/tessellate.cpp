@@ -1,8 +1,11 @@
 // tessellate.cpp — frusta to triangle meshes (see tessellate.h).
 #include "core/tessellate.h"
 
+#include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <glm/geometric.hpp>
+#include <numeric>
 
 namespace sylva {
 
@@ -83,7 +86,9 @@ TriangleMesh tessellate(const SkinnedSkeleton& skinned, const TessellateOptions&
     radials[static_cast<size_t>(n)] = radials[0];
     for (int j = 0; j <= k; ++j) {
       const double v = static_cast<double>(j) / k;
-      const double v_m = fr.v_lower_m + v * (fr.v_upper_m - fr.v_lower_m);
+      // The end rows take the cut's v_m exactly, so a joint's shared row has one v_m on
+      // both sides (the lerp can be an ulp off at v = 1) and displacement agrees there.
+      const double v_m = j == 0 ? fr.v_lower_m : j == k ? fr.v_upper_m : fr.v_lower_m + v * (fr.v_upper_m - fr.v_lower_m);
       for (int i = 0; i <= n; ++i) {
         glm::dvec3 p = surface_point(s, radials[static_cast<size_t>(i)], v);
         if (j == 0 && shares_cut) p = top_rows[static_cast<size_t>(fr.parent)][static_cast<size_t>(i)];
@@ -138,6 +143,93 @@ TriangleMesh tessellate(const SkinnedSkeleton& skinned, const TessellateOptions&
     if (s.cap_upper && !tip_upper) cap(s.upper, k, false);
   }
   return mesh;
+}
+
+void append_mesh(TriangleMesh& into, const TriangleMesh& part, uint32_t frustum_offset) {
+  const uint32_t base = static_cast<uint32_t>(into.positions.size());
+  into.positions.insert(into.positions.end(), part.positions.begin(), part.positions.end());
+  into.normals.insert(into.normals.end(), part.normals.begin(), part.normals.end());
+  into.uvs.insert(into.uvs.end(), part.uvs.begin(), part.uvs.end());
+  into.indices.reserve(into.indices.size() + part.indices.size());
+  for (uint32_t i : part.indices) into.indices.push_back(base + i);
+  into.triangle_frustum.reserve(into.triangle_frustum.size() + part.triangle_frustum.size());
+  for (uint32_t f : part.triangle_frustum) into.triangle_frustum.push_back(frustum_offset + f);
+}
+
+TriangleMesh displace(const TriangleMesh& mesh, const HeightFn& height_m, std::span<const double> scale) {
+  const size_t count = mesh.positions.size();
+  assert(scale.empty() || scale.size() == count);
+  // Coincident vertices, found by sorting on the exact bits of their positions (no
+  // tolerance: tessellate copies shared points, it does not recompute them). Each vertex
+  // gets the first vertex of its group as representative.
+  std::vector<uint32_t> order(count);
+  std::iota(order.begin(), order.end(), 0u);
+  auto less = [&](uint32_t a, uint32_t b) {
+    const glm::dvec3 &p = mesh.positions[a], &q = mesh.positions[b];
+    if (p.x != q.x) return p.x < q.x;
+    if (p.y != q.y) return p.y < q.y;
+    if (p.z != q.z) return p.z < q.z;
+    return a < b;
+  };
+  std::sort(order.begin(), order.end(), less);
+  // Side vertices: used by a triangle whose v_m vary. A cap fan's triangles have one v_m.
+  std::vector<char> on_side(count, 0);
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const uint32_t* tri = &mesh.indices[3 * t];
+    const double v0 = mesh.uvs[tri[0]].y;
+    if (mesh.uvs[tri[1]].y != v0 || mesh.uvs[tri[2]].y != v0) on_side[tri[0]] = on_side[tri[1]] = on_side[tri[2]] = 1;
+  }
+  // Groups of coincident vertices; each moves by the vector of its first side vertex (none:
+  // a cap's centre, which stays in the cut plane as the relief solid's caps do).
+  std::vector<uint32_t> representative(count), group_start(count);
+  std::vector<glm::dvec3> offset(count, glm::dvec3(0));
+  for (size_t k = 0; k < count;) {
+    size_t end = k + 1;
+    while (end < count && mesh.positions[order[end]] == mesh.positions[order[k]]) ++end;
+    uint32_t mover = order[k];
+    bool moves = false;
+    for (size_t q = k; q < end && !moves; ++q)
+      if (on_side[order[q]]) mover = order[q], moves = true;
+    for (size_t q = k; q < end; ++q) representative[order[q]] = order[k], group_start[order[q]] = static_cast<uint32_t>(k);
+    if (moves)
+      offset[order[k]] = (height_m(mesh.uvs[mover].x, mesh.uvs[mover].y) * (scale.empty() ? 1.0 : scale[mover])) *
+                         mesh.normals[mover];
+    k = end;
+  }
+
+  TriangleMesh out = mesh;
+  for (size_t v = 0; v < count; ++v) out.positions[v] = mesh.positions[v] + offset[representative[v]];
+
+  // Angle-weighted normals (Thürmer & Wüthrich 1998): each face's unit normal times its
+  // angle at the vertex. Unlike area weights they do not depend on how a quad is split:
+  // a vertex of the grid is the first corner of two triangles of one quad and of one of
+  // the quad before it, which area weights count 2:1 (a cylinder's normals at level 0
+  // would lean 7.9° off radial).
+  std::vector<glm::dvec3> sum(count, glm::dvec3(0));
+  auto angle = [](const glm::dvec3& e, const glm::dvec3& f) {
+    return std::atan2(glm::length(glm::cross(e, f)), glm::dot(e, f));
+  };
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const uint32_t a = mesh.indices[3 * t], b = mesh.indices[3 * t + 1], c = mesh.indices[3 * t + 2];
+    const glm::dvec3 &pa = out.positions[a], &pb = out.positions[b], &pc = out.positions[c];
+    const glm::dvec3 n = glm::cross(pb - pa, pc - pa);
+    const double area2 = glm::length(n);
+    if (!(area2 > 0)) continue;  // a degenerate face has no normal to give
+    const glm::dvec3 unit = n / area2;
+    sum[a] += angle(pb - pa, pc - pa) * unit;
+    sum[b] += angle(pc - pb, pa - pb) * unit;
+    sum[c] += angle(pa - pc, pb - pc) * unit;
+  }
+  // Share the sums across a group where the original normals agree (within ~0.08°).
+  constexpr double kSameNormal = 1 - 1e-6;
+  for (size_t v = 0; v < count; ++v) {
+    glm::dvec3 n(0);
+    for (size_t q = group_start[v]; q < count && representative[order[q]] == representative[v]; ++q)
+      if (glm::dot(mesh.normals[order[q]], mesh.normals[v]) > kSameNormal) n += sum[order[q]];
+    const double len = glm::length(n);
+    out.normals[v] = len > 0 ? n / len : mesh.normals[v];
+  }
+  return out;
 }
 
 }  // namespace sylva

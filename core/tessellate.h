@@ -19,8 +19,10 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <span>
 #include <vector>
 
 #include "core/skin.h"
@@ -52,5 +54,32 @@ int tessellation_rows(const TessellateOptions& options);
 
 // Tessellates every frustum of `skinned`. Deterministic.
 TriangleMesh tessellate(const SkinnedSkeleton& skinned, const TessellateOptions& options = {});
+
+// Appends `part` to `into`: its indices shifted past into's vertices, its triangle_frustum
+// shifted by `frustum_offset` (so per-plant meshes index one scene-wide frustum array).
+void append_mesh(TriangleMesh& into, const TriangleMesh& part, uint32_t frustum_offset);
+
+// A displacement in metres at texture coordinates (u turns, v_m metres of arc length).
+using HeightFn = std::function<double(double u, double v_m)>;
+
+// The paper's GS+R: `mesh` with every vertex moved along its normal by height_m(u, v_m)
+// (positive: outward), normals recomputed from the displaced surface as angle-weighted
+// sums of face normals (area weights would depend on the split of each grid quad into
+// two triangles and tilt a cylinder's normals by 7.9° at level 0). Cracks cannot open: vertices that coincide in `mesh` (the seam
+// columns u = 0 and u = 1, the rows two frusta share at a joint, a tip row, a cap's rim and
+// the side's rim) are all moved by one vector, that of the first side vertex among them in
+// vertex order (for a rim: the side's), so they coincide afterwards whatever height_m
+// does — even where it is discontinuous (a texture whose u repeat is not a whole number).
+// Caps stay in their cut planes, as the relief solid's do (relief.h): a cap's centre does
+// not move, its rim moves with the side. Normals are shared across coincident vertices
+// where their original normals agree (seams, joints with eq. 8 normals, tips) and kept
+// apart where they do not (a cap's rim against the side: the crease stays).
+// The relief solid of relief.h lifts the surface radially (distance from the axis
+// r(y) + d·H); a move δ along a cone's normal lifts it radially by δ/cos φ (φ the cone's
+// half-angle): the same for a cylinder, 0.5% more at φ = 6°. Deterministic; triangles, uvs and triangle_frustum are
+// unchanged.
+// `scale`, if not empty, holds one factor per vertex that multiplies height_m there (the
+// renderer thins the relief of twigs and needles: relief.h's max_depth_per_radius).
+TriangleMesh displace(const TriangleMesh& mesh, const HeightFn& height_m, std::span<const double> scale = {});
 
 }  // namespace sylva

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The README's first command: install dependencies (Debian 12), build sylva (release),
 # grow the bundled saguaro and elm presets (printing their summaries), and render the
-# saguaro with the CPU ray caster to out/saguaro.png.
+# saguaro with the OpenGL backend (a window-less EGL context: Mesa's llvmpipe on a machine
+# without a GPU, no X server) to out/saguaro.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -12,5 +13,6 @@ mkdir -p out
 for plant in saguaro elm; do
   build/release/app/sylva grow "presets/$plant.lsys" -o "out/$plant.skel.json"
 done
-build/release/app/sylva render presets/saguaro.lsys -o out/saguaro.png --width 800 --height 600 --spp 4
+build/release/app/sylva render presets/saguaro.lsys -o out/saguaro.png --width 800 --height 600 --spp 4 \
+  --backend gl
 echo "skeletons and out/saguaro.png written to out/ (see docs/ for the formats and the other presets)"

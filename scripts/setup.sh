@@ -12,6 +12,9 @@ packages=(
   # The Python module (built for /usr/bin/python3) and its tests.
   python3 python3-dev pybind11-dev python3-numpy python3-pytest
   fonts-dejavu-core  # the text of the benchmarks' plots (core/plot.h)
+  # The GL backend: OpenGL 4.5 + EGL through libglvnd, Mesa's llvmpipe for a machine
+  # without a GPU (surfaceless EGL, no X), glslangValidator for the shader tests.
+  libgl-dev libegl-dev libgl1-mesa-dri libegl-mesa0 glslang-tools
 )
 # Node.js runs the Khronos glTF validator; any npm already on the machine will do.
 command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)

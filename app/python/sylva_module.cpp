@@ -384,9 +384,42 @@ py::sequence per_plant(const py::object& value, size_t count, const char* name) 
   return seq;
 }
 
+// The `bark` argument of export_gltf: a dict with the keys of scene.md's "bark".
+Bark bark_from_dict(const py::object& value) {
+  if (!py::isinstance<py::dict>(value))
+    throw py::type_error("bark must be a dict with keys albedo, height, relief_depth, u_repeat, v_per_metre");
+  Bark bark;
+  for (const auto& [key_object, item] : py::reinterpret_borrow<py::dict>(value)) {
+    const std::string key = py::str(key_object);
+    const py::object v = py::reinterpret_borrow<py::object>(item);
+    if (key == "albedo") {
+      if (py::isinstance<py::str>(v) || py::hasattr(v, "__fspath__")) {
+        bark.albedo_texture = path_string(v.cast<std::filesystem::path>());
+      } else {
+        const auto rgb = v.cast<std::vector<double>>();
+        if (rgb.size() != 3) throw py::value_error("bark['albedo'] must be a path or an (r, g, b) linear colour");
+        bark.albedo_rgb = glm::dvec3(rgb[0], rgb[1], rgb[2]);
+      }
+    } else if (key == "height") {
+      bark.height_texture = path_string(v.cast<std::filesystem::path>());
+    } else if (key == "relief_depth") {
+      bark.relief_depth_m = v.cast<double>();
+      if (!std::isfinite(bark.relief_depth_m) || bark.relief_depth_m < 0)
+        throw py::value_error("bark['relief_depth'] must be a finite number >= 0 (metres)");
+    } else if (key == "u_repeat" || key == "v_per_metre") {
+      const double x = v.cast<double>();
+      if (!std::isfinite(x) || x <= 0) throw py::value_error("bark['" + key + "'] must be a finite number > 0");
+      (key == "u_repeat" ? bark.u_repeat : bark.v_per_metre) = x;
+    } else {
+      throw py::value_error("bark: unknown key '" + key + "' (albedo, height, relief_depth, u_repeat, v_per_metre)");
+    }
+  }
+  return bark;
+}
+
 void python_export_gltf(const py::object& plants, const std::filesystem::path& path, bool mesh, int segments_around,
                         bool instancing, const py::object& names, const py::object& positions,
-                        const py::object& rotate_y_deg, const py::object& scales) {
+                        const py::object& rotate_y_deg, const py::object& scales, const py::object& bark) {
   const std::vector<const Skeleton*> skeletons = skeleton_list(plants);
   if (skeletons.empty()) throw py::value_error("export_gltf needs at least one plant");
   if (segments_around < 3) throw py::value_error("segments_around must be >= 3");
@@ -414,6 +447,11 @@ void python_export_gltf(const py::object& plants, const std::filesystem::path& p
   if (!scales.is_none()) {
     py::sequence seq = per_plant(scales, skeletons.size(), "scales");
     for (size_t i = 0; i < skeletons.size(); ++i) gltf_plants[i].scale = seq[i].cast<double>();
+  }
+  if (!bark.is_none()) {
+    if (!mesh) throw py::value_error("bark shapes the mesh: pass mesh=True too");
+    const Bark b = bark_from_dict(bark);
+    for (GltfPlant& p : gltf_plants) p.bark = b;
   }
   GltfExportOptions options;
   options.mesh = mesh;
@@ -614,23 +652,33 @@ released while growing. A RuntimeWarning reports an interpretation cut at max de
   signatures.disable_function_signatures();
   m.def("export_gltf", &python_export_gltf, "plants"_a, "path"_a, py::kw_only(), "mesh"_a = false,
         "segments_around"_a = 8, "instancing"_a = false, "names"_a = py::none(), "positions"_a = py::none(),
-        "rotate_y_deg"_a = py::none(), "scales"_a = py::none(),
-        R"doc(export_gltf(plants: Skeleton | Sequence[Skeleton], path: str | os.PathLike, *, mesh: bool = False, segments_around: int = 8, instancing: bool = False, names: Sequence[str] | None = None, positions: Sequence[tuple[float, float, float]] | None = None, rotate_y_deg: Sequence[float] | None = None, scales: Sequence[float] | None = None) -> None
+        "rotate_y_deg"_a = py::none(), "scales"_a = py::none(), "bark"_a = py::none(),
+        R"doc(export_gltf(plants: Skeleton | Sequence[Skeleton], path: str | os.PathLike, *, mesh: bool = False, segments_around: int = 8, instancing: bool = False, names: Sequence[str] | None = None, positions: Sequence[tuple[float, float, float]] | None = None, rotate_y_deg: Sequence[float] | None = None, scales: Sequence[float] | None = None, bark: dict | None = None) -> None
 
 Writes plants to a glTF 2.0 file, binary (.glb) or JSON (.gltf) by extension.
 
 plants: a Skeleton or a sequence of Skeletons, one node each, carrying the skeleton
 as a LINES mesh and the exact skeleton document in the node's extras["sylva"].
 Keyword-only:
-  mesh             also write the skinned frusta as a triangle mesh with a bark material
+  mesh             also write the skinned frusta as a triangle mesh (see bark)
   segments_around  columns around each frustum of that mesh (>= 3)
   instancing       repeated identical plants as EXT_mesh_gpu_instancing
   names            node names (default: the grammar file's stem, e.g. "elm")
   positions        per plant (x, y, z) node translation in metres
   rotate_y_deg     per plant rotation about +Y in degrees
   scales           per plant uniform scale
-The file is written atomically; a failure raises RuntimeError with the reason. The GIL
-is released while writing.)doc");
+  bark             the mesh's bark for every plant (needs mesh=True), a dict with the
+                   keys of a scene's "bark": albedo (a PNG/JPEG path, embedded as the
+                   base colour texture, or an (r, g, b) linear colour for material 0),
+                   height (a height map path, baked into a tangent-space normal map),
+                   relief_depth (metres, default 0.02), u_repeat (texture repeats around
+                   the stem, default 1), v_per_metre (repeats per metre along it,
+                   default 1). TEXCOORD_0 becomes (u*u_repeat, v_m*v_per_metre).
+                   e.g. bark=dict(albedo="presets/textures/bark.png",
+                   height="presets/textures/bark_height.png", u_repeat=2)
+The mesh has one material per material index the plants use. The file is written
+atomically; a failure (a missing texture among them) raises RuntimeError with the
+reason, naming the file, and writes nothing. The GIL is released while writing.)doc");
   signatures.enable_function_signatures();
 
   bind_render(m);

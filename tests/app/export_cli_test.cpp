@@ -21,6 +21,8 @@ namespace fs = std::filesystem;
 const std::string kSource = SYLVA_SOURCE_DIR;
 const std::string kPlant = kSource + "/presets/abop_1_24a.lsys";
 const std::string kOtherPlant = kSource + "/presets/abop_1_27_stochastic.lsys";
+const std::string kBarkAlbedo = kSource + "/presets/textures/bark.png";
+const std::string kBarkHeight = kSource + "/presets/textures/bark_height.png";
 // Divides by zero for the seeds whose first rand() is below 1/15.5 (seed 7 among 1..8).
 constexpr const char* kSometimesBroken = "derivation length: 1\naxiom: A\nA -> F(1/floor(rand()*15.5))\n";
 
@@ -78,7 +80,27 @@ TEST(ExportCli, EveryVariantPassesTheKhronosValidator) {
           expect_ok(run_sylva(args));
         }
       }
-  ASSERT_EQ(files.size(), 16u);
+  // Textured barks: from the flags for a grammar, from each plant of a scene (paths
+  // relative to the scene file; a colour albedo with a height map too).
+  for (const char* ext : {".glb", ".gltf"}) {
+    files.push_back(dir.file(std::string("lsys_bark") + ext));
+    expect_ok(run_sylva({"export", kPlant, "-o", files.back(), "--mesh", "--segments-around", "6", "--bark-albedo",
+                         kBarkAlbedo, "--bark-height", kBarkHeight, "--relief-depth", "0.005", "--u-repeat", "2",
+                         "--v-per-metre", "3"}));
+  }
+  fs::create_directories(dir.path() / "textures");
+  fs::copy_file(kBarkAlbedo, dir.path() / "textures/bark.png");
+  fs::copy_file(kBarkHeight, dir.path() / "textures/bark_height.png");
+  const std::string bark_scene = dir.write("bark.scene.json", R"({"format":"sylva-scene","version":1,"plants":[
+    {"grammar":")" + kPlant + R"(","seed":1,"bark":{"albedo":"textures/bark.png","height":"textures/bark_height.png",
+     "relief_depth":0.01,"u_repeat":2,"v_per_metre":1}},
+    {"grammar":")" + kOtherPlant + R"(","seed":2,"position":[2,0,0],
+     "bark":{"albedo":[0.4,0.3,0.2],"height":"textures/bark_height.png","u_repeat":3}}]})");
+  for (const char* ext : {".glb", ".gltf"}) {
+    files.push_back(dir.file(std::string("scene_bark") + ext));
+    expect_ok(run_sylva({"export", bark_scene, "-o", files.back(), "--mesh", "--segments-around", "5"}));
+  }
+  ASSERT_EQ(files.size(), 20u);
   expect_valid(files);
   // The instanced forest holds 2 nodes for 4 plants and reads back as 4 plants.
   sylva::GltfImportResult forest = sylva::import_gltf_skeletons(dir.file("forest_mesh_instanced.glb"));
@@ -187,6 +209,57 @@ TEST(ExportCli, UsageErrorsExitTwoAndInputErrorsExitOne) {
   expect_ok(help);
   EXPECT_NE(help.out.find("--segments-around"), std::string::npos);
   EXPECT_NE(run_sylva({"--help"}).out.find("export"), std::string::npos);
+}
+
+TEST(ExportCli, BarkFlagsNeedAMeshAndAGrammarOrSkeletonAndReadableTextures) {
+  TempDir dir;
+  const std::string skel = dir.file("p.skel.json");
+  expect_ok(run_sylva({"grow", kPlant, "-o", skel}));
+  const std::string scene = dir.write("s.scene.json", R"({"format":"sylva-scene","version":1,"plants":[
+    {"grammar":")" + kPlant + R"("}]})");
+  const std::string out = dir.write("keep.glb", "old contents");
+  const std::vector<std::vector<std::string>> usage = {
+      {"export", kPlant, "-o", out, "--bark-albedo", kBarkAlbedo},  // no --mesh
+      {"export", scene, "-o", out, "--mesh", "--bark-height", kBarkHeight},
+      {"export", kPlant, "-o", out, "--mesh", "--u-repeat", "0"},
+      {"export", kPlant, "-o", out, "--mesh", "--v-per-metre", "-1"},
+      {"export", kPlant, "-o", out, "--mesh", "--relief-depth", "deep"},
+      {"export", kPlant, "-o", out, "--mesh", "--relief-depth", "nan"},
+      {"export", kPlant, "-o", out, "--mesh", "--bark-height"},
+  };
+  for (const auto& args : usage) {
+    ProcessResult r = run_sylva(args);
+    EXPECT_FALSE(crashed(r)) << describe(r);
+    EXPECT_EQ(r.exit_code, 2) << describe(r);
+  }
+  // A missing or unusable texture: exit 1, the file named, the old output untouched.
+  const std::string text = dir.write("notes.png", "not an image");
+  const std::vector<std::pair<std::vector<std::string>, std::string>> input = {
+      {{"export", kPlant, "-o", out, "--mesh", "--bark-albedo", dir.file("missing.png")}, dir.file("missing.png")},
+      {{"export", skel, "-o", out, "--mesh", "--bark-height", dir.file("gone.png")}, dir.file("gone.png")},
+      {{"export", kPlant, "-o", out, "--mesh", "--bark-albedo", text}, text},
+      {{"export", kPlant, "--seed", "1..3", "-o", dir.file("b/p_{seed}.glb"), "--mesh", "--bark-height=" + text}, text},
+  };
+  for (const auto& [args, file] : input) {
+    ProcessResult r = run_sylva(args);
+    EXPECT_FALSE(crashed(r)) << describe(r);
+    EXPECT_EQ(r.exit_code, 1) << describe(r);
+    EXPECT_NE(r.err.find(file), std::string::npos) << describe(r);
+  }
+  EXPECT_EQ(read_file(out), "old contents");
+  EXPECT_FALSE(fs::exists(dir.path() / "b"));  // checked before the batch starts
+  // The flags reach the file: the material's extras carry them.
+  expect_ok(run_sylva({"export", skel, "-o", dir.file("ok.gltf"), "--mesh", "--bark-height=" + kBarkHeight,
+                       "--u-repeat=4", "--v-per-metre", "2.5", "--relief-depth", "0.003"}));
+  const std::string gltf = read_file(dir.path() / "ok.gltf");
+  EXPECT_NE(gltf.find("\"height\":\"" + kBarkHeight + "\",\"relief_depth_m\":0.003,\"u_repeat\":4,\"v_per_metre\":2.5"),
+            std::string::npos);
+  EXPECT_NE(gltf.find("\"normalTexture\""), std::string::npos);
+  EXPECT_EQ(gltf.find("\"baseColorTexture\""), std::string::npos);
+  ProcessResult help = run_sylva({"export", "--help"});
+  expect_ok(help);
+  for (const char* flag : {"--bark-albedo", "--bark-height", "--relief-depth", "--u-repeat", "--v-per-metre"})
+    EXPECT_NE(help.out.find(flag), std::string::npos) << flag;
 }
 
 TEST(Batch, ExportSeedRangeWritesOneValidFilePerSeed) {

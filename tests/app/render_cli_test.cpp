@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 
 #include "tests/app/process.h"
@@ -42,19 +43,70 @@ TEST(RenderCli, SaguaroRendersToPng) {
   EXPECT_EQ(list_dir(dir.path()), std::vector<std::string>{"s.png"});
 }
 
-TEST(RenderCli, AutoBackendFallsBackToTheCpuSayingSo) {
-  TempDir dir;
-  ProcessResult r = run_sylva({"render", kSaguaro, "-o", dir.file("s.png"), "--width", "32", "--height", "24"});
-  ASSERT_EQ(r.exit_code, 0) << describe(r);
-  EXPECT_NE(r.err.find("OpenGL backend not available yet; using the CPU ray caster"), std::string::npos)
-      << describe(r);
+// Runs `sylva render` with EGL unable to find any vendor library (libglvnd reads this
+// variable), so that no OpenGL context can be made whatever the machine has.
+ProcessResult run_sylva_without_egl(const std::vector<std::string>& args) {
+  setenv("__EGL_VENDOR_LIBRARY_FILENAMES", "/nonexistent/sylva-test-no-egl-vendor.json", 1);
+  ProcessResult r = run_sylva(args);
+  unsetenv("__EGL_VENDOR_LIBRARY_FILENAMES");
+  return r;
 }
 
-TEST(RenderCli, GlBackendIsAUsageErrorForNow) {
+TEST(RenderCli, AutoBackendUsesOpenGlOrFallsBackToTheCpuSayingWhy) {
   TempDir dir;
-  ProcessResult r = run_sylva({"render", kSaguaro, "-o", dir.file("s.png"), "--backend", "gl"});
-  EXPECT_EQ(r.exit_code, 2) << describe(r);
-  EXPECT_NE(r.err.find("OpenGL"), std::string::npos) << describe(r);
+  ProcessResult r = run_sylva({"render", kSaguaro, "-o", dir.file("s.png"), "--width", "32", "--height", "24",
+                               "--verbose"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  if (r.err.find("using the CPU ray caster") != std::string::npos) {
+    EXPECT_NE(r.err.find("OpenGL unavailable ("), std::string::npos) << describe(r);
+    EXPECT_NE(r.err.find("CPU ray caster\n"), std::string::npos) << describe(r);
+  } else {
+    EXPECT_NE(r.err.find("OpenGL ray caster ("), std::string::npos) << describe(r);
+    EXPECT_NE(r.err.find("frusta (GPU)"), std::string::npos) << describe(r);
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir.file("s.png")));
+}
+
+TEST(RenderCli, AutoBackendWithoutEglFallsBackToTheCpuSayingWhy) {
+  TempDir dir;
+  ProcessResult r = run_sylva_without_egl({"render", kSaguaro, "-o", dir.file("s.png"), "--width", "32", "--height", "24"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.err.find("OpenGL unavailable (no OpenGL 4.5 core context through EGL"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("using the CPU ray caster"), std::string::npos) << describe(r);
+  EXPECT_TRUE(std::filesystem::exists(dir.file("s.png")));
+}
+
+TEST(RenderCli, WhatTheGlBackendCannotDrawGoesToTheCpuUnderAutoAndFailsUnderGl) {
+  TempDir dir;
+  ProcessResult r = run_sylva({"render", kSaguaro, "-o", dir.file("s.png"), "--width", "32", "--height", "24",
+                               "--geometry", "mesh"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.err.find("the OpenGL backend cannot draw this ("), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("using the CPU ray caster"), std::string::npos) << describe(r);
+  ProcessResult gl = run_sylva({"render", kSaguaro, "-o", dir.file("g.png"), "--geometry", "mesh", "--backend", "gl"});
+  EXPECT_EQ(gl.exit_code, 1) << describe(gl);
+  EXPECT_NE(gl.err.find("--backend gl: the GL backend draws the analytic frusta only"), std::string::npos)
+      << describe(gl);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("g.png")));
+}
+
+TEST(RenderCli, GlBackendRendersWithOpenGl) {
+  TempDir dir;
+  ProcessResult r = run_sylva({"render", kSaguaro, "-o", dir.file("s.png"), "--width", "64", "--height", "48",
+                               "--backend", "gl", "--aov", "depth", "--verbose"});
+  if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 core context") != std::string::npos)
+    GTEST_SKIP() << "no OpenGL context on this machine: " << r.err;
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.err.find("OpenGL ray caster ("), std::string::npos) << describe(r);
+  EXPECT_EQ(r.err.find("CPU ray caster"), std::string::npos) << describe(r);
+  EXPECT_EQ(list_dir(dir.path()), (std::vector<std::string>{"s.depth.exr", "s.png"}));
+}
+
+TEST(RenderCli, GlBackendWithoutEglExitsOneSayingWhyAndWritesNothing) {
+  TempDir dir;
+  ProcessResult r = run_sylva_without_egl({"render", kSaguaro, "-o", dir.file("s.png"), "--backend", "gl"});
+  EXPECT_EQ(r.exit_code, 1) << describe(r);
+  EXPECT_NE(r.err.find("--backend gl: no OpenGL 4.5 core context through EGL"), std::string::npos) << describe(r);
   EXPECT_FALSE(std::filesystem::exists(dir.file("s.png")));
 }
 
@@ -98,16 +150,30 @@ TEST(RenderCli, SceneFileRendersItsPlantsRelativeToTheScene) {
   dir.write("a.scene.json", R"({"image": {"width": 48, "height": 36},
   "camera": {"eye": [8, 4, 8], "target": [0, 3, 0]},
   "plants": [{"grammar": "cactus.lsys", "position": [1, 0, 0], "rotate_y_deg": 30},
-             {"grammar": "cactus.lsys", "seed": 5, "position": [-2, 0, -1], "scale": 0.7}]})");
+             {"grammar": "cactus.lsys", "seed": 5, "position": [-2, 0, -1], "scale": 0.7},
+             {"grammar": "cactus.lsys", "position": [20, 0, 20]}]})");
   ProcessResult r = run_sylva({"render", dir.file("a.scene.json"), "-o", dir.file("a.png"), "--backend", "cpu",
                                "--verbose"});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   auto in = OIIO::ImageInput::open(dir.file("a.png"));
   ASSERT_TRUE(in);
   EXPECT_EQ(in->spec().width, 48);
-  // --verbose lists the passes.
-  for (const char* pass : {"skin", "accel build", "trace", "shade", "write"})
+  // --verbose lists the passes; the third cactus stands behind the camera.
+  for (const char* pass : {"culling", "1 of 3 plants culled", "skin", "accel build", "analytic frusta", "trace",
+                           "shade", "write"})
     EXPECT_NE(r.err.find(pass), std::string::npos) << pass << "\n" << describe(r);
+}
+
+TEST(RenderCli, MeshGeometryListsItsTessellationAndTriangleStructure) {
+  TempDir dir;
+  ProcessResult r = run_sylva({"render", kSaguaro, "-o", dir.file("s.png"), "--width", "48", "--height", "36",
+                               "--backend", "cpu", "--geometry", "mesh", "--mesh-level", "1", "--verbose"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  for (const char* pass : {"culling", "skin", "tessellate", "triangles, GS 1", "accel build",
+                           "Embree triangles", "(GS 1)", "trace", "shade", "write"})
+    EXPECT_NE(r.err.find(pass), std::string::npos) << pass << "\n" << describe(r);
+  EXPECT_EQ(run_sylva({"render", kSaguaro, "-o", dir.file("a.png"), "--geometry", "cones"}).exit_code, 2);
+  EXPECT_EQ(run_sylva({"render", kSaguaro, "-o", dir.file("a.png"), "--mesh-level", "7"}).exit_code, 2);
 }
 
 TEST(RenderCli, BadSceneIsExitOneWithPlaceAndTheOldImageSurvives) {
@@ -139,6 +205,36 @@ TEST(RenderCli, SkeletonInputRenders) {
   ProcessResult r = run_sylva({"render", dir.file("s.skel.json"), "-o", dir.file("s.png"), "--width", "32",
                                "--height", "24", "--backend", "cpu"});
   EXPECT_EQ(r.exit_code, 0) << describe(r);
+}
+
+TEST(RenderCli, SceneWithAMissingBarkTextureFailsAtItsKeyWithStatus1) {
+  TempDir dir;
+  dir.write("s.scene.json", "{\"plants\": [{\"grammar\": \"" + kSaguaro +
+                                "\",\n  \"bark\": {\"height\": \"missing.png\"}}]}");
+  ProcessResult r = run_sylva({"render", dir.file("s.scene.json"), "-o", dir.file("a.png"), "--backend", "cpu"});
+  EXPECT_EQ(r.exit_code, 1) << describe(r);
+  EXPECT_NE(r.err.find("s.scene.json:2:12: error: plants[0].bark.height: no such image file"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find(dir.file("missing.png")), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.png")));
+}
+
+TEST(RenderCli, ReliefScenePresetsRenderAndSayWhatRan) {
+  // The bundled relief scenes, small: the verbose passes name the relief (and a scene
+  // without a height map says "relief: none").
+  TempDir dir;
+  const std::string scenes = std::string(SYLVA_SOURCE_DIR) + "/presets/scenes/";
+  for (const char* name : {"saguaro", "pine"}) {
+    ProcessResult r = run_sylva({"render", scenes + name + ".scene.json", "-o", dir.file(std::string(name) + ".png"),
+                                 "--width", "64", "--height", "48", "--backend", "cpu", "--verbose"});
+    EXPECT_EQ(r.exit_code, 0) << describe(r);
+    EXPECT_NE(r.err.find("1 plant, 32 linear + 8 bisection steps"), std::string::npos) << name << ": " << r.err;
+  }
+  ProcessResult plain = run_sylva({"render", kSaguaro, "-o", dir.file("p.png"), "--width", "32", "--height", "24",
+                                   "--backend", "cpu", "--verbose"});
+  EXPECT_EQ(plain.exit_code, 0) << describe(plain);
+  EXPECT_NE(plain.err.find("relief"), std::string::npos) << plain.err;
+  EXPECT_NE(plain.err.find("none"), std::string::npos) << plain.err;
 }
 
 TEST(RenderCli, UsageErrors) {

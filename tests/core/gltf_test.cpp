@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>  // declarations only; the implementation is Debian's shared library
 
+#include <glm/geometric.hpp>
+
 #include <cmath>
 #include <cstdlib>
 #include <numbers>
@@ -16,12 +18,17 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <map>
+#include <set>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "core/file_io.h"
+#include "core/image_io.h"
 #include "core/json.h"
+#include "core/materials.h"
+#include "core/normal_map.h"
 #include "core/skin.h"
 #include "core/tessellate.h"
 #include "core/turtle.h"
@@ -256,7 +263,7 @@ TEST(GltfExport, ExtrasCarryTheSkinningDataOfEveryFrustum) {
   }
 }
 
-TEST(GltfExport, MeshIsASecondTrianglesPrimitiveWithUnitNormalsAndFrustumTexcoords) {
+TEST(GltfExport, MeshIsOneTrianglesPrimitivePerMaterialIndexWithUnitNormalsAndFrustumTexcoords) {
   TempFolder dir;
   const Skeleton sk = grow_text(kGrammar);
   GltfExportOptions o;
@@ -265,28 +272,46 @@ TEST(GltfExport, MeshIsASecondTrianglesPrimitiveWithUnitNormalsAndFrustumTexcoor
   ASSERT_FALSE(export_gltf({{"plant", sk}}, dir.file("p.glb"), o));
   const Glb glb = read_glb(dir.file("p.glb"));
   const JsonValue& prims = at(at(glb.json, "meshes").elements.at(0), "primitives");
-  ASSERT_EQ(prims.elements.size(), 2u);
-  const JsonValue& tri = prims.elements[1];
-  EXPECT_EQ(at(tri, "mode").text, "4");
-  EXPECT_EQ(at(tri, "material").text, "0");
-  EXPECT_EQ(at(at(at(glb.json, "materials").elements.at(0), "extras"), "sylva").is_object(), true);
   TessellateOptions to;
   to.segments_around = 6;
-  const TriangleMesh tm = tessellate(skin_skeleton(sk), to);
-  const auto& attr = at(tri, "attributes");
+  const SkinnedSkeleton skinned = skin_skeleton(sk);
+  const TriangleMesh tm = tessellate(skinned, to);
+  // The triangles of each material index, in tessellation order.
+  std::map<uint32_t, std::vector<uint32_t>> expected;
+  for (size_t t = 0; t < tm.triangle_count(); ++t)
+    for (int c = 0; c < 3; ++c) expected[skinned.frusta[tm.triangle_frustum[t]].material].push_back(tm.indices[3 * t + c]);
+  ASSERT_GE(expected.size(), 3u);  // the grammar's ' raises the material index
+  ASSERT_EQ(prims.elements.size(), 1 + expected.size());
+  const JsonValue& materials = at(glb.json, "materials");
+  ASSERT_EQ(materials.elements.size(), expected.size());
+  size_t p = 1;
+  for (const auto& [material, indices] : expected) {
+    const JsonValue& tri = prims.elements[p++];
+    EXPECT_EQ(at(tri, "mode").text, "4");
+    const JsonValue& m = materials.elements.at(static_cast<size_t>(at(tri, "material").number));
+    EXPECT_EQ(at(m, "name").text, "sylva_material_" + std::to_string(material));
+    EXPECT_EQ(at(at(at(m, "extras"), "sylva"), "material_index").number, material);
+    // No bark: the material's default colour, no texture.
+    const JsonValue& factor = at(at(m, "pbrMetallicRoughness"), "baseColorFactor");
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(factor.elements.at(k).number, default_material_albedo(material)[k]);
+    EXPECT_EQ(m.find("normalTexture"), nullptr);
+    EXPECT_EQ(accessor_values(glb, static_cast<size_t>(at(tri, "indices").number)),
+              std::vector<double>(indices.begin(), indices.end()));
+    // One set of vertex attributes shared by every triangle primitive.
+    EXPECT_EQ(at(at(tri, "attributes"), "POSITION").number, at(at(prims.elements[1], "attributes"), "POSITION").number);
+    EXPECT_EQ(at(tri, "attributes").find("TANGENT"), nullptr);
+  }
+  const auto& attr = at(prims.elements[1], "attributes");
   const std::vector<double> normals = accessor_values(glb, static_cast<size_t>(at(attr, "NORMAL").number));
   const std::vector<double> uvs = accessor_values(glb, static_cast<size_t>(at(attr, "TEXCOORD_0").number));
-  const std::vector<double> indices = accessor_values(glb, static_cast<size_t>(at(tri, "indices").number));
   ASSERT_EQ(normals.size(), tm.normals.size() * 3);
   ASSERT_EQ(uvs.size(), tm.uvs.size() * 2);
-  ASSERT_EQ(indices.size(), tm.indices.size());
   for (size_t i = 0; i < tm.uvs.size(); ++i) {
     const double len = std::hypot(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
     EXPECT_NEAR(len, 1.0, 1e-6);
-    EXPECT_EQ(uvs[2 * i], static_cast<float>(tm.uvs[i].x));
-    EXPECT_EQ(uvs[2 * i + 1], static_cast<float>(tm.uvs[i].y * kGltfTexcoordVPerMetre));
+    EXPECT_EQ(uvs[2 * i], static_cast<float>(tm.uvs[i].x));  // u_repeat = v_per_metre = 1
+    EXPECT_EQ(uvs[2 * i + 1], static_cast<float>(tm.uvs[i].y));
   }
-  for (size_t i = 0; i < tm.indices.size(); ++i) EXPECT_EQ(indices[i], tm.indices[i]);
 }
 
 TEST(GltfImport, RoundTripGivesTheIdenticalSkeletonFileForGlbAndGltf) {
@@ -401,9 +426,10 @@ TEST(GltfExport, TinygltfReadsOurFilesWithModeMinMaxAndStringExtras) {
     EXPECT_TRUE(warn.empty()) << warn;
     ASSERT_EQ(model.nodes.size(), 1u);
     ASSERT_EQ(model.meshes.size(), 1u);
-    ASSERT_EQ(model.meshes[0].primitives.size(), 2u);
+    ASSERT_GE(model.meshes[0].primitives.size(), 2u);
     EXPECT_EQ(model.meshes[0].primitives[0].mode, TINYGLTF_MODE_LINE);
-    EXPECT_EQ(model.meshes[0].primitives[1].mode, TINYGLTF_MODE_TRIANGLES);
+    for (size_t p = 1; p < model.meshes[0].primitives.size(); ++p)
+      EXPECT_EQ(model.meshes[0].primitives[p].mode, TINYGLTF_MODE_TRIANGLES);
     for (const tinygltf::Accessor& a : model.accessors) {
       EXPECT_FALSE(a.minValues.empty());
       EXPECT_EQ(a.minValues.size(), a.maxValues.size());
@@ -440,6 +466,324 @@ TEST(GltfExport, RefusesBadInputAndLeavesAnExistingFileUntouched) {
   size_t entries = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir.file(""))) ++entries;
   EXPECT_EQ(entries, 1u);
+}
+
+// --- Bark: materials, textures, the baked normal map --------------------------------
+
+const std::string kBarkAlbedo = std::string(SYLVA_SOURCE_DIR) + "/presets/textures/bark.png";
+const std::string kBarkHeight = std::string(SYLVA_SOURCE_DIR) + "/presets/textures/bark_height.png";
+
+Bark textured_bark() {
+  Bark b;
+  b.albedo_texture = kBarkAlbedo;
+  b.height_texture = kBarkHeight;
+  b.relief_depth_m = 0.01;
+  b.u_repeat = 2;
+  b.v_per_metre = 3;
+  return b;
+}
+
+// A vertical cylinder of radius `radius_m` from y = 0 to y = 2, in `segments` segments.
+Skeleton cylinder(double radius_m, uint32_t segments = 1) {
+  Skeleton sk;
+  for (uint32_t k = 0; k <= segments; ++k) sk.joints.push_back({{0, 2.0 * k / segments, 0}, radius_m, 0});
+  sk.chains = {{0, segments + 1, std::nullopt}};
+  return sk;
+}
+
+bool load_with_tinygltf(const std::string& path, tinygltf::Model* model) {
+  tinygltf::TinyGLTF loader;
+  std::string err, warn;
+  const bool ok = path.ends_with(".glb") ? loader.LoadBinaryFromFile(model, &err, &warn, path)
+                                         : loader.LoadASCIIFromFile(model, &err, &warn, path);
+  EXPECT_TRUE(ok) << err;
+  EXPECT_TRUE(warn.empty()) << warn;
+  return ok;
+}
+
+// The float components of accessor `index` (tightly packed, as we write them).
+std::vector<float> floats_of(const tinygltf::Model& model, int index) {
+  const tinygltf::Accessor& a = model.accessors.at(static_cast<size_t>(index));
+  EXPECT_EQ(a.componentType, TINYGLTF_COMPONENT_TYPE_FLOAT);
+  const tinygltf::BufferView& view = model.bufferViews.at(static_cast<size_t>(a.bufferView));
+  const std::vector<unsigned char>& data = model.buffers.at(static_cast<size_t>(view.buffer)).data;
+  const size_t n = a.count * static_cast<size_t>(tinygltf::GetNumComponentsInType(static_cast<uint32_t>(a.type)));
+  std::vector<float> out(n);
+  EXPECT_LE(view.byteOffset + a.byteOffset + n * 4, data.size());
+  std::memcpy(out.data(), data.data() + view.byteOffset + a.byteOffset, n * 4);
+  return out;
+}
+
+TEST(GltfExport, BarkTexturesGiveOneMaterialPerIndexWithAlbedoNormalMapAndUnitTangents) {
+  TempFolder dir;
+  const Skeleton sk = grow_text(kGrammar);
+  const SkinnedSkeleton skinned = skin_skeleton(sk);
+  std::set<uint32_t> used;
+  for (const Frustum& f : skinned.frusta) used.insert(f.material);
+  ASSERT_GE(used.size(), 3u);
+  GltfExportOptions o;
+  o.mesh = true;
+  o.segments_around = 6;
+  GltfPlant plant{"plant", sk};
+  plant.bark = textured_bark();
+  TessellateOptions to;
+  to.segments_around = 6;
+  const TriangleMesh tm = tessellate(skinned, to);
+  const std::string albedo_bytes = slurp(kBarkAlbedo);
+  for (const char* name : {"p.glb", "p.gltf"}) {
+    ASSERT_FALSE(export_gltf({plant}, dir.file(name), o));
+    tinygltf::Model model;
+    ASSERT_TRUE(load_with_tinygltf(dir.file(name), &model));
+    // One material per material index used, all showing the same two images.
+    ASSERT_EQ(model.materials.size(), used.size()) << name;
+    ASSERT_EQ(model.images.size(), 2u) << name;
+    ASSERT_EQ(model.textures.size(), 2u) << name;
+    size_t k = 0;
+    int albedo = -1, normal = -1;
+    for (uint32_t m : used) {
+      const tinygltf::Material& mat = model.materials[k++];
+      EXPECT_EQ(mat.name, "sylva_material_" + std::to_string(m));
+      albedo = mat.pbrMetallicRoughness.baseColorTexture.index;
+      normal = mat.normalTexture.index;
+      ASSERT_GE(albedo, 0);
+      ASSERT_GE(normal, 0);
+      EXPECT_NE(albedo, normal);
+      EXPECT_EQ(mat.pbrMetallicRoughness.baseColorFactor, std::vector<double>({1, 1, 1, 1}));
+      const tinygltf::Value& extras = mat.extras.Get("sylva");
+      EXPECT_EQ(extras.Get("material_index").GetNumberAsInt(), static_cast<int>(m));
+      EXPECT_EQ(extras.Get("albedo").Get<std::string>(), kBarkAlbedo);
+      EXPECT_EQ(extras.Get("height").Get<std::string>(), kBarkHeight);
+      EXPECT_EQ(extras.Get("relief_depth_m").GetNumberAsDouble(), 0.01);
+      EXPECT_EQ(extras.Get("u_repeat").GetNumberAsDouble(), 2);
+      EXPECT_EQ(extras.Get("v_per_metre").GetNumberAsDouble(), 3);
+      EXPECT_EQ(extras.Get("r_ref_m").GetNumberAsDouble(), bark_reference_radius_m(sk));
+    }
+    // The albedo is the file itself; the normal map a 512 × 512 map of mostly-up normals.
+    const tinygltf::Image& albedo_image = model.images.at(static_cast<size_t>(model.textures.at(static_cast<size_t>(albedo)).source));
+    const tinygltf::Image& normal_image = model.images.at(static_cast<size_t>(model.textures.at(static_cast<size_t>(normal)).source));
+    EXPECT_EQ(albedo_image.width, 512);
+    EXPECT_EQ(albedo_image.height, 512);
+    if (std::string(name) == "p.glb") {
+      EXPECT_EQ(albedo_image.mimeType, "image/png");
+      const tinygltf::BufferView& view = model.bufferViews.at(static_cast<size_t>(albedo_image.bufferView));
+      const auto& data = model.buffers.at(0).data;
+      EXPECT_EQ(std::string(data.begin() + static_cast<std::ptrdiff_t>(view.byteOffset),
+                            data.begin() + static_cast<std::ptrdiff_t>(view.byteOffset + view.byteLength)),
+                albedo_bytes);
+    }
+    ASSERT_EQ(normal_image.width, 512);
+    ASSERT_EQ(normal_image.height, 512);
+    ASSERT_GE(normal_image.component, 3);
+    double mean[3] = {0, 0, 0};
+    const size_t texels = 512 * 512;
+    for (size_t t = 0; t < texels; ++t)
+      for (int c = 0; c < 3; ++c) mean[c] += normal_image.image[t * static_cast<size_t>(normal_image.component) + c] / 255.0 / texels;
+    EXPECT_NEAR(mean[0], 0.5, 0.02);
+    EXPECT_NEAR(mean[1], 0.5, 0.02);
+    EXPECT_GT(mean[2], 0.85);
+    // Every triangle primitive carries unit tangents ⊥ the normal, one per vertex.
+    const tinygltf::Mesh& mesh = model.meshes.at(0);
+    ASSERT_EQ(mesh.primitives.size(), 1 + used.size());
+    for (size_t p = 1; p < mesh.primitives.size(); ++p) {
+      const auto& attributes = mesh.primitives[p].attributes;
+      ASSERT_TRUE(attributes.count("TANGENT")) << p;
+      EXPECT_EQ(model.accessors.at(static_cast<size_t>(attributes.at("TANGENT"))).count,
+                model.accessors.at(static_cast<size_t>(attributes.at("POSITION"))).count);
+      EXPECT_EQ(model.accessors.at(static_cast<size_t>(attributes.at("TANGENT"))).type, TINYGLTF_TYPE_VEC4);
+    }
+    const auto& attributes = mesh.primitives[1].attributes;
+    const std::vector<float> tangents = floats_of(model, attributes.at("TANGENT"));
+    const std::vector<float> normals = floats_of(model, attributes.at("NORMAL"));
+    const std::vector<float> uvs = floats_of(model, attributes.at("TEXCOORD_0"));
+    ASSERT_EQ(tangents.size(), tm.positions.size() * 4);
+    ASSERT_EQ(uvs.size(), tm.positions.size() * 2);
+    for (size_t v = 0; v < tm.positions.size(); ++v) {
+      const float* t = &tangents[4 * v];
+      const float* n = &normals[3 * v];
+      EXPECT_NEAR(std::hypot(t[0], t[1], t[2]), 1.0, 1e-6) << v;
+      EXPECT_TRUE(t[3] == 1.0f || t[3] == -1.0f) << v;
+      EXPECT_NEAR(t[0] * n[0] + t[1] * n[1] + t[2] * n[2], 0.0, 1e-5) << v;
+      EXPECT_EQ(uvs[2 * v], static_cast<float>(tm.uvs[v].x * 2)) << v;
+      EXPECT_EQ(uvs[2 * v + 1], static_cast<float>(tm.uvs[v].y * 3)) << v;
+    }
+  }
+}
+
+TEST(GltfExport, TheBakedNormalMapShadesLikeTheReliefInAGltfViewer) {
+  // A cylinder of radius 0.1 m with an analytic height field; a glTF viewer's shading
+  // normal (normal map texel, B = cross(N, T)·w) must match the normal of the relief,
+  // computed from the mesh's own UV Jacobian — independent of the exporter's conventions.
+  TempFolder dir;
+  const uint32_t width = 128, height = 64;
+  auto h = [](double s, double t) {
+    return 0.5 + 0.25 * std::sin(2 * std::numbers::pi * 2 * s) + 0.25 * std::sin(2 * std::numbers::pi * 3 * t);
+  };
+  auto dh_ds = [](double s) { return 0.25 * 2 * std::numbers::pi * 2 * std::cos(2 * std::numbers::pi * 2 * s); };
+  auto dh_dt = [](double t) { return 0.25 * 2 * std::numbers::pi * 3 * std::cos(2 * std::numbers::pi * 3 * t); };
+  std::vector<float> heights;
+  for (uint32_t j = 0; j < height; ++j)
+    for (uint32_t i = 0; i < width; ++i) heights.push_back(static_cast<float>(h((i + 0.5) / width, (j + 0.5) / height)));
+  ASSERT_FALSE(write_image_atomically(dir.file("h.exr"), width, height, {"Y"}, heights, {ChannelFormat::float32}, false));
+  GltfPlant plant{"cylinder", cylinder(0.1, 50)};  // rows every 4 cm: t sampled at 100 values
+  plant.bark.height_texture = dir.file("h.exr");
+  plant.bark.relief_depth_m = 0.01;
+  plant.bark.u_repeat = 2;
+  plant.bark.v_per_metre = 2;
+  GltfExportOptions o;
+  o.mesh = true;
+  o.segments_around = 64;
+  ASSERT_FALSE(export_gltf({plant}, dir.file("c.glb"), o));
+  tinygltf::Model model;
+  ASSERT_TRUE(load_with_tinygltf(dir.file("c.glb"), &model));
+  ASSERT_EQ(model.materials.size(), 1u);
+  const tinygltf::Image& map = model.images.at(static_cast<size_t>(
+      model.textures.at(static_cast<size_t>(model.materials[0].normalTexture.index)).source));
+  ASSERT_EQ(map.width, static_cast<int>(width));
+  ASSERT_EQ(map.height, static_cast<int>(height));
+  const tinygltf::Primitive& prim = model.meshes.at(0).primitives.at(1);
+  const std::vector<float> pos = floats_of(model, prim.attributes.at("POSITION"));
+  const std::vector<float> nrm = floats_of(model, prim.attributes.at("NORMAL"));
+  const std::vector<float> tan = floats_of(model, prim.attributes.at("TANGENT"));
+  const std::vector<float> uv = floats_of(model, prim.attributes.at("TEXCOORD_0"));
+  const tinygltf::Accessor& index_accessor = model.accessors.at(static_cast<size_t>(prim.indices));
+  const tinygltf::BufferView& index_view = model.bufferViews.at(static_cast<size_t>(index_accessor.bufferView));
+  std::vector<uint32_t> indices(index_accessor.count);
+  std::memcpy(indices.data(), model.buffers[0].data.data() + index_view.byteOffset, indices.size() * 4);
+  auto vec = [](const std::vector<float>& a, size_t i, size_t n) {
+    return glm::dvec3(a[n * i], a[n * i + 1], n > 2 ? a[n * i + 2] : 0.0);
+  };
+  size_t checked = 0;
+  double worst_deg = 0;
+  for (size_t tri = 0; tri + 2 < indices.size(); tri += 3) {
+    const uint32_t a = indices[tri], b = indices[tri + 1], c = indices[tri + 2];
+    if (std::abs(nrm[3 * a + 1]) > 0.5 || std::abs(nrm[3 * b + 1]) > 0.5 || std::abs(nrm[3 * c + 1]) > 0.5) continue;
+    // ∂p/∂s and ∂p/∂t of the triangle: [p_b − p_a, p_c − p_a] = J · [uv_b − uv_a, uv_c − uv_a].
+    const glm::dvec3 e1 = vec(pos, b, 3) - vec(pos, a, 3), e2 = vec(pos, c, 3) - vec(pos, a, 3);
+    const glm::dvec3 d1 = vec(uv, b, 2) - vec(uv, a, 2), d2 = vec(uv, c, 2) - vec(uv, a, 2);
+    const double det = d1.x * d2.y - d2.x * d1.y;
+    ASSERT_NE(det, 0.0);
+    const glm::dvec3 dp_ds = (e1 * d2.y - e2 * d1.y) / det, dp_dt = (e2 * d1.x - e1 * d2.x) / det;
+    // The relief's normal at vertex a, with the gradient at the texel a glTF viewer reads.
+    const double s = vec(uv, a, 2).x, t = vec(uv, a, 2).y;
+    const uint32_t i = static_cast<uint32_t>(std::floor((s - std::floor(s)) * width)) % width;
+    const uint32_t j = static_cast<uint32_t>(std::floor((t - std::floor(t)) * height)) % height;
+    const double s_c = (i + 0.5) / width, t_c = (j + 0.5) / height;
+    const glm::dvec3 n = glm::normalize(vec(nrm, a, 3));
+    const glm::dvec3 expected = glm::normalize(n - 0.01 * dh_ds(s_c) / glm::length(dp_ds) * glm::normalize(dp_ds) -
+                                               0.01 * dh_dt(t_c) / glm::length(dp_dt) * glm::normalize(dp_dt));
+    // The viewer: n = x·T + y·B + z·N, B = cross(N, T)·w, (x, y, z) = 2·texel − 1.
+    const unsigned char* texel = &map.image[(size_t{j} * width + i) * static_cast<size_t>(map.component)];
+    const glm::dvec3 tangent_space(texel[0] / 255.0 * 2 - 1, texel[1] / 255.0 * 2 - 1, texel[2] / 255.0 * 2 - 1);
+    const glm::dvec3 T(tan[4 * a], tan[4 * a + 1], tan[4 * a + 2]);
+    const glm::dvec3 B = glm::cross(n, T) * static_cast<double>(tan[4 * a + 3]);
+    const glm::dvec3 shaded = glm::normalize(tangent_space.x * T + tangent_space.y * B + tangent_space.z * n);
+    const double angle_deg = std::acos(std::min(1.0, glm::dot(shaded, expected))) * 180 / std::numbers::pi;
+    worst_deg = std::max(worst_deg, angle_deg);
+    ++checked;
+  }
+  EXPECT_EQ(checked, 50u * 64 * 2);  // every side triangle
+  // The relief tilts normals by up to ~5.7° around and ~5.4° along; a flipped axis would
+  // be off by twice that.
+  EXPECT_LT(worst_deg, 1.0);
+}
+
+TEST(GltfExport, WithoutTexturesMaterialsTakeTheTableColourAndABarkColourReplacesMaterialZero) {
+  TempFolder dir;
+  GltfPlant plant{"plant", grow_text(kGrammar)};
+  plant.bark.albedo_rgb = glm::dvec3(0.5, 0.4, 0.3);
+  GltfExportOptions o;
+  o.mesh = true;
+  ASSERT_FALSE(export_gltf({plant}, dir.file("p.glb"), o));
+  const Glb glb = read_glb(dir.file("p.glb"));
+  for (const char* absent : {"images", "textures", "samplers"}) EXPECT_EQ(glb.json.find(absent), nullptr) << absent;
+  const JsonValue& materials = at(glb.json, "materials");
+  ASSERT_GE(materials.elements.size(), 3u);
+  for (const JsonValue& m : materials.elements) {
+    const uint32_t index = static_cast<uint32_t>(at(at(at(m, "extras"), "sylva"), "material_index").number);
+    const JsonValue& factor = at(at(m, "pbrMetallicRoughness"), "baseColorFactor");
+    const double* table = default_material_albedo(index);
+    const glm::dvec3 expected = index == 0 ? glm::dvec3(0.5, 0.4, 0.3) : glm::dvec3(table[0], table[1], table[2]);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(factor.elements.at(k).number, expected[k]) << index;
+    EXPECT_EQ(m.find("normalTexture"), nullptr);
+  }
+  for (const JsonValue& prim : at(at(glb.json, "meshes").elements.at(0), "primitives").elements)
+    EXPECT_EQ(at(prim, "attributes").find("TANGENT"), nullptr);
+}
+
+TEST(GltfExport, TheReferenceRadiusIsTheMedianSegmentRadius) {
+  EXPECT_DOUBLE_EQ(bark_reference_radius_m(cylinder(0.1)), 0.1);
+  Skeleton sk;
+  sk.joints = {{{0, 0, 0}, 0.4, 0}, {{0, 1, 0}, 0.3, 0}, {{0, 2, 0}, 0.2, 0}, {{0, 3, 0}, 0.1, 0}, {{0, 4, 0}, 0.0, 0}};
+  sk.chains = {{0, 5, std::nullopt}};
+  EXPECT_DOUBLE_EQ(bark_reference_radius_m(sk), (0.25 + 0.15) / 2);  // 0.35, 0.25, 0.15, 0.05
+  EXPECT_EQ(bark_reference_radius_m(Skeleton{}), 0.0);
+}
+
+TEST(GltfExport, MissingOrUnusableTexturesAreErrorsNamingTheFileAndNothingIsWritten) {
+  TempFolder dir;
+  const std::string path = dir.write("keep.glb", "old contents");
+  const std::string not_an_image = dir.write("notes.png", "just text");
+  const Skeleton sk = grow_text(kGrammar);
+  GltfExportOptions o;
+  o.mesh = true;
+  struct Case {
+    std::optional<std::string> albedo, height;
+    std::string file, message;
+  };
+  const std::vector<Case> cases = {
+      {dir.file("missing.png"), std::nullopt, dir.file("missing.png"), "albedo"},
+      {std::nullopt, dir.file("missing_height.png"), dir.file("missing_height.png"), "height map"},
+      {not_an_image, std::nullopt, not_an_image, "PNG or JPEG"},
+      {std::nullopt, not_an_image, not_an_image, "height map"},
+      {kBarkAlbedo, dir.file("missing_height.png"), dir.file("missing_height.png"), "height map"},
+  };
+  for (const Case& c : cases) {
+    GltfPlant plant{"p", sk};
+    plant.bark.albedo_texture = c.albedo;
+    plant.bark.height_texture = c.height;
+    auto err = export_gltf({plant}, path, o);
+    ASSERT_TRUE(err) << c.file;
+    EXPECT_NE(err->find(c.file), std::string::npos) << *err;
+    EXPECT_NE(err->find(c.message), std::string::npos) << *err;
+    auto checked = check_bark_textures(plant.bark);
+    ASSERT_TRUE(checked);
+    EXPECT_EQ(*checked, *err);
+    EXPECT_EQ(slurp(path), "old contents");
+  }
+  // Without a mesh the bark is not used and its textures are not read.
+  GltfPlant plant{"p", sk};
+  plant.bark.albedo_texture = dir.file("missing.png");
+  EXPECT_FALSE(export_gltf({plant}, dir.file("lines.glb")));
+  // Bark numbers out of range are refused too.
+  plant.bark = Bark{};
+  plant.bark.u_repeat = 0;
+  EXPECT_TRUE(export_gltf({plant}, path, o));
+  EXPECT_EQ(slurp(path), "old contents");
+}
+
+TEST(GltfExport, TexturedExportsAreByteIdenticalAndInstancingComparesBarks) {
+  TempFolder dir;
+  GltfPlant plant{"plant", grow_text(kGrammar)};
+  plant.bark = textured_bark();
+  GltfExportOptions o;
+  o.mesh = true;
+  ASSERT_FALSE(export_gltf({plant}, dir.file("a.glb"), o));
+  ASSERT_FALSE(export_gltf({plant}, dir.file("b.glb"), o));
+  EXPECT_EQ(slurp(dir.file("a.glb")), slurp(dir.file("b.glb")));
+  // Two identical plants share a node; the same skeleton with another bark does not, and
+  // its material is a new one while the images are shared.
+  GltfPlant other = plant;
+  other.bark.v_per_metre = 5;
+  GltfPlant moved = plant;
+  moved.position_m[0] = 3;
+  o.instancing = true;
+  ASSERT_FALSE(export_gltf({plant, moved, other}, dir.file("f.glb"), o));
+  const Glb glb = read_glb(dir.file("f.glb"));
+  EXPECT_EQ(at(glb.json, "nodes").elements.size(), 2u);
+  std::set<uint32_t> used;
+  for (const Frustum& f : skin_skeleton(plant.skeleton).frusta) used.insert(f.material);
+  EXPECT_EQ(at(glb.json, "materials").elements.size(), 2 * used.size());
+  EXPECT_EQ(at(glb.json, "images").elements.size(), 3u);  // albedo, and a normal map per v_per_metre
 }
 
 // --- The broken-file corpus ----------------------------------------------------------

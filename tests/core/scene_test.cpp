@@ -4,7 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <glm/geometric.hpp>
+
+#include "tests/core/test_textures.h"
 
 namespace sylva {
 namespace {
@@ -33,7 +37,12 @@ SceneError expect_error(std::string_view text) {
 }
 
 TEST(Scene, ReadsEveryKeyOfTheSpecExample) {
-  SceneReadResult r = parse_scene_json(kExample, "dir/a.scene.json", "dir");
+  // The example's textures must exist and open (they are checked when the scene is read).
+  test::TempFolder dir;
+  std::filesystem::create_directories(dir.file("textures"));
+  test::write_rgb_png(dir.file("textures/bark.png"), 2, 2, [](uint32_t, uint32_t) { return std::array<float, 3>{}; });
+  test::write_rgb_png(dir.file("textures/bark_height.png"), 2, 2, [](uint32_t, uint32_t) { return std::array<float, 3>{}; });
+  SceneReadResult r = parse_scene_json(kExample, "dir/a.scene.json", dir.path());
   ASSERT_TRUE(r.scene) << r.error->format();
   const Scene& s = *r.scene;
   EXPECT_EQ(s.camera.eye, glm::dvec3(6, 3, 6));
@@ -50,16 +59,39 @@ TEST(Scene, ReadsEveryKeyOfTheSpecExample) {
   EXPECT_EQ(s.fog->g, 0.6);
   ASSERT_EQ(s.plants.size(), 1u);
   const ScenePlant& p = s.plants[0];
-  EXPECT_EQ(p.grammar, "dir/presets/saguaro.lsys");  // relative to the scene file
+  EXPECT_EQ(p.grammar, dir.file("presets/saguaro.lsys"));  // relative to the scene file
   EXPECT_EQ(p.seed, 3u);
   EXPECT_EQ(p.steps, 6);
   EXPECT_EQ(p.defines.at("N"), 5);
   EXPECT_EQ(p.position, glm::dvec3(1, 0, 2));
   EXPECT_EQ(p.rotate_y_deg, 90);
   EXPECT_EQ(p.scale, 2);
-  EXPECT_EQ(p.bark.albedo_texture, "dir/textures/bark.png");
-  EXPECT_EQ(p.bark.height_texture, "dir/textures/bark_height.png");
+  EXPECT_EQ(p.bark.albedo_texture, dir.file("textures/bark.png"));
+  EXPECT_EQ(p.bark.height_texture, dir.file("textures/bark_height.png"));
   EXPECT_EQ(p.bark.u_repeat, 2);
+}
+
+TEST(Scene, BarkTextureThatDoesNotExistOrOpenIsAnErrorAtItsKey) {
+  test::TempFolder dir;
+  SceneReadResult r = parse_scene_json(
+      "{\"plants\": [{\"grammar\": \"g.lsys\",\n  \"bark\": {\"u_repeat\": 2,\n   \"albedo\": \"nope.png\"}}]}",
+      "s.scene.json", dir.path());
+  ASSERT_TRUE(r.error);
+  EXPECT_EQ(r.error->line, 3u);
+  EXPECT_EQ(r.error->column, 4u);
+  EXPECT_NE(r.error->message.find("plants[0].bark.albedo"), std::string::npos) << r.error->message;
+  EXPECT_NE(r.error->message.find(dir.file("nope.png")), std::string::npos) << r.error->message;
+  // A file OpenImageIO cannot read, as the height map.
+  {
+    std::ofstream out(dir.file("text.png"));
+    out << "not an image";
+  }
+  r = parse_scene_json("{\"plants\": [{\"grammar\": \"g.lsys\", \"bark\": {\"height\": \"text.png\"}}]}",
+                       "s.scene.json", dir.path());
+  ASSERT_TRUE(r.error);
+  EXPECT_EQ(r.error->line, 1u);
+  EXPECT_EQ(r.error->column, 44u);
+  EXPECT_NE(r.error->message.find("plants[0].bark.height: cannot open image"), std::string::npos) << r.error->message;
 }
 
 TEST(Scene, OnlyPlantsIsRequiredAndTheRestDefaults) {

@@ -137,5 +137,98 @@ TEST(Tessellate, SegmentsAroundOverridesTheColumnsForExport) {
   EXPECT_EQ(tessellate(sk, o).triangle_count(), 10u);
 }
 
+// GS+R: H = 0.5 + 0.5 sin(2π·3u), 5 cm deep, on a cylinder of radius 0.5 in two segments.
+TEST(Displace, VerticesMoveAlongTheirNormalByTheHeightAtTheirUv) {
+  SkinnedSkeleton sk = skin_skeleton(chain_of({{0, 0, 0, 0.5}, {0, 1, 0, 0.5}, {0, 2, 0, 0.5}}));
+  TessellateOptions o;
+  o.level = 2;
+  o.caps = false;
+  const TriangleMesh mesh = tessellate(sk, o);
+  auto height = [](double u, double) { return 0.05 * (0.5 + 0.5 * std::sin(2 * 3.141592653589793 * 3 * u)); };
+  const TriangleMesh displaced = displace(mesh, height);
+  ASSERT_EQ(displaced.positions.size(), mesh.positions.size());
+  EXPECT_EQ(displaced.indices, mesh.indices);
+  EXPECT_EQ(displaced.uvs, mesh.uvs);
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    const glm::dvec3& p = displaced.positions[v];
+    EXPECT_NEAR(std::hypot(p.x, p.z), 0.5 + height(mesh.uvs[v].x, 0), 1e-12) << "vertex " << v;
+    EXPECT_NEAR(p.y, mesh.positions[v].y, 1e-12);
+    EXPECT_NEAR(glm::length(displaced.normals[v]), 1, 1e-12);
+    EXPECT_GT(glm::dot(displaced.normals[v], glm::normalize(glm::dvec3(p.x, 0, p.z))), 0.5);  // outward
+  }
+}
+
+TEST(Displace, CoincidentVerticesStayTogetherSoNoCrackOpens) {
+  // A bent chain (mitred joints), caps, and a height that jumps at the seam (u_repeat 2.5:
+  // H(u = 0) != H(u = 1)) and along v: every vertex pair that coincided still does.
+  SkinnedSkeleton sk = skin_skeleton(chain_of({{0, 0, 0, 0.3}, {0, 1, 0, 0.25}, {0.4, 1.8, 0, 0.2}, {0.5, 2.6, 0.3, 0}}));
+  TessellateOptions o;
+  o.level = 1;
+  const TriangleMesh mesh = tessellate(sk, o);
+  auto height = [](double u, double v_m) { return 0.02 * std::fmod(2.5 * u, 1.0) + 0.01 * std::fmod(3 * v_m, 1.0); };
+  const TriangleMesh displaced = displace(mesh, height);
+  size_t pairs = 0;
+  for (size_t a = 0; a < mesh.positions.size(); ++a)
+    for (size_t b = a + 1; b < mesh.positions.size(); ++b)
+      if (mesh.positions[a] == mesh.positions[b]) {
+        ++pairs;
+        ASSERT_EQ(displaced.positions[a], displaced.positions[b]) << a << " and " << b;
+      }
+  EXPECT_GT(pairs, 100u);  // seams, joint rows, rims, the tip
+}
+
+TEST(Displace, JointRowsShareTheirUvsExactly) {
+  // Displacement is a function of (u, v_m): the rows two frusta share at a joint have the
+  // same uvs bit for bit (and the same positions), so they move alike even unwelded.
+  SkinnedSkeleton sk = skin_skeleton(chain_of({{0, 0, 0, 0.2}, {0, 1, 0, 0.2}, {0.7, 1.7, 0, 0.15}, {0.7, 2.7, 0.4, 0.1}}));
+  ASSERT_EQ(sk.split_joints, 0u);
+  TessellateOptions o;
+  o.level = 2;
+  o.caps = false;
+  const TriangleMesh mesh = tessellate(sk, o);
+  // Displaced, the two rows share one normal too (eq. 8 normals agree at the joint), so
+  // the shading shows no seam there.
+  const TriangleMesh displaced = displace(mesh, [](double u, double v_m) { return 0.01 * (1 + std::sin(9 * u + v_m)); });
+  const int n = tessellation_columns(o), k = tessellation_rows(o);
+  const size_t per = static_cast<size_t>(n + 1) * (k + 1);
+  for (size_t f = 0; f + 1 < sk.frusta.size(); ++f)
+    for (int i = 0; i <= n; ++i) {
+      const size_t top = f * per + static_cast<size_t>(k * (n + 1) + i), bottom = (f + 1) * per + static_cast<size_t>(i);
+      EXPECT_EQ(mesh.uvs[top], mesh.uvs[bottom]) << "joint " << f + 1 << " column " << i;
+      EXPECT_EQ(mesh.positions[top], mesh.positions[bottom]);
+      EXPECT_EQ(displaced.positions[top], displaced.positions[bottom]);
+      EXPECT_LT(glm::length(displaced.normals[top] - displaced.normals[bottom]), 1e-12);
+    }
+}
+
+TEST(Displace, NormalsComeFromTheDisplacedSurfaceAndCreasesStay) {
+  // A constant height on a cylinder with caps: side normals stay radial (angle-weighted
+  // face normals of a regular prism), cap normals stay axial: the rim crease is kept.
+  SkinnedSkeleton sk = skin_skeleton(chain_of({{0, 0, 0, 0.5}, {0, 2, 0, 0.5}}));
+  const TriangleMesh mesh = tessellate(sk, TessellateOptions{});
+  const TriangleMesh displaced = displace(mesh, [](double, double) { return 0.1; });
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    const glm::dvec3 n = displaced.normals[v], original = mesh.normals[v];
+    if (std::abs(original.y) > 0.5) {  // a cap vertex
+      EXPECT_NEAR(n.y, original.y, 1e-12);
+    } else {
+      const glm::dvec3 p = displaced.positions[v];
+      EXPECT_NEAR(glm::dot(n, glm::normalize(glm::dvec3(p.x, 0, p.z))), 1, 1e-12) << "vertex " << v;
+      EXPECT_NEAR(std::hypot(p.x, p.z), 0.6, 1e-12);
+    }
+  }
+}
+
+TEST(Tessellate, AppendMeshShiftsIndicesAndFrusta) {
+  SkinnedSkeleton sk = skin_skeleton(chain_of({{0, 0, 0, 0.2}, {0, 1, 0, 0.2}}));
+  const TriangleMesh part = tessellate(sk, TessellateOptions{});
+  TriangleMesh all = part;
+  append_mesh(all, part, 7);
+  ASSERT_EQ(all.triangle_count(), 2 * part.triangle_count());
+  EXPECT_EQ(all.positions.size(), 2 * part.positions.size());
+  EXPECT_EQ(all.indices[part.indices.size()], part.indices[0] + part.positions.size());
+  EXPECT_EQ(all.triangle_frustum.back(), 7u);
+}
+
 }  // namespace
 }  // namespace sylva

@@ -75,3 +75,43 @@ def test_instancing_of_identical_plants_is_valid(saguaro, tmp_path, validate_glt
     sylva.export_gltf([saguaro, saguaro, saguaro], path, instancing=True, positions=[(0, 0, 0), (3, 0, 0), (6, 0, 0)])
     assert path.read_bytes()[:4] == b"glTF"
     validate_gltf(path)
+
+
+def test_a_textured_bark_gives_materials_with_textures_and_tangents(saguaro, tmp_path, validate_gltf, repo):
+    bark = dict(albedo=repo / "presets/textures/cactus.png", height=str(repo / "presets/textures/cactus_height.png"),
+                relief_depth=0.01, u_repeat=12, v_per_metre=4)
+    for name in ("bark.glb", "bark.gltf"):
+        path = tmp_path / name
+        sylva.export_gltf(saguaro, path, mesh=True, segments_around=6, bark=bark)
+        validate_gltf(path)
+    doc = glb_json(tmp_path / "bark.glb")
+    assert len(doc["images"]) == 2
+    for material in doc["materials"]:
+        assert material["name"].startswith("sylva_material_")
+        assert "baseColorTexture" in material["pbrMetallicRoughness"] and "normalTexture" in material
+        extras = material["extras"]["sylva"]
+        assert (extras["u_repeat"], extras["v_per_metre"], extras["relief_depth_m"]) == (12, 4, 0.01)
+        assert extras["height"].endswith("cactus_height.png") and extras["r_ref_m"] > 0
+    triangles = [p for p in doc["meshes"][0]["primitives"] if p["mode"] == 4]
+    assert triangles and all("TANGENT" in p["attributes"] for p in triangles)
+
+
+def test_bark_colour_and_bark_errors(saguaro, tmp_path):
+    pine = sylva.Grammar.from_file("presets/pine.lsys").grow(seed=1, steps=4)  # wood (0) and needles (1)
+    path = tmp_path / "colour.glb"
+    sylva.export_gltf(pine, path, mesh=True, bark={"albedo": (0.5, 0.4, 0.3)})
+    materials = {m["extras"]["sylva"]["material_index"]: m for m in glb_json(path)["materials"]}
+    assert materials[0]["pbrMetallicRoughness"]["baseColorFactor"] == [0.5, 0.4, 0.3, 1]
+    assert materials[1]["pbrMetallicRoughness"]["baseColorFactor"] == [0.16, 0.34, 0.1, 1]  # the table's
+    out = tmp_path / "x.glb"
+    with pytest.raises(RuntimeError, match="no_such_bark.png"):
+        sylva.export_gltf(saguaro, out, mesh=True, bark={"albedo": str(tmp_path / "no_such_bark.png")})
+    with pytest.raises(ValueError):
+        sylva.export_gltf(saguaro, out, bark={"u_repeat": 2})  # needs mesh=True
+    with pytest.raises(ValueError):
+        sylva.export_gltf(saguaro, out, mesh=True, bark={"u_repeats": 2})
+    with pytest.raises(ValueError):
+        sylva.export_gltf(saguaro, out, mesh=True, bark={"v_per_metre": 0})
+    with pytest.raises(TypeError):
+        sylva.export_gltf(saguaro, out, mesh=True, bark="presets/textures/bark.png")
+    assert not out.exists()

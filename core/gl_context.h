@@ -1,0 +1,66 @@
+// gl_context.h — a window-less OpenGL 4.5 core context through EGL, for `sylva render
+// --backend gl` and the GL tests: no X server, no surface; rendering goes to framebuffer
+// objects (render_gl.h).
+//
+// Which display: EGL devices that are hardware GPUs first (EGL_EXT_platform_device; on an
+// NVIDIA machine that is what works, and Mesa's surfaceless platform would silently give
+// llvmpipe there), then Mesa's surfaceless platform (EGL_MESA_platform_surfaceless: llvmpipe
+// on a CPU-only machine), then software devices, then EGL_DEFAULT_DISPLAY. The first
+// display that gives an OpenGL 4.5 core context current without a surface wins; when
+// none does, `error` says what each one answered.
+//
+// Debug builds (no NDEBUG) ask for a debug context and print GL debug messages above
+// notification severity to stderr.
+//
+// Displays are initialised once per process and never terminated (EGL displays are
+// process-wide; terminating one would pull it from under another context on it).
+#pragma once
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace sylva {
+
+// A failure inside the GL backend (a shader that does not compile, an incomplete
+// framebuffer, a size beyond the driver's limits), with a readable message.
+struct GlError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct GlContextInfo {
+  std::string platform;  // "EGL device 0 (hardware)", "EGL surfaceless (Mesa)", ...
+  std::string vendor;    // GL_VENDOR
+  std::string renderer;  // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+  std::string version;   // GL_VERSION
+  bool software = false; // llvmpipe / softpipe / swrast: timings are the CPU's
+  std::string describe() const;  // "llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 ..., EGL surfaceless"
+};
+
+class GlContext {
+ public:
+  ~GlContext();
+  GlContext(const GlContext&) = delete;
+  GlContext& operator=(const GlContext&) = delete;
+
+  const GlContextInfo& info() const { return info_; }
+  // Makes the context current on the calling thread (creation already did, on its thread).
+  void make_current();
+
+ private:
+  friend struct GlContextResult create_headless_gl_context();
+  GlContext() = default;
+  void* display_ = nullptr;  // EGLDisplay
+  void* context_ = nullptr;  // EGLContext
+  GlContextInfo info_;
+};
+
+struct GlContextResult {
+  std::unique_ptr<GlContext> context;  // null on failure
+  std::string error;                   // why, when context is null
+};
+
+// Creates a headless OpenGL 4.5 core context and makes it current on this thread.
+GlContextResult create_headless_gl_context();
+
+}  // namespace sylva

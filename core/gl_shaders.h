@@ -1,0 +1,67 @@
+// gl_shaders.h — the GLSL sources of the GL backend (shaders/*.glsl, embedded into the
+// library at build time by shaders/embed_shaders.cmake) and how one shader stage of one
+// variant is assembled from them.
+//
+// A stage is `#version 450 core`, then one `#define` per variant switch, then the files of
+// the stage in order, each preceded by `#line 1 N` with N its index in the file list: a
+// driver or glslangValidator message "N:LINE" names file N, line LINE (format_shader_log
+// puts the file names back). The same text goes to the driver and to glslangValidator
+// (tests/gl/gl_shaders_test.cpp), so what CI validates is what runs.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sylva {
+
+struct EmbeddedShader {
+  const char* name;    // file name in shaders/, e.g. "ray_frustum.glsl"
+  const char* source;  // its text
+};
+extern const EmbeddedShader kEmbeddedShaders[];
+extern const size_t kEmbeddedShaderCount;
+
+// The text of shaders/NAME; throws std::logic_error if there is no such file.
+std::string_view embedded_shader(std::string_view name);
+
+enum class ShaderStage { vertex, fragment };
+
+// One stage of one program variant.
+struct ShaderStageSource {
+  ShaderStage stage = ShaderStage::vertex;
+  std::vector<std::string> files;    // shaders/ files, concatenated in this order
+  std::vector<std::string> defines;  // "NAME" or "NAME VALUE", one #define each
+};
+
+// The complete source handed to glShaderSource / glslangValidator.
+std::string assemble_shader(const ShaderStageSource& stage);
+
+// `log` (a driver or glslangValidator info log for `stage`) with "N:" source-string
+// numbers replaced by the file names they stand for.
+std::string format_shader_log(const ShaderStageSource& stage, const std::string& log);
+
+// A program variant: a name for --verbose and messages, and its two stages.
+struct ShaderProgramSource {
+  std::string name;  // e.g. "frusta[GBUFFER_PASS]"
+  ShaderStageSource vertex;
+  ShaderStageSource fragment;
+};
+
+// The variant switches of the frusta program (frusta.vert.glsl + frusta.frag.glsl).
+enum class FrustaPass {
+  gbuffer,             // camera view, front faces, conservative depth (depth_less)
+  gbuffer_eye_inside,  // camera view, back faces, for pyramids that contain the eye
+  shadow,              // orthographic sun view, depth only (depth_greater)
+};
+ShaderProgramSource frusta_program(FrustaPass pass, bool want_uv);
+
+// The deferred shading program (fullscreen.vert.glsl + shade.frag.glsl); `sun` false
+// leaves out the sun and its shadow map (black or absent sun: sky only).
+ShaderProgramSource shade_program(bool sun);
+
+// Every variant the renderer can build (what the shader tests compile).
+std::vector<ShaderProgramSource> all_shader_programs();
+
+}  // namespace sylva

@@ -1,0 +1,75 @@
+// render_gl.h — the OpenGL ray caster (issue 4; paper 000 sec. 2.5, 2.6, 4): the analytic
+// frusta drawn on the GPU with the shading model of the CPU reference (render_cpu.h), so
+// the two give the same picture within the tolerances of tests/gl/render_gl_test.cpp.
+//
+// How a frame is made (shaders/*.glsl, mirroring the CPU code function by function):
+//   upload (once)  one 64-byte GpuSegment record per frustum (skin.h) and 16 bytes of ids
+//                  (plant, chain, segment) in shader storage buffers; nothing per vertex.
+//   shadow map     when the sun shines: the same ray-casting shaders, depth only, in an
+//                  orthographic view along the sun direction fitted to the plants' bounds.
+//   frusta         vertex pulling builds each frustum's 12-triangle bounding pyramid (sec.
+//                  2.6); the fragment shader intersects the pixel's ray with the frustum
+//                  (intersect_frustum_f's GLSL twin), discards misses, writes the real hit
+//                  depth and a G-buffer (normals, distance, ids, u/v_m).
+//   shade          one fullscreen pass: ground plane, sky, sun (Lambert + normalised
+//                  Blinn-Phong) with the shadow map, sky ambient — render_cpu.cpp's lit().
+// --spp N repeats shadow map (if the sun is a disc), frusta and shade N times with the
+// CPU's stratified pixel offsets (one offset per pass for all pixels, the rasteriser
+// sampling where the rays go) and, for a disc sun, a sun direction drawn on the disc per
+// pass: both converge to the CPU's estimate. AOVs come from the pixel centres.
+//
+// Where it differs from the CPU, by design (and measured by the tests):
+//   - float instead of double (the GpuSegment record, float ray casting): depth agrees to
+//     ~1e-6 relative; normals to ~1e-6 rad.
+//   - shadows from a shadow map: a texel is ~1/2 pixel, receivers are offset along their
+//     normal by 2 texels (no acne), so shadow edges can move by that much.
+//   - at --spp 1 a disc sun is treated as its centre (hard shadows); the CPU then takes
+//     one random point of the disc per pixel (noisy penumbrae). Both converge with --spp.
+//   - no bark textures, no relief, no meshes yet (gl_unsupported says so).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "core/gl_context.h"
+#include "core/render_cpu.h"
+
+namespace sylva {
+
+// Why the GL backend cannot render `scene` with `options` as the CPU would (bark
+// textures, relief maps, mesh geometry), or nullopt when it can.
+std::optional<std::string> gl_unsupported(const Scene& scene, const RenderOptions& options);
+
+// A scene's plants on the GPU: skinned and uploaded once, rendered any number of times.
+// Preconditions: an OpenGL 4.5 core context (a GlContext or a window's) is current on the
+// calling thread for the renderer's whole life; every plant's skeleton is set. The
+// renderer sets the context's clip control to (lower left, zero to one) and owns the GL
+// objects it creates. Failures throw GlError.
+class GlRenderer {
+ public:
+  GlRenderer(const Scene& scene, const RenderOptions& options);
+  ~GlRenderer();
+  GlRenderer(const GlRenderer&) = delete;
+  GlRenderer& operator=(const GlRenderer&) = delete;
+
+  // Renders the camera, image size, sun, sky and ground of `scene` over the uploaded
+  // plants (the plants of `scene` are not read again). Passes carry GPU time from
+  // GL_TIME_ELAPSED queries where the name says "(GPU)".
+  RenderResult render(const Scene& scene);
+
+  uint64_t frusta() const;          // frusta uploaded
+  uint64_t uploaded_bytes() const;  // bytes in the segment and id buffers
+  // What was done once: "skin", "upload", "programs" (compile and link).
+  const std::vector<RenderPass>& setup_passes() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// Renders `scene` on the current context: GlRenderer(scene, options).render(scene), with
+// the setup passes first. Throws GlError (gl_unsupported's reason included).
+RenderResult render_gl(const Scene& scene, const RenderOptions& options);
+
+}  // namespace sylva

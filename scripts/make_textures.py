@@ -1,0 +1,249 @@
+#!/usr/bin/python3
+"""make_textures.py — synthesises the bundled bark and cactus textures (presets/textures/).
+
+    /usr/bin/python3 scripts/make_textures.py [OUTPUT_DIR]      (default presets/textures)
+
+Needs numpy only; PNG files are written here with zlib + struct. The output is a pure
+function of the fixed seeds below: running it twice gives byte-identical files.
+
+Conventions (presets/textures/README.md): column index = s (around the stem, one texture
+repeat per 1/u_repeat turn), row index = t (along the stem, one repeat per
+1/v_per_metre metres); heights are 1 at the outermost surface and 0 at the bottom of a
+furrow; albedo is sRGB-encoded. Every field is built from integer frequencies on the
+512 x 512 grid (or from explicitly periodic functions), so each texture tiles seamlessly
+in both directions.
+"""
+import os
+import struct
+import sys
+import zlib
+
+import numpy as np
+
+SIZE = 512
+BARK_SEED = 20240611
+CACTUS_SEED = 20240612
+
+
+# --- PNG ------------------------------------------------------------------------------
+
+def _filter_rows(raw, bpp):
+    """PNG filtering (RFC 2083 6): per row, the filter among None/Sub/Up/Average/Paeth
+    with the smallest sum of absolute signed residuals (the libpng heuristic)."""
+    h, stride = raw.shape
+    x = raw.astype(np.int16)
+    a = np.zeros_like(x)
+    a[:, bpp:] = x[:, :-bpp]
+    b = np.zeros_like(x)
+    b[1:, :] = x[:-1, :]
+    c = np.zeros_like(x)
+    c[1:, bpp:] = x[:-1, :-bpp]
+    p = a + b - c
+    pa, pb, pc = np.abs(p - a), np.abs(p - b), np.abs(p - c)
+    paeth = np.where((pa <= pb) & (pa <= pc), a, np.where(pb <= pc, b, c))
+    candidates = [x, x - a, x - b, x - ((a + b) >> 1), x - paeth]
+    residuals = [(cand & 0xFF).astype(np.uint8) for cand in candidates]
+    cost = np.stack([np.abs(r.astype(np.int8).astype(np.int32)).sum(axis=1) for r in residuals])
+    choice = np.argmin(cost, axis=0)
+    out = bytearray()
+    for y in range(h):
+        out.append(int(choice[y]))
+        out += residuals[choice[y]][y].tobytes()
+    return bytes(out)
+
+
+def write_png(path, pixels):
+    """pixels: (h, w) uint16 (16-bit grey) or (h, w, 3) uint8 (8-bit RGB)."""
+    if pixels.ndim == 2 and pixels.dtype == np.uint16:
+        bit_depth, colour_type, bpp = 16, 0, 2
+        raw = pixels.astype(">u2").view(np.uint8).reshape(pixels.shape[0], -1)
+    elif pixels.ndim == 3 and pixels.shape[2] == 3 and pixels.dtype == np.uint8:
+        bit_depth, colour_type, bpp = 8, 2, 3
+        raw = pixels.reshape(pixels.shape[0], -1)
+    else:
+        raise ValueError("unsupported pixel array")
+    h, w = pixels.shape[:2]
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+    png = b"\x89PNG\r\n\x1a\n"
+    png += chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, bit_depth, colour_type, 0, 0, 0))
+    if colour_type == 2:
+        png += chunk(b"sRGB", b"\x00")  # perceptual; the albedo is sRGB-encoded
+    png += chunk(b"IDAT", zlib.compress(_filter_rows(raw, bpp), 9))
+    png += chunk(b"IEND", b"")
+    tmp = path + ".tmp"
+    with open(tmp, "wb") as f:
+        f.write(png)
+    os.replace(tmp, path)
+
+
+# --- fields ---------------------------------------------------------------------------
+
+def spectral_noise(rng, n, band, beta, stretch_t):
+    """Zero-mean, unit-variance periodic noise on an n x n grid: white noise filtered in
+    the Fourier domain by |k|^-beta for |k| in band (cycles per image), where
+    |k| = sqrt(ks^2 + (stretch_t * kt)^2) — stretch_t > 1 elongates features along t."""
+    white = rng.standard_normal((n, n))
+    spectrum = np.fft.rfft2(white)
+    kt = np.fft.fftfreq(n, 1.0 / n)[:, None]
+    ks = np.fft.rfftfreq(n, 1.0 / n)[None, :]
+    k = np.sqrt(ks ** 2 + (stretch_t * kt) ** 2)
+    lo, hi = band
+    gain = np.where((k >= lo) & (k <= hi), np.maximum(k, 1e-9) ** -beta, 0.0)
+    field = np.fft.irfft2(spectrum * gain, s=(n, n))
+    field -= field.mean()
+    return field / field.std()
+
+
+def warp(field, dt, ds):
+    """Samples a periodic field at (row + dt, col + ds) with bilinear interpolation and
+    wrap-around; periodic displacements keep the result periodic."""
+    n_t, n_s = field.shape
+    t = (np.arange(n_t)[:, None] + dt) % n_t
+    s = (np.arange(n_s)[None, :] + ds) % n_s
+    t0 = np.floor(t).astype(int)
+    s0 = np.floor(s).astype(int)
+    ft, fs = t - t0, s - s0
+    t1, s1 = (t0 + 1) % n_t, (s0 + 1) % n_s
+    return ((1 - ft) * (1 - fs) * field[t0, s0] + (1 - ft) * fs * field[t0, s1] +
+            ft * (1 - fs) * field[t1, s0] + ft * fs * field[t1, s1])
+
+
+def smoothstep(e0, e1, x):
+    x = np.clip((x - e0) / (e1 - e0), 0.0, 1.0)
+    return x * x * (3 - 2 * x)
+
+
+def srgb_encode(linear):
+    linear = np.clip(linear, 0.0, 1.0)
+    return np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * linear ** (1 / 2.4) - 0.055)
+
+
+def to_u8(srgb):
+    return np.clip(np.round(srgb * 255.0), 0, 255).astype(np.uint8)
+
+
+def to_u16(height):
+    return np.clip(np.round(height * 65535.0), 0, 65535).astype(np.uint16)
+
+
+def mix(a, b, w):
+    """Per-pixel linear blend of two colours (3-vectors or fields) by weight w."""
+    return a * (1 - w[..., None]) + b * w[..., None]
+
+
+# --- bark -----------------------------------------------------------------------------
+
+def furrow_distance(rng, n, count, wander, modes):
+    """Distance across s (in furrow spacings, 0..0.5) to the nearest of `count` furrow
+    lines; line i sits at s = (i + 0.5)/count plus a wander made of sine modes 1..modes
+    along t (integer frequencies, so it is periodic), amplitude `wander` spacings."""
+    t = (np.arange(n)[:, None] + 0.5) / n
+    s = (np.arange(n)[None, :] + 0.5) / n
+    best = np.full((n, n), np.inf)
+    for i in range(count):
+        centre = (i + 0.5) / count
+        for k in range(1, modes + 1):
+            centre = centre + wander / count * rng.uniform(0.3, 1.0) / k * np.sin(2 * np.pi * (k * t + rng.uniform()))
+        offset = (s - centre) * count
+        offset -= np.round(offset / count) * count      # periodic in s
+        best = np.minimum(best, np.abs(offset))
+    return best
+
+
+def make_bark(n):
+    """Furrowed bark (elm, oak, poplar): plates separated by furrows that run along the
+    stem. Each furrow is a line that wanders across s with a few periodic sine modes
+    along t, so neighbours approach, touch and part again (plates pinch out, furrows
+    merge and split); shallower secondary furrows split the plates; the plates carry a
+    convex profile, fibres along t and a few short horizontal cracks."""
+    rng = np.random.default_rng(BARK_SEED)
+    warp_s = spectral_noise(rng, n, (3.0, 24.0), 1.0, 2.0)
+    warp_t = spectral_noise(rng, n, (3.0, 24.0), 1.0, 2.0)
+    main = warp(furrow_distance(rng, n, 9, 0.55, 4), 4.0 * warp_t, 2.5 * warp_s)
+    minor = warp(furrow_distance(rng, n, 17, 0.9, 5), 4.0 * warp_t, 2.5 * warp_s)
+    width = 0.36 + 0.10 * spectral_noise(rng, n, (1.0, 6.0), 1.0, 3.0)   # furrow half-width, spacings
+    plate = smoothstep(0.02, 1.0, main / width) ** 0.7
+    plate *= 1.0 - 0.35 * (1.0 - smoothstep(0.0, 0.18, minor))
+    grain = spectral_noise(rng, n, (12.0, 120.0), 0.8, 5.0)     # fibres along t
+    lumps = spectral_noise(rng, n, (2.0, 10.0), 1.0, 1.5)
+    cracks_noise = spectral_noise(rng, n, (4.0, 16.0), 1.0, 0.3)  # elongated across s
+    cracks = (1.0 - smoothstep(0.0, 0.12, np.abs(cracks_noise))) * smoothstep(0.6, 0.95, plate)
+    cracks *= smoothstep(0.5, 1.2, spectral_noise(rng, n, (2.0, 8.0), 1.0, 1.0))  # only some
+
+    height = plate * (0.86 + 0.07 * lumps) + 0.025 * grain * plate - 0.25 * cracks
+    height = (height - height.min()) / (height.max() - height.min())
+
+    # Albedo (linear): dark, slightly reddish furrows; grey-brown plates weathered lighter
+    # on their tops; faint greenish tint (algae/lichen) in patches.
+    furrow = np.array([0.030, 0.021, 0.014])
+    plate_dark = np.array([0.115, 0.088, 0.064])
+    plate_light = np.array([0.205, 0.180, 0.150])
+    lichen = np.array([0.140, 0.160, 0.095])
+    tint = spectral_noise(rng, n, (2.0, 12.0), 1.2, 1.0)
+    speck = spectral_noise(rng, n, (40.0, 200.0), 0.3, 2.0)
+    colour = mix(furrow, plate_dark, smoothstep(0.05, 0.55, height))
+    colour = mix(colour, plate_light, smoothstep(0.55, 1.0, height) * (0.6 + 0.25 * np.clip(lumps, -1.6, 1.6)))
+    colour = mix(colour, lichen, 0.35 * smoothstep(0.8, 1.8, tint) * smoothstep(0.4, 0.8, height))
+    colour *= (1.0 + 0.10 * grain + 0.05 * speck)[..., None]
+    colour *= (1.0 - 0.6 * cracks)[..., None]
+    return to_u8(srgb_encode(colour)), to_u16(height)
+
+
+# --- cactus ---------------------------------------------------------------------------
+
+AREOLES_PER_REPEAT = 4  # along t, per texture repeat
+
+
+def make_cactus(n):
+    """Ribbed cactus skin (saguaro): one rib per texture repeat across s with its crest
+    at s = 0.5 and the groove at s = 0 (= 1), a smooth periodic profile; small raised,
+    lighter areoles along the crest, AREOLES_PER_REPEAT per repeat along t; a waxy green
+    skin a little darker in the grooves."""
+    rng = np.random.default_rng(CACTUS_SEED)
+    s = (np.arange(n)[None, :] + 0.5) / n
+    t = (np.arange(n)[:, None] + 0.5) / n
+    wobble = spectral_noise(rng, n, (1.0, 4.0), 1.5, 1.0)        # the crest wanders a little
+    s_rib = s + 0.012 * wobble
+    rib = ((1.0 - np.cos(2.0 * np.pi * s_rib)) / 2.0) ** 0.8    # 0 in the groove, 1 on the crest
+
+    # Areoles: elliptical pads centred on the crest, every 1/AREOLES_PER_REPEAT along t.
+    phase_t = (t * AREOLES_PER_REPEAT) % 1.0 - 0.5          # -0.5..0.5 between areoles
+    ds = (s_rib - 0.5) / 0.030                               # in areole radii
+    dt = phase_t * (1.0 / AREOLES_PER_REPEAT) / 0.036
+    r2 = ds ** 2 + dt ** 2
+    areole = np.exp(-r2 * 1.6) * smoothstep(1.25, 0.85, np.sqrt(r2))
+    fine = spectral_noise(rng, n, (20.0, 160.0), 0.5, 1.0)
+    streaks = spectral_noise(rng, n, (6.0, 60.0), 1.0, 6.0)     # faint vertical streaks
+
+    height = 0.94 * rib + 0.04 * areole + 0.004 * fine * rib
+    height = (height - height.min()) / (height.max() - height.min())
+
+    groove = np.array([0.035, 0.070, 0.030])
+    skin = np.array([0.095, 0.160, 0.068])
+    crest = np.array([0.120, 0.185, 0.090])
+    pad = np.array([0.50, 0.44, 0.34])
+    colour = mix(groove, skin, smoothstep(0.0, 0.45, rib))
+    colour = mix(colour, crest, smoothstep(0.7, 1.0, rib))
+    colour *= (1.0 + 0.05 * streaks + 0.03 * fine)[..., None]
+    colour = mix(colour, pad * (1.0 + 0.08 * fine)[..., None], smoothstep(0.15, 0.55, areole))
+    return to_u8(srgb_encode(colour)), to_u16(height)
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    out_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "..", "presets", "textures")
+    os.makedirs(out_dir, exist_ok=True)
+    bark_albedo, bark_height = make_bark(SIZE)
+    cactus_albedo, cactus_height = make_cactus(SIZE)
+    for name, pixels in (("bark.png", bark_albedo), ("bark_height.png", bark_height),
+                         ("cactus.png", cactus_albedo), ("cactus_height.png", cactus_height)):
+        path = os.path.join(out_dir, name)
+        write_png(path, pixels)
+        print(f"{os.path.normpath(path)}: {pixels.shape[1]}x{pixels.shape[0]}, {os.path.getsize(path)} bytes")
+
+
+if __name__ == "__main__":
+    main()

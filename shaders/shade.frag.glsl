@@ -1,0 +1,127 @@
+// shade.frag.glsl — deferred shading, one fragment per pixel: render_cpu.cpp's shade() and
+// lit() (the model is stated in core/render_cpu.h), reading what frusta.frag.glsl wrote.
+// The ground plane and the sky are found here analytically, as the CPU does per ray.
+//
+// Sun visibility comes from a shadow map rendered by the same ray-casting shaders
+// (SHADOW_PASS), orthographic along the sun direction of this pass: the CPU's shadow ray
+// toward the same direction, resolved to the map's texels (bilinear 2x2 comparison). The
+// receiver is moved along its geometric normal by u_normal_offset_m (a couple of texels)
+// before the lookup, so a lit surface never shadows itself.
+
+layout(binding = 0) uniform sampler2D g_normal_distance;
+layout(binding = 1) uniform sampler2D g_geometric_u;
+layout(binding = 2) uniform usampler2D g_ids;
+#ifdef SUN
+layout(binding = 3) uniform sampler2DShadow shadow_map;
+#endif
+
+// Per plant: bark albedo (rgb) and w = 1 where it replaces material 0 (Bark::albedo_rgb).
+layout(std430, binding = 3) readonly buffer PlantBark { vec4 plant_bark[]; };
+
+const int kMaxMaterials = 16;
+uniform vec3 u_material_albedo[kMaxMaterials];  // kMaterialAlbedo (materials.h)
+uniform int u_material_count;
+
+uniform vec3 u_right;        // camera frame, as frusta_common.glsl
+uniform vec3 u_up;
+uniform vec3 u_forward;
+uniform vec2 u_half_size;
+uniform vec2 u_image_size;
+uniform vec2 u_jitter;
+uniform float u_eye_above_ground;  // eye.y − ground.height
+uniform vec3 u_sky;                // L_sky
+uniform vec3 u_ground_albedo;
+#ifdef SUN
+uniform vec3 u_sun_dir;            // unit, toward the sun (this pass's sample of the disc)
+uniform vec3 u_sun_radiance;       // E_sun
+uniform vec3 u_eye_rel_light;      // eye − the shadow map's centre c
+uniform vec3 u_light_e0;           // the map's frame (frusta_common.glsl)
+uniform vec3 u_light_e1;
+uniform vec4 u_light_rect;
+uniform vec2 u_light_depth;
+uniform float u_normal_offset_m;   // receiver offset along its geometric normal
+uniform float u_depth_bias;        // in map depth units (0..1)
+#endif
+
+layout(location = 0) out vec4 colour;
+
+const float kPi = 3.14159265358979323846;
+#define kInfinity uintBitsToFloat(0x7F800000u)  // +inf (a const initializer cannot call it)
+const float kSpecular = 0.04;  // k_s
+const float kShininess = 40.0;  // s
+
+vec3 camera_ray_direction(vec2 pixel) {
+  float sx = (2.0 * pixel.x / u_image_size.x - 1.0) * u_half_size.x;
+  float sy = (1.0 - 2.0 * pixel.y / u_image_size.y) * u_half_size.y;
+  return u_forward + sx * u_right + sy * u_up;
+}
+
+#ifdef SUN
+// Sun visibility of a point p (relative to the map's centre) with geometric normal n_geometric.
+float sun_visibility(vec3 p, vec3 n_geometric) {
+  vec3 q = p + u_normal_offset_m * n_geometric;
+  vec2 uv = (vec2(dot(q, u_light_e0), dot(q, u_light_e1)) - u_light_rect.xy) / u_light_rect.zw;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;  // no caster there
+  // Beyond the farthest caster the reference is clamped to the empty map's 1: still lit
+  // where nothing is in the way, shadowed behind every caster.
+  float depth = min((-dot(q, u_sun_dir) - u_light_depth.x) / u_light_depth.y - u_depth_bias, 1.0);
+  return texture(shadow_map, vec3(uv, depth));
+}
+#endif
+
+vec3 lit(vec3 albedo, vec3 n, vec3 n_geometric, vec3 p_rel_eye, vec3 view, bool specular) {
+  vec3 result = albedo * u_sky * (0.5 * (1.0 + n.y));
+#ifdef SUN
+  vec3 l = u_sun_dir;
+  float n_dot_l = dot(n, l);
+  if (n_dot_l <= 0.0 || dot(n_geometric, l) <= 0.0) return result;
+  float visibility = sun_visibility(u_eye_rel_light + p_rel_eye, n_geometric);
+  if (visibility == 0.0) return result;
+  vec3 brdf = albedo / kPi;
+  if (specular) {
+    vec3 h = normalize(l + view);
+    brdf += vec3(kSpecular * (kShininess + 8.0) / (8.0 * kPi) * pow(max(0.0, dot(n, h)), kShininess));
+  }
+  result += brdf * u_sun_radiance * (n_dot_l * visibility);
+#endif
+  return result;
+}
+
+void main() {
+  ivec2 texel = ivec2(gl_FragCoord.xy);
+  vec2 pixel = vec2(gl_FragCoord.x - 0.5 + u_jitter.x, u_image_size.y - gl_FragCoord.y - 0.5 + u_jitter.y);
+  vec3 dir = camera_ray_direction(pixel);
+  vec3 view = -normalize(dir);
+  vec4 normal_distance = texelFetch(g_normal_distance, texel, 0);
+  bool plant_hit = normal_distance.w >= 0.0;
+  float plant_t = plant_hit ? normal_distance.w / length(dir) : kInfinity;
+  float ground_t = dir.y < 0.0 && u_eye_above_ground > 0.0 ? -u_eye_above_ground / dir.y : kInfinity;
+  if (!plant_hit && !(ground_t < kInfinity)) {
+    colour = vec4(u_sky, 1.0);
+    return;
+  }
+  // What is seen, then one call of lit(): a SIMD rasteriser (llvmpipe) runs both sides of
+  // a branch, so the shadow lookup is written once.
+  vec3 albedo, n, n_geometric;
+  float t;
+  bool specular;
+  if (ground_t < plant_t) {
+    albedo = u_ground_albedo;
+    n = n_geometric = vec3(0.0, 1.0, 0.0);
+    t = ground_t;
+    specular = false;
+  } else {
+    vec4 geometric_u = texelFetch(g_geometric_u, texel, 0);
+    uvec4 ids = texelFetch(g_ids, texel, 0);
+    uint plant = ids.x & 0xFFFFFFu;
+    uint material = ids.x >> 24;
+    albedo = material == 0u && plant_bark[plant].w > 0.0
+                 ? plant_bark[plant].rgb
+                 : u_material_albedo[min(int(material), u_material_count - 1)];
+    n = normal_distance.xyz;
+    n_geometric = geometric_u.xyz;
+    t = plant_t;
+    specular = true;
+  }
+  colour = vec4(lit(albedo, n, n_geometric, t * dir, view, specular), 1.0);
+}

@@ -1,0 +1,102 @@
+// gl_test_util.cpp — see gl_test_util.h.
+#include "tests/gl/gl_test_util.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+
+#include "core/image_io.h"
+
+namespace sylva::gl_test {
+
+GlContext* shared_context(std::string* why) {
+  static GlContextResult made = create_headless_gl_context();
+  if (!made.context && why) *why = made.error;
+  if (made.context) made.context->make_current();
+  return made.context.get();
+}
+
+Scene scene_around(const Skeleton& skeleton, uint32_t width, uint32_t height) {
+  Scene scene = default_scene_for(skeleton, width, height);
+  scene.plants.front().skeleton = skeleton;
+  return scene;
+}
+
+Skeleton grow_preset(const std::string& name) {
+  Scene scene;
+  ScenePlant plant;
+  plant.grammar = std::string(SYLVA_SOURCE_DIR) + "/presets/" + name + ".lsys";
+  scene.plants.push_back(plant);
+  if (auto error = grow_scene_plants(scene)) throw std::runtime_error(*error);
+  return *scene.plants.front().skeleton;
+}
+
+std::string Agreement::describe() const {
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "hit/miss agreement %.4f %%, depth rel. error median %.2e (max %.2e), beauty MAD %.5f linear "
+                "(%.3f/255 sRGB), %llu CPU hit pixels, %llu NaN",
+                100 * hit_miss, depth_median_rel, depth_max_rel, beauty_mad, 255 * beauty_mad_srgb,
+                static_cast<unsigned long long>(hit_pixels), static_cast<unsigned long long>(nan_pixels));
+  return line;
+}
+
+Agreement compare(const RenderImage& gl, const RenderImage& cpu) {
+  Agreement a;
+  const size_t pixels = static_cast<size_t>(cpu.width) * cpu.height;
+  if (gl.width != cpu.width || gl.height != cpu.height || gl.depth.size() != pixels || cpu.depth.size() != pixels) {
+    ADD_FAILURE() << "compare: images differ in size or lack depth";
+    return a;
+  }
+  uint64_t agree = 0;
+  std::vector<double> rel;
+  double sum = 0, sum_srgb = 0;
+  for (size_t p = 0; p < pixels; ++p) {
+    const bool gl_hit = !std::isinf(gl.depth[p]), cpu_hit = !std::isinf(cpu.depth[p]);
+    if (std::isnan(gl.depth[p])) ++a.nan_pixels;
+    agree += gl_hit == cpu_hit;
+    a.hit_pixels += cpu_hit;
+    if (gl_hit && cpu_hit) rel.push_back(std::abs(static_cast<double>(gl.depth[p]) - cpu.depth[p]) / cpu.depth[p]);
+    for (int k = 0; k < 3; ++k) {
+      const float g = gl.beauty[p * 4 + k], c = cpu.beauty[p * 4 + k];
+      if (std::isnan(g)) ++a.nan_pixels;
+      sum += std::abs(static_cast<double>(g) - c);
+      sum_srgb += std::abs(static_cast<double>(linear_to_srgb(g)) - linear_to_srgb(c));
+    }
+  }
+  a.hit_miss = static_cast<double>(agree) / pixels;
+  if (!rel.empty()) {
+    std::nth_element(rel.begin(), rel.begin() + rel.size() / 2, rel.end());
+    a.depth_median_rel = rel[rel.size() / 2];
+    a.depth_max_rel = *std::max_element(rel.begin(), rel.end());
+  }
+  a.beauty_mad = sum / (3.0 * pixels);
+  a.beauty_mad_srgb = sum_srgb / (3.0 * pixels);
+  return a;
+}
+
+std::string write_diff_images(const std::string& name, const RenderImage& gl, const RenderImage& cpu) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / ("sylva_gl_" + name);
+  std::filesystem::create_directories(dir);
+  auto png = [&](const std::string& file, const std::vector<float>& rgba) {
+    std::vector<float> encoded(static_cast<size_t>(cpu.width) * cpu.height * 3);
+    for (size_t p = 0; p * 3 < encoded.size(); ++p)
+      for (int k = 0; k < 3; ++k) encoded[p * 3 + k] = linear_to_srgb(rgba[p * 4 + k]);
+    write_image_atomically((dir / file).string(), cpu.width, cpu.height, {"R", "G", "B"}, encoded,
+                           {ChannelFormat::uint8}, true);
+  };
+  png("cpu.png", cpu.beauty);
+  png("gl.png", gl.beauty);
+  std::vector<float> diff(gl.beauty.size());
+  for (size_t i = 0; i < diff.size(); ++i) diff[i] = 8 * std::abs(gl.beauty[i] - cpu.beauty[i]);
+  // Hit/miss disagreement in pure red, on top.
+  for (size_t p = 0; p < gl.depth.size() && p < cpu.depth.size(); ++p)
+    if (std::isinf(gl.depth[p]) != std::isinf(cpu.depth[p])) diff[p * 4] = 1, diff[p * 4 + 1] = diff[p * 4 + 2] = 0;
+  png("diff.png", diff);
+  return dir.string();
+}
+
+}  // namespace sylva::gl_test

@@ -1,0 +1,51 @@
+// gl_test_util.h — what the GL tests share: one headless context per test binary (a test
+// skips, saying why, where none can be made), small scenes whose geometry is known, and
+// the comparison of a GL render with the CPU reference (render_cpu.h), which writes the
+// two images and their difference to the test's temporary folder when it fails.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "core/gl_context.h"
+#include "core/render_cpu.h"
+#include "core/scene.h"
+
+namespace sylva::gl_test {
+
+// The process's context, made on first use; null when none can be made (then *why says why).
+GlContext* shared_context(std::string* why);
+
+// Skips the current test unless a GL 4.5 core context is current.
+#define SYLVA_REQUIRE_GL()                                                             \
+  do {                                                                                 \
+    std::string why_no_gl;                                                             \
+    if (!::sylva::gl_test::shared_context(&why_no_gl))                                  \
+      GTEST_SKIP() << "no OpenGL 4.5 core context through EGL: " << why_no_gl;         \
+  } while (0)
+
+// A scene around `skeleton`: 256×192 unless given, the default scene's camera and sun.
+Scene scene_around(const Skeleton& skeleton, uint32_t width = 256, uint32_t height = 192);
+
+// The skeleton a preset grows with its own seed and steps.
+Skeleton grow_preset(const std::string& name);
+
+// How a GL render agrees with the CPU's.
+struct Agreement {
+  double hit_miss = 0;          // fraction of pixels where both hit a plant or both miss
+  double depth_median_rel = 0;  // median |Z_gl − Z_cpu| / Z_cpu over pixels both hit
+  double depth_max_rel = 0;
+  double beauty_mad = 0;        // mean |gl − cpu| over pixels and RGB, linear values
+  double beauty_mad_srgb = 0;   // the same on sRGB-encoded values in [0, 1] (what a PNG holds)
+  uint64_t hit_pixels = 0;      // pixels the CPU sees a plant in
+  uint64_t nan_pixels = 0;      // GL beauty or depth values that are NaN
+  std::string describe() const;
+};
+Agreement compare(const RenderImage& gl, const RenderImage& cpu);
+
+// Writes cpu.png, gl.png and diff.png (|gl − cpu| × 8) into a folder named after `name`
+// in the test temporary folder; returns the folder.
+std::string write_diff_images(const std::string& name, const RenderImage& gl, const RenderImage& cpu);
+
+}  // namespace sylva::gl_test

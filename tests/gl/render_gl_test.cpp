@@ -1,0 +1,250 @@
+// render_gl_test.cpp — the GL ray caster against the CPU reference (issue 4, sec. 2): the
+// same scene through render_gl and render_cpu, compared pixel by pixel. Tolerances: hit/miss
+// agreement >= 99.5 % of pixels, median relative depth error <= 1e-4, mean absolute beauty
+// difference <= 1/255 on the sRGB-encoded values a PNG holds (stricter than linear). On a
+// failure the two images and their difference are written to the test's temporary folder.
+#include "core/render_gl.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <algorithm>
+#include <filesystem>
+#include <map>
+
+#include "tests/gl/gl_test_util.h"
+
+namespace sylva {
+namespace {
+
+using gl_test::Agreement;
+
+Skeleton chain_of(std::vector<Joint> joints) {
+  Skeleton sk;
+  sk.joints = std::move(joints);
+  sk.chains = {{0, static_cast<uint32_t>(sk.joints.size()), std::nullopt}};
+  return sk;
+}
+
+// Renders `scene` on both backends and checks the issue's tolerances.
+Agreement expect_matches_cpu(const std::string& name, const Scene& scene) {
+  RenderOptions options;
+  options.aovs = kAovDepth;
+  const RenderResult cpu = render_cpu(scene, options);
+  const RenderResult gl = render_gl(scene, options);
+  const Agreement a = gl_test::compare(gl.image, cpu.image);
+  std::printf("[ agreement ] %s %ux%u: %s\n", name.c_str(), scene.width, scene.height, a.describe().c_str());
+  ::testing::Test::RecordProperty("agreement", a.describe());
+  const bool ok = a.hit_miss >= 0.995 && a.depth_median_rel <= 1e-4 && a.beauty_mad_srgb <= 1.0 / 255 &&
+                  a.nan_pixels == 0 && a.hit_pixels > 0;
+  if (!ok)
+    ADD_FAILURE() << name << ": " << a.describe() << "\n  images: "
+                  << gl_test::write_diff_images(name, gl.image, cpu.image);
+  return a;
+}
+
+TEST(RenderGl, SingleSegmentMatchesTheCpu) {
+  SYLVA_REQUIRE_GL();
+  expect_matches_cpu("single_segment", gl_test::scene_around(chain_of({{{0, 0, 0}, 0.3, 0}, {{0, 2, 0}, 0.2, 0}})));
+}
+
+TEST(RenderGl, BentJointMatchesTheCpu) {
+  SYLVA_REQUIRE_GL();
+  // 40° at the middle joint: a mitred joint, one shared cutting plane.
+  const double a = 40 * 3.14159265358979 / 180;
+  expect_matches_cpu("bent_joint", gl_test::scene_around(chain_of({{{0, 0, 0}, 0.25, 0},
+                                                                   {{0, 1.5, 0}, 0.22, 0},
+                                                                   {{1.5 * std::sin(a), 1.5 + 1.5 * std::cos(a), 0}, 0.18, 0}})));
+}
+
+TEST(RenderGl, SharpBendWithAKnuckleMatchesTheCpu) {
+  SYLVA_REQUIRE_GL();
+  // 150°: split into capped legs and a knuckle ball.
+  expect_matches_cpu("sharp_bend", gl_test::scene_around(chain_of({{{0, 0, 0}, 0.2, 0},
+                                                                   {{0, 1.5, 0}, 0.2, 0},
+                                                                   {{0.75, 1.5 - 1.3, 0.1}, 0.2, 0}})));
+}
+
+TEST(RenderGl, BranchMatchesTheCpu) {
+  SYLVA_REQUIRE_GL();
+  Skeleton sk;
+  sk.joints = {{{0, 0, 0}, 0.25, 0}, {{0, 1.2, 0}, 0.2, 0}, {{0, 2.4, 0}, 0.15, 0},
+               {{0, 1.2, 0}, 0.1, 1},  {{0.8, 2.0, 0.3}, 0.06, 1}};
+  sk.chains = {{0, 3, std::nullopt}, {3, 2, ChainParent{0, 1}}};
+  expect_matches_cpu("branch", gl_test::scene_around(sk));
+}
+
+TEST(RenderGl, TipMatchesTheCpu) {
+  SYLVA_REQUIRE_GL();
+  // A cone ending in a point (radius 0): eq. 8 falls back to the exact normal there.
+  expect_matches_cpu("tip", gl_test::scene_around(chain_of({{{0, 0, 0}, 0.3, 0}, {{0, 1, 0}, 0.2, 0}, {{0.2, 2, 0}, 0.0, 1}})));
+}
+
+TEST(RenderGl, SaguaroMatchesTheCpu) {
+  SYLVA_REQUIRE_GL();
+  expect_matches_cpu("saguaro", gl_test::scene_around(gl_test::grow_preset("saguaro")));
+}
+
+TEST(RenderGl, ElmMatchesTheCpu) {
+  SYLVA_REQUIRE_GL();
+  expect_matches_cpu("elm", gl_test::scene_around(gl_test::grow_preset("elm")));
+}
+
+// ---- Stiff cases (the skinning issue's): no NaN, and still the CPU's picture ----------
+
+TEST(RenderGl, AMillionMetresFromTheOriginMatchesTheCpu) {
+  SYLVA_REQUIRE_GL();
+  Skeleton sk = chain_of({{{0, 0, 0}, 0.05, 0}, {{0, 0.4, 0}, 0.04, 0}, {{0.1, 0.8, 0}, 0.02, 1}});
+  Scene scene = gl_test::scene_around(sk);
+  const glm::dvec3 offset(1e6, 0, -1e6);
+  scene.plants.front().position = offset;
+  scene.camera.eye += offset;
+  scene.camera.target += offset;
+  const Agreement a = expect_matches_cpu("million_metres", scene);
+  EXPECT_EQ(a.nan_pixels, 0u);
+}
+
+TEST(RenderGl, GrazingViewsHaveNoNaNAndMatchTheCpu) {
+  SYLVA_REQUIRE_GL();
+  // Looking along a long thin horizontal cylinder, and nearly along its silhouette.
+  Skeleton sk = chain_of({{{0, 1, 0}, 0.1, 0}, {{0, 1, -6}, 0.1, 0}});
+  for (const auto& [name, eye] : {std::pair{"grazing_axis", glm::dvec3(0.02, 1.01, 3)},
+                                  std::pair{"grazing_silhouette", glm::dvec3(0.1001, 1.3, 3)}}) {
+    Scene scene = gl_test::scene_around(sk);
+    scene.camera.eye = eye;
+    scene.camera.target = {eye.x, eye.y - 0.05, -6};
+    scene.camera.fov_y_deg = 30;
+    const Agreement a = expect_matches_cpu(name, scene);
+    EXPECT_EQ(a.nan_pixels, 0u) << name;
+  }
+}
+
+TEST(RenderGl, EyeInsideABoundingPyramidStillSeesTheSurface) {
+  SYLVA_REQUIRE_GL();
+  // The eye inside a thick segment's pyramid but outside the cone: its front faces are
+  // behind the eye; the back-face pass (EYE_INSIDE) must draw it.
+  Skeleton sk = chain_of({{{0, 0, 0}, 1.0, 0}, {{0, 4, 0}, 1.0, 0}});
+  Scene scene = gl_test::scene_around(sk);
+  // The pyramid's square cross-section spans |x|, |z| <= 1 here (axis_frame of +Y is x, −z).
+  scene.camera.eye = {0.9, 2, 0.9};  // outside the cylinder (r = 1.27 > 1), inside the square
+  scene.camera.target = {0, 2.5, -3};
+  scene.camera.fov_y_deg = 60;
+  expect_matches_cpu("eye_inside_pyramid", scene);
+  const RenderResult gl = render_gl(scene, {});
+  bool drawn_from_inside = false;
+  for (const RenderPass& p : gl.passes) drawn_from_inside |= p.detail.find("1 around the eye") != std::string::npos;
+  EXPECT_TRUE(drawn_from_inside) << "the EYE_INSIDE pass did not run";
+}
+
+TEST(RenderGl, AovsFollowTheCpuConventions) {
+  SYLVA_REQUIRE_GL();
+  Scene scene = gl_test::scene_around(chain_of({{{0, 0, 0}, 0.3, 0}, {{0, 2, 0}, 0.2, 2}}), 64, 48);
+  RenderOptions options;
+  options.aovs = kAovDepth | kAovNormal | kAovUv | kAovId;
+  const RenderResult cpu = render_cpu(scene, options);
+  const RenderResult gl = render_gl(scene, options);
+  ASSERT_EQ(gl.image.normal.size(), cpu.image.normal.size());
+  ASSERT_EQ(gl.image.uv.size(), cpu.image.uv.size());
+  ASSERT_EQ(gl.image.id.size(), cpu.image.id.size());
+  int both = 0;
+  for (size_t p = 0; p < gl.image.depth.size(); ++p) {
+    const bool gl_hit = !std::isinf(gl.image.depth[p]), cpu_hit = !std::isinf(cpu.image.depth[p]);
+    if (!gl_hit) {
+      EXPECT_EQ(gl.image.id[p * 3 + 1], -1.0f);
+      EXPECT_EQ(gl.image.normal[p * 3], 0.0f);
+      continue;
+    }
+    if (!cpu_hit) continue;
+    ++both;
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(gl.image.normal[p * 3 + k], cpu.image.normal[p * 3 + k], 1e-4) << p;
+      EXPECT_EQ(gl.image.id[p * 3 + k], cpu.image.id[p * 3 + k]) << p;
+    }
+    // u in turns wraps at 1: compare on the circle.
+    const double du = std::abs(gl.image.uv[p * 2] - cpu.image.uv[p * 2]);
+    EXPECT_LT(std::min(du, 1 - du), 1e-4) << p;
+    EXPECT_NEAR(gl.image.uv[p * 2 + 1], cpu.image.uv[p * 2 + 1], 1e-4) << p;
+  }
+  EXPECT_GT(both, 100);
+}
+
+TEST(RenderGl, MoreSamplesConvergeToTheCpu) {
+  SYLVA_REQUIRE_GL();
+  // --spp 16: both average 16 stratified positions and (disc sun) 16 sun directions.
+  Scene scene = gl_test::scene_around(gl_test::grow_preset("saguaro"), 128, 96);
+  RenderOptions options;
+  options.spp = 16;
+  options.aovs = kAovDepth;
+  const RenderResult cpu = render_cpu(scene, options);
+  const RenderResult gl = render_gl(scene, options);
+  const Agreement a = gl_test::compare(gl.image, cpu.image);
+  std::printf("[ agreement ] saguaro 16 spp 128x96: %s\n", a.describe().c_str());
+  EXPECT_LE(a.beauty_mad_srgb, 1.0 / 255) << a.describe() << "\n  images: "
+                                          << gl_test::write_diff_images("saguaro_16spp", gl.image, cpu.image);
+  EXPECT_GE(a.hit_miss, 0.995);  // AOVs at the pixel centres, as the CPU's
+}
+
+TEST(RenderGl, ScenesTheGlBackendCannotDrawYetAreNamed) {
+  Scene scene = gl_test::scene_around(chain_of({{{0, 0, 0}, 0.3, 0}, {{0, 2, 0}, 0.2, 0}}));
+  EXPECT_FALSE(gl_unsupported(scene, {}));
+  scene.plants.front().bark.albedo_texture = "bark.png";
+  ASSERT_TRUE(gl_unsupported(scene, {}));
+  EXPECT_NE(gl_unsupported(scene, {})->find("texture"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sylva
+
+namespace sylva {
+namespace {
+
+// Not a check: frame times for the report and docs until `sylva bench gpu` exists. Run by
+// hand: sylva_gl_tests --gtest_also_run_disabled_tests --gtest_filter='*FrameTimes*'
+TEST(RenderGl, DISABLED_FrameTimes) {
+  SYLVA_REQUIRE_GL();
+  for (const char* preset : {"saguaro", "pine"}) {
+    Scene scene = gl_test::scene_around(gl_test::grow_preset(preset), 1024, 768);
+    GlRenderer renderer(scene, {});
+    renderer.render(scene);  // warm-up: llvmpipe compiles its shader variants on first draw
+    std::map<std::string, std::vector<double>> ms;
+    for (int frame = 0; frame < 5; ++frame)
+      for (const RenderPass& p : renderer.render(scene).passes) ms[p.name].push_back(p.seconds * 1e3);
+    std::printf("%s 1024x768, %llu frusta, median of 5 frames:", preset,
+                static_cast<unsigned long long>(renderer.frusta()));
+    for (auto& [name, v] : ms) {
+      std::sort(v.begin(), v.end());
+      std::printf("  %s %.1f ms", name.c_str(), v[v.size() / 2]);
+    }
+    std::printf("\n");
+  }
+}
+
+}  // namespace
+}  // namespace sylva
+
+namespace sylva {
+namespace {
+
+TEST(RenderGl, EveryPresetRendersWithoutNaN) {
+  SYLVA_REQUIRE_GL();
+  int presets = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(SYLVA_SOURCE_DIR) + "/presets")) {
+    if (entry.path().extension() != ".lsys") continue;
+    const std::string name = entry.path().stem().string();
+    Scene scene = gl_test::scene_around(gl_test::grow_preset(name), 96, 72);
+    RenderOptions options;
+    options.aovs = kAovDepth;
+    const RenderResult r = render_gl(scene, options);
+    size_t nan = 0, hits = 0;
+    for (float v : r.image.beauty) nan += std::isnan(v);
+    for (float z : r.image.depth) hits += !std::isinf(z), nan += std::isnan(z);
+    EXPECT_EQ(nan, 0u) << name;
+    EXPECT_GT(hits, 0u) << name << ": nothing drawn";
+    ++presets;
+  }
+  EXPECT_GE(presets, 10);
+}
+
+}  // namespace
+}  // namespace sylva
