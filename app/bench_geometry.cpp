@@ -239,8 +239,8 @@ std::vector<PlotPanel> plot_panels(const std::vector<Row>& rows, const std::stri
     series.clear();
     for (const Row& r : rows) {
       std::string name = r.method.family;
-      if (name == "RC+R") name += " b=" + std::to_string(r.method.bisection) + ", steps ↑";
-      if (name == "GS" || name == "GS+R") name += ", m ↑";
+      if (name == "RC+R") name += " b=" + std::to_string(r.method.bisection) + ", s=8..64";
+      if (name == "GS" || name == "GS+R") name += ", m=0..4";
       series_for(name).points.push_back({r.time_s, panel == 0 ? r.depth_rmse : r.colour_rmse});
     }
     (panel == 0 ? depth : colour) = series;
