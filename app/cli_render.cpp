@@ -13,6 +13,7 @@
 #include "app/render_input.h"
 #include "core/image_io.h"
 #include "core/gl_context.h"
+#include "core/render_common.h"
 #include "core/render_cpu.h"
 #include "core/render_gl.h"
 #include "core/scene.h"
@@ -158,9 +159,7 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
   return out;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
+using render_common::seconds_since;
 
 // Restores the previous SIGINT disposition when the render is over.
 class SigintGuard {

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "core/gltf_export.h"
+#include "core/render_common.h"
 #include "core/turtle.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
@@ -19,9 +20,7 @@ bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
+using render_common::seconds_since;
 
 }  // namespace
 

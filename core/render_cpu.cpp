@@ -4,6 +4,7 @@
 #include "core/culling.h"
 #include "core/frustum_tracer.h"
 #include "core/mesh_accel.h"
+#include "core/render_common.h"
 #include "core/texture.h"
 
 #include <unistd.h>
@@ -23,29 +24,15 @@ namespace sylva {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using render_common::CameraFrame;
+using render_common::Clock;
+using render_common::kShininess;
+using render_common::kSpecular;
+using render_common::seconds_since;
+using Rng = render_common::SampleRng;
 constexpr uint32_t kTile = 32;
-constexpr double kSpecular = 0.04;   // k_s: a dielectric's reflectance at normal incidence
-constexpr double kShininess = 40;    // s
 constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// splitmix64 (Steele et al. 2014): a counter-based stream, so every pixel sample draws the
-// same numbers whatever thread renders it.
-struct Rng {
-  uint64_t state;
-  double next() {
-    uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return static_cast<double>(z >> 11) * 0x1.0p-53;
-  }
-};
 
 glm::dvec3 material_albedo(const ScenePlant& plant, uint32_t material) {
   if (material == 0 && plant.bark.albedo_rgb) return *plant.bark.albedo_rgb;
@@ -54,25 +41,7 @@ glm::dvec3 material_albedo(const ScenePlant& plant, uint32_t material) {
   return {a[0], a[1], a[2]};
 }
 
-// The camera's orthonormal frame and the image plane's half extents at distance 1.
-struct CameraFrame {
-  glm::dvec3 eye, forward, right, up;
-  double half_height, half_width;
-  double width, height;
-};
-
-CameraFrame camera_frame(const Scene& scene) {
-  CameraFrame f;
-  f.eye = scene.camera.eye;
-  f.forward = glm::normalize(scene.camera.target - scene.camera.eye);
-  f.right = glm::normalize(glm::cross(f.forward, scene.camera.up));
-  f.up = glm::cross(f.right, f.forward);
-  f.width = scene.width;
-  f.height = scene.height;
-  f.half_height = std::tan(0.5 * scene.camera.fov_y_deg * kPi / 180);
-  f.half_width = f.half_height * f.width / f.height;
-  return f;
-}
+using render_common::camera_frame;
 
 Ray frame_ray(const CameraFrame& f, double x, double y) {
   const double sx = (2 * x / f.width - 1) * f.half_width;
@@ -84,11 +53,7 @@ Ray frame_ray(const CameraFrame& f, double x, double y) {
 // (uniform in solid angle: cos θ uniform in [cos α, 1]).
 glm::dvec3 sun_sample(const Sun& sun, const glm::dvec3& sun_direction, double cos_alpha, const AxisFrame& frame, Rng& rng) {
   if (sun.angular_radius_deg <= 0) return sun_direction;
-  const double cos_t = 1 - rng.next() * (1 - cos_alpha);
-  const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
-  const double phi = 2 * kPi * rng.next();
-  return glm::normalize(cos_t * sun_direction +
-                        sin_t * (std::cos(phi) * frame.e0 + std::sin(phi) * frame.e1));
+  return render_common::sample_sun_disc(sun_direction, cos_alpha, frame, rng);
 }
 
 // What one primary sample saw (the trace pass's output, the shade pass's input).
@@ -133,14 +98,14 @@ class Renderer {
       for (uint32_t y = y0; y < y1; ++y)
         for (uint32_t x = x0; x < x1; ++x) {
           PrimaryHit& h = hits[(y - y0) * kTile + (x - x0)];
-          Rng rng{(static_cast<uint64_t>(y) * scene_.width + x) * 0x100000001B3ull + sample * 0x9E37ull};
+          Rng rng((static_cast<uint64_t>(y) * scene_.width + x) * 0x100000001B3ull + sample * 0x9E37ull);
           double sx = 0.5, sy = 0.5;
           if (spp > 1) {
-            sx = ((sample % grid_x) + rng.next()) / grid_x;
-            sy = ((sample / grid_x) + rng.next()) / grid_y;
+            sx = ((sample % grid_x) + rng.next_double()) / grid_x;
+            sy = ((sample / grid_x) + rng.next_double()) / grid_y;
           }
           trace(frame_ray(frame_, x + sx, y + sy), h);
-          h.rng_state = rng.state;
+          h.rng_state = rng.state();
         }
       *trace_s += seconds_since(start);
       start = Clock::now();
@@ -203,7 +168,7 @@ class Renderer {
   }
 
   glm::dvec3 shade(const PrimaryHit& h, uint64_t* shadow_rays) {
-    Rng rng{h.rng_state};
+    Rng rng(h.rng_state);
     const glm::dvec3 view = -glm::normalize(h.ray.direction);
     if (h.ground_t < kInf) {
       const glm::dvec3 p = h.ray.origin + h.ground_t * h.ray.direction;

@@ -15,12 +15,16 @@
 #include "core/gl_api.h"
 #include "core/gl_program.h"
 #include "core/materials.h"
+#include "core/render_common.h"
 
 namespace sylva {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using render_common::CameraFrame;
+using render_common::camera_frame;
+using render_common::Clock;
+using render_common::seconds_since;
 constexpr double kPi = std::numbers::pi;
 constexpr int kMaxMaterials = 16;         // u_material_albedo's size in shade.frag.glsl
 constexpr uint32_t kMaxPlants = 1u << 24;  // plant index bits in the G-buffer
@@ -28,23 +32,6 @@ constexpr int kShadowTexelsMin = 1024;
 constexpr int kShadowTexelsMax = 8192;
 constexpr double kShadowNormalOffsetTexels = 2;  // receiver offset along its normal
 constexpr double kShadowDepthBiasTexels = 0.5;   // and along the sun direction
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// splitmix64, as render_cpu.cpp: the per-pass pixel offsets and sun samples are a function
-// of the sample index only.
-struct Rng {
-  uint64_t state;
-  double next() {
-    uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return static_cast<double>(z >> 11) * 0x1.0p-53;
-  }
-};
 
 // A double split into two floats whose sum is it to ~2^-48 relative: what the shaders add
 // back in float (frusta_common.glsl).
@@ -54,22 +41,6 @@ struct SplitVec3 {
 SplitVec3 split(const glm::dvec3& v) {
   const glm::vec3 hi(v);
   return {hi, glm::vec3(v - glm::dvec3(hi))};
-}
-
-// render_cpu.cpp's CameraFrame.
-struct CameraFrame {
-  glm::dvec3 eye, forward, right, up;
-  double half_width = 1, half_height = 1;
-};
-CameraFrame camera_frame(const Scene& scene) {
-  CameraFrame f;
-  f.eye = scene.camera.eye;
-  f.forward = glm::normalize(scene.camera.target - scene.camera.eye);
-  f.right = glm::normalize(glm::cross(f.forward, scene.camera.up));
-  f.up = glm::cross(f.right, f.forward);
-  f.half_height = std::tan(0.5 * scene.camera.fov_y_deg * kPi / 180);
-  f.half_width = f.half_height * scene.width / scene.height;
-  return f;
 }
 
 // The orthographic sun view of one pass (frusta_common.glsl's SHADOW_PASS uniforms).
@@ -540,18 +511,15 @@ RenderResult GlRenderer::render(const Scene& scene) {
     }
     // The CPU's stratified grid, one offset per pass; the sun's disc sampled as the CPU's
     // sun_sample does (uniform in solid angle).
-    Rng rng{0x5EED0000ull + sample * 0x9E37ull};
+    render_common::SampleRng rng(0x5EED0000ull + sample * 0x9E37ull);
     double jitter_x = 0.5, jitter_y = 0.5;
     if (spp > 1) {
-      jitter_x = ((sample % grid_x) + rng.next()) / grid_x;
-      jitter_y = ((sample / grid_x) + rng.next()) / grid_y;
+      jitter_x = ((sample % grid_x) + rng.next_double()) / grid_x;
+      jitter_y = ((sample / grid_x) + rng.next_double()) / grid_y;
     }
     glm::dvec3 l = sun_direction;
     if (sun_per_pass) {
-      const double cos_t = 1 - rng.next() * (1 - cos_alpha);
-      const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
-      const double phi = 2 * kPi * rng.next();
-      l = glm::normalize(cos_t * sun_direction + sin_t * (std::cos(phi) * sun_frame.e0 + std::sin(phi) * sun_frame.e1));
+      l = render_common::sample_sun_disc(sun_direction, cos_alpha, sun_frame, rng);
     }
     if (sun_on && (sample == 0 || sun_per_pass)) {
       shadow = st.shadow_frame(l, shadow_texels);

@@ -33,6 +33,8 @@ class Rng {
   // Uniform in [0, 1) with 53 random bits.
   double next_double() { return static_cast<double>(next_u64() >> 11) * 0x1.0p-53; }
   // Standard normal by Box–Muller (deterministic: one pair of uniform draws per call).
+  // The counter: Rng(r.state()) continues r's stream.
+  uint64_t state() const { return state_; }
   double next_gauss() {
     double u1 = 1.0 - next_double();  // (0, 1]: log never sees 0
     double u2 = next_double();

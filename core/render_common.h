@@ -1,0 +1,63 @@
+// render_common.h — what the CPU reference (render_cpu.cpp) and the GL renderer
+// (render_gl.cpp) must share so that they cannot drift apart: the camera frame, the
+// shading constants, the sample stream and the sun-disc sampling. (The GLSL side,
+// shaders/shade.frag.glsl, repeats the two constants and is compared with the CPU by
+// tests/gl/render_gl_test.cpp.)
+#pragma once
+
+#include <chrono>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <numbers>
+
+#include "core/render_cpu.h"
+#include "lsystem/random.h"
+
+namespace sylva::render_common {
+
+using Clock = std::chrono::steady_clock;
+
+inline double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Shading model constants (render_cpu.h states the model).
+constexpr double kSpecular = 0.04;  // k_s: a dielectric's reflectance at normal incidence
+constexpr double kShininess = 40;   // s
+
+// SplitMix64 (lsystem/random.h), counter based: a pixel sample (CPU) or a pass (GL) draws
+// the same numbers whatever thread renders it.
+using SampleRng = lsys::Rng;
+
+// The camera's orthonormal frame and the image plane's half extents at distance 1.
+struct CameraFrame {
+  glm::dvec3 eye, forward, right, up;
+  double half_height = 1, half_width = 1;
+  double width = 1, height = 1;  // pixels
+};
+
+inline CameraFrame camera_frame(const Scene& scene) {
+  CameraFrame f;
+  f.eye = scene.camera.eye;
+  f.forward = glm::normalize(scene.camera.target - scene.camera.eye);
+  f.right = glm::normalize(glm::cross(f.forward, scene.camera.up));
+  f.up = glm::cross(f.right, f.forward);
+  f.width = scene.width;
+  f.height = scene.height;
+  f.half_height = std::tan(0.5 * scene.camera.fov_y_deg * std::numbers::pi / 180);
+  f.half_width = f.half_height * f.width / f.height;
+  return f;
+}
+
+// A unit direction on the sun's disc of angular radius acos(cos_alpha) around
+// `sun_direction` (unit; `frame` = axis_frame(sun_direction)), uniform in solid angle
+// (cos θ uniform in [cos α, 1]); two draws from `rng`.
+inline glm::dvec3 sample_sun_disc(const glm::dvec3& sun_direction, double cos_alpha, const AxisFrame& frame,
+                                  SampleRng& rng) {
+  const double cos_t = 1 - rng.next_double() * (1 - cos_alpha);
+  const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
+  const double phi = 2 * std::numbers::pi * rng.next_double();
+  return glm::normalize(cos_t * sun_direction + sin_t * (std::cos(phi) * frame.e0 + std::sin(phi) * frame.e1));
+}
+
+}  // namespace sylva::render_common
