@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <stdexcept>
 
 #include "core/gl_api.h"
 #include "core/gl_program.h"
@@ -109,6 +110,16 @@ struct PassTimer {
   }
 };
 
+// An immutable-storage buffer holding `bytes` of `data` (zero-sized storage is an error:
+// an empty scene gets one unused 64-byte element).
+GLuint make_buffer(const void* data, size_t bytes, GLbitfield flags = 0) {
+  GLuint buffer = 0;
+  glCreateBuffers(1, &buffer);
+  std::vector<uint8_t> placeholder(64, 0);
+  glNamedBufferStorage(buffer, bytes ? static_cast<GLsizeiptr>(bytes) : 64, bytes ? data : placeholder.data(), flags);
+  return buffer;
+}
+
 }  // namespace
 
 std::optional<std::string> gl_unsupported(const Scene& scene, const RenderOptions& options) {
@@ -129,6 +140,7 @@ struct GlRenderer::State {
   uint64_t uploaded_bytes = 0;
   std::vector<Sphere> spheres;  // around each frustum's bounding pyramid
   bool want_uv = false;
+  size_t plant_count = 0;
 
   GLuint vao = 0;
   GLuint segment_buffer = 0, id_buffer = 0, list_buffer = 0, bark_buffer = 0;
@@ -147,6 +159,27 @@ struct GlRenderer::State {
     const GLuint buffers[] = {segment_buffer, id_buffer, list_buffer, bark_buffer};
     glDeleteBuffers(4, buffers);
     glDeleteVertexArrays(1, &vao);
+  }
+
+  // Skins every plant of `scene` into one record and one id quadruple (plant, chain,
+  // segment, 0) per frustum, and replaces `spheres` with the frusta's bounding spheres.
+  void skin_plants(const Scene& scene, std::vector<GpuSegment>* records, std::vector<uint32_t>* ids) {
+    spheres.clear();
+    for (uint32_t p = 0; p < scene.plants.size(); ++p) {
+      if (!scene.plants[p].skeleton) throw std::logic_error("GlRenderer: a plant has no skeleton (call grow_scene_plants)");
+      const SkinnedSkeleton skinned = skin_skeleton(place_plant(scene.plants[p]), options.skin);
+      for (const Frustum& f : skinned.frusta) {
+        records->push_back(pack_gpu_segment(f));
+        ids->insert(ids->end(), {p, f.chain, f.segment, 0u});
+        const BoundingPyramid pyramid = bounding_pyramid(f.shape);
+        glm::dvec3 centre(0);
+        for (const glm::dvec3& v : pyramid.vertices) centre += v / 8.0;
+        double radius = 0;
+        for (const glm::dvec3& v : pyramid.vertices) radius = std::max(radius, glm::length(v - centre));
+        // The shader grows the pyramid by ~1e-4 of the frustum's size (frusta.vert.glsl).
+        spheres.push_back({centre, radius * 1.001 + 1e-3 * (f.shape.length + std::max(f.shape.radius0, f.shape.radius1))});
+      }
+    }
   }
 
   // The program of a variant, built on first use (compile time goes to *compile_s).
@@ -283,40 +316,20 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options) : state
   st.options = options;
   st.want_uv = (options.aovs & kAovUv) != 0;
   if (scene.plants.size() >= kMaxPlants) throw GlError("the GL backend draws at most 2^24 plants");
+  st.plant_count = scene.plants.size();
 
   Clock::time_point start = Clock::now();
   std::vector<GpuSegment> records;
   std::vector<uint32_t> ids;  // plant, chain, segment, 0 per frustum
-  for (uint32_t p = 0; p < scene.plants.size(); ++p) {
-    if (!scene.plants[p].skeleton) throw std::logic_error("GlRenderer: a plant has no skeleton (call grow_scene_plants)");
-    const SkinnedSkeleton skinned = skin_skeleton(place_plant(scene.plants[p]), options.skin);
-    for (const Frustum& f : skinned.frusta) {
-      records.push_back(pack_gpu_segment(f));
-      ids.insert(ids.end(), {p, f.chain, f.segment, 0u});
-      const BoundingPyramid pyramid = bounding_pyramid(f.shape);
-      glm::dvec3 centre(0);
-      for (const glm::dvec3& v : pyramid.vertices) centre += v / 8.0;
-      double radius = 0;
-      for (const glm::dvec3& v : pyramid.vertices) radius = std::max(radius, glm::length(v - centre));
-      // The shader grows the pyramid by ~1e-4 of the frustum's size (frusta.vert.glsl).
-      st.spheres.push_back({centre, radius * 1.001 + 1e-3 * (f.shape.length + std::max(f.shape.radius0, f.shape.radius1))});
-    }
-  }
+  st.skin_plants(scene, &records, &ids);
   st.frusta = records.size();
   st.setup_passes.push_back({"skin", seconds_since(start),
                              std::to_string(scene.plants.size()) + " plants, " + std::to_string(st.frusta) + " frusta"});
 
   start = Clock::now();
   glCreateVertexArrays(1, &st.vao);
-  auto make_buffer = [](const void* data, size_t bytes) {
-    GLuint buffer = 0;
-    glCreateBuffers(1, &buffer);
-    // Zero-sized storage is an error: an empty scene gets one unused element.
-    std::vector<uint8_t> placeholder(64, 0);
-    glNamedBufferStorage(buffer, bytes ? static_cast<GLsizeiptr>(bytes) : 64, bytes ? data : placeholder.data(), 0);
-    return buffer;
-  };
-  st.segment_buffer = make_buffer(records.data(), records.size() * sizeof(GpuSegment));
+  // The segment records may be rewritten in place (update_plants).
+  st.segment_buffer = make_buffer(records.data(), records.size() * sizeof(GpuSegment), GL_DYNAMIC_STORAGE_BIT);
   st.id_buffer = make_buffer(ids.data(), ids.size() * sizeof(uint32_t));
   std::vector<float> bark;
   for (const ScenePlant& plant : scene.plants) {
@@ -354,6 +367,32 @@ GlRenderer::~GlRenderer() = default;
 uint64_t GlRenderer::frusta() const { return state_->frusta; }
 uint64_t GlRenderer::uploaded_bytes() const { return state_->uploaded_bytes; }
 const std::vector<RenderPass>& GlRenderer::setup_passes() const { return state_->setup_passes; }
+
+uint64_t GlRenderer::update_plants(const Scene& scene) {
+  State& st = *state_;
+  if (scene.plants.size() != st.plant_count)
+    throw std::invalid_argument("GlRenderer::update_plants: the scene has " + std::to_string(scene.plants.size()) +
+                                " plants, the renderer " + std::to_string(st.plant_count));
+  std::vector<GpuSegment> records;
+  std::vector<uint32_t> ids;
+  st.skin_plants(scene, &records, &ids);
+  const size_t record_bytes = records.size() * sizeof(GpuSegment);
+  uint64_t uploaded = record_bytes;
+  if (records.size() == st.frusta) {
+    if (record_bytes) glNamedBufferSubData(st.segment_buffer, 0, static_cast<GLsizeiptr>(record_bytes), records.data());
+  } else {
+    // The topology changed (a frustum more or less): new buffers, ids included.
+    const GLuint old[2] = {st.segment_buffer, st.id_buffer};
+    glDeleteBuffers(2, old);
+    st.segment_buffer = make_buffer(records.data(), record_bytes, GL_DYNAMIC_STORAGE_BIT);
+    st.id_buffer = make_buffer(ids.data(), ids.size() * sizeof(uint32_t));
+    uploaded += ids.size() * sizeof(uint32_t);
+    st.frusta = records.size();
+    st.uploaded_bytes = record_bytes + ids.size() * sizeof(uint32_t);
+  }
+  check_gl("update_plants");
+  return uploaded;
+}
 
 RenderResult GlRenderer::render(const Scene& scene) {
   State& st = *state_;

@@ -58,6 +58,12 @@ class GlRenderer {
   // GL_TIME_ELAPSED queries where the name says "(GPU)".
   RenderResult render(const Scene& scene);
 
+  // Animation (paper 000 sec. 4, the dancing cacti): re-skins the plants of `scene` — the
+  // same plants as the constructor's, their skeletons moved — and re-uploads only the
+  // segment records (the ids too where the number of frusta changed). Returns the bytes
+  // uploaded. Throws std::invalid_argument for a different number of plants.
+  uint64_t update_plants(const Scene& scene);
+
   uint64_t frusta() const;          // frusta uploaded
   uint64_t uploaded_bytes() const;  // bytes in the segment and id buffers
   // What was done once: "skin", "upload", "programs" (compile and link).
