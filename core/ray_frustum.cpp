@@ -32,53 +32,12 @@
 #include <initializer_list>
 #include <limits>
 
+#include "core/compensated.h"
+
 namespace sylva {
 namespace {
 
-// ---- Error-free transformations (double only; the float twin has none, like the GPU) ---
-
-struct Compensated {
-  double hi = 0;
-  double lo = 0;  // hi + lo is the exact value
-};
-
-// a + b exactly (Knuth's TwoSum; no branch on magnitudes).
-Compensated two_sum(double a, double b) {
-  const double s = a + b;
-  const double bb = s - a;
-  return {s, (a - (s - bb)) + (b - bb)};
-}
-
-// a·b exactly: a hardware FMA where there is one (where the compiler could also contract
-// Dekker's products and break them), Dekker's split otherwise.
-Compensated two_product(double a, double b) {
-  const double p = a * b;
-#ifdef FP_FAST_FMA
-  return {p, std::fma(a, b, -p)};
-#else
-  constexpr double kSplit = 134217729.0;  // 2^27 + 1
-  const double ca = kSplit * a;
-  const double a_hi = ca - (ca - a);
-  const double a_lo = a - a_hi;
-  const double cb = kSplit * b;
-  const double b_hi = cb - (cb - b);
-  const double b_lo = b - b_hi;
-  return {p, ((a_hi * b_hi - p) + a_hi * b_lo + a_lo * b_hi) + a_lo * b_lo};
-#endif
-}
-
-// plane.offset − dot(plane.normal, origin) as if in twice double precision (Ogita–Rump–
-// Oishi Dot2): the plane's offset in a frame whose origin is `origin`. Plain double would
-// lose ~1e-10 m at 10⁶ m, a millionth of a 0.1 mm twig.
-double plane_offset_from(const Plane& plane, const glm::dvec3& origin) {
-  Compensated sum{plane.offset, 0};
-  for (int i = 0; i < 3; ++i) {
-    const Compensated product = two_product(-plane.normal[i], origin[i]);
-    const Compensated partial = two_sum(sum.hi, product.hi);
-    sum = {partial.hi, sum.lo + (partial.lo + product.lo)};
-  }
-  return sum.hi + sum.lo;
-}
+using compensated::plane_offset_from;
 
 // ---- The intersector, shared by the double reference and the float twin -----------------
 //
@@ -290,23 +249,10 @@ FrustumHit intersect_frustum(const Ray& ray, const FrustumShape& shape, double t
   const double dir_sq = glm::dot(d, d);
   if (!(dir_sq > 0)) return result;
 
-  // Re-centre: origin − base exactly as hi + lo, the shift s0 to the point of the ray
-  // nearest the midpoint, then (origin − base) + s0·d compensated: the moved origin is
-  // exact to an ulp of its own (small) size even when the eye is 10⁶ away.
-  Compensated relative[3];
-  glm::dvec3 rough{0, 0, 0};
-  for (int i = 0; i < 3; ++i) {
-    relative[i] = two_sum(ray.origin[i], -shape.base[i]);
-    rough[i] = relative[i].hi;
-  }
-  const glm::dvec3 midpoint = (0.5 * shape.length) * shape.axis;
-  const double shift = glm::dot(midpoint - rough, d) / dir_sq;
-  glm::dvec3 origin{0, 0, 0};
-  for (int i = 0; i < 3; ++i) {
-    const Compensated step = two_product(shift, d[i]);
-    const Compensated sum = two_sum(relative[i].hi, step.hi);
-    origin[i] = sum.hi + (sum.lo + relative[i].lo + step.lo);
-  }
+  // Re-centre on the midpoint (compensated.h): t = shift + t_local.
+  const compensated::RecentredRay recentred = compensated::recentre(ray, shape);
+  const glm::dvec3& origin = recentred.origin;
+  const double shift = recentred.shift;
 
   const LocalShape<double> local{shape.axis,
                                  shape.length,

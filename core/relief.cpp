@@ -4,8 +4,8 @@
 // frustum's midpoint in compensated arithmetic (so an eye 10⁶ m away keeps the relief's
 // millimetres), plane offsets are taken relative to the base in compensated arithmetic,
 // the cone's quadratic is the apex-free one with the regrouped discriminant and the
-// stable root pair. The compensated helpers are repeated here (ray_frustum.cpp keeps
-// its own private, mirrored by the GLSL).
+// stable root pair. The re-centring and the compensated plane offsets are
+// compensated.h's, the very code ray_frustum.cpp uses.
 #include "core/relief.h"
 
 #include <algorithm>
@@ -15,6 +15,8 @@
 #include <limits>
 #include <numbers>
 
+#include "core/compensated.h"
+
 namespace sylva {
 namespace {
 
@@ -22,43 +24,7 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kMaxNormalFootprint = 0.5;  // texture units: beyond, the normal is the base one
 
-struct Compensated {
-  double hi = 0;
-  double lo = 0;
-};
-
-Compensated two_sum(double a, double b) {
-  const double s = a + b;
-  const double bb = s - a;
-  return {s, (a - (s - bb)) + (b - bb)};
-}
-
-Compensated two_product(double a, double b) {
-  const double p = a * b;
-#ifdef FP_FAST_FMA
-  return {p, std::fma(a, b, -p)};
-#else
-  constexpr double kSplit = 134217729.0;  // 2^27 + 1
-  const double ca = kSplit * a;
-  const double a_hi = ca - (ca - a);
-  const double a_lo = a - a_hi;
-  const double cb = kSplit * b;
-  const double b_hi = cb - (cb - b);
-  const double b_lo = b - b_hi;
-  return {p, ((a_hi * b_hi - p) + a_hi * b_lo + a_lo * b_hi) + a_lo * b_lo};
-#endif
-}
-
-// plane.offset − dot(plane.normal, origin) in twice double precision (Dot2).
-double plane_offset_from(const Plane& plane, const glm::dvec3& origin) {
-  Compensated sum{plane.offset, 0};
-  for (int i = 0; i < 3; ++i) {
-    const Compensated product = two_product(-plane.normal[i], origin[i]);
-    const Compensated partial = two_sum(sum.hi, product.hi);
-    sum = {partial.hi, sum.lo + (partial.lo + product.lo)};
-  }
-  return sum.hi + sum.lo;
-}
+using compensated::plane_offset_from;
 
 bool shape_rejected(const FrustumShape& shape) {
   return !(shape.length > 0) || !std::isfinite(shape.length) || !(shape.radius0 >= 0) ||
@@ -74,24 +40,8 @@ struct LocalRay {
 };
 
 LocalRay local_ray(const Ray& ray, const FrustumShape& shape) {
-  const glm::dvec3& d = ray.direction;
-  const double dir_sq = glm::dot(d, d);
-  Compensated relative[3];
-  glm::dvec3 rough{0, 0, 0};
-  for (int i = 0; i < 3; ++i) {
-    relative[i] = two_sum(ray.origin[i], -shape.base[i]);
-    rough[i] = relative[i].hi;
-  }
-  const glm::dvec3 midpoint = (0.5 * shape.length) * shape.axis;
-  LocalRay r;
-  r.shift = glm::dot(midpoint - rough, d) / dir_sq;
-  for (int i = 0; i < 3; ++i) {
-    const Compensated step = two_product(r.shift, d[i]);
-    const Compensated sum = two_sum(relative[i].hi, step.hi);
-    r.origin[i] = sum.hi + (sum.lo + relative[i].lo + step.lo);
-  }
-  r.dir = d;
-  return r;
+  const compensated::RecentredRay recentred = compensated::recentre(ray, shape);
+  return {recentred.origin, ray.direction, recentred.shift};
 }
 
 // A half-line or interval bound with the boundary that made it.
