@@ -1,7 +1,8 @@
 // frustum_accel.cpp — Embree 3 user geometry over frusta (see frustum_accel.h).
 #include "core/frustum_accel.h"
 
-#include <embree3/rtcore.h>
+#include "core/embree_scene.h"
+
 
 #include <atomic>
 #include <cmath>
@@ -54,16 +55,6 @@ QueryContext start_query(const GeometryData& data, const Ray& ray, double t_min,
   return q;
 }
 
-// Smallest float >= v (and largest <= v for round_down).
-float round_up(double v) {
-  float f = static_cast<float>(v);
-  return static_cast<double>(f) < v ? std::nextafter(f, kInfF) : f;
-}
-float round_down(double v) {
-  float f = static_cast<float>(v);
-  return static_cast<double>(f) > v ? std::nextafter(f, -kInfF) : f;
-}
-
 void bounds_callback(const RTCBoundsFunctionArguments* args) {
   const auto* data = static_cast<const GeometryData*>(args->geometryUserPtr);
   FrustumShape shape = data->frusta[args->primID].shape;
@@ -75,8 +66,8 @@ void bounds_callback(const RTCBoundsFunctionArguments* args) {
   const glm::dvec3 lo = b.lo - data->centre - glm::dvec3(data->pad);
   const glm::dvec3 hi = b.hi - data->centre + glm::dvec3(data->pad);
   RTCBounds* o = args->bounds_o;
-  o->lower_x = round_down(lo.x), o->lower_y = round_down(lo.y), o->lower_z = round_down(lo.z);
-  o->upper_x = round_up(hi.x), o->upper_y = round_up(hi.y), o->upper_z = round_up(hi.z);
+  o->lower_x = EmbreeScene::round_down(lo.x), o->lower_y = EmbreeScene::round_down(lo.y), o->lower_z = EmbreeScene::round_down(lo.z);
+  o->upper_x = EmbreeScene::round_up(hi.x), o->upper_y = EmbreeScene::round_up(hi.y), o->upper_z = EmbreeScene::round_up(hi.z);
 }
 
 // Tests one candidate with the exact double ray; records it if nearer.
@@ -97,7 +88,7 @@ void intersect_callback(const RTCIntersectFunctionNArguments* args) {
   if (!test_candidate(q, args->primID)) return;
   auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
   // Embree culls with a float tfar: round the exact t up so no nearer box is skipped.
-  rh->ray.tfar = round_up(q->t_best);
+  rh->ray.tfar = EmbreeScene::round_up(q->t_best);
   rh->hit.Ng_x = static_cast<float>(q->best.hit.normal.x);
   rh->hit.Ng_y = static_cast<float>(q->best.hit.normal.y);
   rh->hit.Ng_z = static_cast<float>(q->best.hit.normal.z);
@@ -117,35 +108,13 @@ void occluded_callback(const RTCOccludedFunctionNArguments* args) {
 }  // namespace
 
 struct FrustumAccel::Impl {
-  RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
+  EmbreeScene embree;
   GeometryData data{};
-  std::atomic<int64_t> bytes{0};
-
-  static bool monitor(void* user, ssize_t delta, bool) {
-    static_cast<Impl*>(user)->bytes += delta;
-    return true;
-  }
-
-  RTCRay embree_ray(const Ray& ray, double t_min, double t_max) const {
-    RTCRay r{};
-    const glm::dvec3 o = ray.origin - data.centre;
-    r.org_x = static_cast<float>(o.x), r.org_y = static_cast<float>(o.y), r.org_z = static_cast<float>(o.z);
-    r.dir_x = static_cast<float>(ray.direction.x), r.dir_y = static_cast<float>(ray.direction.y),
-    r.dir_z = static_cast<float>(ray.direction.z);
-    r.tnear = std::max(0.0f, round_down(t_min));
-    r.tfar = std::isfinite(t_max) ? round_up(t_max) : kInfF;
-    r.mask = 0xFFFFFFFFu;
-    return r;
-  }
 };
 
 FrustumAccel::FrustumAccel(std::span<const Frustum> frusta, CustomFrusta custom)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
-  m.device = rtcNewDevice(nullptr);
-  if (!m.device) throw std::runtime_error("Embree: cannot create a device");
-  rtcSetDeviceMemoryMonitorFunction(m.device, &Impl::monitor, &m);
   // Centre and a padding that covers float rounding of rays far across the scene.
   glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
   const bool has_custom = !custom.shell_m.empty() && custom.intersector;
@@ -163,44 +132,36 @@ FrustumAccel::FrustumAccel(std::span<const Frustum> frusta, CustomFrusta custom)
   m.data.custom = has_custom ? custom.intersector : nullptr;
   m.data.centre = frusta.empty() ? glm::dvec3(0) : 0.5 * (lo + hi);
   m.data.pad = frusta.empty() ? 0 : 1e-6 * glm::length(hi - lo);
-  m.scene = rtcNewScene(m.device);
-  rtcSetSceneFlags(m.scene, RTC_SCENE_FLAG_ROBUST);
   if (!frusta.empty()) {
-    RTCGeometry geom = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_USER);
+    RTCGeometry geom = rtcNewGeometry(m.embree.device(), RTC_GEOMETRY_TYPE_USER);
     rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(frusta.size()));
     rtcSetGeometryUserData(geom, &m.data);
     rtcSetGeometryBoundsFunction(geom, bounds_callback, nullptr);
     rtcSetGeometryIntersectFunction(geom, intersect_callback);
     rtcSetGeometryOccludedFunction(geom, occluded_callback);
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(m.scene, geom);
-    rtcReleaseGeometry(geom);
+    m.embree.attach(geom);
   }
-  rtcCommitScene(m.scene);
+  m.embree.commit();
 }
 
-FrustumAccel::~FrustumAccel() {
-  if (!impl_) return;
-  if (impl_->scene) rtcReleaseScene(impl_->scene);
-  if (impl_->device) rtcReleaseDevice(impl_->device);
-}
+FrustumAccel::~FrustumAccel() = default;
 
 BvhHit FrustumAccel::nearest(const Ray& ray, double t_min, double t_max, CustomHitDetail* detail) const {
   QueryContext q = start_query(impl_->data, ray, t_min, t_max, detail);
   RTCRayHit rh{};
-  rh.ray = impl_->embree_ray(ray, t_min, t_max);
+  rh.ray = EmbreeScene::embree_ray(ray, impl_->data.centre, t_min, t_max);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(impl_->scene, &q.embree, &rh);
+  rtcIntersect1(impl_->embree.scene(), &q.embree, &rh);
   return q.best;
 }
 
 bool FrustumAccel::any(const Ray& ray, double t_min, double t_max) const {
   QueryContext q = start_query(impl_->data, ray, t_min, t_max, nullptr);
-  RTCRay r = impl_->embree_ray(ray, t_min, t_max);
-  rtcOccluded1(impl_->scene, &q.embree, &r);
+  RTCRay r = EmbreeScene::embree_ray(ray, impl_->data.centre, t_min, t_max);
+  rtcOccluded1(impl_->embree.scene(), &q.embree, &r);
   return q.best.hit_any();
 }
 
-size_t FrustumAccel::memory_bytes() const { return static_cast<size_t>(std::max<int64_t>(0, impl_->bytes.load())); }
+size_t FrustumAccel::memory_bytes() const { return impl_->embree.memory_bytes(); }
 
 }  // namespace sylva

@@ -3,7 +3,8 @@
 // intersection"; texture differentials as pbrt-v4's Triangle (Pharr, Jakob, Humphreys).
 #include "core/mesh_accel.h"
 
-#include <embree3/rtcore.h>
+#include "core/embree_scene.h"
+
 
 #include <algorithm>
 #include <atomic>
@@ -18,16 +19,6 @@ namespace sylva {
 namespace {
 
 constexpr float kInfF = std::numeric_limits<float>::infinity();
-
-// Smallest float >= v (and largest <= v for round_down).
-float round_up(double v) {
-  float f = static_cast<float>(v);
-  return static_cast<double>(f) < v ? std::nextafter(f, kInfF) : f;
-}
-float round_down(double v) {
-  float f = static_cast<float>(v);
-  return static_cast<double>(f) > v ? std::nextafter(f, -kInfF) : f;
-}
 
 // A ray against one triangle in double, without an inside test: t where the ray crosses
 // the triangle's plane, and the barycentrics (b1, b2) of that point (b0 = 1 − b1 − b2).
@@ -84,14 +75,7 @@ struct MeshTracer::Impl {
   int level = 0;
   bool displaced = false;
   glm::dvec3 centre{0, 0, 0};
-  RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
-  std::atomic<int64_t> bytes{0};
-
-  static bool monitor(void* user, ssize_t delta, bool) {
-    static_cast<Impl*>(user)->bytes += delta;
-    return true;
-  }
+  EmbreeScene embree{/*need_filter_functions=*/true};
 
   MeshQuery start_query(const Ray& ray, double t_min, double t_max) const {
     MeshQuery q{};
@@ -104,15 +88,7 @@ struct MeshTracer::Impl {
   }
 
   RTCRay embree_ray(const Ray& ray, double t_min, double t_max) const {
-    RTCRay r{};
-    const glm::dvec3 o = ray.origin - centre;
-    r.org_x = static_cast<float>(o.x), r.org_y = static_cast<float>(o.y), r.org_z = static_cast<float>(o.z);
-    r.dir_x = static_cast<float>(ray.direction.x), r.dir_y = static_cast<float>(ray.direction.y),
-    r.dir_z = static_cast<float>(ray.direction.z);
-    r.tnear = std::max(0.0f, round_down(t_min));
-    r.tfar = std::isfinite(t_max) ? round_up(t_max) : kInfF;
-    r.mask = 0xFFFFFFFFu;
-    return r;
+    return EmbreeScene::embree_ray(ray, centre, t_min, t_max);
   }
 };
 
@@ -133,18 +109,11 @@ MeshTracer::MeshTracer(TriangleMesh mesh, std::span<const Frustum> frusta, std::
     if (f >= frusta.size() || f >= plant_of_frustum.size())
       throw std::logic_error("MeshTracer: triangle_frustum past the frusta it indexes");
 
-  m.device = rtcNewDevice(nullptr);
-  if (!m.device) throw std::runtime_error("Embree: cannot create a device");
-  if (!rtcGetDeviceProperty(m.device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED))
-    throw std::runtime_error("Embree was built without filter functions (EMBREE_FILTER_FUNCTION)");
-  rtcSetDeviceMemoryMonitorFunction(m.device, &Impl::monitor, &m);
   glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
   for (const glm::dvec3& p : tm.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
   m.centre = tm.positions.empty() ? glm::dvec3(0) : 0.5 * (lo + hi);
-  m.scene = rtcNewScene(m.device);
-  rtcSetSceneFlags(m.scene, RTC_SCENE_FLAG_ROBUST);
   if (tm.triangle_count() > 0) {
-    RTCGeometry geom = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    RTCGeometry geom = rtcNewGeometry(m.embree.device(), RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                           3 * sizeof(float), tm.positions.size()));
     for (size_t i = 0; i < tm.positions.size(); ++i) {
@@ -156,18 +125,12 @@ MeshTracer::MeshTracer(TriangleMesh mesh, std::span<const Frustum> frusta, std::
                                3 * sizeof(uint32_t), tm.triangle_count());
     rtcSetGeometryIntersectFilterFunction(geom, range_filter);
     rtcSetGeometryOccludedFilterFunction(geom, range_filter);
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(m.scene, geom);
-    rtcReleaseGeometry(geom);
+    m.embree.attach(geom);
   }
-  rtcCommitScene(m.scene);
+  m.embree.commit();
 }
 
-MeshTracer::~MeshTracer() {
-  if (!impl_) return;
-  if (impl_->scene) rtcReleaseScene(impl_->scene);
-  if (impl_->device) rtcReleaseDevice(impl_->device);
-}
+MeshTracer::~MeshTracer() = default;
 
 const TriangleMesh& MeshTracer::mesh() const { return impl_->mesh; }
 
@@ -177,7 +140,7 @@ SurfaceHit MeshTracer::nearest(const Ray& ray, double t_min, double t_max) const
   RTCRayHit rh{};
   rh.ray = m.embree_ray(ray, t_min, t_max);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(m.scene, &q.embree, &rh);
+  rtcIntersect1(m.embree.scene(), &q.embree, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return {};
 
   const TriangleMesh& tm = m.mesh;
@@ -229,12 +192,12 @@ bool MeshTracer::any(const Ray& ray, double t_min, double t_max) const {
   const Impl& m = *impl_;
   MeshQuery q = m.start_query(ray, t_min, t_max);
   RTCRay r = m.embree_ray(ray, t_min, t_max);
-  rtcOccluded1(m.scene, &q.embree, &r);
+  rtcOccluded1(m.embree.scene(), &q.embree, &r);
   return r.tfar == -kInfF;
 }
 
 size_t MeshTracer::memory_bytes() const {
-  return impl_->mesh.memory_bytes() + static_cast<size_t>(std::max<int64_t>(0, impl_->bytes.load()));
+  return impl_->mesh.memory_bytes() + impl_->embree.memory_bytes();
 }
 
 std::string MeshTracer::describe() const {
