@@ -8,28 +8,13 @@
 #include <glm/geometric.hpp>
 #include <limits>
 
+#include "tests/core/test_scenes.h"
+
 namespace sylva {
 namespace {
 
 // One vertical cylinder of radius 0.5 from y = 0 to 2 at the origin, seen from +Z.
-Scene cylinder_scene() {
-  Skeleton sk;
-  sk.joints = {{{0, 0, 0}, 0.5, 0}, {{0, 2, 0}, 0.5, 0}};
-  sk.chains = {{0, 2, std::nullopt}};
-  Scene s;
-  s.width = 64;
-  s.height = 48;
-  s.camera.eye = {0, 1, 5};
-  s.camera.target = {0, 1, 0};
-  s.camera.up = {0, 1, 0};
-  s.camera.fov_y_deg = 40;
-  s.ground.height = -10;
-  s.sun.angular_radius_deg = 0;
-  ScenePlant plant;
-  plant.skeleton = sk;
-  s.plants.push_back(plant);
-  return s;
-}
+Scene cylinder_scene() { return test::scene_around(test::cylinder(0.5, 0, 2), {0, 1, 5}, {0, 1, 0}, 64, 48, -10); }
 
 TEST(RenderCpu, CylinderDepthEqualsTheAnalyticDistance) {
   Scene s = cylinder_scene();

@@ -11,6 +11,7 @@
 #include "core/frustum_tracer.h"
 #include "core/relief.h"
 #include "core/render_cpu.h"
+#include "tests/core/test_scenes.h"
 #include "tests/core/test_textures.h"
 
 namespace sylva {
@@ -90,25 +91,13 @@ TEST(FrustumTracerRelief, WithoutReliefTheTracerIsTheExactOne) {
 
 // The cylinder of render_cpu_test, bark optionally relief-mapped by vertical ribs.
 Scene ribbed_cylinder_scene(const std::string& height_path) {
-  Skeleton sk;
-  sk.joints = {{{0, 0, 0}, 0.5, 0}, {{0, 2, 0}, 0.5, 0}};
-  sk.chains = {{0, 2, std::nullopt}};
-  Scene s;
-  s.width = 96;
-  s.height = 72;
-  s.camera.eye = {0, 1, 5};
-  s.camera.target = {0, 1, 0};
-  s.camera.fov_y_deg = 40;
-  s.ground.height = -10;
-  s.sun.angular_radius_deg = 0;
-  ScenePlant plant;
-  plant.skeleton = sk;
+  Scene s = test::scene_around(test::cylinder(0.5, 0, 2), {0, 1, 5}, {0, 1, 0}, 96, 72, -10);
+  ScenePlant& plant = s.plants[0];
   if (!height_path.empty()) {
     plant.bark.height_texture = height_path;
     plant.bark.relief_depth_m = 0.05;
     plant.bark.u_repeat = 8;
   }
-  s.plants.push_back(plant);
   return s;
 }
 

@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include "core/render_cpu.h"
+#include "tests/core/test_scenes.h"
 #include "tests/core/test_textures.h"
 
 namespace sylva {
@@ -18,28 +19,8 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// One vertical cylinder on the Y axis from y0 to y1 of radius r, all joints `material`.
-Skeleton cylinder(double radius, double y0, double y1, uint32_t material = 0) {
-  Skeleton sk;
-  sk.joints = {{{0, y0, 0}, radius, material}, {{0, y1, 0}, radius, material}};
-  sk.chains = {{0, 2, std::nullopt}};
-  return sk;
-}
-
-Scene scene_around(const Skeleton& sk, glm::dvec3 eye, glm::dvec3 target, uint32_t width, uint32_t height) {
-  Scene s;
-  s.width = width;
-  s.height = height;
-  s.camera.eye = eye;
-  s.camera.target = target;
-  s.camera.fov_y_deg = 40;
-  s.ground.height = -100;
-  s.sun.angular_radius_deg = 0;
-  ScenePlant plant;
-  plant.skeleton = sk;
-  s.plants.push_back(plant);
-  return s;
-}
+using test::cylinder;
+using test::scene_around;
 
 TEST(TextureFootprint, PlaneLikeCylinderSeenHeadOnMatchesTheAnalyticFootprint) {
   // A cylinder of radius 50 m seen from 10 m: locally a plane facing the camera. A pixel

@@ -1,0 +1,40 @@
+// test_scenes.h — the small scenes the core tests render: a cylinder whose answers are
+// known analytically, seen by a camera placed by the test, no ground in view, a hard sun.
+#pragma once
+
+#include <cstdint>
+#include <glm/vec3.hpp>
+
+#include "core/scene.h"
+
+namespace sylva::test {
+
+// One vertical cylinder on the Y axis from y0 to y1 of radius r, every joint `material`.
+inline Skeleton cylinder(double radius, double y0, double y1, uint32_t material = 0) {
+  Skeleton sk;
+  sk.joints = {{{0, y0, 0}, radius, material}, {{0, y1, 0}, radius, material}};
+  sk.chains = {{0, 2, std::nullopt}};
+  return sk;
+}
+
+// One plant `sk` at the origin, width × height pixels, the camera at `eye` looking at
+// `target` (40° vertical field of view, +Y up), the ground at `ground_height` (far below
+// by default), a point sun (angular radius 0) in the default direction.
+inline Scene scene_around(const Skeleton& sk, glm::dvec3 eye, glm::dvec3 target, uint32_t width, uint32_t height,
+                          double ground_height = -100) {
+  Scene s;
+  s.width = width;
+  s.height = height;
+  s.camera.eye = eye;
+  s.camera.target = target;
+  s.camera.up = {0, 1, 0};
+  s.camera.fov_y_deg = 40;
+  s.ground.height = ground_height;
+  s.sun.angular_radius_deg = 0;
+  ScenePlant plant;
+  plant.skeleton = sk;
+  s.plants.push_back(plant);
+  return s;
+}
+
+}  // namespace sylva::test
