@@ -86,6 +86,16 @@ bool inside_solid(const FrustumShape& s, const glm::dvec3& p) {
   return r >= 0 && glm::length(d - y * s.axis) <= r;
 }
 
+// The cylinder of radius 1 on the Y axis from y = 0 to 2, uncapped.
+FrustumShape unit_cylinder() {
+  FrustumShape s;
+  s.radius0 = s.radius1 = 1;
+  s.length = 2;
+  s.lower = {{0, 1, 0}, 0};
+  s.upper = {{0, 1, 0}, 2};
+  return s;
+}
+
 Frustum frustum_of(const FrustumShape& shape) {
   Frustum f;
   f.shape = shape;
@@ -353,11 +363,7 @@ TEST(Relief, SinusoidalFieldConvergesAsStepsAndBisectionsGrow) {
 TEST(Relief, RayThroughTheShellThatMissesTheReliefHasNoHit) {
   // Cylinder r = 1, d = 0.1, H ≡ 0.5: the relief solid is the cylinder of radius 1.05.
   const FunctionField half([](double, double) { return 0.5; });
-  FrustumShape s;
-  s.radius0 = s.radius1 = 1;
-  s.length = 2;
-  s.lower = {{0, 1, 0}, 0};
-  s.upper = {{0, 1, 0}, 2};
+  FrustumShape s = unit_cylinder();
   s.cap_lower = s.cap_upper = true;
   const Frustum f = frustum_of(s);
   const ReliefMap map{&half, 0.1, 4, 1};
@@ -378,11 +384,7 @@ TEST(Relief, NormalFollowsTheAnalyticGradient) {
   // normal is ∝ ê − (ρ'(θ)/ρ)·T_u with ρ' = d·0.4·u_repeat·cos(2π s).
   const double d = 0.1, u_repeat = 3;
   const FunctionField field([](double s, double) { return 0.5 + 0.4 * std::sin(2 * kPi * s); }, 1e-6);
-  FrustumShape s;
-  s.radius0 = s.radius1 = 1;
-  s.length = 2;
-  s.lower = {{0, 1, 0}, 0};
-  s.upper = {{0, 1, 0}, 2};
+  FrustumShape s = unit_cylinder();
   const Frustum f = frustum_of(s);
   const ReliefMap map{&field, d, u_repeat, 1};
   ReliefOptions o;
@@ -444,11 +446,7 @@ TEST(Relief, ExactVEqualsLinearVBetweenParallelPlanes) {
 
 TEST(Relief, OriginInsideTheSolidFindsTheWayOut) {
   const FunctionField half([](double, double) { return 0.5; });
-  FrustumShape s;
-  s.radius0 = s.radius1 = 1;
-  s.length = 2;
-  s.lower = {{0, 1, 0}, 0};
-  s.upper = {{0, 1, 0}, 2};
+  FrustumShape s = unit_cylinder();
   const ReliefMap map{&half, 0.1, 4, 1};
   const ReliefHit h = intersect_relief({{0, 1, 0}, {1, 0, 0}}, frustum_of(s), map, {}, 0, 1e30);
   ASSERT_TRUE(h.hit.hit());
