@@ -228,7 +228,10 @@ int run_render(const std::vector<std::string>& args) {
         passes.push_back({"gl context", seconds_since(context_start), context.context->info().describe()});
         try {
           gl_result = render_gl(scene, options);
-          backend_name = "OpenGL ray caster (" + context.context->info().renderer + ")";
+          // Meshes are rasterised (the polygon baseline), frusta ray cast.
+          const std::string& renderer = context.context->info().renderer;
+          backend_name = options.geometry.kind == GeometryKind::mesh ? "OpenGL rasteriser (meshes, " + renderer + ")"
+                                                                     : "OpenGL ray caster (" + renderer + ")";
         } catch (const GlError& e) {
           why_not = e.what();
         }

@@ -55,9 +55,38 @@ enum class FrustaPass {
   gbuffer_eye_inside,  // camera view, back faces, for pyramids that contain the eye
   shadow,              // orthographic sun view, depth only (depth_greater)
 };
+// What a scene asks of the frusta program beyond its pass: each switch is a #define, so a
+// scene without height maps compiles no relief code and one without albedo textures no
+// texture lookups.
+struct FrustaFeatures {
+  bool want_uv = false;            // WANT_UV: u and v_m into the G-buffer (the UV AOV)
+  bool relief = false;             // RELIEF: relief marching for plants with a relief
+                                   // (relief.glsl), in the pyramid of the shell
+  bool bark = false;               // BARK: albedo textures looked up into g_albedo (bark.glsl)
+  int texture_units = 0;           // BARK_TEXTURE_UNITS: distinct bark images bound (albedo
+                                   // and height maps); at least 1 with relief or bark
+  bool conservative_depth = true;  // false: NO_CONSERVATIVE_DEPTH, no depth layout (early-Z
+                                   // measurements)
+};
+// The variant of `pass` with `features`; the shadow pass takes only relief and
+// conservative_depth (it writes depth alone). Its name lists the defines, e.g.
+// "frusta[GBUFFER_PASS WANT_UV RELIEF BARK TEXTURE_UNITS=2]".
+ShaderProgramSource frusta_program(FrustaPass pass, const FrustaFeatures& features);
+// frusta_program(pass, {.want_uv = want_uv}).
 ShaderProgramSource frusta_program(FrustaPass pass, bool want_uv);
 
-// The deferred shading program (fullscreen.vert.glsl + shade.frag.glsl); `sun` false
+// The variant switches of the mesh program (mesh.vert.glsl + mesh.frag.glsl: the polygon
+// baseline rasterised into the frusta's G-buffer, core/gl_mesh.h).
+enum class MeshPass {
+  gbuffer,  // camera view, reversed Z, both faces
+  shadow,   // orthographic sun view, depth only
+};
+// `bark_texture_units` > 0 (gbuffer only): the scene's distinct bark images; the fragment
+// stage then writes the bark albedo through bark.glsl (BARK_TEXTURE_UNITS).
+ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units = 0);
+
+// The deferred shading program (fullscreen.vert.glsl + bark.glsl's per-plant maps +
+// shade.frag.glsl); `sun` false
 // leaves out the sun and its shadow map (black or absent sun: sky only).
 ShaderProgramSource shade_program(bool sun);
 

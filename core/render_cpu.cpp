@@ -271,10 +271,7 @@ Skeleton place_plant(const ScenePlant& plant) {
 
 namespace {
 
-// Per vertex of `mesh` (tessellated from `frusta`): the relief shell's thickness at the
-// vertex over the bark's depth — relief.h's min(d, max_depth_per_radius·r) at each end of
-// the vertex's frustum, linear between — so that GS+R lifts a twig or needle no more
-// than the relief marcher's shell does.
+// plant_mesh's displacement scale per vertex (render_cpu.h).
 std::vector<double> displacement_scale(const TriangleMesh& mesh, std::span<const Frustum> frusta, double depth_m,
                                        double max_depth_per_radius) {
   std::vector<double> scale(mesh.positions.size(), 1.0);
@@ -292,6 +289,19 @@ std::vector<double> displacement_scale(const TriangleMesh& mesh, std::span<const
 }
 
 }  // namespace
+
+TriangleMesh plant_mesh(const SkinnedSkeleton& skinned, const TessellateOptions& tessellation, const HeightFn& height,
+                        double relief_depth_m, double max_depth_per_radius, double* tessellate_s, double* displace_s) {
+  Clock::time_point start = Clock::now();
+  TriangleMesh mesh = tessellate(skinned, tessellation);
+  *tessellate_s += seconds_since(start);
+  if (height) {
+    start = Clock::now();
+    mesh = displace(mesh, height, displacement_scale(mesh, skinned.frusta, relief_depth_m, max_depth_per_radius));
+    *displace_s += seconds_since(start);
+  }
+  return mesh;
+}
 
 HeightFn height_function_for(const SceneTextures& textures, uint32_t plant) {
   if (!textures.has_height(plant)) return {};
@@ -386,17 +396,10 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, 
     g.plant_of_frustum.insert(g.plant_of_frustum.end(), skinned.frusta.size(), p);
     skin_s += seconds_since(start);
     if (!mesh) continue;
-    start = Clock::now();
-    TriangleMesh part = tessellate(skinned, tessellation);
-    tessellate_s += seconds_since(start);
-    if (HeightFn height = options.displace && textures ? height_function_for(*textures, p) : HeightFn{}) {
-      start = Clock::now();
-      part = displace(part, height,
-                      displacement_scale(part, skinned.frusta, plant.bark.relief_depth_m,
-                                         options.relief_options.max_depth_per_radius));
-      displace_s += seconds_since(start);
-      ++displaced;
-    }
+    const HeightFn height = options.displace && textures ? height_function_for(*textures, p) : HeightFn{};
+    TriangleMesh part = plant_mesh(skinned, tessellation, height, plant.bark.relief_depth_m,
+                                   options.relief_options.max_depth_per_radius, &tessellate_s, &displace_s);
+    if (height) ++displaced;
     start = Clock::now();
     if (triangles.positions.empty()) {  // the first plant's mesh is taken, not copied
       for (uint32_t& f : part.triangle_frustum) f += first_frustum;

@@ -157,6 +157,15 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin,
 // plant has no height map or no depth. The function reads `textures`, which must outlive it.
 HeightFn height_function_for(const SceneTextures& textures, uint32_t plant);
 
+// One plant's GS mesh as every mesh path builds it (the CPU's MeshTracer here, GL's
+// GlMesh): `skinned` tessellated with `tessellation`, then, where `height` is set
+// (height_function_for), displaced by it (GS+R) as deep as the relief shell is thick —
+// relief.h's min(relief_depth_m, max_depth_per_radius·r) at each end of a vertex's
+// frustum, linear between — so that GS+R lifts a twig or needle no more than the relief
+// marcher's shell does. Adds the seconds spent to *tessellate_s and *displace_s.
+TriangleMesh plant_mesh(const SkinnedSkeleton& skinned, const TessellateOptions& tessellation, const HeightFn& height,
+                        double relief_depth_m, double max_depth_per_radius, double* tessellate_s, double* displace_s);
+
 // The primary ray through continuous pixel position (x, y) in [0, width] × [0, height]
 // (y downward); pixel (i, j)'s centre is (i + 0.5, j + 0.5). The direction is not unit.
 Ray camera_ray(const Scene& scene, double x, double y);

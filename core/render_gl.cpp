@@ -7,15 +7,20 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <OpenImageIO/imageio.h>
+
 #include <glm/geometric.hpp>
 #include <limits>
 #include <map>
 #include <numbers>
+#include <set>
 #include <stdexcept>
 
 #include "core/gl_api.h"
+#include "core/gl_mesh.h"
 #include "core/gl_program.h"
 #include "core/materials.h"
+#include "core/relief.h"
 #include "core/render_common.h"
 
 namespace sylva {
@@ -120,16 +125,124 @@ GLuint make_buffer(const void* data, size_t bytes, GLbitfield flags = 0) {
   return buffer;
 }
 
+constexpr size_t kMaxBarkImages = 16;  // texture units for u_bark_textures (GL 4.5: >= 16)
+
+// Whether plant `plant` is relief-mapped (render_cpu.cpp's scene_relief, relief.h).
+bool relief_mapped(const ScenePlant& plant, const RenderOptions& options) {
+  return options.geometry.relief && plant.bark.height_texture && plant.bark.relief_depth_m > 0;
+}
+
+// bark.glsl's PlantMaps, std430.
+struct PlantMapsRecord {
+  float u_repeat = 1, v_per_metre = 1, relief_depth_m = 0;
+  int32_t albedo_unit = -1, height_unit = -1;
+  uint32_t height_first = 0;
+  int32_t height_width = 1, height_height = 1;
+};
+static_assert(sizeof(PlantMapsRecord) == 32, "bark.glsl's PlantMaps is 8 scalars");
+
+// A scene's bark images on the GPU (bark.glsl): each distinct file once, as a texture with
+// its full MIP chain bound at unit i for u_bark_textures[i] (albedo GL_RGBA8 with the
+// file's sRGB-encoded values, decoded in the shader after filtering as texture.h does;
+// height GL_R32F), the height maps' finest levels as floats (height_texels), one
+// PlantMaps record per plant. Images are read with OpenImageIO as the CPU's
+// TextureSystem reads them: 8-bit albedo, a gray albedo as gray RGB, height channel 0 as
+// float in [0, 1], row 0 at t = 0.
+struct BarkMaps {
+  std::vector<PlantMapsRecord> plants;
+  std::vector<GLuint> textures;  // unit i
+  std::vector<float> height_texels;
+  bool relief = false;  // some plant is relief-mapped (frusta geometry)
+  bool albedo = false;  // some plant has an albedo texture
+  uint64_t texture_bytes = 0;
+
+  void load(const Scene& scene, const RenderOptions& options) {
+    std::map<std::string, int> albedo_unit, height_unit;
+    std::map<std::string, std::pair<uint32_t, glm::ivec2>> height_level;
+    for (const ScenePlant& plant : scene.plants) {
+      PlantMapsRecord r;
+      r.u_repeat = static_cast<float>(plant.bark.u_repeat);
+      r.v_per_metre = static_cast<float>(plant.bark.v_per_metre);
+      if (plant.bark.albedo_texture) {
+        const std::string& path = *plant.bark.albedo_texture;
+        if (!albedo_unit.count(path)) albedo_unit[path] = upload(path, false);
+        r.albedo_unit = albedo_unit[path];
+        albedo = true;
+      }
+      if (relief_mapped(plant, options)) {
+        // The shade pass offsets a relief plant's shadow lookups whatever the geometry
+        // (render_cpu.cpp); the frusta pass marches it.
+        r.relief_depth_m = static_cast<float>(plant.bark.relief_depth_m);
+        if (options.geometry.kind == GeometryKind::frusta) {
+          const std::string& path = *plant.bark.height_texture;
+          if (!height_unit.count(path)) height_unit[path] = upload(path, true, &height_level[path]);
+          r.height_unit = height_unit[path];
+          r.height_first = height_level[path].first;
+          r.height_width = height_level[path].second.x;
+          r.height_height = height_level[path].second.y;
+          relief = true;
+        }
+      }
+      plants.push_back(r);
+    }
+  }
+
+  // Reads `path` and makes its texture; returns its unit. A height map's finest level goes
+  // to height_texels too (*level: its first texel and size).
+  int upload(const std::string& path, bool height, std::pair<uint32_t, glm::ivec2>* level = nullptr) {
+    if (textures.size() >= kMaxBarkImages) throw GlError("the GL backend binds at most 16 distinct bark images");
+    auto input = OIIO::ImageInput::open(path);
+    if (!input) throw GlError("cannot open texture '" + path + "': " + OIIO::geterror());
+    const OIIO::ImageSpec spec = input->spec();
+    const int w = std::max(1, spec.width), h = std::max(1, spec.height), channels = std::max(1, spec.nchannels);
+    const size_t texels = static_cast<size_t>(w) * h;
+    GLuint texture = 0;
+    glCreateTextures(GL_TEXTURE_2D, 1, &texture);
+    textures.push_back(texture);
+    const int levels = 1 + static_cast<int>(std::floor(std::log2(std::max(w, h))));
+    glTextureStorage2D(texture, levels, height ? GL_R32F : GL_RGBA8, w, h);
+    if (height) {
+      std::vector<float> values(texels);
+      if (!input->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, values.data()))
+        throw GlError("cannot read texture '" + path + "': " + input->geterror());
+      glTextureSubImage2D(texture, 0, 0, 0, w, h, GL_RED, GL_FLOAT, values.data());
+      *level = {static_cast<uint32_t>(height_texels.size()), glm::ivec2(w, h)};
+      height_texels.insert(height_texels.end(), values.begin(), values.end());
+      texture_bytes += texels * sizeof(float) * 7 / 3;  // the MIP chain and the texels
+    } else {
+      std::vector<uint8_t> values(texels * channels), rgba(texels * 4, 255);
+      if (!input->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, values.data()))
+        throw GlError("cannot read texture '" + path + "': " + input->geterror());
+      for (size_t i = 0; i < texels; ++i)
+        for (int k = 0; k < 3; ++k) rgba[i * 4 + k] = values[i * channels + (channels >= 3 ? k : 0)];
+      glTextureSubImage2D(texture, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+      texture_bytes += texels * 4 * 4 / 3;
+    }
+    glGenerateTextureMipmap(texture);
+    glTextureParameteri(texture, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTextureParameteri(texture, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    // Isotropic trilinear. GL_TEXTURE_MAX_ANISOTROPY 16 was measured on llvmpipe against
+    // OpenImageIO's anisotropic lookups: further from the CPU (close-up bark, MAD 1.23/255
+    // against 0.86/255) and two orders of magnitude slower.
+    glTextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTextureParameteri(texture, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    check_gl("bark textures");
+    return static_cast<int>(textures.size()) - 1;
+  }
+};
+
 }  // namespace
 
 std::optional<std::string> gl_unsupported(const Scene& scene, const RenderOptions& options) {
-  if (options.geometry.kind != GeometryKind::frusta)
-    return "the GL backend draws the analytic frusta only (no tessellated meshes yet)";
+  std::set<std::string> images;  // what BarkMaps uploads
   for (const ScenePlant& plant : scene.plants) {
-    if (plant.bark.albedo_texture) return "the GL backend does not draw bark textures yet";
-    if (plant.bark.height_texture && options.geometry.relief && plant.bark.relief_depth_m > 0)
-      return "the GL backend does not draw relief maps yet";
+    if (plant.bark.albedo_texture) images.insert(*plant.bark.albedo_texture);
+    if (options.geometry.kind == GeometryKind::frusta && relief_mapped(plant, options))
+      images.insert(*plant.bark.height_texture);
   }
+  if (images.size() > kMaxBarkImages)
+    return "the GL backend binds at most " + std::to_string(kMaxBarkImages) + " distinct bark images (this scene has " +
+           std::to_string(images.size()) + ")";
   return std::nullopt;
 }
 
@@ -140,6 +253,10 @@ struct GlRenderer::State {
   uint64_t uploaded_bytes = 0;
   std::vector<Sphere> spheres;  // around each frustum's bounding pyramid
   bool want_uv = false;
+  FrustaFeatures features;  // the frusta program's switches for this scene (gl_shaders.h)
+  BarkMaps bark_maps;
+  GLuint maps_buffer = 0, height_texel_buffer = 0;
+  std::unique_ptr<GlMesh> mesh;  // GeometryKind::mesh: the polygon baseline, drawn instead of the frusta
   size_t plant_count = 0;
 
   GLuint vao = 0;
@@ -147,7 +264,7 @@ struct GlRenderer::State {
   std::map<std::string, GlProgram> programs;
 
   uint32_t width = 0, height = 0;
-  GLuint gbuffer_fbo = 0, gbuffer[3] = {0, 0, 0}, depth_buffer = 0;
+  GLuint gbuffer_fbo = 0, gbuffer[4] = {0, 0, 0, 0}, depth_buffer = 0;  // + g_albedo (RGBA16F)
   GLuint accum_fbo = 0, accum = 0;
   int shadow_texels = 0;
   GLuint shadow_fbo = 0, shadow_map = 0;
@@ -156,8 +273,10 @@ struct GlRenderer::State {
     for (auto& [name, program] : programs) glDeleteProgram(program.id);
     release_targets();
     release_shadow_map();
-    const GLuint buffers[] = {segment_buffer, id_buffer, list_buffer, bark_buffer};
-    glDeleteBuffers(4, buffers);
+    const GLuint buffers[] = {segment_buffer, id_buffer, list_buffer, bark_buffer, maps_buffer, height_texel_buffer};
+    glDeleteBuffers(6, buffers);
+    if (!bark_maps.textures.empty())
+      glDeleteTextures(static_cast<GLsizei>(bark_maps.textures.size()), bark_maps.textures.data());
     glDeleteVertexArrays(1, &vao);
   }
 
@@ -171,7 +290,12 @@ struct GlRenderer::State {
       for (const Frustum& f : skinned.frusta) {
         records->push_back(pack_gpu_segment(f));
         ids->insert(ids->end(), {p, f.chain, f.segment, 0u});
-        const BoundingPyramid pyramid = bounding_pyramid(f.shape);
+        // A relief-mapped segment is drawn in the pyramid of its shell (frusta.vert.glsl).
+        const float relief_depth_m = bark_maps.plants.empty() ? 0.0f : bark_maps.plants[p].relief_depth_m;
+        const BoundingPyramid pyramid =
+            bounding_pyramid(relief_depth_m > 0 && f.kind == FrustumKind::segment
+                                 ? relief_shell(f.shape, relief_depth_m, options.geometry.relief_options.max_depth_per_radius)
+                                 : f.shape);
         glm::dvec3 centre(0);
         for (const glm::dvec3& v : pyramid.vertices) centre += v / 8.0;
         double radius = 0;
@@ -180,6 +304,15 @@ struct GlRenderer::State {
         spheres.push_back({centre, radius * 1.001 + 1e-3 * (f.shape.length + std::max(f.shape.radius0, f.shape.radius1))});
       }
     }
+  }
+
+  ShaderProgramSource frusta_variant(FrustaPass pass) const { return frusta_program(pass, features); }
+
+  // Binds what bark.glsl reads: the plant maps, the height texels, the images at units 0..
+  void bind_bark_maps() const {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, maps_buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, height_texel_buffer);
+    for (size_t i = 0; i < bark_maps.textures.size(); ++i) glBindTextureUnit(static_cast<GLuint>(i), bark_maps.textures[i]);
   }
 
   // The program of a variant, built on first use (compile time goes to *compile_s).
@@ -196,11 +329,11 @@ struct GlRenderer::State {
   void release_targets() {
     glDeleteFramebuffers(1, &gbuffer_fbo);
     glDeleteFramebuffers(1, &accum_fbo);
-    glDeleteTextures(3, gbuffer);
+    glDeleteTextures(4, gbuffer);
     glDeleteTextures(1, &accum);
     glDeleteRenderbuffers(1, &depth_buffer);
     gbuffer_fbo = accum_fbo = accum = depth_buffer = 0;
-    gbuffer[0] = gbuffer[1] = gbuffer[2] = 0;
+    gbuffer[0] = gbuffer[1] = gbuffer[2] = gbuffer[3] = 0;
     width = height = 0;
   }
 
@@ -230,9 +363,9 @@ struct GlRenderer::State {
     if (w > static_cast<uint32_t>(max_size) || h > static_cast<uint32_t>(max_size))
       throw GlError("image " + std::to_string(w) + "x" + std::to_string(h) + " exceeds the driver's largest target (" +
                     std::to_string(max_size) + " pixels a side)");
-    const GLenum formats[3] = {GL_RGBA32F, GL_RGBA32F, GL_RGBA32UI};
-    glCreateTextures(GL_TEXTURE_2D, 3, gbuffer);
-    for (int i = 0; i < 3; ++i) {
+    const GLenum formats[4] = {GL_RGBA32F, GL_RGBA32F, GL_RGBA32UI, GL_RGBA16F};
+    glCreateTextures(GL_TEXTURE_2D, 4, gbuffer);
+    for (int i = 0; i < 4; ++i) {
       glTextureStorage2D(gbuffer[i], 1, formats[i], w, h);
       // texelFetch only, but an integer texture with a filtering mode is incomplete.
       glTextureParameteri(gbuffer[i], GL_TEXTURE_MIN_FILTER, GL_NEAREST);
@@ -241,10 +374,11 @@ struct GlRenderer::State {
     glCreateRenderbuffers(1, &depth_buffer);
     glNamedRenderbufferStorage(depth_buffer, GL_DEPTH_COMPONENT32F, w, h);
     glCreateFramebuffers(1, &gbuffer_fbo);
-    for (int i = 0; i < 3; ++i) glNamedFramebufferTexture(gbuffer_fbo, GL_COLOR_ATTACHMENT0 + i, gbuffer[i], 0);
+    for (int i = 0; i < 4; ++i) glNamedFramebufferTexture(gbuffer_fbo, GL_COLOR_ATTACHMENT0 + i, gbuffer[i], 0);
     glNamedFramebufferRenderbuffer(gbuffer_fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_buffer);
-    const GLenum draw_buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
-    glNamedFramebufferDrawBuffers(gbuffer_fbo, 3, draw_buffers);
+    const GLenum draw_buffers[4] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                                    GL_COLOR_ATTACHMENT3};
+    glNamedFramebufferDrawBuffers(gbuffer_fbo, 4, draw_buffers);
     check_framebuffer(gbuffer_fbo, "G-buffer");
     glCreateTextures(GL_TEXTURE_2D, 1, &accum);
     glTextureStorage2D(accum, 1, GL_RGBA32F, w, h);
@@ -318,13 +452,33 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options) : state
   if (scene.plants.size() >= kMaxPlants) throw GlError("the GL backend draws at most 2^24 plants");
   st.plant_count = scene.plants.size();
 
+  // Bark images first: the relief's shells set the pyramids' bounding spheres.
   Clock::time_point start = Clock::now();
+  st.bark_maps.load(scene, options);
+  st.features.want_uv = st.want_uv;
+  st.features.relief = st.bark_maps.relief;
+  st.features.bark = st.bark_maps.albedo;
+  st.features.texture_units = static_cast<int>(st.bark_maps.textures.size());
+  if (!st.bark_maps.textures.empty())
+    st.setup_passes.push_back({"textures", seconds_since(start),
+                               std::to_string(st.bark_maps.textures.size()) + " images, " +
+                                   std::to_string(st.bark_maps.texture_bytes / 1024) + " KiB with MIP chains"});
+
+  start = Clock::now();
   std::vector<GpuSegment> records;
   std::vector<uint32_t> ids;  // plant, chain, segment, 0 per frustum
-  st.skin_plants(scene, &records, &ids);
-  st.frusta = records.size();
-  st.setup_passes.push_back({"skin", seconds_since(start),
-                             std::to_string(scene.plants.size()) + " plants, " + std::to_string(st.frusta) + " frusta"});
+  if (options.geometry.kind == GeometryKind::mesh) {
+    // The polygon baseline (gl_mesh.h): its own skin, tessellate, displace, upload, programs.
+    st.mesh = std::make_unique<GlMesh>(scene, options, st.bark_maps.albedo ? st.features.texture_units : 0);
+    for (const GlMeshSphere& s : st.mesh->bounding_spheres()) st.spheres.push_back({s.centre, s.radius});
+    st.frusta = st.mesh->frusta();
+    st.setup_passes = st.mesh->setup_passes();
+  } else {
+    st.skin_plants(scene, &records, &ids);
+    st.frusta = records.size();
+    st.setup_passes.push_back({"skin", seconds_since(start),
+                               std::to_string(scene.plants.size()) + " plants, " + std::to_string(st.frusta) + " frusta"});
+  }
 
   start = Clock::now();
   glCreateVertexArrays(1, &st.vao);
@@ -340,19 +494,27 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options) : state
       bark.insert(bark.end(), {0.0f, 0.0f, 0.0f, 0.0f});
   }
   st.bark_buffer = make_buffer(bark.data(), bark.size() * sizeof(float));
+  st.maps_buffer = make_buffer(st.bark_maps.plants.data(), st.bark_maps.plants.size() * sizeof(PlantMapsRecord));
+  st.height_texel_buffer =
+      make_buffer(st.bark_maps.height_texels.data(), st.bark_maps.height_texels.size() * sizeof(float));
   glCreateBuffers(1, &st.list_buffer);
   check_gl("upload");
-  st.uploaded_bytes = records.size() * sizeof(GpuSegment) + ids.size() * sizeof(uint32_t);
-  st.setup_passes.push_back({"upload", seconds_since(start),
-                             std::to_string(st.uploaded_bytes / 1024) + " KiB: " + std::to_string(st.frusta) +
-                                 " GpuSegment records (64 B) + ids (16 B)"});
+  if (st.mesh) {
+    st.uploaded_bytes = st.mesh->gpu_bytes();  // its "upload" pass is in already
+  } else {
+    st.uploaded_bytes = records.size() * sizeof(GpuSegment) + ids.size() * sizeof(uint32_t);
+    st.setup_passes.push_back({"upload", seconds_since(start),
+                               std::to_string(st.uploaded_bytes / 1024) + " KiB: " + std::to_string(st.frusta) +
+                                   " GpuSegment records (64 B) + ids (16 B)"});
+  }
 
   // What every frame needs; EYE_INSIDE is built when a frame needs it.
   double compile_s = 0;
   const bool sun_on = scene.sun.radiance.x > 0 || scene.sun.radiance.y > 0 || scene.sun.radiance.z > 0;
   std::string names;
-  std::vector<ShaderProgramSource> needed = {frusta_program(FrustaPass::gbuffer, st.want_uv), shade_program(sun_on)};
-  if (sun_on) needed.push_back(frusta_program(FrustaPass::shadow, false));
+  std::vector<ShaderProgramSource> needed = {st.frusta_variant(FrustaPass::gbuffer), shade_program(sun_on)};
+  if (sun_on) needed.push_back(st.frusta_variant(FrustaPass::shadow));
+  if (st.mesh) needed = {shade_program(sun_on)};  // the mesh built its own
   for (const ShaderProgramSource& source : needed) {
     st.program(source, &compile_s);
     names += (names.empty() ? "" : ", ") + source.name;
@@ -364,6 +526,8 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options) : state
 
 GlRenderer::~GlRenderer() = default;
 
+void GlRenderer::set_conservative_depth(bool on) { state_->features.conservative_depth = on; }
+
 uint64_t GlRenderer::frusta() const { return state_->frusta; }
 uint64_t GlRenderer::uploaded_bytes() const { return state_->uploaded_bytes; }
 const std::vector<RenderPass>& GlRenderer::setup_passes() const { return state_->setup_passes; }
@@ -373,6 +537,14 @@ uint64_t GlRenderer::update_plants(const Scene& scene) {
   if (scene.plants.size() != st.plant_count)
     throw std::invalid_argument("GlRenderer::update_plants: the scene has " + std::to_string(scene.plants.size()) +
                                 " plants, the renderer " + std::to_string(st.plant_count));
+  if (st.mesh) {  // the polygon baseline is re-tessellated and uploaded whole
+    const uint64_t uploaded = st.mesh->update(scene);
+    st.spheres.clear();
+    for (const GlMeshSphere& s : st.mesh->bounding_spheres()) st.spheres.push_back({s.centre, s.radius});
+    st.frusta = st.mesh->frusta();
+    st.uploaded_bytes = st.mesh->gpu_bytes();
+    return uploaded;
+  }
   std::vector<GpuSegment> records;
   std::vector<uint32_t> ids;
   st.skin_plants(scene, &records, &ids);
@@ -420,17 +592,18 @@ RenderResult GlRenderer::render(const Scene& scene) {
   // Frusta whose pyramid may reach within the near plane of the eye: drawn again from
   // their back faces (EYE_INSIDE), since their front faces are clipped or behind the eye.
   std::vector<uint32_t> eye_inside;
-  for (uint32_t i = 0; i < st.spheres.size(); ++i)
+  for (uint32_t i = 0; !st.mesh && i < st.spheres.size(); ++i)
     if (glm::length(st.spheres[i].centre - camera.eye) < st.spheres[i].radius + 4 * near) eye_inside.push_back(i);
   if (!eye_inside.empty())
     glNamedBufferData(st.list_buffer, static_cast<GLsizeiptr>(eye_inside.size() * sizeof(uint32_t)), eye_inside.data(),
                       GL_STREAM_DRAW);
 
   double compile_s = 0;
-  const GLuint gbuffer_program = st.program(frusta_program(FrustaPass::gbuffer, st.want_uv), &compile_s);
+  const GLuint gbuffer_program = st.mesh ? 0 : st.program(st.frusta_variant(FrustaPass::gbuffer), &compile_s);
   const GLuint inside_program =
-      eye_inside.empty() ? 0 : st.program(frusta_program(FrustaPass::gbuffer_eye_inside, st.want_uv), &compile_s);
-  const GLuint shadow_program = sun_on ? st.program(frusta_program(FrustaPass::shadow, false), &compile_s) : 0;
+      eye_inside.empty() ? 0 : st.program(st.frusta_variant(FrustaPass::gbuffer_eye_inside), &compile_s);
+  const GLuint shadow_program =
+      sun_on && !st.mesh ? st.program(st.frusta_variant(FrustaPass::shadow), &compile_s) : 0;
   const GLuint shade = st.program(shade_program(sun_on), &compile_s);
 
   // Uniforms that stay for the frame.
@@ -444,8 +617,26 @@ RenderResult GlRenderer::render(const Scene& scene) {
     set_uniform(p, "u_half_size", camera.half_width, camera.half_height);
     set_uniform(p, "u_image_size", w, h);
     set_uniform(p, "u_near", near);
-    set_uniform(p, "u_twist_rad_per_m", options.skin.twist_rad_per_m);
   }
+  // Ray differentials (texture.h): the next sample to the right / below, one pixel /
+  // sqrt(spp) away, as render_cpu.cpp's direction_dx_, direction_dy_.
+  const double differential_step = 1 / std::sqrt(static_cast<double>(spp));
+  const glm::dvec3 ray_dx = (differential_step * 2 * camera.half_width / w) * camera.right;
+  const glm::dvec3 ray_dy = (-differential_step * 2 * camera.half_height / h) * camera.up;
+  const ReliefOptions& relief = options.geometry.relief_options;
+  for (GLuint p : {gbuffer_program, inside_program, shadow_program}) {
+    if (!p) continue;
+    set_uniform(p, "u_twist_rad_per_m", options.skin.twist_rad_per_m);
+    set_uniform(p, "u_ray_dx", ray_dx);
+    set_uniform(p, "u_ray_dy", ray_dy);
+    set_uniform_int(p, "u_relief_linear_steps", std::max(1, relief.linear_steps));
+    set_uniform_int(p, "u_relief_bisection_steps", std::max(0, relief.bisection_steps));
+    set_uniform_int(p, "u_relief_exact_v", relief.exact_v ? 1 : 0);
+    set_uniform(p, "u_relief_max_depth_per_radius", relief.max_depth_per_radius);
+    // render_cpu.cpp's pixel_spread_rad: the angle between neighbouring samples' rays.
+    set_uniform(p, "u_relief_pixel_spread_rad", glm::length(ray_dy));
+  }
+  set_uniform(shade, "u_pixel_step_rad", glm::length(ray_dy));
   set_uniform(shade, "u_eye_above_ground", camera.eye.y - scene.ground.height);
   set_uniform(shade, "u_sky", scene.sky);
   set_uniform(shade, "u_ground_albedo", scene.ground.albedo);
@@ -477,6 +668,7 @@ RenderResult GlRenderer::render(const Scene& scene) {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, st.id_buffer);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, st.list_buffer);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, st.bark_buffer);
+  st.bind_bark_maps();
   glDisable(GL_BLEND);
   glDisable(GL_SCISSOR_TEST);
   glDisable(GL_STENCIL_TEST);
@@ -496,6 +688,11 @@ RenderResult GlRenderer::render(const Scene& scene) {
     glDepthFunc(GL_LESS);
     glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);
+    if (st.mesh) {
+      st.mesh->draw_shadow({f.centre, f.e0, f.e1, f.direction, f.x_min, f.y_min, f.side, f.s_near, f.s_range});
+      PassTimer::end();
+      return;
+    }
     const SplitVec3 c = split(f.centre);
     set_uniform(shadow_program, "u_light_hi", c.hi);
     set_uniform(shadow_program, "u_light_lo", c.lo);
@@ -518,11 +715,19 @@ RenderResult GlRenderer::render(const Scene& scene) {
     glClearNamedFramebufferfv(st.gbuffer_fbo, GL_COLOR, 0, miss);
     glClearNamedFramebufferfv(st.gbuffer_fbo, GL_COLOR, 1, zero);
     glClearNamedFramebufferuiv(st.gbuffer_fbo, GL_COLOR, 2, zero_ids);
+    glClearNamedFramebufferfv(st.gbuffer_fbo, GL_COLOR, 3, zero);
     glClearNamedFramebufferfv(st.gbuffer_fbo, GL_DEPTH, 0, &far_depth);
+    st.bind_bark_maps();  // the shade pass took units 0..4
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);
+    if (st.mesh) {
+      st.mesh->draw_gbuffer({camera.eye, camera.right, camera.up, camera.forward, camera.half_width, camera.half_height,
+                             w, h, near, jitter_x, jitter_y, differential_step});
+      PassTimer::end();
+      return;
+    }
     set_uniform(gbuffer_program, "u_jitter", jitter_x, jitter_y);
     glUseProgram(gbuffer_program);
     if (vertices > 0) glDrawArrays(GL_TRIANGLES, 0, vertices);
@@ -576,6 +781,7 @@ RenderResult GlRenderer::render(const Scene& scene) {
     glBindTextureUnit(0, st.gbuffer[0]);
     glBindTextureUnit(1, st.gbuffer[1]);
     glBindTextureUnit(2, st.gbuffer[2]);
+    glBindTextureUnit(4, st.gbuffer[3]);
     set_uniform(shade, "u_jitter", jitter_x, jitter_y);
     if (sun_on) {
       glBindTextureUnit(3, st.shadow_map);
@@ -658,11 +864,17 @@ RenderResult GlRenderer::render(const Scene& scene) {
     result.passes.push_back({"shadow map (GPU)", shadow_s,
                              std::to_string(shadow_texels) + "x" + std::to_string(shadow_texels) + ", " +
                                  std::to_string(sun_per_pass ? spp : 1) + " pass(es), " +
-                                 frusta_program(FrustaPass::shadow, false).name});
-  result.passes.push_back({"frusta (GPU)", frusta_s,
-                           std::to_string(st.frusta) + " frusta, " + std::to_string(spp + (options.aovs && spp > 1)) +
-                               " pass(es), " + frusta_program(FrustaPass::gbuffer, st.want_uv).name +
-                               (eye_inside.empty() ? "" : ", " + std::to_string(eye_inside.size()) + " around the eye")});
+                                 (st.mesh ? mesh_program(MeshPass::shadow) : st.frusta_variant(FrustaPass::shadow)).name});
+  if (st.mesh)
+    result.passes.push_back({"mesh (GPU)", frusta_s,
+                             std::to_string(st.mesh->triangles()) + " triangles (" + st.mesh->label() + "), " +
+                                 std::to_string(spp + (options.aovs && spp > 1)) + " pass(es), " +
+                                 st.mesh->gbuffer_variant()});
+  else
+    result.passes.push_back({"frusta (GPU)", frusta_s,
+                             std::to_string(st.frusta) + " frusta, " + std::to_string(spp + (options.aovs && spp > 1)) +
+                                 " pass(es), " + st.frusta_variant(FrustaPass::gbuffer).name +
+                                 (eye_inside.empty() ? "" : ", " + std::to_string(eye_inside.size()) + " around the eye")});
   result.passes.push_back({"shade (GPU)", shade_s, std::to_string(spp) + " pass(es), " + shade_program(sun_on).name});
   result.passes.push_back({"readback", readback_s, std::to_string(w) + "x" + std::to_string(h)});
   result.passes.push_back({"frame (wall)", seconds_since(frame_start), ""});

@@ -12,20 +12,30 @@
 // The clamp keeps that promise where float rounds a cap hit (which lies on an end face)
 // the wrong way. EYE_INSIDE draws back faces (a pyramid around the eye has no front face
 // in view), whose depth bounds the hit from the other side: no layout there.
+// NO_CONSERVATIVE_DEPTH leaves the layouts out (the same clamp, the same depth): what
+// early depth testing is worth can be timed (GlRenderer::set_conservative_depth).
+//
+// RELIEF: frusta of a plant with a relief (bark.glsl's plant_maps[].relief_depth_m > 0)
+// are intersected by relief.glsl's intersect_relief_f inside their shell (the pyramid
+// bounds the shell, frusta.vert.glsl); knuckles keep their exact surface, as on the CPU.
+// BARK: the albedo texture is looked up here, where the hit is known (bark.glsl), over
+// the footprint of the ray differentials, into g_albedo (a = 1); a = 0 leaves the albedo
+// to shade.frag.glsl (material table, bark colour).
 
 flat in FrustumShapeF v_shape;
 flat in uvec4 v_segment_info;
 flat in vec3 v_frame_origin;
 
 #ifdef GBUFFER_PASS
-#ifndef EYE_INSIDE
+#if !defined(EYE_INSIDE) && !defined(NO_CONSERVATIVE_DEPTH)
 layout(depth_less) out float gl_FragDepth;
 #endif
 layout(location = 0) out vec4 g_normal_distance;  // shading normal (toward the eye), distance
 layout(location = 1) out vec4 g_geometric_u;      // geometric normal (toward the eye), u
 layout(location = 2) out uvec4 g_ids;             // plant | material << 24, chain, segment, v_m bits
+layout(location = 3) out vec4 g_albedo;           // linear albedo, a = 1 where decided here
 #endif
-#ifdef SHADOW_PASS
+#if defined(SHADOW_PASS) && !defined(NO_CONSERVATIVE_DEPTH)
 layout(depth_greater) out float gl_FragDepth;
 #endif
 
@@ -43,7 +53,27 @@ void main() {
   ray.origin = v_frame_origin;
   ray.direction = camera_ray_direction(pixel);
 #endif
+  uint plant = segment_ids[v_segment_info.x].x;
+#ifdef RELIEF
+  ReliefMapF map = ReliefMapF(plant_maps[plant], plant_maps[plant].relief_depth_m);
+  bool relief = map.depth_m > 0.0 && !fr.knuckle;
+#ifdef SHADOW_PASS
+  const bool describe = false;
+#else
+  const bool describe = true;
+#endif
+  ReliefHitF relief_hit = ReliefHitF(FrustumHitF(kHitNone, 0.0, vec3(0.0), 0.0, vec3(0.0)), 0.0, 0.0, vec3(0.0), false);
+  FrustumHitF hit;
+  if (relief) {
+    relief_hit = intersect_relief_f(ray, fr, map, 0.0, kInfinity, describe);
+    hit = relief_hit.hit;
+  } else {
+    hit = intersect_frustum_f(ray, fr.shape, 0.0, kInfinity);
+  }
+#else
+  const bool relief = false;
   FrustumHitF hit = intersect_frustum_f(ray, fr.shape, 0.0, kInfinity);
+#endif
   if (hit.kind == kHitNone) discard;
 
 #ifdef SHADOW_PASS
@@ -58,17 +88,42 @@ void main() {
   vec3 view = -ray.direction;
   vec3 n_geometric = hit.normal;
   vec3 n_shading = hit.kind == kHitSide ? surface_normal(fr, hit.y, hit.radial) : hit.normal;
-  if (dot(n_geometric, view) < 0.0) n_geometric = -n_geometric;  // seen from inside
-  if (dot(n_shading, view) < 0.0) n_shading = -n_shading;
   float u = 0.0, v_m = 0.0;
-#ifdef WANT_UV
+#if defined(WANT_UV) || defined(BARK)
   SurfaceUV uv = surface_uv(fr, hit.y, hit.radial, u_twist_rad_per_m);
   u = uv.u;
   v_m = uv.v_m;
 #endif
+#ifdef RELIEF
+  if (relief) {
+    n_shading = relief_hit.shading_normal;
+    u = relief_hit.u;
+    v_m = relief_hit.v_m;
+  }
+#endif
+  vec4 albedo = vec4(0.0);
+#ifdef BARK
+  // describe_frustum_hit's / describe_relief_hit's tangents (frustum_tracer.cpp): around,
+  // a full turn is the circumference at the hit's distance from the axis (the frustum's
+  // radius, the relief's own); along, a metre of arc length is a metre of generator.
+  vec3 position = hit.t * ray.direction;  // relative to the eye
+  float around_m = fr.shape.radius0 + fr.shape.slope * hit.y;
+  if (relief) {
+    vec3 from_base = (ray.origin - fr.shape.base) + position;
+    around_m = length(from_base - dot(from_base, fr.shape.axis) * fr.shape.axis);
+  }
+  vec3 dp_du = (2.0 * kPi * max(around_m, 0.0)) * cross(fr.shape.axis, hit.radial);
+  vec3 dp_dv = normalize(fr.shape.axis + fr.shape.slope * hit.radial);
+  UvFootprint footprint = uv_footprint(position, hit.normal, dp_du, dp_dv, vec3(0.0), ray.direction + u_ray_dx,
+                                       ray.direction + u_ray_dy);
+  albedo = bark_albedo(plant, u, v_m, footprint);
+#endif
+  if (dot(n_geometric, view) < 0.0) n_geometric = -n_geometric;  // seen from inside
+  if (dot(n_shading, view) < 0.0) n_shading = -n_shading;
   uvec4 ids = segment_ids[v_segment_info.x];
   g_normal_distance = vec4(n_shading, hit.t * length(ray.direction));
   g_geometric_u = vec4(n_geometric, u);
   g_ids = uvec4(ids.x | (fr.material << 24), ids.y, ids.z, floatBitsToUint(v_m));
+  g_albedo = albedo;
 #endif
 }

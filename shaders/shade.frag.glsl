@@ -6,15 +6,21 @@
 // (SHADOW_PASS), orthographic along the sun direction of this pass: the CPU's shadow ray
 // toward the same direction, resolved to the map's texels (bilinear 2x2 comparison). The
 // receiver is moved along its geometric normal by u_normal_offset_m (a couple of texels)
-// before the lookup, so a lit surface never shadows itself.
+// before the lookup, so a lit surface never shadows itself; a relief-mapped plant's by at
+// least one pixel footprint, as the CPU starts its shadow rays (render_cpu.h).
+//
+// Albedo: g_albedo where the geometry pass decided it (a = 1: a bark texture, already
+// linear), else the material table, material 0 replaced by the plant's bark colour.
 
 layout(binding = 0) uniform sampler2D g_normal_distance;
 layout(binding = 1) uniform sampler2D g_geometric_u;
 layout(binding = 2) uniform usampler2D g_ids;
+layout(binding = 4) uniform sampler2D g_albedo;
 #ifdef SUN
 layout(binding = 3) uniform sampler2DShadow shadow_map;
 #endif
 
+// plant_maps (bark.glsl, the file before this one): which plants are relief-mapped.
 // Per plant: bark albedo (rgb) and w = 1 where it replaces material 0 (Bark::albedo_rgb).
 layout(std430, binding = 3) readonly buffer PlantBark { vec4 plant_bark[]; };
 
@@ -41,12 +47,15 @@ uniform vec4 u_light_rect;
 uniform vec2 u_light_depth;
 uniform float u_normal_offset_m;   // receiver offset along its geometric normal
 uniform float u_depth_bias;        // in map depth units (0..1)
+uniform float u_pixel_step_rad;    // |∂direction/∂y|: a pixel footprint per unit of t
 #endif
 
 layout(location = 0) out vec4 colour;
 
 const float kPi = 3.14159265358979323846;
+#ifndef kInfinity  // bark.glsl's, where it comes first
 #define kInfinity uintBitsToFloat(0x7F800000u)  // +inf (a const initializer cannot call it)
+#endif
 const float kSpecular = 0.04;  // k_s
 const float kShininess = 40.0;  // s
 
@@ -58,8 +67,8 @@ vec3 camera_ray_direction(vec2 pixel) {
 
 #ifdef SUN
 // Sun visibility of a point p (relative to the map's centre) with geometric normal n_geometric.
-float sun_visibility(vec3 p, vec3 n_geometric) {
-  vec3 q = p + u_normal_offset_m * n_geometric;
+float sun_visibility(vec3 p, vec3 n_geometric, float offset_m) {
+  vec3 q = p + max(u_normal_offset_m, offset_m) * n_geometric;
   vec2 uv = (vec2(dot(q, u_light_e0), dot(q, u_light_e1)) - u_light_rect.xy) / u_light_rect.zw;
   if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;  // no caster there
   // Beyond the farthest caster the reference is clamped to the empty map's 1: still lit
@@ -69,13 +78,13 @@ float sun_visibility(vec3 p, vec3 n_geometric) {
 }
 #endif
 
-vec3 lit(vec3 albedo, vec3 n, vec3 n_geometric, vec3 p_rel_eye, vec3 view, bool specular) {
+vec3 lit(vec3 albedo, vec3 n, vec3 n_geometric, vec3 p_rel_eye, vec3 view, bool specular, float shadow_offset_m) {
   vec3 result = albedo * u_sky * (0.5 * (1.0 + n.y));
 #ifdef SUN
   vec3 l = u_sun_dir;
   float n_dot_l = dot(n, l);
   if (n_dot_l <= 0.0 || dot(n_geometric, l) <= 0.0) return result;
-  float visibility = sun_visibility(u_eye_rel_light + p_rel_eye, n_geometric);
+  float visibility = sun_visibility(u_eye_rel_light + p_rel_eye, n_geometric, shadow_offset_m);
   if (visibility == 0.0) return result;
   vec3 brdf = albedo / kPi;
   if (specular) {
@@ -105,6 +114,7 @@ void main() {
   vec3 albedo, n, n_geometric;
   float t;
   bool specular;
+  float shadow_offset_m = 0.0;
   if (ground_t < plant_t) {
     albedo = u_ground_albedo;
     n = n_geometric = vec3(0.0, 1.0, 0.0);
@@ -115,13 +125,17 @@ void main() {
     uvec4 ids = texelFetch(g_ids, texel, 0);
     uint plant = ids.x & 0xFFFFFFu;
     uint material = ids.x >> 24;
-    albedo = material == 0u && plant_bark[plant].w > 0.0
-                 ? plant_bark[plant].rgb
-                 : u_material_albedo[min(int(material), u_material_count - 1)];
+    vec4 decided = texelFetch(g_albedo, texel, 0);
+    albedo = decided.a > 0.0                               ? decided.rgb
+             : material == 0u && plant_bark[plant].w > 0.0 ? plant_bark[plant].rgb
+                                                           : u_material_albedo[min(int(material), u_material_count - 1)];
     n = normal_distance.xyz;
     n_geometric = geometric_u.xyz;
     t = plant_t;
     specular = true;
+#ifdef SUN
+    if (plant_maps[plant].relief_depth_m > 0.0) shadow_offset_m = t * u_pixel_step_rad;
+#endif
   }
-  colour = vec4(lit(albedo, n, n_geometric, t * dir, view, specular), 1.0);
+  colour = vec4(lit(albedo, n, n_geometric, t * dir, view, specular, shadow_offset_m), 1.0);
 }

@@ -25,6 +25,13 @@ Scene scene_around(const Skeleton& skeleton, uint32_t width, uint32_t height) {
   return scene;
 }
 
+Skeleton chain_of(std::vector<Joint> joints) {
+  Skeleton sk;
+  sk.joints = std::move(joints);
+  sk.chains = {{0, static_cast<uint32_t>(sk.joints.size()), std::nullopt}};
+  return sk;
+}
+
 Skeleton grow_preset(const std::string& name) {
   Scene scene;
   ScenePlant plant;

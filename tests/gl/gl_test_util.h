@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "core/gl_context.h"
 #include "core/render_cpu.h"
@@ -27,6 +28,9 @@ GlContext* shared_context(std::string* why);
 
 // A scene around `skeleton`: 256×192 unless given, the default scene's camera and sun.
 Scene scene_around(const Skeleton& skeleton, uint32_t width = 256, uint32_t height = 192);
+
+// One root chain through `joints`.
+Skeleton chain_of(std::vector<Joint> joints);
 
 // The skeleton a preset grows with its own seed and steps.
 Skeleton grow_preset(const std::string& name);

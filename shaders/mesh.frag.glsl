@@ -1,0 +1,66 @@
+// mesh.frag.glsl — the polygon baseline's fragment (paper 000 sec. 4, GS and GS+R): what
+// mesh_accel.cpp's MeshTracer::nearest reports for the ray through this fragment, written
+// into the G-buffer exactly as frusta.frag.glsl writes a ray-cast hit (shade.frag.glsl
+// reads both alike). No discard, no gl_FragDepth: the rasterised depth is the hit's.
+//
+// GBUFFER_PASS: the barycentric interpolation of the vertex normals, renormalised (the
+// shading normal), the triangle's plane normal (geometric), both turned toward the eye as
+// render_cpu.cpp's shade() does; the Euclidean distance; ids; u in [0, 1), v_m.
+// SHADOW_PASS: depth only.
+//
+// BARK_TEXTURE_UNITS (bark.glsl comes first): the bark albedo of bark.glsl's bark_albedo
+// over the footprint of texture.h's ray differentials. On a triangle (a plane with affine
+// u, v_m) the neighbouring sample's ray meets the plane where u, v_m have moved by their
+// screen derivatives, so the footprint is dFdx/dFdy of (u, v_m), one pixel / sqrt(spp)
+// (u_footprint_scale). A cap fan, whose vertices share one v_m, has no uv parametrisation:
+// the zero footprint there, as MeshTracer's zero dp_du, dp_dv give on the CPU.
+
+#ifdef GBUFFER_PASS
+in vec3 v_rel_eye;
+in vec3 v_local;
+in vec3 v_normal;
+in vec2 v_uv;
+flat in uvec4 v_ids;
+
+layout(location = 0) out vec4 g_normal_distance;  // shading normal (toward the eye), distance
+layout(location = 1) out vec4 g_geometric_u;      // geometric normal (toward the eye), u
+layout(location = 2) out uvec4 g_ids;             // plant | material << 24, chain, segment, v_m bits
+layout(location = 3) out vec4 g_albedo;           // a = 1: bark texture albedo; a = 0: the material table
+#ifdef BARK_TEXTURE_UNITS
+uniform float u_footprint_scale;  // 1 / sqrt(spp): the ray differentials' step
+#endif
+#endif
+
+void main() {
+#ifdef GBUFFER_PASS
+  // The triangle's plane: any two differences of interpolated points of it lie in it
+  // (perspective-correct interpolation keeps them on the plane, helper pixels extrapolate
+  // it). Taken in the plant's frame, whose coordinates are a plant's size, not the eye's
+  // distance: the tangents keep float precision. The sign does not matter (turned below).
+  vec3 n_geometric = cross(dFdx(v_local), dFdy(v_local));
+  float n_geometric_length = length(n_geometric);
+  float n_shading_length = length(v_normal);
+  vec3 n_shading = n_shading_length > 0.0 ? v_normal / n_shading_length : vec3(0.0);
+  if (n_geometric_length > 0.0) n_geometric /= n_geometric_length;
+  else n_geometric = n_shading;  // a triangle seen exactly edge-on: no plane to measure
+  if (!(n_shading_length > 0.0)) n_shading = n_geometric;
+  vec3 view = -v_rel_eye;
+  if (dot(n_geometric, view) < 0.0) n_geometric = -n_geometric;  // seen from inside
+  if (dot(n_shading, view) < 0.0) n_shading = -n_shading;
+  // tessellate.h gives the seam column u = 1 on the triangles before it: [0, 1) as skin.h.
+  float u = v_uv.x - floor(v_uv.x);
+  g_normal_distance = vec4(n_shading, length(v_rel_eye));
+  g_geometric_u = vec4(n_geometric, u);
+  g_ids = uvec4(v_ids.xyz, floatBitsToUint(v_uv.y));
+#ifdef BARK_TEXTURE_UNITS
+  // Derivatives first, in uniform control flow; the image rows run downward (texture.h's y).
+  vec2 duv_dx = dFdx(v_uv) * u_footprint_scale, duv_dy = -dFdy(v_uv) * u_footprint_scale;
+  bool cap = abs(duv_dx.y) + abs(duv_dy.y) <= 1e-5 * abs(v_uv.y);  // one v_m: rounding only
+  UvFootprint footprint = cap ? UvFootprint(0.0, 0.0, 0.0, 0.0)
+                              : UvFootprint(duv_dx.x, duv_dx.y, duv_dy.x, duv_dy.y);
+  g_albedo = bark_albedo(v_ids.x & 0xFFFFFFu, u, v_uv.y, footprint);
+#else
+  g_albedo = vec4(0.0);
+#endif
+#endif
+}

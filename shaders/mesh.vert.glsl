@@ -1,0 +1,48 @@
+// mesh.vert.glsl — the polygon baseline (paper 000 sec. 4, GS and GS+R): one vertex of a
+// tessellated mesh (tessellate.h) as core/gl_mesh.cpp uploads it, projected as
+// frusta.vert.glsl projects a bounding pyramid's corner (views.glsl), so both fill one
+// G-buffer alike.
+//
+// Frames: a position is stored relative to its plant's origin_hi (a float-exact point near
+// the plant); the eye (or the shadow map's centre) comes as hi + lo floats, so
+// eye − origin_hi = (eye_hi − origin_hi) + eye_lo keeps float precision at 10^6 m, as in
+// frusta_common.glsl. Every vertex of a plant shares one origin, so the vertices that
+// tessellate copies across a joint stay bit-identical here: the mesh stays watertight.
+
+layout(location = 0) in vec3 a_position;  // metres, relative to the plant's origin_hi
+layout(location = 1) in vec3 a_normal;    // unit shading normal (tessellate.h, or displace's)
+layout(location = 2) in vec2 a_uv;        // u turns, v_m metres
+layout(location = 3) in uint a_frustum;   // index into mesh_frusta
+
+// Per frustum (gl_mesh.cpp's MeshFrustumRecord): its plant's origin_hi (xyz), and
+// plant | material << 24, chain, segment (knuckle: joint) index, 0.
+struct MeshFrustum {
+  vec4 origin_hi;
+  uvec4 ids;
+};
+layout(std430, binding = 7) readonly buffer MeshFrusta { MeshFrustum mesh_frusta[]; };
+
+#ifdef GBUFFER_PASS
+out vec3 v_rel_eye;         // position − eye: the distance, and the ray it lies on
+out vec3 v_local;           // position − origin_hi: the triangle's plane (geometric normal)
+out vec3 v_normal;
+out vec2 v_uv;
+flat out uvec4 v_ids;       // plant | material << 24, chain, segment, 0
+#endif
+
+void main() {
+  MeshFrustum f = mesh_frusta[a_frustum];
+  // views.glsl's projections, as frusta.vert.glsl's: a triangle's depth is that of the
+  // ray-cast frusta for the same point, in the G-buffer and in the shadow map.
+#ifdef SHADOW_PASS
+  gl_Position = light_clip_position(a_position - ((u_light_hi - f.origin_hi.xyz) + u_light_lo));
+#else
+  vec3 p = a_position - ((u_eye_hi - f.origin_hi.xyz) + u_eye_lo);  // relative to the eye
+  gl_Position = camera_clip_position(p);
+  v_rel_eye = p;
+  v_local = a_position;
+  v_normal = a_normal;
+  v_uv = a_uv;
+  v_ids = f.ids;
+#endif
+}
