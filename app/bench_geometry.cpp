@@ -20,17 +20,15 @@
 // (on --threads threads); build: the passes before it (skin, tessellate, textures,
 // acceleration structure). Memory: what the traced geometry holds.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
-#include <limits>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "app/bench_metrics.h"
 #include "app/cli.h"
 #include "app/render_input.h"
 #include "core/file_io.h"
@@ -71,22 +69,6 @@ struct Args {
   int reference_bisection = 24;
 };
 
-uint32_t parse_count(const std::string& flag, const std::string& v, uint64_t max) {
-  auto n = parse_u64(v);
-  if (!n || *n == 0 || *n > max) throw UsageError{flag + " " + v + ": expected an integer from 1 to " + std::to_string(max)};
-  return static_cast<uint32_t>(*n);
-}
-
-std::string stem_of(const std::string& path) {
-  std::string name = path.substr(path.find_last_of('/') + 1);
-  for (const char* ext : {".scene.json", ".skel.json", ".lsys", ".glb", ".gltf"}) {
-    const std::string e = ext;
-    if (name.size() > e.size() && name.compare(name.size() - e.size(), e.size(), e) == 0)
-      return name.substr(0, name.size() - e.size());
-  }
-  return name;
-}
-
 Args parse_args(const std::vector<std::string>& args) {
   Args out;
   std::vector<std::string> rest;
@@ -110,7 +92,7 @@ Args parse_args(const std::vector<std::string>& args) {
   if (out.grammar.help) return out;
   if (!is_render_input(out.grammar.grammar))
     throw UsageError{"INPUT '" + out.grammar.grammar + "' must end in .lsys, .skel.json, .scene.json, .glb or .gltf"};
-  const std::string stem = stem_of(out.grammar.grammar);
+  const std::string stem = input_stem(out.grammar.grammar);
   if (out.csv.empty()) out.csv = stem + ".geometry.csv";
   if (out.plot.empty()) out.plot = stem + ".geometry.png";
   return out;
@@ -126,84 +108,25 @@ struct Method {
 struct Row {
   Method method;
   double build_s = 0, time_s = 0;
-  double depth_rmse = 0, depth_max = 0, mismatch = 0;
-  double colour_rmse = 0, colour_max = 0;
+  ImageErrors errors{};
   uint64_t memory = 0;
 };
 
-// Renders the scene with `geometry`; time of the trace + shade pass and the rest.
-struct Timed {
-  RenderResult result;
-  double build_s = 0, time_s = 0;
-};
-
-Timed render_with(const Scene& scene, const GeometryOptions& geometry, unsigned threads) {
-  RenderOptions options;
-  options.aovs = kAovDepth;
-  options.threads = threads;
-  options.geometry = geometry;
-  Timed t{render_cpu(scene, options)};
-  bool traced = false;
-  for (const RenderPass& p : t.result.passes) {
-    if (p.name.rfind("trace + shade", 0) == 0) t.time_s = p.seconds, traced = true;
-    else if (!traced) t.build_s += p.seconds;
-  }
-  return t;
-}
-
-void compare(const RenderImage& ref, const RenderImage& img, Row& row) {
-  double depth_sq = 0, colour_sq = 0;
-  size_t both = 0, mismatch = 0;
-  const size_t pixels = static_cast<size_t>(ref.width) * ref.height;
-  for (size_t i = 0; i < pixels; ++i) {
-    const bool a = std::isfinite(ref.depth[i]), b = std::isfinite(img.depth[i]);
-    if (a && b) {
-      const double d = static_cast<double>(img.depth[i]) - ref.depth[i];
-      depth_sq += d * d;
-      row.depth_max = std::max(row.depth_max, std::abs(d));
-      ++both;
-    } else if (a != b) {
-      ++mismatch;
-    }
-    for (int c = 0; c < 3; ++c) {
-      const double d = static_cast<double>(img.beauty[i * 4 + c]) - ref.beauty[i * 4 + c];
-      colour_sq += d * d;
-      row.colour_max = std::max(row.colour_max, std::abs(d));
-    }
-  }
-  row.depth_rmse = both ? std::sqrt(depth_sq / both) : 0;
-  row.mismatch = pixels ? static_cast<double>(mismatch) / pixels : 0;
-  row.colour_rmse = pixels ? std::sqrt(colour_sq / (3.0 * pixels)) : 0;
-}
-
 std::vector<Method> methods_for(bool relief, bool quick) {
   std::vector<Method> m;
-  GeometryOptions rc;
-  rc.kind = GeometryKind::frusta;
-  rc.relief = false;
-  m.push_back({"RC", "RC", rc});
+  m.push_back({"RC", "RC", frusta_geometry()});
   if (relief) {
     const std::vector<int> steps = quick ? std::vector<int>{8, 32} : std::vector<int>{8, 16, 32, 64};
     const std::vector<int> bisections = quick ? std::vector<int>{0, 8} : std::vector<int>{0, 4, 8};
     for (int b : bisections)
-      for (int s : steps) {
-        GeometryOptions g = rc;
-        g.relief = true;
-        g.relief_options.linear_steps = s;
-        g.relief_options.bisection_steps = b;
-        g.relief_options.exact_v = false;
-        m.push_back({"RC+R", "RC+R " + std::to_string(s) + "x" + std::to_string(b), g, s, b});
-      }
+      for (int s : steps)
+        m.push_back({"RC+R", "RC+R " + std::to_string(s) + "x" + std::to_string(b), relief_geometry(s, b), s, b});
   }
   const int max_level = quick ? 2 : 4;
   for (int displaced = 0; displaced <= (relief ? 1 : 0); ++displaced)
     for (int level = 0; level <= max_level; ++level) {
-      GeometryOptions g;
-      g.kind = GeometryKind::mesh;
-      g.mesh_level = level;
-      g.displace = displaced != 0;
       const std::string family = displaced ? "GS+R" : "GS";
-      m.push_back({family, family + " m=" + std::to_string(level), g, 0, 0, level});
+      m.push_back({family, family + " m=" + std::to_string(level), mesh_geometry(level, displaced != 0), 0, 0, level});
     }
   return m;
 }
@@ -218,7 +141,8 @@ std::string csv_text(const std::vector<Row>& rows, const std::string& input, con
   for (const Row& r : rows) {
     std::snprintf(line, sizeof line, "%s,%s,%d,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%llu\n", r.method.name.c_str(),
                   r.method.family.c_str(), r.method.steps, r.method.bisection, r.method.level, r.build_s, r.time_s,
-                  r.depth_rmse, r.depth_max, r.mismatch, r.colour_rmse, r.colour_max,
+                  r.errors.depth_rmse_m, r.errors.depth_max_m, r.errors.hit_mismatch, r.errors.colour_rmse,
+                  r.errors.colour_max,
                   static_cast<unsigned long long>(r.memory));
     out << line;
   }
@@ -228,12 +152,6 @@ std::string csv_text(const std::vector<Row>& rows, const std::string& input, con
 std::vector<PlotPanel> plot_panels(const std::vector<Row>& rows, const std::string& title) {
   // One series per family (RC+R: one per bisection count), in the methods' order.
   std::vector<PlotSeries> series;
-  auto series_for = [&](const std::string& name) -> PlotSeries& {
-    for (PlotSeries& s : series)
-      if (s.name == name) return s;
-    series.push_back({name, plot_colour(series.size()), {}, true});
-    return series.back();
-  };
   std::vector<PlotSeries> depth, colour;
   for (int panel = 0; panel < 2; ++panel) {
     series.clear();
@@ -241,7 +159,8 @@ std::vector<PlotPanel> plot_panels(const std::vector<Row>& rows, const std::stri
       std::string name = r.method.family;
       if (name == "RC+R") name += " b=" + std::to_string(r.method.bisection) + ", s=8..64";
       if (name == "GS" || name == "GS+R") name += ", m=0..4";
-      series_for(name).points.push_back({r.time_s, panel == 0 ? r.depth_rmse : r.colour_rmse});
+      series_named(series, name).points.push_back(
+          {r.time_s, panel == 0 ? r.errors.depth_rmse_m : r.errors.colour_rmse});
     }
     (panel == 0 ? depth : colour) = series;
   }
@@ -267,35 +186,26 @@ int run_bench_geometry(const std::vector<std::string>& args) {
   if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
   const Scene scene = std::move(std::get<Scene>(loaded));
   const unsigned threads = a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency());
-  bool relief = false;
-  for (const ScenePlant& p : scene.plants) relief = relief || p.bark.height_texture.has_value();
-
-  GeometryOptions reference;
-  reference.kind = GeometryKind::frusta;
-  reference.relief = relief;
-  reference.relief_options.linear_steps = a.reference_steps;
-  reference.relief_options.bisection_steps = a.reference_bisection;
-  reference.relief_options.exact_v = true;
+  const bool relief = scene_has_relief(scene);
   std::cerr << "sylva bench geometry: " << a.grammar.grammar << ", " << scene.width << "x" << scene.height << ", "
-            << threads << " threads; reference "
-            << (relief ? "RC+R " + std::to_string(a.reference_steps) + "x" + std::to_string(a.reference_bisection) +
-                             " exact v"
-                       : std::string("RC (the scene has no height map)"))
+            << threads << " threads; reference " << describe_reference(relief, a.reference_steps, a.reference_bisection)
             << "\n";
-  const Timed ref = render_with(scene, reference, threads);
+  const TimedRender ref =
+      render_cpu_timed(scene, reference_geometry(relief, a.reference_steps, a.reference_bisection), threads);
 
   std::vector<Row> rows;
   std::printf("%-16s %9s %9s %12s %12s %9s %12s %12s %10s\n", "method", "build_s", "time_s", "depth_rmse_m",
               "depth_max_m", "mismatch", "colour_rmse", "colour_max", "memory_KiB");
   for (const Method& m : methods_for(relief, a.quick)) {
     Row row{m};
-    const Timed t = render_with(scene, m.geometry, threads);
+    const TimedRender t = render_cpu_timed(scene, m.geometry, threads);
     row.build_s = t.build_s;
     row.time_s = t.time_s;
     row.memory = t.result.geometry_bytes;
-    compare(ref.result.image, t.result.image, row);
+    row.errors = compare_images(ref.result.image, t.result.image);
+    const ImageErrors& e = row.errors;
     std::printf("%-16s %9.4f %9.4f %12.4g %12.4g %9.5f %12.4g %12.4g %10.0f\n", m.name.c_str(), row.build_s,
-                row.time_s, row.depth_rmse, row.depth_max, row.mismatch, row.colour_rmse, row.colour_max,
+                row.time_s, e.depth_rmse_m, e.depth_max_m, e.hit_mismatch, e.colour_rmse, e.colour_max,
                 row.memory / 1024.0);
     std::fflush(stdout);
     rows.push_back(row);
@@ -307,7 +217,7 @@ int run_bench_geometry(const std::vector<std::string>& args) {
     std::cerr << e->format() << "\n";
     return kInputError;
   }
-  if (auto e = write_loglog_plot(plot_panels(rows, stem_of(a.grammar.grammar)), a.plot)) {
+  if (auto e = write_loglog_plot(plot_panels(rows, input_stem(a.grammar.grammar)), a.plot)) {
     std::cerr << e->format() << "\n";
     return kInputError;
   }

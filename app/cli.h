@@ -45,6 +45,8 @@ int run_bench(const std::vector<std::string>& args);
 int run_bench_raycast(const std::vector<std::string>& args);
 // `sylva bench geometry` (bench_geometry.cpp), dispatched by run_bench.
 int run_bench_geometry(const std::vector<std::string>& args);
+// `sylva bench gpu` (bench_gpu.cpp), dispatched by run_bench.
+int run_bench_gpu(const std::vector<std::string>& args);
 int run_render(const std::vector<std::string>& args);
 int run_export(const std::vector<std::string>& args);
 
