@@ -16,7 +16,7 @@ namespace sylva {
 namespace {
 
 constexpr const char* kFont = "DejaVuSans";
-constexpr int kMarginLeft = 78, kMarginRight = 200, kMarginTop = 44, kMarginBottom = 58;
+constexpr int kMarginLeft = 78, kMarginRight = 250, kMarginTop = 58, kMarginBottom = 58;
 
 using Colour = std::array<float, 3>;
 constexpr Colour kBlack{0, 0, 0}, kGrid{0.88f, 0.88f, 0.88f}, kMinorGrid{0.95f, 0.95f, 0.95f};
@@ -137,9 +137,11 @@ void draw_panel(Canvas& canvas, int x_offset, const PlotPanel& panel, const Plot
   canvas.line(left, bottom, right, bottom, 1.2, kBlack);
   canvas.line(right, top, right, bottom, 1, kBlack);
   canvas.line(left, top, right, top, 1, kBlack);
-  text.push_back({(left + right) / 2, 8, panel.title, 16, AX::Center, AY::Top});
+  // The title on the first line, the y axis's label on the second (a long title, centred
+  // over the axes, would otherwise run into it).
+  text.push_back({(left + right) / 2, 6, panel.title, 16, AX::Center, AY::Top});
   text.push_back({(left + right) / 2, o.height - 8, panel.x_label, 14, AX::Center, AY::Bottom});
-  text.push_back({x_offset + 8, top - 10, panel.y_label, 14, AX::Left, AY::Bottom});
+  text.push_back({x_offset + 8, top - 8, panel.y_label, 14, AX::Left, AY::Bottom});
 
   // Series, then the legend at the right.
   int legend_y = top + 6;

@@ -41,7 +41,7 @@ struct PlotPanel {
 };
 
 struct PlotOptions {
-  int panel_width = 640;   // pixels per panel
+  int panel_width = 720;   // pixels per panel (the legend takes 250 at the right)
   int height = 480;        // pixels
 };
 

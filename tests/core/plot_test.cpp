@@ -10,7 +10,7 @@
 namespace sylva {
 namespace {
 
-constexpr int kW = 640, kH = 480;
+constexpr int kW = 720, kH = 480;  // PlotOptions defaults
 
 // Whether some pixel within `radius` of (x, y) has colour c (within 0.02).
 bool colour_near(const std::vector<float>& img, int width, int x, int y, int radius, const std::array<float, 3>& c) {
@@ -29,7 +29,7 @@ TEST(Plot, PointsLandWhereTheirDecadesAre) {
   PlotPanel panel{"t", "x", "y", {{"a", plot_colour(0), {{1e-3, 1e-4}, {1e-2, 1e-3}, {1e-1, 1e-2}}, true}}};
   const std::vector<float> img = draw_loglog_plot({panel});
   ASSERT_EQ(img.size(), static_cast<size_t>(kW) * kH * 3);
-  const int left = 78, right = kW - 200, top = 44, bottom = kH - 58;
+  const int left = 78, right = kW - 250, top = 58, bottom = kH - 58;
   EXPECT_TRUE(colour_near(img, kW, left, bottom, 2, plot_colour(0)));
   EXPECT_TRUE(colour_near(img, kW, (left + right) / 2, (top + bottom) / 2, 2, plot_colour(0)));
   EXPECT_TRUE(colour_near(img, kW, right, top, 2, plot_colour(0)));
@@ -41,7 +41,7 @@ TEST(Plot, ZeroAndNonFinitePointsAreLeftOutNotDrawn) {
   PlotPanel panel{"t", "x", "y", {{"a", plot_colour(1), {{1e-2, 1e-2}, {1e-1, 0}, {NAN, 1}, {1, 1}}, true}}};
   const std::vector<float> img = draw_loglog_plot({panel});
   for (float v : img) ASSERT_TRUE(std::isfinite(v));
-  const int left = 78, right = kW - 200, top = 44, bottom = kH - 58;
+  const int left = 78, right = kW - 250, top = 58, bottom = kH - 58;
   EXPECT_TRUE(colour_near(img, kW, left, bottom, 2, plot_colour(1)));
   EXPECT_TRUE(colour_near(img, kW, right, top, 2, plot_colour(1)));
 }
