@@ -2,7 +2,8 @@
 # The README's first command: install dependencies (Debian 12), build sylva (release),
 # grow the bundled saguaro and elm presets (printing their summaries), and render the
 # saguaro with the OpenGL backend (a window-less EGL context: Mesa's llvmpipe on a machine
-# without a GPU, no X server) to out/saguaro.png.
+# without a GPU, no X server) to out/saguaro.png, then its scene (bark texture, relief-mapped
+# ribs) to out/saguaro_ribs.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -15,4 +16,7 @@ for plant in saguaro elm; do
 done
 build/release/app/sylva render presets/saguaro.lsys -o out/saguaro.png --width 800 --height 600 --spp 4 \
   --backend gl
-echo "skeletons and out/saguaro.png written to out/ (see docs/ for the formats and the other presets)"
+# The same plant in its scene: bark texture and relief-mapped ribs, marched in the shaders.
+build/release/app/sylva render presets/scenes/saguaro.scene.json -o out/saguaro_ribs.png --width 800 --height 600 \
+  --spp 4 --backend gl
+echo "skeletons, out/saguaro.png and out/saguaro_ribs.png written to out/ (see docs/ for the formats and the other presets)"
