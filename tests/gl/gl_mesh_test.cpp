@@ -40,22 +40,15 @@ Agreement expect_mesh_matches_cpu(const std::string& name, const Scene& scene, c
     ADD_FAILURE() << name << ": gl_unsupported refuses it: " << *why;
     return {};
   }
-  const RenderResult cpu = render_cpu(scene, options);
-  const RenderResult gl = render_gl(scene, options);
+  RenderResult gl;
+  const std::string label = "mesh_" + name + (options.geometry.displace ? "_GS+R" : "_GS") +
+                            std::to_string(options.geometry.mesh_level);
+  const Agreement a = gl_test::expect_matches_cpu(label, scene, options, &gl);
   if (!program.empty()) {
     bool drawn = false;
     for (const RenderPass& p : gl.passes) drawn |= p.name == "mesh (GPU)" && p.detail.find(program) != std::string::npos;
     EXPECT_TRUE(drawn) << name << ": no mesh pass with " << program;
   }
-  const Agreement a = gl_test::compare(gl.image, cpu.image);
-  std::printf("[ agreement ] %s %ux%u GS%s %d: %s\n", name.c_str(), scene.width, scene.height,
-              options.geometry.displace ? "(+R)" : "", options.geometry.mesh_level, a.describe().c_str());
-  ::testing::Test::RecordProperty("agreement", a.describe());
-  const bool ok = a.hit_miss >= 0.995 && a.depth_median_rel <= 1e-4 && a.beauty_mad_srgb <= 1.0 / 255 &&
-                  a.nan_pixels == 0 && a.hit_pixels > 0;
-  if (!ok)
-    ADD_FAILURE() << name << ": " << a.describe() << "\n  images: "
-                  << gl_test::write_diff_images("mesh_" + name, gl.image, cpu.image);
   return a;
 }
 

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/image_io.h"
+#include "core/render_gl.h"
 
 namespace sylva::gl_test {
 
@@ -104,6 +105,20 @@ std::string write_diff_images(const std::string& name, const RenderImage& gl, co
     if (std::isinf(gl.depth[p]) != std::isinf(cpu.depth[p])) diff[p * 4] = 1, diff[p * 4 + 1] = diff[p * 4 + 2] = 0;
   png("diff.png", diff);
   return dir.string();
+}
+
+Agreement expect_matches_cpu(const std::string& name, const Scene& scene, const RenderOptions& options,
+                             RenderResult* gl_out) {
+  const RenderResult cpu = render_cpu(scene, options);
+  RenderResult gl = render_gl(scene, options);
+  const Agreement a = compare(gl.image, cpu.image);
+  std::printf("[ agreement ] %s %ux%u: %s\n", name.c_str(), scene.width, scene.height, a.describe().c_str());
+  ::testing::Test::RecordProperty("agreement", a.describe());
+  const bool ok = a.hit_miss >= 0.995 && a.depth_median_rel <= 1e-4 && a.beauty_mad_srgb <= 1.0 / 255 &&
+                  a.nan_pixels == 0 && a.hit_pixels > 0;
+  if (!ok) ADD_FAILURE() << name << ": " << a.describe() << "\n  images: " << write_diff_images(name, gl.image, cpu.image);
+  if (gl_out) *gl_out = std::move(gl);
+  return a;
 }
 
 }  // namespace sylva::gl_test

@@ -22,21 +22,11 @@ using gl_test::Agreement;
 
 using gl_test::chain_of;
 
-// Renders `scene` on both backends and checks the tolerances.
+// Renders `scene` on both backends (depth AOV) and checks the tolerances.
 Agreement expect_matches_cpu(const std::string& name, const Scene& scene) {
   RenderOptions options;
   options.aovs = kAovDepth;
-  const RenderResult cpu = render_cpu(scene, options);
-  const RenderResult gl = render_gl(scene, options);
-  const Agreement a = gl_test::compare(gl.image, cpu.image);
-  std::printf("[ agreement ] %s %ux%u: %s\n", name.c_str(), scene.width, scene.height, a.describe().c_str());
-  ::testing::Test::RecordProperty("agreement", a.describe());
-  const bool ok = a.hit_miss >= 0.995 && a.depth_median_rel <= 1e-4 && a.beauty_mad_srgb <= 1.0 / 255 &&
-                  a.nan_pixels == 0 && a.hit_pixels > 0;
-  if (!ok)
-    ADD_FAILURE() << name << ": " << a.describe() << "\n  images: "
-                  << gl_test::write_diff_images(name, gl.image, cpu.image);
-  return a;
+  return gl_test::expect_matches_cpu(name, scene, options);
 }
 
 TEST(RenderGl, SingleSegmentMatchesTheCpu) {
