@@ -9,19 +9,13 @@
 #include <limits>
 #include <numbers>
 
-#include "core/render_cpu.h"
+#include "core/render_common.h"
+#include "core/util/math.h"
 
 namespace sylva {
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180;
-
-std::array<glm::dvec3, 8> corners(const Aabb& b) {
-  std::array<glm::dvec3, 8> c;
-  for (int k = 0; k < 8; ++k) c[k] = {k & 1 ? b.hi.x : b.lo.x, k & 2 ? b.hi.y : b.lo.y, k & 4 ? b.hi.z : b.lo.z};
-  return c;
-}
 
 bool corners_outside(const Plane& plane, const std::array<glm::dvec3, 8>& c) {
   for (const glm::dvec3& p : c)
@@ -59,7 +53,7 @@ Aabb plant_box(const Skeleton& placed, const SkinOptions& skin, double relief_m)
   const double inf = std::numeric_limits<double>::infinity();
   Aabb box{glm::dvec3(inf), glm::dvec3(-inf)};
   if (placed.joints.empty()) return Aabb{};
-  const double tilt = skin.max_tilt_deg * kDeg;
+  const double tilt = skin.max_tilt_deg * kRadPerDeg;
   const double knuckle = 1 / std::cos(std::numbers::pi / (2.0 * std::max(2, skin.knuckle_frusta)));
   // Per joint: the largest reach of a cut through it, in joint radii.
   std::vector<double> reach(placed.joints.size(), std::max(1.0, knuckle));
@@ -97,7 +91,7 @@ std::optional<Aabb> shadow_box(const Scene& scene, const Aabb& box) {
   const Sun& sun = scene.sun;
   if (!sun_is_on(sun)) return box;
   const glm::dvec3 l = glm::normalize(sun.direction);
-  const double alpha = std::max(0.0, sun.angular_radius_deg) * kDeg;
+  const double alpha = std::max(0.0, sun.angular_radius_deg) * kRadPerDeg;
   const double elevation = std::asin(std::clamp(l.y, -1.0, 1.0));
   if (elevation - alpha <= 0) return std::nullopt;  // the disc touches the horizon
   const double y_min = std::sin(elevation - alpha), y_max = std::sin(std::min(elevation + alpha, std::numbers::pi / 2));
@@ -132,7 +126,7 @@ bool plant_is_culled(const Scene& scene, const ViewFrustum& view, const Aabb& bo
   if (shadow) return outside_view(view, *shadow);
   // Shadows without end: the infinite sweep along −l' for every l' of the disc.
   const glm::dvec3 l = glm::normalize(scene.sun.direction);
-  const double sin_alpha = std::sin(std::max(0.0, scene.sun.angular_radius_deg) * kDeg);
+  const double sin_alpha = std::sin(std::max(0.0, scene.sun.angular_radius_deg) * kRadPerDeg);
   const auto c = corners(box);
   for (const Plane& plane : view.planes)
     if (corners_outside(plane, c) && glm::dot(plane.normal, -l) <= -sin_alpha) return true;

@@ -32,7 +32,7 @@
 
 #include <optional>
 
-#include "core/bvh.h"
+#include "core/util/bounds.h"
 #include "core/scene.h"
 #include "core/skin.h"
 

@@ -31,8 +31,8 @@
 
 #include <glm/geometric.hpp>
 
-#include "core/file_io.h"
-#include "core/json.h"
+#include "core/util/file_io.h"
+#include "core/util/json.h"
 #include "core/materials.h"
 #include "core/normal_map.h"
 #include "core/skin.h"

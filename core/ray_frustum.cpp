@@ -32,7 +32,7 @@
 #include <initializer_list>
 #include <limits>
 
-#include "core/compensated.h"
+#include "core/recentre.h"
 
 namespace sylva {
 namespace {

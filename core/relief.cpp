@@ -15,12 +15,12 @@
 #include <limits>
 #include <numbers>
 
-#include "core/compensated.h"
+#include "core/recentre.h"
+#include "core/util/math.h"
 
 namespace sylva {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kMaxNormalFootprint = 0.5;  // texture units: beyond, the normal is the base one
 

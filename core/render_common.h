@@ -10,7 +10,9 @@
 #include <glm/geometric.hpp>
 #include <numbers>
 
-#include "core/render_cpu.h"
+#include "core/ray_frustum.h"
+#include "core/scene.h"
+#include "core/skin.h"
 #include "lsystem/random.h"
 
 namespace sylva::render_common {
@@ -49,6 +51,14 @@ inline CameraFrame camera_frame(const Scene& scene) {
   return f;
 }
 
+// The ray through continuous pixel position (x, y) of `f`'s image (y downward); the
+// direction is not unit.
+inline Ray frame_ray(const CameraFrame& f, double x, double y) {
+  const double sx = (2 * x / f.width - 1) * f.half_width;
+  const double sy = (1 - 2 * y / f.height) * f.half_height;
+  return {f.eye, f.forward + sx * f.right + sy * f.up};
+}
+
 // A unit direction on the sun's disc of angular radius acos(cos_alpha) around
 // `sun_direction` (unit; `frame` = axis_frame(sun_direction)), uniform in solid angle
 // (cos θ uniform in [cos α, 1]); two draws from `rng`.
@@ -61,3 +71,13 @@ inline glm::dvec3 sample_sun_disc(const glm::dvec3& sun_direction, double cos_al
 }
 
 }  // namespace sylva::render_common
+
+namespace sylva {
+
+// The primary ray through continuous pixel position (x, y) in [0, width] × [0, height]
+// (y downward); pixel (i, j)'s centre is (i + 0.5, j + 0.5). The direction is not unit.
+inline Ray camera_ray(const Scene& scene, double x, double y) {
+  return render_common::frame_ray(render_common::camera_frame(scene), x, y);
+}
+
+}  // namespace sylva

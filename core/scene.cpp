@@ -9,9 +9,9 @@
 #include <limits>
 #include <numbers>
 
-#include "core/file_io.h"
-#include "core/json.h"
-#include "core/texture.h"
+#include "core/util/file_io.h"
+#include "core/util/json.h"
+#include "core/util/image_io.h"
 #include "core/turtle.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
@@ -347,6 +347,22 @@ std::optional<std::string> grow_scene_plants(Scene& scene, uint64_t max_modules)
     plant.skeleton = std::move(grown->skeleton);
   }
   return std::nullopt;
+}
+
+Skeleton place_plant(const ScenePlant& plant) {
+  Skeleton sk = *plant.skeleton;
+  const double angle = plant.rotate_y_deg * std::numbers::pi / 180;
+  const double c = std::cos(angle), s = std::sin(angle);
+  for (Joint& j : sk.joints) {
+    const double x = plant.scale * j.position_m[0], y = plant.scale * j.position_m[1],
+                 z = plant.scale * j.position_m[2];
+    // R_y: x' = c x + s z, z' = −s x + c z (right-handed, counter-clockwise seen from +Y).
+    j.position_m[0] = plant.position.x + c * x + s * z;
+    j.position_m[1] = plant.position.y + y;
+    j.position_m[2] = plant.position.z - s * x + c * z;
+    j.radius_m *= plant.scale;
+  }
+  return sk;
 }
 
 }  // namespace sylva

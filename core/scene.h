@@ -17,6 +17,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/skeleton.h"
+#include "core/util/bounds.h"
 
 namespace sylva {
 
@@ -107,11 +108,12 @@ SceneReadResult parse_scene_json(std::string_view text, std::string_view file,
 // Reads and parses a scene file; paths in it are relative to its folder.
 SceneReadResult read_scene_file(const std::string& path);
 
+// The skeleton of `plant` placed in the world: p' = position + R_y(rotate_y_deg)·(scale·p),
+// radii scaled. Precondition: plant.skeleton is set.
+Skeleton place_plant(const ScenePlant& plant);
+
 // Axis-aligned bounds of a skeleton's joints grown by their radii (metres).
-struct SkeletonBounds {
-  glm::dvec3 lo{0, 0, 0};
-  glm::dvec3 hi{0, 0, 0};
-};
+using SkeletonBounds = Aabb;
 SkeletonBounds skeleton_bounds(const Skeleton& skeleton);
 
 // Camera framing a box for an image of width × height: a 3/4 view from the front right,

@@ -14,8 +14,8 @@
 #include <limits>
 #include <utility>
 
-#include "core/file_io.h"
-#include "core/json.h"
+#include "core/util/file_io.h"
+#include "core/util/json.h"
 
 namespace sylva {
 namespace {

@@ -4,6 +4,7 @@
 // in apex-free form), sec. 2.4 (eq. 8 normals), sec. 2.6 (bounding pyramid). Sharp bends,
 // which the paper leaves open, are split into capped legs plus a knuckle ball (skin.h).
 #include "core/skin.h"
+#include "core/util/math.h"
 
 #include <algorithm>
 #include <cassert>
@@ -20,7 +21,6 @@ namespace {
 using glm::dvec2;
 using glm::dvec3;
 
-constexpr double kPi = std::numbers::pi;
 
 double deg_to_rad(double deg) { return deg * kPi / 180.0; }
 

@@ -66,7 +66,7 @@ dvec3 rotate_about(const dvec3& v, const dvec3& k, double angle_rad) {
 
 }  // namespace
 
-lsys::Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g, TurtleStats* stats) {
+Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g, TurtleStats* stats) {
   using namespace lsys;
   auto t0 = std::chrono::steady_clock::now();
   const TurtleDefaults& d = g.turtle;
@@ -250,7 +250,7 @@ lsys::Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Gram
   return sk;
 }
 
-lsys::Expected<GrowResult> grow(const lsys::Grammar& g, const lsys::DeriveOptions& options,
+Expected<GrowResult> grow(const lsys::Grammar& g, const lsys::DeriveOptions& options,
                                 const std::string& grammar_path, const std::map<std::string, double>& defines) {
   auto t0 = std::chrono::steady_clock::now();
   GrowResult r;
@@ -258,7 +258,7 @@ lsys::Expected<GrowResult> grow(const lsys::Grammar& g, const lsys::DeriveOption
   if (!word) return word.error();
   r.modules = word->size();
   const lsys::Word* turtle_word = &*word;
-  lsys::Expected<lsys::Word> interpreted = lsys::Word{};
+  Expected<lsys::Word> interpreted = lsys::Word{};
   if (!g.homomorphism.empty()) {
     interpreted = lsys::interpret(g, *word, options, &r.interpret);
     if (!interpreted) return interpreted.error();

@@ -30,7 +30,7 @@ struct TurtleStats {
 
 // Interprets `word` (the interpreted word: homomorphism already applied) with the turtle
 // settings of `grammar`.
-lsys::Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& grammar,
+Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& grammar,
                                         TurtleStats* stats = nullptr);
 
 // Everything `sylva grow` does: derive, interpret, build the skeleton, record the source.
@@ -46,7 +46,7 @@ struct GrowResult {
 // Grows `grammar` (already parsed with its define overrides). `grammar_path` and
 // `defines` are recorded in skeleton.source; seed and steps come from options or the
 // grammar.
-lsys::Expected<GrowResult> grow(const lsys::Grammar& grammar, const lsys::DeriveOptions& options,
+Expected<GrowResult> grow(const lsys::Grammar& grammar, const lsys::DeriveOptions& options,
                                 const std::string& grammar_path,
                                 const std::map<std::string, double>& defines);
 

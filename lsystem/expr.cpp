@@ -1,5 +1,6 @@
 // expr.cpp — the bytecode machine for grammar expressions (see expr.h).
 #include "lsystem/expr.h"
+#include "core/util/math.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,8 +9,6 @@
 namespace sylva::lsys {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kRadPerDeg = kPi / 180.0;
 
 const FuncInfo kFuncs[] = {
     {"sin", 1, false},   {"cos", 1, false},   {"tan", 1, false},   {"asin", 1, false},

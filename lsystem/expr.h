@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "lsystem/diagnostic.h"
+#include "core/util/diagnostic.h"
 #include "lsystem/random.h"
 
 namespace sylva::lsys {

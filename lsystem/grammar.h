@@ -15,7 +15,7 @@
 #include <string_view>
 #include <vector>
 
-#include "lsystem/diagnostic.h"
+#include "core/util/diagnostic.h"
 #include "lsystem/expr.h"
 #include "lsystem/word.h"
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "app/python/sylva_python.h"
-#include "core/render_cpu.h"
+#include "core/cpu/render_cpu.h"
 #include "core/scene.h"
 
 namespace py = pybind11;

@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "app/python/sylva_python.h"
-#include "core/file_io.h"
+#include "core/util/file_io.h"
 #include "core/gltf_export.h"
 #include "core/skeleton.h"
 #include "core/turtle.h"
@@ -78,7 +78,7 @@ std::string path_string(const std::filesystem::path& path) { return path.string(
 
 }  // namespace
 
-GrammarFailure::GrammarFailure(lsys::Diagnostic d)
+GrammarFailure::GrammarFailure(sylva::Diagnostic d)
     : std::runtime_error(d.message), diagnostic(std::move(d)) {}
 
 SkeletonFailure::SkeletonFailure(SkeletonError e)
@@ -174,7 +174,7 @@ Skeleton grammar_grow(const PyGrammar& self, const py::object& steps, const py::
                       const py::object& defines_object, uint64_t max_modules) {
   const lsys::DeriveOptions options = derive_options(steps, seed, max_modules);
   const std::map<std::string, double> defines = defines_from_python(defines_object);
-  std::optional<lsys::Diagnostic> failure;
+  std::optional<sylva::Diagnostic> failure;
   std::optional<GrowResult> result;
   uint64_t still_expandable = 0;
   int max_depth = 0;
@@ -208,7 +208,7 @@ std::string grammar_derive(const PyGrammar& self, const py::object& steps, const
                            const py::object& defines_object, uint64_t max_modules) {
   const lsys::DeriveOptions options = derive_options(steps, seed, max_modules);
   const std::map<std::string, double> defines = defines_from_python(defines_object);
-  std::optional<lsys::Diagnostic> failure;
+  std::optional<sylva::Diagnostic> failure;
   std::string text;
   {
     py::gil_scoped_release release;
@@ -522,7 +522,7 @@ void bind_module(py::module_& m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const GrammarFailure& e) {
-      const lsys::Diagnostic& d = e.diagnostic;
+      const sylva::Diagnostic& d = e.diagnostic;
       // A -D name the grammar lacks has no place: the message alone reads best.
       const std::string text = d.loc.line == 0 ? d.file + ": error: " + d.message : chomp(d.format());
       set_located_error(g_grammar_error, text, d.message, d.file, d.loc.line, d.loc.column, d.source_line);

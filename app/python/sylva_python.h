@@ -15,15 +15,15 @@
 #include <string>
 
 #include "core/skeleton.h"
-#include "lsystem/diagnostic.h"
+#include "core/util/diagnostic.h"
 #include "lsystem/grammar.h"
 
 namespace sylva::python {
 
 // Thrown for a grammar problem; becomes sylva.GrammarError.
 struct GrammarFailure : std::runtime_error {
-  explicit GrammarFailure(lsys::Diagnostic d);
-  lsys::Diagnostic diagnostic;
+  explicit GrammarFailure(sylva::Diagnostic d);
+  sylva::Diagnostic diagnostic;
 };
 
 // Thrown for an invalid skeleton document; becomes sylva.SkeletonError.

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "core/render_gl.h"
+#include "core/gl/render_gl.h"
 #include "core/scene.h"
 #include "tests/app/process.h"
 

@@ -1,5 +1,6 @@
 // Tests for core/animate.h: skeletons swaying in the wind (the dancing cacti).
 #include "core/animate.h"
+#include "core/util/math.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +14,6 @@ namespace sylva {
 namespace {
 
 using glm::dvec3;
-constexpr double kPi = std::numbers::pi;
 
 Joint joint(dvec3 p, double radius, uint32_t material = 0) { return Joint{{p.x, p.y, p.z}, radius, material}; }
 dvec3 position(const Joint& j) { return {j.position_m[0], j.position_m[1], j.position_m[2]}; }

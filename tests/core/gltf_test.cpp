@@ -24,9 +24,9 @@
 #include <string>
 #include <vector>
 
-#include "core/file_io.h"
-#include "core/image_io.h"
-#include "core/json.h"
+#include "core/util/file_io.h"
+#include "core/util/image_io.h"
+#include "core/util/json.h"
 #include "core/materials.h"
 #include "core/normal_map.h"
 #include "core/skin.h"

@@ -23,6 +23,7 @@
 // With SYLVA_ACCURACY_TABLE=path set, the suite writes the worst errors per case there as
 // the markdown table of docs/accuracy.md.
 #include "core/ray_frustum.h"
+#include "core/util/math.h"
 
 #include <gtest/gtest.h>
 
@@ -57,7 +58,6 @@ constexpr double kFloatEdgeBand = 1e-5;            // × S
 constexpr double kFloatGrazingCos = 3e-3;
 constexpr double kFloatSurfaceTolerance = 1e-4;  // × S
 
-constexpr double kPi = 3.14159265358979323846;
 
 // ---- Long double reference -------------------------------------------------------------
 

@@ -2,6 +2,7 @@
 // force, the marcher against the two exact limits (H ≡ 1: the shell; H ≡ 0: the inner
 // frustum), convergence on an analytic field, silhouettes, the perturbed normal.
 #include "core/relief.h"
+#include "core/util/math.h"
 
 #include <gtest/gtest.h>
 
@@ -16,7 +17,6 @@
 namespace sylva {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 const double kShellFraction = ReliefOptions{}.max_depth_per_radius;
 
 // An analytic height field H(s, t).

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "core/file_io.h"
+#include "core/util/file_io.h"
 
 namespace sylva {
 namespace {

@@ -1,6 +1,7 @@
 // Tests for core/skin.h: skinning skeleton chains into conical frusta (paper 000, sec. 2),
 // the sharp-bend split, (u, v), normals, bounding pyramids and the GPU record.
 #include "core/skin.h"
+#include "core/util/math.h"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +16,6 @@ namespace sylva {
 namespace {
 
 using glm::dvec3;
-constexpr double kPi = std::numbers::pi;
 
 Joint joint(dvec3 p, double radius, uint32_t material = 0) {
   return Joint{{p.x, p.y, p.z}, radius, material};

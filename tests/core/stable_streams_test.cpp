@@ -47,12 +47,12 @@ C(n) : n < 4 -> F(uniform(0.2, 0.4)) +(uniform(-10, 10)) C(n+1)
 Skeleton grow_branches(const std::map<std::string, double>& overrides, const lsys::DeriveOptions& options = {}) {
   lsys::ParseOptions parse_options;
   parse_options.define_overrides = overrides;
-  lsys::Expected<lsys::Grammar> grammar = lsys::parse_grammar(kGrammar, "branches.lsys", parse_options);
+  sylva::Expected<lsys::Grammar> grammar = lsys::parse_grammar(kGrammar, "branches.lsys", parse_options);
   if (!grammar.ok()) {
     ADD_FAILURE() << grammar.error().format();
     return {};
   }
-  lsys::Expected<GrowResult> grown = grow(*grammar, options, "branches.lsys", overrides);
+  sylva::Expected<GrowResult> grown = grow(*grammar, options, "branches.lsys", overrides);
   if (!grown.ok()) {
     ADD_FAILURE() << grown.error().format();
     return {};

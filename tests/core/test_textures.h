@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "core/image_io.h"
+#include "core/util/image_io.h"
 
 namespace sylva::test {
 

@@ -25,15 +25,15 @@ using Position = std::array<double, 3>;
 constexpr double kTolerance = 1e-12;
 
 // Parses `text` as test.lsys and grows it with default options.
-lsys::Expected<GrowResult> grow_text(std::string_view text) {
-  lsys::Expected<lsys::Grammar> grammar = lsys::parse_grammar(text, "test.lsys", {});
+sylva::Expected<GrowResult> grow_text(std::string_view text) {
+  sylva::Expected<lsys::Grammar> grammar = lsys::parse_grammar(text, "test.lsys", {});
   if (!grammar.ok()) return grammar.error();
   return grow(*grammar, {}, "test.lsys", {});
 }
 
 // The skeleton `text` grows into; an empty skeleton (and a test failure) if it does not.
 Skeleton skeleton_of(std::string_view text) {
-  lsys::Expected<GrowResult> result = grow_text(text);
+  sylva::Expected<GrowResult> result = grow_text(text);
   if (!result.ok()) {
     ADD_FAILURE() << "grammar failed to grow:\n" << result.error().format();
     return {};
@@ -43,7 +43,7 @@ Skeleton skeleton_of(std::string_view text) {
 
 // The formatted error `text` fails with, or "no error".
 std::string grow_error(std::string_view text) {
-  lsys::Expected<GrowResult> result = grow_text(text);
+  sylva::Expected<GrowResult> result = grow_text(text);
   return result.ok() ? "no error" : result.error().format();
 }
 
@@ -138,7 +138,7 @@ TEST(TurtleMove, SmallfInsideABranchStartsARootChainNotAChildOfTheBranchPoint) {
 }
 
 TEST(TurtleMove, ZeroLengthFMakesNoJointAndIsCounted) {
-  lsys::Expected<GrowResult> result = grow_text("axiom: FF(0)F\n");
+  sylva::Expected<GrowResult> result = grow_text("axiom: FF(0)F\n");
   ASSERT_TRUE(result.ok()) << result.error().format();
   const Skeleton& skeleton = result->skeleton;
   ASSERT_EQ(skeleton.chains.size(), 1u);
@@ -149,7 +149,7 @@ TEST(TurtleMove, ZeroLengthFMakesNoJointAndIsCounted) {
 }
 
 TEST(TurtleMove, ZeroLengthMovesAreCountedForFAndf) {
-  lsys::Expected<GrowResult> result = grow_text("axiom: F(0)Ff(0)F(0)\n");
+  sylva::Expected<GrowResult> result = grow_text("axiom: F(0)Ff(0)F(0)\n");
   ASSERT_TRUE(result.ok()) << result.error().format();
   EXPECT_EQ(result->turtle.zero_length_moves, 3u);
   EXPECT_EQ(result->skeleton.segment_count(), 1u);
@@ -545,14 +545,14 @@ TEST(TurtleChains, ParentsComeBeforeChildrenAndSegmentsAreOnePerF) {
       "axiom: X\n"
       "X -> F-[[X]+X]+F[+FX]-X\n"
       "F -> FF\n";
-  lsys::Expected<lsys::Grammar> grammar = lsys::parse_grammar(text, "test.lsys", {});
+  sylva::Expected<lsys::Grammar> grammar = lsys::parse_grammar(text, "test.lsys", {});
   ASSERT_TRUE(grammar.ok()) << grammar.error().format();
-  lsys::Expected<lsys::Word> word = lsys::derive(*grammar);
+  sylva::Expected<lsys::Word> word = lsys::derive(*grammar);
   ASSERT_TRUE(word.ok()) << word.error().format();
   uint64_t f_count = 0;
   for (const lsys::Module& m : word->modules) f_count += m.symbol == lsys::kSymF;
 
-  lsys::Expected<GrowResult> grown = grow(*grammar, {}, "test.lsys", {});
+  sylva::Expected<GrowResult> grown = grow(*grammar, {}, "test.lsys", {});
   ASSERT_TRUE(grown.ok()) << grown.error().format();
   const Skeleton& skeleton = grown->skeleton;
   ASSERT_GT(skeleton.chains.size(), 10u);
@@ -592,7 +592,7 @@ TEST(TurtleChains, GrowRecordsTheSourceOfTheSkeleton) {
 // ---- errors ----------------------------------------------------------------------
 
 TEST(TurtleErrors, NegativeRadiusIsAnErrorNamingTheModule) {
-  lsys::Expected<GrowResult> result = grow_text("axiom: F!(-1)F\n");
+  sylva::Expected<GrowResult> result = grow_text("axiom: F!(-1)F\n");
   ASSERT_FALSE(result.ok());
   const std::string message = result.error().format();
   EXPECT_NE(message.find("test.lsys"), std::string::npos) << message;

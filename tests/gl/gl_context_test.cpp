@@ -1,9 +1,9 @@
 // gl_context_test.cpp — the headless EGL context (gl_context.h).
-#include "core/gl_context.h"
+#include "core/gl/gl_context.h"
 
 #include <gtest/gtest.h>
 
-#include "core/gl_api.h"
+#include "core/gl/gl_api.h"
 #include "tests/gl/gl_test_util.h"
 
 namespace sylva {

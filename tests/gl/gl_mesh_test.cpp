@@ -5,7 +5,7 @@
 // relative depth error <= 1e-4, mean absolute beauty difference <= 1/255 on sRGB values.
 // The shadow map is the mesh's own (a sun shines in every scene here). On a failure the
 // two images and their difference are written to the test's temporary folder.
-#include "core/gl_mesh.h"
+#include "core/gl/gl_mesh.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/render_gl.h"
+#include "core/gl/render_gl.h"
 #include "tests/gl/gl_test_util.h"
 
 namespace sylva {

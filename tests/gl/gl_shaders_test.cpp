@@ -2,15 +2,15 @@
 // glslangValidator (the Khronos reference front end; Debian glslang-tools), and through
 // the driver of the current context with an info log free of warnings. Both see exactly
 // the text assemble_shader gives the renderer.
-#include "core/gl_shaders.h"
+#include "core/gl/gl_shaders.h"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
-#include "core/gl_api.h"
-#include "core/gl_program.h"
+#include "core/gl/gl_api.h"
+#include "core/gl/gl_program.h"
 #include "tests/app/process.h"
 #include "tests/gl/gl_test_util.h"
 

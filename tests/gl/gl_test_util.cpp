@@ -8,8 +8,9 @@
 #include <memory>
 #include <sstream>
 
-#include "core/image_io.h"
-#include "core/render_gl.h"
+#include "core/util/color.h"
+#include "core/util/image_io.h"
+#include "core/gl/render_gl.h"
 
 namespace sylva::gl_test {
 

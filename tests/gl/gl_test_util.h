@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "core/gl_context.h"
-#include "core/render_cpu.h"
+#include "core/gl/gl_context.h"
+#include "core/cpu/render_cpu.h"
 #include "core/scene.h"
 
 namespace sylva::gl_test {

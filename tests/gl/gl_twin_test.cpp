@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "core/gl_api.h"
-#include "core/gl_shaders.h"
+#include "core/gl/gl_api.h"
+#include "core/gl/gl_shaders.h"
 #include "core/ray_frustum.h"
-#include "core/render_cpu.h"
+#include "core/cpu/render_cpu.h"
 #include "core/skin.h"
 #include "tests/gl/gl_test_util.h"
 

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "core/render_gl.h"
+#include "core/gl/render_gl.h"
 #include "core/skin.h"
 #include "tests/gl/gl_test_util.h"
 

@@ -3,7 +3,7 @@
 // agreement >= 99.5 % of pixels, median relative depth error <= 1e-4, mean absolute beauty
 // difference <= 1/255 on the sRGB-encoded values a PNG holds (stricter than linear). On a
 // failure the two images and their difference are written to the test's temporary folder.
-#include "core/render_gl.h"
+#include "core/gl/render_gl.h"
 
 #include <gtest/gtest.h>
 

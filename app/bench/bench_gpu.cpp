@@ -1,0 +1,515 @@
+// bench_gpu.cpp — `sylva bench gpu [INPUT...]`: error against GPU time of every way the
+// GL backend can draw the plants (issue 4 §4–5; paper 000 sec. 4, Table 1 and the
+// dancing cacti of fig. 8).
+//
+// For each input and image size, each method builds one GlRenderer (render_gl.h), renders
+// --warmup frames (shader variants are built at the first draw, drivers settle), then
+// --frames frames. A frame's GPU time is the sum of its "(GPU)" passes (GL_TIME_ELAPSED
+// queries: shadow map, frusta, shade); the table gives its median and 10th/90th
+// percentiles, fps from the median, and the frame's wall time (readback included).
+// Methods:
+//   RC          the analytic frusta, relief left out;
+//   RC-nocd     the same without the conservative depth layout (layout(depth_less) lets
+//               the GPU keep early depth tests while the shader writes gl_FragDepth):
+//               what that layout buys;
+//   RC+R s×b    relief-mapped frusta, s uniform and b bisection steps, v interpolated;
+//   GS m        the frusta tessellated at GS level m (16·4^m triangles a segment);
+//   GS+R m      the same meshes displaced by the height map;
+//   RC-anim     RC with every plant swaying (core/animate.h) at 60 frames a second of
+//               animation time: per frame the skeletons are swayed, re-skinned and their
+//               segment records uploaded again (GlRenderer::update_plants); the CPU time
+//               of the sway and of re-skin + upload and the bytes uploaded per frame are
+//               reported beside the GPU time.
+// Methods the GL backend refuses (gl_unsupported) are reported as skipped, with its reason.
+//
+// Errors (bench_metrics.h, as `sylva bench geometry`) of the last measured frame against
+// the CPU's converged reference at the same size: RC+R with --reference-steps ×
+// --reference-bisection steps and exact v (RC where no plant has a height map); RC-anim's
+// against the CPU's RC of the same (last) pose. Every render here, GL and CPU, uses the
+// sun as a point (angular radius 0): at one sample a pixel the GL backend draws a disc
+// sun's centre while the CPU draws a random point of the disc, whose noise would
+// otherwise swamp the colour errors.
+//
+// Memory: the bytes the renderer uploaded (GlRenderer::uploaded_bytes: segment records
+// and ids, or the mesh) plus its render targets (G-buffer, depth, accumulation, shadow
+// map), counted from their formats; bark textures are left out.
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "app/bench/bench_metrics.h"
+#include "app/cli/cli.h"
+#include "app/cli/render_input.h"
+#include "core/animate.h"
+#include "core/util/file_io.h"
+#include "core/gl/gl_context.h"
+#include "app/bench/plot.h"
+#include "core/render_common.h"
+#include "core/gl/render_gl.h"
+
+namespace sylva::cli {
+
+namespace {
+
+using render_common::Clock;
+using render_common::seconds_since;
+
+const char* const kFamilies[] = {"RC", "RC-nocd", "RC+R", "GS", "GS+R", "RC-anim"};
+
+void print_help() {
+  std::cout
+      << "usage: sylva bench gpu [INPUT...] [--width W --height H] [--frames N] [--warmup K]\n"
+         "                       [--methods LIST] [--csv FILE] [--plot FILE.png] [--quick]\n"
+         "                       [--reference-steps N] [--reference-bisection N]\n\n"
+         "Error against GPU time per frame of the GL backend's ways to draw INPUT (scenes,\n"
+         "grammars, skeletons or glTF exports, as for `sylva render`; a bare name is looked\n"
+         "up in presets/scenes/NAME.scene.json, then presets/NAME.lsys; default: the pine and\n"
+         "saguaro scenes): ray-cast frusta (RC; RC-nocd without the conservative depth\n"
+         "layout), relief-mapped frusta (RC+R), meshes (GS, m = 0..4), displaced meshes\n"
+         "(GS+R) and swaying skeletons re-uploaded every frame (RC-anim). GPU time is the\n"
+         "sum of the GL_TIME_ELAPSED passes; errors are against the CPU's converged\n"
+         "reference. Methods the GL backend cannot draw yet are listed as skipped.\n\n"
+         "  --width W, --height H   one image size (default: 1024x768 and 1920x1080)\n"
+         "  --frames N              measured frames per method (default 100)\n"
+         "  --warmup K              frames rendered before measuring (default 5)\n"
+         "  --methods LIST          comma-separated families: RC,RC-nocd,RC+R,GS,GS+R,RC-anim\n"
+         "  --csv FILE              the table as CSV (default bench_gpu.csv)\n"
+         "  --plot FILE             log-log depth error vs GPU time PNG (default bench_gpu.png)\n"
+         "  --quick                 a 160x120 image, 3 frames after 1, fewer settings (tests)\n"
+         "  --reference-steps N     uniform relief steps of the reference (default 1024)\n"
+         "  --reference-bisection N bisection steps of the reference (default 24)\n";
+}
+
+struct ImageSize {
+  uint32_t width = 0, height = 0;
+};
+
+struct Args {
+  std::vector<std::string> inputs;
+  std::optional<uint32_t> width, height, frames, warmup;
+  std::vector<std::string> families;  // empty: every family
+  bool quick = false;
+  bool help = false;
+  std::string csv = "bench_gpu.csv", plot = "bench_gpu.png";
+  int reference_steps = 1024;
+  int reference_bisection = 24;
+};
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// A family name as kFamilies spells it, from any case; UsageError when unknown.
+std::string family_named(const std::string& name) {
+  for (const char* f : kFamilies)
+    if (lower(name) == lower(f)) return f;
+  throw UsageError{"--methods: unknown method family '" + name + "' (available: RC, RC-nocd, RC+R, GS, GS+R, RC-anim)"};
+}
+
+// INPUT as given when it is a render input, else a preset's scene or grammar by name.
+std::string resolve_input(const std::string& input) {
+  if (is_render_input(input)) return input;
+  const std::string presets = SYLVA_PRESETS_DIR;
+  for (const std::string& candidate : {presets + "/scenes/" + input + ".scene.json", presets + "/" + input + ".lsys"})
+    if (std::filesystem::exists(candidate)) return candidate;
+  throw UsageError{"INPUT '" + input +
+                   "' is neither a .lsys, .skel.json, .scene.json, .glb or .gltf file nor a preset name"};
+}
+
+Args parse_args(const std::vector<std::string>& args) {
+  Args out;
+  for (size_t i = 1; i < args.size(); ++i) {  // args[0] is "gpu"
+    const std::string& a = args[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= args.size()) throw UsageError{a + " needs a value"};
+      return args[++i];
+    };
+    if (a == "-h" || a == "--help") out.help = true;
+    else if (a == "--width") out.width = parse_count(a, value(), 16384);
+    else if (a == "--height") out.height = parse_count(a, value(), 16384);
+    else if (a == "--frames") out.frames = parse_count(a, value(), 1'000'000);
+    else if (a == "--warmup") out.warmup = static_cast<uint32_t>(parse_count(a, value(), 1'000'000));
+    else if (a == "--quick") out.quick = true;
+    else if (a == "--csv") out.csv = value();
+    else if (a == "--plot") out.plot = value();
+    else if (a == "--reference-steps") out.reference_steps = static_cast<int>(parse_count(a, value(), 1 << 20));
+    else if (a == "--reference-bisection") out.reference_bisection = static_cast<int>(parse_count(a, value(), 60));
+    else if (a == "--methods") {
+      std::stringstream list(value());
+      for (std::string name; std::getline(list, name, ',');)
+        if (!name.empty()) out.families.push_back(family_named(name));
+      if (out.families.empty()) throw UsageError{"--methods needs at least one method family"};
+    } else if (!a.empty() && a[0] == '-') throw UsageError{"unknown option '" + a + "'"};
+    else out.inputs.push_back(a);
+  }
+  if (out.help) return out;
+  if (out.width.has_value() != out.height.has_value()) throw UsageError{"give --width and --height together"};
+  for (std::string& input : out.inputs) input = resolve_input(input);
+  if (out.inputs.empty()) out.inputs = {resolve_input("pine"), resolve_input("saguaro")};
+  return out;
+}
+
+struct Method {
+  std::string family;  // one of kFamilies
+  std::string name;    // e.g. "RC+R 32x4", "GS m=2"
+  GeometryOptions geometry;
+  int steps = 0, bisection = 0, level = -1;
+  bool conservative_depth = true;
+  bool animated = false;
+};
+
+std::vector<Method> methods_for(bool relief, bool quick, const std::vector<std::string>& families) {
+  auto wanted = [&](const std::string& family) {
+    return families.empty() || std::find(families.begin(), families.end(), family) != families.end();
+  };
+  std::vector<Method> m;
+  const GeometryOptions rc = frusta_geometry();
+  if (wanted("RC")) m.push_back({"RC", "RC", rc});
+  if (wanted("RC-nocd")) {
+    Method no_layout{"RC-nocd", "RC no cons. depth", rc};
+    no_layout.conservative_depth = false;
+    m.push_back(no_layout);
+  }
+  if (relief && wanted("RC+R")) {
+    using Setting = std::pair<int, int>;  // uniform steps, bisection steps
+    const std::vector<Setting> settings =
+        quick ? std::vector<Setting>{{16, 4}} : std::vector<Setting>{{8, 0}, {16, 4}, {32, 4}, {64, 8}};
+    for (const auto& [steps, bisection] : settings)
+      m.push_back({"RC+R", "RC+R " + std::to_string(steps) + "x" + std::to_string(bisection),
+                   relief_geometry(steps, bisection), steps, bisection});
+  }
+  const int max_level = quick ? 1 : 4;
+  for (int displaced = 0; displaced <= (relief ? 1 : 0); ++displaced) {
+    const std::string family = displaced ? "GS+R" : "GS";
+    if (!wanted(family)) continue;
+    for (int level = 0; level <= max_level; ++level)
+      m.push_back({family, family + " m=" + std::to_string(level), mesh_geometry(level, displaced != 0), 0, 0, level});
+  }
+  if (wanted("RC-anim")) {
+    Method anim{"RC-anim", "RC anim", rc};
+    anim.animated = true;
+    m.push_back(anim);
+  }
+  return m;
+}
+
+// p-th quantile (0..1) of `values`, linear between order statistics; NaN when empty.
+double quantile(std::vector<double> values, double p) {
+  if (values.empty()) return std::nan("");
+  std::sort(values.begin(), values.end());
+  const double at = p * static_cast<double>(values.size() - 1);
+  const size_t below = static_cast<size_t>(std::floor(at));
+  const size_t above = std::min(below + 1, values.size() - 1);
+  return values[below] + (at - static_cast<double>(below)) * (values[above] - values[below]);
+}
+
+// GPU time of a frame: its "(GPU)" passes.
+double gpu_seconds(const RenderResult& frame) {
+  double total = 0;
+  for (const RenderPass& p : frame.passes)
+    if (p.name.find("(GPU)") != std::string::npos) total += p.seconds;
+  return total;
+}
+
+double pass_seconds(const RenderResult& frame, const std::string& name) {
+  for (const RenderPass& p : frame.passes)
+    if (p.name == name) return p.seconds;
+  return std::nan("");
+}
+
+// Bytes of the GL renderer's render targets at w × h, counted from the formats that
+// render_gl.cpp's ensure_targets allocates (keep in step): G-buffer RGBA32F, RGBA32F,
+// RGBA32UI and RGBA16F, a 32-bit float depth buffer, an RGBA32F accumulation target (76
+// bytes a pixel), and the shadow map (DEPTH_COMPONENT32F), whose side the frame's
+// "shadow map (GPU)" pass names ("2048x2048, ..."). Bark textures are not counted.
+uint64_t render_target_bytes(const RenderResult& frame, uint32_t w, uint32_t h) {
+  uint64_t bytes = static_cast<uint64_t>(w) * h * (16 + 16 + 16 + 8 + 4 + 16);
+  for (const RenderPass& p : frame.passes) {
+    unsigned side_x = 0, side_y = 0;
+    if (p.name == "shadow map (GPU)" && std::sscanf(p.detail.c_str(), "%ux%u", &side_x, &side_y) == 2)
+      bytes += static_cast<uint64_t>(side_x) * side_y * 4;
+  }
+  return bytes;
+}
+
+struct Row {
+  std::string input;
+  ImageSize size;
+  Method method;
+  std::string status = "ok";  // ok, skipped (the GL backend refuses), failed (it threw)
+  std::string reason{};
+  std::vector<double> gpu_s{}, wall_s{}, sway_s{}, update_s{}, upload_bytes{};  // per measured frame
+  uint64_t frusta = 0, setup_upload_bytes = 0, memory_bytes = 0;
+  std::string reference{};
+  std::optional<ImageErrors> errors{};
+};
+
+// What a method is measured against: the converged reference of the input at this size,
+// rendered on the CPU the first time a method needs it.
+class LazyReference {
+ public:
+  LazyReference(const Scene& scene, const Args& args) : scene_(scene), args_(args) {}
+  const RenderImage& image() {
+    if (!image_) {
+      const bool relief = scene_has_relief(scene_);
+      const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+      std::cerr << "sylva bench gpu: CPU reference " << describe() << ", " << scene_.width << "x" << scene_.height
+                << ", " << threads << " threads\n";
+      image_ = render_cpu_timed(scene_, reference_geometry(relief, args_.reference_steps, args_.reference_bisection),
+                                threads)
+                   .result.image;
+    }
+    return *image_;
+  }
+  std::string describe() const {
+    return describe_reference(scene_has_relief(scene_), args_.reference_steps, args_.reference_bisection) + " (CPU)";
+  }
+
+ private:
+  const Scene& scene_;
+  const Args& args_;
+  std::optional<RenderImage> image_;
+};
+
+void run_method(const Scene& scene, uint32_t frames, uint32_t warmup, LazyReference& reference,
+                Row& row) {
+  const Method& m = row.method;
+  RenderOptions options;
+  options.aovs = kAovDepth;
+  options.geometry = m.geometry;
+  if (auto why = gl_unsupported(scene, options)) {
+    row.status = "skipped";
+    row.reason = *why;
+    return;
+  }
+  try {
+    Scene posed = scene;  // RC-anim's plants at the frame's pose
+    std::vector<Skeleton> rest;
+    if (m.animated)
+      for (const ScenePlant& p : scene.plants) rest.push_back(*p.skeleton);
+    const SwayParameters sway;
+    GlRenderer renderer(scene, options);
+    renderer.set_conservative_depth(m.conservative_depth);
+    row.frusta = renderer.frusta();
+    row.setup_upload_bytes = renderer.uploaded_bytes();
+    RenderResult frame;
+    for (uint32_t f = 0; f < warmup + frames; ++f) {
+      double sway_s = 0, update_s = 0, uploaded = 0;
+      if (m.animated) {
+        Clock::time_point start = Clock::now();
+        sway_scene_plants(posed, rest, f / 60.0, sway);
+        sway_s = seconds_since(start);
+        start = Clock::now();
+        uploaded = static_cast<double>(renderer.update_plants(posed));
+        update_s = seconds_since(start);
+      }
+      frame = renderer.render(posed);
+      if (f < warmup) continue;
+      row.gpu_s.push_back(gpu_seconds(frame));
+      row.wall_s.push_back(pass_seconds(frame, "frame (wall)"));
+      if (m.animated) {
+        row.sway_s.push_back(sway_s);
+        row.update_s.push_back(update_s);
+        row.upload_bytes.push_back(uploaded);
+      }
+    }
+    row.frusta = frame.frusta;
+    row.memory_bytes = renderer.uploaded_bytes() + render_target_bytes(frame, scene.width, scene.height);
+    if (m.animated) {
+      // The moving plants have no converged reference: the CPU draws the last pose the
+      // same way, which checks that update_plants uploaded it.
+      row.reference = "RC at the same pose (CPU)";
+      const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+      row.errors = compare_images(render_cpu_timed(posed, m.geometry, threads).result.image, frame.image);
+    } else {
+      row.reference = reference.describe();
+      row.errors = compare_images(reference.image(), frame.image);
+    }
+  } catch (const std::exception& e) {
+    row.status = "failed";
+    row.reason = e.what();
+  }
+}
+
+// A CSV field, quoted when it holds a comma, a quote or a line break (RFC 4180).
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+// A number for the CSV: empty when not measured (NaN).
+std::string csv_number(double v) {
+  if (std::isnan(v)) return "";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+const char* const kCsvColumns =
+    "device,gl_renderer,input,width,height,method,family,steps,bisection,mesh_level,status,reason,frames,"
+    "gpu_ms_median,gpu_ms_p10,gpu_ms_p90,fps,wall_ms_median,frusta,setup_upload_bytes,gpu_memory_bytes,"
+    "upload_bytes_per_frame,sway_ms_median,update_ms_median,reference,depth_rmse_m,depth_max_m,hit_mismatch,"
+    "colour_rmse,colour_max\n";
+
+std::string csv_text(const std::vector<Row>& rows, const std::string& device, const GlContextInfo& gl,
+                     uint32_t frames, uint32_t warmup) {
+  std::ostringstream out;
+  out << "# sylva bench gpu on " << device << " (" << gl.describe() << "), " << frames << " frames after " << warmup
+      << " warm-up frames, sun as a point\n";
+  out << kCsvColumns;
+  for (const Row& r : rows) {
+    const Method& m = r.method;
+    const double median_ms = quantile(r.gpu_s, 0.5) * 1e3;
+    const ImageErrors e = r.errors.value_or(ImageErrors{});
+    auto error = [&](double v) { return csv_number(r.errors ? v : std::nan("")); };
+    out << csv_field(device) << ',' << csv_field(gl.renderer) << ',' << csv_field(r.input) << ',' << r.size.width
+        << ',' << r.size.height << ',' << csv_field(m.name) << ',' << csv_field(m.family) << ',' << m.steps << ','
+        << m.bisection << ',' << m.level << ',' << r.status << ',' << csv_field(r.reason) << ',' << r.gpu_s.size()
+        << ',' << csv_number(median_ms) << ',' << csv_number(quantile(r.gpu_s, 0.1) * 1e3) << ','
+        << csv_number(quantile(r.gpu_s, 0.9) * 1e3) << ',' << csv_number(1e3 / median_ms) << ','
+        << csv_number(quantile(r.wall_s, 0.5) * 1e3) << ',' << r.frusta << ',' << r.setup_upload_bytes << ','
+        << r.memory_bytes << ',' << csv_number(quantile(r.upload_bytes, 0.5)) << ','
+        << csv_number(quantile(r.sway_s, 0.5) * 1e3) << ',' << csv_number(quantile(r.update_s, 0.5) * 1e3) << ','
+        << csv_field(r.reference) << ',' << error(e.depth_rmse_m) << ',' << error(e.depth_max_m) << ','
+        << error(e.hit_mismatch) << ',' << error(e.colour_rmse) << ',' << error(e.colour_max) << '\n';
+  }
+  return out.str();
+}
+
+// "saguaro.scene.json 1920x1080": the input's file name and the image size.
+std::string where(const Row& r) {
+  return r.input.substr(r.input.find_last_of('/') + 1) + " " + std::to_string(r.size.width) + "x" +
+         std::to_string(r.size.height);
+}
+
+void print_row(const Row& r) {
+  if (r.status != "ok") {
+    std::printf("%-28s %-18s %s: %s\n", where(r).c_str(), r.method.name.c_str(), r.status.c_str(), r.reason.c_str());
+  } else {
+    const double median_ms = quantile(r.gpu_s, 0.5) * 1e3;
+    const ImageErrors& e = *r.errors;
+    std::printf("%-28s %-18s %9.3f %9.3f %9.3f %9.1f %9.2f %10.2f %10.1f %10.1f %9.3f %11.4g %9.5f %11.4g\n",
+                where(r).c_str(), r.method.name.c_str(), median_ms, quantile(r.gpu_s, 0.1) * 1e3,
+                quantile(r.gpu_s, 0.9) * 1e3, 1e3 / median_ms, quantile(r.wall_s, 0.5) * 1e3,
+                r.memory_bytes / 1048576.0, r.setup_upload_bytes / 1024.0,
+                r.upload_bytes.empty() ? 0.0 : quantile(r.upload_bytes, 0.5) / 1024.0,
+                r.update_s.empty() ? 0.0 : quantile(r.update_s, 0.5) * 1e3, e.depth_rmse_m, e.hit_mismatch,
+                e.colour_rmse);
+  }
+  std::fflush(stdout);
+}
+
+// One panel per input and size: depth RMSE against GPU time, a series per family (RC+R
+// and the meshes as curves over their settings, named in the legend); RC-anim has no
+// converged error.
+std::vector<PlotPanel> plot_panels(const std::vector<Row>& rows, const std::string& device) {
+  std::vector<PlotPanel> panels;
+  std::vector<std::map<std::string, std::string>> settings;  // per panel: family -> settings drawn
+  const Row* first_of_panel = nullptr;
+  for (const Row& r : rows) {
+    if (!first_of_panel || r.input != first_of_panel->input || r.size.width != first_of_panel->size.width ||
+        r.size.height != first_of_panel->size.height) {
+      panels.push_back({where(r) + ", " + device, "GPU time per frame (ms)", "depth RMSE (m)", {}});
+      settings.emplace_back();
+      first_of_panel = &r;
+    }
+    if (r.status != "ok" || r.method.animated) continue;
+    series_named(panels.back().series, r.method.family)
+        .points.push_back({quantile(r.gpu_s, 0.5) * 1e3, r.errors->depth_rmse_m});
+    // The legend lists the settings drawn: "GS m=0,1,2", "RC+R 8x0,16x4".
+    if (r.method.name.rfind(r.method.family + " ", 0) == 0) {
+      const std::string setting = r.method.name.substr(r.method.family.size() + 1);  // "m=2", "16x4"
+      std::string& text = settings.back()[r.method.family];
+      text += text.empty() ? setting : "," + setting.substr(setting.find('=') + 1);
+    }
+  }
+  for (size_t p = 0; p < panels.size(); ++p)
+    for (PlotSeries& series : panels[p].series)
+      if (auto found = settings[p].find(series.name); found != settings[p].end()) series.name += " " + found->second;
+  return panels;
+}
+
+// "software (llvmpipe)" for a software rasteriser (its first word), else GL_RENDERER.
+std::string device_label(const GlContextInfo& info) {
+  if (!info.software) return info.renderer;
+  return "software (" + info.renderer.substr(0, info.renderer.find(' ')) + ")";
+}
+
+}  // namespace
+
+int run_bench_gpu(const std::vector<std::string>& args) {
+  Args a = parse_args(args);
+  if (a.help) {
+    print_help();
+    return kOk;
+  }
+  const uint32_t frames = a.frames.value_or(a.quick ? 3 : 100);
+  const uint32_t warmup = a.warmup.value_or(a.quick ? 1 : 5);
+  std::vector<ImageSize> sizes;
+  if (a.width) sizes.push_back({*a.width, *a.height});
+  else if (a.quick) sizes.push_back({160, 120});
+  else sizes = {{1024, 768}, {1920, 1080}};
+
+  GlContextResult gl = create_headless_gl_context();
+  if (!gl.context) {
+    std::cerr << "sylva bench gpu: no OpenGL 4.5 context: " << gl.error << "\n";
+    return kInputError;
+  }
+  const std::string device = device_label(gl.context->info());
+  std::cerr << "sylva bench gpu: " << gl.context->info().describe() << "\n";
+  std::printf("device: %s\n", device.c_str());
+  std::printf("%-28s %-18s %9s %9s %9s %9s %9s %10s %10s %10s %9s %11s %9s %11s\n", "input", "method", "gpu_ms", "p10",
+              "p90", "fps", "wall_ms", "mem_MiB", "setup_KiB", "KiB/frame", "upd_ms", "depth_rmse", "mismatch",
+              "colour_rmse");
+
+  std::vector<Row> rows;
+  for (const std::string& input : a.inputs) {
+    for (const ImageSize& size : sizes) {
+      std::vector<RenderPass> passes;
+      GrammarArgs grammar;
+      grammar.grammar = input;
+      auto loaded = load_render_input(grammar, size.width, size.height, passes);
+      if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
+      Scene scene = std::move(std::get<Scene>(loaded));
+      scene.sun.angular_radius_deg = 0;
+      LazyReference reference(scene, a);
+      for (const Method& m : methods_for(scene_has_relief(scene), a.quick, a.families)) {
+        Row row{input, size, m};
+        run_method(scene, frames, warmup, reference, row);
+        print_row(row);
+        rows.push_back(std::move(row));
+      }
+    }
+  }
+
+  if (auto e = write_file_atomically(a.csv, csv_text(rows, device, gl.context->info(), frames, warmup))) {
+    std::cerr << e->format() << "\n";
+    return kInputError;
+  }
+  if (auto e = write_loglog_plot(plot_panels(rows, device), a.plot)) {
+    std::cerr << e->format() << "\n";
+    return kInputError;
+  }
+  std::cerr << "sylva bench gpu: wrote " << a.csv << " and " << a.plot << "\n";
+  const auto failed = std::count_if(rows.begin(), rows.end(), [](const Row& r) { return r.status == "failed"; });
+  if (failed > 0) {
+    std::cerr << "sylva bench gpu: " << failed << " method(s) failed (see the table)\n";
+    return kInputError;
+  }
+  return kOk;
+}
+
+}  // namespace sylva::cli

@@ -1,0 +1,72 @@
+// batch.h — many seeds of one grammar in one command (issue 5 §3): `--seed A..B` with an
+// output pattern `-o out/elm_{seed}.glb`, one derivation per task on a pool of threads
+// (one per core), progress on stderr, and a failure on one seed reported by its seed
+// without stopping or damaging the others. Shared by `sylva grow` and `sylva export`,
+// together with the grammar loading both do.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/cli/cli.h"
+#include "lsystem/derive.h"
+#include "lsystem/grammar.h"
+
+namespace sylva::cli {
+
+// An inclusive range of seeds, first <= last.
+struct SeedRange {
+  uint64_t first = 0;
+  uint64_t last = 0;
+  uint64_t count() const { return last - first + 1; }  // precondition: not the whole 2^64
+};
+
+// Most seeds one command may ask for.
+inline constexpr uint64_t kMaxBatchSeeds = 1'000'000;
+
+// Removes a `--seed A..B` or `--seed=A..B` from `args` and returns it; a single seed is
+// left for parse_grammar_args. `value_flags` are the flags whose next argument is a
+// value, not a flag (so `-o --seed` is not read as a seed). Throws UsageError for a
+// malformed range ("5..1", "1..x") or one of more than kMaxBatchSeeds seeds.
+std::optional<SeedRange> take_seed_range(std::vector<std::string>& args,
+                                         const std::vector<std::string>& value_flags);
+
+// The flags of parse_grammar_args that take a value.
+const std::vector<std::string>& grammar_value_flags();
+
+// True when `pattern` holds "{seed}".
+bool has_seed_placeholder(const std::string& pattern);
+
+// `pattern` with every "{seed}" replaced by the seed in decimal.
+std::string expand_seed_pattern(const std::string& pattern, uint64_t seed);
+
+// Loads the grammar with its -D overrides; prints the diagnostic and sets *exit_code
+// (a -D naming no #define is a usage error, anything else an input error) on failure.
+std::optional<lsys::Grammar> load_grammar_for(const GrammarArgs& args, int* exit_code);
+
+// The derivation options of the grammar flags (steps, seed, max modules).
+lsys::DeriveOptions derive_options_for(const GrammarArgs& args);
+
+// What one seed's task reports: an error (the message, without the seed), or a line of
+// summary for stdout.
+struct SeedTaskResult {
+  std::optional<std::string> error;
+  std::string summary;  // printed on stdout when not empty (one line, no newline)
+  std::string warning;  // printed on stderr before the progress line when not empty
+};
+
+// Runs task(seed) for every seed of `range` on min(cores, seeds) threads. Each finished
+// seed prints "sylva SUBCOMMAND: [k/N] seed S: ok|error: ..." on stderr; the end prints
+// a tally naming the failed seeds. An exception in a task counts as that seed's failure.
+// Returns kOk when every seed succeeded, kInputError otherwise.
+int run_seed_batch(const std::string& subcommand, const SeedRange& range,
+                   const std::function<SeedTaskResult(uint64_t seed)>& task);
+
+// Creates the folder that will hold `path` (for output patterns like out/{seed}.glb).
+// Returns an error message on failure.
+std::optional<std::string> create_parent_folder(const std::string& path);
+
+}  // namespace sylva::cli

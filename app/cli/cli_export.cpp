@@ -1,0 +1,269 @@
+// cli_export.cpp — `sylva export INPUT -o FILE.gltf|FILE.glb [--mesh] [--segments-around N]`
+// (cli.md, issue 5): a grammar, skeleton or scene to glTF 2.0 with the skeleton in the
+// node extras (core/gltf_export.h); `--seed A..B` with `-o out/p_{seed}.glb` exports a
+// batch in parallel (app/batch.h). The mesh's bark comes from each plant of a scene, or
+// for a grammar or skeleton from the --bark-* flags (scene.md's bark keys as flags).
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/cli/batch.h"
+#include "app/cli/cli.h"
+#include "core/gltf_export.h"
+#include "core/scene.h"
+#include "core/skeleton.h"
+#include "core/turtle.h"
+
+namespace sylva::cli {
+
+namespace {
+
+void print_export_help() {
+  std::cout << "usage: sylva export INPUT -o FILE.gltf|FILE.glb [--mesh] [--segments-around N] [--instancing]\n"
+               "                    [--bark-albedo FILE] [--bark-height FILE] [--relief-depth M]\n"
+               "                    [--u-repeat N] [--v-per-metre N]\n"
+               "                    [-n STEPS] [--seed S|A..B] [-D NAME=VALUE]... [--max-modules N]\n\n"
+               "Writes glTF 2.0 (Y up, metres; .glb binary or .gltf with embedded data), atomically.\n"
+               "Each plant is a node named after its grammar with the skeleton as a LINES mesh\n"
+               "(POSITION, _RADIUS) and the exact skeleton, seed and skinning data in the node's\n"
+               "extras.sylva. INPUT is a .lsys grammar, a .skel.json skeleton or a .scene.json scene.\n\n"
+               "  -o, --output FILE        the .gltf or .glb file to write\n"
+               "      --mesh               also write the skinned frusta as a triangle mesh: normals,\n"
+               "                           TEXCOORD_0 = (turns around * u_repeat, metres along *\n"
+               "                           v_per_metre), one material per material index\n"
+               "      --segments-around N  columns around each frustum of the mesh, 3 to 4096 (default 8)\n"
+               "      --instancing         repeated identical plants of a scene as one node with\n"
+               "                           EXT_mesh_gpu_instancing\n"
+               "Bark of the mesh (a scene gives each plant's own; these are for a .lsys or .skel.json\n"
+               "INPUT and need --mesh):\n"
+               "      --bark-albedo FILE   albedo texture (PNG or JPEG, sRGB), embedded as baseColorTexture\n"
+               "      --bark-height FILE   height map (1 = outermost, 0 = furrow bottom), baked into a\n"
+               "                           tangent-space normalTexture at the plant's median radius\n"
+               "      --relief-depth M     relief depth in metres, >= 0 (default 0.02)\n"
+               "      --u-repeat N         texture repeats around the stem, > 0 (default 1)\n"
+               "      --v-per-metre N      texture repeats per metre along the stem, > 0 (default 1)\n"
+               "  A missing or unreadable texture is an error (exit 1); nothing is written.\n"
+               "For a .lsys INPUT:\n"
+               "  -n, --steps N            derivation steps (overrides 'derivation length:')\n"
+               "      --seed S             random seed, an integer from 0 to 2^64-1 (overrides 'seed:')\n"
+               "      --seed A..B          a batch: every seed from A to B, in parallel on all cores;\n"
+               "                           -o must then hold {seed} (out/elm_{seed}.glb), its folder is\n"
+               "                           created; a failed seed is named on stderr, the others are\n"
+               "                           still written, and the exit status is 1\n"
+               "  -D NAME=VALUE            override '#define NAME' (repeatable)\n"
+               "      --max-modules N      stop with an error if a word would exceed N modules\n"
+               "  -h, --help               show this help\n";
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// The node name of a plant: the file name without folder and extension(s).
+std::string plant_name(const std::string& path) {
+  std::string name = std::filesystem::path(path).filename().string();
+  for (const char* ext : {".lsys", ".skel.json", ".json"})
+    if (ends_with(name, ext) && name.size() > std::string(ext).size()) {
+      name.resize(name.size() - std::string(ext).size());
+      break;
+    }
+  return name;
+}
+
+enum class InputKind { grammar, skeleton, scene };
+
+// The value of flag `name` at raw_args[*i] ("--name V" or "--name=V"); advances *i.
+std::string flag_value(const std::vector<std::string>& raw_args, size_t* i, const std::string& name) {
+  const std::string& a = raw_args[*i];
+  if (a.size() > name.size()) return a.substr(name.size() + 1);
+  if (*i + 1 >= raw_args.size()) throw UsageError{name + " needs a value"};
+  return raw_args[++*i];
+}
+
+// A finite number from `text`, in (lo, hi] or [lo, hi] (`open_low`); a usage error naming `name`.
+double number_flag(const std::string& name, const std::string& text, double lo, bool open_low) {
+  double v = 0;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  const bool ok = ec == std::errc() && ptr == text.data() + text.size() && std::isfinite(v) && v <= 1e6 &&
+                  (open_low ? v > lo : v >= lo);
+  if (!ok)
+    throw UsageError{name + " " + text + ": expected a number " + (open_low ? "> " : ">= ") +
+                     (lo == 0 ? "0" : std::to_string(lo)) + " and <= 1e6"};
+  return v;
+}
+
+bool is_flag(const std::string& a, const std::string& name) { return a == name || a.rfind(name + "=", 0) == 0; }
+
+}  // namespace
+
+int run_export(const std::vector<std::string>& raw_args) {
+  // The export flags first; what is left is the grammar flags' business.
+  GltfExportOptions options;
+  Bark bark;                 // from the --bark-* flags
+  bool bark_flags = false;
+  std::vector<std::string> args;
+  for (size_t i = 0; i < raw_args.size(); ++i) {
+    const std::string& a = raw_args[i];
+    if (is_flag(a, "--bark-albedo")) {
+      bark.albedo_texture = flag_value(raw_args, &i, "--bark-albedo");
+      bark_flags = true;
+    } else if (is_flag(a, "--bark-height")) {
+      bark.height_texture = flag_value(raw_args, &i, "--bark-height");
+      bark_flags = true;
+    } else if (is_flag(a, "--relief-depth")) {
+      bark.relief_depth_m = number_flag("--relief-depth", flag_value(raw_args, &i, "--relief-depth"), 0, false);
+      bark_flags = true;
+    } else if (is_flag(a, "--u-repeat")) {
+      bark.u_repeat = number_flag("--u-repeat", flag_value(raw_args, &i, "--u-repeat"), 0, true);
+      bark_flags = true;
+    } else if (is_flag(a, "--v-per-metre")) {
+      bark.v_per_metre = number_flag("--v-per-metre", flag_value(raw_args, &i, "--v-per-metre"), 0, true);
+      bark_flags = true;
+    } else if (a == "--mesh") {
+      options.mesh = true;
+    } else if (a == "--instancing") {
+      options.instancing = true;
+    } else if (a == "--segments-around" || a.rfind("--segments-around=", 0) == 0) {
+      std::string v;
+      if (a.size() > std::string("--segments-around").size()) {
+        v = a.substr(std::string("--segments-around=").size());
+      } else {
+        if (i + 1 >= raw_args.size()) throw UsageError{"--segments-around needs a value"};
+        v = raw_args[++i];
+      }
+      const auto n = parse_u64(v);
+      if (!n || *n < 3 || *n > 4096) throw UsageError{"--segments-around " + v + ": expected an integer from 3 to 4096"};
+      options.segments_around = static_cast<int>(*n);
+    } else {
+      args.push_back(a);
+      // Keep a value that follows a value-taking flag with it, whatever it looks like.
+      for (const std::string& f : grammar_value_flags())
+        if (a == f && i + 1 < raw_args.size()) args.push_back(raw_args[++i]);
+    }
+  }
+  const std::optional<SeedRange> range = take_seed_range(args, grammar_value_flags());
+  GrammarArgs a;
+  try {
+    a = parse_grammar_args(args, true);
+  } catch (const UsageError& e) {
+    if (e.message.rfind("missing GRAMMAR", 0) == 0)
+      throw UsageError{"missing INPUT (a .lsys grammar, a .skel.json skeleton or a .scene.json scene)"};
+    if (e.message.rfind("missing -o", 0) == 0) throw UsageError{"missing -o FILE.gltf|FILE.glb"};
+    throw;
+  }
+  if (a.help) {
+    print_export_help();
+    return kOk;
+  }
+  const std::string& input = a.grammar;
+  InputKind kind;
+  if (ends_with(input, ".skel.json")) kind = InputKind::skeleton;
+  else if (ends_with(input, ".scene.json")) kind = InputKind::scene;
+  else if (ends_with(input, ".lsys")) kind = InputKind::grammar;
+  else throw UsageError{"INPUT '" + input + "' must be a .lsys grammar, a .skel.json skeleton or a .scene.json scene"};
+  if (!ends_with(a.output, ".gltf") && !ends_with(a.output, ".glb"))
+    throw UsageError{"-o " + a.output + ": the output must end in .gltf or .glb"};
+  if (kind != InputKind::grammar && (a.steps || a.seed || range || !a.defines.empty()))
+    throw UsageError{"-n, --seed and -D apply to a .lsys INPUT only"};
+  if (bark_flags && kind == InputKind::scene)
+    throw UsageError{"--bark-albedo, --bark-height, --relief-depth, --u-repeat and --v-per-metre apply to a .lsys or "
+                     ".skel.json INPUT only (a scene gives each plant's bark)"};
+  if (bark_flags && !options.mesh)
+    throw UsageError{"--bark-albedo, --bark-height, --relief-depth, --u-repeat and --v-per-metre shape the mesh: "
+                     "add --mesh"};
+  if (range && !has_seed_placeholder(a.output))
+    throw UsageError{"--seed " + std::to_string(range->first) + ".." + std::to_string(range->last) +
+                     " writes one file per seed: -o must hold {seed}, e.g. -o out/plant_{seed}.glb"};
+
+  // The textures are checked once, before any plant grows or any file is written.
+  if (auto err = check_bark_textures(bark)) {
+    std::cerr << *err << "\n";
+    return kInputError;
+  }
+
+  if (kind == InputKind::skeleton) {
+    SkeletonReadResult read = read_skeleton_file(input);
+    if (!read.skeleton) {
+      std::cerr << (read.error ? read.error->format() : input + ": error: unreadable skeleton") << "\n";
+      return kInputError;
+    }
+    GltfPlant plant;
+    plant.name = plant_name(input);
+    plant.skeleton = std::move(*read.skeleton);
+    plant.bark = bark;
+    if (auto err = export_gltf({plant}, a.output, options)) {
+      std::cerr << *err << "\n";
+      return kInputError;
+    }
+    return kOk;
+  }
+  if (kind == InputKind::scene) {
+    SceneReadResult read = read_scene_file(input);
+    if (!read.scene) {
+      std::cerr << (read.error ? read.error->format() : input + ": error: unreadable scene") << "\n";
+      return kInputError;
+    }
+    Scene& scene = *read.scene;
+    if (auto err = grow_scene_plants(scene, a.max_modules)) {
+      std::cerr << *err;
+      if (!err->empty() && err->back() != '\n') std::cerr << "\n";
+      return kInputError;
+    }
+    std::vector<GltfPlant> plants;
+    for (ScenePlant& sp : scene.plants) {
+      GltfPlant p;
+      p.name = plant_name(sp.grammar.empty() ? input : sp.grammar);
+      p.skeleton = std::move(*sp.skeleton);
+      for (int k = 0; k < 3; ++k) p.position_m[k] = sp.position[k];
+      p.rotate_y_deg = sp.rotate_y_deg;
+      p.scale = sp.scale;
+      p.bark = sp.bark;
+      plants.push_back(std::move(p));
+    }
+    if (auto err = export_gltf(plants, a.output, options)) {
+      std::cerr << *err << "\n";
+      return kInputError;
+    }
+    return kOk;
+  }
+
+  int code = kOk;
+  auto g = load_grammar_for(a, &code);
+  if (!g) return code;
+  // Grows with `one`'s seed and exports to `output`; the error text or nothing.
+  auto export_one = [&](const GrammarArgs& one, const std::string& output) -> std::optional<std::string> {
+    auto grown = grow(*g, derive_options_for(one), one.grammar, one.defines);
+    if (!grown) return grown.error().format();
+    GltfPlant plant;
+    plant.name = plant_name(input);
+    plant.skeleton = std::move(grown->skeleton);
+    plant.bark = bark;
+    return export_gltf({plant}, output, options);
+  };
+  if (range) {
+    if (auto err = create_parent_folder(expand_seed_pattern(a.output, range->first))) {
+      std::cerr << *err << "\n";
+      return kInputError;
+    }
+    return run_seed_batch("export", *range, [&](uint64_t seed) {
+      GrammarArgs one = a;
+      one.seed = seed;
+      SeedTaskResult r;
+      r.error = export_one(one, expand_seed_pattern(a.output, seed));
+      return r;
+    });
+  }
+  const std::string output = has_seed_placeholder(a.output) && a.seed ? expand_seed_pattern(a.output, *a.seed) : a.output;
+  if (auto err = export_one(a, output)) {
+    std::cerr << *err;
+    if (!err->empty() && err->back() != '\n') std::cerr << "\n";
+    return kInputError;
+  }
+  return kOk;
+}
+
+}  // namespace sylva::cli

@@ -1,0 +1,166 @@
+// cli_grow.cpp — `sylva derive` and `sylva grow` (cli.md).
+#include <chrono>
+#include <cinttypes>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <sstream>
+
+#include "app/cli/batch.h"
+#include "app/cli/cli.h"
+#include "core/util/file_io.h"
+#include "core/turtle.h"
+#include "lsystem/derive.h"
+#include "lsystem/grammar.h"
+
+namespace sylva::cli {
+
+namespace {
+
+const char* const kGrammarFlags =
+    "  -n, --steps N          derivation steps (overrides 'derivation length:')\n"
+    "      --seed S           random seed, an integer from 0 to 2^64-1 (overrides 'seed:')\n"
+    "  -D NAME=VALUE          override '#define NAME' (repeatable)\n"
+    "      --max-modules N    stop with an error if a word would exceed N modules\n"
+    "                         (default 50000000)\n"
+    "  -h, --help             show this help\n";
+
+void print_derive_help() {
+  std::cout << "usage: sylva derive GRAMMAR [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n\n"
+               "Derives the grammar's word and prints it to stdout (modules without spaces,\n"
+               "arguments in shortest round-trip decimal form).\n\n"
+            << kGrammarFlags;
+}
+
+void print_grow_help() {
+  std::cout << "usage: sylva grow GRAMMAR [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n"
+               "                  -o FILE.skel.json\n\n"
+               "Derives the grammar, interprets the word with the turtle and writes the skeleton\n"
+               "(sylva-skeleton JSON) atomically; prints one summary line: modules, chains,\n"
+               "segments, bounding box, time.\n\n"
+               "  -o, --output FILE      the skeleton file to write\n"
+               "      --seed A..B        a batch: every seed from A to B, in parallel on all cores;\n"
+               "                         -o must then hold {seed} (out/elm_{seed}.skel.json), its\n"
+               "                         folder is created; a failed seed is named on stderr,\n"
+               "                         the others are still written, and the exit status is 1\n"
+            << kGrammarFlags;
+}
+
+std::string format_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+}  // namespace
+
+int run_derive(const std::vector<std::string>& args) {
+  GrammarArgs a = parse_grammar_args(args, false);
+  if (a.help) {
+    print_derive_help();
+    return kOk;
+  }
+  int code = kOk;
+  auto g = load_grammar_for(a, &code);
+  if (!g) return code;
+  auto word = lsys::derive(*g, derive_options_for(a));
+  if (!word) {
+    std::cerr << word.error().format();
+    return kInputError;
+  }
+  std::string text = lsys::print_word(*word, g->symbols);
+  text += '\n';
+  std::fwrite(text.data(), 1, text.size(), stdout);
+  std::fflush(stdout);
+  return kOk;
+}
+
+namespace {
+
+// Grows one plant and writes it to `output`: the text grow prints on failure (a
+// diagnostic) or, on success, its summary line and any warning.
+struct GrowOutcome {
+  std::optional<std::string> error;  // as printed on stderr, ending in a newline
+  std::string warning;               // stderr text, may be empty
+  std::string summary;               // the stdout summary line, without newline
+};
+
+GrowOutcome grow_to_file(const lsys::Grammar& g, const GrammarArgs& a, const std::string& output) {
+  GrowOutcome out;
+  auto result = grow(g, derive_options_for(a), a.grammar, a.defines);
+  if (!result) {
+    out.error = result.error().format();
+    return out;
+  }
+  const Skeleton& sk = result->skeleton;
+  if (result->interpret.still_expandable)
+    out.warning = a.grammar + ": warning: the interpretation stopped at maximum depth " + std::to_string(g.max_depth) +
+                  " with " + std::to_string(result->interpret.still_expandable) + " modules still expandable\n";
+  std::string json = write_skeleton_json(sk);
+  if (auto err = write_file_atomically(output, json)) {
+    out.error = err->format() + "\n";
+    return out;
+  }
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  if (!sk.joints.empty()) {
+    for (int k = 0; k < 3; ++k) lo[k] = std::numeric_limits<double>::infinity(), hi[k] = -lo[k];
+    for (const Joint& j : sk.joints)
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], j.position_m[k] - j.radius_m);
+        hi[k] = std::max(hi[k], j.position_m[k] + j.radius_m);
+      }
+  }
+  std::ostringstream line;
+  line << a.grammar << ": " << result->modules << " modules, " << sk.chains.size() << " chains, "
+       << sk.segment_count() << " segments, bbox [" << format_number(lo[0]) << "," << format_number(lo[1]) << ","
+       << format_number(lo[2]) << "]..[" << format_number(hi[0]) << "," << format_number(hi[1]) << ","
+       << format_number(hi[2]) << "] m, " << format_number(result->seconds * 1e3) << " ms";
+  if (result->turtle.zero_length_moves) line << ", " << result->turtle.zero_length_moves << " zero-length moves";
+  out.summary = line.str();
+  return out;
+}
+
+}  // namespace
+
+int run_grow(const std::vector<std::string>& raw_args) {
+  std::vector<std::string> args = raw_args;
+  const std::optional<SeedRange> range = take_seed_range(args, grammar_value_flags());
+  GrammarArgs a = parse_grammar_args(args, true);
+  if (a.help) {
+    print_grow_help();
+    return kOk;
+  }
+  if (range && !has_seed_placeholder(a.output))
+    throw UsageError{"--seed " + std::to_string(range->first) + ".." + std::to_string(range->last) +
+                     " writes one file per seed: -o must hold {seed}, e.g. -o out/plant_{seed}.skel.json"};
+  int code = kOk;
+  auto g = load_grammar_for(a, &code);
+  if (!g) return code;
+  if (range) {
+    if (auto err = create_parent_folder(expand_seed_pattern(a.output, range->first))) {
+      std::cerr << *err << "\n";
+      return kInputError;
+    }
+    return run_seed_batch("grow", *range, [&](uint64_t seed) {
+      GrammarArgs one = a;
+      one.seed = seed;
+      GrowOutcome o = grow_to_file(*g, one, expand_seed_pattern(a.output, seed));
+      SeedTaskResult r;
+      r.error = o.error;
+      r.summary = o.summary;
+      r.warning = o.warning;
+      return r;
+    });
+  }
+  GrowOutcome o = grow_to_file(*g, a, has_seed_placeholder(a.output) && a.seed
+                                          ? expand_seed_pattern(a.output, *a.seed) : a.output);
+  std::cerr << o.warning;
+  if (o.error) {
+    std::cerr << *o.error;
+    return kInputError;
+  }
+  std::cout << o.summary << "\n";
+  return kOk;
+}
+
+}  // namespace sylva::cli

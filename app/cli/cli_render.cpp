@@ -1,0 +1,278 @@
+// cli_render.cpp — `sylva render` (cli.md, scene.md): a scene, grammar or skeleton to an
+// image through the OpenGL ray caster (render_gl.h, on a headless EGL context) or the CPU
+// ray caster (render_cpu.h), as --backend says.
+#include <signal.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+
+#include "app/cli/cli.h"
+#include "app/cli/render_input.h"
+#include "core/render_output.h"
+#include "core/util/image_io.h"
+#include "core/gl/gl_context.h"
+#include "core/render_common.h"
+#include "core/cpu/render_cpu.h"
+#include "core/gl/render_gl.h"
+#include "core/scene.h"
+
+namespace sylva::cli {
+
+namespace {
+
+constexpr int kInterrupted = 130;  // 128 + SIGINT, the shell's convention
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_sigint(int) { g_interrupted.store(true); }
+static_assert(std::atomic<bool>::is_always_lock_free, "the SIGINT handler needs a lock-free flag");
+
+void print_render_help() {
+  std::cout
+      << "usage: sylva render INPUT -o IMAGE [--backend auto|gl|cpu] [--width W --height H]\n"
+         "                    [--aov depth,normal,uv,id] [--spp N] [--verbose]\n"
+         "                    [--geometry frusta|mesh] [--mesh-level M]\n"
+         "                    [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n\n"
+         "Renders INPUT — a .scene.json scene, a .lsys grammar, a .skel.json skeleton or a .glb/.gltf\n"
+         "written by `sylva export` (its skeletons are read back from node extras) (all but\n"
+         "the scene in a default scene: the plant at the origin, the sun from (0.5, 1, 0.3), a\n"
+         "camera framing it) — to IMAGE, written atomically. The format follows IMAGE's\n"
+         "extension: .png (8-bit sRGB), .exr (linear half, AOVs as extra channels), or any\n"
+         "format OpenImageIO writes. For a non-EXR IMAGE each AOV goes to its own EXR next to\n"
+         "it: IMAGE without its extension + .depth.exr, .normal.exr, .uv.exr, .id.exr.\n\n"
+         "  -o, --output IMAGE     the image to write\n"
+         "      --backend B        auto (default): OpenGL on a window-less EGL context (the GPU,\n"
+         "                         or Mesa's llvmpipe without one), else the CPU ray caster,\n"
+         "                         saying why; gl: OpenGL or exit 1 saying why; cpu: the CPU\n"
+         "                         reference (bark textures and relief are CPU-only for now)\n"
+         "      --width W          image width in pixels (default: the scene's, else 1024)\n"
+         "      --height H         image height in pixels (default: the scene's, else 768)\n"
+         "      --aov LIST         extra outputs, comma-separated: depth (channel Z, distance\n"
+         "                         from the eye, +inf on a miss), normal (N.X N.Y N.Z),\n"
+         "                         uv (U V), id (id.plant id.chain id.segment)\n"
+         "      --spp N            samples per pixel, stratified (default 1: pixel centres)\n"
+         "      --verbose          list the passes that ran and what each cost\n"
+         "      --geometry G       what stands for the plants: frusta (default: the exact\n"
+         "                         conical frusta) or mesh (the polygon baseline: the frusta\n"
+         "                         tessellated, displaced by bark height maps where a scene\n"
+         "                         gives them)\n"
+         "      --mesh-level M     the mesh's subdivision level, 0 to 6: 16·4^M triangles per\n"
+         "                         segment (default 2)\n"
+         "grammar input only:\n"
+         "  -n, --steps N          derivation steps (overrides 'derivation length:')\n"
+         "      --seed S           random seed, an integer from 0 to 2^64-1\n"
+         "  -D NAME=VALUE          override '#define NAME' (repeatable)\n"
+         "      --max-modules N    stop with an error if a word would exceed N modules\n"
+         "  -h, --help             show this help\n\n"
+         "Exit status: 0 success, 1 bad input or unwritable output, 2 usage error,\n"
+         "3 internal error, 130 interrupted (Ctrl-C; nothing is written).\n";
+}
+
+struct RenderArgs {
+  GrammarArgs grammar;  // INPUT in .grammar, -o in .output
+  std::string backend = "auto";
+  std::optional<uint32_t> width, height;
+  uint32_t aovs = 0;
+  uint32_t spp = 1;
+  bool verbose = false;
+  GeometryOptions geometry;
+  bool grammar_flags = false;  // -n, --seed, -D or --max-modules given
+};
+
+uint32_t parse_size(const std::string& flag, const std::string& v, uint32_t max) {
+  auto n = parse_u64(v);
+  if (!n || *n == 0 || *n > max)
+    throw UsageError{flag + " " + v + ": expected an integer from 1 to " + std::to_string(max)};
+  return static_cast<uint32_t>(*n);
+}
+
+RenderArgs parse_render_args(const std::vector<std::string>& args) {
+  RenderArgs out;
+  std::vector<std::string> rest;
+  for (size_t i = 0; i < args.size(); ++i) {
+    std::string a = args[i], inline_value;
+    bool has_inline = false;
+    if (a.rfind("--", 0) == 0 && a.find('=') != std::string::npos) {
+      inline_value = a.substr(a.find('=') + 1);
+      a = a.substr(0, a.find('='));
+      has_inline = true;
+    }
+    auto value = [&]() -> std::string {
+      if (has_inline) return inline_value;
+      if (i + 1 >= args.size()) throw UsageError{a + " needs a value"};
+      return args[++i];
+    };
+    if (a == "--backend") {
+      out.backend = value();
+      if (out.backend != "auto" && out.backend != "gl" && out.backend != "cpu")
+        throw UsageError{"--backend " + out.backend + ": expected auto, gl or cpu"};
+    } else if (a == "--width") {
+      out.width = parse_size(a, value(), 65536);
+    } else if (a == "--height") {
+      out.height = parse_size(a, value(), 65536);
+    } else if (a == "--spp") {
+      out.spp = parse_size(a, value(), 65536);
+    } else if (a == "--aov") {
+      std::string list = value();
+      size_t start = 0;
+      for (;;) {
+        size_t comma = list.find(',', start);
+        std::string name = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+        if (name == "depth") out.aovs |= kAovDepth;
+        else if (name == "normal") out.aovs |= kAovNormal;
+        else if (name == "uv") out.aovs |= kAovUv;
+        else if (name == "id") out.aovs |= kAovId;
+        else throw UsageError{"--aov: unknown AOV '" + name + "' (expected depth, normal, uv or id)"};
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+      }
+    } else if (a == "--geometry") {
+      const std::string g = value();
+      if (g == "frusta") out.geometry.kind = GeometryKind::frusta;
+      else if (g == "mesh") out.geometry.kind = GeometryKind::mesh;
+      else throw UsageError{"--geometry " + g + ": expected frusta or mesh"};
+    } else if (a == "--mesh-level") {
+      const std::string v = value();
+      auto n = parse_u64(v);
+      if (!n || *n > 6) throw UsageError{"--mesh-level " + v + ": expected an integer from 0 to 6"};
+      out.geometry.mesh_level = static_cast<int>(*n);
+    } else if (a == "--verbose" || a == "-v") {
+      out.verbose = true;
+    } else {
+      if (a == "-n" || a == "--steps" || a == "--seed" || a == "-D" || a == "--define" ||
+          a == "--max-modules" || (a.size() > 2 && (a.rfind("-D", 0) == 0 || a.rfind("-n", 0) == 0)))
+        out.grammar_flags = true;
+      rest.push_back(args[i]);
+    }
+  }
+  try {
+    out.grammar = parse_grammar_args(rest, true);
+  } catch (const UsageError& e) {
+    if (e.message.rfind("missing GRAMMAR", 0) == 0)
+      throw UsageError{"missing INPUT (a .lsys grammar, .skel.json skeleton or .scene.json scene)"};
+    if (e.message.rfind("missing -o", 0) == 0) throw UsageError{"missing -o IMAGE"};
+    if (e.message.rfind("unexpected argument", 0) == 0)
+      throw UsageError{e.message.substr(0, e.message.find(" (one GRAMMAR")) + " (one INPUT only)"};
+    throw;
+  }
+  return out;
+}
+
+using render_common::seconds_since;
+
+// Restores the previous SIGINT disposition when the render is over.
+class SigintGuard {
+ public:
+  SigintGuard() {
+    struct sigaction action {};
+    action.sa_handler = on_sigint;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, &previous_);
+  }
+  ~SigintGuard() { sigaction(SIGINT, &previous_, nullptr); }
+  SigintGuard(const SigintGuard&) = delete;
+  SigintGuard& operator=(const SigintGuard&) = delete;
+
+ private:
+  struct sigaction previous_ {};
+};
+
+}  // namespace
+
+int run_render(const std::vector<std::string>& args) {
+  RenderArgs a = parse_render_args(args);
+  if (a.grammar.help) {
+    print_render_help();
+    return kOk;
+  }
+  const std::string& input = a.grammar.grammar;
+  const std::string& output = a.grammar.output;
+  if (!is_render_input(input))
+    throw UsageError{"INPUT '" + input + "' must end in .lsys, .skel.json, .scene.json, .glb or .gltf"};
+  if (a.grammar_flags && !is_grammar_input(input))
+    throw UsageError{"-n, --seed, -D and --max-modules apply to a .lsys grammar only"};
+  if (!can_write_image_format(output))
+    throw UsageError{"-o " + output + ": OpenImageIO cannot write this format (use .png, .exr, ...)"};
+
+  SigintGuard sigint;
+  g_interrupted.store(false);
+  std::vector<RenderPass> passes;
+  auto loaded = load_render_input(a.grammar, a.width, a.height, passes);
+  if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
+  Scene scene = std::move(std::get<Scene>(loaded));
+  auto start = std::chrono::steady_clock::now();
+
+  RenderOptions options;
+  options.spp = a.spp;
+  options.aovs = a.aovs;
+  options.geometry = a.geometry;
+  options.cancel = &g_interrupted;
+  options.progress = ::isatty(STDERR_FILENO) == 1;
+  // The backend (cli.md): gl, or for auto OpenGL where a context can be made and the scene
+  // needs nothing the GL backend lacks; otherwise the CPU, saying why.
+  std::string backend_name = "CPU ray caster";
+  std::optional<RenderResult> gl_result;
+  if (a.backend != "cpu") {
+    std::string why_not;
+    const char* fallback = "OpenGL unavailable";
+    if (auto unsupported = gl_unsupported(scene, options)) {
+      why_not = *unsupported;
+      fallback = "the OpenGL backend cannot draw this";
+    } else {
+      const auto context_start = std::chrono::steady_clock::now();
+      GlContextResult context = create_headless_gl_context();
+      if (!context.context) {
+        why_not = context.error;
+      } else {
+        passes.push_back({"gl context", seconds_since(context_start), context.context->info().describe()});
+        try {
+          gl_result = render_gl(scene, options);
+          // Meshes are rasterised (the polygon baseline), frusta ray cast.
+          const std::string& renderer = context.context->info().renderer;
+          backend_name = options.geometry.kind == GeometryKind::mesh ? "OpenGL rasteriser (meshes, " + renderer + ")"
+                                                                     : "OpenGL ray caster (" + renderer + ")";
+        } catch (const GlError& e) {
+          why_not = e.what();
+        }
+      }
+    }
+    if (!gl_result) {
+      if (a.backend == "gl") {
+        std::cerr << "sylva render: --backend gl: " << why_not << "\n";
+        return kInputError;
+      }
+      std::cerr << "sylva render: " << fallback << " (" << why_not << "); using the CPU ray caster\n";
+    }
+  }
+  RenderResult result = gl_result ? std::move(*gl_result) : render_cpu(scene, options);
+  if (result.cancelled || g_interrupted.load()) {
+    std::cerr << "sylva render: interrupted; nothing written\n";
+    return kInterrupted;
+  }
+  passes.insert(passes.end(), result.passes.begin(), result.passes.end());
+
+  start = std::chrono::steady_clock::now();
+  ImageWriteResult written = write_render(output, result.image);
+  if (written.error) {
+    std::cerr << written.error->format() << "\n";
+    return kInputError;
+  }
+  std::string files;
+  for (const std::string& f : written.written) files += (files.empty() ? "" : ", ") + f;
+  passes.push_back({"write", seconds_since(start), files});
+
+  if (a.verbose) {
+    std::cerr << "sylva render: " << scene.width << "x" << scene.height << ", " << a.spp << " spp, " << backend_name
+              << (scene.fog ? "; fog is parsed but not rendered in this version" : "") << "\n";
+    for (const RenderPass& p : passes) {
+      char line[256];
+      std::snprintf(line, sizeof line, "  %-22s %9.3f ms", p.name.c_str(), p.seconds * 1e3);
+      std::cerr << line << (p.detail.empty() ? "" : "  " + p.detail) << "\n";
+    }
+  }
+  return kOk;
+}
+
+}  // namespace sylva::cli

@@ -1,0 +1,60 @@
+// main.cpp — `sylva`: one executable with git-style subcommands (cli.md).
+#include <exception>
+#include <iostream>
+#include <new>
+#include <string>
+#include <vector>
+
+#include "app/cli/cli.h"
+
+namespace {
+
+void print_help(std::ostream& out) {
+  out << "usage: sylva SUBCOMMAND [ARGS...]\n\n"
+               "sylva grows plants from L-system grammars (The Algorithmic Beauty of Plants, cpfg).\n\n"
+               "subcommands:\n"
+               "  derive GRAMMAR [-n STEPS] [--seed S] [-D NAME=VALUE]...   print the derived word\n"
+               "  grow   GRAMMAR [-n STEPS] [--seed S] [-D ...] -o FILE.skel.json\n"
+               "                                      write the skeleton and print a summary\n"
+               "  render INPUT -o IMAGE [--backend auto|gl|cpu] [--aov ...]   render to PNG/EXR\n"
+               "  export INPUT -o FILE.gltf|FILE.glb [--mesh]   glTF 2.0 with the skeleton in extras\n"
+               "  bench  lsystem [--quick]            derivation and turtle benchmarks\n\n"
+               "'sylva SUBCOMMAND --help' describes every flag.\n"
+               "Exit status: 0 success, 1 bad input, 2 usage error, 3 internal error.\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace sylva::cli;
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) {
+    std::cerr << "sylva: error: missing SUBCOMMAND\n\n";
+    print_help(std::cerr);
+    return kUsageError;
+  }
+  const std::string sub = args[0];
+  args.erase(args.begin());
+  try {
+    if (sub == "-h" || sub == "--help" || sub == "help") {
+      print_help(std::cout);
+      return kOk;
+    }
+    if (sub == "derive") return run_derive(args);
+    if (sub == "grow") return run_grow(args);
+    if (sub == "bench") return run_bench(args);
+    if (sub == "render") return run_render(args);
+    if (sub == "export") return run_export(args);
+    std::cerr << "sylva: error: unknown subcommand '" << sub << "' (see 'sylva --help')\n";
+    return kUsageError;
+  } catch (const UsageError& e) {
+    std::cerr << "sylva " << sub << ": error: " << e.message << " (see 'sylva " << sub << " --help')\n";
+    return kUsageError;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "sylva: error: out of memory\n";
+    return kInternalError;
+  } catch (const std::exception& e) {
+    std::cerr << "sylva: internal error: " << e.what() << "\n";
+    return kInternalError;
+  }
+}

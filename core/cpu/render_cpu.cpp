@@ -1,0 +1,474 @@
+// render_cpu.cpp — the CPU reference ray caster (see render_cpu.h for the shading model).
+#include "core/cpu/render_cpu.h"
+#include "core/plant_mesh.h"
+
+#include "core/culling.h"
+#include "core/cpu/frustum_tracer.h"
+#include "core/cpu/mesh_accel.h"
+#include "core/render_common.h"
+#include "core/cpu/texture.h"
+#include "core/util/math.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <glm/geometric.hpp>
+#include <limits>
+#include <mutex>
+#include <numbers>
+#include <stdexcept>
+#include <thread>
+
+namespace sylva {
+
+namespace {
+
+using render_common::CameraFrame;
+using render_common::Clock;
+using render_common::kShininess;
+using render_common::kSpecular;
+using render_common::seconds_since;
+using Rng = render_common::SampleRng;
+constexpr uint32_t kTile = 32;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+glm::dvec3 material_albedo(const ScenePlant& plant, uint32_t material) {
+  if (material == 0 && plant.bark.albedo_rgb) return *plant.bark.albedo_rgb;
+  constexpr uint32_t n = sizeof kMaterialAlbedo / sizeof kMaterialAlbedo[0];
+  const double* a = kMaterialAlbedo[std::min(material, n - 1)];
+  return {a[0], a[1], a[2]};
+}
+
+using render_common::camera_frame;
+using render_common::frame_ray;
+
+// A unit direction toward the sun: its centre for a point sun, else uniform over the disc
+// (uniform in solid angle: cos θ uniform in [cos α, 1]).
+glm::dvec3 sun_sample(const Sun& sun, const glm::dvec3& sun_direction, double cos_alpha, const AxisFrame& frame, Rng& rng) {
+  if (sun.angular_radius_deg <= 0) return sun_direction;
+  return render_common::sample_sun_disc(sun_direction, cos_alpha, frame, rng);
+}
+
+// What one primary sample saw (the trace pass's output, the shade pass's input).
+struct PrimaryHit {
+  Ray ray;
+  SurfaceHit surface;        // plant hit (surface.hit() false: none)
+  double ground_t = kInf;    // ground hit; kInf: none
+  uint64_t rng_state = 0;
+};
+
+class Renderer {
+ public:
+  Renderer(const Scene& scene, const SceneGeometry& geometry, const RenderOptions& options,
+           const SceneTextures* textures)
+      : scene_(scene), geometry_(geometry), options_(options), frame_(camera_frame(scene)),
+        tracer_(*geometry.tracer), sun_direction_(glm::normalize(scene.sun.direction)),
+        sun_frame_(axis_frame(sun_direction_)),
+        cos_alpha_(std::cos(scene.sun.angular_radius_deg * kPi / 180)),
+        sun_on_(scene.sun.radiance.x > 0 || scene.sun.radiance.y > 0 || scene.sun.radiance.z > 0),
+        textures_(textures) {
+    // Ray differentials: frame_ray is affine in (x, y), so the neighbouring sample's
+    // direction is the direction plus a constant; one pixel / sqrt(spp) (texture.h).
+    const double step = 1 / std::sqrt(static_cast<double>(std::max(1u, options.spp)));
+    direction_dx_ = (step * 2 * frame_.half_width / frame_.width) * frame_.right;
+    direction_dy_ = (-step * 2 * frame_.half_height / frame_.height) * frame_.up;
+  }
+
+  // Renders tile `index` into `image`; adds its thread time to *trace_s and *shade_s.
+  void render_tile(uint32_t index, RenderImage& image, double* trace_s, double* shade_s,
+                   uint64_t* shadow_rays) {
+    const uint32_t tiles_x = (scene_.width + kTile - 1) / kTile;
+    const uint32_t x0 = (index % tiles_x) * kTile, y0 = (index / tiles_x) * kTile;
+    const uint32_t x1 = std::min(x0 + kTile, scene_.width), y1 = std::min(y0 + kTile, scene_.height);
+    const uint32_t spp = std::max(1u, options_.spp);
+    const uint32_t grid_x = static_cast<uint32_t>(std::ceil(std::sqrt(static_cast<double>(spp))));
+    const uint32_t grid_y = (spp + grid_x - 1) / grid_x;
+    PrimaryHit hits[kTile * kTile];
+    glm::dvec3 sum[kTile * kTile];
+    for (auto& s : sum) s = glm::dvec3(0);
+    for (uint32_t sample = 0; sample < spp; ++sample) {
+      Clock::time_point start = Clock::now();
+      for (uint32_t y = y0; y < y1; ++y)
+        for (uint32_t x = x0; x < x1; ++x) {
+          PrimaryHit& h = hits[(y - y0) * kTile + (x - x0)];
+          Rng rng((static_cast<uint64_t>(y) * scene_.width + x) * 0x100000001B3ull + sample * 0x9E37ull);
+          double sx = 0.5, sy = 0.5;
+          if (spp > 1) {
+            sx = ((sample % grid_x) + rng.next_double()) / grid_x;
+            sy = ((sample / grid_x) + rng.next_double()) / grid_y;
+          }
+          trace(frame_ray(frame_, x + sx, y + sy), h);
+          h.rng_state = rng.state();
+        }
+      *trace_s += seconds_since(start);
+      start = Clock::now();
+      for (uint32_t y = y0; y < y1; ++y)
+        for (uint32_t x = x0; x < x1; ++x) {
+          const uint32_t k = (y - y0) * kTile + (x - x0);
+          sum[k] += shade(hits[k], shadow_rays);
+        }
+      *shade_s += seconds_since(start);
+    }
+    for (uint32_t y = y0; y < y1; ++y)
+      for (uint32_t x = x0; x < x1; ++x) {
+        const glm::dvec3 c = sum[(y - y0) * kTile + (x - x0)] / static_cast<double>(spp);
+        float* px = &image.beauty[(static_cast<size_t>(y) * scene_.width + x) * 4];
+        px[0] = static_cast<float>(c.r), px[1] = static_cast<float>(c.g), px[2] = static_cast<float>(c.b);
+        px[3] = 1;
+        if (options_.aovs) write_aovs(image, x, y, spp == 1 ? &hits[(y - y0) * kTile + (x - x0)] : nullptr);
+      }
+  }
+
+ private:
+  void trace(const Ray& ray, PrimaryHit& h) {
+    h.ray = ray;
+    h.surface = tracer_.nearest(ray, 0, kInf);
+    h.ground_t = kInf;
+    if (ray.direction.y < 0 && ray.origin.y > scene_.ground.height) {
+      double t = (scene_.ground.height - ray.origin.y) / ray.direction.y;
+      if (t < h.surface.t) h.ground_t = t;
+    }
+  }
+
+  // Sun visibility from `p` (offset along the geometric normal `n_geometric`, by at least
+  // `offset_m`).
+  double sun_visibility(const glm::dvec3& p, const glm::dvec3& n_geometric, const glm::dvec3& l,
+                        uint64_t* shadow_rays, double offset_m) {
+    const double scale = std::max({1.0, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    Ray shadow{p + std::max(1e-7 * scale, offset_m) * n_geometric, l};
+    ++*shadow_rays;
+    // The ground cannot shadow anything above it; only plants cast shadows.
+    return tracer_.any(shadow, 0, kInf) ? 0.0 : 1.0;
+  }
+
+  glm::dvec3 lit(const glm::dvec3& albedo, const glm::dvec3& n, const glm::dvec3& n_geometric,
+                 const glm::dvec3& p, const glm::dvec3& view, bool specular, Rng& rng,
+                 uint64_t* shadow_rays, double shadow_offset_m = 0) {
+    glm::dvec3 colour = albedo * scene_.sky * (0.5 * (1 + n.y));
+    if (!sun_on_) return colour;
+    const glm::dvec3 l = sun_sample(scene_.sun, sun_direction_, cos_alpha_, sun_frame_, rng);
+    const double n_dot_l = glm::dot(n, l);
+    if (n_dot_l <= 0 || glm::dot(n_geometric, l) <= 0) return colour;
+    const double visibility = sun_visibility(p, n_geometric, l, shadow_rays, shadow_offset_m);
+    if (visibility == 0) return colour;
+    glm::dvec3 brdf = albedo / kPi;
+    if (specular) {
+      const glm::dvec3 h = glm::normalize(l + view);
+      brdf += glm::dvec3(kSpecular * (kShininess + 8) / (8 * kPi) *
+                         std::pow(std::max(0.0, glm::dot(n, h)), kShininess));
+    }
+    return colour + brdf * scene_.sun.radiance * (n_dot_l * visibility);
+  }
+
+  glm::dvec3 shade(const PrimaryHit& h, uint64_t* shadow_rays) {
+    Rng rng(h.rng_state);
+    const glm::dvec3 view = -glm::normalize(h.ray.direction);
+    if (h.ground_t < kInf) {
+      const glm::dvec3 p = h.ray.origin + h.ground_t * h.ray.direction;
+      const glm::dvec3 up(0, 1, 0);
+      return lit(scene_.ground.albedo, up, up, p, view, false, rng, shadow_rays);
+    }
+    const SurfaceHit& s = h.surface;
+    if (!s.hit()) return scene_.sky;
+    glm::dvec3 n = s.shading_normal;
+    glm::dvec3 ng = s.geometric_normal;
+    if (glm::dot(ng, view) < 0) ng = -ng;   // seen from inside: light the side we see
+    if (glm::dot(n, view) < 0) n = -n;
+    const ScenePlant& plant = scene_.plants[s.plant];
+    glm::dvec3 albedo;
+    if (textures_ && textures_->has_albedo(s.plant)) {
+      const UvFootprint footprint = uv_footprint(s, {h.ray.origin, h.ray.direction + direction_dx_},
+                                                 {h.ray.origin, h.ray.direction + direction_dy_});
+      albedo = textures_->albedo(s.plant, s.u, s.v_m, footprint);
+    } else {
+      albedo = material_albedo(plant, s.material);
+    }
+    // A relief hit's shadow ray starts a pixel footprint above it (render_cpu.h).
+    const bool relief = textures_ && options_.geometry.relief && textures_->has_height(s.plant) &&
+                        plant.bark.relief_depth_m > 0;
+    const double shadow_offset_m = relief ? s.t * glm::length(direction_dy_) : 0.0;
+    return lit(albedo, n, ng, s.position, view, true, rng, shadow_rays, shadow_offset_m);
+  }
+
+  void write_aovs(RenderImage& image, uint32_t x, uint32_t y, const PrimaryHit* centre_hit) {
+    PrimaryHit local;
+    if (!centre_hit) {
+      trace(frame_ray(frame_, x + 0.5, y + 0.5), local);
+      centre_hit = &local;
+    }
+    const SurfaceHit& s = centre_hit->surface;
+    const size_t pixel = static_cast<size_t>(y) * scene_.width + x;
+    const bool hit = s.hit();
+    glm::dvec3 n(0);
+    if (hit) {
+      n = s.shading_normal;
+      if (glm::dot(n, centre_hit->ray.direction) > 0) n = -n;
+    }
+    if (!image.depth.empty())
+      image.depth[pixel] = hit ? static_cast<float>(s.t * glm::length(centre_hit->ray.direction))
+                               : std::numeric_limits<float>::infinity();
+    if (!image.normal.empty())
+      for (int k = 0; k < 3; ++k) image.normal[pixel * 3 + k] = static_cast<float>(n[k]);
+    if (!image.uv.empty()) {
+      image.uv[pixel * 2 + 0] = hit ? static_cast<float>(s.u) : 0.0f;
+      image.uv[pixel * 2 + 1] = hit ? static_cast<float>(s.v_m) : 0.0f;
+    }
+    if (!image.id.empty()) {
+      image.id[pixel * 3 + 0] = hit ? static_cast<float>(s.plant) : -1.0f;
+      image.id[pixel * 3 + 1] = hit ? static_cast<float>(s.chain) : -1.0f;
+      image.id[pixel * 3 + 2] = hit ? static_cast<float>(s.segment) : -1.0f;
+    }
+  }
+
+  const Scene& scene_;
+  const SceneGeometry& geometry_;
+  const RenderOptions& options_;
+  const CameraFrame frame_;
+  const SceneTracer& tracer_;
+  const glm::dvec3 sun_direction_;
+  const AxisFrame sun_frame_;
+  const double cos_alpha_;
+  const bool sun_on_;
+  const SceneTextures* textures_;  // bark albedo textures; nullptr: none
+  glm::dvec3 direction_dx_{0}, direction_dy_{0};  // ray differentials' direction offsets
+};
+
+void draw_progress(uint32_t done, uint32_t total, double elapsed_s) {
+  constexpr int kWidth = 40;
+  const int filled = static_cast<int>(kWidth * static_cast<double>(done) / total);
+  char bar[kWidth + 1];
+  for (int i = 0; i < kWidth; ++i) bar[i] = i < filled ? '#' : '.';
+  bar[kWidth] = 0;
+  std::fprintf(stderr, "\rsylva render: [%s] %3d%% %.1f s", bar, static_cast<int>(100.0 * done / total),
+               elapsed_s);
+  std::fflush(stderr);
+}
+
+// The relief of the frusta tracer (relief.h): every plant whose bark has a height map and
+// a relief depth > 0, when options.relief. Textures come from `textures`, else are opened
+// into g.own_textures. Adds the "relief" pass: its plants, or "none" (no marching).
+SceneRelief scene_relief(const Scene& scene, const GeometryOptions& options, const SceneTextures* textures,
+                         SceneGeometry& g, std::vector<RenderPass>* passes) {
+  SceneRelief relief;
+  relief.options = options.relief_options;
+  const Clock::time_point start = Clock::now();
+  std::vector<char> skinned(scene.plants.size(), 0);  // culled plants have no frusta
+  for (uint32_t p : g.plant_of_frustum) skinned[p] = 1;
+  std::vector<uint32_t> plants;
+  for (uint32_t p = 0; p < scene.plants.size(); ++p)
+    if (options.relief && skinned[p] && scene.plants[p].bark.height_texture && scene.plants[p].bark.relief_depth_m > 0)
+      plants.push_back(p);
+  if (!plants.empty() && !textures) {
+    SceneTextures::OpenResult opened = SceneTextures::open(scene);
+    if (opened.error) throw std::runtime_error(*opened.error);
+    g.own_textures = std::move(opened.textures);
+    textures = g.own_textures.get();
+  }
+  if (!plants.empty()) {
+    relief.plants.resize(scene.plants.size());
+    for (uint32_t p : plants) relief.plants[p] = textures->relief_map(p);
+  }
+  if (passes) {
+    const ReliefOptions& o = relief.options;
+    passes->push_back({"relief", seconds_since(start),
+                       plants.empty() ? std::string("none")
+                                      : std::to_string(plants.size()) + (plants.size() == 1 ? " plant, " : " plants, ") +
+                                            std::to_string(o.linear_steps) +
+                                            " linear + " + std::to_string(o.bisection_steps) + " bisection steps, v " +
+                                            (o.exact_v ? "exact" : "linear")});
+  }
+  return relief;
+}
+
+}  // namespace
+
+SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, const GeometryOptions& options,
+                                   std::vector<RenderPass>* passes, const SceneTextures* textures) {
+  SceneGeometry g;
+  const bool mesh = options.kind == GeometryKind::mesh;
+  TessellateOptions tessellation;
+  tessellation.level = options.mesh_level;
+  // Height maps for GS+R: the caller's textures, else opened here for as long as needed.
+  bool any_height = false;
+  for (const ScenePlant& plant : scene.plants) any_height = any_height || plant.bark.height_texture.has_value();
+  std::unique_ptr<SceneTextures> own_textures;
+  if (mesh && options.displace && any_height && !textures) {
+    SceneTextures::OpenResult opened = SceneTextures::open(scene);
+    if (opened.error) throw std::runtime_error(*opened.error);
+    own_textures = std::move(opened.textures);
+    textures = own_textures.get();
+  }
+  const ViewFrustum view = view_frustum(scene);
+  double cull_s = 0, skin_s = 0, tessellate_s = 0, displace_s = 0;
+  uint32_t culled = 0, displaced = 0;
+  TriangleMesh triangles;
+  for (uint32_t p = 0; p < scene.plants.size(); ++p) {
+    const ScenePlant& plant = scene.plants[p];
+    Clock::time_point start = Clock::now();
+    Skeleton placed = place_plant(plant);
+    skin_s += seconds_since(start);
+    if (options.cull) {
+      start = Clock::now();
+      // A relief or displacement reaches out to relief_depth_m beyond the frusta.
+      const double relief_m = plant.bark.height_texture ? std::max(0.0, plant.bark.relief_depth_m) : 0.0;
+      const bool out = plant_is_culled(scene, view, plant_box(placed, skin, relief_m));
+      cull_s += seconds_since(start);
+      if (out) {
+        ++culled;
+        continue;
+      }
+    }
+    start = Clock::now();
+    const SkinnedSkeleton skinned = skin_skeleton(placed, skin);
+    const uint32_t first_frustum = static_cast<uint32_t>(g.frusta.size());
+    g.frusta.insert(g.frusta.end(), skinned.frusta.begin(), skinned.frusta.end());
+    g.plant_of_frustum.insert(g.plant_of_frustum.end(), skinned.frusta.size(), p);
+    skin_s += seconds_since(start);
+    if (!mesh) continue;
+    const HeightFn height = options.displace && textures ? height_function_for(*textures, p) : HeightFn{};
+    TriangleMesh part = plant_mesh(skinned, tessellation, height, plant.bark.relief_depth_m,
+                                   options.relief_options.max_depth_per_radius, &tessellate_s, &displace_s);
+    if (height) ++displaced;
+    start = Clock::now();
+    if (triangles.positions.empty()) {  // the first plant's mesh is taken, not copied
+      for (uint32_t& f : part.triangle_frustum) f += first_frustum;
+      triangles = std::move(part);
+    } else {
+      append_mesh(triangles, part, first_frustum);
+    }
+    tessellate_s += seconds_since(start);
+  }
+  const std::string plants = std::to_string(scene.plants.size());
+  if (passes && options.cull)
+    passes->push_back({"culling", cull_s, std::to_string(culled) + " of " + plants + " plants culled"});
+  if (passes)
+    passes->push_back({"skin", skin_s,
+                       std::to_string(scene.plants.size() - culled) + " plants, " + std::to_string(g.frusta.size()) +
+                           " frusta"});
+  if (passes && mesh)
+    passes->push_back({"tessellate", tessellate_s,
+                       std::to_string(triangles.triangle_count()) + " triangles, GS " +
+                           std::to_string(options.mesh_level) + ", " + std::to_string(triangles.memory_bytes() / 1024) +
+                           " KiB"});
+  if (passes && displaced > 0)
+    passes->push_back({"displace", displace_s, std::to_string(displaced) + " plants by their height maps"});
+  Clock::time_point start = Clock::now();
+  switch (options.kind) {
+    case GeometryKind::frusta:
+      g.tracer = std::make_unique<FrustumTracer>(g.frusta, g.plant_of_frustum,
+                                                 scene_relief(scene, options, textures, g, passes));
+      break;
+    case GeometryKind::mesh:
+      g.tracer = std::make_unique<MeshTracer>(std::move(triangles), g.frusta, g.plant_of_frustum, options.mesh_level,
+                                              displaced > 0);
+      break;
+  }
+  if (passes)
+    passes->push_back({"accel build", seconds_since(start),
+                       g.tracer->describe() + ", " + std::to_string(g.tracer->memory_bytes() / 1024) + " KiB"});
+  return g;
+}
+
+RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
+  RenderResult result;
+  for (const ScenePlant& plant : scene.plants)
+    if (!plant.skeleton) throw std::logic_error("render_cpu: a plant has no skeleton (call grow_scene_plants)");
+  // Bark textures: opened once, for the shading and for the relief or displacement.
+  std::unique_ptr<SceneTextures> textures;
+  if (std::any_of(scene.plants.begin(), scene.plants.end(), [](const ScenePlant& p) {
+        return p.bark.albedo_texture || p.bark.height_texture;
+      })) {
+    const Clock::time_point start = Clock::now();
+    SceneTextures::OpenResult opened = SceneTextures::open(scene);
+    if (opened.error) throw std::runtime_error(*opened.error);
+    textures = std::move(opened.textures);
+    result.passes.push_back({"textures", seconds_since(start), std::to_string(textures->file_count()) + " files"});
+  }
+  // The relief's shading normal is filtered over a pixel's footprint (relief.h): the
+  // angle between neighbouring samples' rays at the image centre.
+  GeometryOptions geometry_options = options.geometry;
+  geometry_options.relief_options.pixel_spread_rad =
+      2 * std::tan(0.5 * scene.camera.fov_y_deg * kPi / 180) / scene.height /
+      std::sqrt(static_cast<double>(std::max(1u, options.spp)));
+  SceneGeometry geometry = build_scene_geometry(scene, options.skin, geometry_options, &result.passes, textures.get());
+  result.frusta = geometry.frusta.size();
+  result.geometry_bytes = geometry.tracer->memory_bytes();
+
+  RenderImage& image = result.image;
+  image.width = scene.width;
+  image.height = scene.height;
+  const size_t pixels = static_cast<size_t>(scene.width) * scene.height;
+  image.beauty.assign(pixels * 4, 0.0f);
+  if (options.aovs & kAovDepth) image.depth.assign(pixels, 0.0f);
+  if (options.aovs & kAovNormal) image.normal.assign(pixels * 3, 0.0f);
+  if (options.aovs & kAovUv) image.uv.assign(pixels * 2, 0.0f);
+  if (options.aovs & kAovId) image.id.assign(pixels * 3, 0.0f);
+
+  const uint32_t tiles_x = (scene.width + kTile - 1) / kTile;
+  const uint32_t tiles_y = (scene.height + kTile - 1) / kTile;
+  const uint32_t tiles = tiles_x * tiles_y;
+  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  threads = std::min<unsigned>(threads, tiles);
+
+  Renderer renderer(scene, geometry, options, textures.get());
+  std::atomic<uint32_t> next_tile{0}, done_tiles{0};
+  std::mutex totals_mutex;
+  double trace_s = 0, shade_s = 0;
+  uint64_t shadow_rays = 0;
+  auto worker = [&] {
+    double my_trace = 0, my_shade = 0;
+    uint64_t my_shadow = 0;
+    for (;;) {
+      if (options.cancel && options.cancel->load(std::memory_order_relaxed)) break;
+      const uint32_t tile = next_tile.fetch_add(1, std::memory_order_relaxed);
+      if (tile >= tiles) break;
+      renderer.render_tile(tile, image, &my_trace, &my_shade, &my_shadow);
+      done_tiles.fetch_add(1, std::memory_order_release);
+    }
+    std::lock_guard lock(totals_mutex);
+    trace_s += my_trace;
+    shade_s += my_shade;
+    shadow_rays += my_shadow;
+  };
+
+  const Clock::time_point start = Clock::now();
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
+  if (options.progress) {
+    // This thread draws the bar; the workers render.
+    pool.emplace_back(worker);
+    bool drawn = false;
+    while (done_tiles.load(std::memory_order_acquire) < tiles &&
+           !(options.cancel && options.cancel->load())) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      const double elapsed = seconds_since(start);
+      if (elapsed > 1.0) draw_progress(done_tiles.load(), tiles, elapsed), drawn = true;
+    }
+    for (std::thread& t : pool) t.join();
+    if (drawn) {
+      draw_progress(done_tiles.load(), tiles, seconds_since(start));
+      std::fputc('\n', stderr);
+    }
+  } else {
+    worker();
+    for (std::thread& t : pool) t.join();
+  }
+  const double wall = seconds_since(start);
+  result.cancelled = done_tiles.load() < tiles;
+  result.primary_rays = pixels * std::max(1u, options.spp);
+  result.shadow_rays = shadow_rays;
+  result.passes.push_back({"trace + shade (wall)", wall,
+                           std::to_string(threads) + " threads, " + std::to_string(tiles) + " tiles of 32x32"});
+  result.passes.push_back({"trace (thread time)", trace_s,
+                           std::to_string(result.primary_rays) + " primary rays, " +
+                               std::to_string(options.spp) + " spp"});
+  result.passes.push_back({"shade (thread time)", shade_s,
+                           std::to_string(shadow_rays) + (scene.sun.angular_radius_deg > 0 ? " soft" : " hard") +
+                               " shadow rays"});
+  return result;
+}
+
+}  // namespace sylva

@@ -1,0 +1,91 @@
+// render_cpu.h — the CPU reference ray caster (issue 3, sec. 2): one ray per sample
+// through a pinhole camera, conical frusta (skin.h) found through Embree (frustum_accel.h) and
+// intersected exactly (ray_frustum.h), shaded under the scene's sun and sky over a
+// ground plane. The GPU ray caster must match it.
+//
+// Shading (linear RGB), at a point with albedo ρ, unit shading normal n facing the ray,
+// sun direction l, view direction v, half vector h = normalize(l + v):
+//   L = ρ/π · E_sun · max(n·l, 0) · V                   (Lambert under the sun)
+//     + k_s · (s + 8)/(8π) · (n·h)^s · E_sun · max(n·l, 0) · V   (normalised Blinn-Phong)
+//     + ρ · L_sky · (1 + n_y)/2                          (sky ambient: the sky's share
+//                                                         of the hemisphere around n)
+// with E_sun = scene.sun.radiance, L_sky = scene.sky, k_s = 0.04, s = 40, V the sun's
+// visibility: one shadow ray per sample toward the sun's centre when its angular radius
+// is 0 (hard shadows), else toward a uniform point of the sun's disc (soft shadows that
+// converge with --spp). The ground (y = ground.height, normal +Y, no specular) is shaded
+// the same way, with the plants' shadows. A ray that hits nothing sees L_sky.
+// Plant albedo comes from the material index (kMaterialAlbedo); bark.albedo given as a
+// colour replaces material 0 (wood); bark.albedo given as a texture covers every segment
+// of its plant whatever its material (texture.h: mipmapped lookup, sRGB decoded after
+// filtering), filtered over the footprint of the ray differentials through the
+// neighbouring pixel positions, one pixel step / sqrt(spp) away (texture.h uv_footprint).
+// Normals: the C0-interpolated normal of eq. 8; on a relief-mapped plant (bark.height,
+// GeometryOptions::relief) the relief surface of relief.h with its perturbed normal,
+// filtered over the pixel's footprint (ReliefOptions::pixel_spread_rad, set here from the
+// camera: 2·tan(fov_y/2)/height/sqrt(spp)). A relief hit's shadow ray starts one pixel
+// footprint (t·|∂direction/∂y|) above it along its geometric normal, instead of the usual
+// 1e-7·scale: relief roughness below a pixel is shaded through the filtered normal and
+// must not also shadow itself from the finest-level geometry (which aliases to speckles).
+//
+// Outputs: beauty RGBA (linear; A = 1 everywhere, the sky is part of the picture) and, on
+// request, AOVs of the plant surface seen through each pixel's centre: depth (Euclidean
+// distance from the eye, +inf where no plant is hit — the ground and the sky are not
+// plants), world-space shading normal (0 on a miss), uv (u turns, v_m metres of arc
+// length; 0 on a miss), id (plant, chain, segment as floats, exact below 2^24; −1 on a
+// miss). For a knuckle frustum id.segment is the joint's index.
+//
+// Sampling: --spp N takes N stratified samples per pixel (a jittered ceil(sqrt N)-wide
+// grid); N = 1 samples the centre exactly. Random numbers depend only on the pixel and
+// sample, so images are identical for every thread count.
+//
+// Threads: 32×32 tiles handed out by an atomic counter to `threads` workers.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <memory>
+#include <vector>
+
+#include "core/materials.h"  // kMaterialAlbedo: default albedo by material index
+#include "core/relief.h"
+#include "core/render_common.h"  // camera_ray: the camera convention both renderers follow
+#include "core/render_types.h"
+#include "core/scene.h"
+#include "core/skin.h"
+#include "core/surface.h"
+#include "core/tessellate.h"
+
+namespace sylva {
+
+class SceneTextures;  // texture.h
+
+// World-space geometry of a scene: every plant's skeleton transformed (position,
+// rotate_y_deg, scale) and skinned, and what the renderer traces: the frusta themselves
+// or a mesh made from them (GeometryOptions).
+struct SceneGeometry {
+  std::vector<Frustum> frusta;
+  std::vector<uint32_t> plant_of_frustum;  // plant index of each frustum
+  std::shared_ptr<const SceneTextures> own_textures;  // opened here when the caller gave
+                                                      // none and the relief needs them
+  std::unique_ptr<SceneTracer> tracer;     // over `frusta` (or a mesh made from them)
+};
+
+// Skins and indexes every plant (each plant's skeleton must be set: grow_scene_plants)
+// that geometry.cull does not leave out (culling.h; a culled plant has no frusta, its
+// index stays valid), then builds the tracer: the frusta, or their GS mesh at
+// geometry.mesh_level in Embree (mesh_accel.h), displaced where geometry.displace and the
+// plant has a height map (as deep as the relief shell is thick: relief.h's
+// max_depth_per_radius thins it on twigs and needles). `textures` supplies the height maps; null: they are opened here
+// when a displaced mesh needs them (std::runtime_error naming the file if one cannot be).
+// Passes: "culling" (when on), "skin", "tessellate" and "displace" (mesh), "accel build".
+SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin,
+                                   const GeometryOptions& geometry = {},
+                                   std::vector<RenderPass>* passes = nullptr,
+                                   const SceneTextures* textures = nullptr);
+
+// Renders `scene` (every plant's skeleton set). Deterministic for any thread count.
+RenderResult render_cpu(const Scene& scene, const RenderOptions& options);
+
+}  // namespace sylva

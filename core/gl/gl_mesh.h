@@ -1,0 +1,135 @@
+// gl_mesh.h — the polygon baseline on the GPU (issue 4 §3; paper 000 sec. 4, "GS" and
+// "GS+R"): the tessellated meshes of the CPU reference's mesh path rasterised into the
+// G-buffer of the GL ray caster (render_gl.h), which then shades them exactly as it shades
+// the ray-cast frusta. GlRenderer uses it when RenderOptions::geometry.kind is mesh.
+//
+// The meshes are the CPU's (render_cpu.cpp build_scene_geometry, GeometryKind::mesh), made
+// by the same functions: each plant placed (place_plant), skinned (skin_skeleton with
+// RenderOptions::skin), tessellated at GeometryOptions::mesh_level (tessellate.h: 16·4^m
+// triangles per segment) and, where GeometryOptions::displace and the plant's bark has a
+// height map and relief_depth_m > 0, displaced by it (GS+R: displace with
+// height_function_for, through plant_mesh). Plants are not culled (the CPU culls only
+// plants that cannot change a pixel).
+//
+// Upload, once (and again by update):
+//   vertices  36 B each: position in metres relative to its plant's origin_hi (float; the
+//             origin is a float-exact point at the plant's centre, and the shader adds
+//             back eye − origin_hi as (eye_hi − origin_hi) + eye_lo, so 10^6 m offsets
+//             keep float precision as frusta_common.glsl's records do), unit shading
+//             normal, (u turns, v_m metres), frustum index;
+//   indices   uint32, 3 per triangle (tessellate.h's, counter-clockwise from outside);
+//   frusta    32 B each: its plant's origin_hi, then plant | material << 24, chain,
+//             segment (knuckle: joint), 0 — shader storage binding 7 (the renderer's
+//             buffers take 0–3).
+//
+// Drawing: the caller binds the framebuffer, clears it and sets the depth test; the draw
+// binds its own program, vertex array and buffers, disables face culling (the CPU's Embree
+// triangles are hit from both sides) and restores the vertex array and the culling state.
+//   draw_gbuffer  shaders/mesh.*.glsl GBUFFER_PASS: frusta.vert.glsl's jittered reversed-Z
+//                 infinite projection (depth = near / z_forward, so GL_GREATER against a
+//                 cleared 0), and the G-buffer of frusta.frag.glsl: location 0 shading
+//                 normal toward the eye + Euclidean distance, 1 geometric normal toward the
+//                 eye + u, 2 plant | material << 24, chain, segment, v_m bits, 3 albedo:
+//                 with bark_texture_units > 0 bark.glsl's bark_albedo over the screen
+//                 derivatives of (u, v_m) (the ray differentials' footprint on a plane),
+//                 a = 1 where the plant has an albedo texture; else 0 (the material
+//                 table). The renderer binds bark.glsl's maps and images (render_gl.cpp).
+//   draw_shadow   SHADOW_PASS: depth only in the orthographic sun view of frusta.vert.glsl
+//                 (depth (s − s_near) / s_range, GL_LESS against a cleared 1).
+//
+// Against the CPU's MeshTracer (mesh_accel.h), by design: the rasteriser's coverage rules
+// instead of Embree's watertight test (a silhouette pixel may differ); float interpolation
+// of the vertex attributes instead of double barycentrics (depth ~1e-7 relative); the
+// geometric normal from screen derivatives of the interpolated position in the plant's
+// frame (the triangle's plane, to float precision) instead of the cross product of its
+// edges; the bark albedo through GL's trilinear filter (bark.glsl says how it differs
+// from OpenImageIO's).
+//
+// Preconditions: an OpenGL 4.5 core context is current on the calling thread for the
+// object's whole life; every plant's skeleton is set. Failures throw GlError (GL) or
+// std::runtime_error (a height map that cannot be opened).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/render_types.h"
+#include "core/scene.h"
+
+namespace sylva {
+
+class SceneTextures;  // texture.h
+
+// The camera of one G-buffer pass (render_common.h's CameraFrame and the pass's jitter).
+struct GlMeshCamera {
+  glm::dvec3 eye{0}, right{1, 0, 0}, up{0, 1, 0}, forward{0, 0, -1};  // unit frame
+  double half_width = 1, half_height = 1;  // the image plane's half extents at distance 1
+  uint32_t width = 1, height = 1;          // pixels
+  double near = 1e-3;                      // reversed-Z near plane, metres along forward
+  double jitter_x = 0.5, jitter_y = 0.5;   // where in its pixel the pass samples
+  double footprint_scale = 1;              // 1 / sqrt(spp): the bark albedo's ray differentials
+};
+
+// The orthographic sun view of one shadow pass (frusta_common.glsl's SHADOW_PASS uniforms).
+struct GlMeshSunView {
+  glm::dvec3 centre{0};                          // c, metres
+  glm::dvec3 e0{1, 0, 0}, e1{0, 0, 1};           // axis_frame(direction)
+  glm::dvec3 direction{0, 1, 0};                 // unit, toward the sun
+  double x_min = 0, y_min = 0, side = 1;         // the square map, metres relative to c
+  double s_near = 0, s_range = 1;                // s = −dot(p − c, direction)
+};
+
+// A sphere around one frustum's triangles (displaced ones included), metres.
+struct GlMeshSphere {
+  glm::dvec3 centre{0};
+  double radius = 0;
+};
+
+class GlMesh {
+ public:
+  // Tessellates (and displaces) every plant of `scene` as RenderOptions::geometry asks
+  // and uploads the result; builds the G-buffer program, and the shadow program when the
+  // scene's sun shines. `bark_texture_units` > 0: the number of bark images the renderer
+  // binds for bark.glsl (the G-buffer program then writes the bark albedo). `textures`
+  // supplies the height maps; null: opened here when a displaced mesh needs them.
+  GlMesh(const Scene& scene, const RenderOptions& options, int bark_texture_units = 0,
+         const SceneTextures* textures = nullptr);
+  ~GlMesh();
+  GlMesh(const GlMesh&) = delete;
+  GlMesh& operator=(const GlMesh&) = delete;
+
+  // Re-tessellates the plants of `scene` (moved skeletons: animation) and uploads the
+  // meshes again, whole (the polygon baseline has no lighter record to send). Returns the
+  // bytes uploaded.
+  uint64_t update(const Scene& scene, const SceneTextures* textures = nullptr);
+
+  // One G-buffer pass / one shadow-map pass (see the header comment for what the caller
+  // sets up).
+  void draw_gbuffer(const GlMeshCamera& camera);
+  void draw_shadow(const GlMeshSunView& view);
+
+  uint64_t triangles() const;   // triangles uploaded
+  uint64_t frusta() const;      // frusta tessellated
+  uint64_t gpu_bytes() const;   // bytes in the vertex, index and frustum buffers
+  int level() const;            // GeometryOptions::mesh_level
+  bool displaced() const;       // whether any plant was displaced (GS+R)
+  // "GS 2" or "GS+R 2".
+  std::string label() const;
+  // The name of the G-buffer program variant (gl_shaders.h mesh_program).
+  std::string gbuffer_variant() const;
+  // One per frustum: for the renderer's near plane and shadow-map frame.
+  const std::vector<GlMeshSphere>& bounding_spheres() const;
+  // What the constructor (or the last update) did: "skin", "tessellate", "displace" (when
+  // a plant was), "upload", and "programs" (constructor only).
+  const std::vector<RenderPass>& setup_passes() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace sylva

@@ -1,0 +1,164 @@
+// gl_shaders.cpp — see gl_shaders.h.
+#include "core/gl/gl_shaders.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace sylva {
+
+std::string_view embedded_shader(std::string_view name) {
+  for (size_t i = 0; i < kEmbeddedShaderCount; ++i)
+    if (name == kEmbeddedShaders[i].name) return kEmbeddedShaders[i].source;
+  throw std::logic_error("embedded_shader: no shaders/" + std::string(name) + " in this build");
+}
+
+std::string assemble_shader(const ShaderStageSource& stage) {
+  std::string text = "#version 450 core\n";
+  for (const std::string& define : stage.defines) text += "#define " + define + "\n";
+  for (size_t i = 0; i < stage.files.size(); ++i) {
+    text += "#line 1 " + std::to_string(i) + "\n";
+    text += embedded_shader(stage.files[i]);
+    if (text.back() != '\n') text += '\n';
+  }
+  return text;
+}
+
+std::string format_shader_log(const ShaderStageSource& stage, const std::string& log) {
+  // Mesa writes "N:L(C): error: ...", glslang "ERROR: N:L: ...": a number right before
+  // ':' at the start of a line or after "ERROR: " / "WARNING: " is a source string.
+  std::string out;
+  size_t line_start = 0;
+  while (line_start < log.size()) {
+    size_t line_end = log.find('\n', line_start);
+    if (line_end == std::string::npos) line_end = log.size();
+    std::string line = log.substr(line_start, line_end - line_start);
+    size_t p = 0;
+    for (const char* prefix : {"ERROR: ", "WARNING: "})
+      if (line.rfind(prefix, 0) == 0) p = std::string(prefix).size();
+    size_t digits = p;
+    while (digits < line.size() && line[digits] >= '0' && line[digits] <= '9') ++digits;
+    if (digits > p && digits < line.size() && line[digits] == ':') {
+      const size_t index = std::stoul(line.substr(p, digits - p));
+      if (index < stage.files.size()) line = line.substr(0, p) + stage.files[index] + line.substr(digits);
+    }
+    out += line + "\n";
+    line_start = line_end + 1;
+  }
+  return out;
+}
+
+namespace {
+
+// The frusta program's shared files, in the order of the C++ they mirror: the intersector
+// (ray_frustum.h), skinning and the GPU record (skin.h), the views (shared with the
+// meshes), then the pass's interface.
+const std::vector<std::string> kFrustaCommon = {"ray_frustum.glsl", "skin.glsl", "views.glsl", "frusta_common.glsl"};
+
+std::vector<std::string> with(std::vector<std::string> files, const std::string& last) {
+  files.push_back(last);
+  return files;
+}
+
+}  // namespace
+
+ShaderProgramSource frusta_program(FrustaPass pass, const FrustaFeatures& features) {
+  ShaderProgramSource p;
+  std::vector<std::string> defines;
+  switch (pass) {
+    case FrustaPass::gbuffer:
+      defines = {"GBUFFER_PASS"};
+      break;
+    case FrustaPass::gbuffer_eye_inside:
+      defines = {"GBUFFER_PASS", "EYE_INSIDE"};
+      break;
+    case FrustaPass::shadow:
+      defines = {"SHADOW_PASS"};
+      break;
+  }
+  const bool shadow = pass == FrustaPass::shadow;
+  const bool bark = features.bark && !shadow;
+  // The G-buffer pass's relief filters the normal's heights through the height texture;
+  // the shadow pass reads the finest level alone (height_texels).
+  const int units = (bark || (features.relief && !shadow)) ? std::max(1, features.texture_units) : 0;
+  if (features.want_uv && !shadow) defines.push_back("WANT_UV");
+  if (features.relief) defines.push_back("RELIEF");
+  if (bark) defines.push_back("BARK");
+  if (units > 0) defines.push_back("BARK_TEXTURE_UNITS " + std::to_string(units));
+  if (!features.conservative_depth) defines.push_back("NO_CONSERVATIVE_DEPTH");
+  p.name = "frusta[";
+  for (size_t i = 0; i < defines.size(); ++i) {
+    std::string name = defines[i];
+    if (name.rfind("BARK_TEXTURE_UNITS ", 0) == 0) name = "TEXTURE_UNITS=" + std::to_string(units);
+    p.name += (i ? " " : "") + name;
+  }
+  p.name += "]";
+  std::vector<std::string> files = kFrustaCommon;
+  if (features.relief || bark) files.push_back("bark.glsl");
+  if (features.relief) files.push_back("relief.glsl");
+  p.vertex = {ShaderStage::vertex, with(files, "frusta.vert.glsl"), defines};
+  p.fragment = {ShaderStage::fragment, with(files, "frusta.frag.glsl"), defines};
+  return p;
+}
+
+ShaderProgramSource frusta_program(FrustaPass pass, bool want_uv) {
+  FrustaFeatures features;
+  features.want_uv = want_uv;
+  return frusta_program(pass, features);
+}
+
+ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units) {
+  const bool shadow = pass == MeshPass::shadow;
+  std::vector<std::string> defines = {shadow ? "SHADOW_PASS" : "GBUFFER_PASS"};
+  ShaderProgramSource p;
+  p.name = shadow ? "mesh[SHADOW_PASS" : "mesh[GBUFFER_PASS";
+  std::vector<std::string> fragment_files = {"mesh.frag.glsl"};
+  if (!shadow && bark_texture_units > 0) {
+    defines.push_back("BARK_TEXTURE_UNITS " + std::to_string(bark_texture_units));
+    p.name += " TEXTURE_UNITS=" + std::to_string(bark_texture_units);
+    fragment_files.insert(fragment_files.begin(), "bark.glsl");
+  }
+  p.name += "]";
+  p.vertex = {ShaderStage::vertex, {"views.glsl", "mesh.vert.glsl"}, defines};
+  p.fragment = {ShaderStage::fragment, fragment_files, defines};
+  return p;
+}
+
+ShaderProgramSource shade_program(bool sun) {
+  ShaderProgramSource p;
+  std::vector<std::string> defines;
+  if (sun) defines.push_back("SUN");
+  p.name = sun ? "shade[SUN]" : "shade[]";
+  p.vertex = {ShaderStage::vertex, {"fullscreen.vert.glsl"}, {}};
+  p.fragment = {ShaderStage::fragment, {"bark.glsl", "shade.frag.glsl"}, defines};
+  return p;
+}
+
+std::vector<ShaderProgramSource> all_shader_programs() {
+  std::vector<ShaderProgramSource> all;
+  for (FrustaPass pass : {FrustaPass::gbuffer, FrustaPass::gbuffer_eye_inside, FrustaPass::shadow})
+    for (bool uv : {false, true})
+      for (bool relief : {false, true})
+        for (bool bark : {false, true}) {
+          if (pass == FrustaPass::shadow && (uv || bark)) continue;
+          FrustaFeatures features;
+          features.want_uv = uv;
+          features.relief = relief;
+          features.bark = bark;
+          features.texture_units = relief && bark ? 2 : 1;  // one image each (albedo, height)
+          all.push_back(frusta_program(pass, features));
+        }
+  // Without the conservative depth layouts (early-Z measurements).
+  for (FrustaPass pass : {FrustaPass::gbuffer, FrustaPass::shadow}) {
+    FrustaFeatures features;
+    features.conservative_depth = false;
+    all.push_back(frusta_program(pass, features));
+    features.relief = true;
+    all.push_back(frusta_program(pass, features));
+  }
+  for (MeshPass pass : {MeshPass::gbuffer, MeshPass::shadow}) all.push_back(mesh_program(pass));
+  all.push_back(mesh_program(MeshPass::gbuffer, 1));  // with the bark albedo
+  for (bool sun : {false, true}) all.push_back(shade_program(sun));
+  return all;
+}
+
+}  // namespace sylva

@@ -1,0 +1,34 @@
+// render_output.h — a render's images in files (cli.md): the beauty and every AOV the
+// image holds, each file written atomically (util/image_io.h).
+//
+// Encodings by the target's extension:
+//   .exr             linear; beauty R G B A as half, AOVs as extra float channels in the
+//                    same file (Z; N.X N.Y N.Z; U V; id.plant id.chain id.segment)
+//   .hdr .pfm .tif .tiff   linear float beauty; AOVs in side files as for a PNG
+//   anything else OIIO writes (.png, .jpg, ...)   8-bit sRGB-encoded beauty; each AOV
+//                    goes to its own EXR next to it, named after the image without its
+//                    extension: saguaro.png → saguaro.depth.exr, saguaro.normal.exr,
+//                    saguaro.uv.exr, saguaro.id.exr
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/render_types.h"
+#include "core/util/file_io.h"
+
+namespace sylva {
+
+// The file each AOV goes to for `image_path` (itself for an EXR; a side file otherwise).
+std::string aov_path(const std::string& image_path, const std::string& aov_name);
+
+// Writes a render: the beauty and every AOV the image holds, as described above.
+// Returns the paths written, or the first error (files already renamed stay).
+struct ImageWriteResult {
+  std::vector<std::string> written;
+  std::optional<FileError> error;
+};
+ImageWriteResult write_render(const std::string& path, const RenderImage& image);
+
+}  // namespace sylva

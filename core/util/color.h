@@ -1,0 +1,13 @@
+// color.h — the sRGB transfer function both ways (IEC 61966-2-1), shared by image output
+// (linear → encoded), texture lookups (encoded → linear, after filtering) and plots.
+#pragma once
+
+namespace sylva {
+
+// The encoded value of a linear one, clamped to [0, 1] (NaN gives 0).
+float linear_to_srgb(float linear);
+
+// The linear value of an encoded one in [0, 1] (clamped).
+double srgb_to_linear(double encoded);
+
+}  // namespace sylva

@@ -1,0 +1,124 @@
+// image_io.cpp — OpenImageIO output, made atomic by a temporary file and rename().
+#include "core/util/image_io.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+namespace sylva {
+
+namespace {
+
+OIIO::TypeDesc oiio_type(ChannelFormat f) {
+  switch (f) {
+    case ChannelFormat::uint8: return OIIO::TypeDesc::UINT8;
+    case ChannelFormat::half: return OIIO::TypeDesc::HALF;
+    case ChannelFormat::float32: return OIIO::TypeDesc::FLOAT;
+  }
+  return OIIO::TypeDesc::FLOAT;
+}
+
+std::string temporary_path_for(const std::string& path) {
+  static std::atomic<uint64_t> counter{0};
+  std::filesystem::path p(path);
+  std::string name = "." + p.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+                     std::to_string(counter.fetch_add(1));
+  return (p.parent_path() / name).string();
+}
+
+}  // namespace
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+std::optional<FileError> write_image_atomically(const std::string& path, uint32_t width, uint32_t height,
+                                                const std::vector<std::string>& channel_names,
+                                                const std::vector<float>& pixels,
+                                                const std::vector<ChannelFormat>& formats, bool srgb) {
+  const size_t channels = channel_names.size();
+  if (path.empty() || path.back() == '/') return FileError{path, "not a file name", 0};
+  if (channels == 0 || pixels.size() != static_cast<size_t>(width) * height * channels ||
+      (formats.size() != 1 && formats.size() != channels))
+    return FileError{path, "internal error: image buffer does not match its channels", 0};
+
+  // The plugin is chosen by the target's extension; the temporary name has none.
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) return FileError{path, "cannot write this image format: " + OIIO::geterror(), 0};
+  OIIO::ImageSpec spec(static_cast<int>(width), static_cast<int>(height), static_cast<int>(channels),
+                       oiio_type(formats[0]));
+  spec.channelnames = channel_names;
+  if (formats.size() == channels && std::any_of(formats.begin(), formats.end(),
+                                                [&](ChannelFormat f) { return f != formats[0]; })) {
+    spec.channelformats.clear();
+    for (ChannelFormat f : formats) spec.channelformats.push_back(oiio_type(f));
+  }
+  spec.alpha_channel = -1;
+  for (size_t c = 0; c < channels; ++c)
+    if (channel_names[c] == "A") spec.alpha_channel = static_cast<int>(c);
+  spec.z_channel = -1;
+  for (size_t c = 0; c < channels; ++c)
+    if (channel_names[c] == "Z") spec.z_channel = static_cast<int>(c);
+  spec.attribute("oiio:ColorSpace", srgb ? "sRGB" : "Linear");
+  spec.attribute("Software", "sylva");
+  // A fixed date keeps images byte-identical for identical input (OpenEXR writes capDate).
+  spec.attribute("DateTime", "1970:01:01 00:00:00");
+  if (lower_extension(path) == ".exr") spec.attribute("compression", "zip");
+
+  const std::string temp = temporary_path_for(path);
+  auto fail = [&](const std::string& what) {
+    std::error_code ignored;
+    std::filesystem::remove(temp, ignored);
+    return FileError{path, what, 0};
+  };
+  if (!out->open(temp, spec)) return fail("cannot write: " + out->geterror());
+  if (!out->write_image(OIIO::TypeDesc::FLOAT, pixels.data())) {
+    std::string why = out->geterror();
+    out->close();
+    return fail("cannot write: " + why);
+  }
+  if (!out->close()) return fail("cannot write: " + out->geterror());
+  out.reset();
+
+  // Make the bytes durable before the rename publishes them.
+  int fd = ::open(temp.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0 || ::fsync(fd) != 0) {
+    int error = errno;
+    if (fd >= 0) ::close(fd);
+    FileError e = fail(std::string("cannot sync the temporary file: ") + std::strerror(error));
+    e.error_number = error;
+    return e;
+  }
+  ::close(fd);
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+    int error = errno;
+    FileError e = fail(std::string("cannot rename the temporary file over it: ") + std::strerror(error));
+    e.error_number = error;
+    return e;
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> image_open_error(const std::string& path) {
+  auto input = OIIO::ImageInput::open(path);
+  if (input) return std::nullopt;
+  std::string reason = OIIO::geterror();
+  if (reason.empty()) reason = "OpenImageIO cannot read it";
+  return reason;
+}
+
+bool can_write_image_format(const std::string& path) {
+  return OIIO::ImageOutput::create(path) != nullptr;
+}
+
+}  // namespace sylva

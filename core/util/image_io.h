@@ -1,0 +1,41 @@
+// image_io.h — writing images with OpenImageIO, atomically (cli.md): the pixels go to a
+// temporary file in the target's folder through OIIO, which is fsynced and then renamed
+// over the target, so a failed or interrupted write never leaves a truncated file and
+// never damages one that was there. Knows nothing of renders: core/render_output.h lays
+// a render's beauty and AOVs out into files.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/util/file_io.h"
+
+namespace sylva {
+
+// How one channel is stored in the file.
+enum class ChannelFormat : uint8_t { uint8, half, float32 };
+
+// Writes `pixels` (interleaved float, row-major from the top-left, one value per channel
+// named in `channel_names`) to `path` in the format OIIO picks from its extension,
+// atomically. `formats` gives each channel's storage (one entry: all channels); uint8
+// channels are expected already encoded in [0, 1] (values are clamped and rounded).
+// `srgb`: tag the file as sRGB (else linear).
+std::optional<FileError> write_image_atomically(const std::string& path, uint32_t width,
+                                                uint32_t height,
+                                                const std::vector<std::string>& channel_names,
+                                                const std::vector<float>& pixels,
+                                                const std::vector<ChannelFormat>& formats,
+                                                bool srgb);
+
+// The lower-case extension of `path`, with its dot (".png"; "" when there is none).
+std::string lower_extension(const std::string& path);
+
+// Whether OpenImageIO can open `path` as an image: nullopt if it can, else the reason.
+std::optional<std::string> image_open_error(const std::string& path);
+
+// Whether OpenImageIO has a writer for `path`'s extension (checked before rendering).
+bool can_write_image_format(const std::string& path);
+
+}  // namespace sylva

@@ -1,0 +1,293 @@
+// Tests for core/file_io.h: whole-file reads and atomic writes.
+//
+// Failures are provoked for real: a read-only directory (run as an unprivileged user
+// when the tests run as root, since root ignores permissions), a file size limit
+// (RLIMIT_FSIZE) that makes write() fail part way, and a directory in the way of rename().
+#include "core/util/file_io.h"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+namespace sylva {
+namespace {
+
+using namespace std::string_literals;
+namespace fs = std::filesystem;
+
+class FileIoTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = ::testing::TempDir() + "sylva-file-io-test-XXXXXX";
+    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
+    directory_ = pattern;
+    ::chmod(directory_.c_str(), 0755);  // traversable by an unprivileged child process
+  }
+  void TearDown() override {
+    for (const auto& entry : fs::recursive_directory_iterator(directory_)) {
+      if (entry.is_directory() && !entry.is_symlink()) ::chmod(entry.path().c_str(), 0755);
+    }
+    fs::remove_all(directory_);
+  }
+
+  std::string path(const std::string& name) const { return directory_ + "/" + name; }
+
+  // Names in `dir`, sorted: shows whether a temporary file was left behind.
+  static std::vector<std::string> entries(const std::string& dir) {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+  // Reads and writes without the code under test.
+  static std::string contents(const std::string& file) {
+    std::ifstream in(file, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  static void put(const std::string& file, const std::string& bytes) {
+    std::ofstream out(file, std::ios::binary);
+    out << bytes;
+  }
+
+  static mode_t permissions(const std::string& file) {
+    struct stat info {};
+    EXPECT_EQ(::stat(file.c_str(), &info), 0);
+    return info.st_mode & 07777;
+  }
+
+  // Whether `message` is "<what> '<dir>/.<name>.tmp-<pid>-<counter>'<tail>": a failure
+  // on the temporary file, whose name holds this process's id and a counter.
+  static bool is_temporary_failure(const std::string& message, const std::string& what,
+                                   const std::string& dir, const std::string& name,
+                                   const std::string& tail) {
+    const std::string prefix = what + " '" + dir + "/." + name + ".tmp-" + std::to_string(::getpid()) + "-";
+    const std::string suffix = "'" + tail;
+    if (message.size() < prefix.size() + suffix.size() + 1) return false;
+    if (message.compare(0, prefix.size(), prefix) != 0) return false;
+    if (message.compare(message.size() - suffix.size(), suffix.size(), suffix) != 0) return false;
+    const std::string counter = message.substr(prefix.size(), message.size() - prefix.size() - suffix.size());
+    return std::all_of(counter.begin(), counter.end(), [](char c) { return c >= '0' && c <= '9'; });
+  }
+
+  std::string directory_;
+};
+
+// ---- read_text_file ---------------------------------------------------------------
+
+TEST_F(FileIoTest, ReadsEveryByteUntranslated) {
+  const std::string bytes = "a\0b\r\nc\xFF\n"s;
+  put(path("f"), bytes);
+  const FileReadResult result = read_text_file(path("f"));
+  ASSERT_FALSE(result.error.has_value()) << result.error->format();
+  EXPECT_EQ(*result.contents, bytes);
+}
+
+TEST_F(FileIoTest, ReadsEmptyAndLargeFiles) {
+  put(path("empty"), "");
+  EXPECT_EQ(read_text_file(path("empty")).contents, std::optional<std::string>(""));
+  std::string large;
+  for (int i = 0; i < 300'000; ++i) large += static_cast<char>('a' + i % 26);
+  put(path("large"), large);
+  EXPECT_EQ(read_text_file(path("large")).contents, std::optional<std::string>(large));
+}
+
+TEST_F(FileIoTest, AMissingFileIsAnErrorNamingThePathAndTheReason) {
+  const FileReadResult result = read_text_file(path("missing.json"));
+  EXPECT_FALSE(result.contents.has_value());
+  ASSERT_TRUE(result.error.has_value());
+  EXPECT_EQ(result.error->path, path("missing.json"));
+  EXPECT_EQ(result.error->error_number, ENOENT);
+  EXPECT_EQ(result.error->format(),
+            path("missing.json") + ": error: cannot open for reading: No such file or directory");
+}
+
+TEST_F(FileIoTest, ADirectoryIsNotReadable) {
+  const FileReadResult result = read_text_file(directory_);
+  ASSERT_TRUE(result.error.has_value());
+  EXPECT_EQ(result.error->error_number, EISDIR);
+  EXPECT_EQ(result.error->format(), directory_ + ": error: cannot read: Is a directory");
+}
+
+// ---- write_file_atomically --------------------------------------------------------
+
+TEST_F(FileIoTest, WritingCreatesAFileWithExactlyTheBytes) {
+  const std::string bytes = "{\n\0\r\n}"s;
+  EXPECT_EQ(write_file_atomically(path("plant.skel.json"), bytes), std::nullopt);
+  EXPECT_EQ(contents(path("plant.skel.json")), bytes);
+  EXPECT_EQ(entries(directory_), std::vector<std::string>{"plant.skel.json"});
+}
+
+TEST_F(FileIoTest, WritingReplacesAnExistingFileAndLeavesNoTemporaryFile) {
+  put(path("plant.skel.json"), "old contents, longer than the new ones");
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(write_file_atomically(path("plant.skel.json"), "new " + std::to_string(i)), std::nullopt);
+  }
+  EXPECT_EQ(contents(path("plant.skel.json")), "new 4");
+  EXPECT_EQ(entries(directory_), std::vector<std::string>{"plant.skel.json"});
+}
+
+TEST_F(FileIoTest, NewFilesGetTheUsualPermissionsLessTheUmask) {
+  const mode_t previous = ::umask(022);
+  const std::optional<FileError> error = write_file_atomically(path("new.json"), "x");
+  ::umask(previous);
+  EXPECT_EQ(error, std::nullopt);
+  EXPECT_EQ(permissions(path("new.json")), 0644u);
+}
+
+TEST_F(FileIoTest, ReplacingAFileKeepsItsPermissions) {
+  put(path("private.json"), "old");
+  ::chmod(path("private.json").c_str(), 0600);
+  EXPECT_EQ(write_file_atomically(path("private.json"), "new"), std::nullopt);
+  EXPECT_EQ(permissions(path("private.json")), 0600u);
+  EXPECT_EQ(contents(path("private.json")), "new");
+}
+
+TEST_F(FileIoTest, AnUnwritableDirectoryLeavesTheExistingFileUntouched) {
+  const std::string dir = path("read-only");
+  ASSERT_EQ(::mkdir(dir.c_str(), 0755), 0);
+  const std::string target = dir + "/plant.skel.json";
+  put(target, "old contents");
+  ASSERT_EQ(::chmod(dir.c_str(), 0555), 0);
+
+  std::string message;
+  int error_number = 0;
+  if (::geteuid() != 0) {
+    const std::optional<FileError> error = write_file_atomically(target, "new contents");
+    ASSERT_TRUE(error.has_value());
+    message = error->format();
+    error_number = error->error_number;
+  } else {
+    // Root ignores directory permissions: try as the unprivileged user "nobody".
+    int pipe_fds[2];
+    ASSERT_EQ(::pipe(pipe_fds), 0);
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      ::close(pipe_fds[0]);
+      if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(2);
+      const std::optional<FileError> error = write_file_atomically(target, "new contents");
+      if (!error) ::_exit(1);
+      const std::string report = std::to_string(error->error_number) + " " + error->format();
+      if (::write(pipe_fds[1], report.data(), report.size()) < 0) ::_exit(3);
+      ::_exit(0);
+    }
+    ::close(pipe_fds[1]);
+    std::string report;
+    char buffer[512];
+    for (ssize_t n; (n = ::read(pipe_fds[0], buffer, sizeof buffer)) > 0;) report.append(buffer, n);
+    ::close(pipe_fds[0]);
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status));
+    if (WEXITSTATUS(status) == 2) GTEST_SKIP() << "running as root and cannot drop privileges";
+    ASSERT_EQ(WEXITSTATUS(status), 0) << "the write into a read-only directory succeeded";
+    const size_t space = report.find(' ');
+    error_number = std::stoi(report.substr(0, space));
+    message = report.substr(space + 1);
+  }
+  EXPECT_EQ(error_number, EACCES);
+  EXPECT_EQ(message, target + ": error: cannot create a temporary file in directory '" + dir +
+                         "': Permission denied");
+  EXPECT_EQ(contents(target), "old contents");
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"plant.skel.json"});
+}
+
+TEST_F(FileIoTest, AFailedWriteLeavesTheExistingFileUntouchedAndNoTemporaryFile) {
+  const std::string target = path("plant.skel.json");
+  put(target, "old contents");
+  // Files may not grow past 16 bytes: write() stops part way with EFBIG.
+  struct rlimit previous_limit {};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &previous_limit), 0);
+  struct rlimit small_limit = previous_limit;
+  small_limit.rlim_cur = 16;
+  auto* previous_handler = ::signal(SIGXFSZ, SIG_IGN);
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small_limit), 0);
+  const std::optional<FileError> error = write_file_atomically(target, std::string(4096, 'x'));
+  ::setrlimit(RLIMIT_FSIZE, &previous_limit);
+  ::signal(SIGXFSZ, previous_handler);
+
+  ASSERT_TRUE(error.has_value());
+  EXPECT_EQ(error->path, target);
+  EXPECT_EQ(error->error_number, EFBIG);
+  EXPECT_TRUE(is_temporary_failure(error->message, "cannot write temporary file", directory_,
+                                   "plant.skel.json", ": File too large"))
+      << error->message;
+  EXPECT_EQ(contents(target), "old contents");
+  EXPECT_EQ(entries(directory_), std::vector<std::string>{"plant.skel.json"});
+}
+
+TEST_F(FileIoTest, AFailedRenameRemovesTheTemporaryFile) {
+  // A non-empty directory where the file should go: rename() cannot replace it.
+  const std::string target = path("plant.skel.json");
+  ASSERT_EQ(::mkdir(target.c_str(), 0755), 0);
+  put(target + "/inside", "kept");
+  const std::optional<FileError> error = write_file_atomically(target, "new contents");
+  ASSERT_TRUE(error.has_value());
+  EXPECT_EQ(error->error_number, EISDIR);
+  EXPECT_TRUE(is_temporary_failure(error->message, "cannot rename temporary file", directory_,
+                                   "plant.skel.json", " over it: Is a directory"))
+      << error->message;
+  EXPECT_EQ(contents(target + "/inside"), "kept");
+  EXPECT_EQ(entries(directory_), std::vector<std::string>{"plant.skel.json"});
+}
+
+TEST_F(FileIoTest, AMissingDirectoryIsAnErrorNamingIt) {
+  const std::string target = path("no-such-dir/plant.skel.json");
+  const std::optional<FileError> error = write_file_atomically(target, "x");
+  ASSERT_TRUE(error.has_value());
+  EXPECT_EQ(error->error_number, ENOENT);
+  EXPECT_EQ(error->format(), target + ": error: cannot create a temporary file in directory '" +
+                                 path("no-such-dir") + "': No such file or directory");
+  EXPECT_TRUE(entries(directory_).empty());
+}
+
+TEST_F(FileIoTest, AnEmptyPathOrADirectoryPathIsAnError) {
+  const std::optional<FileError> empty = write_file_atomically("", "x");
+  ASSERT_TRUE(empty.has_value());
+  EXPECT_EQ(empty->format(), ": error: cannot write: the path is empty");
+  const std::optional<FileError> slash = write_file_atomically(directory_ + "/", "x");
+  ASSERT_TRUE(slash.has_value());
+  EXPECT_EQ(slash->format(), directory_ + "/: error: cannot write: Is a directory");
+  EXPECT_TRUE(entries(directory_).empty());
+}
+
+TEST_F(FileIoTest, ARelativePathIsWrittenInTheCurrentDirectory) {
+  const fs::path previous = fs::current_path();
+  fs::current_path(directory_);
+  const std::optional<FileError> error = write_file_atomically("relative.json", "here");
+  fs::current_path(previous);
+  EXPECT_EQ(error, std::nullopt);
+  EXPECT_EQ(contents(path("relative.json")), "here");
+  EXPECT_EQ(entries(directory_), std::vector<std::string>{"relative.json"});
+}
+
+TEST_F(FileIoTest, ALongFileNameStillFitsItsTemporaryName) {
+  const std::string name = std::string(250, 'n') + ".json";  // 255 bytes, the limit
+  EXPECT_EQ(write_file_atomically(path(name), "long"), std::nullopt);
+  EXPECT_EQ(contents(path(name)), "long");
+  EXPECT_EQ(entries(directory_), std::vector<std::string>{name});
+}
+
+TEST_F(FileIoTest, ASymbolicLinkIsReplacedNotWrittenThrough) {
+  put(path("real.json"), "real");
+  fs::create_symlink(path("real.json"), path("link.json"));
+  EXPECT_EQ(write_file_atomically(path("link.json"), "new"), std::nullopt);
+  EXPECT_FALSE(fs::is_symlink(path("link.json")));
+  EXPECT_EQ(contents(path("link.json")), "new");
+  EXPECT_EQ(contents(path("real.json")), "real");
+}
+
+}  // namespace
+}  // namespace sylva
