@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "app/cli/cli.h"
+#include "app/studio/studio.h"
 
 namespace {
 
@@ -18,6 +19,7 @@ void print_help(std::ostream& out) {
                "                                      write the skeleton and print a summary\n"
                "  render INPUT -o IMAGE [--backend auto|gl|cpu] [--aov ...]   render to PNG/EXR\n"
                "  export INPUT -o FILE.gltf|FILE.glb [--mesh]   glTF 2.0 with the skeleton in extras\n"
+               "  studio [INPUT] [--screenshot OUT.png]   edit a grammar and watch the plant regrow\n"
                "  bench  lsystem [--quick]            derivation and turtle benchmarks\n\n"
                "'sylva SUBCOMMAND --help' describes every flag.\n"
                "Exit status: 0 success, 1 bad input, 2 usage error, 3 internal error.\n";
@@ -45,6 +47,7 @@ int main(int argc, char** argv) {
     if (sub == "bench") return run_bench(args);
     if (sub == "render") return run_render(args);
     if (sub == "export") return run_export(args);
+    if (sub == "studio") return sylva::studio::run_studio(args);
     std::cerr << "sylva: error: unknown subcommand '" << sub << "' (see 'sylva --help')\n";
     return kUsageError;
   } catch (const UsageError& e) {
