@@ -5,6 +5,8 @@
 #include <chrono>
 #include <thread>
 
+#include <glm/geometric.hpp>
+
 #include "app/studio/define_controls.h"
 #include "app/studio/grow_worker.h"
 #include "app/studio/orbit_camera.h"
@@ -116,7 +118,7 @@ TEST(GrowWorker, GrowsAPlantOffTheCallingThread) {
   ASSERT_EQ(out->skeletons.size(), 1u);
   EXPECT_EQ(out->steps, 4);
   EXPECT_EQ(out->shown_step, 4);
-  EXPECT_EQ(out->segments, 31u) << "1 + 2 + 4 + 8 + 16 segments";
+  EXPECT_EQ(out->segments, 15u) << "1 + 2 + 4 + 8 segments";
   EXPECT_EQ(out->skeletons[0].source.grammar, "tree.lsys");
 }
 
@@ -145,7 +147,7 @@ TEST(GrowWorker, SixtyRapidEditsKeepOnlyTheLast) {
   ASSERT_FALSE(out->error);
   EXPECT_EQ(out->generation, last);
   EXPECT_EQ(out->steps, 10);
-  EXPECT_EQ(out->segments, 2047u);
+  EXPECT_EQ(out->segments, 1023u);
   const WorkerCounts c = w.counts();
   EXPECT_EQ(c.submitted, 61u);
   EXPECT_LT(c.started, 61u) << "queued requests are replaced before they start";
@@ -176,7 +178,7 @@ TEST(GrowWorker, StepsComeFromTheCache) {
   ASSERT_TRUE(out);
   EXPECT_TRUE(out->from_cache);
   EXPECT_EQ(out->shown_step, 2);
-  EXPECT_EQ(out->segments, 7u);
+  EXPECT_EQ(out->segments, 3u);
   r.show_step = 0;
   w.submit(r);
   out = wait_result(w);
