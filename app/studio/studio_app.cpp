@@ -145,7 +145,7 @@ void StudioApp::load_text(const std::string& path, std::string text, const std::
   history_.reset(doc_state());
   restore_text_ = path_.empty() ? std::nullopt : restorable_autosave(path_, saved_text_);
   show_presets_ = false;
-  status_ = "opened " + (scene_path_.empty() ? path_ : scene_path_);
+  status_ = "opened " + base_name(scene_path_.empty() ? path_ : scene_path_);
   submit_regrow();
 }
 

@@ -206,9 +206,9 @@ int run_studio(const std::vector<std::string>& raw_args) {
       if (app.plants_applied() != traced_plants && app.plant_drawn()) {
         traced_plants = app.plants_applied();
         trace("plant", std::to_string(app.plant()->segments) + " segments");
-        if (auto r = app.rect("editor"))
-          trace("editor", std::to_string(r->min.x) + " " + std::to_string(r->min.y) + " " +
-                              std::to_string(app.editor().line_height()));
+        const ImVec2 o = app.editor().text_origin();  // where line 1's text starts
+        trace("editor", std::to_string(o.x) + " " + std::to_string(o.y) + " " +
+                            std::to_string(app.editor().line_height()));
       }
       const std::string err_line = app.error() ? app.error()->format().substr(0, app.error()->format().find('\n')) : "";
       if (err_line != traced_error) trace("error", traced_error = err_line);
