@@ -20,7 +20,8 @@ void print_help(std::ostream& out) {
                "  render INPUT -o IMAGE [--backend auto|gl|cpu] [--aov ...]   render to PNG/EXR\n"
                "  export INPUT -o FILE.gltf|FILE.glb [--mesh]   glTF 2.0 with the skeleton in extras\n"
                "  studio [INPUT] [--screenshot OUT.png]   edit a grammar and watch the plant regrow\n"
-               "  bench  lsystem [--quick]            derivation and turtle benchmarks\n\n"
+               "  bench  lsystem [--quick]            derivation and turtle benchmarks\n"
+               "  bench  studio [--quick]             the studio's edit-to-picture latency, frame time, memory\n\n"
                "'sylva SUBCOMMAND --help' describes every flag.\n"
                "Exit status: 0 success, 1 bad input, 2 usage error, 3 internal error.\n";
 }
@@ -44,6 +45,7 @@ int main(int argc, char** argv) {
     }
     if (sub == "derive") return run_derive(args);
     if (sub == "grow") return run_grow(args);
+    if (sub == "bench" && !args.empty() && args[0] == "studio") return sylva::studio::run_bench_studio(args);
     if (sub == "bench") return run_bench(args);
     if (sub == "render") return run_render(args);
     if (sub == "export") return run_export(args);

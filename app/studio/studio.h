@@ -11,4 +11,8 @@ namespace sylva::studio {
 // Throws cli::UsageError for bad arguments.
 int run_studio(const std::vector<std::string>& args);
 
+// `sylva bench studio [--quick]` (bench_studio.cpp): edit-to-picture latency, UI frame
+// time during a long derivation, memory over many regrows; args start with "studio".
+int run_bench_studio(const std::vector<std::string>& args);
+
 }  // namespace sylva::studio

@@ -351,6 +351,13 @@ void StudioApp::frame_plant() {
   if (any) orbit_.frame(lo, hi, scene_.width, scene_.height);
 }
 
+void StudioApp::set_define(const std::string& name, double value) {
+  overrides_[name] = value;
+  field_text_.erase(name);
+  snapshot();
+  submit_regrow();
+}
+
 void StudioApp::write_parameters_to_text() {
   if (overrides_.empty()) return;
   std::string t = text_;

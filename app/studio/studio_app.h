@@ -98,6 +98,8 @@ class StudioApp {
   void undo();
   void redo();
   void write_parameters_to_text();
+  // What releasing a define's slider at `value` does: override, undo step, regrow.
+  void set_define(const std::string& name, double value);
   void step();     // one more derivation step
   void run();      // to the derivation length
   void rewind();   // back to the axiom
