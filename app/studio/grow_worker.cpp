@@ -132,6 +132,7 @@ void GrowWorker::run() {
       }
     }
     idle_.notify_all();
+    if (!cancelled && notify_) notify_();
   }
 }
 

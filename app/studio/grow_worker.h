@@ -20,6 +20,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -84,6 +85,9 @@ class GrowWorker {
   // `cache_bytes`: the most bytes the step cache may hold (words beyond it are not kept,
   // and stepping to them derives again).
   explicit GrowWorker(uint64_t cache_bytes = 1ull << 30);
+  // Called on the worker thread whenever a result becomes ready (a window loop that
+  // sleeps between events wakes itself with it: glfwPostEmptyEvent). Set before submit().
+  void on_result(std::function<void()> notify) { notify_ = std::move(notify); }
   ~GrowWorker();  // cancels and joins
   GrowWorker(const GrowWorker&) = delete;
   GrowWorker& operator=(const GrowWorker&) = delete;
@@ -123,6 +127,7 @@ class GrowWorker {
   std::atomic<uint64_t> generation_{0};
   std::atomic<int64_t> progress_step_{0}, progress_steps_{0};
   std::unique_ptr<Cache> cache_;  // touched by the worker thread only
+  std::function<void()> notify_;
   uint64_t cache_bytes_;
   std::thread thread_;
 };

@@ -56,6 +56,8 @@ StudioApp::StudioApp(StudioOptions options, Viewport* viewport)
     : options_(std::move(options)), viewport_(viewport), worker_(std::make_unique<GrowWorker>()) {
   show_presets_ = true;  // until a document is opened
   scene_ = Scene{};
+  scene_.plants.assign(1, ScenePlant{});  // an untitled grammar: typing grows it
+  edited_plants_.push_back(0);
   const glm::dvec3 d = glm::normalize(scene_.sun.direction);
   sun_azimuth_deg_ = static_cast<float>(std::atan2(d.x, d.z) / kRadPerDeg);
   sun_elevation_deg_ = static_cast<float>(std::asin(d.y) / kRadPerDeg);
@@ -70,6 +72,11 @@ std::string StudioApp::title() const {
 }
 
 bool StudioApp::dirty() const { return text_ != saved_text_; }
+
+bool StudioApp::wants_frames() const {
+  return worker_->busy() || worker_->result_waiting() || edited_at_ || unsnapped_at_ || animating_ ||
+         view_half_res_ || latency_start_;
+}
 
 std::optional<WidgetRect> StudioApp::rect(const std::string& name) const {
   auto it = rects_.find(name);

@@ -69,6 +69,10 @@ class StudioApp {
   // (save / don't save / cancel) and quit_requested() turns true when they answer so.
   bool request_close();
   bool quit_requested() const { return quit_; }
+  // Whether the next frame should come at once rather than on the next input event: the
+  // worker runs or has a result, a timer (debounce, undo step) is pending, an animation
+  // or a camera drag is on.
+  bool wants_frames() const;
   std::optional<std::string> save();                        // to the document's path
   std::optional<std::string> save_as(const std::string& path);
 

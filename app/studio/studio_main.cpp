@@ -171,6 +171,7 @@ int run_studio(const std::vector<std::string>& raw_args) {
     const char* presets = std::getenv("SYLVA_PRESETS");
     options.presets_dir = presets ? presets : SYLVA_PRESETS_DIR;
     StudioApp app(options, &viewport);
+    app.worker().on_result([] { glfwPostEmptyEvent(); });
     if (!a.input.empty())
       if (auto err = app.open(a.input)) {
         std::cerr << *err << (err->empty() || err->back() != '\n' ? "\n" : "");
@@ -181,9 +182,10 @@ int run_studio(const std::vector<std::string>& raw_args) {
     uint64_t traced_plants = 0;
     std::string traced_error, title;
     while (code == cli::kOk) {
-      const bool busy = app.worker().busy();
-      if (!a.screenshot.empty() || busy) glfwPollEvents();
-      else glfwWaitEventsTimeout(0.1);
+      // Sleep until input, a worker result (glfwPostEmptyEvent) or a timer tick, unless
+      // something is in motion.
+      if (!a.screenshot.empty() || app.wants_frames()) glfwPollEvents();
+      else glfwWaitEventsTimeout(0.25);
       if (glfwWindowShouldClose(window)) {
         glfwSetWindowShouldClose(window, GLFW_FALSE);
         app.request_close();
