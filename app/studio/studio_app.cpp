@@ -571,8 +571,7 @@ void StudioApp::draw_editor(ImVec2 size) {
   if (editor_.draw("editor", text_, mark, size)) {
     define_lines_ = scan_defines(text_);
     edited_at_ = now_;
-    if (!unsnapped_at_) unsnapped_at_ = now_;
-    unsnapped_at_ = now_;
+    unsnapped_at_ = now_;  // the undo step comes after a pause in typing
     animating_ = false;
   }
   keep("editor");
