@@ -75,7 +75,7 @@ bool StudioApp::dirty() const { return text_ != saved_text_; }
 
 bool StudioApp::wants_frames() const {
   return worker_->busy() || worker_->result_waiting() || edited_at_ || unsnapped_at_ || animating_ ||
-         view_half_res_ || latency_start_;
+         view_half_res_ || latency_start_ || (viewport_ && viewport_->busy());
 }
 
 std::optional<WidgetRect> StudioApp::rect(const std::string& name) const {
@@ -629,10 +629,12 @@ void StudioApp::draw_viewport(ImVec2 size) {
   if (img.texture) {
     dl->AddImage(img.texture, origin, ImVec2(origin.x + image_size.x, origin.y + image_size.y),
                  img.flip_v ? ImVec2(0, 1) : ImVec2(0, 0), img.flip_v ? ImVec2(1, 0) : ImVec2(1, 1));
-    drawn_version_ = plants_applied_;
-    if (latency_start_) {
-      latencies_.push_back(std::chrono::duration<double>(Clock::now() - *latency_start_).count());
-      latency_start_.reset();
+    if (img.current) {
+      drawn_version_ = plants_applied_;
+      if (latency_start_) {
+        latencies_.push_back(std::chrono::duration<double>(Clock::now() - *latency_start_).count());
+        latency_start_.reset();
+      }
     }
   } else {
     dl->AddRectFilled(origin, ImVec2(origin.x + image_size.x, origin.y + image_size.y), IM_COL32(40, 44, 52, 255));
@@ -640,7 +642,7 @@ void StudioApp::draw_viewport(ImVec2 size) {
                                : (viewport_ && !viewport_->stats().error.empty() ? viewport_->stats().error.c_str()
                                                                                  : "no renderer");
     dl->AddText(ImVec2(origin.x + 10, origin.y + 10), IM_COL32(200, 200, 200, 255), why);
-    if (plant_) {
+    if (plant_ && (!viewport_ || !viewport_->busy())) {
       drawn_version_ = plants_applied_;  // nothing more to wait for
       if (latency_start_) {
         latencies_.push_back(std::chrono::duration<double>(Clock::now() - *latency_start_).count());

@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <thread>
 
 #include <backends/imgui_impl_glfw.h>
@@ -165,14 +166,19 @@ int run_studio(const std::vector<std::string>& raw_args) {
 
   int code = cli::kOk;
   {
-    const char* gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    GlViewport viewport(gl_renderer ? gl_renderer : "");
+    std::unique_ptr<GlViewport> viewport_ptr;
+    try {
+      viewport_ptr = std::make_unique<GlViewport>([] { glfwPostEmptyEvent(); });
+    } catch (const std::exception& e) {
+      std::cerr << "sylva studio: error: " << e.what() << "\n";
+      code = cli::kInputError;
+    }
     StudioOptions options;
     const char* presets = std::getenv("SYLVA_PRESETS");
     options.presets_dir = presets ? presets : SYLVA_PRESETS_DIR;
-    StudioApp app(options, &viewport);
+    StudioApp app(options, viewport_ptr.get());
     app.worker().on_result([] { glfwPostEmptyEvent(); });
-    if (!a.input.empty())
+    if (code == cli::kOk && !a.input.empty())
       if (auto err = app.open(a.input)) {
         std::cerr << *err << (err->empty() || err->back() != '\n' ? "\n" : "");
         code = cli::kInputError;

@@ -5,7 +5,9 @@
 // The redo ladder (cpfg's New L-system / New view / New rendering, studio-gui.md sec. 1):
 // set_plants() is called when the plants or how they are skinned changed (a regrow, a
 // skin or geometry option, bark on/off); image() re-renders only when the camera, sun or
-// size changed since the last picture, and never re-skins or re-uploads.
+// size changed since the last picture, and never re-skins or re-uploads. A viewport may
+// make its pictures on another thread: image() then returns the newest finished one at
+// once, and says whether it already shows the newest plants.
 #pragma once
 
 #include <cstdint>
@@ -24,6 +26,7 @@ struct ViewImage {
   ImTextureID texture = nullptr;  // null: nothing to show
   bool flip_v = false;            // the texture's rows are bottom-up (a GL framebuffer)
   uint32_t width = 0, height = 0;
+  bool current = true;            // shows the plants of the last set_plants (not older ones)
 };
 
 struct ViewStats {
@@ -44,6 +47,8 @@ class Viewport {
   // plants last set.
   virtual ViewImage image(const Scene& scene) = 0;
   virtual const ViewStats& stats() const = 0;
+  // Whether a picture is being made (the UI keeps drawing frames to show it when done).
+  virtual bool busy() const { return false; }
   // Renders `scene` at its width × height with `options` through the same renderer as
   // `sylva render` and writes it to `path` (format by extension, atomically); the error
   // text or nothing.
