@@ -1,8 +1,6 @@
 // render_common.h — what the CPU reference (render_cpu.cpp) and the GL renderer
-// (render_gl.cpp) must share so that they cannot drift apart: the camera frame, the
-// shading constants, the sample stream and the sun-disc sampling. (The GLSL side,
-// shaders/shade.frag.glsl, repeats the two constants and is compared with the CPU by
-// tests/gl/render_gl_test.cpp.)
+// (render_gl.cpp) must share so that they cannot drift apart: the camera frame, the sample
+// stream and the sun-disc sampling. The shading model and its constants: core/shading.h.
 #pragma once
 
 #include <chrono>
@@ -22,10 +20,6 @@ using Clock = std::chrono::steady_clock;
 inline double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
-
-// Shading model constants (render_cpu.h states the model).
-constexpr double kSpecular = 0.04;  // k_s: a dielectric's reflectance at normal incidence
-constexpr double kShininess = 40;   // s
 
 // SplitMix64 (lsystem/random.h), counter based: a pixel sample (CPU) or a pass (GL) draws
 // the same numbers whatever thread renders it.

@@ -33,7 +33,11 @@ struct Camera {
 struct Sun {
   glm::dvec3 direction{0.4, 1.0, 0.2};  // toward the sun, need not be unit (stored unit)
   double angular_radius_deg = 0.27;
-  glm::dvec3 radiance{3, 3, 2.8};       // irradiance at normal incidence, linear RGB
+  // Despite its name (kept: it is the scene file's key, scene.md), the sun's irradiance at
+  // normal incidence, W/m² per linear RGB channel — not a radiance: a surface whose normal
+  // makes an angle θ with the sun receives radiance·cos θ whatever the disc's size
+  // (core/shading.h E_sun).
+  glm::dvec3 radiance{3, 3, 2.8};
 };
 
 struct Ground {

@@ -1,6 +1,7 @@
 // shade.frag.glsl — deferred shading, one fragment per pixel: render_cpu.cpp's shade() and
-// lit() (the model is stated in core/render_cpu.h), reading what frusta.frag.glsl wrote.
-// The ground plane and the sky are found here analytically, as the CPU does per ray.
+// lit(), reading what frusta.frag.glsl wrote, through the model's functions in shading.glsl
+// (the file before this one; the model is stated in core/shading.h). The ground plane and
+// the sky are found here analytically, as the CPU does per ray.
 //
 // Sun visibility comes from a shadow map rendered by the same ray-casting shaders
 // (SHADOW_PASS), orthographic along the sun direction of this pass: the CPU's shadow ray
@@ -52,13 +53,6 @@ uniform float u_pixel_step_rad;    // |∂direction/∂y|: a pixel footprint per
 
 layout(location = 0) out vec4 colour;
 
-const float kPi = 3.14159265358979323846;
-#ifndef kInfinity  // bark.glsl's, where it comes first
-#define kInfinity uintBitsToFloat(0x7F800000u)  // +inf (a const initializer cannot call it)
-#endif
-const float kSpecular = 0.04;  // k_s
-const float kShininess = 40.0;  // s
-
 vec3 camera_ray_direction(vec2 pixel) {
   float sx = (2.0 * pixel.x / u_image_size.x - 1.0) * u_half_size.x;
   float sy = (1.0 - 2.0 * pixel.y / u_image_size.y) * u_half_size.y;
@@ -78,22 +72,17 @@ float sun_visibility(vec3 p, vec3 n_geometric, float offset_m) {
 }
 #endif
 
+// The model at a surface point, the shadow map looked up only where the sun faces it.
 vec3 lit(vec3 albedo, vec3 n, vec3 n_geometric, vec3 p_rel_eye, vec3 view, bool specular, float shadow_offset_m) {
-  vec3 result = albedo * u_sky * (0.5 * (1.0 + n.y));
 #ifdef SUN
   vec3 l = u_sun_dir;
-  float n_dot_l = dot(n, l);
-  if (n_dot_l <= 0.0 || dot(n_geometric, l) <= 0.0) return result;
-  float visibility = sun_visibility(u_eye_rel_light + p_rel_eye, n_geometric, shadow_offset_m);
-  if (visibility == 0.0) return result;
-  vec3 brdf = albedo / kPi;
-  if (specular) {
-    vec3 h = normalize(l + view);
-    brdf += vec3(kSpecular * (kShininess + 8.0) / (8.0 * kPi) * pow(max(0.0, dot(n, h)), kShininess));
-  }
-  result += brdf * u_sun_radiance * (n_dot_l * visibility);
+  float cos_sun = sun_cosine(n, n_geometric, l);
+  float visibility =
+      cos_sun <= 0.0 ? 0.0 : sun_visibility(u_eye_rel_light + p_rel_eye, n_geometric, shadow_offset_m);
+  return surface_radiance(albedo, n, l, view, specular, u_sky, u_sun_radiance, cos_sun, visibility);
+#else
+  return sky_ambient(albedo, n, u_sky);
 #endif
-  return result;
 }
 
 void main() {
@@ -104,9 +93,9 @@ void main() {
   vec4 normal_distance = texelFetch(g_normal_distance, texel, 0);
   bool plant_hit = normal_distance.w >= 0.0;
   float plant_t = plant_hit ? normal_distance.w / length(dir) : kInfinity;
-  float ground_t = dir.y < 0.0 && u_eye_above_ground > 0.0 ? -u_eye_above_ground / dir.y : kInfinity;
+  float ground_t = ground_distance(u_eye_above_ground, dir.y);
   if (!plant_hit && !(ground_t < kInfinity)) {
-    colour = vec4(u_sky, 1.0);
+    colour = vec4(sky_radiance(u_sky), 1.0);
     return;
   }
   // What is seen, then one call of lit(): a SIMD rasteriser (llvmpipe) runs both sides of
@@ -117,7 +106,7 @@ void main() {
   float shadow_offset_m = 0.0;
   if (ground_t < plant_t) {
     albedo = u_ground_albedo;
-    n = n_geometric = vec3(0.0, 1.0, 0.0);
+    n = n_geometric = kGroundNormal;
     t = ground_t;
     specular = false;
   } else {

@@ -6,6 +6,7 @@
 #include "core/cpu/frustum_tracer.h"
 #include "core/cpu/mesh_accel.h"
 #include "core/render_common.h"
+#include "core/shading.h"
 #include "core/cpu/texture.h"
 #include "core/util/math.h"
 
@@ -28,8 +29,6 @@ namespace {
 
 using render_common::CameraFrame;
 using render_common::Clock;
-using render_common::kShininess;
-using render_common::kSpecular;
 using render_common::seconds_since;
 using Rng = render_common::SampleRng;
 constexpr uint32_t kTile = 32;
@@ -126,11 +125,8 @@ class Renderer {
   void trace(const Ray& ray, PrimaryHit& h) {
     h.ray = ray;
     h.surface = tracer_.nearest(ray, 0, kInf);
-    h.ground_t = kInf;
-    if (ray.direction.y < 0 && ray.origin.y > scene_.ground.height) {
-      double t = (scene_.ground.height - ray.origin.y) / ray.direction.y;
-      if (t < h.surface.t) h.ground_t = t;
-    }
+    const double ground_t = shading::ground_distance(ray.origin.y - scene_.ground.height, ray.direction.y);
+    h.ground_t = ground_t < h.surface.t ? ground_t : kInf;
   }
 
   // Sun visibility from `p` (offset along the geometric normal `n_geometric`, by at least
@@ -144,23 +140,17 @@ class Renderer {
     return tracer_.any(shadow, 0, kInf) ? 0.0 : 1.0;
   }
 
+  // The shading model (shading.h) at a surface point, its sun visibility from one shadow
+  // ray toward a sample of the sun, cast only where the sun faces the point.
   glm::dvec3 lit(const glm::dvec3& albedo, const glm::dvec3& n, const glm::dvec3& n_geometric,
                  const glm::dvec3& p, const glm::dvec3& view, bool specular, Rng& rng,
                  uint64_t* shadow_rays, double shadow_offset_m = 0) {
-    glm::dvec3 colour = albedo * scene_.sky * (0.5 * (1 + n.y));
-    if (!sun_on_) return colour;
+    if (!sun_on_) return shading::sky_ambient(albedo, n, scene_.sky);
     const glm::dvec3 l = sun_sample(scene_.sun, sun_direction_, cos_alpha_, sun_frame_, rng);
-    const double n_dot_l = glm::dot(n, l);
-    if (n_dot_l <= 0 || glm::dot(n_geometric, l) <= 0) return colour;
-    const double visibility = sun_visibility(p, n_geometric, l, shadow_rays, shadow_offset_m);
-    if (visibility == 0) return colour;
-    glm::dvec3 brdf = albedo / kPi;
-    if (specular) {
-      const glm::dvec3 h = glm::normalize(l + view);
-      brdf += glm::dvec3(kSpecular * (kShininess + 8) / (8 * kPi) *
-                         std::pow(std::max(0.0, glm::dot(n, h)), kShininess));
-    }
-    return colour + brdf * scene_.sun.radiance * (n_dot_l * visibility);
+    const double cos_sun = shading::sun_cosine(n, n_geometric, l);
+    const double visibility = cos_sun <= 0 ? 0.0 : sun_visibility(p, n_geometric, l, shadow_rays, shadow_offset_m);
+    return shading::surface_radiance(albedo, n, l, view, specular, scene_.sky, scene_.sun.radiance, cos_sun,
+                                     visibility);
   }
 
   glm::dvec3 shade(const PrimaryHit& h, uint64_t* shadow_rays) {
@@ -168,11 +158,11 @@ class Renderer {
     const glm::dvec3 view = -glm::normalize(h.ray.direction);
     if (h.ground_t < kInf) {
       const glm::dvec3 p = h.ray.origin + h.ground_t * h.ray.direction;
-      const glm::dvec3 up(0, 1, 0);
-      return lit(scene_.ground.albedo, up, up, p, view, false, rng, shadow_rays);
+      return lit(scene_.ground.albedo, shading::kGroundNormal, shading::kGroundNormal, p, view, false, rng,
+                 shadow_rays);
     }
     const SurfaceHit& s = h.surface;
-    if (!s.hit()) return scene_.sky;
+    if (!s.hit()) return shading::sky_radiance(scene_.sky);
     glm::dvec3 n = s.shading_normal;
     glm::dvec3 ng = s.geometric_normal;
     if (glm::dot(ng, view) < 0) ng = -ng;   // seen from inside: light the side we see

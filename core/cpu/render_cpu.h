@@ -3,17 +3,13 @@
 // intersected exactly (ray_frustum.h), shaded under the scene's sun and sky over a
 // ground plane. The GPU ray caster must match it.
 //
-// Shading (linear RGB), at a point with albedo ρ, unit shading normal n facing the ray,
-// sun direction l, view direction v, half vector h = normalize(l + v):
-//   L = ρ/π · E_sun · max(n·l, 0) · V                   (Lambert under the sun)
-//     + k_s · (s + 8)/(8π) · (n·h)^s · E_sun · max(n·l, 0) · V   (normalised Blinn-Phong)
-//     + ρ · L_sky · (1 + n_y)/2                          (sky ambient: the sky's share
-//                                                         of the hemisphere around n)
-// with E_sun = scene.sun.radiance, L_sky = scene.sky, k_s = 0.04, s = 40, V the sun's
-// visibility: one shadow ray per sample toward the sun's centre when its angular radius
-// is 0 (hard shadows), else toward a uniform point of the sun's disc (soft shadows that
-// converge with --spp). The ground (y = ground.height, normal +Y, no specular) is shaded
-// the same way, with the plants' shadows. A ray that hits nothing sees L_sky.
+// Shading: the model of core/shading.h (sky ambient, Lambert + normalised Blinn-Phong under the
+// sun, the ground, the sky seen by a miss), in double, with E_sun = scene.sun.radiance (the
+// sun's irradiance at normal incidence) and L_sky = scene.sky. The sun's visibility V: one
+// shadow ray per sample, cast where sun_cosine > 0, toward the sun's centre when its angular
+// radius is 0 (hard shadows), else toward a uniform point of the sun's disc (soft shadows
+// that converge with --spp); only plants cast shadows. The ground (y = ground.height) is
+// shaded the same way, with the plants' shadows.
 // Plant albedo comes from the material index (kMaterialAlbedo); bark.albedo given as a
 // colour replaces material 0 (wood); bark.albedo given as a texture covers every segment
 // of its plant whatever its material (texture.h: mipmapped lookup, sRGB decoded after

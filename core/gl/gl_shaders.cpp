@@ -2,7 +2,10 @@
 #include "core/gl/gl_shaders.h"
 
 #include <algorithm>
+#include <charconv>
 #include <stdexcept>
+
+#include "core/shading.h"
 
 namespace sylva {
 
@@ -123,13 +126,28 @@ ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units) {
   return p;
 }
 
+std::string glsl_float(double value) {
+  // The shortest decimal that reads back as `value` (a double): the text core/shading.h
+  // writes, so the GLSL compiler rounds the same literal as before to float.
+  char buffer[64];
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  if (error != std::errc()) throw std::logic_error("glsl_float: cannot format a constant");
+  std::string text(buffer, end);
+  if (text.find_first_of(".eE") == std::string::npos) text += ".0";  // 40 → 40.0, a float
+  return text;
+}
+
+std::vector<std::string> shading_defines() {
+  return {"SHADING_SPECULAR " + glsl_float(shading::kSpecular), "SHADING_SHININESS " + glsl_float(shading::kShininess)};
+}
+
 ShaderProgramSource shade_program(bool sun) {
   ShaderProgramSource p;
-  std::vector<std::string> defines;
+  std::vector<std::string> defines = shading_defines();
   if (sun) defines.push_back("SUN");
   p.name = sun ? "shade[SUN]" : "shade[]";
   p.vertex = {ShaderStage::vertex, {"fullscreen.vert.glsl"}, {}};
-  p.fragment = {ShaderStage::fragment, {"bark.glsl", "shade.frag.glsl"}, defines};
+  p.fragment = {ShaderStage::fragment, {"bark.glsl", "shading.glsl", "shade.frag.glsl"}, defines};
   return p;
 }
 

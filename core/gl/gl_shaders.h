@@ -85,9 +85,17 @@ enum class MeshPass {
 // stage then writes the bark albedo through bark.glsl (BARK_TEXTURE_UNITS).
 ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units = 0);
 
+// `value` as a GLSL float literal that reads back as it: the shortest decimal of the
+// double, with ".0" added where it has no point or exponent (40 → "40.0", 0.04 → "0.04").
+std::string glsl_float(double value);
+
+// The #defines shading.glsl needs: core/shading.h's constants, SHADING_SPECULAR (k_s) and
+// SHADING_SHININESS (s), as glsl_float literals — how the GLSL twins get them from C++.
+std::vector<std::string> shading_defines();
+
 // The deferred shading program (fullscreen.vert.glsl + bark.glsl's per-plant maps +
-// shade.frag.glsl); `sun` false
-// leaves out the sun and its shadow map (black or absent sun: sky only).
+// shading.glsl's model + shade.frag.glsl), with shading_defines(); `sun` false leaves out
+// the sun and its shadow map (black or absent sun: sky only).
 ShaderProgramSource shade_program(bool sun);
 
 // Every variant the renderer can build (what the shader tests compile).
