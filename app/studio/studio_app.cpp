@@ -852,7 +852,9 @@ void StudioApp::draw_presets() {
   if (files.empty()) ImGui::TextDisabled("no presets in %s", options_.presets_dir.c_str());
   for (const std::string& f : files) {
     const std::string label = std::filesystem::relative(f, options_.presets_dir, ec).string();
-    if (ImGui::Selectable(label.c_str(), f == path_ || f == scene_path_)) {
+    const bool chosen = ImGui::Selectable(label.c_str(), f == path_ || f == scene_path_);
+    keep("preset:" + label);
+    if (chosen) {
       if (dirty()) {
         open_after_prompt_ = f;
         close_prompt_ = true;

@@ -6,6 +6,8 @@
 #include <fstream>
 
 #include "app/studio/document_files.h"
+#include "core/gltf_export.h"
+#include "core/skeleton.h"
 #include "core/util/file_io.h"
 #include "tests/studio/headless_ui.h"
 
@@ -317,6 +319,54 @@ TEST_F(Fixture, OpensAScene) {
   EXPECT_NE(app->path().find("saguaro.lsys"), std::string::npos);
   EXPECT_GT(viewport.segments, 0u);
   EXPECT_EQ(app->scene().plants.size(), 1u);
+}
+
+TEST_F(Fixture, ExportsTheShownPlantThroughTheCliWriters) {
+  auto app = opened();
+  app->set_define("N", 3);
+  ASSERT_TRUE(ui.settle(*app));
+  ASSERT_EQ(viewport.segments, 7u);
+  const std::string glb = dir.file("tree.glb"), skel = dir.file("tree.skel.json");
+  ASSERT_FALSE(app->export_gltf_file(glb, /*mesh=*/true));
+  ASSERT_FALSE(app->export_skeleton_file(skel));
+  GltfImportResult back = import_gltf_skeletons(glb);
+  ASSERT_FALSE(back.error) << *back.error;
+  ASSERT_EQ(back.plants.size(), 1u);
+  EXPECT_EQ(back.plants[0].name, "tree");
+  EXPECT_EQ(back.plants[0].skeleton.segment_count(), 7u) << "the plant on screen, with the override";
+  EXPECT_EQ(back.plants[0].skeleton.source.defines.at("N"), 3);
+  SkeletonReadResult read = read_skeleton_file(skel);
+  ASSERT_TRUE(read.skeleton);
+  EXPECT_EQ(read.skeleton->segment_count(), 7u);
+  EXPECT_FALSE(app->export_png_file(dir.file("tree.png"), 64, 64).value_or("").empty())
+      << "the fake viewport renders nothing: the error comes back, nothing is written";
+  EXPECT_FALSE(std::filesystem::exists(dir.file("tree.png")));
+}
+
+TEST_F(Fixture, ThePresetBrowserOpensAPreset) {
+  auto app = make_app();
+  ui.frames(*app, 3);  // no document: the browser is open
+  EXPECT_EQ(app->title(), "sylva studio \xE2\x80\x94 untitled");
+  auto elm = app->rect("preset:elm.lsys");
+  ASSERT_TRUE(elm);
+  EXPECT_TRUE(app->rect("preset:scenes/pine.scene.json"));
+  ui.click(*app, elm->centre());
+  EXPECT_NE(app->path().find("presets/elm.lsys"), std::string::npos);
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plant_drawn(); }, 60));
+  EXPECT_EQ(viewport.segments, 1769u);
+  EXPECT_FALSE(app->rect("preset:elm.lsys")) << "the browser closes once a preset is open";
+}
+
+TEST_F(Fixture, AnUntitledDocumentGrowsAsItIsTyped) {
+  StudioOptions o;
+  o.debounce_s = 0;
+  auto app = make_app(o);
+  ui.frames(*app, 2);
+  ui.click(*app, ImVec2(app->editor().text_origin().x + 5, app->editor().text_origin().y + 5));
+  ui.type(*app, "axiom: FF");
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plant_drawn() && viewport.segments == 2u; }));
+  EXPECT_TRUE(app->dirty());
+  EXPECT_EQ(app->title(), "sylva studio \xE2\x80\x94 untitled*");
 }
 
 TEST_F(Fixture, AMissingFileIsAnErrorAndChangesNothing) {
