@@ -132,7 +132,8 @@ int run_studio(const std::vector<std::string>& raw_args) {
     print_help();
     return cli::kOk;
   }
-  // Check the input before any window opens: a bad file is a located error, exit 1.
+  // The window first: a grammar's errors come from the worker once the app runs (a
+  // --screenshot of a grammar that does not parse then exits 1 with the located error).
   glfwSetErrorCallback(on_glfw_error);
   if (!glfwInit()) {
     std::cerr << "sylva studio: error: cannot open a window (no display? on a machine without one run "
