@@ -401,6 +401,7 @@ Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStat
   uint64_t peak = cur.capacity_bytes();
   double growth = 2.0;
   int64_t step = 0;
+  if (options.on_step && !options.on_step(0, cur)) return g.error_at({}, "cancelled at step 0");
   try {
     for (step = 1; step <= steps; ++step) {
       next.clear();
@@ -412,6 +413,8 @@ Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStat
       peak = std::max<uint64_t>(peak, cur.capacity_bytes() + next.capacity_bytes());
       growth = cur.size() ? std::max(1.0, static_cast<double>(next.size()) / static_cast<double>(cur.size())) : 2.0;
       std::swap(cur, next);
+      if (options.on_step && !options.on_step(step, cur))
+        return g.error_at({}, "cancelled at step " + std::to_string(step));
     }
   } catch (const DeriveFailure& f) {
     return failure_diagnostic(g, cur, rewriter, f.message, f.loc, "step", step);

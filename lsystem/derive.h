@@ -20,6 +20,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 
 #include "lsystem/grammar.h"
@@ -30,6 +31,10 @@ struct DeriveOptions {
   std::optional<int64_t> steps;     // overrides `derivation length:`
   std::optional<uint64_t> seed;     // overrides `seed:`
   uint64_t max_modules = 50'000'000;
+  // Called with the word after the axiom (step 0) and after every step; returning false
+  // stops the derivation, which then fails with the message "cancelled at step N". Lets a
+  // front end keep each step's word and cancel a long derivation between steps.
+  std::function<bool(int64_t step, const Word& word)> on_step;
 };
 
 struct DeriveStats {

@@ -15,6 +15,8 @@ packages=(
   # The GL backend: OpenGL 4.5 + EGL through libglvnd, Mesa's llvmpipe for a machine
   # without a GPU (surfaceless EGL, no X), glslangValidator for the shader tests.
   libgl-dev libegl-dev libgl1-mesa-dri libegl-mesa0 glslang-tools
+  # The studio's window tests: a virtual X server (xvfb-run) and simulated input.
+  xvfb xauth xdotool
 )
 # Node.js runs the Khronos glTF validator; any npm already on the machine will do.
 command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)

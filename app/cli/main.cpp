@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "app/cli/cli.h"
+#include "app/studio/studio.h"
 
 namespace {
 
@@ -18,7 +19,9 @@ void print_help(std::ostream& out) {
                "                                      write the skeleton and print a summary\n"
                "  render INPUT -o IMAGE [--backend auto|gl|cpu] [--aov ...]   render to PNG/EXR\n"
                "  export INPUT -o FILE.gltf|FILE.glb [--mesh]   glTF 2.0 with the skeleton in extras\n"
-               "  bench  lsystem [--quick]            derivation and turtle benchmarks\n\n"
+               "  studio [INPUT] [--screenshot OUT.png]   edit a grammar and watch the plant regrow\n"
+               "  bench  lsystem [--quick]            derivation and turtle benchmarks\n"
+               "  bench  studio [--quick]             the studio's edit-to-picture latency, frame time, memory\n\n"
                "'sylva SUBCOMMAND --help' describes every flag.\n"
                "Exit status: 0 success, 1 bad input, 2 usage error, 3 internal error.\n";
 }
@@ -42,9 +45,11 @@ int main(int argc, char** argv) {
     }
     if (sub == "derive") return run_derive(args);
     if (sub == "grow") return run_grow(args);
+    if (sub == "bench" && !args.empty() && args[0] == "studio") return sylva::studio::run_bench_studio(args);
     if (sub == "bench") return run_bench(args);
     if (sub == "render") return run_render(args);
     if (sub == "export") return run_export(args);
+    if (sub == "studio") return sylva::studio::run_studio(args);
     std::cerr << "sylva: error: unknown subcommand '" << sub << "' (see 'sylva --help')\n";
     return kUsageError;
   } catch (const UsageError& e) {

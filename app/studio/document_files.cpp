@@ -1,0 +1,41 @@
+// document_files.cpp — see document_files.h.
+#include "app/studio/document_files.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+
+#include "core/util/file_io.h"
+
+namespace sylva::studio {
+
+std::string base_name(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
+std::string autosave_path(const std::string& path) {
+  const std::filesystem::path p(path);
+  return (p.parent_path() / ("." + p.filename().string() + ".autosave")).string();
+}
+
+FileStamp stamp_of(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return {};
+  FileStamp s;
+  s.mtime_ns = static_cast<int64_t>(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec;
+  s.size = static_cast<int64_t>(st.st_size);
+  return s;
+}
+
+std::optional<std::string> restorable_autosave(const std::string& path, const std::string& file_text) {
+  const std::string a = autosave_path(path);
+  const FileStamp as = stamp_of(a), fs = stamp_of(path);
+  if (as.size < 0) return std::nullopt;
+  if (fs.size >= 0 && as.mtime_ns < fs.mtime_ns) return std::nullopt;
+  FileReadResult r = read_text_file(a);
+  if (!r.contents || *r.contents == file_text) return std::nullopt;
+  return r.contents;
+}
+
+void remove_autosave(const std::string& path) { ::unlink(autosave_path(path).c_str()); }
+
+}  // namespace sylva::studio

@@ -1,0 +1,36 @@
+// document_files.h — what the studio does with files (studio.md "Never blocking, never
+// losing work"): saves are atomic (write_file_atomically, cli.md), an edited document is
+// autosaved beside itself as `.NAME.autosave`, and a file's identity on disk (mtime,
+// size) is remembered so a change by another program is noticed.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace sylva::studio {
+
+// `.NAME.autosave` in the folder of `path` (the same for an untitled document's
+// fallback name, e.g. "untitled.lsys" in the working folder).
+std::string autosave_path(const std::string& path);
+
+// What a file looked like on disk, to notice changes made by others.
+struct FileStamp {
+  int64_t mtime_ns = 0;
+  int64_t size = -1;  // -1: no such file
+  bool operator==(const FileStamp&) const = default;
+};
+FileStamp stamp_of(const std::string& path);
+
+// An autosave of `path` that should be offered for restoring: it exists, is newer than
+// the file (or the file is gone), and holds something other than the file's text.
+// Returns its text.
+std::optional<std::string> restorable_autosave(const std::string& path, const std::string& file_text);
+
+// Removes the autosave of `path` (after a save, or when the user discards the edits).
+void remove_autosave(const std::string& path);
+
+// The file name without its folder ("elm.lsys").
+std::string base_name(const std::string& path);
+
+}  // namespace sylva::studio

@@ -1,0 +1,65 @@
+// gl_viewport.h — the studio's viewport: the GL ray caster (core/gl/render_gl.h) over the
+// plants, shown as a texture with ImGui::Image.
+//
+// The pictures are made on a render thread of its own with its own window-less OpenGL
+// context (gl_context.h: EGL), so a slow picture — hundreds of milliseconds per frame on
+// llvmpipe — never stalls the window: the UI thread posts what to draw (latest wins, like
+// the grow worker's mailbox), keeps drawing frames, and uploads each finished picture into
+// the window's texture, on its own context (the one GL upload the UI thread does).
+// The ladder (viewport.h): set_plants() makes the render thread build a new GlRenderer
+// (skin + upload to its context); image() asks for a new picture only when the camera,
+// sun, sky, ground or size changed, or new plants arrived.
+//
+// How a picture reaches the texture is one function, present(): for now
+// GlRenderer::render()'s readback (rows top-down, no flip), copied to the UI thread.
+// Preconditions: construct, call and destroy on the UI thread with the window's context
+// current (the texture lives there).
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "app/studio/viewport.h"
+
+namespace sylva::studio {
+
+class GlViewport : public Viewport {
+ public:
+  // `on_picture` is called on the render thread when a picture is ready (the window loop
+  // wakes itself with it). Throws GlError when the render thread gets no GL context.
+  explicit GlViewport(std::function<void()> on_picture = {});
+  ~GlViewport() override;
+  GlViewport(const GlViewport&) = delete;
+  GlViewport& operator=(const GlViewport&) = delete;
+
+  void set_plants(const Scene& scene, const RenderOptions& options) override;
+  ViewImage image(const Scene& scene) override;
+  const ViewStats& stats() const override { return stats_; }
+  bool busy() const override;
+  std::optional<std::string> write_image(const Scene& scene, const RenderOptions& options,
+                                         const std::string& path) override;
+
+ private:
+  struct Shared;
+  void run();              // the render thread
+  void take_picture();     // UI thread: a finished picture into the texture
+
+  std::unique_ptr<Shared> shared_;
+  std::thread thread_;
+  unsigned texture_ = 0;   // GLuint, in the UI thread's context
+  uint32_t texture_w_ = 0, texture_h_ = 0;
+  uint64_t plants_version_ = 0;     // set_plants calls
+  uint64_t shown_version_ = 0;      // the plants the texture shows
+  std::vector<double> asked_view_;  // the last picture asked for
+  uint64_t asked_version_ = 0;
+  ViewStats stats_;
+};
+
+}  // namespace sylva::studio

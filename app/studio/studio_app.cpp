@@ -1,0 +1,1012 @@
+// studio_app.cpp — see studio_app.h.
+#include "app/studio/studio_app.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+
+#include <glm/geometric.hpp>
+#include <imgui_stdlib.h>
+
+#include "core/gltf_export.h"
+#include "core/skeleton.h"
+#include "core/util/file_io.h"
+#include "core/util/math.h"
+
+namespace sylva::studio {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// The node name of a plant in glTF: the grammar's file name without its extension.
+std::string stem(const std::string& path) {
+  std::string name = base_name(path);
+  if (ends_with(name, ".lsys")) name.resize(name.size() - 5);
+  return name.empty() ? "plant" : name;
+}
+
+// Bytes of the token at `column` (1-based) of `line` in `text`: a name or number, else 1.
+uint32_t token_length(const std::string& text, uint32_t line, uint32_t column) {
+  if (column == 0) return 0;
+  size_t at = offset_of(text, line, column);
+  size_t end = at;
+  auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.'; };
+  while (end < text.size() && word(text[end])) ++end;
+  return static_cast<uint32_t>(std::max<size_t>(1, end - at));
+}
+
+bool key_pressed(char key) { return ImGui::IsKeyPressed(static_cast<int>(key), false); }
+
+std::optional<uint64_t> parse_u64_exact(const std::string& s) {
+  uint64_t v = 0;
+  auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || p != s.data() + s.size() || s.empty()) return std::nullopt;
+  return v;
+}
+
+}  // namespace
+
+StudioApp::StudioApp(StudioOptions options, Viewport* viewport)
+    : options_(std::move(options)), viewport_(viewport), worker_(std::make_unique<GrowWorker>()) {
+  show_presets_ = true;  // until a document is opened
+  scene_ = Scene{};
+  scene_.plants.assign(1, ScenePlant{});  // an untitled grammar: typing grows it
+  edited_plants_.push_back(0);
+  const glm::dvec3 d = glm::normalize(scene_.sun.direction);
+  sun_azimuth_deg_ = static_cast<float>(std::atan2(d.x, d.z) / kRadPerDeg);
+  sun_elevation_deg_ = static_cast<float>(std::asin(d.y) / kRadPerDeg);
+}
+
+StudioApp::~StudioApp() = default;
+
+std::string StudioApp::display_name() const { return path_.empty() ? "untitled" : base_name(path_); }
+
+std::string StudioApp::title() const {
+  return "sylva studio \xE2\x80\x94 " + display_name() + (dirty() ? "*" : "");
+}
+
+bool StudioApp::dirty() const { return text_ != saved_text_; }
+
+bool StudioApp::wants_frames() const {
+  return worker_->busy() || worker_->result_waiting() || edited_at_ || unsnapped_at_ || animating_ ||
+         view_half_res_ || latency_start_ || (viewport_ && viewport_->busy());
+}
+
+std::optional<WidgetRect> StudioApp::rect(const std::string& name) const {
+  auto it = rects_.find(name);
+  if (it == rects_.end()) return std::nullopt;
+  return it->second;
+}
+
+void StudioApp::keep(const std::string& name) { rects_[name] = WidgetRect{ImGui::GetItemRectMin(), ImGui::GetItemRectMax()}; }
+
+// ---- documents --------------------------------------------------------------------
+
+std::optional<std::string> StudioApp::open(const std::string& path) {
+  if (ends_with(path, ".scene.json")) {
+    SceneReadResult read = read_scene_file(path);
+    if (!read.scene) return read.error ? read.error->format() : path + ": error: unreadable scene";
+    Scene scene = std::move(*read.scene);
+    // The editor shows the first plant's grammar; plants from other grammars (or ready
+    // skeletons) grow once, here.
+    std::string grammar;
+    for (const ScenePlant& p : scene.plants)
+      if (!p.grammar.empty() && !p.skeleton) {
+        grammar = p.grammar;
+        break;
+      }
+    if (grammar.empty()) return path + ": error: the scene has no plant grown from a grammar to edit";
+    Scene others = scene;
+    for (ScenePlant& p : others.plants)
+      if (p.grammar == grammar) p.skeleton = Skeleton{};  // not grown here
+    if (auto err = grow_scene_plants(others, options_.max_modules)) return *err;
+    for (size_t i = 0; i < scene.plants.size(); ++i)
+      if (scene.plants[i].grammar != grammar) scene.plants[i].skeleton = std::move(others.plants[i].skeleton);
+    FileReadResult r = read_text_file(grammar);
+    if (!r.contents) return r.error->format();
+    load_text(grammar, std::move(*r.contents), path, std::move(scene));
+    return std::nullopt;
+  }
+  FileReadResult r = read_text_file(path);
+  if (!r.contents) return r.error->format();
+  load_text(path, std::move(*r.contents), "", Scene{});
+  return std::nullopt;
+}
+
+void StudioApp::load_text(const std::string& path, std::string text, const std::string& scene_path, Scene scene) {
+  worker_->cancel();
+  path_ = path;
+  scene_path_ = scene_path;
+  saved_text_ = text;
+  text_ = std::move(text);
+  editor_.replace(text_);
+  disk_stamp_ = stamp_of(path_);
+  autosaved_text_ = text_;
+  define_lines_ = scan_defines(text_);
+  overrides_.clear();
+  seed_.reset();
+  steps_.reset();
+  show_step_.reset();
+  animating_ = false;
+  edited_at_.reset();
+  unsnapped_at_.reset();
+  error_.reset();
+  plant_.reset();
+  camera_set_ = false;
+  scene_ = std::move(scene);
+  edited_plants_.clear();
+  if (scene_path_.empty()) {
+    scene_.plants.assign(1, ScenePlant{});
+    scene_.plants[0].grammar = path_;
+    edited_plants_.push_back(0);
+  } else {
+    for (size_t i = 0; i < scene_.plants.size(); ++i)
+      if (scene_.plants[i].grammar == path_) edited_plants_.push_back(i);
+  }
+  history_.reset(doc_state());
+  restore_text_ = path_.empty() ? std::nullopt : restorable_autosave(path_, saved_text_);
+  show_presets_ = false;
+  status_ = "opened " + base_name(scene_path_.empty() ? path_ : scene_path_);
+  submit_regrow();
+}
+
+std::optional<std::string> StudioApp::save() {
+  if (path_.empty()) {
+    dialog_ = FileDialog::save_as;
+    dialog_path_ = "untitled.lsys";
+    return std::nullopt;
+  }
+  if (auto err = write_file_atomically(path_, text_)) {
+    status_ = err->format();
+    return status_;
+  }
+  saved_text_ = text_;
+  disk_stamp_ = stamp_of(path_);
+  remove_autosave(path_);
+  autosaved_text_ = text_;
+  status_ = "saved " + path_;
+  return std::nullopt;
+}
+
+std::optional<std::string> StudioApp::save_as(const std::string& path) {
+  if (path.empty()) return std::string("no file name");
+  const std::string old = path_;
+  path_ = path;
+  if (auto err = save()) {
+    path_ = old;
+    return err;
+  }
+  if (!old.empty() && old != path_) remove_autosave(old);
+  for (size_t i : edited_plants_) scene_.plants[i].grammar = path_;
+  return std::nullopt;
+}
+
+bool StudioApp::request_close() {
+  if (!dirty()) {
+    quit_ = true;
+    return true;
+  }
+  close_prompt_ = true;
+  return false;
+}
+
+// ---- regrowing --------------------------------------------------------------------
+
+DocState StudioApp::doc_state() const { return DocState{text_, overrides_, seed_, steps_}; }
+
+void StudioApp::snapshot() {
+  history_.record(doc_state());
+  unsnapped_at_.reset();
+}
+
+void StudioApp::apply_state(const DocState& s) {
+  set_text(s.text);
+  overrides_ = s.defines;
+  seed_ = s.seed;
+  steps_ = s.steps;
+  field_text_.clear();
+  submit_regrow();
+}
+
+void StudioApp::undo() {
+  if (doc_state() != history_.current()) snapshot();  // what was typed since is a step too
+  if (history_.can_undo()) apply_state(history_.undo());
+}
+
+void StudioApp::redo() {
+  if (doc_state() != history_.current()) snapshot();
+  if (history_.can_redo()) apply_state(history_.redo());
+}
+
+void StudioApp::set_text(std::string text) {
+  if (text == text_) return;
+  text_ = std::move(text);
+  editor_.replace(text_);
+  define_lines_ = scan_defines(text_);
+  edited_at_.reset();
+}
+
+void StudioApp::submit_regrow() {
+  edited_at_.reset();
+  // Overrides of defines the text no longer has would fail the parse: drop them.
+  for (auto it = overrides_.begin(); it != overrides_.end();) {
+    const bool known = std::any_of(define_lines_.begin(), define_lines_.end(),
+                                   [&](const DefineLine& d) { return d.name == it->first; });
+    it = known ? std::next(it) : overrides_.erase(it);
+  }
+  GrowRequest r;
+  r.text = text_;
+  r.file = path_.empty() ? "untitled.lsys" : path_;
+  r.max_modules = options_.max_modules;
+  r.show_step = show_step_;
+  for (size_t i : edited_plants_) {
+    const ScenePlant& p = scene_.plants[i];
+    PlantVariant v;
+    v.defines = p.defines;
+    for (const auto& [k, x] : overrides_) v.defines[k] = x;
+    v.seed = seed_ ? seed_ : p.seed;
+    v.steps = steps_ ? steps_ : p.steps;
+    r.plants.push_back(std::move(v));
+  }
+  if (r.plants.empty()) return;
+  latency_start_ = Clock::now();
+  worker_->submit(std::move(r));
+}
+
+Scene StudioApp::view_scene() const {
+  Scene s = scene_;
+  if (!bark_)
+    for (ScenePlant& p : s.plants) p.bark = Bark{};
+  return s;
+}
+
+void StudioApp::plants_changed() {
+  if (!viewport_ || !plant_) return;
+  viewport_->set_plants(view_scene(), render_options_);
+}
+
+void StudioApp::apply_outcome(GrowOutcome outcome) {
+  if (outcome.error) {
+    error_ = std::move(outcome.error);
+    animating_ = false;
+    return;
+  }
+  error_.reset();
+  for (size_t k = 0; k < edited_plants_.size() && k < outcome.skeletons.size(); ++k)
+    scene_.plants[edited_plants_[k]].skeleton = std::move(outcome.skeletons[k]);
+  outcome.skeletons.clear();
+  if (!camera_set_) {
+    // A grammar's first plant: the default scene's framing (scene.md); a scene: its camera.
+    if (scene_path_.empty()) {
+      const Skeleton& sk = *scene_.plants[0].skeleton;
+      Scene d = default_scene_for(sk, scene_.width, scene_.height);
+      d.plants = std::move(scene_.plants);
+      scene_ = std::move(d);
+      const glm::dvec3 dir = glm::normalize(scene_.sun.direction);
+      sun_azimuth_deg_ = static_cast<float>(std::atan2(dir.x, dir.z) / kRadPerDeg);
+      sun_elevation_deg_ = static_cast<float>(std::asin(dir.y) / kRadPerDeg);
+    }
+    orbit_ = OrbitCamera::from(scene_.camera);
+    camera_set_ = true;
+  }
+  plant_ = std::move(outcome);
+  ++plants_applied_;
+  plants_changed();
+}
+
+void StudioApp::poll_worker() {
+  if (auto outcome = worker_->poll()) {
+    const auto submitted = outcome->submitted;
+    const bool ok = !outcome->error;
+    apply_outcome(std::move(*outcome));
+    if (ok) latency_start_ = submitted;
+    else latency_start_.reset();
+  }
+  if (animating_ && !worker_->busy() && plant_ && !error_) {
+    if (plant_->shown_step >= plant_->steps) {
+      animating_ = false;
+    } else {
+      show_step_ = plant_->shown_step + 1;
+      submit_regrow();
+    }
+  }
+}
+
+void StudioApp::step() {
+  animating_ = false;
+  const int64_t at = plant_ ? plant_->shown_step : 0;
+  const int64_t steps = plant_ ? plant_->steps : 0;
+  if (at + 1 > steps) steps_ = at + 1;  // past the derivation length: derive further
+  show_step_ = at + 1;
+  submit_regrow();
+}
+
+void StudioApp::run() {
+  animating_ = false;
+  show_step_.reset();
+  submit_regrow();
+}
+
+void StudioApp::rewind() {
+  animating_ = false;
+  show_step_ = 0;
+  submit_regrow();
+}
+
+void StudioApp::animate() {
+  show_step_ = 0;
+  animating_ = true;
+  submit_regrow();
+}
+
+void StudioApp::frame_plant() {
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+  bool any = false;
+  for (const ScenePlant& p : scene_.plants) {
+    if (!p.skeleton || p.skeleton->joints.empty()) continue;
+    const SkeletonBounds b = skeleton_bounds(place_plant(p));
+    lo = glm::min(lo, b.lo);
+    hi = glm::max(hi, b.hi);
+    any = true;
+  }
+  if (any) orbit_.frame(lo, hi, scene_.width, scene_.height);
+}
+
+void StudioApp::set_define(const std::string& name, double value) {
+  overrides_[name] = value;
+  field_text_.erase(name);
+  snapshot();
+  submit_regrow();
+}
+
+void StudioApp::write_parameters_to_text() {
+  if (overrides_.empty()) return;
+  std::string t = text_;
+  // Replace from the last line up so earlier offsets stay valid.
+  std::vector<DefineLine> lines = scan_defines(t);
+  std::sort(lines.begin(), lines.end(), [](const DefineLine& a, const DefineLine& b) { return a.value_begin > b.value_begin; });
+  for (const DefineLine& d : lines) {
+    auto it = overrides_.find(d.name);
+    if (it != overrides_.end()) t = with_define_value(t, d, it->second);
+  }
+  overrides_.clear();
+  field_text_.clear();
+  set_text(std::move(t));
+  snapshot();
+  submit_regrow();
+}
+
+// ---- files ------------------------------------------------------------------------
+
+void StudioApp::autosave(double now) {
+  if (now - last_autosave_ < options_.autosave_s) return;
+  last_autosave_ = now;
+  if (!dirty() || text_ == autosaved_text_) return;
+  const std::string target = autosave_path(path_.empty() ? "untitled.lsys" : path_);
+  if (auto err = write_file_atomically(target, text_)) status_ = "autosave: " + err->format();
+  else autosaved_text_ = text_;
+}
+
+void StudioApp::watch_file(double now) {
+  if (path_.empty() || now - last_watch_ < options_.watch_s) return;
+  last_watch_ = now;
+  const FileStamp s = stamp_of(path_);
+  if (s == disk_stamp_) return;
+  disk_stamp_ = s;
+  FileReadResult r = read_text_file(path_);
+  if (!r.contents || *r.contents == saved_text_) return;
+  if (!dirty()) {
+    saved_text_ = *r.contents;
+    set_text(*r.contents);
+    autosaved_text_ = text_;
+    snapshot();
+    submit_regrow();
+    status_ = "reloaded " + path_ + " (changed on disk)";
+  } else {
+    external_prompt_ = true;
+  }
+}
+
+std::optional<std::string> StudioApp::export_gltf_file(const std::string& path, bool mesh) {
+  if (!plant_) return std::string("no plant to export yet");
+  std::vector<GltfPlant> plants;
+  for (const ScenePlant& sp : scene_.plants) {
+    if (!sp.skeleton) continue;
+    GltfPlant p;
+    p.name = stem(sp.grammar.empty() ? path_ : sp.grammar);
+    p.skeleton = *sp.skeleton;
+    for (int k = 0; k < 3; ++k) p.position_m[k] = sp.position[k];
+    p.rotate_y_deg = sp.rotate_y_deg;
+    p.scale = sp.scale;
+    p.bark = sp.bark;
+    plants.push_back(std::move(p));
+  }
+  GltfExportOptions o;
+  o.mesh = mesh;
+  return export_gltf(plants, path, o);
+}
+
+std::optional<std::string> StudioApp::export_skeleton_file(const std::string& path) {
+  if (!plant_) return std::string("no plant to export yet");
+  const Skeleton& sk = *scene_.plants[edited_plants_.front()].skeleton;
+  if (auto err = write_file_atomically(path, write_skeleton_json(sk))) return err->format();
+  return std::nullopt;
+}
+
+std::optional<std::string> StudioApp::export_png_file(const std::string& path, uint32_t width, uint32_t height) {
+  if (!plant_) return std::string("no plant to export yet");
+  if (!viewport_) return std::string("no renderer in this session");
+  Scene s = view_scene();
+  s.camera = orbit_.camera();
+  s.width = width;
+  s.height = height;
+  return viewport_->write_image(s, render_options_, path);
+}
+
+// ---- the frame --------------------------------------------------------------------
+
+void StudioApp::handle_shortcuts() {
+  const ImGuiIO& io = ImGui::GetIO();
+  if (!io.KeyCtrl) return;
+  if (key_pressed('Z')) io.KeyShift ? redo() : undo();
+  if (key_pressed('Y')) redo();
+  if (key_pressed('F')) editor_.open_find();
+  if (key_pressed('G')) editor_.open_goto();
+  if (key_pressed('S')) {
+    if (io.KeyShift) dialog_ = FileDialog::save_as, dialog_path_ = path_.empty() ? "untitled.lsys" : path_;
+    else save();
+  }
+  if (key_pressed('O')) dialog_ = FileDialog::open, dialog_path_ = path_;
+}
+
+void StudioApp::frame(double now) {
+  now_ = now;
+  rects_.clear();
+  poll_worker();
+  handle_shortcuts();
+
+  // A pause in typing: grow the new text; a longer one: an undo step.
+  if (edited_at_ && now - *edited_at_ >= options_.debounce_s) submit_regrow();
+  if (unsnapped_at_ && now - *unsnapped_at_ >= options_.snapshot_s) snapshot();
+  autosave(now);
+  watch_file(now);
+
+  const ImGuiViewport* vp = ImGui::GetMainViewport();
+  ImGui::SetNextWindowPos(vp->WorkPos);
+  ImGui::SetNextWindowSize(vp->WorkSize);
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowRounding, 0);
+  ImGui::Begin("studio", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
+                   ImGuiWindowFlags_MenuBar | ImGuiWindowFlags_NoBringToFrontOnFocus);
+  ImGui::PopStyleVar();
+  draw_menu();
+  const ImVec2 avail = ImGui::GetContentRegionAvail();
+  const float left = std::floor(avail.x * 0.42f);
+  const float status_h = ImGui::GetFrameHeightWithSpacing();
+
+  ImGui::BeginChild("left", ImVec2(left, avail.y - status_h), false);
+  {
+    const float message_h = ImGui::GetTextLineHeightWithSpacing() * 2 + 4;
+    draw_editor(ImVec2(ImGui::GetContentRegionAvail().x, ImGui::GetContentRegionAvail().y - message_h));
+    draw_message_bar();
+  }
+  ImGui::EndChild();
+  ImGui::SameLine();
+  ImGui::BeginChild("right", ImVec2(0, avail.y - status_h), false);
+  {
+    const ImVec2 r = ImGui::GetContentRegionAvail();
+    draw_viewport(ImVec2(r.x, std::floor(r.y * 0.6f)));
+    ImGui::BeginChild("panels", ImVec2(0, 0), true);
+    draw_parameters();
+    draw_derivation();
+    draw_view();
+    ImGui::EndChild();
+  }
+  ImGui::EndChild();
+
+  // Status line: what was last done, and the cursor.
+  ImGui::Separator();
+  ImGui::Text("Ln %u, Col %u", editor_.cursor_line(), editor_.cursor_column());
+  ImGui::SameLine(160);
+  ImGui::TextUnformatted(status_.c_str());
+  ImGui::End();
+
+  if (show_presets_) draw_presets();
+  draw_file_dialog();
+  draw_modals();
+}
+
+void StudioApp::draw_menu() {
+  if (!ImGui::BeginMenuBar()) return;
+  if (ImGui::BeginMenu("File")) {
+    if (ImGui::MenuItem("Open...", "Ctrl+O")) dialog_ = FileDialog::open, dialog_path_ = path_;
+    if (ImGui::MenuItem("Presets...")) show_presets_ = true;
+    if (ImGui::MenuItem("Save", "Ctrl+S")) save();
+    if (ImGui::MenuItem("Save as...", "Ctrl+Shift+S"))
+      dialog_ = FileDialog::save_as, dialog_path_ = path_.empty() ? "untitled.lsys" : path_;
+    if (ImGui::MenuItem("Reload from disk", nullptr, false, !path_.empty())) {
+      FileReadResult r = read_text_file(path_);
+      if (r.contents) {
+        saved_text_ = *r.contents;
+        set_text(*r.contents);
+        snapshot();
+        submit_regrow();
+      }
+    }
+    ImGui::Separator();
+    if (ImGui::MenuItem("Quit")) request_close();
+    ImGui::EndMenu();
+  }
+  if (ImGui::BeginMenu("Edit")) {
+    if (ImGui::MenuItem("Undo", "Ctrl+Z", false, history_.can_undo() || doc_state() != history_.current())) undo();
+    if (ImGui::MenuItem("Redo", "Ctrl+Shift+Z", false, history_.can_redo())) redo();
+    if (ImGui::MenuItem("Find", "Ctrl+F")) editor_.open_find();
+    if (ImGui::MenuItem("Go to line", "Ctrl+G")) editor_.open_goto();
+    ImGui::EndMenu();
+  }
+  if (ImGui::BeginMenu("Export")) {
+    const std::string base = path_.empty() ? "untitled" : (std::filesystem::path(path_).parent_path() / stem(path_)).string();
+    if (ImGui::MenuItem("glTF...", nullptr, false, plant_.has_value()))
+      dialog_ = FileDialog::export_gltf, dialog_path_ = base + ".glb";
+    if (ImGui::MenuItem("PNG...", nullptr, false, plant_.has_value()))
+      dialog_ = FileDialog::export_png, dialog_path_ = base + ".png";
+    if (ImGui::MenuItem("Skeleton...", nullptr, false, plant_.has_value()))
+      dialog_ = FileDialog::export_skeleton, dialog_path_ = base + ".skel.json";
+    ImGui::EndMenu();
+  }
+  ImGui::EndMenuBar();
+}
+
+void StudioApp::draw_editor(ImVec2 size) {
+  std::optional<EditorMark> mark;
+  if (error_ && error_->loc.line > 0)
+    mark = EditorMark{error_->loc.line, error_->loc.column, token_length(text_, error_->loc.line, error_->loc.column),
+                      error_->message};
+  if (editor_.draw("editor", text_, mark, size)) {
+    define_lines_ = scan_defines(text_);
+    edited_at_ = now_;
+    unsnapped_at_ = now_;  // the undo step comes after a pause in typing
+    animating_ = false;
+  }
+  keep("editor");
+  if (editor_.deactivated() && doc_state() != history_.current()) snapshot();
+}
+
+void StudioApp::draw_message_bar() {
+  if (error_) {
+    const std::string first = error_->format().substr(0, error_->format().find('\n'));
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.5f, 0.45f, 1));
+    const bool clicked = ImGui::Selectable(first.c_str(), false);
+    ImGui::PopStyleColor();
+    keep("message");
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("click to go to the error\n%s", error_->format().c_str());
+    if (clicked && error_->loc.line > 0) editor_.jump_to(error_->loc.line, std::max(1u, error_->loc.column));
+    ImGui::TextDisabled("the viewport keeps the last good plant");
+  } else if (plant_) {
+    ImGui::TextDisabled("%s", plant_->warning.empty() ? "no errors" : plant_->warning.c_str());
+    keep("message");
+  } else {
+    ImGui::TextDisabled("%s", worker_->busy() ? "growing..." : "");
+  }
+}
+
+void StudioApp::draw_viewport(ImVec2 size) {
+  ImGui::BeginChild("viewport", size, true, ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoScrollWithMouse);
+  const ImVec2 avail = ImGui::GetContentRegionAvail();
+  const ImGuiIO& io = ImGui::GetIO();
+  const float line = ImGui::GetTextLineHeightWithSpacing();
+  const ImVec2 image_size(std::max(1.0f, avail.x), std::max(1.0f, avail.y - line));
+  // The scene's size follows the panel; while the camera is dragged, half the pixels.
+  const uint32_t scale = view_half_res_ ? 2 : 1;
+  scene_.width = std::max<uint32_t>(1, static_cast<uint32_t>(image_size.x) / scale);
+  scene_.height = std::max<uint32_t>(1, static_cast<uint32_t>(image_size.y) / scale);
+  scene_.camera = orbit_.camera();
+  const ImVec2 origin = ImGui::GetCursorScreenPos();
+  ImGui::InvisibleButton("##view", image_size,
+                         ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonMiddle);
+  keep("viewport");
+  const bool hovered = ImGui::IsItemHovered(), active = ImGui::IsItemActive();
+  if (active && (io.MouseDelta.x != 0 || io.MouseDelta.y != 0)) {
+    if (ImGui::IsMouseDown(ImGuiMouseButton_Middle) || (io.KeyShift && ImGui::IsMouseDown(ImGuiMouseButton_Left)))
+      orbit_.pan(io.MouseDelta.x, io.MouseDelta.y, image_size.y);
+    else if (ImGui::IsMouseDown(ImGuiMouseButton_Left))
+      orbit_.orbit(io.MouseDelta.x, io.MouseDelta.y);
+  }
+  view_half_res_ = active;
+  if (hovered && io.MouseWheel != 0) orbit_.zoom(io.MouseWheel);
+  if (hovered && !io.WantTextInput && key_pressed('F') && !io.KeyCtrl) frame_plant();
+  scene_.camera = orbit_.camera();
+
+  ImDrawList* dl = ImGui::GetWindowDrawList();
+  ViewImage img;
+  if (viewport_ && plant_) img = viewport_->image(view_scene());
+  if (img.texture) {
+    dl->AddImage(img.texture, origin, ImVec2(origin.x + image_size.x, origin.y + image_size.y),
+                 img.flip_v ? ImVec2(0, 1) : ImVec2(0, 0), img.flip_v ? ImVec2(1, 0) : ImVec2(1, 1));
+    if (img.current) {
+      drawn_version_ = plants_applied_;
+      if (latency_start_) {
+        latencies_.push_back(std::chrono::duration<double>(Clock::now() - *latency_start_).count());
+        latency_start_.reset();
+      }
+    }
+  } else {
+    dl->AddRectFilled(origin, ImVec2(origin.x + image_size.x, origin.y + image_size.y), IM_COL32(40, 44, 52, 255));
+    const char* why = !plant_ ? (worker_->busy() ? "growing..." : "no plant yet")
+                               : (viewport_ && !viewport_->stats().error.empty() ? viewport_->stats().error.c_str()
+                                                                                 : "no renderer");
+    dl->AddText(ImVec2(origin.x + 10, origin.y + 10), IM_COL32(200, 200, 200, 255), why);
+    if (plant_ && (!viewport_ || !viewport_->busy())) {
+      drawn_version_ = plants_applied_;  // nothing more to wait for
+      if (latency_start_) {
+        latencies_.push_back(std::chrono::duration<double>(Clock::now() - *latency_start_).count());
+        latency_start_.reset();
+      }
+    }
+  }
+  if (worker_->busy()) {
+    int64_t step = 0, steps = 0;
+    worker_->progress(&step, &steps);
+    char text[96];
+    std::snprintf(text, sizeof text, "regrowing... step %lld/%lld", static_cast<long long>(step),
+                  static_cast<long long>(steps));
+    dl->AddText(ImVec2(origin.x + 10, origin.y + image_size.y - line - 4), IM_COL32(255, 230, 150, 255), text);
+  }
+  // Under the picture: what it is and what it cost.
+  if (plant_) {
+    double gpu_ms = 0;
+    if (viewport_)
+      for (const RenderPass& p : viewport_->stats().passes)
+        if (p.name.find("(GPU)") != std::string::npos) gpu_ms += p.seconds * 1e3;
+    ImGui::Text("%llu segments  step %lld/%lld  %llu modules  GPU %.1f ms  frame %.1f ms",
+                static_cast<unsigned long long>(plant_->segments), static_cast<long long>(plant_->shown_step),
+                static_cast<long long>(plant_->steps), static_cast<unsigned long long>(plant_->modules), gpu_ms,
+                io.DeltaTime * 1e3);
+  }
+  ImGui::EndChild();
+}
+
+void StudioApp::draw_parameters() {
+  if (!ImGui::CollapsingHeader("Parameters", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  ImGui::Checkbox("continuous", &continuous_);
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("regrow while dragging (off: when the slider is released)");
+  ImGui::SameLine();
+  if (ImGui::Button("Write to text")) write_parameters_to_text();
+  keep("write_to_text");
+  ImGui::SameLine();
+  if (ImGui::Button("Reset") && !overrides_.empty()) {
+    overrides_.clear();
+    field_text_.clear();
+    snapshot();
+    submit_regrow();
+  }
+  const float field_w = 90;
+  for (const DefineLine& d : define_lines_) {
+    ImGui::PushID(d.name.c_str());
+    double value = 0;
+    bool known = false;
+    if (auto it = overrides_.find(d.name); it != overrides_.end()) value = it->second, known = true;
+    if (!known && plant_)
+      for (const lsys::Define& gd : plant_->defines)
+        if (gd.name == d.name) value = gd.value, known = true;
+    if (!known) value = parse_exact(d.value_text).value_or(0);
+    bool changed = false, released = false;
+    if (d.has_range()) {
+      ImGui::SetNextItemWidth(std::max(80.0f, ImGui::GetContentRegionAvail().x - field_w - 130));
+      double v = value;
+      if (ImGui::SliderScalar("##slider", ImGuiDataType_Double, &v, &*d.min, &*d.max, "%.4g",
+                              ImGuiSliderFlags_NoRoundToFormat)) {
+        if (d.step) v = *d.min + std::round((v - *d.min) / *d.step) * *d.step;
+        v = std::clamp(v, *d.min, *d.max);
+        if (v != value) value = v, changed = true;
+      }
+      keep("slider:" + d.name);
+      released = ImGui::IsItemDeactivatedAfterEdit();
+      ImGui::SameLine();
+    }
+    // The typed field: exact (parsed whole, shortest round-trip shown).
+    std::string& field = field_text_[d.name];
+    if (!ImGui::IsAnyItemActive() || field.empty()) {
+      // refreshed below unless this field is being typed in
+    }
+    ImGui::SetNextItemWidth(field_w);
+    const std::string shown = shortest(value);
+    std::string buffer = field.empty() ? shown : field;
+    const bool typed_enter = ImGui::InputText("##field", &buffer, ImGuiInputTextFlags_EnterReturnsTrue);
+    keep("field:" + d.name);
+    const bool field_active = ImGui::IsItemActive();
+    if (field_active) field = buffer;
+    if (typed_enter || ImGui::IsItemDeactivatedAfterEdit()) {
+      if (auto v = parse_exact(buffer)) {
+        value = *v;
+        changed = released = true;
+      }
+      field.clear();
+    } else if (!field_active) {
+      field.clear();
+    }
+    ImGui::SameLine();
+    const bool overridden = overrides_.count(d.name) > 0;
+    if (overridden) ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.85f, 0.4f, 1));
+    ImGui::TextUnformatted(d.name.c_str());
+    if (overridden) ImGui::PopStyleColor();
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("#define %s %s (line %u)%s", d.name.c_str(), d.value_text.c_str(), d.line,
+                        overridden ? "\noverridden: not in the text until 'Write to text'" : "");
+    if (changed) overrides_[d.name] = value;
+    if ((changed && continuous_) || released) submit_regrow();
+    if (released) snapshot();
+    ImGui::PopID();
+  }
+  // Seed and steps: exact integers.
+  {
+    const uint64_t grammar_seed = plant_ ? plant_->grammar_seed : 1;
+    std::string seed_text = std::to_string(seed_.value_or(grammar_seed));
+    ImGui::SetNextItemWidth(160);
+    if (ImGui::InputText("seed", &seed_text, ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_CharsDecimal))
+      if (auto v = parse_u64_exact(seed_text)) seed_ = *v, snapshot(), submit_regrow();
+    ImGui::SameLine();
+    if (ImGui::Button("+1")) seed_ = seed_.value_or(grammar_seed) + 1, snapshot(), submit_regrow();
+    keep("seed+1");
+    ImGui::SameLine();
+    int64_t steps = steps_.value_or(plant_ ? plant_->grammar_steps : 1);
+    const int64_t one = 1;
+    ImGui::SetNextItemWidth(120);
+    if (ImGui::InputScalar("steps", ImGuiDataType_S64, &steps, &one, nullptr, "%lld",
+                           ImGuiInputTextFlags_EnterReturnsTrue)) {
+      steps_ = std::max<int64_t>(0, steps);
+      show_step_.reset();
+      snapshot();
+      submit_regrow();
+    }
+  }
+}
+
+void StudioApp::draw_derivation() {
+  if (!ImGui::CollapsingHeader("Derivation", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (ImGui::Button("Rewind")) rewind();
+  keep("button:Rewind");
+  ImGui::SameLine();
+  if (ImGui::Button("Step")) step();
+  keep("button:Step");
+  ImGui::SameLine();
+  if (ImGui::Button("Run")) run();
+  keep("button:Run");
+  ImGui::SameLine();
+  if (ImGui::Button(animating_ ? "Stop" : "Animate")) animating_ ? (void)(animating_ = false) : animate();
+  keep("button:Animate");
+  ImGui::SameLine();
+  if (worker_->busy()) {
+    if (ImGui::Button("Cancel")) worker_->cancel(), animating_ = false;
+  } else if (plant_) {
+    ImGui::Text("step %lld of %lld%s", static_cast<long long>(plant_->shown_step), static_cast<long long>(plant_->steps),
+                plant_->from_cache ? " (cached)" : "");
+  }
+}
+
+void StudioApp::draw_view() {
+  if (!ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  bool sun = false;
+  ImGui::SetNextItemWidth(150);
+  sun |= ImGui::SliderFloat("sun azimuth", &sun_azimuth_deg_, -180, 180, "%.0f deg");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(150);
+  sun |= ImGui::SliderFloat("elevation", &sun_elevation_deg_, 1, 90, "%.0f deg");
+  if (sun) {
+    const double az = sun_azimuth_deg_ * kRadPerDeg, el = sun_elevation_deg_ * kRadPerDeg;
+    scene_.sun.direction = {std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az)};
+  }
+  bool skin = false;
+  skin |= ImGui::Checkbox("bark", &bark_);
+  ImGui::SameLine();
+  skin |= ImGui::Checkbox("relief", &render_options_.geometry.relief);
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(100);
+  int knuckles = render_options_.skin.knuckle_frusta;
+  if (ImGui::SliderInt("knuckle frusta", &knuckles, 2, 16)) render_options_.skin.knuckle_frusta = knuckles;
+  skin |= ImGui::IsItemDeactivatedAfterEdit();
+  ImGui::SameLine();
+  if (ImGui::Button("Frame (F)")) frame_plant();
+  if (skin) plants_changed();
+  if (viewport_) {
+    const ViewStats& st = viewport_->stats();
+    std::string passes;
+    for (const RenderPass& p : st.passes)
+      if (p.name.find("(GPU)") != std::string::npos) {
+        char b[96];
+        std::snprintf(b, sizeof b, "%s%s %.2f ms", passes.empty() ? "" : ", ", p.name.substr(0, p.name.find(" (")).c_str(),
+                      p.seconds * 1e3);
+        passes += b;
+      }
+    ImGui::TextDisabled("GPU: %s", passes.empty() ? "-" : passes.c_str());
+    ImGui::TextDisabled("%llu frusta, render %.1f ms, skin+upload %.1f ms%s%s",
+                        static_cast<unsigned long long>(st.frusta), st.render_ms, st.upload_ms,
+                        st.renderer.empty() ? "" : ", ", st.renderer.c_str());
+  }
+  if (!latencies_.empty()) ImGui::TextDisabled("last regrow: %.0f ms edit to picture", latencies_.back() * 1e3);
+}
+
+void StudioApp::draw_presets() {
+  ImGui::SetNextWindowSize(ImVec2(360, 420), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowPos(ImVec2(60, 60), ImGuiCond_FirstUseEver);
+  if (!ImGui::Begin("Presets", &show_presets_, ImGuiWindowFlags_NoSavedSettings)) {
+    ImGui::End();
+    return;
+  }
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const char* sub : {"", "scenes"}) {
+    const std::filesystem::path dir = std::filesystem::path(options_.presets_dir) / sub;
+    for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+      const std::string p = e.path().string();
+      if (ends_with(p, ".lsys") || ends_with(p, ".scene.json")) files.push_back(p);
+    }
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) ImGui::TextDisabled("no presets in %s", options_.presets_dir.c_str());
+  for (const std::string& f : files) {
+    const std::string label = std::filesystem::relative(f, options_.presets_dir, ec).string();
+    const bool chosen = ImGui::Selectable(label.c_str(), f == path_ || f == scene_path_);
+    keep("preset:" + label);
+    if (chosen) {
+      if (dirty()) {
+        open_after_prompt_ = f;
+        close_prompt_ = true;
+      } else if (auto err = open(f)) {
+        status_ = *err;
+      }
+    }
+  }
+  ImGui::End();
+}
+
+void StudioApp::draw_file_dialog() {
+  if (dialog_ == FileDialog::none) return;
+  const char* titles[] = {"", "Open", "Save as", "Export glTF", "Export PNG", "Export skeleton"};
+  const char* title = titles[static_cast<int>(dialog_)];
+  if (!ImGui::IsPopupOpen(title)) ImGui::OpenPopup(title);
+  if (!ImGui::BeginPopupModal(title, nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
+  ImGui::TextUnformatted(dialog_ == FileDialog::open ? "a .lsys grammar or .scene.json scene" : "file");
+  ImGui::SetNextItemWidth(480);
+  if (ImGui::IsWindowAppearing()) ImGui::SetKeyboardFocusHere();
+  bool go = ImGui::InputText("##path", &dialog_path_, ImGuiInputTextFlags_EnterReturnsTrue);
+  if (dialog_ == FileDialog::export_png) {
+    ImGui::SetNextItemWidth(120);
+    ImGui::InputInt("width", &export_width_);
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(120);
+    ImGui::InputInt("height", &export_height_);
+    export_width_ = std::clamp(export_width_, 1, 16384);
+    export_height_ = std::clamp(export_height_, 1, 16384);
+  }
+  if (dialog_ == FileDialog::export_gltf) ImGui::Checkbox("mesh (the skinned frusta as triangles)", &export_mesh_);
+  go |= ImGui::Button("OK");
+  ImGui::SameLine();
+  const bool cancel = ImGui::Button("Cancel") || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape));
+  if (go) {
+    std::optional<std::string> err;
+    switch (dialog_) {
+      case FileDialog::open:
+        if (dirty()) open_after_prompt_ = dialog_path_, close_prompt_ = true;
+        else err = open(dialog_path_);
+        break;
+      case FileDialog::save_as: err = save_as(dialog_path_); break;
+      case FileDialog::export_gltf: err = export_gltf_file(dialog_path_, export_mesh_); break;
+      case FileDialog::export_png:
+        err = export_png_file(dialog_path_, static_cast<uint32_t>(export_width_), static_cast<uint32_t>(export_height_));
+        break;
+      case FileDialog::export_skeleton: err = export_skeleton_file(dialog_path_); break;
+      case FileDialog::none: break;
+    }
+    if (err) status_ = *err;
+    else if (dialog_ != FileDialog::open && dialog_ != FileDialog::save_as) status_ = "wrote " + dialog_path_;
+  }
+  if (go || cancel) {
+    dialog_ = FileDialog::none;
+    ImGui::CloseCurrentPopup();
+  }
+  ImGui::EndPopup();
+}
+
+void StudioApp::draw_modals() {
+  if (restore_text_) {
+    if (!ImGui::IsPopupOpen("Restore unsaved edits?")) ImGui::OpenPopup("Restore unsaved edits?");
+    if (ImGui::BeginPopupModal("Restore unsaved edits?", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+      ImGui::Text("%s has edits that were never saved (%s).", display_name().c_str(), autosave_path(path_).c_str());
+      if (ImGui::Button("Restore")) {
+        set_text(*restore_text_);
+        snapshot();
+        submit_regrow();
+        restore_text_.reset();
+        ImGui::CloseCurrentPopup();
+      }
+      keep("button:Restore");
+      ImGui::SameLine();
+      if (ImGui::Button("Discard")) {
+        remove_autosave(path_);
+        restore_text_.reset();
+        ImGui::CloseCurrentPopup();
+      }
+      keep("button:Discard");
+      ImGui::EndPopup();
+    }
+  }
+  if (close_prompt_) {
+    if (!ImGui::IsPopupOpen("Unsaved edits")) ImGui::OpenPopup("Unsaved edits");
+    if (ImGui::BeginPopupModal("Unsaved edits", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+      ImGui::Text("Save the changes to %s?", display_name().c_str());
+      auto proceed = [&] {
+        close_prompt_ = false;
+        ImGui::CloseCurrentPopup();
+        if (open_after_prompt_) {
+          const std::string next = *open_after_prompt_;
+          open_after_prompt_.reset();
+          if (auto err = open(next)) status_ = *err;
+        } else {
+          quit_ = true;
+        }
+      };
+      if (ImGui::Button("Save")) {
+        if (path_.empty()) {
+          close_prompt_ = false;
+          dialog_ = FileDialog::save_as;
+          dialog_path_ = "untitled.lsys";
+          ImGui::CloseCurrentPopup();
+        } else if (!save()) {
+          proceed();
+        }
+      }
+      keep("button:Save");
+      ImGui::SameLine();
+      if (ImGui::Button("Don't save")) {
+        remove_autosave(path_.empty() ? "untitled.lsys" : path_);
+        saved_text_ = text_;  // nothing left to lose: the user said so
+        proceed();
+      }
+      keep("button:DontSave");
+      ImGui::SameLine();
+      if (ImGui::Button("Cancel")) {
+        close_prompt_ = false;
+        open_after_prompt_.reset();
+        ImGui::CloseCurrentPopup();
+      }
+      keep("button:Cancel");
+      ImGui::EndPopup();
+    }
+  }
+  if (external_prompt_) {
+    if (!ImGui::IsPopupOpen("Changed on disk")) ImGui::OpenPopup("Changed on disk");
+    if (ImGui::BeginPopupModal("Changed on disk", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+      ImGui::Text("%s was changed by another program, and has unsaved edits here.", display_name().c_str());
+      if (ImGui::Button("Reload (lose my edits)")) {
+        FileReadResult r = read_text_file(path_);
+        if (r.contents) {
+          saved_text_ = *r.contents;
+          set_text(*r.contents);
+          snapshot();
+          submit_regrow();
+        }
+        external_prompt_ = false;
+        ImGui::CloseCurrentPopup();
+      }
+      keep("button:Reload");
+      ImGui::SameLine();
+      if (ImGui::Button("Keep mine")) {
+        FileReadResult r = read_text_file(path_);
+        if (r.contents) saved_text_ = *r.contents;  // the disk's text is what "saved" means now
+        external_prompt_ = false;
+        ImGui::CloseCurrentPopup();
+      }
+      keep("button:KeepMine");
+      ImGui::EndPopup();
+    }
+  }
+}
+
+}  // namespace sylva::studio

@@ -1,0 +1,203 @@
+// studio_app.h — the studio's window contents and behaviour (../shared/spec/studio.md),
+// independent of GLFW and of GL: one call per frame between ImGui::NewFrame() and
+// ImGui::Render() builds every widget from the app's state, and the app reacts to what
+// the user did. The window (studio_main.cpp) and the headless tests (tests/studio/) drive
+// the same object; the plants are drawn by a Viewport (viewport.h), which the tests fake.
+//
+// What happens where:
+//   editor text ── debounce ──► GrowWorker (parse, derive, interpret, skeleton) ──► poll()
+//   parameters ── continuous or on release ──►    "        (the ladder's top rung)
+//   skin / bark / relief options ──► Viewport::set_plants (re-skin, re-upload)
+//   camera / sun / size ──► Viewport::image (re-render only)
+// A parse or derivation error leaves the last good plant on screen and marks the text.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <imgui.h>
+
+#include "app/studio/code_editor.h"
+#include "app/studio/define_controls.h"
+#include "app/studio/document_files.h"
+#include "app/studio/grow_worker.h"
+#include "app/studio/orbit_camera.h"
+#include "app/studio/undo_history.h"
+#include "app/studio/viewport.h"
+#include "core/render_types.h"
+#include "core/scene.h"
+#include "core/util/diagnostic.h"
+
+namespace sylva::studio {
+
+struct StudioOptions {
+  std::string presets_dir;        // the preset browser's folder
+  double debounce_s = 0.15;       // a pause in typing before the text is grown again
+  double snapshot_s = 0.8;        // a pause in typing before an undo step is taken
+  double autosave_s = 3;          // how often an edited document is autosaved
+  double watch_s = 0.5;           // how often the file on disk is checked for changes
+  uint64_t max_modules = 50'000'000;
+};
+
+// Where the tests click: screen rectangles of named widgets from the last frame.
+struct WidgetRect {
+  ImVec2 min{0, 0}, max{0, 0};
+  ImVec2 centre() const { return ImVec2((min.x + max.x) * 0.5f, (min.y + max.y) * 0.5f); }
+};
+
+class StudioApp {
+ public:
+  StudioApp(StudioOptions options, Viewport* viewport);
+  ~StudioApp();
+  StudioApp(const StudioApp&) = delete;
+  StudioApp& operator=(const StudioApp&) = delete;
+
+  // Opens a .lsys grammar or a .scene.json scene (its plants grow; the editor shows the
+  // first plant's grammar). Returns the error text, changing nothing, when it cannot.
+  // An autosave newer than the file is offered for restoring.
+  std::optional<std::string> open(const std::string& path);
+  // One frame of widgets at time `now` (seconds, any origin, increasing).
+  void frame(double now);
+
+  std::string title() const;  // "sylva studio — elm.lsys*"
+  bool dirty() const;         // the text differs from the file's
+  // The window asks to close: true if it may close now; otherwise the app asks the user
+  // (save / don't save / cancel) and quit_requested() turns true when they answer so.
+  bool request_close();
+  bool quit_requested() const { return quit_; }
+  // Whether the next frame should come at once rather than on the next input event: the
+  // worker runs or has a result, a timer (debounce, undo step) is pending, an animation
+  // or a camera drag is on.
+  bool wants_frames() const;
+  std::optional<std::string> save();                        // to the document's path
+  std::optional<std::string> save_as(const std::string& path);
+
+  // State, for the window's --screenshot and for tests.
+  const std::string& text() const { return text_; }
+  const std::string& path() const { return path_; }
+  const std::optional<Diagnostic>& error() const { return error_; }
+  const std::optional<GrowOutcome>& plant() const { return plant_; }  // the last good plant
+  uint64_t plants_applied() const { return plants_applied_; }        // results put on screen
+  bool plant_drawn() const { return drawn_version_ == plants_applied_ && plants_applied_ > 0; }
+  GrowWorker& worker() { return *worker_; }
+  CodeEditor& editor() { return editor_; }
+  const UndoHistory& history() const { return history_; }
+  const std::map<std::string, double>& overrides() const { return overrides_; }
+  const Scene& scene() const { return scene_; }
+  const OrbitCamera& camera() const { return orbit_; }
+  bool restore_offered() const { return restore_text_.has_value(); }
+  bool close_prompt_open() const { return close_prompt_; }
+  bool external_change_prompt_open() const { return external_prompt_; }
+  const std::string& status() const { return status_; }
+  // Edit-to-picture latencies (submit to the first frame showing the result), seconds.
+  const std::vector<double>& latencies() const { return latencies_; }
+  std::optional<WidgetRect> rect(const std::string& name) const;
+  bool continuous() const { return continuous_; }
+
+  // Actions the menus and shortcuts call (also for tests).
+  void undo();
+  void redo();
+  void write_parameters_to_text();
+  // What releasing a define's slider at `value` does: override, undo step, regrow.
+  void set_define(const std::string& name, double value);
+  void step();     // one more derivation step
+  void run();      // to the derivation length
+  void rewind();   // back to the axiom
+  void animate();  // from the axiom, one step per frame
+  void frame_plant();
+  std::optional<std::string> export_gltf_file(const std::string& path, bool mesh);
+  std::optional<std::string> export_skeleton_file(const std::string& path);
+  std::optional<std::string> export_png_file(const std::string& path, uint32_t width, uint32_t height);
+
+ private:
+  enum class FileDialog { none, open, save_as, export_gltf, export_png, export_skeleton };
+
+  void load_text(const std::string& path, std::string text, const std::string& scene_path, Scene scene);
+  void submit_regrow();
+  void apply_outcome(GrowOutcome outcome);
+  void set_text(std::string text);  // from undo/reload/write-to-text: editor follows
+  DocState doc_state() const;
+  void apply_state(const DocState& s);
+  void snapshot();
+  void poll_worker();
+  void handle_shortcuts();
+  void autosave(double now);
+  void watch_file(double now);
+  void draw_menu();
+  void draw_editor(ImVec2 size);
+  void draw_message_bar();
+  void draw_viewport(ImVec2 size);
+  void draw_parameters();
+  void draw_derivation();
+  void draw_view();
+  void draw_presets();
+  void draw_modals();
+  void draw_file_dialog();
+  void keep(const std::string& name);  // records the last item's rect under `name`
+  Scene view_scene() const;            // scene_ with the view's bark toggle applied
+  void plants_changed();               // skin/bark/relief options or new plants → set_plants
+  std::string display_name() const;
+
+  StudioOptions options_;
+  Viewport* viewport_;
+  std::unique_ptr<GrowWorker> worker_;
+  CodeEditor editor_;
+  UndoHistory history_;
+
+  // The document.
+  std::string path_;                 // the grammar file; empty: untitled
+  std::string scene_path_;           // the scene it came with, if any
+  std::string text_;
+  std::string saved_text_;           // the text as on disk
+  FileStamp disk_stamp_;
+  std::vector<DefineLine> define_lines_;
+  std::map<std::string, double> overrides_;
+  std::optional<uint64_t> seed_;
+  std::optional<int64_t> steps_;
+  std::optional<int64_t> show_step_;
+  bool continuous_ = true;
+
+  // The plants.
+  Scene scene_;                      // camera, sun, ...; plants with their skeletons
+  std::vector<size_t> edited_plants_;  // indices of scene_'s plants grown from the text
+  std::optional<GrowOutcome> plant_;
+  std::optional<Diagnostic> error_;
+  uint64_t plants_applied_ = 0, drawn_version_ = 0;
+  std::optional<std::chrono::steady_clock::time_point> latency_start_;
+  std::vector<double> latencies_;
+  bool animating_ = false;
+  bool camera_set_ = false;
+  OrbitCamera orbit_;
+  RenderOptions render_options_;
+  bool bark_ = true;
+  float sun_azimuth_deg_ = 0, sun_elevation_deg_ = 45;
+  bool view_half_res_ = false;
+
+  // Time.
+  double now_ = 0;
+  std::optional<double> edited_at_;    // text changed, regrow not yet submitted
+  std::optional<double> unsnapped_at_; // text changed, undo step not yet taken
+  double last_autosave_ = 0, last_watch_ = 0;
+  std::string autosaved_text_;
+
+  // Prompts and dialogs.
+  std::optional<std::string> restore_text_;
+  bool close_prompt_ = false;
+  std::optional<std::string> open_after_prompt_;  // a file to open once the prompt is answered
+  bool external_prompt_ = false;
+  bool quit_ = false;
+  FileDialog dialog_ = FileDialog::none;
+  std::string dialog_path_;
+  int export_width_ = 1920, export_height_ = 1080;
+  bool export_mesh_ = true;
+  bool show_presets_ = false;
+  std::string status_;
+  std::map<std::string, WidgetRect> rects_;
+  std::map<std::string, std::string> field_text_;  // typed fields being edited
+};
+
+}  // namespace sylva::studio

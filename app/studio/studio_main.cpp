@@ -1,0 +1,256 @@
+// studio_main.cpp — `sylva studio [INPUT] [--screenshot OUT.png [--frames N]] [--size WxH]`
+// (../shared/spec/studio.md): the GLFW window with an OpenGL 4.5 core context, Dear
+// ImGui's GLFW and OpenGL 3 backends (inside Debian's libimgui.a), the StudioApp and the
+// GL viewport, and the loop that drives them.
+//
+// Under Xvfb (llvmpipe) the front buffer cannot be read back, so --screenshot reads the
+// back buffer after ImGui has drawn it and before the swap
+// (../shared/notes/studio-gui.md sec. 4).
+// OpenGL from gl_api.h (the core prototypes); GLFW must not include its own GL header.
+#include "core/gl/gl_api.h"
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <thread>
+
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+
+#include "app/cli/cli.h"
+#include "app/studio/gl_viewport.h"
+#include "app/studio/studio.h"
+#include "app/studio/studio_app.h"
+#include "core/util/image_io.h"
+
+namespace sylva::studio {
+
+namespace {
+
+void print_help() {
+  std::cout << "usage: sylva studio [INPUT] [--size WxH] [--screenshot OUT.png [--frames N]]\n\n"
+               "Opens the studio: edit a grammar and watch the plant regrow. INPUT is a .lsys grammar\n"
+               "or a .scene.json scene (the editor shows its first plant's grammar); without one, the\n"
+               "preset browser opens. Needs a display (on a machine without one: xvfb-run -a sylva studio ...).\n\n"
+               "  --size WxH          window size in pixels (default 1280x800)\n"
+               "  --screenshot FILE   grow the plant, draw N frames after it is on screen, write the\n"
+               "                      window's pixels to FILE (PNG, atomically) and exit 0; exit 1 with\n"
+               "                      the located error, writing nothing, if INPUT does not parse\n"
+               "  --frames N          frames to draw before the screenshot (default 3)\n"
+               "  -h, --help          show this help\n\n"
+               "In the window: Ctrl+Z / Ctrl+Shift+Z (Ctrl+Y) undo and redo whole edits, Ctrl+F find,\n"
+               "Ctrl+G go to line, Ctrl+S save; in the viewport left drag orbits, middle drag or\n"
+               "Shift+left drag pans, the wheel zooms, F frames the plant.\n";
+}
+
+struct StudioArgs {
+  std::string input;
+  std::string screenshot;
+  int frames = 3;
+  int width = 1280, height = 800;
+  bool help = false;
+};
+
+StudioArgs parse_args(const std::vector<std::string>& args) {
+  StudioArgs a;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& s = args[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= args.size()) throw cli::UsageError{s + " needs a value"};
+      return args[++i];
+    };
+    if (s == "-h" || s == "--help") {
+      a.help = true;
+    } else if (s == "--screenshot") {
+      a.screenshot = value();
+    } else if (s == "--frames") {
+      const std::string v = value();
+      auto n = cli::parse_u64(v);
+      if (!n || *n > 10000) throw cli::UsageError{"--frames " + v + ": expected an integer from 0 to 10000"};
+      a.frames = static_cast<int>(*n);
+    } else if (s == "--size") {
+      const std::string v = value();
+      const size_t x = v.find('x');
+      auto w = x == std::string::npos ? std::nullopt : cli::parse_u64(v.substr(0, x));
+      auto h = x == std::string::npos ? std::nullopt : cli::parse_u64(v.substr(x + 1));
+      if (!w || !h || *w < 64 || *h < 64 || *w > 16384 || *h > 16384)
+        throw cli::UsageError{"--size " + v + ": expected WxH, each from 64 to 16384"};
+      a.width = static_cast<int>(*w);
+      a.height = static_cast<int>(*h);
+    } else if (!s.empty() && s[0] == '-') {
+      throw cli::UsageError{"unknown option '" + s + "'"};
+    } else if (a.input.empty()) {
+      a.input = s;
+    } else {
+      throw cli::UsageError{"unexpected argument '" + s + "' (one INPUT only)"};
+    }
+  }
+  if (!a.screenshot.empty() && a.input.empty()) throw cli::UsageError{"--screenshot needs an INPUT"};
+  if (!a.screenshot.empty() && !can_write_image_format(a.screenshot))
+    throw cli::UsageError{"--screenshot " + a.screenshot + ": OpenImageIO cannot write this format"};
+  return a;
+}
+
+void on_glfw_error(int code, const char* message) { std::fprintf(stderr, "sylva studio: GLFW %d: %s\n", code, message); }
+
+// The window's pixels, read from the back buffer (before the swap), top row first.
+std::optional<std::string> write_screenshot(const std::string& path, int w, int h) {
+  std::vector<uint8_t> px(static_cast<size_t>(w) * h * 4);
+  glReadBuffer(GL_BACK);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, px.data());
+  std::vector<float> rgb(static_cast<size_t>(w) * h * 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int k = 0; k < 3; ++k)
+        rgb[(static_cast<size_t>(y) * w + x) * 3 + k] = px[(static_cast<size_t>(h - 1 - y) * w + x) * 4 + k] / 255.0f;
+  if (auto err = write_image_atomically(path, static_cast<uint32_t>(w), static_cast<uint32_t>(h), {"R", "G", "B"}, rgb,
+                                        {ChannelFormat::uint8}, true))
+    return err->format();
+  return std::nullopt;
+}
+
+// For the xdotool smoke test (SYLVA_STUDIO_TRACE=1): what happened, one line each.
+void trace(const char* what, const std::string& detail) {
+  static const bool on = std::getenv("SYLVA_STUDIO_TRACE") != nullptr;
+  if (!on) return;
+  std::printf("studio: %s %s\n", what, detail.c_str());
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int run_studio(const std::vector<std::string>& raw_args) {
+  const StudioArgs a = parse_args(raw_args);
+  if (a.help) {
+    print_help();
+    return cli::kOk;
+  }
+  // The window first: a grammar's errors come from the worker once the app runs (a
+  // --screenshot of a grammar that does not parse then exits 1 with the located error).
+  glfwSetErrorCallback(on_glfw_error);
+  if (!glfwInit()) {
+    std::cerr << "sylva studio: error: cannot open a window (no display? on a machine without one run "
+                 "'xvfb-run -a sylva studio ...')\n";
+    return cli::kInputError;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  GLFWwindow* window = glfwCreateWindow(a.width, a.height, "sylva studio", nullptr, nullptr);
+  if (!window) {
+    std::cerr << "sylva studio: error: cannot create an OpenGL 4.5 core window\n";
+    glfwTerminate();
+    return cli::kInputError;
+  }
+  glfwSetWindowPos(window, 0, 0);
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(a.screenshot.empty() ? 1 : 0);
+
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = nullptr;
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 450");
+  // Whole-document undo (undo_history.h): the text widget must not undo by itself.
+  io.KeyMap[ImGuiKey_Z] = -1;
+  io.KeyMap[ImGuiKey_Y] = -1;
+
+  int code = cli::kOk;
+  {
+    std::unique_ptr<GlViewport> viewport_ptr;
+    try {
+      viewport_ptr = std::make_unique<GlViewport>([] { glfwPostEmptyEvent(); });
+    } catch (const std::exception& e) {
+      std::cerr << "sylva studio: error: " << e.what() << "\n";
+      code = cli::kInputError;
+    }
+    StudioOptions options;
+    const char* presets = std::getenv("SYLVA_PRESETS");
+    options.presets_dir = presets ? presets : SYLVA_PRESETS_DIR;
+    StudioApp app(options, viewport_ptr.get());
+    app.worker().on_result([] { glfwPostEmptyEvent(); });
+    if (code == cli::kOk && !a.input.empty())
+      if (auto err = app.open(a.input)) {
+        std::cerr << *err << (err->empty() || err->back() != '\n' ? "\n" : "");
+        code = cli::kInputError;
+      }
+    const auto start = std::chrono::steady_clock::now();
+    int frames_after_plant = -1;
+    uint64_t traced_plants = 0;
+    std::string traced_error, title;
+    while (code == cli::kOk) {
+      // Sleep until input, a worker result (glfwPostEmptyEvent) or a timer tick, unless
+      // something is in motion.
+      if (!a.screenshot.empty() || app.wants_frames()) glfwPollEvents();
+      else glfwWaitEventsTimeout(0.25);
+      if (glfwWindowShouldClose(window)) {
+        glfwSetWindowShouldClose(window, GLFW_FALSE);
+        app.request_close();
+      }
+      if (app.quit_requested()) break;
+      ImGui_ImplOpenGL3_NewFrame();
+      ImGui_ImplGlfw_NewFrame();
+      ImGui::NewFrame();
+      app.frame(glfwGetTime());
+      ImGui::Render();
+      int fw = 0, fh = 0;
+      glfwGetFramebufferSize(window, &fw, &fh);
+      glBindFramebuffer(GL_FRAMEBUFFER, 0);
+      glViewport(0, 0, fw, fh);
+      glClearColor(0.1f, 0.1f, 0.12f, 1);
+      glClear(GL_COLOR_BUFFER_BIT);
+      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+      if (app.title() != title) glfwSetWindowTitle(window, (title = app.title()).c_str());
+
+      if (app.plants_applied() != traced_plants && app.plant_drawn()) {
+        traced_plants = app.plants_applied();
+        trace("plant", std::to_string(app.plant()->segments) + " segments");
+        const ImVec2 o = app.editor().text_origin();  // where line 1's text starts
+        trace("editor", std::to_string(o.x) + " " + std::to_string(o.y) + " " +
+                            std::to_string(app.editor().line_height()));
+      }
+      const std::string err_line = app.error() ? app.error()->format().substr(0, app.error()->format().find('\n')) : "";
+      if (err_line != traced_error) trace("error", traced_error = err_line);
+
+      if (!a.screenshot.empty()) {
+        if (app.error() && !app.plant() && !app.worker().busy()) {
+          std::cerr << app.error()->format();
+          code = cli::kInputError;
+          break;
+        }
+        if (app.plant_drawn() && !app.worker().busy()) ++frames_after_plant;
+        if (frames_after_plant >= a.frames) {
+          if (auto err = write_screenshot(a.screenshot, fw, fh)) {
+            std::cerr << *err << "\n";
+            code = cli::kInputError;
+          }
+          break;
+        }
+        if (std::chrono::steady_clock::now() - start > std::chrono::minutes(5)) {
+          std::cerr << "sylva studio: error: the plant did not appear within 5 minutes\n";
+          code = cli::kInternalError;
+          break;
+        }
+      }
+      glfwSwapBuffers(window);
+    }
+  }
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  glfwDestroyWindow(window);
+  glfwTerminate();
+  return code;
+}
+
+}  // namespace sylva::studio

@@ -1,0 +1,59 @@
+// viewport.h — what the studio's UI needs from the thing that draws the plants: the GL
+// viewport (gl_viewport.h) in the window, a recording fake in the headless tests. The
+// UI thread calls every method; nothing here may block on the worker.
+//
+// The redo ladder (cpfg's New L-system / New view / New rendering, studio-gui.md sec. 1):
+// set_plants() is called when the plants or how they are skinned changed (a regrow, a
+// skin or geometry option, bark on/off); image() re-renders only when the camera, sun or
+// size changed since the last picture, and never re-skins or re-uploads. A viewport may
+// make its pictures on another thread: image() then returns the newest finished one at
+// once, and says whether it already shows the newest plants.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <imgui.h>
+
+#include "core/render_types.h"
+#include "core/scene.h"
+
+namespace sylva::studio {
+
+struct ViewImage {
+  ImTextureID texture = nullptr;  // null: nothing to show
+  bool flip_v = false;            // the texture's rows are bottom-up (a GL framebuffer)
+  uint32_t width = 0, height = 0;
+  bool current = true;            // shows the plants of the last set_plants (not older ones)
+};
+
+struct ViewStats {
+  std::vector<RenderPass> passes;  // the last picture's passes ("(GPU)" ones are GPU time)
+  double render_ms = 0;            // wall time of the last picture on the UI thread
+  double upload_ms = 0;            // wall time of the last set_plants (skin + upload)
+  uint64_t frusta = 0;
+  std::string renderer;            // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+  std::string error;               // why nothing is drawn (gl_unsupported, GlError)
+};
+
+class Viewport {
+ public:
+  virtual ~Viewport() = default;
+  // `scene`'s plants (every skeleton set) are the new plants.
+  virtual void set_plants(const Scene& scene, const RenderOptions& options) = 0;
+  // The picture of `scene` (its camera, sun, sky, ground, width × height) over the
+  // plants last set.
+  virtual ViewImage image(const Scene& scene) = 0;
+  virtual const ViewStats& stats() const = 0;
+  // Whether a picture is being made (the UI keeps drawing frames to show it when done).
+  virtual bool busy() const { return false; }
+  // Renders `scene` at its width × height with `options` through the same renderer as
+  // `sylva render` and writes it to `path` (format by extension, atomically); the error
+  // text or nothing.
+  virtual std::optional<std::string> write_image(const Scene& scene, const RenderOptions& options,
+                                                 const std::string& path) = 0;
+};
+
+}  // namespace sylva::studio

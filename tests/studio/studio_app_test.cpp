@@ -1,0 +1,381 @@
+// studio_app_test.cpp — the studio's window contents driven headless (no X, no GL): an
+// ImGui context with simulated mouse and keys, the real worker thread, a fake viewport
+// that records what it was asked to do.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "app/studio/document_files.h"
+#include "core/gltf_export.h"
+#include "core/skeleton.h"
+#include "core/util/file_io.h"
+#include "tests/studio/headless_ui.h"
+
+namespace sylva::studio::test {
+namespace {
+
+// Lines: 1 ANGLE, 2 N, 3 LEN, 4 angle, 5 derivation length, 6 axiom, 7 productions, 8 A.
+const char* const kTree =
+    "#define ANGLE 30 /* [0, 90] */\n"
+    "#define N 4 /* [1, 8, 1] */\n"
+    "#define LEN 1\n"
+    "angle: ANGLE\n"
+    "derivation length: N\n"
+    "axiom: A\n"
+    "productions:\n"
+    "A -> F(LEN)[+A][-A]\n";
+
+struct Fixture : ::testing::Test {
+  Fixture() : dir(::testing::UnitTest::GetInstance()->current_test_info()->name()) {
+    path = dir.file("tree.lsys");
+    EXPECT_FALSE(write_file_atomically(path, kTree));
+  }
+  std::unique_ptr<StudioApp> make_app(StudioOptions o = {}) {
+    o.presets_dir = std::string(SYLVA_SOURCE_DIR) + "/presets";
+    return std::make_unique<StudioApp>(o, &viewport);
+  }
+  // Opens `path` and waits for its plant.
+  std::unique_ptr<StudioApp> opened(StudioOptions o = {}) {
+    auto app = make_app(o);
+    EXPECT_FALSE(app->open(path));
+    EXPECT_TRUE(ui.until(*app, [&] { return app->plant_drawn(); }));
+    return app;
+  }
+  // Clicks at the end of `line` in the editor.
+  void click_line_end(StudioApp& app, uint32_t line) {
+    const ImVec2 o = app.editor().text_origin();
+    const float lh = app.editor().line_height();
+    ui.click(app, ImVec2(o.x + 2, o.y + (static_cast<float>(line) - 0.5f) * lh));
+    ui.key(app, kKeyEnd);
+  }
+  TempDir dir;
+  std::string path;
+  HeadlessUi ui;
+  FakeViewport viewport;
+};
+
+TEST_F(Fixture, OpensAGrammarAndShowsItsPlant) {
+  auto app = opened();
+  EXPECT_EQ(app->title(), "sylva studio \xE2\x80\x94 tree.lsys");
+  EXPECT_FALSE(app->dirty());
+  EXPECT_EQ(viewport.segments, 15u);
+  EXPECT_EQ(viewport.set_plants_calls, 1);
+  EXPECT_FALSE(app->error());
+  ASSERT_TRUE(app->rect("slider:ANGLE")) << "a range annotation gives a slider";
+  EXPECT_FALSE(app->rect("slider:LEN")) << "no annotation: a typed field only";
+  EXPECT_TRUE(app->rect("field:LEN"));
+}
+
+TEST_F(Fixture, TypingAnErrorMarksItsLineAndKeepsThePlantThenTheFixRegrows) {
+  auto app = opened();
+  click_line_end(*app, 8);
+  EXPECT_EQ(app->editor().cursor_line(), 8u);
+  ui.type(*app, "[");  // an unbalanced bracket
+  EXPECT_TRUE(app->dirty());
+  EXPECT_EQ(app->title(), "sylva studio \xE2\x80\x94 tree.lsys*");
+  ASSERT_TRUE(ui.until(*app, [&] { return app->error().has_value(); }));
+  EXPECT_EQ(app->error()->loc.line, 8u);
+  EXPECT_EQ(app->error()->file, path);
+  ui.frames(*app, 2);
+  EXPECT_TRUE(app->editor().marker_drawn());
+  EXPECT_EQ(app->editor().marker_line(), 8u);
+  EXPECT_EQ(viewport.segments, 15u) << "the last good plant stays";
+  const uint64_t applied = app->plants_applied();
+
+  ui.key(*app, kKeyBackspace);
+  ui.type(*app, "[+A]");  // a fourth branch
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plants_applied() > applied && app->plant_drawn(); }));
+  EXPECT_FALSE(app->error());
+  EXPECT_FALSE(app->editor().marker_drawn());
+  EXPECT_EQ(viewport.segments, 40u);
+}
+
+TEST_F(Fixture, ClickingTheMessageJumpsToTheError) {
+  auto app = opened();
+  click_line_end(*app, 6);
+  ui.type(*app, "(");  // axiom: A(  — unterminated
+  ASSERT_TRUE(ui.until(*app, [&] { return app->error().has_value(); }));
+  ui.frames(*app, 2);
+  click_line_end(*app, 1);  // move the cursor away
+  EXPECT_EQ(app->editor().cursor_line(), 1u);
+  auto message = app->rect("message");
+  ASSERT_TRUE(message);
+  ui.click(*app, message->centre());
+  ui.frames(*app, 3);
+  EXPECT_EQ(app->editor().cursor_line(), app->error()->loc.line);
+  EXPECT_EQ(app->editor().cursor_column(), std::max(1u, app->error()->loc.column));
+}
+
+TEST_F(Fixture, OneSliderDragIsOneUndoStepAndTheTextIsUntouched) {
+  auto app = opened();
+  const size_t steps_before = app->history().size();
+  auto slider = app->rect("slider:ANGLE");
+  ASSERT_TRUE(slider);
+  ImGuiIO& io = ImGui::GetIO();
+  // Press on the slider, drag across it over many frames, release.
+  io.MousePos = ImVec2(slider->min.x + 5, slider->centre().y);
+  ui.frame(*app);
+  io.MouseDown[0] = true;
+  for (int i = 0; i < 20; ++i) {
+    io.MousePos.x += (slider->max.x - slider->min.x) * 0.03f;
+    ui.frame(*app);
+  }
+  io.MouseDown[0] = false;
+  ui.frame(*app);
+  ASSERT_TRUE(app->overrides().count("ANGLE"));
+  const double dragged = app->overrides().at("ANGLE");
+  EXPECT_GT(dragged, 30);
+  EXPECT_EQ(app->text(), kTree) << "a slider does not touch the text";
+  EXPECT_FALSE(app->dirty());
+  EXPECT_EQ(app->history().size(), steps_before + 1) << "one drag, one step";
+  ASSERT_TRUE(ui.settle(*app));
+  app->undo();
+  EXPECT_FALSE(app->overrides().count("ANGLE"));
+  app->redo();
+  EXPECT_EQ(app->overrides().at("ANGLE"), dragged);
+}
+
+TEST_F(Fixture, ATypedValueIsExactAndWritesToTheText) {
+  auto app = opened();
+  auto field = app->rect("field:LEN");
+  ASSERT_TRUE(field);
+  ui.click(*app, field->centre());
+  ui.key(*app, 'A', /*ctrl=*/true);  // select all
+  ui.type(*app, "0.30000000000000004");
+  ui.key(*app, kKeyEnter);
+  ASSERT_TRUE(app->overrides().count("LEN"));
+  EXPECT_EQ(app->overrides().at("LEN"), 0.1 + 0.2);
+  ASSERT_TRUE(ui.settle(*app));
+  auto write = app->rect("write_to_text");
+  ASSERT_TRUE(write);
+  ui.click(*app, write->centre());
+  EXPECT_TRUE(app->overrides().empty());
+  EXPECT_NE(app->text().find("#define LEN 0.30000000000000004\n"), std::string::npos) << app->text();
+  EXPECT_TRUE(app->dirty());
+}
+
+TEST_F(Fixture, UndoRestoresWholeEditsNotKeystrokes) {
+  StudioOptions o;
+  o.snapshot_s = 0.5;
+  auto app = opened(o);
+  click_line_end(*app, 8);
+  ui.type(*app, "F");
+  ui.type(*app, "F");
+  ui.type(*app, "F");
+  ui.advance(1.0);  // a pause in typing: one undo step
+  ui.frame(*app);
+  ui.type(*app, "G");
+  ui.key(*app, 'Z', /*ctrl=*/true);
+  EXPECT_NE(app->text().find("[-A]FFF\n"), std::string::npos) << app->text();
+  ui.key(*app, 'Z', true);
+  EXPECT_EQ(app->text(), kTree);
+  ui.key(*app, 'Z', true, /*shift=*/true);
+  EXPECT_NE(app->text().find("[-A]FFF\n"), std::string::npos);
+  ui.key(*app, 'Y', true);
+  EXPECT_NE(app->text().find("[-A]FFFG\n"), std::string::npos);
+}
+
+TEST_F(Fixture, GoToLineAndFind) {
+  auto app = opened();
+  ui.key(*app, 'G', true);
+  ui.type(*app, "5");
+  ui.key(*app, kKeyEnter);
+  ui.frames(*app, 3);
+  EXPECT_EQ(app->editor().cursor_line(), 5u);
+  ui.key(*app, 'F', true);
+  ui.type(*app, "axiom");
+  ui.key(*app, kKeyEnter);
+  ui.frames(*app, 3);
+  EXPECT_EQ(app->editor().cursor_line(), 6u);
+}
+
+TEST_F(Fixture, AutosavesAndOffersToRestore) {
+  StudioOptions o;
+  o.autosave_s = 1;
+  {
+    auto app = opened(o);
+    click_line_end(*app, 8);
+    ui.type(*app, "F");
+    ui.advance(2);
+    ui.frames(*app, 2);
+    FileReadResult saved = read_text_file(autosave_path(path));
+    ASSERT_TRUE(saved.contents) << "autosave beside the file";
+    EXPECT_EQ(*saved.contents, app->text());
+  }  // "crash": the app goes away with unsaved edits
+  auto app = make_app(o);
+  ASSERT_FALSE(app->open(path));
+  EXPECT_TRUE(app->restore_offered());
+  EXPECT_EQ(app->text(), kTree);
+  ui.frames(*app, 3);
+  auto restore = app->rect("button:Restore");
+  ASSERT_TRUE(restore);
+  ui.click(*app, restore->centre());
+  EXPECT_FALSE(app->restore_offered());
+  EXPECT_NE(app->text().find("[-A]F\n"), std::string::npos);
+  EXPECT_TRUE(app->dirty());
+  ASSERT_FALSE(app->save());
+  EXPECT_FALSE(std::filesystem::exists(autosave_path(path))) << "a save removes the autosave";
+  EXPECT_EQ(*read_text_file(path).contents, app->text());
+}
+
+TEST_F(Fixture, ClosingWithUnsavedEditsAsksFirst) {
+  auto app = opened();
+  EXPECT_TRUE(make_app()->request_close()) << "nothing to lose: closes at once";
+  click_line_end(*app, 8);
+  ui.type(*app, "F");
+  EXPECT_FALSE(app->request_close());
+  ui.frames(*app, 3);
+  EXPECT_TRUE(app->close_prompt_open());
+  EXPECT_FALSE(app->quit_requested());
+  auto cancel = app->rect("button:Cancel");
+  ASSERT_TRUE(cancel);
+  ui.click(*app, cancel->centre());
+  EXPECT_FALSE(app->quit_requested());
+  EXPECT_FALSE(app->request_close());
+  ui.frames(*app, 3);
+  auto save = app->rect("button:Save");
+  ASSERT_TRUE(save);
+  ui.click(*app, save->centre());
+  EXPECT_TRUE(app->quit_requested());
+  EXPECT_EQ(*read_text_file(path).contents, app->text()) << "saved, atomically, before closing";
+}
+
+TEST_F(Fixture, ReloadsAFileChangedOnDisk) {
+  StudioOptions o;
+  o.watch_s = 0;
+  auto app = opened(o);
+  std::string changed = kTree;
+  changed.replace(changed.find("#define N 4"), 11, "#define N 2");
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_FALSE(write_file_atomically(path, changed));
+  ASSERT_TRUE(ui.until(*app, [&] { return app->text() == changed && viewport.segments == 3u; }));
+  EXPECT_FALSE(app->dirty());
+  // With unsaved edits the user is asked instead.
+  click_line_end(*app, 8);
+  ui.type(*app, "F");
+  ASSERT_FALSE(write_file_atomically(path, kTree));
+  ASSERT_TRUE(ui.until(*app, [&] { return app->external_change_prompt_open(); }));
+  EXPECT_NE(app->text(), kTree);
+}
+
+TEST_F(Fixture, CameraAndSunReRenderWithoutRegrowing) {
+  auto app = opened();
+  const int plants = viewport.set_plants_calls, renders = viewport.renders;
+  auto view = app->rect("viewport");
+  ASSERT_TRUE(view);
+  ImGuiIO& io = ImGui::GetIO();
+  io.MousePos = view->centre();
+  ui.frame(*app);
+  io.MouseDown[0] = true;
+  for (int i = 0; i < 5; ++i) io.MousePos.x += 10, ui.frame(*app);
+  io.MouseDown[0] = false;
+  ui.frames(*app, 2);
+  EXPECT_EQ(viewport.set_plants_calls, plants) << "orbiting never re-skins";
+  EXPECT_GT(viewport.renders, renders);
+  EXPECT_EQ(app->worker().counts().submitted, 1u) << "nor derives";
+}
+
+TEST_F(Fixture, StepRewindAndAnimateUseTheStepCache) {
+  auto app = opened();
+  app->rewind();
+  ASSERT_TRUE(ui.settle(*app));
+  EXPECT_EQ(app->plant()->shown_step, 0);
+  EXPECT_TRUE(app->plant()->from_cache);
+  auto step = app->rect("button:Step");
+  ASSERT_TRUE(step);
+  ui.click(*app, step->centre());
+  ASSERT_TRUE(ui.settle(*app));
+  EXPECT_EQ(app->plant()->shown_step, 1);
+  EXPECT_EQ(viewport.segments, 1u);
+  app->animate();
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plant()->shown_step == 4 && !app->worker().busy(); }));
+  EXPECT_EQ(viewport.segments, 15u);
+  app->step();  // past the derivation length: derives one more step
+  ASSERT_TRUE(ui.settle(*app));
+  EXPECT_EQ(app->plant()->shown_step, 5);
+  EXPECT_EQ(viewport.segments, 31u);
+}
+
+TEST_F(Fixture, SixtyRapidEditsPutOnlyTheLastPlantOnScreen) {
+  StudioOptions o;
+  o.debounce_s = 0;  // every keystroke goes to the worker
+  auto app = opened(o);
+  const uint64_t applied = app->plants_applied();
+  click_line_end(*app, 8);
+  for (int i = 0; i < 30; ++i) ui.type(*app, "F"), ui.key(*app, kKeyBackspace);
+  ui.type(*app, "[+A]");
+  ASSERT_TRUE(ui.settle(*app));
+  const WorkerCounts c = app->worker().counts();
+  EXPECT_GE(c.submitted, 60u);
+  EXPECT_EQ(viewport.segments, 40u) << "the last text's plant";
+  EXPECT_LE(app->plants_applied() - applied, c.finished) << "never a stale one";
+  EXPECT_EQ(c.started, c.cancelled + c.finished);
+}
+
+TEST_F(Fixture, OpensAScene) {
+  auto app = make_app();
+  ASSERT_FALSE(app->open(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes/saguaro.scene.json"));
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plant_drawn(); }, 60));
+  EXPECT_NE(app->path().find("saguaro.lsys"), std::string::npos);
+  EXPECT_GT(viewport.segments, 0u);
+  EXPECT_EQ(app->scene().plants.size(), 1u);
+}
+
+TEST_F(Fixture, ExportsTheShownPlantThroughTheCliWriters) {
+  auto app = opened();
+  app->set_define("N", 3);
+  ASSERT_TRUE(ui.settle(*app));
+  ASSERT_EQ(viewport.segments, 7u);
+  const std::string glb = dir.file("tree.glb"), skel = dir.file("tree.skel.json");
+  ASSERT_FALSE(app->export_gltf_file(glb, /*mesh=*/true));
+  ASSERT_FALSE(app->export_skeleton_file(skel));
+  GltfImportResult back = import_gltf_skeletons(glb);
+  ASSERT_FALSE(back.error) << *back.error;
+  ASSERT_EQ(back.plants.size(), 1u);
+  EXPECT_EQ(back.plants[0].name, "tree");
+  EXPECT_EQ(back.plants[0].skeleton.segment_count(), 7u) << "the plant on screen, with the override";
+  EXPECT_EQ(back.plants[0].skeleton.source.defines.at("N"), 3);
+  SkeletonReadResult read = read_skeleton_file(skel);
+  ASSERT_TRUE(read.skeleton);
+  EXPECT_EQ(read.skeleton->segment_count(), 7u);
+  EXPECT_FALSE(app->export_png_file(dir.file("tree.png"), 64, 64).value_or("").empty())
+      << "the fake viewport renders nothing: the error comes back, nothing is written";
+  EXPECT_FALSE(std::filesystem::exists(dir.file("tree.png")));
+}
+
+TEST_F(Fixture, ThePresetBrowserOpensAPreset) {
+  auto app = make_app();
+  ui.frames(*app, 3);  // no document: the browser is open
+  EXPECT_EQ(app->title(), "sylva studio \xE2\x80\x94 untitled");
+  auto elm = app->rect("preset:elm.lsys");
+  ASSERT_TRUE(elm);
+  EXPECT_TRUE(app->rect("preset:scenes/pine.scene.json"));
+  ui.click(*app, elm->centre());
+  EXPECT_NE(app->path().find("presets/elm.lsys"), std::string::npos);
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plant_drawn(); }, 60));
+  EXPECT_EQ(viewport.segments, 1769u);
+  EXPECT_FALSE(app->rect("preset:elm.lsys")) << "the browser closes once a preset is open";
+}
+
+TEST_F(Fixture, AnUntitledDocumentGrowsAsItIsTyped) {
+  StudioOptions o;
+  o.debounce_s = 0;
+  auto app = make_app(o);
+  ui.frames(*app, 2);
+  ui.click(*app, ImVec2(app->editor().text_origin().x + 5, app->editor().text_origin().y + 5));
+  ui.type(*app, "axiom: FF");
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plant_drawn() && viewport.segments == 2u; }));
+  EXPECT_TRUE(app->dirty());
+  EXPECT_EQ(app->title(), "sylva studio \xE2\x80\x94 untitled*");
+}
+
+TEST_F(Fixture, AMissingFileIsAnErrorAndChangesNothing) {
+  auto app = make_app();
+  auto err = app->open(dir.file("nope.lsys"));
+  ASSERT_TRUE(err);
+  EXPECT_NE(err->find("nope.lsys"), std::string::npos);
+  EXPECT_TRUE(app->path().empty());
+}
+
+}  // namespace
+}  // namespace sylva::studio::test
