@@ -11,10 +11,24 @@ void set3(uint32_t p, const char* name, const glm::vec3& v) { glProgramUniform3f
 void set2(uint32_t p, const char* name, const glm::vec2& v) { glProgramUniform2f(p, location(p, name), v.x, v.y); }
 }  // namespace
 
+GlFloatSplit split_to_floats(const glm::dvec3& v) {
+  GlFloatSplit s;
+  for (int i = 0; i < 3; ++i) {
+    // Rounded through a volatile float: GCC 12's SLP vectorizer (-O2) folds the round trip
+    // double(float(x)) back to x when it vectorizes this, and lo comes out 0 — the map's
+    // centre 10^6 m out lost its last 3 cm and the plants shadowed themselves.
+    volatile float hi = static_cast<float>(v[i]);
+    s.hi[i] = hi;
+    s.lo[i] = static_cast<float>(v[i] - static_cast<double>(s.hi[i]));
+  }
+  return s;
+}
+
 GlCameraView camera_view(const render_common::CameraFrame& frame, double near, uint32_t width, uint32_t height) {
   GlCameraView v;
-  v.eye_hi = glm::vec3(frame.eye);
-  v.eye_lo = glm::vec3(frame.eye - glm::dvec3(v.eye_hi));
+  const GlFloatSplit eye = split_to_floats(frame.eye);
+  v.eye_hi = eye.hi;
+  v.eye_lo = eye.lo;
   v.right = glm::vec3(frame.right);
   v.up = glm::vec3(frame.up);
   v.forward = glm::vec3(frame.forward);

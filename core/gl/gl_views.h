@@ -20,6 +20,13 @@
 
 namespace sylva {
 
+// A double position as two floats whose sum is it to ~2^-48 relative: what the shaders add
+// back in float (frusta_common.glsl "Frames").
+struct GlFloatSplit {
+  glm::vec3 hi{0}, lo{0};  // hi = float(v), lo = float(v − hi)
+};
+GlFloatSplit split_to_floats(const glm::dvec3& v);
+
 // views.glsl's GBUFFER_PASS uniforms (and shade.frag.glsl's camera).
 struct GlCameraView {
   glm::vec3 eye_hi{0}, eye_lo{0};                          // u_eye_hi, u_eye_lo

@@ -40,16 +40,6 @@ constexpr int kShadowTexelsMax = 8192;
 constexpr double kShadowNormalOffsetTexels = 2;  // receiver offset along its normal
 constexpr double kShadowDepthBiasTexels = 0.5;   // and along the sun direction
 
-// A double split into two floats whose sum is it to ~2^-48 relative: what the shaders add
-// back in float (frusta_common.glsl).
-struct SplitVec3 {
-  glm::vec3 hi, lo;
-};
-SplitVec3 split(const glm::dvec3& v) {
-  const glm::vec3 hi(v);
-  return {hi, glm::vec3(v - glm::dvec3(hi))};
-}
-
 // The orthographic sun view of one shadow pass, in double (sun_view: as the shaders get it).
 struct ShadowFrame {
   glm::dvec3 direction{0, 1, 0};  // unit, toward the sun
@@ -62,7 +52,7 @@ struct ShadowFrame {
 
 GlSunView sun_view(const ShadowFrame& f, uint32_t texels) {
   GlSunView v;
-  const SplitVec3 c = split(f.centre);
+  const GlFloatSplit c = split_to_floats(f.centre);
   v.light_hi = c.hi;
   v.light_lo = c.lo;
   v.e0 = glm::vec3(f.e0);
@@ -126,6 +116,24 @@ std::optional<std::string> gl_unsupported(const Scene& scene, const RenderOption
            " distinct bark images (this scene has " + std::to_string(images) + ")";
   return std::nullopt;
 }
+
+// ---- Frame: what one draw() records ------------------------------------------------------
+
+struct GlRenderer::Frame {
+  Clock::time_point start;
+  GlFrameStats stats;
+  uint32_t width = 0, height = 0, spp = 1;
+  CameraFrame camera;
+  double near = 1e-3;               // reversed-Z near plane, metres along forward
+  double differential_step = 1;     // 1 / sqrt(spp): the ray differentials' step (texture.h)
+  glm::dvec3 ray_dx{0}, ray_dy{0};  // the next sample's direction to the right / below
+  bool sun_on = false;
+  glm::dvec3 sun_radiance{0};
+  std::vector<uint32_t> eye_inside;  // frusta whose pyramid may reach the eye's near plane
+  GLuint gbuffer_program = 0, inside_program = 0, shadow_program = 0, shade_program = 0, present_program = 0;
+  GlCameraView camera_view;  // this sample's (its jitter set per geometry pass)
+  ShadowFrame shadow;  // the last shadow pass's view: the shade passes look it up
+};
 
 // ---- State: what lives as long as the renderer ------------------------------------------
 
@@ -194,28 +202,118 @@ struct GlRenderer::State {
     }
   }
 
+  // The shadow map's side for a w × h frame: a texel about a pixel where the plants fill
+  // the picture (the default framing); the map's fill dominates a frame on llvmpipe.
+  static uint32_t shadow_map_texels(uint32_t w, uint32_t h) {
+    GLint max_size = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+    int texels = kShadowTexelsMin;
+    while (texels < static_cast<int>(std::max(w, h)) && texels < kShadowTexelsMax) texels *= 2;
+    return static_cast<uint32_t>(std::min(texels, max_size));
+  }
+
+  // The camera of frame `f`; the reversed-Z near plane far below any hit that matters, far
+  // above float's smallest; the frusta around the eye; the ray differentials.
+  void frame_views(const Scene& scene, Frame& f) {
+    f.camera = camera_frame(scene);
+    double farthest = 1e-3;
+    for (const Sphere& sphere : spheres)
+      farthest = std::max(farthest, glm::length(sphere.centre - f.camera.eye) + sphere.radius);
+    f.near = 1e-6 * farthest;
+    f.camera_view = camera_view(f.camera, f.near, f.width, f.height);
+    // Frusta whose pyramid may reach within the near plane of the eye: drawn again from
+    // their back faces (EYE_INSIDE), since their front faces are clipped or behind the eye.
+    for (uint32_t i = 0; !mesh && i < spheres.size(); ++i)
+      if (glm::length(spheres[i].centre - f.camera.eye) < spheres[i].radius + 4 * f.near) f.eye_inside.push_back(i);
+    if (!f.eye_inside.empty()) {
+      const size_t bytes = f.eye_inside.size() * sizeof(uint32_t);
+      glNamedBufferData(list_buffer.id(), static_cast<GLsizeiptr>(bytes), f.eye_inside.data(), GL_STREAM_DRAW);
+      f.stats.frame_bytes_uploaded += bytes;
+    }
+    f.stats.eye_inside = static_cast<uint32_t>(f.eye_inside.size());
+    // Ray differentials (texture.h): the next sample to the right / below, one pixel /
+    // sqrt(spp) away, as render_cpu.cpp's direction_dx_, direction_dy_.
+    f.differential_step = 1 / std::sqrt(static_cast<double>(f.spp));
+    f.ray_dx = (f.differential_step * 2 * f.camera.half_width / f.width) * f.camera.right;
+    f.ray_dy = (-f.differential_step * 2 * f.camera.half_height / f.height) * f.camera.up;
+  }
+
+  // The variants frame `f` draws with, built where this is their first use (the frame's
+  // compile time and names).
+  void frame_programs(Frame& f) {
+    GlFrameStats& s = f.stats;
+    f.gbuffer_program = mesh ? 0 : program(frusta_variant(FrustaPass::gbuffer), &s.compile_s, &s.compiled);
+    f.inside_program =
+        f.eye_inside.empty() ? 0 : program(frusta_variant(FrustaPass::gbuffer_eye_inside), &s.compile_s, &s.compiled);
+    f.shadow_program = f.sun_on && !mesh ? program(frusta_variant(FrustaPass::shadow), &s.compile_s, &s.compiled) : 0;
+    f.shade_program = program(shade_program(f.sun_on), &s.compile_s, &s.compiled);
+    s.pass(GlPass::geometry).program = mesh ? mesh->gbuffer_variant() : frusta_variant(FrustaPass::gbuffer).name;
+    s.pass(GlPass::shade).program = shade_program(f.sun_on).name;
+    if (f.sun_on)
+      s.pass(GlPass::shadow).program = (mesh ? mesh_program(MeshPass::shadow) : frusta_variant(FrustaPass::shadow)).name;
+  }
+
+  // The programs' uniforms that stay for the frame: the camera (but its jitter), the ray
+  // differentials and the relief's sampling, the sky, ground and materials.
+  void frame_uniforms(const Scene& scene, const Frame& f) const {
+    for (GLuint p : {f.gbuffer_program, f.inside_program, f.shade_program})
+      if (p) set_camera_uniforms(p, f.camera_view);
+    const ReliefOptions& relief = options.geometry.relief_options;
+    for (GLuint p : {f.gbuffer_program, f.inside_program, f.shadow_program}) {
+      if (!p) continue;
+      set_uniform(p, "u_twist_rad_per_m", options.skin.twist_rad_per_m);
+      set_uniform(p, "u_ray_dx", f.ray_dx);
+      set_uniform(p, "u_ray_dy", f.ray_dy);
+      set_uniform_int(p, "u_relief_linear_steps", std::max(1, relief.linear_steps));
+      set_uniform_int(p, "u_relief_bisection_steps", std::max(0, relief.bisection_steps));
+      set_uniform_int(p, "u_relief_exact_v", relief.exact_v ? 1 : 0);
+      set_uniform(p, "u_relief_max_depth_per_radius", relief.max_depth_per_radius);
+      // render_cpu.cpp's pixel_spread_rad: the angle between neighbouring samples' rays.
+      set_uniform(p, "u_relief_pixel_spread_rad", glm::length(f.ray_dy));
+    }
+    const GLuint shade = f.shade_program;
+    set_uniform(shade, "u_pixel_step_rad", glm::length(f.ray_dy));
+    set_uniform(shade, "u_eye_above_ground", f.camera.eye.y - scene.ground.height);
+    set_uniform(shade, "u_sky", scene.sky);
+    set_uniform(shade, "u_ground_albedo", scene.ground.albedo);
+    float albedo[gl::kMaxMaterials * 3];
+    const int count = static_cast<int>(kMaterialTableSize);
+    for (int i = 0; i < count; ++i) {
+      const double* a = default_material_albedo(static_cast<uint32_t>(i));
+      for (int k = 0; k < 3; ++k) albedo[3 * i + k] = static_cast<float>(a[k]);
+    }
+    set_uniform_vec3_array(shade, "u_material_albedo", count, albedo);
+    set_uniform_int(shade, "u_material_count", count);
+  }
+
+  // The buffers and textures every pass reads (bindings.h), and the state every pass
+  // starts from.
+  void bind_frame(const Frame& f) const {
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    glBindVertexArray(vao.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kSegmentsBinding, segment_buffer.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kSegmentIdsBinding, id_buffer.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kSegmentListBinding, list_buffer.id());
+    bark_maps->bind();
+    glBindTextureUnit(gl::kGNormalDistanceUnit, targets.gbuffer[0].id());
+    glBindTextureUnit(gl::kGGeometricUUnit, targets.gbuffer[1].id());
+    glBindTextureUnit(gl::kGIdsUnit, targets.gbuffer[2].id());
+    glBindTextureUnit(gl::kGAlbedoUnit, targets.gbuffer[3].id());
+    glBindTextureUnit(gl::kShadowMapUnit, f.sun_on ? shadow_map.map.id() : 0);
+    glBindTextureUnit(gl::kAccumulationUnit, targets.accumulation.id());
+    glDisable(GL_BLEND);
+    glDisable(GL_SCISSOR_TEST);
+    glDisable(GL_STENCIL_TEST);
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glDepthMask(GL_TRUE);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glFrontFace(GL_CCW);
+  }
+
   void take_mesh_spheres() {
     spheres.clear();
     for (const GlMeshSphere& s : mesh->bounding_spheres()) spheres.push_back({s.centre, s.radius});
   }
-};
-
-// ---- Frame: what one draw() records ------------------------------------------------------
-
-struct GlRenderer::Frame {
-  Clock::time_point start;
-  GlFrameStats stats;
-  uint32_t width = 0, height = 0, spp = 1;
-  CameraFrame camera;
-  double near = 1e-3;               // reversed-Z near plane, metres along forward
-  double differential_step = 1;     // 1 / sqrt(spp): the ray differentials' step (texture.h)
-  glm::dvec3 ray_dx{0}, ray_dy{0};  // the next sample's direction to the right / below
-  bool sun_on = false;
-  glm::dvec3 sun_radiance{0};
-  std::vector<uint32_t> eye_inside;  // frusta whose pyramid may reach the eye's near plane
-  GLuint gbuffer_program = 0, inside_program = 0, shadow_program = 0, shade_program = 0, present_program = 0;
-  GlCameraView camera_view;  // this sample's (its jitter set per geometry pass)
-  ShadowFrame shadow;  // the last shadow pass's view: the shade passes look it up
 };
 
 // ---- Construction: what is uploaded once -------------------------------------------------
@@ -383,8 +481,8 @@ const GlFrameStats& GlRenderer::draw_frame(const Scene& scene, const GlTarget* t
   return st.last;
 }
 
-// Sizes the targets, frames the camera, picks the programs and sets what stays for the
-// frame: the camera block (but its jitter), the programs' frame uniforms, the bindings.
+// Everything a frame's passes share, before the first: its stats' counts, the targets at
+// its size, the camera and near plane, the programs, their frame uniforms, the bindings.
 void GlRenderer::begin_frame(const Scene& scene, Frame& f) {
   State& st = *state_;
   GlFrameStats& s = f.stats;
@@ -401,114 +499,19 @@ void GlRenderer::begin_frame(const Scene& scene, Frame& f) {
   s.triangles = st.mesh ? st.mesh->triangles() : 0;
   s.geometry_bytes = st.uploaded_bytes;
   s.plant_bytes_uploaded = std::exchange(st.pending_plant_bytes, 0);
-  st.timers.begin_frame(s.frame);
   s.targets_allocated += st.targets.resize(f.width, f.height) ? 2 : 0;  // G-buffer, accumulation
-
-  // The camera; the reversed-Z near plane far below any hit that matters, far above
-  // float's smallest.
-  f.camera = camera_frame(scene);
-  double farthest = 1e-3;
-  for (const Sphere& sphere : st.spheres)
-    farthest = std::max(farthest, glm::length(sphere.centre - f.camera.eye) + sphere.radius);
-  f.near = 1e-6 * farthest;
-  // Frusta whose pyramid may reach within the near plane of the eye: drawn again from
-  // their back faces (EYE_INSIDE), since their front faces are clipped or behind the eye.
-  for (uint32_t i = 0; !st.mesh && i < st.spheres.size(); ++i)
-    if (glm::length(st.spheres[i].centre - f.camera.eye) < st.spheres[i].radius + 4 * f.near) f.eye_inside.push_back(i);
-  if (!f.eye_inside.empty()) {
-    const size_t bytes = f.eye_inside.size() * sizeof(uint32_t);
-    glNamedBufferData(st.list_buffer.id(), static_cast<GLsizeiptr>(bytes), f.eye_inside.data(), GL_STREAM_DRAW);
-    s.frame_bytes_uploaded += bytes;
-  }
-  s.eye_inside = static_cast<uint32_t>(f.eye_inside.size());
-  f.camera_view = camera_view(f.camera, f.near, f.width, f.height);
-  // Ray differentials (texture.h): the next sample to the right / below, one pixel /
-  // sqrt(spp) away, as render_cpu.cpp's direction_dx_, direction_dy_.
-  f.differential_step = 1 / std::sqrt(static_cast<double>(f.spp));
-  f.ray_dx = (f.differential_step * 2 * f.camera.half_width / f.width) * f.camera.right;
-  f.ray_dy = (-f.differential_step * 2 * f.camera.half_height / f.height) * f.camera.up;
-
-  // Programs: the variants this frame draws with, built where this is their first use.
   f.sun_on = sun_shines(scene);
   f.sun_radiance = scene.sun.radiance;
-  f.gbuffer_program = st.mesh ? 0 : st.program(st.frusta_variant(FrustaPass::gbuffer), &s.compile_s, &s.compiled);
-  f.inside_program =
-      f.eye_inside.empty() ? 0 : st.program(st.frusta_variant(FrustaPass::gbuffer_eye_inside), &s.compile_s, &s.compiled);
-  f.shadow_program =
-      f.sun_on && !st.mesh ? st.program(st.frusta_variant(FrustaPass::shadow), &s.compile_s, &s.compiled) : 0;
-  f.shade_program = st.program(shade_program(f.sun_on), &s.compile_s, &s.compiled);
-  s.pass(GlPass::geometry).program =
-      st.mesh ? st.mesh->gbuffer_variant() : st.frusta_variant(FrustaPass::gbuffer).name;
-  s.pass(GlPass::shade).program = shade_program(f.sun_on).name;
-  if (f.sun_on)
-    s.pass(GlPass::shadow).program =
-        (st.mesh ? mesh_program(MeshPass::shadow) : st.frusta_variant(FrustaPass::shadow)).name;
-
-  // The programs' uniforms that stay for the frame: the camera (but its jitter), the ray
-  // differentials and the relief's sampling, the sky, ground and materials.
-  for (GLuint p : {f.gbuffer_program, f.inside_program, f.shade_program})
-    if (p) set_camera_uniforms(p, f.camera_view);
-  const ReliefOptions& relief = st.options.geometry.relief_options;
-  for (GLuint p : {f.gbuffer_program, f.inside_program, f.shadow_program}) {
-    if (!p) continue;
-    set_uniform(p, "u_twist_rad_per_m", st.options.skin.twist_rad_per_m);
-    set_uniform(p, "u_ray_dx", f.ray_dx);
-    set_uniform(p, "u_ray_dy", f.ray_dy);
-    set_uniform_int(p, "u_relief_linear_steps", std::max(1, relief.linear_steps));
-    set_uniform_int(p, "u_relief_bisection_steps", std::max(0, relief.bisection_steps));
-    set_uniform_int(p, "u_relief_exact_v", relief.exact_v ? 1 : 0);
-    set_uniform(p, "u_relief_max_depth_per_radius", relief.max_depth_per_radius);
-    // render_cpu.cpp's pixel_spread_rad: the angle between neighbouring samples' rays.
-    set_uniform(p, "u_relief_pixel_spread_rad", glm::length(f.ray_dy));
-  }
-  const GLuint shade = f.shade_program;
-  set_uniform(shade, "u_pixel_step_rad", glm::length(f.ray_dy));
-  set_uniform(shade, "u_eye_above_ground", f.camera.eye.y - scene.ground.height);
-  set_uniform(shade, "u_sky", scene.sky);
-  set_uniform(shade, "u_ground_albedo", scene.ground.albedo);
-  {
-    float albedo[gl::kMaxMaterials * 3];
-    const int count = static_cast<int>(kMaterialTableSize);
-    for (int i = 0; i < count; ++i) {
-      const double* a = default_material_albedo(static_cast<uint32_t>(i));
-      for (int k = 0; k < 3; ++k) albedo[3 * i + k] = static_cast<float>(a[k]);
-    }
-    set_uniform_vec3_array(shade, "u_material_albedo", count, albedo);
-    set_uniform_int(shade, "u_material_count", count);
-  }
-
-  // The shadow map: a texel about a pixel where the plants fill the picture (the default
-  // framing); the map's fill dominates a frame on llvmpipe.
   if (f.sun_on) {
-    GLint max_size = 0;
-    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
-    int texels = kShadowTexelsMin;
-    while (texels < static_cast<int>(std::max(f.width, f.height)) && texels < kShadowTexelsMax) texels *= 2;
-    s.shadow_texels = static_cast<uint32_t>(std::min(texels, max_size));
+    s.shadow_texels = st.shadow_map_texels(f.width, f.height);
     s.targets_allocated += st.shadow_map.resize(s.shadow_texels) ? 1 : 0;
   }
   s.target_bytes = st.targets.bytes() + (f.sun_on ? st.shadow_map.bytes() : 0);
-
-  // Bindings and the state every pass starts from.
-  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-  glBindVertexArray(st.vao.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kSegmentsBinding, st.segment_buffer.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kSegmentIdsBinding, st.id_buffer.id());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kSegmentListBinding, st.list_buffer.id());
-  st.bark_maps->bind();
-  glBindTextureUnit(gl::kGNormalDistanceUnit, st.targets.gbuffer[0].id());
-  glBindTextureUnit(gl::kGGeometricUUnit, st.targets.gbuffer[1].id());
-  glBindTextureUnit(gl::kGIdsUnit, st.targets.gbuffer[2].id());
-  glBindTextureUnit(gl::kGAlbedoUnit, st.targets.gbuffer[3].id());
-  glBindTextureUnit(gl::kShadowMapUnit, f.sun_on ? st.shadow_map.map.id() : 0);
-  glBindTextureUnit(gl::kAccumulationUnit, st.targets.accumulation.id());
-  glDisable(GL_BLEND);
-  glDisable(GL_SCISSOR_TEST);
-  glDisable(GL_STENCIL_TEST);
-  glDisable(GL_FRAMEBUFFER_SRGB);
-  glDepthMask(GL_TRUE);
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glFrontFace(GL_CCW);
+  st.frame_views(scene, f);
+  st.frame_programs(f);
+  st.frame_uniforms(scene, f);
+  st.bind_frame(f);
+  st.timers.begin_frame(s.frame);
 }
 
 // The shadow map for sun direction `l`: the frusta ray cast (or the mesh rasterised),

@@ -94,6 +94,15 @@ std::optional<std::string> gl_unsupported(const Scene& scene, const RenderOption
 //     framebuffer, program and vertex array bindings at 0, blending, depth test and culling
 //     off; a window's UI sets its own state after it (Dear ImGui's GL3 backend does).
 //   - Options (spp, AOVs, geometry, skin) are fixed at construction.
+//
+// From a window (the studio), on its GL thread:
+//   GlRenderer renderer(scene, options);                  // once per scene (new plants: a new one)
+//   GlTextureTarget image(w, h, GlTextureTarget::Format::rgba8);
+//   per frame:  scene.width = w, scene.height = h; image.resize(w, h);
+//               renderer.draw(scene, image.target());     // returns at once
+//               ImGui::Image((ImTextureID)(intptr_t)image.texture(), {w, h}, {0, 1}, {1, 0});
+//               if (auto timed = renderer.timed_frame()) stats = *timed;  // GPU ms, a frame late
+// or renderer.draw(scene, GlTarget{0, w, h, GlTargetEncoding::srgb}) into the back buffer.
 class GlRenderer {
  public:
   // Preconditions: every plant's skeleton is set. Throws GlError (gl_unsupported's cases
