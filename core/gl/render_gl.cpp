@@ -631,6 +631,8 @@ void GlRenderer::present_pass(Frame& f, const GlTarget& target) {
 void GlRenderer::end_frame(Frame& f) {
   State& st = *state_;
   st.timers.end_frame();
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glUseProgram(0);
   glBindVertexArray(0);
