@@ -32,8 +32,8 @@ struct PlantMaps {
   int height_width;      // its finest level's size in texels
   int height_height;
 };
-layout(std430, binding = 4) readonly buffer PlantMapsBuffer { PlantMaps plant_maps[]; };
-layout(std430, binding = 5) readonly buffer HeightTexels { float height_texels[]; };
+layout(std430, binding = PLANT_MAPS_BINDING) readonly buffer PlantMapsBuffer { PlantMaps plant_maps[]; };
+layout(std430, binding = HEIGHT_TEXELS_BINDING) readonly buffer HeightTexels { float height_texels[]; };
 
 // HeightTexture::height of texture.cpp: bilinear, periodic, texel i's centre at
 // s = (i + 0.5)/width.
@@ -96,7 +96,10 @@ UvFootprint uv_footprint(vec3 position, vec3 geometric_normal, vec3 dp_du, vec3 
 }
 
 #ifdef BARK_TEXTURE_UNITS
-layout(binding = 0) uniform sampler2D u_bark_textures[BARK_TEXTURE_UNITS];
+#if BARK_TEXTURE_UNITS > MAX_BARK_IMAGES
+#error "more bark images than bindings.glsl gives units"
+#endif
+layout(binding = BARK_TEXTURES_UNIT) uniform sampler2D u_bark_textures[BARK_TEXTURE_UNITS];
 
 // textureGrad on u_bark_textures[unit] (unit in [0, BARK_TEXTURE_UNITS)).
 vec4 bark_texture_grad(int unit, vec2 st, vec2 d_dx, vec2 d_dy) {

@@ -123,7 +123,7 @@ void main() {
   uvec4 ids = segment_ids[v_segment_info.x];
   g_normal_distance = vec4(n_shading, hit.t * length(ray.direction));
   g_geometric_u = vec4(n_geometric, u);
-  g_ids = uvec4(ids.x | (fr.material << 24), ids.y, ids.z, floatBitsToUint(v_m));
+  g_ids = uvec4(ids.x | (fr.material << PLANT_INDEX_BITS), ids.y, ids.z, floatBitsToUint(v_m));
   g_albedo = albedo;
 #endif
 }

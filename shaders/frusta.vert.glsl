@@ -1,5 +1,6 @@
 // frusta.vert.glsl — vertex pulling (paper 000, sec. 2.6): vertex gl_VertexID draws corner
-// kPyramidTriangles[gl_VertexID % 36] of the bounding pyramid of frustum gl_VertexID / 36,
+// kPyramidTriangles[gl_VertexID % 36] of the bounding pyramid of frustum gl_VertexID / 36
+// (36: PYRAMID_VERTICES, bindings.glsl),
 // built from its GpuSegment record (around the relief's shell where the plant has one); no
 // vertex buffer. Every vertex of a frustum unpacks the same record and passes the same
 // flat values on.
@@ -10,9 +11,9 @@ flat out vec3 v_frame_origin;     // the ray's origin frame: eye (light centre) 
 
 void main() {
 #ifdef EYE_INSIDE
-  uint segment = segment_list[gl_VertexID / 36];
+  uint segment = segment_list[gl_VertexID / PYRAMID_VERTICES];
 #else
-  uint segment = uint(gl_VertexID / 36);
+  uint segment = uint(gl_VertexID / PYRAMID_VERTICES);
 #endif
   GpuSegment g = segments[segment];
   FrustumF fr = unpack_gpu_segment(g);
@@ -31,7 +32,7 @@ void main() {
 #endif
   float size = fr.shape.length_m + radius_max;
   // Margins far above float rounding (~1e-7 of the size), far below a pixel.
-  vec3 corner = bounding_pyramid_vertex(bounded, kPyramidTriangles[gl_VertexID % 36],
+  vec3 corner = bounding_pyramid_vertex(bounded, kPyramidTriangles[gl_VertexID % PYRAMID_VERTICES],
                                         1e-4 * radius_max + 1e-6 * size, 1e-4 * size);
 #ifdef SHADOW_PASS
   vec3 frame_origin = (u_light_hi - origin_hi) + u_light_lo;

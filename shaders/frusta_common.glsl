@@ -1,16 +1,16 @@
 // frusta_common.glsl — what every stage of the frusta program shares: the buffers the
-// renderer uploads once (core/render_gl.cpp) and the per-pass uniforms (with views.glsl's).
+// renderer uploads once (core/gl/render_gl.cpp) and the per-pass uniforms (with views.glsl's).
 //
 // Frames: positions are never sent in world coordinates. Each record is relative to its
 // origin_hi (skin.h), and the eye (or the shadow map's centre) is sent as hi + lo floats,
 // so eye − origin_hi = (eye_hi − origin_hi) + eye_lo keeps float precision at 10^6 m.
 
 // One GpuSegment per frustum (skin.h), uploaded once.
-layout(std430, binding = 0) readonly buffer Segments { GpuSegment segments[]; };
+layout(std430, binding = SEGMENTS_BINDING) readonly buffer Segments { GpuSegment segments[]; };
 // Per frustum: plant, chain, segment (knuckle: joint) index, 0.
-layout(std430, binding = 1) readonly buffer SegmentIds { uvec4 segment_ids[]; };
+layout(std430, binding = SEGMENT_IDS_BINDING) readonly buffer SegmentIds { uvec4 segment_ids[]; };
 // EYE_INSIDE: the frusta whose bounding pyramid may contain the eye (this frame's list).
-layout(std430, binding = 2) readonly buffer SegmentList { uint segment_list[]; };
+layout(std430, binding = SEGMENT_LIST_BINDING) readonly buffer SegmentList { uint segment_list[]; };
 
 uniform float u_twist_rad_per_m;  // SkinOptions::twist_rad_per_m (u of surface_uv, relief's u)
 

@@ -20,7 +20,7 @@ struct MeshFrustum {
   vec4 origin_hi;
   uvec4 ids;
 };
-layout(std430, binding = 7) readonly buffer MeshFrusta { MeshFrustum mesh_frusta[]; };
+layout(std430, binding = MESH_FRUSTA_BINDING) readonly buffer MeshFrusta { MeshFrustum mesh_frusta[]; };
 
 #ifdef GBUFFER_PASS
 out vec3 v_rel_eye;         // position − eye: the distance, and the ray it lies on

@@ -13,20 +13,19 @@
 // Albedo: g_albedo where the geometry pass decided it (a = 1: a bark texture, already
 // linear), else the material table, material 0 replaced by the plant's bark colour.
 
-layout(binding = 0) uniform sampler2D g_normal_distance;
-layout(binding = 1) uniform sampler2D g_geometric_u;
-layout(binding = 2) uniform usampler2D g_ids;
-layout(binding = 4) uniform sampler2D g_albedo;
+layout(binding = G_NORMAL_DISTANCE_UNIT) uniform sampler2D g_normal_distance;
+layout(binding = G_GEOMETRIC_U_UNIT) uniform sampler2D g_geometric_u;
+layout(binding = G_IDS_UNIT) uniform usampler2D g_ids;
+layout(binding = G_ALBEDO_UNIT) uniform sampler2D g_albedo;
 #ifdef SUN
-layout(binding = 3) uniform sampler2DShadow shadow_map;
+layout(binding = SHADOW_MAP_UNIT) uniform sampler2DShadow shadow_map;
 #endif
 
 // plant_maps (bark.glsl, the file before this one): which plants are relief-mapped.
 // Per plant: bark albedo (rgb) and w = 1 where it replaces material 0 (Bark::albedo_rgb).
-layout(std430, binding = 3) readonly buffer PlantBark { vec4 plant_bark[]; };
+layout(std430, binding = PLANT_BARK_BINDING) readonly buffer PlantBark { vec4 plant_bark[]; };
 
-const int kMaxMaterials = 16;
-uniform vec3 u_material_albedo[kMaxMaterials];  // kMaterialAlbedo (materials.h)
+uniform vec3 u_material_albedo[MAX_MATERIALS];  // kMaterialAlbedo (materials.h)
 uniform int u_material_count;
 
 uniform vec3 u_right;        // camera frame, as frusta_common.glsl
@@ -112,8 +111,8 @@ void main() {
   } else {
     vec4 geometric_u = texelFetch(g_geometric_u, texel, 0);
     uvec4 ids = texelFetch(g_ids, texel, 0);
-    uint plant = ids.x & 0xFFFFFFu;
-    uint material = ids.x >> 24;
+    uint plant = ids.x & PLANT_INDEX_MASK;
+    uint material = ids.x >> PLANT_INDEX_BITS;
     vec4 decided = texelFetch(g_albedo, texel, 0);
     albedo = decided.a > 0.0                               ? decided.rgb
              : material == 0u && plant_bark[plant].w > 0.0 ? plant_bark[plant].rgb

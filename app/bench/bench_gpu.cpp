@@ -4,9 +4,10 @@
 //
 // For each input and image size, each method builds one GlRenderer (render_gl.h), renders
 // --warmup frames (shader variants are built at the first draw, drivers settle), then
-// --frames frames. A frame's GPU time is the sum of its "(GPU)" passes (GL_TIME_ELAPSED
-// queries: shadow map, frusta, shade); the table gives its median and 10th/90th
-// percentiles, fps from the median, and the frame's wall time (readback included).
+// --frames frames, each drawn, waited for (GlRenderer::wait_for_frame) and read back. A
+// frame's GPU time is GlFrameStats::gpu_s (GL_TIME_ELAPSED queries: shadow map, frusta or
+// mesh, shade); the table gives its median and 10th/90th percentiles, fps from the median,
+// and the frame's wall time (draw, wait and readback).
 // Methods:
 //   RC          the analytic frusta, relief left out;
 //   RC-nocd     the same without the conservative depth layout (layout(depth_less) lets
@@ -31,8 +32,8 @@
 // otherwise swamp the colour errors.
 //
 // Memory: the bytes the renderer uploaded (GlRenderer::uploaded_bytes: segment records
-// and ids, or the mesh) plus its render targets (G-buffer, depth, accumulation, shadow
-// map), counted from their formats; bark textures are left out.
+// and ids, or the mesh) plus its render targets (GlFrameStats::target_bytes: G-buffer,
+// depth, accumulation, shadow map, from their formats); bark textures are left out.
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -214,35 +215,6 @@ double quantile(std::vector<double> values, double p) {
   return values[below] + (at - static_cast<double>(below)) * (values[above] - values[below]);
 }
 
-// GPU time of a frame: its "(GPU)" passes.
-double gpu_seconds(const RenderResult& frame) {
-  double total = 0;
-  for (const RenderPass& p : frame.passes)
-    if (p.name.find("(GPU)") != std::string::npos) total += p.seconds;
-  return total;
-}
-
-double pass_seconds(const RenderResult& frame, const std::string& name) {
-  for (const RenderPass& p : frame.passes)
-    if (p.name == name) return p.seconds;
-  return std::nan("");
-}
-
-// Bytes of the GL renderer's render targets at w × h, counted from the formats that
-// render_gl.cpp's ensure_targets allocates (keep in step): G-buffer RGBA32F, RGBA32F,
-// RGBA32UI and RGBA16F, a 32-bit float depth buffer, an RGBA32F accumulation target (76
-// bytes a pixel), and the shadow map (DEPTH_COMPONENT32F), whose side the frame's
-// "shadow map (GPU)" pass names ("2048x2048, ..."). Bark textures are not counted.
-uint64_t render_target_bytes(const RenderResult& frame, uint32_t w, uint32_t h) {
-  uint64_t bytes = static_cast<uint64_t>(w) * h * (16 + 16 + 16 + 8 + 4 + 16);
-  for (const RenderPass& p : frame.passes) {
-    unsigned side_x = 0, side_y = 0;
-    if (p.name == "shadow map (GPU)" && std::sscanf(p.detail.c_str(), "%ux%u", &side_x, &side_y) == 2)
-      bytes += static_cast<uint64_t>(side_x) * side_y * 4;
-  }
-  return bytes;
-}
-
 struct Row {
   std::string input;
   ImageSize size;
@@ -303,7 +275,8 @@ void run_method(const Scene& scene, uint32_t frames, uint32_t warmup, LazyRefere
     renderer.set_conservative_depth(m.conservative_depth);
     row.frusta = renderer.frusta();
     row.setup_upload_bytes = renderer.uploaded_bytes();
-    RenderResult frame;
+    RenderImage image;
+    GlFrameStats stats;
     for (uint32_t f = 0; f < warmup + frames; ++f) {
       double sway_s = 0, update_s = 0, uploaded = 0;
       if (m.animated) {
@@ -314,27 +287,31 @@ void run_method(const Scene& scene, uint32_t frames, uint32_t warmup, LazyRefere
         uploaded = static_cast<double>(renderer.update_plants(posed));
         update_s = seconds_since(start);
       }
-      frame = renderer.render(posed);
+      const Clock::time_point start = Clock::now();
+      renderer.draw(posed);
+      stats = renderer.wait_for_frame();
+      image = renderer.read_back();
+      const double wall_s = seconds_since(start);
       if (f < warmup) continue;
-      row.gpu_s.push_back(gpu_seconds(frame));
-      row.wall_s.push_back(pass_seconds(frame, "frame (wall)"));
+      row.gpu_s.push_back(stats.gpu_s());
+      row.wall_s.push_back(wall_s);
       if (m.animated) {
         row.sway_s.push_back(sway_s);
         row.update_s.push_back(update_s);
         row.upload_bytes.push_back(uploaded);
       }
     }
-    row.frusta = frame.frusta;
-    row.memory_bytes = renderer.uploaded_bytes() + render_target_bytes(frame, scene.width, scene.height);
+    row.frusta = stats.frusta;
+    row.memory_bytes = renderer.uploaded_bytes() + stats.target_bytes;
     if (m.animated) {
       // The moving plants have no converged reference: the CPU draws the last pose the
       // same way, which checks that update_plants uploaded it.
       row.reference = "RC at the same pose (CPU)";
       const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-      row.errors = compare_images(render_cpu_timed(posed, m.geometry, threads).result.image, frame.image);
+      row.errors = compare_images(render_cpu_timed(posed, m.geometry, threads).result.image, image);
     } else {
       row.reference = reference.describe();
-      row.errors = compare_images(reference.image(), frame.image);
+      row.errors = compare_images(reference.image(), image);
     }
   } catch (const std::exception& e) {
     row.status = "failed";

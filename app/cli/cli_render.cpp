@@ -214,6 +214,7 @@ int run_render(const std::vector<std::string>& args) {
   // needs nothing the GL backend lacks; otherwise the CPU, saying why.
   std::string backend_name = "CPU ray caster";
   std::optional<RenderResult> gl_result;
+  GlFrameStats gl_stats;
   if (a.backend != "cpu") {
     std::string why_not;
     const char* fallback = "OpenGL unavailable";
@@ -228,7 +229,7 @@ int run_render(const std::vector<std::string>& args) {
       } else {
         passes.push_back({"gl context", seconds_since(context_start), context.context->info().describe()});
         try {
-          gl_result = render_gl(scene, options);
+          gl_result = render_gl(scene, options, &gl_stats);
           // Meshes are rasterised (the polygon baseline), frusta ray cast.
           const std::string& renderer = context.context->info().renderer;
           backend_name = options.geometry.kind == GeometryKind::mesh ? "OpenGL rasteriser (meshes, " + renderer + ")"
@@ -266,10 +267,17 @@ int run_render(const std::vector<std::string>& args) {
   if (a.verbose) {
     std::cerr << "sylva render: " << scene.width << "x" << scene.height << ", " << a.spp << " spp, " << backend_name
               << (scene.fog ? "; fog is parsed but not rendered in this version" : "") << "\n";
-    for (const RenderPass& p : passes) {
+    auto print = [](const char* name, double seconds, const std::string& detail) {
       char line[256];
-      std::snprintf(line, sizeof line, "  %-22s %9.3f ms", p.name.c_str(), p.seconds * 1e3);
-      std::cerr << line << (p.detail.empty() ? "" : "  " + p.detail) << "\n";
+      std::snprintf(line, sizeof line, "  %-22s %9.3f ms", name, seconds * 1e3);
+      std::cerr << line << (detail.empty() ? "" : "  " + detail) << "\n";
+    };
+    for (const RenderPass& p : passes) print(p.name.c_str(), p.seconds, p.detail);
+    if (gl_result) {
+      // The GL frame's totals (GlFrameStats): GPU time over its passes, what it sent, what it holds.
+      print("GPU total", gl_stats.gpu_s(),
+            std::to_string((gl_stats.plant_bytes_uploaded + 1023) / 1024) + " KiB of plant data uploaded, " +
+                std::to_string((gl_stats.target_bytes + 1023) / 1024) + " KiB of render targets");
     }
   }
   return kOk;

@@ -61,8 +61,9 @@ struct Candidate {
 };
 
 // Tries one display: initialise, bind OpenGL, create a 4.5 core context, make it current
-// without a surface, check the version. Returns the context or sets *why.
-EGLContext try_display(const Candidate& c, std::string* why) {
+// without a surface, check the version. Returns the context (and its config, or
+// EGL_NO_CONFIG_KHR, in *config_out) or sets *why.
+EGLContext try_display(const Candidate& c, EGLConfig* config_out, std::string* why) {
   EGLint major = 0, minor = 0;
   if (c.display == EGL_NO_DISPLAY) {
     *why = "no display";
@@ -115,6 +116,7 @@ EGLContext try_display(const Candidate& c, std::string* why) {
     eglDestroyContext(c.display, context);
     return EGL_NO_CONTEXT;
   }
+  *config_out = config;
   return context;
 }
 
@@ -167,7 +169,8 @@ GlContextResult create_headless_gl_context() {
   std::string reasons;
   for (const Candidate& c : candidates) {
     std::string why;
-    EGLContext context = try_display(c, &why);
+    EGLConfig config = nullptr;
+    EGLContext context = try_display(c, &config, &why);
     if (context == EGL_NO_CONTEXT) {
       reasons += (reasons.empty() ? "" : "; ") + c.name + ": " + why;
       continue;
@@ -175,6 +178,7 @@ GlContextResult create_headless_gl_context() {
     result.context.reset(new GlContext());
     result.context->display_ = c.display;
     result.context->context_ = context;
+    result.context->config_ = config;
     GlContextInfo& info = result.context->info_;
     info.platform = c.name;
     info.vendor = gl_string(GL_VENDOR);
@@ -206,6 +210,46 @@ void GlContext::make_current() {
   if (!eglMakeCurrent(static_cast<EGLDisplay>(display_), EGL_NO_SURFACE, EGL_NO_SURFACE,
                       static_cast<EGLContext>(context_)))
     throw GlError("eglMakeCurrent failed (" + egl_error_name(eglGetError()) + ")");
+}
+
+void GlContext::make_current(const GlPbuffer& surface) {
+  auto egl_surface = static_cast<EGLSurface>(surface.surface_);
+  if (!eglMakeCurrent(static_cast<EGLDisplay>(display_), egl_surface, egl_surface, static_cast<EGLContext>(context_)))
+    throw GlError("eglMakeCurrent with a pbuffer failed (" + egl_error_name(eglGetError()) + ")");
+}
+
+GlPbufferResult GlContext::create_pbuffer(uint32_t width, uint32_t height) const {
+  GlPbufferResult result;
+  auto display = static_cast<EGLDisplay>(display_);
+  EGLConfig config = static_cast<EGLConfig>(config_);
+  if (!config) {  // a context without a config takes any surface's: choose an RGBA8 one
+    const EGLint attributes[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
+                                 EGL_RED_SIZE,     8,               EGL_GREEN_SIZE,      8,
+                                 EGL_BLUE_SIZE,    8,               EGL_ALPHA_SIZE,      8,
+                                 EGL_NONE};
+    EGLint count = 0;
+    if (!eglChooseConfig(display, attributes, &config, 1, &count) || count < 1) {
+      result.error = "no RGBA8 pbuffer config for OpenGL on this display";
+      return result;
+    }
+  }
+  const EGLint attributes[] = {EGL_WIDTH, static_cast<EGLint>(width), EGL_HEIGHT, static_cast<EGLint>(height),
+                               EGL_NONE};
+  EGLSurface surface = eglCreatePbufferSurface(display, config, attributes);
+  if (surface == EGL_NO_SURFACE) {
+    result.error = "eglCreatePbufferSurface failed (" + egl_error_name(eglGetError()) + ")";
+    return result;
+  }
+  result.pbuffer.reset(new GlPbuffer());
+  result.pbuffer->display_ = display;
+  result.pbuffer->surface_ = surface;
+  result.pbuffer->width_ = width;
+  result.pbuffer->height_ = height;
+  return result;
+}
+
+GlPbuffer::~GlPbuffer() {
+  eglDestroySurface(static_cast<EGLDisplay>(display_), static_cast<EGLSurface>(surface_));
 }
 
 }  // namespace sylva

@@ -14,8 +14,12 @@
 //
 // Displays are initialised once per process and never terminated (EGL displays are
 // process-wide; terminating one would pull it from under another context on it).
+//
+// A pbuffer (GlPbuffer) gives the context a default framebuffer without a window system:
+// the tests draw through GlRenderer's window path (GlTarget framebuffer 0) into one.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -37,6 +41,33 @@ struct GlContextInfo {
   std::string describe() const;  // "llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 ..., EGL surfaceless"
 };
 
+class GlContext;
+
+// An off-screen EGL surface of the context's display: made current with the context
+// (GlContext::make_current(pbuffer)), its colour buffer is the default framebuffer
+// (RGBA8), as a window's back buffer is. Destroy it while another surface (or none) is
+// current.
+class GlPbuffer {
+ public:
+  ~GlPbuffer();
+  GlPbuffer(const GlPbuffer&) = delete;
+  GlPbuffer& operator=(const GlPbuffer&) = delete;
+  uint32_t width() const { return width_; }
+  uint32_t height() const { return height_; }
+
+ private:
+  friend class GlContext;
+  GlPbuffer() = default;
+  void* display_ = nullptr;  // EGLDisplay
+  void* surface_ = nullptr;  // EGLSurface
+  uint32_t width_ = 0, height_ = 0;
+};
+
+struct GlPbufferResult {
+  std::unique_ptr<GlPbuffer> pbuffer;  // null on failure
+  std::string error;                   // why, when pbuffer is null
+};
+
 class GlContext {
  public:
   ~GlContext();
@@ -44,14 +75,21 @@ class GlContext {
   GlContext& operator=(const GlContext&) = delete;
 
   const GlContextInfo& info() const { return info_; }
-  // Makes the context current on the calling thread (creation already did, on its thread).
+  // Makes the context current on the calling thread (creation already did, on its thread),
+  // without a surface, or with `surface`'s default framebuffer (a pbuffer of this context's).
   void make_current();
+  void make_current(const GlPbuffer& surface);
+
+  // A width × height RGBA8 pbuffer on the context's display, or why there is none (the
+  // display or the driver offers no pbuffer config for desktop OpenGL).
+  GlPbufferResult create_pbuffer(uint32_t width, uint32_t height) const;
 
  private:
   friend struct GlContextResult create_headless_gl_context();
   GlContext() = default;
   void* display_ = nullptr;  // EGLDisplay
   void* context_ = nullptr;  // EGLContext
+  void* config_ = nullptr;   // EGLConfig the context was made with; null: EGL_NO_CONFIG_KHR
   GlContextInfo info_;
 };
 

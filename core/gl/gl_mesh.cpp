@@ -10,8 +10,11 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/gl/bindings.h"
 #include "core/gl/gl_api.h"
+#include "core/gl/gl_objects.h"
 #include "core/gl/gl_program.h"
+#include "core/gl/gl_views.h"
 #include "core/render_common.h"
 #include "core/cpu/texture.h"
 #include "core/plant_mesh.h"
@@ -32,15 +35,7 @@ struct MeshVertex {
 };
 static_assert(sizeof(MeshVertex) == 36);
 
-// One frustum as mesh.vert.glsl's MeshFrustum (std430: vec4, uvec4).
-struct MeshFrustumRecord {
-  float origin_hi[4];  // the plant's origin, float-exact; w unused
-  uint32_t ids[4];     // plant | material << 24, chain, segment, 0
-};
-static_assert(sizeof(MeshFrustumRecord) == 32);
-
-constexpr GLuint kMeshFrustaBinding = 7;  // mesh.vert.glsl
-constexpr uint32_t kMaxPlants = 1u << 24;  // plant bits of the G-buffer's ids
+using gl::MeshFrustumRecord;
 
 // What is uploaded, built on the CPU.
 struct MeshArrays {
@@ -65,7 +60,8 @@ void append_plant(MeshArrays& out, const TriangleMesh& part, const SkinnedSkelet
 
   const uint32_t first_frustum = static_cast<uint32_t>(out.frusta.size());
   for (const Frustum& f : skinned.frusta)
-    out.frusta.push_back({{origin_hi.x, origin_hi.y, origin_hi.z, 0.0f}, {plant | (f.material << 24), f.chain, f.segment, 0u}});
+    out.frusta.push_back({{origin_hi.x, origin_hi.y, origin_hi.z, 0.0f},
+                          {plant | (f.material << gl::kPlantIndexBits), f.chain, f.segment, 0u}});
 
   // tessellate.h gives every frustum its own vertices (a joint's shared row is copied),
   // so a vertex's frustum is that of any triangle using it.
@@ -107,26 +103,6 @@ void append_plant(MeshArrays& out, const TriangleMesh& part, const SkinnedSkelet
   }
 }
 
-GLuint make_buffer(const void* data, size_t bytes) {
-  GLuint buffer = 0;
-  glCreateBuffers(1, &buffer);
-  // Zero-sized storage is an error: an empty mesh gets one unused 64-byte element.
-  const uint8_t placeholder[64] = {};
-  glNamedBufferStorage(buffer, bytes ? static_cast<GLsizeiptr>(bytes) : 64, bytes ? data : placeholder, 0);
-  return buffer;
-}
-
-void check_gl(const char* where) {
-  const GLenum error = glGetError();
-  if (error != GL_NO_ERROR) throw GlError(std::string("GL mesh, ") + where + ": GL error " + std::to_string(error));
-}
-
-GLint location(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
-void set_vec3(GLuint p, const char* name, const glm::vec3& v) { glProgramUniform3f(p, location(p, name), v.x, v.y, v.z); }
-void set_vec2(GLuint p, const char* name, double a, double b) {
-  glProgramUniform2f(p, location(p, name), static_cast<float>(a), static_cast<float>(b));
-}
-
 bool sun_shines(const Scene& scene) {
   return scene.sun.radiance.x > 0 || scene.sun.radiance.y > 0 || scene.sun.radiance.z > 0;
 }
@@ -141,27 +117,15 @@ struct GlMesh::State {
   bool displaced = false;
   int bark_texture_units = 0;  // > 0: the G-buffer program writes the bark albedo
   std::unique_ptr<SceneTextures> own_textures;  // height maps opened here, kept for update
-  GLuint vao = 0, vertex_buffer = 0, index_buffer = 0, frustum_buffer = 0;
-  GLuint gbuffer_program = 0, shadow_program = 0;
-
-  ~State() {
-    release_buffers();
-    glDeleteVertexArrays(1, &vao);
-    if (gbuffer_program) glDeleteProgram(gbuffer_program);
-    if (shadow_program) glDeleteProgram(shadow_program);
-  }
-
-  void release_buffers() {
-    const GLuint buffers[3] = {vertex_buffer, index_buffer, frustum_buffer};
-    glDeleteBuffers(3, buffers);
-    vertex_buffer = index_buffer = frustum_buffer = 0;
-  }
+  GlVertexArray vao;
+  GlBuffer vertex_buffer, index_buffer, frustum_buffer;
+  GlProgramObject gbuffer_program, shadow_program;
 
   // Tessellates, displaces and uploads every plant; replaces the passes' record with what
   // this did. Returns the bytes uploaded.
   uint64_t build(const Scene& scene, const SceneTextures* textures) {
     setup_passes.clear();
-    if (scene.plants.size() >= kMaxPlants) throw GlError("the GL backend draws at most 2^24 plants");
+    if (scene.plants.size() >= gl::kMaxPlants) throw GlError("the GL backend draws at most 2^24 plants");
     const GeometryOptions& geometry = options.geometry;
     TessellateOptions tessellation;
     tessellation.level = geometry.mesh_level;
@@ -216,22 +180,24 @@ struct GlMesh::State {
                               std::to_string(arrays.displaced_plants) + " plants by their height maps"});
 
     const Clock::time_point start = Clock::now();
-    release_buffers();
-    vertex_buffer = make_buffer(arrays.vertices.data(), vertex_bytes);
-    index_buffer = make_buffer(arrays.indices.data(), index_bytes);
-    frustum_buffer = make_buffer(arrays.frusta.data(), frustum_bytes);
-    if (!vao) glCreateVertexArrays(1, &vao);
-    glVertexArrayVertexBuffer(vao, 0, vertex_buffer, 0, sizeof(MeshVertex));
-    glVertexArrayElementBuffer(vao, index_buffer);
-    glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, offsetof(MeshVertex, position));
-    glVertexArrayAttribFormat(vao, 1, 3, GL_FLOAT, GL_FALSE, offsetof(MeshVertex, normal));
-    glVertexArrayAttribFormat(vao, 2, 2, GL_FLOAT, GL_FALSE, offsetof(MeshVertex, uv));
-    glVertexArrayAttribIFormat(vao, 3, 1, GL_UNSIGNED_INT, offsetof(MeshVertex, frustum));
+    vertex_buffer.reset();
+    index_buffer.reset();
+    frustum_buffer.reset();
+    vertex_buffer = make_gl_buffer(arrays.vertices.data(), vertex_bytes);
+    index_buffer = make_gl_buffer(arrays.indices.data(), index_bytes);
+    frustum_buffer = make_gl_buffer(arrays.frusta.data(), frustum_bytes);
+    if (!vao) vao = make_gl_vertex_array();
+    glVertexArrayVertexBuffer(vao.id(), 0, vertex_buffer.id(), 0, sizeof(MeshVertex));
+    glVertexArrayElementBuffer(vao.id(), index_buffer.id());
+    glVertexArrayAttribFormat(vao.id(), 0, 3, GL_FLOAT, GL_FALSE, offsetof(MeshVertex, position));
+    glVertexArrayAttribFormat(vao.id(), 1, 3, GL_FLOAT, GL_FALSE, offsetof(MeshVertex, normal));
+    glVertexArrayAttribFormat(vao.id(), 2, 2, GL_FLOAT, GL_FALSE, offsetof(MeshVertex, uv));
+    glVertexArrayAttribIFormat(vao.id(), 3, 1, GL_UNSIGNED_INT, offsetof(MeshVertex, frustum));
     for (GLuint a = 0; a < 4; ++a) {
-      glVertexArrayAttribBinding(vao, a, 0);
-      glEnableVertexArrayAttrib(vao, a);
+      glVertexArrayAttribBinding(vao.id(), a, 0);
+      glEnableVertexArrayAttrib(vao.id(), a);
     }
-    check_gl("upload");
+    check_gl("GL mesh upload");
     gpu_bytes = vertex_bytes + index_bytes + frustum_bytes;
     setup_passes.push_back({"upload", seconds_since(start),
                             std::to_string(gpu_bytes / 1024) + " KiB: " + std::to_string(arrays.vertices.size()) +
@@ -241,12 +207,12 @@ struct GlMesh::State {
   }
 
   GLuint program(MeshPass pass, double* compile_s) {
-    GLuint& id = pass == MeshPass::shadow ? shadow_program : gbuffer_program;
-    if (id) return id;
+    GlProgramObject& program = pass == MeshPass::shadow ? shadow_program : gbuffer_program;
+    if (program) return program.id();
     const Clock::time_point start = Clock::now();
-    id = build_gl_program(mesh_program(pass, bark_texture_units)).id;
+    program = GlProgramObject(build_gl_program(mesh_program(pass, bark_texture_units)).id);
     if (compile_s) *compile_s += seconds_since(start);
-    return id;
+    return program.id();
   }
 
   // Draws every triangle with `program` (its uniforms set), both faces.
@@ -256,8 +222,8 @@ struct GlMesh::State {
     glGetIntegerv(GL_VERTEX_ARRAY_BINDING, &previous_vao);
     const GLboolean cull = glIsEnabled(GL_CULL_FACE);
     glDisable(GL_CULL_FACE);
-    glBindVertexArray(vao);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kMeshFrustaBinding, frustum_buffer);
+    glBindVertexArray(vao.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kMeshFrustaBinding, frustum_buffer.id());
     glUseProgram(program_id);
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * triangles), GL_UNSIGNED_INT, nullptr);
     glBindVertexArray(static_cast<GLuint>(previous_vao));
@@ -280,46 +246,28 @@ GlMesh::GlMesh(const Scene& scene, const RenderOptions& options, int bark_textur
     names += ", " + mesh_program(MeshPass::shadow).name;
   }
   st.setup_passes.push_back({"programs", compile_s, names});
-  check_gl("programs");
+  check_gl("GL mesh programs");
 }
 
 GlMesh::~GlMesh() = default;
 
 uint64_t GlMesh::update(const Scene& scene, const SceneTextures* textures) { return state_->build(scene, textures); }
 
-void GlMesh::draw_gbuffer(const GlMeshCamera& c) {
+void GlMesh::draw_gbuffer(const GlCameraView& camera, double footprint_scale) {
   State& st = *state_;
   const GLuint p = st.program(MeshPass::gbuffer, nullptr);
-  const glm::vec3 eye_hi(c.eye);
-  set_vec3(p, "u_eye_hi", eye_hi);
-  set_vec3(p, "u_eye_lo", glm::vec3(c.eye - glm::dvec3(eye_hi)));
-  set_vec3(p, "u_right", glm::vec3(c.right));
-  set_vec3(p, "u_up", glm::vec3(c.up));
-  set_vec3(p, "u_forward", glm::vec3(c.forward));
-  set_vec2(p, "u_half_size", c.half_width, c.half_height);
-  set_vec2(p, "u_image_size", c.width, c.height);
-  set_vec2(p, "u_jitter", c.jitter_x, c.jitter_y);
-  glProgramUniform1f(p, location(p, "u_near"), static_cast<float>(c.near));
-  if (st.bark_texture_units > 0)
-    glProgramUniform1f(p, location(p, "u_footprint_scale"), static_cast<float>(c.footprint_scale));
+  set_camera_uniforms(p, camera);
+  if (st.bark_texture_units > 0) set_uniform(p, "u_footprint_scale", footprint_scale);
   st.draw(p);
-  check_gl("G-buffer pass");
+  check_gl("GL mesh G-buffer pass");
 }
 
-void GlMesh::draw_shadow(const GlMeshSunView& v) {
+void GlMesh::draw_shadow(const GlSunView& view) {
   State& st = *state_;
   const GLuint p = st.program(MeshPass::shadow, nullptr);
-  const glm::vec3 centre_hi(v.centre);
-  set_vec3(p, "u_light_hi", centre_hi);
-  set_vec3(p, "u_light_lo", glm::vec3(v.centre - glm::dvec3(centre_hi)));
-  set_vec3(p, "u_light_e0", glm::vec3(v.e0));
-  set_vec3(p, "u_light_e1", glm::vec3(v.e1));
-  set_vec3(p, "u_light_dir", glm::vec3(v.direction));
-  glProgramUniform4f(p, location(p, "u_light_rect"), static_cast<float>(v.x_min), static_cast<float>(v.y_min),
-                     static_cast<float>(v.side), static_cast<float>(v.side));
-  set_vec2(p, "u_light_depth", v.s_near, v.s_range);
+  set_sun_view_uniforms(p, view);
   st.draw(p);
-  check_gl("shadow pass");
+  check_gl("GL mesh shadow pass");
 }
 
 uint64_t GlMesh::triangles() const { return state_->triangles; }

@@ -18,13 +18,14 @@
 //             keep float precision as frusta_common.glsl's records do), unit shading
 //             normal, (u turns, v_m metres), frustum index;
 //   indices   uint32, 3 per triangle (tessellate.h's, counter-clockwise from outside);
-//   frusta    32 B each: its plant's origin_hi, then plant | material << 24, chain,
-//             segment (knuckle: joint), 0 — shader storage binding 7 (the renderer's
-//             buffers take 0–3).
+//   frusta    32 B each (bindings.h's MeshFrustumRecord): its plant's origin_hi, then
+//             plant | material << 24, chain, segment (knuckle: joint), 0 — shader storage
+//             binding kMeshFrustaBinding.
 //
 // Drawing: the caller binds the framebuffer, clears it and sets the depth test; the draw
-// binds its own program, vertex array and buffers, disables face culling (the CPU's Embree
-// triangles are hit from both sides) and restores the vertex array and the culling state.
+// sets the view (gl_views.h, as the renderer sets it for the frusta), binds its own program,
+// vertex array and buffers, disables face culling (the CPU's Embree triangles are hit from
+// both sides) and restores the vertex array and the culling state.
 //   draw_gbuffer  shaders/mesh.*.glsl GBUFFER_PASS: frusta.vert.glsl's jittered reversed-Z
 //                 infinite projection (depth = near / z_forward, so GL_GREATER against a
 //                 cleared 0), and the G-buffer of frusta.frag.glsl: location 0 shading
@@ -57,31 +58,13 @@
 
 #include <glm/vec3.hpp>
 
+#include "core/gl/gl_views.h"
 #include "core/render_types.h"
 #include "core/scene.h"
 
 namespace sylva {
 
 class SceneTextures;  // texture.h
-
-// The camera of one G-buffer pass (render_common.h's CameraFrame and the pass's jitter).
-struct GlMeshCamera {
-  glm::dvec3 eye{0}, right{1, 0, 0}, up{0, 1, 0}, forward{0, 0, -1};  // unit frame
-  double half_width = 1, half_height = 1;  // the image plane's half extents at distance 1
-  uint32_t width = 1, height = 1;          // pixels
-  double near = 1e-3;                      // reversed-Z near plane, metres along forward
-  double jitter_x = 0.5, jitter_y = 0.5;   // where in its pixel the pass samples
-  double footprint_scale = 1;              // 1 / sqrt(spp): the bark albedo's ray differentials
-};
-
-// The orthographic sun view of one shadow pass (frusta_common.glsl's SHADOW_PASS uniforms).
-struct GlMeshSunView {
-  glm::dvec3 centre{0};                          // c, metres
-  glm::dvec3 e0{1, 0, 0}, e1{0, 0, 1};           // axis_frame(direction)
-  glm::dvec3 direction{0, 1, 0};                 // unit, toward the sun
-  double x_min = 0, y_min = 0, side = 1;         // the square map, metres relative to c
-  double s_near = 0, s_range = 1;                // s = −dot(p − c, direction)
-};
 
 // A sphere around one frustum's triangles (displaced ones included), metres.
 struct GlMeshSphere {
@@ -108,9 +91,9 @@ class GlMesh {
   uint64_t update(const Scene& scene, const SceneTextures* textures = nullptr);
 
   // One G-buffer pass / one shadow-map pass (see the header comment for what the caller
-  // sets up).
-  void draw_gbuffer(const GlMeshCamera& camera);
-  void draw_shadow(const GlMeshSunView& view);
+  // sets up). `footprint_scale`: 1 / sqrt(spp), the bark albedo's ray differentials.
+  void draw_gbuffer(const GlCameraView& camera, double footprint_scale);
+  void draw_shadow(const GlSunView& view);
 
   uint64_t triangles() const;   // triangles uploaded
   uint64_t frusta() const;      // frusta tessellated

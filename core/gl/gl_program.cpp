@@ -77,4 +77,27 @@ GlProgram build_gl_program(const ShaderProgramSource& source) {
   return result;
 }
 
+namespace {
+GLint location(uint32_t program, const char* name) { return glGetUniformLocation(program, name); }
+}  // namespace
+
+void set_uniform(uint32_t p, const char* name, double value) {
+  glProgramUniform1f(p, location(p, name), static_cast<float>(value));
+}
+void set_uniform(uint32_t p, const char* name, double x, double y) {
+  glProgramUniform2f(p, location(p, name), static_cast<float>(x), static_cast<float>(y));
+}
+void set_uniform(uint32_t p, const char* name, double x, double y, double z, double w) {
+  glProgramUniform4f(p, location(p, name), static_cast<float>(x), static_cast<float>(y), static_cast<float>(z),
+                     static_cast<float>(w));
+}
+void set_uniform(uint32_t p, const char* name, const glm::vec3& v) {
+  glProgramUniform3f(p, location(p, name), v.x, v.y, v.z);
+}
+void set_uniform(uint32_t p, const char* name, const glm::dvec3& v) { set_uniform(p, name, glm::vec3(v)); }
+void set_uniform_int(uint32_t p, const char* name, int value) { glProgramUniform1i(p, location(p, name), value); }
+void set_uniform_vec3_array(uint32_t p, const char* name, int count, const float* xyz) {
+  glProgramUniform3fv(p, location(p, name), count, xyz);
+}
+
 }  // namespace sylva

@@ -2,10 +2,19 @@
 // current OpenGL context, with the driver's info logs kept: a failure throws GlError
 // naming the variant and each message's file and line; a success still returns the logs
 // (the shader tests require them free of warnings).
+//
+// Uniforms of the default block are set by name on a program (glProgramUniform*, no
+// glUseProgram): a name the variant does not declare, or one the compiler removed as
+// unused, has location -1 and is silently skipped, so one call fits every variant. Values
+// given as double are converted to float once, here. The std140 blocks every variant shares
+// (the camera, the sun's view) are buffers instead (bindings.h).
 #pragma once
 
 #include <cstdint>
 #include <string>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
 
 #include "core/gl/gl_context.h"
 #include "core/gl/gl_shaders.h"
@@ -13,12 +22,22 @@
 namespace sylva {
 
 struct GlProgram {
-  uint32_t id = 0;       // the GL program object (the caller deletes it)
+  uint32_t id = 0;       // the GL program object (the caller deletes it, or gives it to a
+                         // GlProgramObject, gl_objects.h)
   std::string name;      // the variant's name
   std::string info_log;  // compile logs of both stages and the link log, file names restored
 };
 
 // Compiles both stages and links them. Throws GlError with the logs on failure.
 GlProgram build_gl_program(const ShaderProgramSource& source);
+
+void set_uniform(uint32_t program, const char* name, double value);                  // float
+void set_uniform(uint32_t program, const char* name, double x, double y);            // vec2
+void set_uniform(uint32_t program, const char* name, double x, double y, double z, double w);  // vec4
+void set_uniform(uint32_t program, const char* name, const glm::vec3& value);        // vec3
+void set_uniform(uint32_t program, const char* name, const glm::dvec3& value);       // vec3
+void set_uniform_int(uint32_t program, const char* name, int value);                 // int, bool, sampler
+// vec3 name[count] from `count` consecutive x, y, z floats.
+void set_uniform_vec3_array(uint32_t program, const char* name, int count, const float* xyz);
 
 }  // namespace sylva

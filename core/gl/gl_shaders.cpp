@@ -20,6 +20,14 @@ std::string assemble_shader(const ShaderStageSource& stage) {
   for (const std::string& define : stage.defines) text += "#define " + define + "\n";
   for (size_t i = 0; i < stage.files.size(); ++i) {
     text += "#line 1 " + std::to_string(i) + "\n";
+    if (i == 0) {
+      // bindings.glsl heads file 0's slot under its own number, then file 0 starts at its
+      // line 1 again.
+      text += "#line 1 " + std::to_string(stage.files.size()) + "\n";
+      text += embedded_shader(kBindingsFile);
+      if (text.back() != '\n') text += '\n';
+      text += "#line 1 0\n";
+    }
     text += embedded_shader(stage.files[i]);
     if (text.back() != '\n') text += '\n';
   }
@@ -43,6 +51,7 @@ std::string format_shader_log(const ShaderStageSource& stage, const std::string&
     if (digits > p && digits < line.size() && line[digits] == ':') {
       const size_t index = std::stoul(line.substr(p, digits - p));
       if (index < stage.files.size()) line = line.substr(0, p) + stage.files[index] + line.substr(digits);
+      else if (index == stage.files.size()) line = line.substr(0, p) + kBindingsFile + line.substr(digits);
     }
     out += line + "\n";
     line_start = line_end + 1;
@@ -141,6 +150,15 @@ std::vector<std::string> shading_defines() {
   return {"SHADING_SPECULAR " + glsl_float(shading::kSpecular), "SHADING_SHININESS " + glsl_float(shading::kShininess)};
 }
 
+ShaderProgramSource present_program(bool srgb) {
+  ShaderProgramSource p;
+  p.name = srgb ? "present[SRGB]" : "present[]";
+  p.vertex = {ShaderStage::vertex, {"fullscreen.vert.glsl"}, {}};
+  p.fragment = {ShaderStage::fragment, {"present.frag.glsl"}, srgb ? std::vector<std::string>{"SRGB"}
+                                                                  : std::vector<std::string>{}};
+  return p;
+}
+
 ShaderProgramSource shade_program(bool sun) {
   ShaderProgramSource p;
   std::vector<std::string> defines = shading_defines();
@@ -176,6 +194,7 @@ std::vector<ShaderProgramSource> all_shader_programs() {
   for (MeshPass pass : {MeshPass::gbuffer, MeshPass::shadow}) all.push_back(mesh_program(pass));
   all.push_back(mesh_program(MeshPass::gbuffer, 1));  // with the bark albedo
   for (bool sun : {false, true}) all.push_back(shade_program(sun));
+  for (bool srgb : {false, true}) all.push_back(present_program(srgb));
   return all;
 }
 

@@ -5,7 +5,9 @@
 // A stage is `#version 450 core`, then one `#define` per variant switch, then the files of
 // the stage in order, each preceded by `#line 1 N` with N its index in the file list: a
 // driver or glslangValidator message "N:LINE" names file N, line LINE (format_shader_log
-// puts the file names back). The same text goes to the driver and to glslangValidator
+// puts the file names back). shaders/bindings.glsl (binding points, texture units, the
+// std140 blocks and shared constants: core/gl/bindings.h) opens every stage, at the head
+// of file 0's slot under number F (the number of files), so that every file may use it. The same text goes to the driver and to glslangValidator
 // (tests/gl/gl_shaders_test.cpp), so what CI validates is what runs.
 #pragma once
 
@@ -23,6 +25,9 @@ struct EmbeddedShader {
 extern const EmbeddedShader kEmbeddedShaders[];
 extern const size_t kEmbeddedShaderCount;
 
+// The file every stage begins with (bindings.h is its C++ side).
+inline constexpr const char* kBindingsFile = "bindings.glsl";
+
 // The text of shaders/NAME; throws std::logic_error if there is no such file.
 std::string_view embedded_shader(std::string_view name);
 
@@ -39,7 +44,7 @@ struct ShaderStageSource {
 std::string assemble_shader(const ShaderStageSource& stage);
 
 // `log` (a driver or glslangValidator info log for `stage`) with "N:" source-string
-// numbers replaced by the file names they stand for.
+// numbers replaced by the file names they stand for (N = files.size(): bindings.glsl).
 std::string format_shader_log(const ShaderStageSource& stage, const std::string& log);
 
 // A program variant: a name for --verbose and messages, and its two stages.
@@ -97,6 +102,11 @@ std::vector<std::string> shading_defines();
 // shading.glsl's model + shade.frag.glsl), with shading_defines(); `sun` false leaves out
 // the sun and its shadow map (black or absent sun: sky only).
 ShaderProgramSource shade_program(bool sun);
+
+// The present program (fullscreen.vert.glsl + present.frag.glsl): the accumulated beauty
+// divided by the sample count into the caller's target (render_gl.h), as linear values or,
+// `srgb`, encoded for display (IEC 61966-2-1, core/util/color.h's linear_to_srgb).
+ShaderProgramSource present_program(bool srgb);
 
 // Every variant the renderer can build (what the shader tests compile).
 std::vector<ShaderProgramSource> all_shader_programs();

@@ -1,8 +1,10 @@
-// render_gl.h — the OpenGL ray caster (issue 4; paper 000 sec. 2.5, 2.6, 4): the analytic
-// frusta drawn on the GPU with the shading model of the CPU reference (render_cpu.h), so
-// the two give the same picture within the tolerances of tests/gl/render_gl_test.cpp.
+// render_gl.h — the OpenGL ray caster (paper 000 sec. 2.5, 2.6, 4): the analytic frusta
+// drawn on the GPU with the shading model of the CPU reference (render_cpu.h), so the two
+// give the same picture within the tolerances of tests/gl/render_gl_test.cpp; and the frame
+// API a window uses (GlRenderer::draw into a GlTarget, GlFrameStats).
 //
-// How a frame is made (shaders/*.glsl, mirroring the CPU code function by function):
+// How a frame is made (shaders/*.glsl, mirroring the CPU code function by function; one
+// GlRenderer method per pass, GlPass in gl_frame_stats.h):
 //   upload (once)  one 64-byte GpuSegment record per frustum (skin.h) and 16 bytes of ids
 //                  (plant, chain, segment) in shader storage buffers; nothing per vertex.
 //                  Bark images, each distinct file once, with MIP chains; per plant its
@@ -21,7 +23,10 @@
 //                  uploaded once, rasterised into the same G-buffer and, depth only, into
 //                  the shadow map; the shading is the same.
 //   shade          one fullscreen pass: ground plane, sky, sun (Lambert + normalised
-//                  Blinn-Phong) with the shadow map, sky ambient — render_cpu.cpp's lit().
+//                  Blinn-Phong) with the shadow map, sky ambient — render_cpu.cpp's lit() —
+//                  added into the renderer's accumulation target.
+//   present        only when the caller gives a target (gl_target.h): the accumulated
+//                  beauty ÷ spp into it, linear or sRGB-encoded.
 // --spp N repeats shadow map (if the sun is a disc), frusta and shade N times with the
 // CPU's stratified pixel offsets (one offset per pass for all pixels, the rasteriser
 // sampling where the rays go) and, for a disc sun, a sun direction drawn on the disc per
@@ -55,8 +60,13 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
 
 #include "core/gl/gl_context.h"
+#include "core/gl/gl_frame_stats.h"
+#include "core/gl/gl_target.h"
 #include "core/render_types.h"
 #include "core/scene.h"
 
@@ -66,47 +76,109 @@ namespace sylva {
 // images than it binds), or nullopt when it can.
 std::optional<std::string> gl_unsupported(const Scene& scene, const RenderOptions& options);
 
-// A scene's plants on the GPU: skinned and uploaded once, rendered any number of times.
-// Preconditions: an OpenGL 4.5 core context (a GlContext or a window's) is current on the
-// calling thread for the renderer's whole life; every plant's skeleton is set. The
-// renderer sets the context's clip control to (lower left, zero to one) and owns the GL
-// objects it creates. Failures throw GlError.
+// A scene's plants on the GPU: skinned and uploaded once, drawn any number of times.
+//
+// Contract:
+//   - Threads: an OpenGL 4.5 core context (a GlContext, or a window's) is current on the
+//     calling thread for the renderer's whole life, construction to destruction; one thread
+//     at a time. Failures throw GlError.
+//   - What is done when. The constructor loads the bark images, skins (or, for
+//     GeometryKind::mesh, tessellates) every plant and uploads it, and builds the programs
+//     the first frame needs. draw() reads only the camera, image size, sun, sky and ground of
+//     the scene it is given: a new camera or sun redraws the same buffers (0 plant bytes
+//     uploaded), a new image size reallocates the render targets and nothing else, a
+//     program variant is built the first time a frame needs it (EYE_INSIDE, a sun that
+//     starts shining). Only update_plants sends plant data again.
+//   - GL state: draw() sets what its passes need (clip control lower left / zero to one,
+//     viewport, depth test, culling, blending, scissor off, sRGB writes off) and leaves the
+//     framebuffer, program and vertex array bindings at 0, blending, depth test and culling
+//     off; a window's UI sets its own state after it (Dear ImGui's GL3 backend does).
+//   - Options (spp, AOVs, geometry, skin) are fixed at construction.
+//
+// From a window (the studio), on its GL thread:
+//   GlRenderer renderer(scene, options);                  // once per scene (new plants: a new one)
+//   GlTextureTarget image(w, h, GlTextureTarget::Format::rgba8);
+//   per frame:  scene.width = w, scene.height = h; image.resize(w, h);
+//               renderer.draw(scene, image.target());     // returns at once
+//               ImGui::Image((ImTextureID)(intptr_t)image.texture(), {w, h}, {0, 1}, {1, 0});
+//               if (auto timed = renderer.timed_frame()) stats = *timed;  // GPU ms, a frame late
+// or renderer.draw(scene, GlTarget{0, w, h, GlTargetEncoding::srgb}) into the back buffer.
 class GlRenderer {
  public:
+  // Preconditions: every plant's skeleton is set. Throws GlError (gl_unsupported's cases
+  // included), std::logic_error for a plant without a skeleton.
   GlRenderer(const Scene& scene, const RenderOptions& options);
   ~GlRenderer();
   GlRenderer(const GlRenderer&) = delete;
   GlRenderer& operator=(const GlRenderer&) = delete;
 
-  // Renders the camera, image size, sun, sky and ground of `scene` over the uploaded
-  // plants (the plants of `scene` are not read again). Passes carry GPU time from
-  // GL_TIME_ELAPSED queries where the name says "(GPU)".
+  // ---- Frames ---------------------------------------------------------------------------
+  // Draws one frame of `scene` (its camera, image size, sun, sky and ground; its plants are
+  // not read: they are the ones uploaded) into the renderer's own targets, and, given a
+  // target, presents it there (gl_target.h; the target's size must be the scene's, else
+  // std::invalid_argument). Returns once the work is submitted: no glFinish, no readback,
+  // no wait on a query. The stats returned (valid until the next draw) have everything but
+  // the GPU times; those follow through timed_frame or wait_for_frame. RenderOptions::cancel
+  // is checked between samples (stats.cancelled).
+  const GlFrameStats& draw(const Scene& scene);
+  const GlFrameStats& draw(const Scene& scene, const GlTarget& target);
+
+  // The last drawn frame: beauty (the shade passes' sum ÷ spp, RGBA with alpha 1) and the
+  // AOVs of RenderOptions::aovs (at the pixel centres), top row first, as render_cpu gives
+  // them. Waits for the GPU to finish the frame. Throws std::logic_error before any draw.
+  RenderImage read_back();
+
+  // The newest frame whose GPU times have arrived since the last call, without waiting
+  // (usually the frame before the last, or an older one); nullopt when none has.
+  std::optional<GlFrameStats> timed_frame();
+  // The last drawn frame's stats with its GPU times, waiting for the GPU to answer (what
+  // the CLI and `bench gpu` do after each frame). Throws std::logic_error before any draw.
+  const GlFrameStats& wait_for_frame();
+
+  // One frame as the CLI and render_gl() need it: draw(scene), wait_for_frame, read_back.
+  // Passes: describe_frame's, then "readback" (the transfer alone) and "frame (wall)".
   RenderResult render(const Scene& scene);
 
+  // ---- Plants and variants ----------------------------------------------------------------
   // Animation (paper 000 sec. 4, the dancing cacti): re-skins the plants of `scene` — the
   // same plants as the constructor's, their skeletons moved — and re-uploads only the
-  // segment records (the ids too where the number of frusta changed). Returns the bytes
-  // uploaded. Throws std::invalid_argument for a different number of plants.
+  // segment records (the ids too where the number of frusta changed; the polygon baseline
+  // its whole mesh). Returns the bytes uploaded (the next frame's plant_bytes_uploaded).
+  // Throws std::invalid_argument for a different number of plants.
   uint64_t update_plants(const Scene& scene);
 
   // Whether the frusta programs declare conservative depth (layout(depth_less) /
   // depth_greater, frusta.frag.glsl; default true): false builds the NO_CONSERVATIVE_DEPTH
-  // variants from the next render on, the same pictures, for timing what early depth
+  // variants from the next frame on, the same pictures, for timing what early depth
   // testing is worth.
   void set_conservative_depth(bool on);
 
   uint64_t frusta() const;          // frusta uploaded
-  uint64_t uploaded_bytes() const;  // bytes in the segment and id buffers
-  // What was done once: "skin", "upload", "programs" (compile and link).
+  uint64_t uploaded_bytes() const;  // bytes in the segment and id buffers (or the mesh's)
+  // What was done once: "textures", "skin", "upload", "programs" (compile and link); the
+  // mesh's own for GeometryKind::mesh.
   const std::vector<RenderPass>& setup_passes() const;
 
  private:
-  struct State;
+  struct State;  // what was uploaded, the programs, targets and timers (render_gl.cpp)
+  struct Frame;  // one frame's views, programs and stats while it is recorded
+
+  // The passes of draw(), in order; each is timed as its GlPass.
+  void begin_frame(const Scene& scene, Frame& f);                // targets, views, programs, uniforms
+  void shadow_pass(Frame& f, const glm::dvec3& sun_direction);   // GlPass::shadow
+  void geometry_pass(Frame& f, double jitter_x, double jitter_y);  // GlPass::geometry
+  void shade_pass(Frame& f, const glm::dvec3& sun_direction);    // GlPass::shade
+  void present_pass(Frame& f, const GlTarget& target);           // GlPass::present
+  void end_frame(Frame& f);                                      // submit, stats
+  const GlFrameStats& draw_frame(const Scene& scene, const GlTarget* target);
+  void take_timed_frames(bool wait);
+
   std::unique_ptr<State> state_;
 };
 
 // Renders `scene` on the current context: GlRenderer(scene, options).render(scene), with
-// the setup passes first. Throws GlError (gl_unsupported's reason included).
-RenderResult render_gl(const Scene& scene, const RenderOptions& options);
+// the setup passes first; the frame's stats (GPU times in) go to *stats when given.
+// Throws GlError (gl_unsupported's reason included).
+RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrameStats* stats = nullptr);
 
 }  // namespace sylva

@@ -1,0 +1,117 @@
+// bindings.h — the C++ side of shaders/bindings.glsl: every shader storage binding point
+// and texture unit of the GL backend, the constants C++ and GLSL must agree on, and the C++
+// mirrors of the records the shaders read, their layouts pinned by static_assert.
+// bindings.glsl's SEGMENTS_BINDING is kSegmentsBinding here, and so on;
+// tests/gl/gl_bindings_test.cpp compares every #define of bindings.glsl with kGlslConstants
+// and asks the driver for each binding and for the offsets and strides of every record
+// below, so a change on one side alone fails a test.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "core/materials.h"
+#include "core/skin.h"
+
+namespace sylva::gl {
+
+// Shader storage buffers (std430), by binding point.
+inline constexpr uint32_t kSegmentsBinding = 0;      // GpuSegment per frustum (skin.h)
+inline constexpr uint32_t kSegmentIdsBinding = 1;    // uint32 plant, chain, segment, 0 per frustum
+inline constexpr uint32_t kSegmentListBinding = 2;   // uint32 frustum indices, EYE_INSIDE, per frame
+inline constexpr uint32_t kPlantBarkBinding = 3;     // PlantBarkRecord per plant
+inline constexpr uint32_t kPlantMapsBinding = 4;     // PlantMapsRecord per plant
+inline constexpr uint32_t kHeightTexelsBinding = 5;  // float height texels
+inline constexpr uint32_t kMeshFrustaBinding = 6;    // MeshFrustumRecord per frustum (gl_mesh.h)
+
+// Texture units.
+inline constexpr uint32_t kBarkTexturesUnit = 0;  // bark image i at kBarkTexturesUnit + i
+inline constexpr uint32_t kGNormalDistanceUnit = 16;
+inline constexpr uint32_t kGGeometricUUnit = 17;
+inline constexpr uint32_t kGIdsUnit = 18;
+inline constexpr uint32_t kGAlbedoUnit = 19;
+inline constexpr uint32_t kShadowMapUnit = 20;
+inline constexpr uint32_t kAccumulationUnit = 21;
+
+// Constants.
+inline constexpr uint32_t kMaxBarkImages = 16;  // GL 4.5 guarantees 16 texture units a stage
+inline constexpr uint32_t kMaxMaterials = 16;   // shade.frag.glsl's u_material_albedo
+inline constexpr uint32_t kPlantIndexBits = 24;  // G-buffer ids.x = plant | material << 24
+inline constexpr uint32_t kPlantIndexMask = (1u << kPlantIndexBits) - 1;
+inline constexpr uint32_t kMaxPlants = 1u << kPlantIndexBits;
+inline constexpr uint32_t kPyramidVertices = 36;  // vertex pulling: 36 vertices a frustum
+
+static_assert(kBarkTexturesUnit + kMaxBarkImages <= kGNormalDistanceUnit,
+              "the bark images' units must not reach the G-buffer's");
+static_assert(kMaterialTableSize <= kMaxMaterials, "materials.h's table must fit shade.frag.glsl's");
+// The material index is 8 bits in a GpuSegment (skin.h) and in the G-buffer's ids.x.
+static_assert(kPlantIndexBits + 8 <= 32);
+
+// bindings.glsl's #defines with their values, for the test that keeps the two in step.
+struct GlslConstant {
+  const char* name;
+  uint32_t value;
+};
+inline constexpr GlslConstant kGlslConstants[] = {
+    {"SEGMENTS_BINDING", kSegmentsBinding},
+    {"SEGMENT_IDS_BINDING", kSegmentIdsBinding},
+    {"SEGMENT_LIST_BINDING", kSegmentListBinding},
+    {"PLANT_BARK_BINDING", kPlantBarkBinding},
+    {"PLANT_MAPS_BINDING", kPlantMapsBinding},
+    {"HEIGHT_TEXELS_BINDING", kHeightTexelsBinding},
+    {"MESH_FRUSTA_BINDING", kMeshFrustaBinding},
+    {"BARK_TEXTURES_UNIT", kBarkTexturesUnit},
+    {"G_NORMAL_DISTANCE_UNIT", kGNormalDistanceUnit},
+    {"G_GEOMETRIC_U_UNIT", kGGeometricUUnit},
+    {"G_IDS_UNIT", kGIdsUnit},
+    {"G_ALBEDO_UNIT", kGAlbedoUnit},
+    {"SHADOW_MAP_UNIT", kShadowMapUnit},
+    {"ACCUMULATION_UNIT", kAccumulationUnit},
+    {"MAX_BARK_IMAGES", kMaxBarkImages},
+    {"MAX_MATERIALS", kMaxMaterials},
+    {"PLANT_INDEX_BITS", kPlantIndexBits},
+    {"PLANT_INDEX_MASK", kPlantIndexMask},
+    {"PYRAMID_VERTICES", kPyramidVertices},
+};
+
+// ---- Records (std430 arrays in shader storage) ----------------------------------------
+
+// The frusta's records are skin.h's GpuSegment (64 bytes, skin.glsl's twin) and four
+// uint32 ids a frustum.
+static_assert(sizeof(GpuSegment) == 64);
+
+// shade.frag.glsl's plant_bark[plant]: the bark colour (Bark::albedo_rgb), w = 1 where it
+// replaces material 0.
+struct PlantBarkRecord {
+  float rgb[3] = {0, 0, 0};
+  float replaces_material0 = 0;
+};
+static_assert(sizeof(PlantBarkRecord) == 16);
+
+// bark.glsl's PlantMaps: per plant, its bark textures' parameters.
+struct PlantMapsRecord {
+  float u_repeat = 1, v_per_metre = 1, relief_depth_m = 0;
+  int32_t albedo_unit = -1, height_unit = -1;  // index into u_bark_textures; −1: none
+  uint32_t height_first = 0;                   // first texel in HeightTexels
+  int32_t height_width = 1, height_height = 1;
+};
+static_assert(sizeof(PlantMapsRecord) == 32 && offsetof(PlantMapsRecord, albedo_unit) == 12 &&
+              offsetof(PlantMapsRecord, height_first) == 20 && offsetof(PlantMapsRecord, height_height) == 28);
+
+// mesh.vert.glsl's MeshFrustum (std430: vec4, uvec4).
+struct MeshFrustumRecord {
+  float origin_hi[4];  // the plant's origin, float-exact; w unused
+  uint32_t ids[4];     // plant | material << kPlantIndexBits, chain, segment, 0
+};
+static_assert(sizeof(MeshFrustumRecord) == 32 && offsetof(MeshFrustumRecord, ids) == 16);
+
+// ---- Uniform blocks (std140): none ----------------------------------------------------
+// The views every geometry pass draws in (views.glsl: the camera, the sun's orthographic
+// view) and the shading parameters are default-block uniforms, set by name per program
+// (gl_views.h, gl_program.h). A std140 block for the views was built and measured: on
+// llvmpipe the same values read from a uniform block compile to different float code (ulp
+// differences in depth, normals and a few pixels), and the GL backend's pictures must stay
+// byte-identical across such a refactor. A block added later gets its binding here, its
+// std140 mirror struct with static_asserts on its offsets, and a line in the layout test.
+
+}  // namespace sylva::gl

@@ -1,0 +1,37 @@
+// bindings.glsl — where the GL backend's shaders meet its C++: every shader storage binding
+// point, texture unit and uniform block, and the constants both sides must agree on.
+// core/gl/bindings.h mirrors each line (its names: SEGMENTS_BINDING is kSegmentsBinding);
+// tests/gl/gl_bindings_test.cpp checks the #defines against it and asks the driver for the
+// records' layouts and every binding. gl_shaders.cpp puts this file at the head of every stage,
+// so every shader file may use these names.
+
+// Shader storage buffers (std430), by binding point.
+#define SEGMENTS_BINDING 0        // frusta_common.glsl Segments: a GpuSegment per frustum (skin.glsl)
+#define SEGMENT_IDS_BINDING 1     // frusta_common.glsl SegmentIds: plant, chain, segment, 0 per frustum
+#define SEGMENT_LIST_BINDING 2    // frusta_common.glsl SegmentList: EYE_INSIDE's frusta, this frame
+#define PLANT_BARK_BINDING 3      // shade.frag.glsl PlantBark: a bark colour per plant
+#define PLANT_MAPS_BINDING 4      // bark.glsl PlantMapsBuffer: a PlantMaps per plant
+#define HEIGHT_TEXELS_BINDING 5   // bark.glsl HeightTexels: height maps' finest levels
+#define MESH_FRUSTA_BINDING 6     // mesh.vert.glsl MeshFrusta: a MeshFrustum per frustum
+
+// Texture units. Bark images take units BARK_TEXTURES_UNIT .. + MAX_BARK_IMAGES − 1; the
+// G-buffer, the shadow map and the accumulated beauty sit above them, so no pass rebinds
+// another's textures.
+#define BARK_TEXTURES_UNIT 0      // bark.glsl u_bark_textures[i]
+#define G_NORMAL_DISTANCE_UNIT 16 // shade.frag.glsl g_normal_distance (G-buffer attachment 0)
+#define G_GEOMETRIC_U_UNIT 17     // g_geometric_u (attachment 1)
+#define G_IDS_UNIT 18             // g_ids (attachment 2)
+#define G_ALBEDO_UNIT 19          // g_albedo (attachment 3)
+#define SHADOW_MAP_UNIT 20        // shade.frag.glsl shadow_map
+#define ACCUMULATION_UNIT 21      // present.frag.glsl u_accumulation
+
+// Constants.
+#define MAX_BARK_IMAGES 16        // distinct bark images a scene may bind (GL 4.5 guarantees 16 units a stage)
+#define MAX_MATERIALS 16          // shade.frag.glsl's material table (materials.h fills it)
+#define PLANT_INDEX_BITS 24       // G-buffer ids.x: plant | material << PLANT_INDEX_BITS
+#define PLANT_INDEX_MASK 0xFFFFFFu
+#define PYRAMID_VERTICES 36       // a frustum's bounding pyramid: 12 triangles (skin.glsl)
+
+// Uniform blocks (std140): none. The views (views.glsl's camera and sun uniforms) and the
+// shading parameters are default-block uniforms set by name (core/gl/gl_views.h,
+// gl_program.h); bindings.h says why they are not a block.
