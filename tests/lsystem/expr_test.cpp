@@ -126,7 +126,7 @@ TEST(ExpressionErrors, DeepNestingIsAnErrorNotAStackOverflow) {
 
 TEST(ExpressionErrors, DerivationErrorsNameTheProductionAndTheModule) {
   auto g = testing::parse_ok("axiom: A(2)\np1: A(x) -> A(x-1)B(1/x)\n");
-  auto w = derive(g, DeriveOptions{3, std::nullopt, 1000});
+  auto w = derive(g, DeriveOptions{3, std::nullopt, 1000, {}});
   ASSERT_FALSE(w.ok());
   const Diagnostic& d = w.error();
   EXPECT_EQ(d.loc.line, 2u);

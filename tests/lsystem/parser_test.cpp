@@ -94,7 +94,7 @@ TEST(ModuleNames, UndeclaredNamesAreOneCharacterEachIncludingUtf8) {
 }
 
 TEST(ModuleNames, MultiCharacterModulesRewriteLikeAnyOther) {
-  EXPECT_EQ(derive_text("module: Apex Leaf\naxiom: Apex\nApex -> F[Leaf]Apex\n", DeriveOptions{2, {}, 1000}),
+  EXPECT_EQ(derive_text("module: Apex Leaf\naxiom: Apex\nApex -> F[Leaf]Apex\n", DeriveOptions{2, {}, 1000, {}}),
             "F[Leaf]F[Leaf]Apex");
 }
 
