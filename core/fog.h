@@ -106,8 +106,7 @@ double fog_transmittance_of_depth(double depth);
 double fog_density(const FogMedium& medium, double y);
 
 // The part of [t0, t1] (t0 <= t1, t1 may be +inf) where origin + t·direction lies at or
-// below top. Empty when t1_clipped <= t0_clipped (then both are t0 … either way, test
-// `empty`).
+// below top; `empty` when there is none (t0, t1 are then meaningless).
 struct FogClip {
   double t0 = 0, t1 = 0;
   bool empty = true;
@@ -119,7 +118,8 @@ FogClip fog_clip_to_top(const FogMedium& medium, const glm::dvec3& origin, const
 // in closed form for every h >= 0, accurate as the segment becomes horizontal:
 //   τ = σ_t·ρ(y_low)·exp_integral(L, h·|d_y|)
 // with L the length of the part below top and y_low its lower end (where ρ is largest).
-// Result in [0, +inf] (+inf only for an unbounded homogeneous ray).
+// Result in [0, +inf]: a ray that never leaves the fog (unbounded and homogeneous, or
+// horizontal) gets a depth far beyond kFogMaxDepth (lengths are clamped to kFogFar), T = 0.
 double fog_optical_depth(const FogMedium& medium, const glm::dvec3& origin, const glm::dvec3& direction,
                          double t0, double t1);
 
