@@ -29,6 +29,7 @@ ImageWriteResult write_render(const std::string& path, const RenderImage& image)
       {"normal", &image.normal, {"N.X", "N.Y", "N.Z"}},
       {"uv", &image.uv, {"U", "V"}},
       {"id", &image.id, {"id.plant", "id.chain", "id.segment"}},
+      {"fog", &image.fog, {"fog.R", "fog.G", "fog.B", "fog.T"}},
   };
 
   if (ext == ".exr") {

@@ -3,12 +3,13 @@
 //
 // Encodings by the target's extension:
 //   .exr             linear; beauty R G B A as half, AOVs as extra float channels in the
-//                    same file (Z; N.X N.Y N.Z; U V; id.plant id.chain id.segment)
+//                    same file (Z; N.X N.Y N.Z; U V; id.plant id.chain id.segment;
+//                    fog.R fog.G fog.B fog.T)
 //   .hdr .pfm .tif .tiff   linear float beauty; AOVs in side files as for a PNG
 //   anything else OIIO writes (.png, .jpg, ...)   8-bit sRGB-encoded beauty; each AOV
 //                    goes to its own EXR next to it, named after the image without its
 //                    extension: saguaro.png → saguaro.depth.exr, saguaro.normal.exr,
-//                    saguaro.uv.exr, saguaro.id.exr
+//                    saguaro.uv.exr, saguaro.id.exr, saguaro.fog.exr
 #pragma once
 
 #include <optional>

@@ -3,15 +3,20 @@
 // images and the passes it ran. No renderer's code is needed to read or write them.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/relief.h"
+#include "core/scene.h"
 #include "core/skin.h"
 
 namespace sylva {
+
+class FogConeSource;  // core/fog_integrator.h
 
 // Which AOVs to compute (bit flags).
 enum AovFlags : uint32_t {
@@ -19,6 +24,7 @@ enum AovFlags : uint32_t {
   kAovNormal = 1u << 1,  // N.X N.Y N.Z
   kAovUv = 1u << 2,      // U V
   kAovId = 1u << 3,      // id.plant id.chain id.segment
+  kAovFog = 1u << 4,     // fog.R fog.G fog.B fog.T (spec/fog.md, "Outputs")
 };
 
 // Which geometry stands for the plants (issue 3: the analytic frusta are the reference,
@@ -40,6 +46,19 @@ struct GeometryOptions {
   ReliefOptions relief_options;  // how the relief marcher samples
 };
 
+// How a scene's fog is rendered (spec/fog.md); every field overrides the scene's `fog` key
+// of the same name, and none matters without one.
+struct FogRenderOptions {
+  std::optional<FogMode> mode;     // --fog-mode
+  std::optional<uint32_t> steps;   // --fog-steps, 1 to kFogMaxSteps
+  std::optional<uint64_t> photons; // --photons, 1 to kFogMaxPhotons (for the cones)
+  std::optional<std::array<uint32_t, 4>> cone_params;  // --cone-params p1,p2,p3,p4; nullopt: auto
+  // Shadow cones already built for this scene's plants and sun (viewpoint independent, so
+  // one set serves every camera and frame); null: the renderer has none (fog_integrator.h
+  // says what each mode then does).
+  const FogConeSource* cones = nullptr;
+};
+
 struct RenderOptions {
   uint32_t spp = 1;                             // samples per pixel, >= 1
   uint32_t aovs = 0;                            // AovFlags
@@ -48,6 +67,7 @@ struct RenderOptions {
   bool progress = false;                        // progress bar on stderr after 1 s
   SkinOptions skin;                             // how plants are skinned
   GeometryOptions geometry;                     // what stands for the plants
+  FogRenderOptions fog;                         // how the scene's fog is rendered
 };
 
 // Float images, row-major from the top-left pixel, channels interleaved.
@@ -58,6 +78,7 @@ struct RenderImage {
   std::vector<float> normal;  // N.X N.Y N.Z; empty unless kAovNormal
   std::vector<float> uv;      // U V; empty unless kAovUv
   std::vector<float> id;      // id.plant id.chain id.segment; empty unless kAovId
+  std::vector<float> fog;     // fog.R fog.G fog.B fog.T; empty unless kAovFog (and the scene has fog)
 };
 
 // One pass of the render and what it cost.

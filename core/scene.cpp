@@ -3,12 +3,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <limits>
 #include <numbers>
 
+#include "core/fog.h"
 #include "core/util/file_io.h"
 #include "core/util/json.h"
 #include "core/util/image_io.h"
@@ -17,6 +19,25 @@
 #include "lsystem/grammar.h"
 
 namespace sylva {
+
+const char* fog_mode_name(FogMode mode) {
+  switch (mode) {
+    case FogMode::automatic: return "auto";
+    case FogMode::brute: return "brute";
+    case FogMode::medium: return "medium";
+    case FogMode::fast: return "fast";
+    case FogMode::refined: return "refined";
+    case FogMode::reference: return "reference";
+  }
+  return "auto";
+}
+
+std::optional<FogMode> fog_mode_from_name(std::string_view name) {
+  for (FogMode m : {FogMode::automatic, FogMode::brute, FogMode::medium, FogMode::fast, FogMode::refined,
+                    FogMode::reference})
+    if (name == fog_mode_name(m)) return m;
+  return std::nullopt;
+}
 
 std::string SceneError::format() const {
   std::string out = file;
@@ -195,6 +216,73 @@ ScenePlant read_plant(const JsonValue& v, const std::string& base_dir, size_t in
   return p;
 }
 
+// The `fog` object (spec/fog.md). Every key out of range is reported at the key (its line
+// and column), so the message points at what to change.
+Fog read_fog(const JsonValue& v, double ground_height) {
+  expect_object(v, "fog");
+  check_keys(v, "fog", {"sigma_s", "sigma_a", "g", "height_falloff", "top", "mode", "steps", "photons"});
+  Fog f;
+  for (const JsonMember& m : v.members) {
+    const std::string& key = m.key.name;
+    const JsonValue& value = m.value;
+    const std::string what = "fog." + key;
+    auto at_key = [&](const std::string& message) -> Located { return Located{m.key.line, m.key.column, message}; };
+    // What the file says, for the message: a number's source text, a quoted string, a kind.
+    const std::string shown = value.is_number()   ? value.text
+                              : value.is_string() ? json_excerpt(value.text)
+                                                  : std::string(value.kind_name());
+    auto coefficient = [&]() {
+      if (!value.is_number()) throw at_key(what + " must be a number, not " + value.kind_name());
+      if (!(value.number >= 0 && value.number <= 1e6))
+        throw at_key(what + " must be in [0, 1e+06] per metre, not " + value.text);
+      return value.number;
+    };
+    if (key == "sigma_s") {
+      f.sigma_s = coefficient();
+    } else if (key == "sigma_a") {
+      f.sigma_a = coefficient();
+    } else if (key == "height_falloff") {
+      f.height_falloff = coefficient();
+    } else if (key == "g") {
+      if (!value.is_number()) throw at_key(what + " must be a number, not " + value.kind_name());
+      // Beyond ±g* Schlick's k = 1.55g − 0.55g³ leaves (−1, 1) and the phase function is no
+      // longer a distribution (fog.h); g = ±1 itself is a delta.
+      if (!(std::abs(value.number) < kFogMaxAbsG)) {
+        char range[64];
+        std::snprintf(range, sizeof range, "(-%.6f, %.6f)", kFogMaxAbsG, kFogMaxAbsG);
+        throw at_key(what + " must be in " + range + ", where Schlick's k = 1.55g - 0.55g^3 stays inside (-1, 1), not " +
+                     value.text);
+      }
+      f.g = value.number;
+    } else if (key == "top") {
+      if (!value.is_number()) throw at_key(what + " must be a number (world y, metres), not " + value.kind_name());
+      if (!(value.number > ground_height)) {
+        char ground[64];
+        std::snprintf(ground, sizeof ground, "%g", ground_height);
+        throw at_key(what + " " + value.text + " must be above the ground (ground.height " + ground + ")");
+      }
+      f.top = value.number;
+    } else if (key == "mode") {
+      const std::optional<FogMode> mode = value.is_string() ? fog_mode_from_name(value.text) : std::nullopt;
+      if (!mode)
+        throw at_key(what + " must be one of \"auto\", \"brute\", \"medium\", \"fast\", \"refined\", \"reference\", not " +
+                     shown);
+      f.mode = *mode;
+    } else if (key == "steps") {
+      const auto n = value.as_uint64();
+      if (!n || *n == 0 || *n > kFogMaxSteps)
+        throw at_key(what + " must be an integer from 1 to " + std::to_string(kFogMaxSteps) + ", not " + shown);
+      f.steps = static_cast<uint32_t>(*n);
+    } else if (key == "photons") {
+      const auto n = value.as_uint64();
+      if (!n || *n == 0 || *n > kFogMaxPhotons)
+        throw at_key(what + " must be an integer from 1 to " + std::to_string(kFogMaxPhotons) + ", not " + shown);
+      f.photons = *n;
+    }
+  }
+  return f;
+}
+
 Scene read_scene(const JsonValue& root, const std::string& base_dir) {
   expect_object(root, "a scene");
   check_keys(root, "the scene",
@@ -220,16 +308,7 @@ Scene read_scene(const JsonValue& root, const std::string& base_dir) {
     if (auto* h = x->find("height")) s.ground.height = number(*h, "ground.height");
     if (auto* a = x->find("albedo")) s.ground.albedo = colour(*a, "ground.albedo");
   }
-  if (auto* x = root.find("fog")) {
-    expect_object(*x, "fog");
-    check_keys(*x, "fog", {"sigma_s", "sigma_a", "g", "height_falloff"});
-    Fog f;
-    if (auto* y = x->find("sigma_s")) f.sigma_s = number_in(*y, "fog.sigma_s", 0, 1e6, false, false);
-    if (auto* y = x->find("sigma_a")) f.sigma_a = number_in(*y, "fog.sigma_a", 0, 1e6, false, false);
-    if (auto* y = x->find("g")) f.g = number_in(*y, "fog.g", -1, 1, true, true);
-    if (auto* y = x->find("height_falloff")) f.height_falloff = number_in(*y, "fog.height_falloff", 0, 1e6, false, false);
-    s.fog = f;
-  }
+  if (auto* x = root.find("fog")) s.fog = read_fog(*x, s.ground.height);
   const JsonValue* plants = root.find("plants");
   if (!plants) fail(root, "a scene needs \"plants\" (an array of plants)");
   if (!plants->is_array()) fail(*plants, std::string("plants must be an array, not ") + plants->kind_name());

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -45,13 +46,38 @@ struct Ground {
   glm::dvec3 albedo{0.35, 0.3, 0.25};
 };
 
-// Participating media. Parsed and kept; not rendered yet.
-struct Fog {
-  double sigma_s = 0.05;         // scattering coefficient, 1/m
-  double sigma_a = 0.005;        // absorption coefficient, 1/m
-  double g = 0.6;                // Henyey–Greenstein asymmetry, (-1, 1)
-  double height_falloff = 0.0;   // 1/m
+// How the fog's single scattering is computed (spec/fog.md, "How the integral is computed";
+// core/fog_integrator.h implements each).
+enum class FogMode : uint8_t {
+  automatic,  // "auto": refined on the CPU
+  brute,      // stratified samples, a shadow ray at each
+  medium,     // the same samples, shadow rays only inside the shadow cones
+  fast,       // no sunlight inside the cones, closed form outside
+  refined,    // the cones' intervals refined to the exact transitions, closed form
+  reference,  // converged: every visibility change bisected, many sun-disc samples
 };
+const char* fog_mode_name(FogMode mode);                          // "auto", "brute", ...
+std::optional<FogMode> fog_mode_from_name(std::string_view name);  // nullopt: not a mode
+
+// The participating medium and how it is rendered (spec/fog.md): density
+// ρ(y) = exp(−height_falloff·(y − ground.height)) up to `top`, 0 above it; σ = coefficient·ρ.
+struct Fog {
+  double sigma_s = 0.05;         // scattering coefficient at the ground, 1/m, >= 0
+  double sigma_a = 0.005;        // absorption coefficient at the ground, 1/m, >= 0
+  double g = 0.6;                // Henyey–Greenstein asymmetry that Schlick's phase approximates,
+                                 // |g| < kFogMaxAbsG (fog.h: where Schlick's |k| reaches 1)
+  double height_falloff = 0.0;   // 1/m, >= 0 (0: homogeneous)
+  double top = std::numeric_limits<double>::infinity();  // world y of the fog's ceiling, above
+                                 // ground.height; +inf (no `top` key): none
+  FogMode mode = FogMode::automatic;
+  uint32_t steps = 64;           // samples along a ray (brute, medium; probes of refined), >= 1
+  uint64_t photons = 1'000'000;  // sun photons for the shadow cones, >= 1
+};
+
+// The most samples along one camera ray (`steps`, --fog-steps) and the most photons
+// (`photons`, --photons) a scene or the command line may ask for.
+constexpr uint32_t kFogMaxSteps = 65536;
+constexpr uint64_t kFogMaxPhotons = 1'000'000'000;
 
 // The bark of a plant. albedo is a texture path or a constant colour. Texture paths are
 // checked when the scene is read: a file that does not exist or that OpenImageIO cannot

@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -24,6 +25,12 @@ namespace sylva::cli {
 namespace {
 
 constexpr int kInterrupted = 130;  // 128 + SIGINT, the shell's convention
+constexpr uint32_t kMaxConeParam = 100000;  // --cone-params: any larger is a typo
+
+// The fog modes that need the shadow cones of sun photons (spec/fog.md). This build has no
+// photon tracer yet (core/cpu/photons.h): they run only from the tests, and auto refines
+// whole rays instead (fog_integrator.h).
+bool needs_cones(FogMode mode) { return mode == FogMode::medium || mode == FogMode::fast || mode == FogMode::refined; }
 
 std::atomic<bool> g_interrupted{false};
 extern "C" void on_sigint(int) { g_interrupted.store(true); }
@@ -32,8 +39,9 @@ static_assert(std::atomic<bool>::is_always_lock_free, "the SIGINT handler needs 
 void print_render_help() {
   std::cout
       << "usage: sylva render INPUT -o IMAGE [--backend auto|gl|cpu] [--width W --height H]\n"
-         "                    [--aov depth,normal,uv,id] [--spp N] [--verbose]\n"
+         "                    [--aov depth,normal,uv,id,fog] [--spp N] [--verbose]\n"
          "                    [--geometry frusta|mesh] [--mesh-level M]\n"
+         "                    [--fog-mode MODE] [--fog-steps N] [--photons N] [--cone-params P]\n"
          "                    [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n\n"
          "Renders INPUT — a .scene.json scene, a .lsys grammar, a .skel.json skeleton or a .glb/.gltf\n"
          "written by `sylva export` (its skeletons are read back from node extras) (all but\n"
@@ -41,17 +49,20 @@ void print_render_help() {
          "camera framing it) — to IMAGE, written atomically. The format follows IMAGE's\n"
          "extension: .png (8-bit sRGB), .exr (linear half, AOVs as extra channels), or any\n"
          "format OpenImageIO writes. For a non-EXR IMAGE each AOV goes to its own EXR next to\n"
-         "it: IMAGE without its extension + .depth.exr, .normal.exr, .uv.exr, .id.exr.\n\n"
+         "it: IMAGE without its extension + .depth.exr, .normal.exr, .uv.exr, .id.exr, .fog.exr.\n\n"
          "  -o, --output IMAGE     the image to write\n"
          "      --backend B        auto (default): OpenGL on a window-less EGL context (the GPU,\n"
          "                         or Mesa's llvmpipe without one), else the CPU ray caster,\n"
          "                         saying why; gl: OpenGL or exit 1 saying why; cpu: the CPU\n"
-         "                         reference (bark textures and relief are CPU-only for now)\n"
+         "                         reference (bark textures, relief and fog are CPU-only for now)\n"
          "      --width W          image width in pixels (default: the scene's, else 1024)\n"
          "      --height H         image height in pixels (default: the scene's, else 768)\n"
          "      --aov LIST         extra outputs, comma-separated: depth (channel Z, distance\n"
          "                         from the eye, +inf on a miss), normal (N.X N.Y N.Z),\n"
-         "                         uv (U V), id (id.plant id.chain id.segment)\n"
+         "                         uv (U V), id (id.plant id.chain id.segment), fog (a scene\n"
+         "                         with fog: fog.R fog.G fog.B, the light the fog scatters\n"
+         "                         toward the eye, and fog.T, the transmittance to what the\n"
+         "                         pixel's centre sees: beauty = fog.T x surface + fog.RGB)\n"
          "      --spp N            samples per pixel, stratified (default 1: pixel centres)\n"
          "      --verbose          list the passes that ran and what each cost\n"
          "      --geometry G       what stands for the plants: frusta (default: the exact\n"
@@ -60,6 +71,19 @@ void print_render_help() {
          "                         gives them)\n"
          "      --mesh-level M     the mesh's subdivision level, 0 to 6: 16·4^M triangles per\n"
          "                         segment (default 2)\n"
+         "a scene with fog only (each overrides the scene's fog key of the same name):\n"
+         "      --fog-mode MODE    how the light the fog scatters is computed: auto (default:\n"
+         "                         refined), brute (ray marching, a shadow ray per sample),\n"
+         "                         reference (converged: every shadow edge bisected, 16 sun-\n"
+         "                         disc points); medium, fast and refined use the shadow cones\n"
+         "                         of sun photons, which this build cannot make yet (auto then\n"
+         "                         refines whole rays)\n"
+         "      --fog-steps N      samples along each ray, 1 to " << kFogMaxSteps << " (default 64)\n"
+         "      --photons N        sun photons for the shadow cones, 1 to " << kFogMaxPhotons << "\n"
+         "                         (default 1000000)\n"
+         "      --cone-params P    the cones' clustering: p1,p2,p3,p4 (neighbours >= p3 + 1,\n"
+         "                         sectors >= 2, vectors per ring >= 1, least vectors per cone\n"
+         "                         >= 1; each at most " << kMaxConeParam << ") or auto (default)\n"
          "grammar input only:\n"
          "  -n, --steps N          derivation steps (overrides 'derivation length:')\n"
          "      --seed S           random seed, an integer from 0 to 2^64-1\n"
@@ -78,6 +102,8 @@ struct RenderArgs {
   uint32_t spp = 1;
   bool verbose = false;
   GeometryOptions geometry;
+  FogRenderOptions fog;        // --fog-mode, --fog-steps, --photons, --cone-params
+  bool fog_flags = false;      // any of them given
   bool grammar_flags = false;  // -n, --seed, -D or --max-modules given
 };
 
@@ -86,6 +112,27 @@ uint32_t parse_size(const std::string& flag, const std::string& v, uint32_t max)
   if (!n || *n == 0 || *n > max)
     throw UsageError{flag + " " + v + ": expected an integer from 1 to " + std::to_string(max)};
   return static_cast<uint32_t>(*n);
+}
+
+// --cone-params p1,p2,p3,p4 (paper 002 sec. 3.2.1) or auto (nullopt): four integers with
+// p1 >= p3 + 1 (a ring needs its seed and p3 neighbours), p2 >= 2, p3 >= 1, p4 >= 1.
+std::optional<std::array<uint32_t, 4>> parse_cone_params(const std::string& v) {
+  if (v == "auto") return std::nullopt;
+  const std::string expected = "--cone-params " + v +
+                               ": expected auto or p1,p2,p3,p4: integers with p1 >= p3 + 1, p2 >= 2, p3 >= 1, "
+                               "p4 >= 1, each at most " + std::to_string(kMaxConeParam);
+  std::array<uint32_t, 4> p{};
+  size_t start = 0;
+  for (int k = 0; k < 4; ++k) {
+    const size_t comma = v.find(',', start);
+    if ((k < 3) != (comma != std::string::npos)) throw UsageError{expected};
+    auto n = parse_u64(v.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (!n || *n > kMaxConeParam) throw UsageError{expected};
+    p[k] = static_cast<uint32_t>(*n);
+    start = comma + 1;
+  }
+  if (p[0] < p[2] + 1 || p[1] < 2 || p[2] < 1 || p[3] < 1) throw UsageError{expected};
+  return p;
 }
 
 RenderArgs parse_render_args(const std::vector<std::string>& args) {
@@ -124,7 +171,8 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
         else if (name == "normal") out.aovs |= kAovNormal;
         else if (name == "uv") out.aovs |= kAovUv;
         else if (name == "id") out.aovs |= kAovId;
-        else throw UsageError{"--aov: unknown AOV '" + name + "' (expected depth, normal, uv or id)"};
+        else if (name == "fog") out.aovs |= kAovFog;
+        else throw UsageError{"--aov: unknown AOV '" + name + "' (expected depth, normal, uv, id or fog)"};
         if (comma == std::string::npos) break;
         start = comma + 1;
       }
@@ -138,6 +186,29 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
       auto n = parse_u64(v);
       if (!n || *n > 6) throw UsageError{"--mesh-level " + v + ": expected an integer from 0 to 6"};
       out.geometry.mesh_level = static_cast<int>(*n);
+    } else if (a == "--fog-mode") {
+      const std::string v = value();
+      const std::optional<FogMode> mode = fog_mode_from_name(v);
+      if (!mode) throw UsageError{"--fog-mode " + v + ": expected auto, brute, medium, fast, refined or reference"};
+      if (needs_cones(*mode))
+        throw UsageError{"--fog-mode " + v +
+                         ": needs the shadow cones of sun photons, which this build cannot make yet "
+                         "(use auto, brute or reference)"};
+      out.fog.mode = *mode;
+      out.fog_flags = true;
+    } else if (a == "--fog-steps") {
+      out.fog.steps = parse_size(a, value(), kFogMaxSteps);
+      out.fog_flags = true;
+    } else if (a == "--photons") {
+      const std::string v = value();
+      auto n = parse_u64(v);
+      if (!n || *n == 0 || *n > kFogMaxPhotons)
+        throw UsageError{"--photons " + v + ": expected an integer from 1 to " + std::to_string(kFogMaxPhotons)};
+      out.fog.photons = *n;
+      out.fog_flags = true;
+    } else if (a == "--cone-params") {
+      out.fog.cone_params = parse_cone_params(value());
+      out.fog_flags = true;
     } else if (a == "--verbose" || a == "-v") {
       out.verbose = true;
     } else {
@@ -203,11 +274,21 @@ int run_render(const std::vector<std::string>& args) {
   if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
   Scene scene = std::move(std::get<Scene>(loaded));
   auto start = std::chrono::steady_clock::now();
+  if (!scene.fog && (a.fog_flags || (a.aovs & kAovFog)))
+    throw UsageError{"--fog-mode, --fog-steps, --photons, --cone-params and --aov fog apply to a scene with fog "
+                     "only ('" + input + "' has no fog key)"};
+  if (scene.fog && !a.fog.mode && needs_cones(scene.fog->mode)) {
+    std::cerr << input << ": error: fog.mode \"" << fog_mode_name(scene.fog->mode)
+              << "\" needs the shadow cones of sun photons, which this build cannot make yet (use auto, brute or "
+                 "reference, or --fog-mode)\n";
+    return kInputError;
+  }
 
   RenderOptions options;
   options.spp = a.spp;
   options.aovs = a.aovs;
   options.geometry = a.geometry;
+  options.fog = a.fog;
   options.cancel = &g_interrupted;
   options.progress = ::isatty(STDERR_FILENO) == 1;
   // The backend (cli.md): gl, or for auto OpenGL where a context can be made and the scene
@@ -218,7 +299,10 @@ int run_render(const std::vector<std::string>& args) {
   if (a.backend != "cpu") {
     std::string why_not;
     const char* fallback = "OpenGL unavailable";
-    if (auto unsupported = gl_unsupported(scene, options)) {
+    if (scene.fog) {
+      why_not = "fog is rendered by the CPU ray caster only, for now";
+      fallback = "the OpenGL backend cannot draw this";
+    } else if (auto unsupported = gl_unsupported(scene, options)) {
       why_not = *unsupported;
       fallback = "the OpenGL backend cannot draw this";
     } else {
@@ -266,7 +350,7 @@ int run_render(const std::vector<std::string>& args) {
 
   if (a.verbose) {
     std::cerr << "sylva render: " << scene.width << "x" << scene.height << ", " << a.spp << " spp, " << backend_name
-              << (scene.fog ? "; fog is parsed but not rendered in this version" : "") << "\n";
+              << (scene.fog ? "; fog without shadow cones (this build traces no sun photons)" : "") << "\n";
     auto print = [](const char* name, double seconds, const std::string& detail) {
       char line[256];
       std::snprintf(line, sizeof line, "  %-22s %9.3f ms", name, seconds * 1e3);

@@ -3,6 +3,8 @@
 #include "core/plant_mesh.h"
 
 #include "core/culling.h"
+#include "core/fog.h"
+#include "core/fog_integrator.h"
 #include "core/cpu/frustum_tracer.h"
 #include "core/cpu/mesh_accel.h"
 #include "core/render_common.h"
@@ -20,6 +22,7 @@
 #include <limits>
 #include <mutex>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -59,16 +62,29 @@ struct PrimaryHit {
   uint64_t rng_state = 0;
 };
 
+// What a tile's work cost, summed over its samples (thread time).
+struct TileCost {
+  double trace_s = 0, shade_s = 0, fog_s = 0;
+  uint64_t shadow_rays = 0;      // the surfaces' shadow rays
+  uint64_t fog_rays = 0;         // camera rays integrated through the fog
+  uint64_t fog_shadow_rays = 0;  // the fog's shadow rays
+  uint64_t fog_stopped = 0;      // fog rays whose sunlit part stopped at kFogNegligibleDepth
+};
+
+// The fog's random numbers come from their own stream of the sample (so the surface's
+// draws are those of a render without fog).
+constexpr uint64_t kFogStream = 0xF06;
+
 class Renderer {
  public:
   Renderer(const Scene& scene, const SceneGeometry& geometry, const RenderOptions& options,
-           const SceneTextures* textures)
+           const SceneTextures* textures, const FogIntegrator* fog)
       : scene_(scene), geometry_(geometry), options_(options), frame_(camera_frame(scene)),
         tracer_(*geometry.tracer), sun_direction_(glm::normalize(scene.sun.direction)),
         sun_frame_(axis_frame(sun_direction_)),
         cos_alpha_(std::cos(scene.sun.angular_radius_deg * kPi / 180)),
         sun_on_(scene.sun.radiance.x > 0 || scene.sun.radiance.y > 0 || scene.sun.radiance.z > 0),
-        textures_(textures) {
+        textures_(textures), fog_(fog) {
     // Ray differentials: frame_ray is affine in (x, y), so the neighbouring sample's
     // direction is the direction plus a constant; one pixel / sqrt(spp) (texture.h).
     const double step = 1 / std::sqrt(static_cast<double>(std::max(1u, options.spp)));
@@ -76,9 +92,8 @@ class Renderer {
     direction_dy_ = (-step * 2 * frame_.half_height / frame_.height) * frame_.up;
   }
 
-  // Renders tile `index` into `image`; adds its thread time to *trace_s and *shade_s.
-  void render_tile(uint32_t index, RenderImage& image, double* trace_s, double* shade_s,
-                   uint64_t* shadow_rays) {
+  // Renders tile `index` into `image`; adds what it cost to *cost.
+  void render_tile(uint32_t index, RenderImage& image, TileCost* cost) {
     const uint32_t tiles_x = (scene_.width + kTile - 1) / kTile;
     const uint32_t x0 = (index % tiles_x) * kTile, y0 = (index / tiles_x) * kTile;
     const uint32_t x1 = std::min(x0 + kTile, scene_.width), y1 = std::min(y0 + kTile, scene_.height);
@@ -87,13 +102,14 @@ class Renderer {
     const uint32_t grid_y = (spp + grid_x - 1) / grid_x;
     PrimaryHit hits[kTile * kTile];
     glm::dvec3 sum[kTile * kTile];
+    FogRayResult centre_fog[kTile * kTile];  // spp = 1: the sample is the pixel's centre
     for (auto& s : sum) s = glm::dvec3(0);
     for (uint32_t sample = 0; sample < spp; ++sample) {
       Clock::time_point start = Clock::now();
       for (uint32_t y = y0; y < y1; ++y)
         for (uint32_t x = x0; x < x1; ++x) {
           PrimaryHit& h = hits[(y - y0) * kTile + (x - x0)];
-          Rng rng((static_cast<uint64_t>(y) * scene_.width + x) * 0x100000001B3ull + sample * 0x9E37ull);
+          Rng rng(sample_seed(x, y, sample));
           double sx = 0.5, sy = 0.5;
           if (spp > 1) {
             sx = ((sample % grid_x) + rng.next_double()) / grid_x;
@@ -102,26 +118,34 @@ class Renderer {
           trace(frame_ray(frame_, x + sx, y + sy), h);
           h.rng_state = rng.state();
         }
-      *trace_s += seconds_since(start);
+      cost->trace_s += seconds_since(start);
       start = Clock::now();
+      const double fog_before = cost->fog_s;
       for (uint32_t y = y0; y < y1; ++y)
         for (uint32_t x = x0; x < x1; ++x) {
           const uint32_t k = (y - y0) * kTile + (x - x0);
-          sum[k] += shade(hits[k], shadow_rays);
+          sum[k] += shade(hits[k], cost, spp == 1 ? &centre_fog[k] : nullptr);
         }
-      *shade_s += seconds_since(start);
+      cost->shade_s += seconds_since(start) - (cost->fog_s - fog_before);
     }
     for (uint32_t y = y0; y < y1; ++y)
       for (uint32_t x = x0; x < x1; ++x) {
-        const glm::dvec3 c = sum[(y - y0) * kTile + (x - x0)] / static_cast<double>(spp);
+        const uint32_t k = (y - y0) * kTile + (x - x0);
+        const glm::dvec3 c = sum[k] / static_cast<double>(spp);
         float* px = &image.beauty[(static_cast<size_t>(y) * scene_.width + x) * 4];
         px[0] = static_cast<float>(c.r), px[1] = static_cast<float>(c.g), px[2] = static_cast<float>(c.b);
         px[3] = 1;
-        if (options_.aovs) write_aovs(image, x, y, spp == 1 ? &hits[(y - y0) * kTile + (x - x0)] : nullptr);
+        if (options_.aovs) write_aovs(image, x, y, spp == 1 ? &hits[k] : nullptr, spp == 1 ? &centre_fog[k] : nullptr, cost);
       }
   }
 
  private:
+  // Pixel (x, y)'s sample `sample`: its random stream (sample = spp is the fog AOV's
+  // extra centre ray when spp > 1).
+  uint64_t sample_seed(uint32_t x, uint32_t y, uint32_t sample) const {
+    return (static_cast<uint64_t>(y) * scene_.width + x) * 0x100000001B3ull + sample * 0x9E37ull;
+  }
+
   void trace(const Ray& ray, PrimaryHit& h) {
     h.ray = ray;
     h.surface = tracer_.nearest(ray, 0, kInf);
@@ -148,12 +172,45 @@ class Renderer {
     if (!sun_on_) return shading::sky_ambient(albedo, n, scene_.sky);
     const glm::dvec3 l = sun_sample(scene_.sun, sun_direction_, cos_alpha_, sun_frame_, rng);
     const double cos_sun = shading::sun_cosine(n, n_geometric, l);
-    const double visibility = cos_sun <= 0 ? 0.0 : sun_visibility(p, n_geometric, l, shadow_rays, shadow_offset_m);
-    return shading::surface_radiance(albedo, n, l, view, specular, scene_.sky, scene_.sun.radiance, cos_sun,
+    // Through fog the sunlight arrives attenuated by T_sun (spec/fog.md); where none arrives
+    // no shadow ray is needed.
+    const double sun_transmittance =
+        fog_ && cos_sun > 0 ? fog_sun_transmittance(fog_->medium(), p, sun_direction_) : 1.0;
+    const double visibility = cos_sun <= 0 || sun_transmittance == 0
+                                  ? 0.0
+                                  : sun_visibility(p, n_geometric, l, shadow_rays, shadow_offset_m);
+    const glm::dvec3 sun_irradiance = fog_ ? scene_.sun.radiance * sun_transmittance : scene_.sun.radiance;
+    return shading::surface_radiance(albedo, n, l, view, specular, scene_.sky, sun_irradiance, cos_sun,
                                      visibility);
   }
 
-  glm::dvec3 shade(const PrimaryHit& h, uint64_t* shadow_rays) {
+  // What the sample sees: the surface (or sky) L_end, and through fog T·L_end + in-scatter,
+  // the fog's part stored in *fog_out when asked for.
+  glm::dvec3 shade(const PrimaryHit& h, TileCost* cost, FogRayResult* fog_out) {
+    const glm::dvec3 end = shade_end(h, &cost->shadow_rays);
+    if (!fog_) return end;
+    const FogRayResult f = integrate_fog(h, cost);
+    if (fog_out) *fog_out = f;
+    return f.transmittance * end + f.inscatter;
+  }
+
+  // The fog along the sample's ray up to what it hit (spec/fog.md: the first surface, or
+  // infinity; above the top the fog's closed forms see no fog).
+  FogRayResult integrate_fog(const PrimaryHit& h, TileCost* cost) const {
+    const Clock::time_point start = Clock::now();
+    const double length = glm::length(h.ray.direction);
+    const double t_hit = h.ground_t < kInf ? h.ground_t : h.surface.t;  // kInf: nothing hit
+    Rng rng(lsys::mix_pair(h.rng_state, kFogStream));
+    const FogRayResult f = fog_->integrate(h.ray.origin, h.ray.direction / length, t_hit * length, rng);
+    ++cost->fog_rays;
+    cost->fog_shadow_rays += f.shadow_rays;
+    cost->fog_stopped += f.terminated_early ? 1 : 0;
+    cost->fog_s += seconds_since(start);
+    return f;
+  }
+
+  // L_end: the shaded ground or plant, or the sky.
+  glm::dvec3 shade_end(const PrimaryHit& h, uint64_t* shadow_rays) {
     Rng rng(h.rng_state);
     const glm::dvec3 view = -glm::normalize(h.ray.direction);
     if (h.ground_t < kInf) {
@@ -183,10 +240,15 @@ class Renderer {
     return lit(albedo, n, ng, s.position, view, true, rng, shadow_rays, shadow_offset_m);
   }
 
-  void write_aovs(RenderImage& image, uint32_t x, uint32_t y, const PrimaryHit* centre_hit) {
+  // The AOVs through pixel (x, y)'s centre: `centre_hit` and `centre_fog` are the sample's
+  // own when it was the centre (spp = 1), else null and traced here.
+  void write_aovs(RenderImage& image, uint32_t x, uint32_t y, const PrimaryHit* centre_hit,
+                  const FogRayResult* centre_fog, TileCost* cost) {
     PrimaryHit local;
     if (!centre_hit) {
+      Rng rng(sample_seed(x, y, std::max(1u, options_.spp)));
       trace(frame_ray(frame_, x + 0.5, y + 0.5), local);
+      local.rng_state = rng.state();
       centre_hit = &local;
     }
     const SurfaceHit& s = centre_hit->surface;
@@ -211,6 +273,11 @@ class Renderer {
       image.id[pixel * 3 + 1] = hit ? static_cast<float>(s.chain) : -1.0f;
       image.id[pixel * 3 + 2] = hit ? static_cast<float>(s.segment) : -1.0f;
     }
+    if (!image.fog.empty()) {
+      const FogRayResult f = centre_fog ? *centre_fog : integrate_fog(*centre_hit, cost);
+      for (int k = 0; k < 3; ++k) image.fog[pixel * 4 + k] = static_cast<float>(f.inscatter[k]);
+      image.fog[pixel * 4 + 3] = static_cast<float>(f.transmittance);
+    }
   }
 
   const Scene& scene_;
@@ -223,6 +290,7 @@ class Renderer {
   const double cos_alpha_;
   const bool sun_on_;
   const SceneTextures* textures_;  // bark albedo textures; nullptr: none
+  const FogIntegrator* fog_;       // the scene's fog; nullptr: none
   glm::dvec3 direction_dx_{0}, direction_dy_{0};  // ray differentials' direction offsets
 };
 
@@ -396,6 +464,17 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   if (options.aovs & kAovNormal) image.normal.assign(pixels * 3, 0.0f);
   if (options.aovs & kAovUv) image.uv.assign(pixels * 2, 0.0f);
   if (options.aovs & kAovId) image.id.assign(pixels * 3, 0.0f);
+  if ((options.aovs & kAovFog) && scene.fog) image.fog.assign(pixels * 4, 0.0f);
+
+  // The fog (spec/fog.md): only a scene with a `fog` key runs any of it.
+  std::optional<FogIntegrator> fog;
+  if (scene.fog) {
+    FogIntegratorOptions fog_options;
+    fog_options.mode = options.fog.mode.value_or(scene.fog->mode);
+    fog_options.steps = options.fog.steps.value_or(scene.fog->steps);
+    fog.emplace(fog_medium_of(scene), fog_sun_of(scene.sun), scene.sky, *geometry.tracer, options.fog.cones,
+                fog_options);
+  }
 
   const uint32_t tiles_x = (scene.width + kTile - 1) / kTile;
   const uint32_t tiles_y = (scene.height + kTile - 1) / kTile;
@@ -403,25 +482,27 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   threads = std::min<unsigned>(threads, tiles);
 
-  Renderer renderer(scene, geometry, options, textures.get());
+  Renderer renderer(scene, geometry, options, textures.get(), fog ? &*fog : nullptr);
   std::atomic<uint32_t> next_tile{0}, done_tiles{0};
   std::mutex totals_mutex;
-  double trace_s = 0, shade_s = 0;
-  uint64_t shadow_rays = 0;
+  TileCost total;
   auto worker = [&] {
-    double my_trace = 0, my_shade = 0;
-    uint64_t my_shadow = 0;
+    TileCost mine;
     for (;;) {
       if (options.cancel && options.cancel->load(std::memory_order_relaxed)) break;
       const uint32_t tile = next_tile.fetch_add(1, std::memory_order_relaxed);
       if (tile >= tiles) break;
-      renderer.render_tile(tile, image, &my_trace, &my_shade, &my_shadow);
+      renderer.render_tile(tile, image, &mine);
       done_tiles.fetch_add(1, std::memory_order_release);
     }
     std::lock_guard lock(totals_mutex);
-    trace_s += my_trace;
-    shade_s += my_shade;
-    shadow_rays += my_shadow;
+    total.trace_s += mine.trace_s;
+    total.shade_s += mine.shade_s;
+    total.fog_s += mine.fog_s;
+    total.shadow_rays += mine.shadow_rays;
+    total.fog_rays += mine.fog_rays;
+    total.fog_shadow_rays += mine.fog_shadow_rays;
+    total.fog_stopped += mine.fog_stopped;
   };
 
   const Clock::time_point start = Clock::now();
@@ -449,15 +530,26 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   const double wall = seconds_since(start);
   result.cancelled = done_tiles.load() < tiles;
   result.primary_rays = pixels * std::max(1u, options.spp);
-  result.shadow_rays = shadow_rays;
+  result.shadow_rays = total.shadow_rays + total.fog_shadow_rays;
   result.passes.push_back({"trace + shade (wall)", wall,
                            std::to_string(threads) + " threads, " + std::to_string(tiles) + " tiles of 32x32"});
-  result.passes.push_back({"trace (thread time)", trace_s,
+  result.passes.push_back({"trace (thread time)", total.trace_s,
                            std::to_string(result.primary_rays) + " primary rays, " +
                                std::to_string(options.spp) + " spp"});
-  result.passes.push_back({"shade (thread time)", shade_s,
-                           std::to_string(shadow_rays) + (scene.sun.angular_radius_deg > 0 ? " soft" : " hard") +
+  result.passes.push_back({"shade (thread time)", total.shade_s,
+                           std::to_string(total.shadow_rays) + (scene.sun.angular_radius_deg > 0 ? " soft" : " hard") +
                                " shadow rays"});
+  if (fog) {
+    const FogMode mode = fog->mode();
+    const bool cone_mode = mode == FogMode::medium || mode == FogMode::fast || mode == FogMode::refined;
+    std::string detail = std::string(fog_mode_name(mode));
+    if (options.fog.mode.value_or(scene.fog->mode) == FogMode::automatic) detail += " (auto)";
+    detail += ", " + std::to_string(options.fog.steps.value_or(scene.fog->steps)) + " steps";
+    if (cone_mode) detail += options.fog.cones ? ", shadow cones" : ", no shadow cones (every ray searched whole)";
+    detail += "; " + std::to_string(total.fog_rays) + " rays, " + std::to_string(total.fog_shadow_rays) +
+              " shadow rays, " + std::to_string(total.fog_stopped) + " stopped at T < 4e-18";
+    result.passes.push_back({"fog (thread time)", total.fog_s, detail});
+  }
   return result;
 }
 

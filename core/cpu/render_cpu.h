@@ -10,6 +10,13 @@
 // radius is 0 (hard shadows), else toward a uniform point of the sun's disc (soft shadows
 // that converge with --spp); only plants cast shadows. The ground (y = ground.height) is
 // shaded the same way, with the plants' shadows.
+// Fog (a scene's `fog` key; spec/fog.md, docs/fog.md): the sunlight E_sun is
+// multiplied by T_sun(p), the fog's transmittance from p toward the sun (the sky ambient
+// is not attenuated), and each sample's pixel value becomes T(0, t_end)·L_end + the fog's
+// in-scatter along the sample's ray (core/fog_integrator.h, mode and steps from the scene
+// or RenderOptions::fog), L_end the shaded surface or L_sky for a ray that hits nothing
+// (with T(0, ∞), which is 0 wherever the ray never leaves the fog). Without a `fog` key
+// none of it runs.
 // Plant albedo comes from the material index (kMaterialAlbedo); bark.albedo given as a
 // colour replaces material 0 (wood); bark.albedo given as a texture covers every segment
 // of its plant whatever its material (texture.h: mipmapped lookup, sRGB decoded after
@@ -28,7 +35,10 @@
 // distance from the eye, +inf where no plant is hit — the ground and the sky are not
 // plants), world-space shading normal (0 on a miss), uv (u turns, v_m metres of arc
 // length; 0 on a miss), id (plant, chain, segment as floats, exact below 2^24; −1 on a
-// miss). For a knuckle frustum id.segment is the joint's index.
+// miss). For a knuckle frustum id.segment is the joint's index. fog (kAovFog, a scene with
+// fog only): the fog's in-scatter RGB and T(0, t_end) through the pixel's centre, so that
+// beauty = fog.T·L_end + fog.RGB at spp 1 (at spp > 1 the centre ray is integrated again,
+// with its own random stream).
 //
 // Sampling: --spp N takes N stratified samples per pixel (a jittered ceil(sqrt N)-wide
 // grid); N = 1 samples the centre exactly. Random numbers depend only on the pixel and

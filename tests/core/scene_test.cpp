@@ -142,6 +142,100 @@ TEST(Scene, WrongTypesAndRangesAreLocated) {
   EXPECT_NE(e.message.find("version"), std::string::npos);
 }
 
+TEST(SceneFog, ReadsEveryFogKeyOfTheSpec) {
+  // spec/fog.md's example.
+  SceneReadResult r = parse_scene_json(R"({"plants": [],
+    "fog": {"sigma_s": 0.05, "sigma_a": 0.005, "g": 0.6, "height_falloff": 0.0, "top": 30,
+            "mode": "auto", "steps": 64, "photons": 1000000}})",
+                                       "s", "");
+  ASSERT_TRUE(r.scene) << r.error->format();
+  const Fog& f = *r.scene->fog;
+  EXPECT_EQ(f.sigma_s, 0.05);
+  EXPECT_EQ(f.sigma_a, 0.005);
+  EXPECT_EQ(f.g, 0.6);
+  EXPECT_EQ(f.height_falloff, 0.0);
+  EXPECT_EQ(f.top, 30);
+  EXPECT_EQ(f.mode, FogMode::automatic);
+  EXPECT_EQ(f.steps, 64u);
+  EXPECT_EQ(f.photons, 1000000u);
+  r = parse_scene_json(R"({"plants": [], "fog": {"mode": "reference", "steps": 7, "photons": 12, "top": -0.5,
+                           "height_falloff": 0.3}, "ground": {"height": -1}})",
+                       "s", "");
+  ASSERT_TRUE(r.scene) << r.error->format();
+  EXPECT_EQ(r.scene->fog->mode, FogMode::reference);
+  EXPECT_EQ(r.scene->fog->steps, 7u);
+  EXPECT_EQ(r.scene->fog->photons, 12u);
+  EXPECT_EQ(r.scene->fog->top, -0.5);  // above a ground at -1
+  EXPECT_EQ(r.scene->fog->height_falloff, 0.3);
+}
+
+TEST(SceneFog, AbsentKeysDefault) {
+  SceneReadResult r = parse_scene_json(R"({"plants": [], "fog": {}})", "s", "");
+  ASSERT_TRUE(r.scene) << r.error->format();
+  const Fog& f = *r.scene->fog;
+  EXPECT_TRUE(std::isinf(f.top));  // no ceiling
+  EXPECT_EQ(f.mode, FogMode::automatic);
+  EXPECT_EQ(f.steps, 64u);
+  EXPECT_EQ(f.photons, 1000000u);
+  EXPECT_EQ(f.sigma_s, 0.05);
+}
+
+TEST(SceneFog, ModeNamesRoundTrip) {
+  for (FogMode m : {FogMode::automatic, FogMode::brute, FogMode::medium, FogMode::fast, FogMode::refined,
+                    FogMode::reference})
+    EXPECT_EQ(fog_mode_from_name(fog_mode_name(m)), m);
+  EXPECT_EQ(fog_mode_name(FogMode::automatic), std::string("auto"));
+  EXPECT_FALSE(fog_mode_from_name("automatic"));
+  EXPECT_FALSE(fog_mode_from_name("Brute"));
+}
+
+TEST(SceneFog, EveryKeyOutOfRangeIsAnErrorAtTheKey) {
+  struct Bad {
+    const char* member;  // the fog object's one member
+    const char* says;    // part of the message
+  };
+  const Bad bad[] = {
+      {R"("sigma_s": -0.1)", "fog.sigma_s must be in [0, 1e+06]"},
+      {R"("sigma_a": -1e-9)", "fog.sigma_a must be in [0, 1e+06]"},
+      {R"("sigma_s": 2e6)", "fog.sigma_s must be in [0, 1e+06]"},
+      {R"("height_falloff": -1)", "fog.height_falloff must be in [0, 1e+06]"},
+      {R"("sigma_s": "thick")", "fog.sigma_s must be a number, not a string"},
+      {R"("sigma_a": null)", "fog.sigma_a must be a number, not null"},
+      {R"("g": 1)", "fog.g must be in (-0.938117, 0.938117)"},
+      {R"("g": -1)", "fog.g must be in (-0.938117, 0.938117)"},
+      {R"("g": 0.95)", "where Schlick's k"},  // |g| < 1 but |k| > 1
+      {R"("g": [0.5])", "fog.g must be a number, not an array"},
+      {R"("top": -3)", "fog.top -3 must be above the ground (ground.height 0)"},
+      {R"("top": 0)", "must be above the ground"},
+      {R"("top": "high")", "fog.top must be a number"},
+      {R"("mode": "fastest")", R"(fog.mode must be one of "auto", "brute", "medium", "fast", "refined", "reference", not "fastest")"},
+      {R"("mode": 3)", "fog.mode must be one of"},
+      {R"("steps": 0)", "fog.steps must be an integer from 1 to 65536, not 0"},
+      {R"("steps": 1.5)", "fog.steps must be an integer from 1 to 65536, not 1.5"},
+      {R"("steps": 65537)", "not 65537"},
+      {R"("steps": -4)", "not -4"},
+      {R"("steps": "64")", "fog.steps must be an integer from 1 to 65536, not \"64\""},
+      {R"("photons": 0)", "fog.photons must be an integer from 1 to 1000000000, not 0"},
+      {R"("photons": 2e9)", "not 2e9"},
+      {R"("photons": true)", "not a boolean"},
+      {R"("densty": 1)", "unknown key \"densty\" in fog"},
+  };
+  for (const Bad& b : bad) {
+    // The fog object's key starts at line 2, column 10.
+    const std::string text = std::string("{\"plants\": [],\n \"fog\": {") + b.member + "}}";
+    SceneError e = expect_error(text);
+    EXPECT_EQ(e.line, 2u) << b.member;
+    EXPECT_EQ(e.column, 10u) << b.member;
+    EXPECT_NE(e.message.find(b.says), std::string::npos) << b.member << ": " << e.message;
+    EXPECT_EQ(e.format().rfind("s.scene.json:2:10: error: ", 0), 0u) << e.format();
+  }
+  // The top is compared with the ground wherever the ground key stands.
+  SceneError e = expect_error("{\"fog\": {\"top\": 4},\n \"ground\": {\"height\": 5}, \"plants\": []}");
+  EXPECT_EQ(e.line, 1u);
+  EXPECT_EQ(e.column, 10u);
+  EXPECT_NE(e.message.find("fog.top 4 must be above the ground (ground.height 5)"), std::string::npos) << e.message;
+}
+
 TEST(Scene, MalformedJsonIsLocated) {
   SceneError e = expect_error("{\"plants\": [],\n}");
   EXPECT_EQ(e.line, 1u);  // the trailing comma

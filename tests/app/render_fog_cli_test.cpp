@@ -1,0 +1,183 @@
+// render_fog_cli_test.cpp — `sylva render` on scenes with fog (cli.md's fog flags,
+// spec/fog.md's `fog` AOV), as a user runs it.
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "tests/app/process.h"
+
+namespace {
+
+const std::string kSaguaro = std::string(SYLVA_SOURCE_DIR) + "/presets/saguaro.lsys";
+
+std::vector<std::string> channel_names(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) return {"<cannot open " + path + ">"};
+  std::vector<std::string> names = in->spec().channelnames;
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// A small saguaro scene; `fog` is the scene's fog member (empty: none).
+std::string write_scene(TempDir& dir, const std::string& fog) {
+  std::filesystem::copy_file(kSaguaro, dir.file("cactus.lsys"), std::filesystem::copy_options::overwrite_existing);
+  dir.write("f.scene.json", R"({"image": {"width": 32, "height": 24},
+  "camera": {"eye": [8, 4, 8], "target": [0, 3, 0]},
+  "sun": {"direction": [-0.5, 0.6, -0.4], "angular_radius_deg": 0.27},
+  )" + (fog.empty() ? std::string() : "\"fog\": " + fog + ",") +
+                                R"(
+  "plants": [{"grammar": "cactus.lsys", "steps": 4}]})");
+  return dir.file("f.scene.json");
+}
+
+const char* const kFog = R"({"sigma_s": 0.05, "sigma_a": 0.01, "g": 0.6, "top": 20, "mode": "brute", "steps": 4})";
+
+TEST(RenderFogCli, AFoggySceneRendersOnTheCpuWithTheFogPassAndTheFogAov) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, kFog);
+  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.exr"), "--aov", "fog,depth", "--verbose"});
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  // The GL backend draws no fog: auto says so and renders on the CPU.
+  EXPECT_NE(r.err.find("fog is rendered by the CPU ray caster only"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("fog (thread time)"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("brute, 4 steps"), std::string::npos) << describe(r);
+  std::vector<std::string> expected = {"R", "G", "B", "A", "Z", "fog.R", "fog.G", "fog.B", "fog.T"};
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(channel_names(dir.file("f.exr")), expected);
+  // fog.T is a transmittance: in (0, 1] everywhere; the sky pixels' is that of the fog up
+  // to its top.
+  auto in = OIIO::ImageInput::open(dir.file("f.exr"));
+  ASSERT_TRUE(in);
+  const OIIO::ImageSpec& spec = in->spec();
+  const int t_channel = spec.channelindex("fog.T");
+  ASSERT_GE(t_channel, 0);
+  std::vector<float> t(32 * 24);
+  ASSERT_TRUE(in->read_image(0, 0, t_channel, t_channel + 1, OIIO::TypeDesc::FLOAT, t.data()));
+  for (float v : t) {
+    EXPECT_GT(v, 0.0f);
+    EXPECT_LE(v, 1.0f);
+  }
+}
+
+TEST(RenderFogCli, PngPutsTheFogAovInASideFile) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, kFog);
+  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--aov", "fog", "--backend", "cpu",
+                               "--fog-mode", "reference", "--fog-steps", "2"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  std::vector<std::string> expected = {"fog.R", "fog.G", "fog.B", "fog.T"};
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(channel_names(dir.file("f.fog.exr")), expected);
+}
+
+TEST(RenderFogCli, TheGlBackendRefusesFogWithStatusOne) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, kFog);
+  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "gl"});
+  EXPECT_EQ(r.exit_code, 1) << describe(r);
+  EXPECT_NE(r.err.find("fog is rendered by the CPU ray caster only"), std::string::npos) << describe(r);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("f.png")));
+}
+
+TEST(RenderFogCli, BadFogFlagsAreUsageErrors) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, kFog);
+  struct Bad {
+    std::vector<std::string> flags;
+    const char* says;
+  };
+  const Bad bad[] = {
+      {{"--photons", "0"}, "--photons 0: expected an integer from 1 to 1000000000"},
+      {{"--photons", "-5"}, "--photons -5"},
+      {{"--photons", "2000000000"}, "--photons 2000000000"},
+      {{"--photons", "many"}, "--photons many"},
+      {{"--fog-steps", "0"}, "--fog-steps 0: expected an integer from 1 to 65536"},
+      {{"--fog-steps", "1000000"}, "--fog-steps 1000000"},
+      {{"--fog-steps", "1.5"}, "--fog-steps 1.5"},
+      {{"--fog-mode", "warp"}, "--fog-mode warp: expected auto, brute, medium, fast, refined or reference"},
+      {{"--fog-mode", "fast"}, "--fog-mode fast: needs the shadow cones"},
+      {{"--fog-mode", "medium"}, "needs the shadow cones"},
+      {{"--fog-mode", "refined"}, "needs the shadow cones"},
+      {{"--cone-params", "96,8,24"}, "--cone-params 96,8,24: expected auto or p1,p2,p3,p4"},
+      {{"--cone-params", "96,8,24,16,2"}, "expected auto or p1,p2,p3,p4"},
+      {{"--cone-params", "0,0,0,0"}, "expected auto or p1,p2,p3,p4"},
+      {{"--cone-params", "24,8,24,16"}, "p1 >= p3 + 1"},  // p1 must exceed p3
+      {{"--cone-params", "96,1,24,16"}, "p2 >= 2"},
+      {{"--cone-params", "96,8,24,0"}, "p4 >= 1"},
+      {{"--cone-params", "96,8,24,1000000"}, "each at most 100000"},
+      {{"--cone-params", "a,b,c,d"}, "expected auto or p1,p2,p3,p4"},
+      {{"--cone-params", "96,,24,16"}, "expected auto or p1,p2,p3,p4"},
+      {{"--cone-params", "automatic"}, "expected auto or p1,p2,p3,p4"},
+      {{"--aov", "fogg"}, "unknown AOV 'fogg'"},
+  };
+  for (const Bad& b : bad) {
+    std::vector<std::string> args = {"render", scene, "-o", dir.file("f.png"), "--backend", "cpu"};
+    args.insert(args.end(), b.flags.begin(), b.flags.end());
+    ProcessResult r = run_sylva(args);
+    EXPECT_EQ(r.exit_code, 2) << b.flags[0] << " " << b.flags[1] << ": " << describe(r);
+    EXPECT_NE(r.err.find(b.says), std::string::npos) << describe(r);
+    EXPECT_FALSE(std::filesystem::exists(dir.file("f.png")));
+  }
+}
+
+TEST(RenderFogCli, GoodConeParamsAndPhotonsAreAccepted) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, kFog);
+  for (const char* params : {"auto", "96,8,24,16", "25,2,24,1"}) {
+    ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--photons", "1000",
+                                 "--cone-params", params, "--fog-steps", "2"});
+    EXPECT_EQ(r.exit_code, 0) << params << ": " << describe(r);
+  }
+}
+
+TEST(RenderFogCli, FogFlagsOnASceneWithoutFogAreUsageErrors) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, "");
+  for (const std::vector<std::string>& flags : std::vector<std::vector<std::string>>{
+           {"--fog-mode", "brute"}, {"--fog-steps", "8"}, {"--photons", "10"}, {"--cone-params", "auto"},
+           {"--aov", "fog"}}) {
+    std::vector<std::string> args = {"render", scene, "-o", dir.file("f.png"), "--backend", "cpu"};
+    args.insert(args.end(), flags.begin(), flags.end());
+    ProcessResult r = run_sylva(args);
+    EXPECT_EQ(r.exit_code, 2) << flags[0] << ": " << describe(r);
+    EXPECT_NE(r.err.find("apply to a scene with fog only"), std::string::npos) << describe(r);
+  }
+  // Without fog and without the flags: no fog pass at all.
+  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_EQ(r.err.find("fog"), std::string::npos) << describe(r);
+}
+
+TEST(RenderFogCli, ASceneModeThatNeedsConesIsAnInputErrorUnlessOverridden) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, R"({"mode": "fast", "top": 20, "steps": 2})");
+  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu"});
+  EXPECT_EQ(r.exit_code, 1) << describe(r);
+  EXPECT_NE(r.err.find("fog.mode \"fast\" needs the shadow cones"), std::string::npos) << describe(r);
+  r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--fog-mode", "brute"});
+  EXPECT_EQ(r.exit_code, 0) << describe(r);
+}
+
+TEST(RenderFogCli, BadFogKeyInASceneIsExitOneAtTheKey) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, R"({"g": 0.99})");
+  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu"});
+  EXPECT_EQ(r.exit_code, 1) << describe(r);
+  EXPECT_NE(r.err.find("f.scene.json:4:11: error: fog.g must be in (-0.938117, 0.938117)"), std::string::npos)
+      << describe(r);
+}
+
+TEST(RenderFogCli, HelpDescribesTheFogFlags) {
+  ProcessResult help = run_sylva({"render", "--help"});
+  EXPECT_EQ(help.exit_code, 0);
+  for (const char* flag : {"--fog-mode", "--fog-steps", "--photons", "--cone-params", "fog.T", ".fog.exr"})
+    EXPECT_NE(help.out.find(flag), std::string::npos) << flag;
+}
+
+}  // namespace

@@ -1,0 +1,195 @@
+// render_fog_test.cpp — the CPU renderer through fog (spec/fog.md, "What a pixel sees" and
+// "Outputs"): beauty = fog.T·L_end + fog.RGB with L_end computed here independently, the
+// sunlight on surfaces attenuated by T_sun, what a ray that leaves the fog sees, and that a
+// scene without fog runs none of it.
+#include "core/cpu/render_cpu.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "core/fog.h"
+#include "core/fog_integrator.h"
+#include "core/util/math.h"
+#include "tests/core/test_scenes.h"
+
+namespace sylva {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// A cylinder of radius 0.5 and 2 m on the ground at the origin, seen from 6 m away and
+// 1.5 m up: ground below, sky above, the plant in the middle; a point sun; homogeneous fog
+// under a top at 30 m.
+Scene foggy_cylinder(FogMode mode = FogMode::brute) {
+  Scene s = test::scene_around(test::cylinder(0.5, 0, 2), {0, 1.5, 6}, {0, 1, 0}, 48, 36, 0);
+  s.sun.direction = glm::normalize(glm::dvec3(0.4, 1, -0.3));
+  Fog f;
+  f.sigma_s = 0.05;
+  f.sigma_a = 0.01;
+  f.g = 0.6;
+  f.top = 30;
+  f.mode = mode;
+  f.steps = 8;
+  s.fog = f;
+  return s;
+}
+
+bool has_pass(const RenderResult& r, const std::string& prefix) {
+  return std::any_of(r.passes.begin(), r.passes.end(),
+                     [&](const RenderPass& p) { return p.name.rfind(prefix, 0) == 0; });
+}
+
+TEST(RenderFog, ASceneWithoutFogRunsNoneOfIt) {
+  Scene s = foggy_cylinder();
+  s.fog.reset();
+  RenderOptions o;
+  o.aovs = kAovFog;
+  const RenderResult r = render_cpu(s, o);
+  EXPECT_FALSE(has_pass(r, "fog"));
+  EXPECT_FALSE(has_pass(r, "photons"));
+  EXPECT_FALSE(has_pass(r, "cones"));
+  EXPECT_TRUE(r.image.fog.empty());  // no fog, no fog AOV
+}
+
+TEST(RenderFog, AFoggySceneListsTheFogPassAndBruteAndReferenceTraceNoPhotons) {
+  for (FogMode mode : {FogMode::brute, FogMode::reference}) {
+    Scene s = foggy_cylinder(mode);
+    s.fog->steps = 2;
+    const RenderResult r = render_cpu(s, {});
+    ASSERT_TRUE(has_pass(r, "fog")) << fog_mode_name(mode);
+    const auto fog = std::find_if(r.passes.begin(), r.passes.end(),
+                                  [](const RenderPass& p) { return p.name.rfind("fog", 0) == 0; });
+    EXPECT_NE(fog->detail.find(fog_mode_name(mode)), std::string::npos) << fog->detail;
+    EXPECT_NE(fog->detail.find(std::to_string(48 * 36) + " rays"), std::string::npos) << fog->detail;
+    EXPECT_GT(fog->seconds, 0);
+    EXPECT_FALSE(has_pass(r, "photons")) << fog_mode_name(mode);
+    EXPECT_FALSE(has_pass(r, "cones")) << fog_mode_name(mode);
+  }
+}
+
+TEST(RenderFog, BeautyIsFogTransmittanceTimesWhatIsSeenPlusTheFogsLight) {
+  const Scene s = foggy_cylinder();
+  RenderOptions o;
+  o.aovs = kAovFog | kAovDepth;
+  const RenderResult r = render_cpu(s, o);
+  ASSERT_EQ(r.image.fog.size(), size_t(48 * 36 * 4));
+  const FogMedium m = fog_medium_of(s);
+  const glm::dvec3 sun = s.sun.direction;
+  const SceneGeometry geometry = build_scene_geometry(s, {});
+  int ground = 0, sky = 0, plant = 0;
+  for (uint32_t j = 0; j < s.height; ++j)
+    for (uint32_t i = 0; i < s.width; ++i) {
+      const size_t p = static_cast<size_t>(j) * s.width + i;
+      const float* fog = &r.image.fog[p * 4];
+      const float* beauty = &r.image.beauty[p * 4];
+      const Ray ray = camera_ray(s, i + 0.5, j + 0.5);
+      const double length = glm::length(ray.direction);
+      const glm::dvec3 d = ray.direction / length;
+      glm::dvec3 end;
+      double t_end;
+      if (std::isfinite(r.image.depth[p])) {  // the plant: L_end is its shading; check T only
+        ++plant;
+        t_end = r.image.depth[p];
+        EXPECT_NEAR(fog[3], fog_transmittance(m, ray.origin, d, 0, t_end), 2e-6) << i << "," << j;
+        for (int c = 0; c < 3; ++c) EXPECT_GE(beauty[c], fog[c] * (1 - 1e-6f)) << i << "," << j;
+        continue;
+      }
+      if (d.y < 0) {  // the ground: ρ_g·L_sky + ρ_g/π·E_sun·(n·s)·V·T_sun
+        ++ground;
+        t_end = -ray.origin.y / d.y;
+        const glm::dvec3 x = ray.origin + t_end * d;
+        const bool shadowed = geometry.tracer->any(Ray{x + glm::dvec3(0, 1e-7 * 6, 0), sun}, 0, kInf);
+        const double t_sun = fog_sun_transmittance(m, x, sun);
+        EXPECT_LT(t_sun, 0.25);  // 30 m of fog toward the sun: sunlight visibly dimmed
+        end = s.ground.albedo * s.sky + (shadowed ? 0.0 : sun.y * t_sun / kPi) * s.ground.albedo * s.sun.radiance;
+      } else {  // the sky, through the fog up to its top
+        ++sky;
+        t_end = kInf;
+        end = s.sky;
+      }
+      EXPECT_NEAR(fog[3], fog_transmittance(m, ray.origin, d, 0, t_end), 2e-7) << i << "," << j;
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(beauty[c], fog[3] * end[c] + fog[c], 2e-6 * (1 + beauty[c])) << i << "," << j << " channel " << c;
+    }
+  EXPECT_GT(ground, 100);
+  EXPECT_GT(sky, 100);
+  EXPECT_GT(plant, 50);
+}
+
+TEST(RenderFog, ARayLeavingHeightFogWithoutATopSeesTheAttenuatedSky) {
+  Scene s = foggy_cylinder();
+  s.fog->top = kInf;
+  s.fog->height_falloff = 0.2;
+  RenderOptions o;
+  o.aovs = kAovFog;
+  const RenderResult r = render_cpu(s, o);
+  const FogMedium m = fog_medium_of(s);
+  const uint32_t i = 2, j = 1;  // top-left: sky
+  const Ray ray = camera_ray(s, i + 0.5, j + 0.5);
+  const glm::dvec3 d = glm::normalize(ray.direction);
+  ASSERT_GT(d.y, 0);
+  // τ(0, ∞) = σ_t·e^{−h·y0}/(h·d_y), finite: the sky shows through.
+  const double tau = 0.06 * std::exp(-0.2 * 1.5) / (0.2 * d.y);
+  const size_t p = static_cast<size_t>(j) * s.width + i;
+  EXPECT_NEAR(r.image.fog[p * 4 + 3], std::exp(-tau), 1e-6);
+  EXPECT_GT(r.image.fog[p * 4 + 3], 0.1f);
+  EXPECT_NEAR(r.image.beauty[p * 4 + 2], r.image.fog[p * 4 + 3] * s.sky.z + r.image.fog[p * 4 + 2], 1e-6);
+  EXPECT_NEAR(fog_transmittance(m, ray.origin, d, 0, kInf), std::exp(-tau), 1e-12);
+}
+
+TEST(RenderFog, IdenticalForEveryThreadCount) {
+  const Scene s = foggy_cylinder(FogMode::automatic);
+  RenderOptions one, two;
+  one.threads = 1, two.threads = 2;
+  one.aovs = two.aovs = kAovFog;
+  one.spp = two.spp = 2;
+  const RenderResult a = render_cpu(s, one), b = render_cpu(s, two);
+  EXPECT_EQ(a.image.beauty, b.image.beauty);
+  EXPECT_EQ(a.image.fog, b.image.fog);
+}
+
+TEST(RenderFog, OptionsOverrideTheScenesModeAndSteps) {
+  const Scene s = foggy_cylinder(FogMode::reference);
+  RenderOptions o;
+  o.fog.mode = FogMode::brute;
+  o.fog.steps = 3;
+  const RenderResult r = render_cpu(s, o);
+  const auto fog = std::find_if(r.passes.begin(), r.passes.end(),
+                                [](const RenderPass& p) { return p.name.rfind("fog", 0) == 0; });
+  ASSERT_NE(fog, r.passes.end());
+  EXPECT_EQ(fog->detail.rfind("brute, 3 steps", 0), 0u) << fog->detail;
+  o.fog.mode = FogMode::fast;  // V = 0 inside the cones: meaningless without them
+  EXPECT_THROW(render_cpu(s, o), std::invalid_argument);
+}
+
+TEST(RenderFog, SurfacesReceiveSunlightAttenuatedByTheFog) {
+  // The same scene with a fog that only absorbs (σ_s = 0: it scatters nothing toward the
+  // eye): a ground pixel's sunlit part shrinks by T_sun, its sky ambient part does not, and
+  // both by T along the camera ray.
+  Scene clear = foggy_cylinder(), foggy = foggy_cylinder();
+  clear.fog.reset();
+  foggy.fog->sigma_s = 0;
+  foggy.fog->sigma_a = 0.02;
+  const RenderResult a = render_cpu(clear, {}), b = render_cpu(foggy, {});
+  const FogMedium m = fog_medium_of(foggy);
+  const uint32_t i = 24, j = 34;  // bottom middle: the ground, in the sun
+  const Ray ray = camera_ray(clear, i + 0.5, j + 0.5);
+  const glm::dvec3 d = glm::normalize(ray.direction);
+  const double t = -ray.origin.y / d.y;
+  const glm::dvec3 x = ray.origin + t * d;
+  const double T = fog_transmittance(m, ray.origin, d, 0, t), t_sun = fog_sun_transmittance(m, x, clear.sun.direction);
+  const size_t p = static_cast<size_t>(j) * clear.width + i;
+  const double ambient = clear.ground.albedo.x * clear.sky.x;
+  const double sunlit_clear = a.image.beauty[p * 4] - ambient;
+  EXPECT_GT(sunlit_clear, 0.1);
+  EXPECT_NEAR(b.image.beauty[p * 4], T * (ambient + t_sun * sunlit_clear), 1e-6);
+}
+
+}  // namespace
+}  // namespace sylva
