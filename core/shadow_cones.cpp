@@ -10,6 +10,7 @@
 #include <glm/geometric.hpp>
 #include <memory>
 #include <nanoflann.hpp>
+#include <thread>
 
 #include "core/relief.h"
 #include "core/skin.h"
@@ -433,192 +434,192 @@ glm::dvec3 least_principal_axis(double m[3][3]) {
 
 glm::dvec3 to_d(const glm::vec3& v) { return {v.x, v.y, v.z}; }
 
-// Clusters one plant's vectors (indices into all.vectors, in their order).
-class PlantClusterer {
- public:
-  PlantClusterer(const ShadowVectors& all, const std::vector<uint32_t>& members, uint32_t plant,
-                 const ConeParams& params, const ConeLimits& limits, ClusterReport& report,
-                 std::vector<ShadowCone>& out, std::vector<uint32_t>* cone_of_vector)
-      : all_(all), members_(members), plant_(plant), p_(params), limits_(limits), report_(report),
-        out_(out), cone_of_vector_(cone_of_vector), removed_(members.size(), 0) {}
+// A seed's cone as the vectors make it, whatever earlier cones took (step 5 before the
+// p4 test): a pure function of the seed, so the seeds of a block can be proposed in
+// parallel and accepted in order with the very result of the sequential loop.
+struct Proposal {
+  bool possible = false;       // rings passed, a usable radius and axis
+  ShadowCone cone;             // all but `vectors`
+  std::vector<uint32_t> disc;  // the candidates within the radius (plant-local indices)
+};
 
-  void run() {
-    cloud_.points.reserve(members_.size());
-    for (uint32_t i = 0; i < members_.size(); ++i) {
-      const glm::vec3& p = vec(i).position;
-      cloud_.points.push_back({p.x, p.y, p.z});
-    }
-    tree_ = std::make_unique<KdTree>(3, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(10));
-    neighbours_.resize(p_.p1);
-    dists_.resize(p_.p1);
-    for (uint32_t seed = 0; seed < members_.size(); ++seed) {
-      if (removed_[seed]) continue;
-      ++report_.seeds;
-      try_seed(seed);
-    }
-    for (uint8_t r : removed_) {
-      if (r) ++report_.covered;
-      else ++report_.discarded;
-    }
-  }
-
- private:
-  const ShadowVector& vec(uint32_t local) const { return all_.vectors[members_[local]]; }
-
-  void try_seed(uint32_t seed) {
-    const glm::vec3& sp = vec(seed).position;
-    const float query[3] = {sp.x, sp.y, sp.z};
-    const uint32_t found =
-        static_cast<uint32_t>(tree_->knnSearch(query, p_.p1, neighbours_.data(), dists_.data()));
-    // K: vectors in order of distance, the seed first (a vector at the seed's very
-    // position may come before it).
-    k_.clear();
-    k_dist_.clear();
-    k_.push_back(seed);
-    k_dist_.push_back(0);
-    for (uint32_t i = 0; i < found && k_.size() < p_.p1; ++i) {
-      if (neighbours_[i] == seed) continue;
-      k_.push_back(neighbours_[i]);
-      k_dist_.push_back(std::sqrt(double(dists_[i])));
-    }
-    const uint32_t rings = static_cast<uint32_t>((k_.size() - 1) / p_.p3);
-    if (rings == 0) return;
-
-    // Step 2: the plane perpendicular to K's mean direction, and each vector's sector.
-    glm::dvec3 mean{0, 0, 0};
-    for (uint32_t v : k_) mean += to_d(vec(v).direction);
-    if (!(glm::length(mean) > 0)) return;
-    mean = glm::normalize(mean);
-    const AxisFrame plane = axis_frame(mean);
-    const glm::dvec3 seed_p = to_d(sp);
-
-    // Steps 3–4: rings of p3 vectors, the index of dispersion of their sector counts.
-    counts_.assign(p_.p2, 0);
-    const double expected = double(p_.p3) / p_.p2;
-    uint32_t passed = 0;
-    for (uint32_t ring = 1; ring <= rings; ++ring) {
-      std::fill(counts_.begin(), counts_.end(), 0u);
-      for (uint32_t i = (ring - 1) * p_.p3 + 1; i <= ring * p_.p3; ++i) {
-        const glm::dvec3 q = to_d(vec(k_[i]).position) - seed_p;
-        const double angle = std::atan2(glm::dot(q, plane.e1), glm::dot(q, plane.e0));  // [-π, π]
-        const int sector = std::clamp(int((angle + kPi) / (2 * kPi) * p_.p2), 0, int(p_.p2) - 1);
-        ++counts_[sector];
-      }
-      double variance = 0;
-      for (uint32_t c : counts_) variance += (c - expected) * (c - expected);
-      variance /= p_.p2;
-      if (variance / expected > p_.variance_threshold) break;
-      passed = ring;
-    }
-    if (passed == 0) return;
-    const uint32_t candidates = passed * p_.p3 + 1;
-    const double r = k_dist_[candidates - 1];
-
-    // Step 5: axis (eq. 3), expansion (the smallest dot product, as tan), normal, radius.
-    glm::dvec3 axis{0, 0, 0};
-    for (uint32_t i = 0; i < candidates; ++i) axis += to_d(vec(k_[i]).direction);
-    if (!(glm::length(axis) > 0)) return;
-    axis = glm::normalize(axis);
-    double tan_theta = 0;
-    for (uint32_t i = 0; i < candidates; ++i) {
-      const glm::dvec3 d = to_d(vec(k_[i]).direction);
-      const double along = glm::dot(d, axis);
-      if (!(along > 0)) return;  // a vector at 90° or more from the axis: no cone
-      tan_theta = std::max(tan_theta, glm::length(glm::cross(d, axis)) / along);
-    }
-    glm::dvec3 centroid{0, 0, 0};
-    for (uint32_t i = 0; i < candidates; ++i) centroid += to_d(vec(k_[i]).position);
-    centroid /= double(candidates);
-    double cov[3][3] = {};
-    for (uint32_t i = 0; i < candidates; ++i) {
-      const glm::dvec3 q = to_d(vec(k_[i]).position) - centroid;
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) cov[a][b] += q[a] * q[b];
-    }
-    const glm::dvec3 normal = least_principal_axis(cov);
-    const double radius = r * std::abs(glm::dot(normal, axis));  // Fig. 5
-
-    // The cone holds the candidates within the radius of the axis line through the seed;
-    // its vectors are those of them still in the set. A hair of margin keeps them inside
-    // after rounding (world position, base).
-    const double margin = 1e-9 * r + 1e-13 * (glm::length(all_.origin) + glm::length(seed_p));
-    if (!(radius > 2 * margin)) return;
-    cone_.clear();
-    double s_min = 0, s_max = 0;
-    for (uint32_t i = 0; i < candidates; ++i) {
-      const glm::dvec3 q = to_d(vec(k_[i]).position) - seed_p;
-      const double s = glm::dot(q, axis);
-      const glm::dvec3 perp = q - s * axis;
-      if (glm::dot(perp, perp) > (radius - margin) * (radius - margin) && i > 0) continue;
-      s_min = std::min(s_min, s);
-      s_max = std::max(s_max, s);
-      if (!removed_[k_[i]]) cone_.push_back(k_[i]);
-    }
-    if (cone_.size() < p_.p4) return;
-    s_min -= margin;
-    s_max += margin;
-
-    ShadowCone cone;
-    cone.base = all_.origin + seed_p + s_min * axis;
-    cone.axis = axis;
-    cone.radius_base_m = radius;
-    cone.tan_theta = tan_theta;
-    cone.plant = plant_;
-    cone.vectors = static_cast<uint32_t>(cone_.size());
-    double length = limits_.max_length_m;
-    if (limits_.ground && axis.y < 0) {
-      // The whole cross-section below the ground: its highest point, base.y + s·a_y +
-      // r(s)·sqrt(1 − a_y²), at or below ground_height.
-      const double horizontal = std::sqrt(std::max(0.0, 1 - axis.y * axis.y));
-      const double descent = -axis.y - tan_theta * horizontal;
-      if (descent > 0) {
-        const double s_ground = (cone.base.y - limits_.ground_height + radius * horizontal) / descent;
-        length = std::min(length, s_ground);
-      }
-    }
-    cone.length_m = std::max(length, s_max - s_min);
-    out_.push_back(cone);
-    ++report_.cones;
-    for (uint32_t v : cone_) {
-      removed_[v] = 1;
-      if (cone_of_vector_) (*cone_of_vector_)[members_[v]] = static_cast<uint32_t>(out_.size() - 1);
-    }
-  }
-
-  const ShadowVectors& all_;
-  const std::vector<uint32_t>& members_;
-  uint32_t plant_;
-  const ConeParams& p_;
-  const ConeLimits& limits_;
-  ClusterReport& report_;
-  std::vector<ShadowCone>& out_;
-  std::vector<uint32_t>* cone_of_vector_;
-  std::vector<uint8_t> removed_;
-  PointCloud cloud_;
-  std::unique_ptr<KdTree> tree_;
-  std::vector<uint32_t> neighbours_, k_, cone_, counts_;
-  std::vector<float> dists_;
-  std::vector<double> k_dist_;
+// What a thread reuses from seed to seed.
+struct Scratch {
+  std::vector<uint32_t> neighbours, k, counts;
+  std::vector<float> dists;
+  std::vector<double> k_dist;
 };
 
 }  // namespace
 
-std::vector<ShadowCone> cluster_shadow_cones(const ShadowVectors& vectors,
-                                             std::span<const uint32_t> plant_of_frustum,
-                                             const ConeParams& params, const ConeLimits& limits,
-                                             ClusterReport* report,
-                                             std::vector<uint32_t>* cone_of_vector) {
-  assert(cone_params_error(params) == nullptr && "cluster_shadow_cones: invalid ConeParams");
-  assert(limits.max_length_m > 0 && std::isfinite(limits.max_length_m));
-  ClusterReport local_report;
-  ClusterReport& rep = report ? *report : local_report;
-  rep = {};
-  rep.vectors = vectors.vectors.size();
-  if (cone_of_vector) cone_of_vector->assign(vectors.vectors.size(), kNoCone);
-  std::vector<ShadowCone> cones;
-  if (vectors.vectors.empty()) return cones;
+// One plant's vectors: their positions in a kd-tree, and optionally everyone's nearest
+// neighbours found once.
+struct ShadowVectorIndex::Plant {
+  uint32_t plant = 0;
+  std::vector<uint32_t> members;  // indices into vectors, in their order
+  PointCloud cloud;
+  std::unique_ptr<KdTree> tree;
+  uint32_t table_p1 = 0;          // > 0: neighbours[i·table_p1 ..] holds i's nearest
+  std::vector<uint32_t> table;    // plant-local indices, nearest first (the vector itself
+  std::vector<float> table_dist;  // among them), squared distances
+  std::vector<uint32_t> table_count;
+};
 
-  // The vectors of each plant, in their order.
+namespace {
+
+// Runs body(thread, begin, end) over [0, n) split into `threads` contiguous ranges.
+template <class Body>
+void parallel_ranges(size_t n, unsigned threads, Body&& body) {
+  threads = static_cast<unsigned>(std::max<size_t>(1, std::min<size_t>(threads, n / 64 + 1)));
+  if (threads == 1) return body(0u, size_t(0), n);
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < threads; ++t)
+    pool.emplace_back([&, t] { body(t, n * t / threads, n * (t + 1) / threads); });
+  for (std::thread& th : pool) th.join();
+}
+
+unsigned thread_count(unsigned requested) {
+  return requested ? requested : std::max(1u, std::thread::hardware_concurrency());
+}
+
+// Steps 1–5 for `seed` of `plant` (see shadow_cones.h).
+void propose(const ShadowVectors& all, const ShadowVectorIndex::Plant& plant, uint32_t seed, const ConeParams& p,
+             const ConeLimits& limits, Scratch& w, Proposal& out) {
+  out.possible = false;
+  out.disc.clear();
+  auto vec = [&](uint32_t local) -> const ShadowVector& { return all.vectors[plant.members[local]]; };
+  const glm::vec3& sp = vec(seed).position;
+  // Step 1: K, in order of distance, the seed first (a vector at the seed's very
+  // position may come before it).
+  const uint32_t* found_index;
+  const float* found_dist;
+  uint32_t found;
+  if (plant.table_p1 >= p.p1) {
+    found_index = &plant.table[size_t(seed) * plant.table_p1];
+    found_dist = &plant.table_dist[size_t(seed) * plant.table_p1];
+    found = std::min(plant.table_count[seed], p.p1);
+  } else {
+    w.neighbours.resize(p.p1);
+    w.dists.resize(p.p1);
+    const float query[3] = {sp.x, sp.y, sp.z};
+    found = static_cast<uint32_t>(plant.tree->knnSearch(query, p.p1, w.neighbours.data(), w.dists.data()));
+    found_index = w.neighbours.data();
+    found_dist = w.dists.data();
+  }
+  w.k.clear();
+  w.k_dist.clear();
+  w.k.push_back(seed);
+  w.k_dist.push_back(0);
+  for (uint32_t i = 0; i < found && w.k.size() < p.p1; ++i) {
+    if (found_index[i] == seed) continue;
+    w.k.push_back(found_index[i]);
+    w.k_dist.push_back(std::sqrt(double(found_dist[i])));
+  }
+  const uint32_t rings = static_cast<uint32_t>((w.k.size() - 1) / p.p3);
+  if (rings == 0) return;
+
+  // Step 2: the plane perpendicular to K's mean direction, and each vector's sector.
+  glm::dvec3 mean{0, 0, 0};
+  for (uint32_t v : w.k) mean += to_d(vec(v).direction);
+  if (!(glm::length(mean) > 0)) return;
+  mean = glm::normalize(mean);
+  const AxisFrame plane = axis_frame(mean);
+  const glm::dvec3 seed_p = to_d(sp);
+
+  // Steps 3–4: rings of p3 vectors, the index of dispersion of their sector counts.
+  w.counts.assign(p.p2, 0);
+  const double expected = double(p.p3) / p.p2;
+  uint32_t passed = 0;
+  for (uint32_t ring = 1; ring <= rings; ++ring) {
+    std::fill(w.counts.begin(), w.counts.end(), 0u);
+    for (uint32_t i = (ring - 1) * p.p3 + 1; i <= ring * p.p3; ++i) {
+      const glm::dvec3 q = to_d(vec(w.k[i]).position) - seed_p;
+      const double angle = std::atan2(glm::dot(q, plane.e1), glm::dot(q, plane.e0));  // [-π, π]
+      const int sector = std::clamp(int((angle + kPi) / (2 * kPi) * p.p2), 0, int(p.p2) - 1);
+      ++w.counts[sector];
+    }
+    double variance = 0;
+    for (uint32_t c : w.counts) variance += (c - expected) * (c - expected);
+    variance /= p.p2;
+    if (variance / expected > p.variance_threshold) break;
+    passed = ring;
+  }
+  if (passed == 0) return;
+  const uint32_t candidates = passed * p.p3 + 1;
+  if (candidates < p.p4) return;  // too few even if none were taken
+  const double r = w.k_dist[candidates - 1];
+
+  // Step 5: axis (eq. 3), expansion (the smallest dot product, as tan), normal, radius.
+  glm::dvec3 axis{0, 0, 0};
+  for (uint32_t i = 0; i < candidates; ++i) axis += to_d(vec(w.k[i]).direction);
+  if (!(glm::length(axis) > 0)) return;
+  axis = glm::normalize(axis);
+  double tan_theta = 0;
+  for (uint32_t i = 0; i < candidates; ++i) {
+    const glm::dvec3 d = to_d(vec(w.k[i]).direction);
+    const double along = glm::dot(d, axis);
+    if (!(along > 0)) return;  // a vector at 90° or more from the axis: no cone
+    tan_theta = std::max(tan_theta, glm::length(glm::cross(d, axis)) / along);
+  }
+  glm::dvec3 centroid{0, 0, 0};
+  for (uint32_t i = 0; i < candidates; ++i) centroid += to_d(vec(w.k[i]).position);
+  centroid /= double(candidates);
+  double cov[3][3] = {};
+  for (uint32_t i = 0; i < candidates; ++i) {
+    const glm::dvec3 q = to_d(vec(w.k[i]).position) - centroid;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) cov[a][b] += q[a] * q[b];
+  }
+  const glm::dvec3 normal = least_principal_axis(cov);
+  const double radius = r * std::abs(glm::dot(normal, axis));  // Fig. 5
+
+  // The cone holds the candidates within the radius of the axis line through the seed.
+  // A hair of margin keeps them inside after rounding (world position, base).
+  const double margin = 1e-9 * r + 1e-13 * (glm::length(all.origin) + glm::length(seed_p));
+  if (!(radius > 2 * margin)) return;
+  double s_min = 0, s_max = 0;
+  for (uint32_t i = 0; i < candidates; ++i) {
+    const glm::dvec3 q = to_d(vec(w.k[i]).position) - seed_p;
+    const double s = glm::dot(q, axis);
+    const glm::dvec3 perp = q - s * axis;
+    if (glm::dot(perp, perp) > (radius - margin) * (radius - margin) && i > 0) continue;
+    s_min = std::min(s_min, s);
+    s_max = std::max(s_max, s);
+    out.disc.push_back(w.k[i]);
+  }
+  if (out.disc.size() < p.p4) return;
+  s_min -= margin;
+  s_max += margin;
+
+  ShadowCone& cone = out.cone;
+  cone.base = all.origin + seed_p + s_min * axis;
+  cone.axis = axis;
+  cone.radius_base_m = radius;
+  cone.tan_theta = tan_theta;
+  cone.plant = plant.plant;
+  double length = limits.max_length_m;
+  if (limits.ground && axis.y < 0) {
+    // The whole cross-section below the ground: its highest point, base.y + s·a_y +
+    // r(s)·sqrt(1 − a_y²), at or below ground_height.
+    const double horizontal = std::sqrt(std::max(0.0, 1 - axis.y * axis.y));
+    const double descent = -axis.y - tan_theta * horizontal;
+    if (descent > 0) {
+      const double s_ground = (cone.base.y - limits.ground_height + radius * horizontal) / descent;
+      length = std::min(length, s_ground);
+    }
+  }
+  cone.length_m = std::max(length, s_max - s_min);
+  out.possible = true;
+}
+
+constexpr uint32_t kBlock = 4096;  // seeds proposed in parallel, then accepted in order
+
+}  // namespace
+
+ShadowVectorIndex::ShadowVectorIndex(const ShadowVectors& vectors, std::span<const uint32_t> plant_of_frustum,
+                                     uint32_t neighbours_p1, unsigned threads)
+    : vectors_(vectors) {
+  if (vectors.vectors.empty()) return;
   std::vector<uint32_t> order(vectors.vectors.size());
   for (uint32_t i = 0; i < order.size(); ++i) {
     assert(vectors.vectors[i].frustum < plant_of_frustum.size());
@@ -626,17 +627,101 @@ std::vector<ShadowCone> cluster_shadow_cones(const ShadowVectors& vectors,
   }
   auto plant_of = [&](uint32_t v) { return plant_of_frustum[vectors.vectors[v].frustum]; };
   std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return plant_of(a) < plant_of(b); });
-  std::vector<uint32_t> members;
   for (size_t begin = 0; begin < order.size();) {
-    const uint32_t plant = plant_of(order[begin]);
     size_t end = begin;
-    while (end < order.size() && plant_of(order[end]) == plant) ++end;
-    members.assign(order.begin() + begin, order.begin() + end);
-    ++rep.plants;
-    PlantClusterer(vectors, members, plant, params, limits, rep, cones, cone_of_vector).run();
+    while (end < order.size() && plant_of(order[end]) == plant_of(order[begin])) ++end;
+    auto plant = std::make_unique<Plant>();
+    plant->plant = plant_of(order[begin]);
+    plant->members.assign(order.begin() + begin, order.begin() + end);
+    plant->cloud.points.reserve(plant->members.size());
+    for (uint32_t m : plant->members) {
+      const glm::vec3& p = vectors.vectors[m].position;
+      plant->cloud.points.push_back({p.x, p.y, p.z});
+    }
+    plant->tree = std::make_unique<KdTree>(3, plant->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+    if (neighbours_p1 > 0) {
+      Plant& pl = *plant;
+      const size_t n = pl.members.size();
+      pl.table_p1 = neighbours_p1;
+      pl.table.resize(n * neighbours_p1);
+      pl.table_dist.resize(n * neighbours_p1);
+      pl.table_count.resize(n);
+      parallel_ranges(n, thread_count(threads), [&](unsigned, size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i) {
+          const std::array<float, 3>& q = pl.cloud.points[i];
+          pl.table_count[i] = static_cast<uint32_t>(
+              pl.tree->knnSearch(q.data(), neighbours_p1, &pl.table[i * neighbours_p1], &pl.table_dist[i * neighbours_p1]));
+        }
+      });
+    }
+    plants_.push_back(std::move(plant));
     begin = end;
   }
+}
+
+ShadowVectorIndex::~ShadowVectorIndex() = default;
+
+std::vector<ShadowCone> ShadowVectorIndex::cluster(const ConeParams& params, const ConeLimits& limits,
+                                                   ClusterReport* report, std::vector<uint32_t>* cone_of_vector,
+                                                   unsigned threads) const {
+  assert(cone_params_error(params) == nullptr && "cluster: invalid ConeParams");
+  assert(limits.max_length_m > 0 && std::isfinite(limits.max_length_m));
+  ClusterReport local_report;
+  ClusterReport& rep = report ? *report : local_report;
+  rep = {};
+  rep.vectors = vectors_.vectors.size();
+  if (cone_of_vector) cone_of_vector->assign(vectors_.vectors.size(), kNoCone);
+  std::vector<ShadowCone> cones;
+  const unsigned workers = thread_count(threads);
+  std::vector<Scratch> scratch(workers);
+  std::vector<Proposal> proposals;
+  std::vector<uint32_t> seeds;
+  for (const auto& plant_ptr : plants_) {
+    const Plant& plant = *plant_ptr;
+    ++rep.plants;
+    const uint32_t n = static_cast<uint32_t>(plant.members.size());
+    std::vector<uint8_t> removed(n, 0);
+    for (uint32_t block = 0; block < n; block += kBlock) {
+      seeds.clear();
+      for (uint32_t i = block; i < std::min(n, block + kBlock); ++i)
+        if (!removed[i]) seeds.push_back(i);
+      if (proposals.size() < seeds.size()) proposals.resize(seeds.size());
+      parallel_ranges(seeds.size(), workers, [&](unsigned t, size_t b, size_t e) {
+        for (size_t k = b; k < e; ++k) propose(vectors_, plant, seeds[k], params, limits, scratch[t], proposals[k]);
+      });
+      // In order: a seed an earlier cone (of this block too) took is no seed.
+      for (size_t k = 0; k < seeds.size(); ++k) {
+        if (removed[seeds[k]]) continue;
+        ++rep.seeds;
+        const Proposal& prop = proposals[k];
+        if (!prop.possible) continue;
+        uint32_t fresh = 0;
+        for (uint32_t v : prop.disc) fresh += !removed[v];
+        if (fresh < params.p4) continue;
+        ShadowCone cone = prop.cone;
+        cone.vectors = fresh;
+        const uint32_t index = static_cast<uint32_t>(cones.size());
+        cones.push_back(cone);
+        ++rep.cones;
+        for (uint32_t v : prop.disc) {
+          if (removed[v]) continue;
+          removed[v] = 1;
+          if (cone_of_vector) (*cone_of_vector)[plant.members[v]] = index;
+        }
+      }
+    }
+    for (uint8_t r : removed) {
+      if (r) ++rep.covered;
+      else ++rep.discarded;
+    }
+  }
   return cones;
+}
+
+std::vector<ShadowCone> cluster_shadow_cones(const ShadowVectors& vectors, std::span<const uint32_t> plant_of_frustum,
+                                             const ConeParams& params, const ConeLimits& limits, ClusterReport* report,
+                                             std::vector<uint32_t>* cone_of_vector, unsigned threads) {
+  return ShadowVectorIndex(vectors, plant_of_frustum, 0, threads).cluster(params, limits, report, cone_of_vector, threads);
 }
 
 }  // namespace sylva

@@ -62,7 +62,9 @@
 //      of them still in the set. Fewer than p4: no cone from this seed. Otherwise the
 //      cone is kept and its vectors are removed from the set.
 //   6. After the last seed, whatever no cone took is discarded (sec. 3.2.1).
-// Deterministic: the same vectors in the same order give the same cones.
+// Deterministic: the same vectors in the same order give the same cones, on any number
+// of threads (a seed's cone before the p4 test depends on the seed alone, so blocks of
+// seeds are proposed in parallel and accepted in order).
 //
 // Hierarchy (sec. 6.2): a BVH over the cones' bounding boxes, built in a frame aligned
 // with the cones' mean axis (sunlight's cones are nearly parallel, so boxes in the world
@@ -79,6 +81,7 @@
 #include <cstdint>
 #include <glm/vec3.hpp>
 #include <limits>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -214,15 +217,46 @@ struct ClusterReport {
 
 inline constexpr uint32_t kNoCone = 0xffffffffu;
 
-// Clusters `vectors` into cones, per plant (plant_of_frustum[v.frustum]; every frustum
-// index must be in range), as the header comment describes. Plants are clustered one
-// after the other, in increasing plant index; the cones come out in that order. Writes
-// what happened to *report, and for each vector the index of the cone that took it
-// (kNoCone: discarded) to *cone_of_vector, when they are non-null.
+// The shadow vectors of a scene grouped per plant, each plant's positions in a kd-tree,
+// ready to be clustered (as the header comment describes) with one parameter set or
+// several (the automatic choice clusters one window many times). With neighbours_p1 > 0
+// every vector's nearest neighbours_p1 are found once, here, and shared by every
+// clustering whose p1 <= neighbours_p1 (the nearest p1 are a prefix of them, up to ties
+// in distance); with 0
+// each clustering finds them as it goes. `vectors` must outlive the index, unchanged;
+// every frustum index must be within plant_of_frustum.
+class ShadowVectorIndex {
+ public:
+  ShadowVectorIndex(const ShadowVectors& vectors, std::span<const uint32_t> plant_of_frustum,
+                    uint32_t neighbours_p1 = 0, unsigned threads = 0);
+  ~ShadowVectorIndex();
+  ShadowVectorIndex(const ShadowVectorIndex&) = delete;
+  ShadowVectorIndex& operator=(const ShadowVectorIndex&) = delete;
+
+  // Plants are clustered one after the other, in increasing plant index, and the cones
+  // come out in that order. Within a plant, blocks of seeds have their cones proposed on
+  // `threads` threads (0: every core) and accepted in seed order, so the result is the
+  // sequential algorithm's for every thread count. Writes what happened to *report, and
+  // for each vector the index of the cone that took it (kNoCone: discarded) to
+  // *cone_of_vector, when they are non-null. Thread-safe (const).
+  std::vector<ShadowCone> cluster(const ConeParams& params, const ConeLimits& limits,
+                                  ClusterReport* report = nullptr,
+                                  std::vector<uint32_t>* cone_of_vector = nullptr,
+                                  unsigned threads = 0) const;
+
+  struct Plant;  // (shadow_cones.cpp)
+
+ private:
+  const ShadowVectors& vectors_;
+  std::vector<std::unique_ptr<Plant>> plants_;
+};
+
+// ShadowVectorIndex(vectors, plant_of_frustum).cluster(params, limits, ...).
 std::vector<ShadowCone> cluster_shadow_cones(const ShadowVectors& vectors,
                                              std::span<const uint32_t> plant_of_frustum,
                                              const ConeParams& params, const ConeLimits& limits,
                                              ClusterReport* report = nullptr,
-                                             std::vector<uint32_t>* cone_of_vector = nullptr);
+                                             std::vector<uint32_t>* cone_of_vector = nullptr,
+                                             unsigned threads = 0);
 
 }  // namespace sylva

@@ -729,6 +729,37 @@ TEST(Clustering, IsDeterministicAndSeparatesPlants) {
   EXPECT_TRUE(seen_plant_3);
 }
 
+TEST(Clustering, IsTheSameOnEveryThreadCountAndWithSharedNeighbours) {
+  // Blocks of seeds are proposed in parallel and accepted in order: the sequential
+  // result, whatever the thread count; and a neighbour table shared by several
+  // clusterings gives each one's own result.
+  const glm::dvec3 sun = glm::normalize(glm::dvec3(0.2, -1, 0.1));
+  Occluder ring;
+  ring.inside = [](double x, double y) { return x * x + y * y <= 4 && x * x + y * y >= 0.25; };
+  const ShadowVectors v = photons_on(ring, sun, kSunRadiusRad, 2.2, 60000, 11);
+  ASSERT_GT(v.vectors.size(), 20000u);  // more than a few blocks of seeds
+  const ConeParams params;
+  const ConeLimits limits{20, false, 0};
+  std::vector<uint32_t> one_of, many_of;
+  const std::vector<ShadowCone> one = cluster_shadow_cones(v, kOnePlant, params, limits, nullptr, &one_of, 1);
+  const std::vector<ShadowCone> many = cluster_shadow_cones(v, kOnePlant, params, limits, nullptr, &many_of, 3);
+  const ShadowVectorIndex shared(v, kOnePlant, 2 * params.p1, 2);
+  std::vector<uint32_t> shared_of;
+  const std::vector<ShadowCone> from_table = shared.cluster(params, limits, nullptr, &shared_of, 2);
+  ASSERT_GT(one.size(), 50u);
+  for (const std::vector<ShadowCone>* other : {&many, &from_table}) {
+    ASSERT_EQ(other->size(), one.size());
+    for (size_t i = 0; i < one.size(); ++i) {
+      EXPECT_EQ((*other)[i].base, one[i].base);
+      EXPECT_EQ((*other)[i].radius_base_m, one[i].radius_base_m);
+      EXPECT_EQ((*other)[i].tan_theta, one[i].tan_theta);
+      EXPECT_EQ((*other)[i].vectors, one[i].vectors);
+    }
+  }
+  EXPECT_EQ(many_of, one_of);
+  EXPECT_EQ(shared_of, one_of);
+}
+
 TEST(Clustering, NoVectorsGiveNoCones) {
   ClusterReport report;
   EXPECT_TRUE(cluster_shadow_cones({}, kOnePlant, ConeParams{}, {20, false, 0}, &report).empty());

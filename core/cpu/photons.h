@@ -1,0 +1,145 @@
+// photons.h — sun photons and the shadow cones made from them (paper 002 sec. 3.1–3.2,
+// 6.1): the viewpoint-independent half of the fog (../shared/spec/fog.md, "Photons and
+// cones"), built once per (plants, sun) and reused by every camera, frame and fog mode.
+//
+// Photons leave a disc perpendicular to the sun that covers the plants' bounding sphere
+// for every direction of the sun's disc: centred on the sphere's sunward tangent plane,
+// radius R·(1 + 2·tan α)/cos α for a sphere of radius R and a sun of angular radius α.
+// Positions: the R2 low-discrepancy sequence (Roberts 2018, the plastic number's
+// additive recurrence) rotated by the seed (Cranley–Patterson) and mapped to the disc by
+// the concentric map (Shirley & Chiu 1997), so shadow vectors come out evenly spread
+// instead of Poisson-clumped: the sector test of the clustering sees the occluder's
+// edges, not the emitter's noise. Directions: uniform over the sun's disc (cos θ uniform
+// in [cos α, 1], 1 − cos θ drawn as u·2·sin²(α/2): 1 − cos α in double would keep only
+// ~11 of its 16 digits at the sun's 4.7 mrad). Photon i's numbers depend only on
+// (seed, i), so the result is the same for every thread count.
+//
+// Each photon is traced through the plants' exact frusta (Embree, frustum_accel.h; no
+// relief: the shadow of a bark relief a centimetre deep is below the cones' resolution).
+// At the first frustum it hits it leaves a shadow vector where it exits that frustum's
+// solid (frustum_solid_interval; Fig. 2b: on the occluder's far side), with its
+// direction and the frustum's index. Photons that hit nothing leave nothing.
+//
+// Units and frames: world space, metres, Y up; the vectors' float positions are
+// relative to the bounding sphere's centre (ShadowVectors::origin).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/cpu/render_cpu.h"  // SceneGeometry
+#include "core/render_types.h"
+#include "core/scene.h"
+#include "core/shadow_cones.h"
+#include "core/skin.h"
+#include "core/surface.h"
+
+namespace sylva {
+
+struct SunPhotonOptions {
+  uint64_t photons = 1'000'000;             // photons emitted, >= 0
+  uint64_t seed = 0;                        // the sequence's rotation and the directions' stream
+  unsigned threads = 0;                     // 0: every core
+  const std::atomic<bool>* cancel = nullptr;  // set to stop early (the result says so)
+  bool occupancy_mask = true;  // skip photons the sun-frame mask proves to miss (false:
+                               // trace every photon; the vectors are the same, tested)
+};
+
+// The emitter of a set of frusta under a sun.
+struct SunEmitter {
+  glm::dvec3 centre{0, 0, 0};     // the plants' bounding sphere
+  double sphere_radius_m = 0;
+  glm::dvec3 to_sun{0, 1, 0};     // unit, toward the sun's centre
+  double sun_radius_rad = 0;      // α
+  glm::dvec3 disc_centre{0, 0, 0};
+  double disc_radius_m = 0;
+};
+
+// The emitter for `frusta` (empty: a zero sphere) under `sun`.
+SunEmitter sun_emitter(std::span<const Frustum> frusta, const Sun& sun);
+
+struct SunPhotons {
+  ShadowVectors vectors;  // in photon order; origin = the emitter's sphere centre
+  SunEmitter emitter;
+  uint64_t traced = 0;    // photons traced (== options.photons unless cancelled)
+  double seconds = 0;     // wall time of the tracing (not the accelerator's build)
+  double cpu_seconds = 0; // CPU time of the tracing summed over its threads (core-seconds:
+                          // photons per second per core = traced / cpu_seconds, a rate
+                          // that other processes on the machine disturb less than wall time)
+  double build_seconds = 0;  // the accelerator's build
+  bool cancelled = false;
+};
+
+// Traces options.photons sun photons through `frusta` (see the header comment).
+SunPhotons trace_sun_photons(std::span<const Frustum> frusta, const Sun& sun, const SunPhotonOptions& options);
+
+// ---- Automatic cone parameters (sec. 6.1) ----------------------------------------------
+
+// How well a cone set matches the exact shadow, measured on random points of the
+// plants' shadow region (uniform in the bounding sphere's sweep along the sun, from its
+// sunward tangent plane to 2R beyond its far side or the ground), each classified by an
+// exact shadow ray toward the sun's centre.
+struct ConeCoverage {
+  uint64_t points = 0;             // sample points
+  uint64_t shadowed = 0;           // of them in the exact shadow
+  double missed_shadow = 0;        // shadowed points outside every cone / shadowed points
+  double covered_lit = 0;          // lit points inside a cone / shadowed points
+  double error() const { return missed_shadow + covered_lit; }  // symmetric difference / shadow
+};
+
+// One candidate of the automatic choice and what it measured.
+struct ConeCandidate {
+  ConeParams params;
+  ConeCoverage coverage;
+  uint64_t cones = 0;
+};
+
+// What the automatic choice did (--verbose prints it).
+struct AutoConeReport {
+  double density_per_m2 = 0;   // shadow vectors per m² of the emitter disc that hit
+  double spacing_m = 0;        // their mean spacing, 1/sqrt(density)
+  uint64_t window_vectors = 0; // vectors in the trial window the candidates were tried on
+  std::vector<ConeCandidate> candidates;
+  size_t chosen = 0;           // index into candidates
+  double seconds = 0;
+  std::string describe() const;  // a few lines: density, each candidate, the choice
+};
+
+// ---- Photons and cones, once per (plants, sun) -----------------------------------------
+
+struct SunConeOptions {
+  SunPhotonOptions photons;
+  std::optional<ConeParams> params;  // nullopt: automatic (sec. 6.1)
+  uint64_t coverage_points = 20000;  // points of the final coverage measurement (0: none)
+};
+
+// Everything the fog integrator reads (through `cones`) and what it cost.
+struct SunCones {
+  ShadowVectors vectors;
+  ConeSet cones;
+  ConeParams params;                   // the parameters used
+  ConeLimits limits;                   // where the cones end
+  ClusterReport cluster;
+  std::optional<AutoConeReport> automatic;  // set when the parameters were chosen
+  std::optional<ConeCoverage> coverage;     // of the final set (coverage_points > 0)
+  SunEmitter emitter;
+  uint64_t photons = 0;
+  double photon_seconds = 0;  // tracing (and the accelerator's build)
+  double cone_seconds = 0;    // clustering, the choice, the hierarchy, the coverage
+  bool cancelled = false;
+  std::vector<RenderPass> passes;  // "photons", "cone params", "cones", "cone coverage"
+};
+
+// Traces the photons of `scene`'s sun through `geometry`'s frusta and clusters their
+// shadow vectors into cones ending at scene.ground (the length limit: the bounding
+// sphere's sweep, 2R beyond its far side or to the ground). A sun at or below the
+// horizon (no sunlight reaches the fog) traces nothing and gives no cones.
+std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, const Scene& scene,
+                                                const SunConeOptions& options);
+
+}  // namespace sylva
