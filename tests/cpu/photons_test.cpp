@@ -224,7 +224,7 @@ TEST(SunCones, SunBelowTheHorizonTracesNothing) {
   EXPECT_TRUE(c->passes.empty());
 }
 
-TEST(SunCones, AFlatOccludersConesFillItsShadowAndTheChoiceIsTheBestMeasured) {
+TEST(SunCones, AFlatOccludersConesFillItsShadowAndTheChoiceIsAsGoodAsAnyTried) {
   // A short fat cylinder (a table top, radius 1.5, 0.1 thick) at y = 3 under a high sun:
   // its shadow is a slanted cylinder down to the ground.
   Skeleton top = test::cylinder(1.5, 3, 3.1);
@@ -239,7 +239,10 @@ TEST(SunCones, AFlatOccludersConesFillItsShadowAndTheChoiceIsTheBestMeasured) {
   ASSERT_TRUE(c->automatic);
   const AutoConeReport& a = *c->automatic;
   ASSERT_FALSE(a.candidates.empty());
-  for (const ConeCandidate& k : a.candidates) EXPECT_GE(k.coverage.error(), a.candidates[a.chosen].coverage.error());
+  // The descent stops where no neighbour gains more than the noise (0.005): nothing it
+  // tried is better than the choice by more than that.
+  for (const ConeCandidate& k : a.candidates)
+    EXPECT_GE(k.coverage.error(), a.candidates[a.chosen].coverage.error() - 0.005 - 1e-12);
   EXPECT_EQ(c->params.p1, a.candidates[a.chosen].params.p1);
   EXPECT_GT(a.density_per_m2, 0);
   EXPECT_NE(a.describe().find("automatic"), std::string::npos);
