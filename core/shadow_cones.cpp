@@ -63,10 +63,125 @@ FrustumShape cone_local_shape(const ShadowCone& cone) {
   return s;
 }
 
+namespace {
+
+// A half-line or interval bound of t with the boundary that made it (relief.cpp's).
+struct Bounds {
+  double lo = -kInf, hi = kInf;
+  SolidBoundary lo_by = SolidBoundary::range, hi_by = SolidBoundary::range;
+  void at_least(double t, SolidBoundary by) {
+    if (t > lo) lo = t, lo_by = by;
+  }
+  void at_most(double t, SolidBoundary by) {
+    if (t < hi) hi = t, hi_by = by;
+  }
+  bool empty() const { return !(lo <= hi); }
+  // Restricts to a·t >= c; false when nothing is left.
+  bool linear_at_least(double a, double c, SolidBoundary by) {
+    if (a > 0) at_least(c / a, by);
+    else if (a < 0) at_most(c / a, by);
+    else if (!(0 >= c)) return false;
+    return !empty();
+  }
+};
+
+}  // namespace
+
+// frustum_solid_interval (relief.cpp's local_solid_interval) specialised to a cone in its
+// own frame: planes s = 0 and s = end perpendicular to the axis through the origin, so the
+// slab is two linear bounds with exact offsets, and the ray, already moved into the frame
+// by a subtraction exact to half an ulp of its result, is re-centred on the midpoint in
+// plain double (measured on one core: 160 ns a test against the general function's 270,
+// whose compensated re-centring and plane offsets the cone's own frame makes
+// unnecessary; cone tests are most of a camera ray's cone query). Same regrouped
+// discriminant, same root choice, same answers to rounding (the stiff matrix, and the
+// tests against frustum_solid_interval).
+SolidInterval ShadowConeGeometry::interval(const Ray& ray, double t_min, double t_max) const {
+  SolidInterval out;
+  const glm::dvec3& d = ray.direction;
+  const double dd = glm::dot(d, d);
+  if (!(dd > 0)) return out;
+  const glm::dvec3 from_base = ray.origin - base;
+  const double shift = glm::dot((0.5 * end) * axis - from_base, d) / dd;
+  const glm::dvec3 o = from_base + shift * d;
+  const double oy = glm::dot(o, axis), dy = glm::dot(d, axis);
+  Bounds b;
+  if (!b.linear_at_least(dy, -oy, SolidBoundary::lower)) return out;         // s >= 0
+  if (!b.linear_at_least(-dy, oy - end, SolidBoundary::upper)) return out;   // s <= end
+  const double rho = radius0 + slope * oy, slope_dir_y = slope * dy;
+  if (!b.linear_at_least(slope_dir_y, -rho, SolidBoundary::side)) return out;  // r(s) >= 0
+  const glm::dvec3 origin_perp = o - oy * axis, dir_perp = d - dy * axis;
+  const double A = glm::dot(dir_perp, dir_perp) - slope_dir_y * slope_dir_y;
+  const double half_b = glm::dot(origin_perp, dir_perp) - rho * slope_dir_y;
+  const double C = glm::dot(origin_perp, origin_perp) - rho * rho;
+  const glm::dvec3 radial_term = rho * dir_perp - slope_dir_y * origin_perp;
+  const glm::dvec3 moment = glm::cross(origin_perp, dir_perp);
+  const double discriminant = glm::dot(radial_term, radial_term) - glm::dot(moment, moment);
+  if (A == 0) {
+    if (!b.linear_at_least(-2 * half_b, C, SolidBoundary::side)) return out;
+  } else if (!(discriminant >= 0)) {
+    if (A > 0 || std::isnan(discriminant)) return out;  // A < 0: the whole line (near the apex)
+  } else {
+    const double sign_b = half_b >= 0 ? 1.0 : -1.0;
+    const double root = std::sqrt(discriminant);
+    const double q = -(half_b + sign_b * root);
+    double r0 = q / A;
+    // The other root: C/q or the textbook form, the one with the smaller error bound
+    // (relief.cpp says why: a tangent ray re-centred at the tangent point). The textbook
+    // bound is at least ε·|q|/|A| (|q| = |half_b| + √D'), so where ε·(|w⊥|² + ρ²)/|q|
+    // is below that, C/q wins without the rest of the bounds (nearly every ray).
+    const double op2 = glm::dot(origin_perp, origin_perp);
+    bool pair = (op2 + rho * rho) * std::abs(A) <= q * q;
+    if (!pair && q != 0) {
+      constexpr double eps = std::numeric_limits<double>::epsilon();
+      const double dp2 = glm::dot(dir_perp, dir_perp);
+      const double c_error = eps * (op2 + rho * rho);
+      const double half_b_error = eps * (std::sqrt(op2 * dp2) + std::abs(rho * slope_dir_y));
+      const double d_error = eps * (glm::dot(radial_term, radial_term) + glm::dot(moment, moment));
+      const double root_error = d_error / (root + std::sqrt(d_error) + std::numeric_limits<double>::min());
+      const double direct_bound = (eps * (std::abs(half_b) + root) + half_b_error + root_error) / std::abs(A);
+      pair = c_error / std::abs(q) <= direct_bound;
+    }
+    double r1 = pair ? C / q : (-half_b + sign_b * root) / A;
+    if (r1 < r0) std::swap(r0, r1);
+    if (A > 0) {
+      b.at_least(r0, SolidBoundary::side);
+      b.at_most(r1, SolidBoundary::side);
+      if (b.empty()) return out;
+    } else {
+      // Outside the roots; the nappe bound leaves one half-line (the longer where both).
+      Bounds first = b, second = b;
+      first.at_most(r0, SolidBoundary::side);
+      second.at_least(r1, SolidBoundary::side);
+      const bool first_ok = !first.empty(), second_ok = !second.empty();
+      if (!first_ok && !second_ok) return out;
+      if (first_ok && second_ok) b = (first.hi - first.lo >= second.hi - second.lo) ? first : second;
+      else b = first_ok ? first : second;
+    }
+  }
+  if (!std::isfinite(b.lo) || !std::isfinite(b.hi)) return out;
+  out.t_enter = shift + b.lo, out.enter = b.lo_by;
+  out.t_exit = shift + b.hi, out.exit = b.hi_by;
+  if (!(out.t_enter > t_min)) out.t_enter = t_min, out.enter = SolidBoundary::range;
+  if (!(out.t_exit < t_max)) out.t_exit = t_max, out.exit = SolidBoundary::range;
+  out.hit = out.t_enter <= out.t_exit && std::isfinite(out.t_enter) && std::isfinite(out.t_exit);
+  return out;
+}
+
+ShadowConeGeometry cone_geometry(const ShadowCone& cone) {
+  ShadowConeGeometry g;
+  g.base = cone.base;
+  g.axis = cone.axis;
+  g.end = cone.end_s();
+  g.radius0 = cone.radius_base_m;
+  // frustum_shape.h's slope from the end radii (0 at an apex, never below).
+  g.slope = (std::max(0.0, cone.radius_at(g.end)) - cone.radius_base_m) / g.end;
+  return g;
+}
+
 SolidInterval shadow_cone_interval(const Ray& ray, const ShadowCone& cone, double t_min,
                                    double t_max) {
-  const Ray local{ray.origin - cone.base, ray.direction};
-  return frustum_solid_interval(local, cone_local_shape(cone), t_min, t_max);
+  return cone_geometry(cone).interval(ray, t_min, t_max);
 }
 
 void sort_and_merge(std::vector<ConeInterval>& intervals) {
@@ -289,7 +404,7 @@ ConeSet::ConeSet(std::vector<ShadowCone> cones) : cones_(std::move(cones)) {
   local_.reserve(cones_.size());
   std::vector<BuildItem> items(cones_.size());
   for (size_t i = 0; i < cones_.size(); ++i) {
-    local_.push_back({cones_[i].base, cone_local_shape(cones_[i])});
+    local_.push_back(cone_geometry(cones_[i]));
     items[i].box = cone_box(frame_, cones_[i]);
     items[i].centroid = 0.5 * (items[i].box.lo + items[i].box.hi);
   }
@@ -304,9 +419,7 @@ ConeSet::ConeSet(std::vector<ShadowCone> cones) : cones_(std::move(cones)) {
 
 void ConeSet::collect(const Ray& ray, double t_min, double t_max, uint32_t cone,
                       std::vector<ConeInterval>* out) const {
-  const Local& l = local_[cone];
-  const SolidInterval iv =
-      frustum_solid_interval({ray.origin - l.base, ray.direction}, l.shape, t_min, t_max);
+  const SolidInterval iv = local_[cone].interval(ray, t_min, t_max);
   if (iv.hit && iv.t_exit > iv.t_enter) out->push_back({iv.t_enter, iv.t_exit});
 }
 
@@ -365,7 +478,7 @@ bool ConeSet::contains(const glm::dvec3& point) const {
 }
 
 size_t ConeSet::memory_bytes() const {
-  return cones_.capacity() * sizeof(ShadowCone) + local_.capacity() * sizeof(Local) +
+  return cones_.capacity() * sizeof(ShadowCone) + local_.capacity() * sizeof(ShadowConeGeometry) +
          nodes_.capacity() * sizeof(Node) + order_.capacity() * sizeof(uint32_t);
 }
 

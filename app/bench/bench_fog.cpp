@@ -10,6 +10,9 @@
 // the vectors, how much of the exact shadow they miss and how much lit space they cover
 // (ConeCoverage, on random points of the plants' shadow region).
 // The photon rate per core: --per-core-photons photons traced on one thread.
+// The cone query: for each photon count (seed 1), the scene camera's pixel-centre rays
+// (512×384) collect their cone intervals (ConeSet::intervals, the hierarchy), timed on one
+// thread: microseconds per camera ray and merged intervals per ray.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -24,6 +27,7 @@
 #include "app/cli/render_input.h"
 #include "core/cpu/photons.h"
 #include "core/cpu/render_cpu.h"
+#include "core/render_common.h"
 #include "core/util/file_io.h"
 
 namespace sylva::cli {
@@ -216,6 +220,25 @@ int run_bench_fog(const std::vector<std::string>& args) {
                   cov.covered_lit, params_text(c->params).c_str());
       std::fflush(stdout);
       if (seed == 1 && c->automatic) std::cerr << c->automatic->describe();
+      if (seed == 1) {
+        // The camera's rays against the cones, one thread.
+        Scene view = scene;
+        view.width = 512;
+        view.height = 384;
+        std::vector<ConeInterval> intervals;
+        uint64_t total = 0;
+        const auto start = render_common::Clock::now();
+        for (uint32_t y = 0; y < view.height; ++y)
+          for (uint32_t x = 0; x < view.width; ++x) {
+            c->cones.intervals(camera_ray(view, x + 0.5, y + 0.5), 0, 1e30, &intervals);
+            total += intervals.size();
+          }
+        const double seconds = render_common::seconds_since(start);
+        const double rays = double(view.width) * view.height;
+        std::printf("%10s cone query: %.3g us per camera ray (512x384, 1 thread), %.3g intervals per ray, "
+                    "%zu cones, hierarchy depth %u\n",
+                    "", seconds / rays * 1e6, total / rays, c->cones.size(), c->cones.depth());
+      }
     }
   for (const auto& [path, text] : {std::pair{a.csv, csv.str()}, std::pair{a.cones_csv, cones_csv.str()}}) {
     if (auto e = write_file_atomically(path, text)) {

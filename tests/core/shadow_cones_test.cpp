@@ -276,6 +276,46 @@ TEST(ConeInterval, StiffMatrixAgreesWithLongDoubleReference) {
               stats.worst, stats.worst_grazing);
 }
 
+TEST(ConeInterval, AgreesWithTheGeneralFrustumSolidInterval) {
+  // The specialised cone interval against frustum_solid_interval on the same solid
+  // (cone_local_shape), random cones and rays: the same interval to rounding.
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> u(0, 1);
+  auto unit = [&] {
+    std::normal_distribution<double> n;
+    return glm::normalize(glm::dvec3(n(rng), n(rng), n(rng)));
+  };
+  int hits = 0;
+  double worst = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const double r = std::exp(std::log(1e-3) + u(rng) * std::log(1e3));
+    const double tan_theta = (u(rng) - 0.5) * (u(rng) < 0.5 ? 0.02 : 1.0);
+    const double length = std::exp(std::log(1e-2) + u(rng) * std::log(1e5));
+    const glm::dvec3 base = (u(rng) < 0.3 ? 1e5 : 1.0) * unit();
+    const ShadowCone c = make_cone(base, unit(), r, tan_theta, length);
+    const glm::dvec3 target = c.base + u(rng) * c.end_s() * c.axis + 1.2 * r * unit();
+    const Ray ray{target - (3 * (c.end_s() + r) * u(rng) + r) * unit(), glm::normalize(unit())};
+    const Ray aimed{ray.origin, target - ray.origin};
+    for (const Ray& q : {ray, aimed}) {
+      const SolidInterval a = shadow_cone_interval(q, c, 0, kFar);
+      const SolidInterval b = frustum_solid_interval({q.origin - c.base, q.direction}, cone_local_shape(c), 0, kFar);
+      const double scale = std::max(glm::length(q.origin - c.base), c.end_s() + r) / glm::length(q.direction);
+      const double width = std::max(a.hit ? a.t_exit - a.t_enter : 0, b.hit ? b.t_exit - b.t_enter : 0);
+      if (a.hit != b.hit) {
+        EXPECT_LT(width, 1e-6 * scale) << "hit/miss differ on a wide interval, cone " << i;
+        continue;
+      }
+      if (!a.hit) continue;
+      ++hits;
+      const double e = std::max(std::abs(a.t_enter - b.t_enter), std::abs(a.t_exit - b.t_exit)) / scale;
+      worst = std::max(worst, e);
+      EXPECT_LT(e, 1e-12) << "cone " << i;
+    }
+  }
+  EXPECT_GT(hits, 5000);
+  std::printf("against frustum_solid_interval: %d hits, worst difference %.3g of the scale\n", hits, worst);
+}
+
 TEST(ConeInterval, CylinderCrossedHeadOnHasTheDiameterAsWidth) {
   const ShadowCone c = make_cone({0, 0, 0}, {0, -1, 0}, 0.5, 0, 10);
   const SolidInterval iv = shadow_cone_interval({{3, -4, 0}, {-1, 0, 0}}, c, 0, kFar);
