@@ -628,34 +628,41 @@ void propose(const ShadowVectors& all, const ShadowVectorIndex::Plant& plant, ui
   const glm::vec3 sp = vec(seed).position;
   // Step 1: K, in order of distance, the seed first (a vector at the seed's very
   // position may come before it).
-  const uint32_t* found_index;
-  const float* found_dist;
-  uint32_t found;
-  if (plant.table_p1 >= p.p1) {
-    found_index = &plant.table[size_t(seed) * plant.table_p1];
-    found_dist = &plant.table_dist[size_t(seed) * plant.table_p1];
-    found = std::min(plant.table_count[seed], p.p1);
-  } else {
-    w.neighbours.resize(p.p1);
-    w.dists.resize(p.p1);
-    const float query[3] = {sp.x, sp.y, sp.z};
-    found = static_cast<uint32_t>(plant.tree->knnSearch(query, p.p1, w.neighbours.data(), w.dists.data()));
-    found_index = w.neighbours.data();
-    found_dist = w.dists.data();
-  }
-  w.k.clear();
-  w.k_dist.clear();
-  w.k.push_back(seed);
-  w.k_dist.push_back(0);
-  for (uint32_t i = 0; i < found && w.k.size() < p.p1; ++i) {
-    if (found_index[i] == seed) continue;
-    w.k.push_back(found_index[i]);
-    w.k_dist.push_back(std::sqrt(double(found_dist[i])));
-  }
-  const uint32_t rings = static_cast<uint32_t>((w.k.size() - 1) / p.p3);
-  if (rings == 0) return;
+  // K is gathered in two stages: the seed's first ring (p3 + 1 neighbours, where most
+  // seeds among thin twigs already fail), then, only if that ring passes, all p1.
+  auto gather = [&](uint32_t count) {
+    const uint32_t* found_index;
+    const float* found_dist;
+    uint32_t found;
+    if (plant.table_p1 >= count) {
+      found_index = &plant.table[size_t(seed) * plant.table_p1];
+      found_dist = &plant.table_dist[size_t(seed) * plant.table_p1];
+      found = std::min(plant.table_count[seed], count);
+    } else {
+      w.neighbours.resize(count);
+      w.dists.resize(count);
+      const float query[3] = {sp.x, sp.y, sp.z};
+      found = static_cast<uint32_t>(plant.tree->knnSearch(query, count, w.neighbours.data(), w.dists.data()));
+      found_index = w.neighbours.data();
+      found_dist = w.dists.data();
+    }
+    w.k.clear();
+    w.k_dist.clear();
+    w.k.push_back(seed);
+    w.k_dist.push_back(0);
+    for (uint32_t i = 0; i < found && w.k.size() < count; ++i) {
+      if (found_index[i] == seed) continue;
+      w.k.push_back(found_index[i]);
+      w.k_dist.push_back(std::sqrt(double(found_dist[i])));
+    }
+  };
+  const uint32_t first = std::min(p.p1, p.p3 + 1);
+  gather(first);
+  if (w.k.size() < p.p3 + 1) return;  // not even one ring
 
-  // Step 2: the plane perpendicular to K's mean direction, and each vector's sector.
+  // Step 2: the plane perpendicular to the mean direction (of the seed and its first
+  // ring: sunlight's directions differ by the sun's radius, so which vectors it averages
+  // moves the plane by less than that), and each vector's sector in it.
   glm::dvec3 mean{0, 0, 0};
   for (uint32_t v : w.k) mean += to_d(vec(v).direction);
   if (!(glm::length(mean) > 0)) return;
@@ -666,8 +673,13 @@ void propose(const ShadowVectors& all, const ShadowVectorIndex::Plant& plant, ui
   // Steps 3–4: rings of p3 vectors, the index of dispersion of their sector counts.
   w.counts.assign(p.p2, 0);
   const double expected = double(p.p3) / p.p2;
-  uint32_t passed = 0;
+  uint32_t passed = 0, rings = 1;
   for (uint32_t ring = 1; ring <= rings; ++ring) {
+    if (ring == 2) {
+      gather(p.p1);  // the first ring passed: the rest of K
+      rings = static_cast<uint32_t>((w.k.size() - 1) / p.p3);
+      if (rings < 2) break;
+    }
     std::fill(w.counts.begin(), w.counts.end(), 0u);
     for (uint32_t i = (ring - 1) * p.p3 + 1; i <= ring * p.p3; ++i) {
       const glm::dvec3 q = to_d(vec(w.k[i]).position) - seed_p;
@@ -680,6 +692,7 @@ void propose(const ShadowVectors& all, const ShadowVectorIndex::Plant& plant, ui
     variance /= p.p2;
     if (variance / expected > p.variance_threshold) break;
     passed = ring;
+    if (ring == 1 && p.p1 > first) rings = 2;  // go on to gather the rest
   }
   if (passed == 0) return;
   const uint32_t candidates = passed * p.p3 + 1;

@@ -28,9 +28,13 @@
 //      earlier cones spans those cones' holes, whose scattered rims pass the sector test,
 //      and grows cones across the occluder's edge: measured, a 0.6 m cone from 25
 //      vectors on a 1 m disc, 52% of the shadow's volume covered again outside it.)
-//   2. The mean direction of K; each vector of K gets an angle around it (its position
-//      relative to the seed, projected into the plane perpendicular to the mean
-//      direction) and falls into one of p2 equal angular sectors.
+//   2. The mean direction of the seed and its first ring (below); each vector of K gets
+//      an angle around it (its position relative to the seed, projected into the plane
+//      perpendicular to the mean direction) and falls into one of p2 equal angular
+//      sectors. (Sunlight's directions differ by the sun's radius, so which of K's
+//      vectors the mean takes tilts the plane by less than that; taking the first ring's
+//      lets K be gathered in two stages, the first ring and then, only if it passes, the
+//      rest: most seeds among thin twigs fail at the first ring.)
 //   3. Rings of p3 vectors each, outwards from the seed in the order of K (the paper's
 //      "p3, the number of points per sector test, which determines r1..rk"): ring k holds
 //      K[(k−1)·p3 + 1 .. k·p3] and reaches out to r_k, the distance of its last vector.
