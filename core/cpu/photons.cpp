@@ -117,7 +117,7 @@ bool parallel_chunks(uint64_t chunks, unsigned threads, const std::atomic<bool>*
 // The tests check that the mask changes no shadow vector.
 class SunMask {
  public:
-  SunMask(std::span<const Frustum> frusta, const SunEmitter& e) : frame_(axis_frame(e.to_sun)), e_(e) {
+  SunMask(std::span<const Frustum> frusta, const SunEmitter& e, unsigned threads) : frame_(axis_frame(e.to_sun)), e_(e) {
     struct Capsule {
       glm::dvec2 a, b;
       double radius, z0, z1;
@@ -161,18 +161,29 @@ class SunMask {
     thickness_ = std::max(1e-9, (z_hi - z_lo) / slabs_) * (1 + 1e-9);
     const double drift = 0.5 * thickness_ * tan_a * 1.001 + 1e-9;
     cells_.assign(size_t(nx_) * ny_, 0);
-    for (const Capsule& c : capsules) {
-      const uint32_t s0 = slab_of(c.z0), s1 = slab_of(c.z1);
-      const uint32_t bits = static_cast<uint32_t>(((uint64_t(1) << (s1 + 1)) - 1) & ~((uint64_t(1) << s0) - 1));
-      const double r = c.radius + drift + cell_ * 0.7072;
-      const glm::dvec2 box_lo = glm::min(c.a, c.b) - r, box_hi = glm::max(c.a, c.b) + r;
-      const uint32_t x0 = cell_x(box_lo.x), x1 = cell_x(box_hi.x), y0 = cell_y(box_lo.y), y1 = cell_y(box_hi.y);
-      for (uint32_t y = y0; y <= y1; ++y)
-        for (uint32_t x = x0; x <= x1; ++x) {
-          const glm::dvec2 centre = lo_ + (glm::dvec2(x, y) + 0.5) * cell_;
-          if (segment_distance(centre, c.a, c.b) <= r) cells_[size_t(y) * nx_ + x] |= bits;
-        }
-    }
+    // Rows of cells in bands, one band per thread (every band reads every capsule).
+    const unsigned bands = std::max(1u, std::min(threads, ny_ / 16 + 1));
+    auto rasterise = [&](uint32_t row_begin, uint32_t row_end) {
+      for (const Capsule& c : capsules) {
+        const uint32_t s0 = slab_of(c.z0), s1 = slab_of(c.z1);
+        const uint32_t bits = static_cast<uint32_t>(((uint64_t(1) << (s1 + 1)) - 1) & ~((uint64_t(1) << s0) - 1));
+        const double r = c.radius + drift + cell_ * 0.7072;
+        const glm::dvec2 box_lo = glm::min(c.a, c.b) - r, box_hi = glm::max(c.a, c.b) + r;
+        const uint32_t y0 = std::max(row_begin, cell_y(box_lo.y)), y1 = std::min(row_end - 1, cell_y(box_hi.y));
+        if (y0 > y1 || cell_y(box_lo.y) >= row_end || cell_y(box_hi.y) < row_begin) continue;
+        const uint32_t x0 = cell_x(box_lo.x), x1 = cell_x(box_hi.x);
+        for (uint32_t y = y0; y <= y1; ++y)
+          for (uint32_t x = x0; x <= x1; ++x) {
+            const glm::dvec2 centre = lo_ + (glm::dvec2(x, y) + 0.5) * cell_;
+            if (segment_distance(centre, c.a, c.b) <= r) cells_[size_t(y) * nx_ + x] |= bits;
+          }
+      }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned b = 1; b < bands; ++b)
+      pool.emplace_back(rasterise, uint32_t(uint64_t(ny_) * b / bands), uint32_t(uint64_t(ny_) * (b + 1) / bands));
+    rasterise(0, uint32_t(uint64_t(ny_) / bands));
+    for (std::thread& t : pool) t.join();
     // The coarse bitmap, keyed by the position at the middle depth: grown by the drift
     // from there to either end of the depth range, in coarse cells, and one more.
     z_mid_ = 0.5 * (z_lo + z_hi);
@@ -331,20 +342,50 @@ SunPhotons trace_photons(const FrustumAccel& accel, const SunMask& mask, std::sp
 
 }  // namespace
 
-SunPhotons trace_sun_photons(std::span<const Frustum> frusta, const Sun& sun, const SunPhotonOptions& options) {
-  const SunEmitter e = sun_emitter(frusta, sun);
-  if (frusta.empty() || options.photons == 0) {
+struct SunPhotonTracer::Impl {
+  std::span<const Frustum> frusta;
+  SunEmitter emitter;
+  std::optional<FrustumAccel> accel;  // none without frusta
+  std::optional<SunMask> mask;
+  double build_seconds = 0;
+};
+
+SunPhotonTracer::SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun, unsigned threads)
+    : impl_(std::make_unique<Impl>()) {
+  const Clock::time_point start = Clock::now();
+  impl_->frusta = frusta;
+  impl_->emitter = sun_emitter(frusta, sun);
+  if (!frusta.empty()) {
+    impl_->accel.emplace(frusta);
+    impl_->mask.emplace(frusta, impl_->emitter, thread_count(threads));
+  }
+  impl_->build_seconds = seconds_since(start);
+}
+
+SunPhotonTracer::~SunPhotonTracer() = default;
+
+const SunEmitter& SunPhotonTracer::emitter() const { return impl_->emitter; }
+double SunPhotonTracer::build_seconds() const { return impl_->build_seconds; }
+std::span<const Frustum> SunPhotonTracer::frusta() const { return impl_->frusta; }
+
+SunPhotons SunPhotonTracer::trace(const SunPhotonOptions& options) const {
+  if (!impl_->accel) {
     SunPhotons out;
-    out.emitter = e;
-    out.vectors.origin = e.centre;
+    out.emitter = impl_->emitter;
+    out.vectors.origin = impl_->emitter.centre;
     return out;
   }
-  const Clock::time_point build_start = Clock::now();
-  const FrustumAccel accel(frusta);
-  const SunMask mask(frusta, e);
-  const double build_s = seconds_since(build_start);
-  SunPhotons out = trace_photons(accel, mask, frusta, e, options);
-  out.build_seconds = build_s;
+  return trace_photons(*impl_->accel, *impl_->mask, impl_->frusta, impl_->emitter, options);
+}
+
+bool SunPhotonTracer::toward_sun_blocked(const glm::dvec3& point) const {
+  return impl_->accel && impl_->accel->any({point, impl_->emitter.to_sun}, 0, kInf);
+}
+
+SunPhotons trace_sun_photons(std::span<const Frustum> frusta, const Sun& sun, const SunPhotonOptions& options) {
+  const SunPhotonTracer tracer(frusta, sun, options.threads);
+  SunPhotons out = tracer.trace(options);
+  out.build_seconds = tracer.build_seconds();
   return out;
 }
 
@@ -369,9 +410,10 @@ struct Window {
 // tangent plane to 2R beyond its far side, above the ground; drawn until `min_shadowed`
 // are in the exact shadow (a ray toward the sun's centre hits a frustum) or `max_points`
 // were drawn. Deterministic for `seed`.
-ShadowSamples sample_shadow_region(const FrustumAccel& accel, const SunEmitter& e, const Window& w, double ground,
+ShadowSamples sample_shadow_region(const SunPhotonTracer& tracer, const Window& w, double ground,
                                    uint64_t max_points, uint64_t min_shadowed, uint64_t seed) {
   ShadowSamples out;
+  const SunEmitter& e = tracer.emitter();
   const AxisFrame f = axis_frame(e.to_sun);
   const double depth = 4 * e.sphere_radius_m;
   const glm::dvec3 top = e.centre + e.sphere_radius_m * e.to_sun;
@@ -388,7 +430,7 @@ ShadowSamples sample_shadow_region(const FrustumAccel& accel, const SunEmitter& 
     }
     const glm::dvec3 p = top + a * f.e0 + b * f.e1 - depth * rng.next_double() * e.to_sun;
     if (p.y < ground) continue;
-    const bool shadowed = accel.any({p, e.to_sun}, 0, kInf);
+    const bool shadowed = tracer.toward_sun_blocked(p);
     out.points.push_back(p);
     out.shadowed.push_back(shadowed);
     out.shadowed_count += shadowed;
@@ -440,14 +482,15 @@ ConeParams params_at(const std::array<int, kAxes>& g) {
 
 // Sec. 6.1: the parameters that minimise the measured error (miss_weight·missed shadow +
 // covered lit space) on a window of about kWindowVectors vectors at the full density.
-constexpr uint64_t kWindowVectors = 12000;
+constexpr uint64_t kWindowVectors = 8000;
 
-AutoConeReport choose_cone_params(const FrustumAccel& accel, const ShadowVectors& vectors,
+AutoConeReport choose_cone_params(const SunPhotonTracer& tracer, const ShadowVectors& vectors,
                                   std::span<const uint32_t> plant_of_frustum, const ConeLimits& limits,
-                                  const SunEmitter& e, uint64_t photons, double ground, uint64_t seed,
+                                  uint64_t photons, double ground, uint64_t seed,
                                   double miss_weight, unsigned threads) {
   AutoConeReport report;
   report.miss_weight = miss_weight;
+  const SunEmitter& e = tracer.emitter();
   const Clock::time_point start = Clock::now();
   report.density_per_m2 = photons / (kPi * e.disc_radius_m * e.disc_radius_m);
   report.spacing_m = report.density_per_m2 > 0 ? 1 / std::sqrt(report.density_per_m2) : 0;
@@ -484,7 +527,7 @@ AutoConeReport choose_cone_params(const FrustumAccel& accel, const ShadowVectors
   const double margin = 2 * report.spacing_m * std::sqrt(p1_max / kPi);
   Window inner = w;
   inner.half_size = std::max(0.5 * w.half_size, w.half_size - margin);
-  const ShadowSamples samples = sample_shadow_region(accel, e, inner, ground, 40000, 2000, seed);
+  const ShadowSamples samples = sample_shadow_region(tracer, inner, ground, 40000, 2000, seed);
   // Every candidate's K is a prefix of the largest: neighbours found once.
   const ShadowVectorIndex index(window, plant_of_frustum, p1_max, threads);
   std::map<std::array<int, kAxes>, size_t> tried;  // grid point → candidate
@@ -553,7 +596,7 @@ std::string AutoConeReport::describe() const {
 // ---- Photons and cones -----------------------------------------------------------------
 
 std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, const Scene& scene,
-                                                const SunConeOptions& options) {
+                                                const SunConeOptions& options, const SunPhotonTracer* tracer) {
   auto out = std::make_unique<SunCones>();
   out->emitter = sun_emitter(geometry.frusta, scene.sun);
   const SunEmitter& e = out->emitter;
@@ -561,9 +604,9 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
   if (!(e.to_sun.y > 0) || geometry.frusta.empty() || options.photons.photons == 0) return out;
 
   const Clock::time_point start = Clock::now();
-  const FrustumAccel accel(geometry.frusta);
-  const SunMask mask(geometry.frusta, e);
-  SunPhotons photons = trace_photons(accel, mask, geometry.frusta, e, options.photons);
+  std::optional<SunPhotonTracer> own;
+  if (!tracer) tracer = &own.emplace(geometry.frusta, scene.sun, options.photons.threads);
+  SunPhotons photons = tracer->trace(options.photons);
   out->photon_seconds = seconds_since(start);
   out->photons = photons.traced;
   out->cancelled = photons.cancelled;
@@ -586,7 +629,7 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
       std::min(1e6, std::max(0.0, top - ground) / std::max(e.to_sun.y, 1e-3) + 2 * e.sphere_radius_m + 1e-3);
   if (!options.params && !out->vectors.vectors.empty()) {
     const Clock::time_point t = Clock::now();
-    out->automatic = choose_cone_params(accel, out->vectors, geometry.plant_of_frustum, out->limits, e,
+    out->automatic = choose_cone_params(*tracer, out->vectors, geometry.plant_of_frustum, out->limits,
                                         out->photons, ground, options.photons.seed, options.miss_weight,
                                         options.photons.threads);
     out->params = out->automatic->candidates[out->automatic->chosen].params;
@@ -608,7 +651,7 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
   if (options.coverage_points > 0) {
     const Clock::time_point t = Clock::now();
     const ShadowSamples samples =
-        sample_shadow_region(accel, e, Window{}, ground, options.coverage_points, options.coverage_points,
+        sample_shadow_region(*tracer, Window{}, ground, options.coverage_points, options.coverage_points,
                              options.photons.seed + 1);
     out->coverage = measure_coverage(out->cones, samples);
     std::snprintf(detail, sizeof detail, "%llu points, %llu shadowed: missed shadow %.4f, covered lit %.4f",

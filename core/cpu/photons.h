@@ -71,18 +71,42 @@ struct SunPhotons {
   double cpu_seconds = 0; // CPU time of the tracing summed over its threads (core-seconds:
                           // photons per second per core = traced / cpu_seconds, a rate
                           // that other processes on the machine disturb less than wall time)
-  double build_seconds = 0;  // the accelerator's build
+  double build_seconds = 0;  // the accelerator's and the mask's build
   bool cancelled = false;
 };
 
-// Traces options.photons sun photons through `frusta` (see the header comment).
+// The plants as the sun's photons see them, built once per (plants, sun) and reused by
+// every trace (seeds, photon counts): Embree over the exact frusta (frustum_accel.h) and
+// the sun-frame occupancy mask (photons.cpp), built on `threads` threads (0: every
+// core). `frusta` must outlive it, unchanged. Thread-safe (const).
+class SunPhotonTracer {
+ public:
+  SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun, unsigned threads = 0);
+  ~SunPhotonTracer();
+  SunPhotonTracer(const SunPhotonTracer&) = delete;
+  SunPhotonTracer& operator=(const SunPhotonTracer&) = delete;
+
+  // options.photons sun photons (see the header comment); build_seconds is left 0.
+  SunPhotons trace(const SunPhotonOptions& options) const;
+  // Whether a frustum blocks the sun's centre from `point` (an exact shadow ray).
+  bool toward_sun_blocked(const glm::dvec3& point) const;
+  const SunEmitter& emitter() const;
+  double build_seconds() const;  // the accelerator's and the mask's
+  std::span<const Frustum> frusta() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// SunPhotonTracer(frusta, sun).trace(options), with build_seconds set.
 SunPhotons trace_sun_photons(std::span<const Frustum> frusta, const Sun& sun, const SunPhotonOptions& options);
 
 // ---- Automatic cone parameters (sec. 6.1) ----------------------------------------------
 //
 // The paper chose p1..p4 by hand and left their automatic choice as future work. Here
 // they are chosen by measurement at the photons' own density: on a square window of the
-// emitter plane around the vectors' median, holding about 12000 of them (the density is
+// emitter plane around the vectors' median, holding about 8000 of them (the density is
 // the full one, so the choice holds for all), candidates are clustered and each is
 // measured on random points of the window's shadow region (ConeCoverage); a coordinate
 // descent over a grid (p3 ∈ {6..32} vectors per ring, p2 ∈ {4..16} sectors, threshold
@@ -154,8 +178,11 @@ struct SunCones {
 // Traces the photons of `scene`'s sun through `geometry`'s frusta and clusters their
 // shadow vectors into cones ending at scene.ground (the length limit: the bounding
 // sphere's sweep, 2R beyond its far side or to the ground). A sun at or below the
-// horizon (no sunlight reaches the fog) traces nothing and gives no cones.
+// horizon (no sunlight reaches the fog) traces nothing and gives no cones. `tracer`, when
+// given, must be built over geometry.frusta and scene.sun (several photon counts or seeds
+// then share its build); null: one is built here (its build counted in photon_seconds).
 std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, const Scene& scene,
-                                                const SunConeOptions& options);
+                                                const SunConeOptions& options,
+                                                const SunPhotonTracer* tracer = nullptr);
 
 }  // namespace sylva
