@@ -86,7 +86,8 @@ int run_bench(const std::vector<std::string>& args) {
                  "       sylva bench raycast [PRESET] [--width W --height H] [--csv FILE] [--quick]\n"
                  "       sylva bench geometry INPUT [--width W --height H] [--csv FILE] [--plot FILE] [--quick]\n"
                  "       sylva bench gpu [INPUT...] [--width W --height H] [--frames N] [--methods LIST]\n"
-                 "                       [--csv FILE] [--plot FILE] [--quick]\n\n"
+                 "                       [--csv FILE] [--plot FILE] [--quick]\n"
+                 "       sylva bench fog SCENE [--photons LIST] [--seeds N] [--csv FILE] [--quick]\n\n"
                  "Derivation throughput (modules produced per second, one thread) for ABOP 1.24a,\n"
                  "Honda's tree (ABOP 2.6) and ABOP 1.31a; turtle segments per second; peak bytes\n"
                  "per module; memcpy bandwidth in the same run. --quick uses small sizes (a smoke\n"
@@ -98,14 +99,17 @@ int run_bench(const std::vector<std::string>& args) {
                  "(CSV and a log-log plot); `sylva bench geometry --help` for details.\n"
                  "gpu: GPU time per frame (timer queries) and error of the GL backend's ray casting,\n"
                  "relief mapping, meshes and animated skeletons, at 1024x768 and 1920x1080 (CSV and\n"
-                 "a log-log plot); `sylva bench gpu --help` for details.\n";
+                 "a log-log plot); `sylva bench gpu --help` for details.\n"
+                 "fog: sun photons and shadow cones (time, cones, the shadow they miss and the lit\n"
+                 "space they cover) against the photon count; `sylva bench fog --help` for details.\n";
     return args.empty() ? kUsageError : kOk;
   }
   if (args[0] == "raycast") return run_bench_raycast(args);
   if (args[0] == "geometry") return run_bench_geometry(args);
   if (args[0] == "gpu") return run_bench_gpu(args);
+  if (args[0] == "fog") return run_bench_fog(args);
   if (args[0] != "lsystem")
-    throw UsageError{"unknown benchmark '" + args[0] + "' (available: lsystem, raycast, geometry, gpu)"};
+    throw UsageError{"unknown benchmark '" + args[0] + "' (available: lsystem, raycast, geometry, gpu, fog)"};
   bool quick = false;
   std::string presets = SYLVA_PRESETS_DIR;
   std::vector<std::string> gb_args = {"sylva-bench"};

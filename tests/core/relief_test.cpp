@@ -202,6 +202,30 @@ TEST(FrustumSolidInterval, MissesForRejectedShapesAndEmptyRanges) {
   EXPECT_FALSE(frustum_solid_interval(ray, s, 0, 100).hit);
 }
 
+TEST(FrustumSolidInterval, TangentRayTouchesAtAPointNotAChord) {
+  // A ray perpendicular to the axis at distance r(y) from it, re-centred at the tangent
+  // point, where half_b and the discriminant are both rounding noise: the interval is at
+  // most sqrt(ε)-wide (the problem's conditioning), not C/q's noise over noise (a chord
+  // 27% of the radius wide before the root choice in local_solid_interval).
+  FrustumShape s;
+  s.axis = glm::normalize(glm::dvec3(0.3, -1, 0.2));
+  s.base = {0, 0, 0};
+  s.length = 1;
+  s.radius0 = 1;
+  s.radius1 = 1 + std::tan(0.2679 * kPi / 180);
+  s.lower = {s.axis, 0};
+  s.upper = {s.axis, 1};
+  const AxisFrame f = axis_frame(s.axis);
+  const glm::dvec3 world_base{0.1, 7, 0.3};
+  const double away = 3 * (s.length + s.radius1);
+  const glm::dvec3 p = world_base + 0.5 * s.axis + s.radius_at(0.5) * f.e1;  // on the side
+  const SolidInterval iv = frustum_solid_interval({p + away * f.e0 - world_base, -f.e0}, s, 0, 1e30);
+  if (iv.hit) {
+    EXPECT_LT(iv.t_exit - iv.t_enter, 1e-7);
+    EXPECT_NEAR(iv.t_enter, away, 1e-7);
+  }
+}
+
 // A fixed set of rays at a random shape with relief, and the relief map around it.
 struct ReliefCase {
   Frustum frustum;

@@ -1,0 +1,667 @@
+// photons.cpp — sun photons, shadow vectors (paper 002 sec. 3.1, Fig. 2b), the automatic
+// choice of the cone parameters (sec. 6.1, the paper's future work) and the cones built
+// once per (plants, sun). See photons.h for the contract.
+#include "core/cpu/photons.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <glm/geometric.hpp>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <thread>
+#include <time.h>
+
+#include "core/cpu/bvh.h"  // frustum_bounds
+#include "core/cpu/frustum_accel.h"
+#include "core/cpu/render_cpu.h"
+#include "core/render_common.h"
+#include "core/relief.h"
+#include "core/util/math.h"
+#include "lsystem/random.h"
+
+namespace sylva {
+namespace {
+
+using render_common::Clock;
+using render_common::seconds_since;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr uint64_t kChunk = 1u << 15;  // photons per work item (cancellation granularity)
+
+// R2 (Roberts 2018): x_i = frac(offset + i·(1/g, 1/g²)), g the plastic number, in 64-bit
+// fixed point so that photon 10⁹ is as exact as photon 1.
+constexpr uint64_t kR2Step0 = 0xC13FA9A902A6328FULL;  // 2^64 / g
+constexpr uint64_t kR2Step1 = 0x91E10DA5C79E7B1CULL;  // 2^64 / g²
+
+// CPU time of this process, all threads (seconds).
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+double unit_from_fixed(uint64_t x) { return static_cast<double>(x >> 11) * 0x1.0p-53; }
+
+// Shirley & Chiu's concentric map of [0,1)² onto the unit disc (area-preserving).
+glm::dvec2 concentric_disc(double u, double v) {
+  const double a = 2 * u - 1, b = 2 * v - 1;
+  if (a == 0 && b == 0) return {0, 0};
+  double r, phi;
+  if (std::abs(a) > std::abs(b)) {
+    r = a;
+    phi = (kPi / 4) * (b / a);
+  } else {
+    r = b;
+    phi = kPi / 2 - (kPi / 4) * (a / b);
+  }
+  return {r * std::cos(phi), r * std::sin(phi)};
+}
+
+// The photon's direction, away from the sun: uniform over the disc of angular radius α
+// around `to_sun` (one_minus_cos_alpha = 2·sin²(α/2)). With (x, y) uniform in the unit
+// disc (by rejection: no trigonometry) and h = (x² + y²)·(1 − cos α) = 1 − cos θ, which is
+// then uniform in [0, 1 − cos α] (uniform in solid angle), the direction is
+// (1 − h)·s + sin θ·(x, y)/ρ with sin θ/ρ = sqrt((1 − cos α)·(2 − h)).
+glm::dvec3 photon_direction(const glm::dvec3& to_sun, const AxisFrame& f, double one_minus_cos_alpha, lsys::Rng& rng) {
+  if (one_minus_cos_alpha == 0) return -to_sun;
+  double x, y;
+  do {
+    x = 2 * rng.next_double() - 1;
+    y = 2 * rng.next_double() - 1;
+  } while (x * x + y * y > 1);
+  const double h = (x * x + y * y) * one_minus_cos_alpha;
+  const double lateral = std::sqrt(one_minus_cos_alpha * (2 - h));
+  return -((1 - h) * to_sun + lateral * (x * f.e0 + y * f.e1));
+}
+
+unsigned thread_count(unsigned requested) {
+  return requested ? requested : std::max(1u, std::thread::hardware_concurrency());
+}
+
+// Runs work(chunk) for chunks [0, chunks) on `threads` threads; stops handing out chunks
+// once `cancel` is set. Returns whether every chunk ran.
+template <class Work>
+bool parallel_chunks(uint64_t chunks, unsigned threads, const std::atomic<bool>* cancel, Work&& work) {
+  std::atomic<uint64_t> next{0}, done{0};
+  auto worker = [&] {
+    for (;;) {
+      if (cancel && cancel->load(std::memory_order_relaxed)) return;
+      const uint64_t c = next.fetch_add(1, std::memory_order_relaxed);
+      if (c >= chunks) return;
+      work(c);
+      done.fetch_add(1, std::memory_order_relaxed);
+    }
+  };
+  threads = static_cast<unsigned>(std::min<uint64_t>(threads, std::max<uint64_t>(1, chunks)));
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  return done.load() == chunks;
+}
+
+// A conservative occupancy mask of the plants in the sun's frame, so that the photons
+// that certainly miss every frustum (most of them: a crown is porous) skip Embree.
+// Depth z runs along the photons from the emitter plane; the frusta's depth range is cut
+// into at most 32 slabs, thin enough that a photon drifts sideways by about half a cell
+// within one (tan α per metre of depth). A grid of cells over the plants' lateral extent
+// holds, per cell, one bit per slab: set where a frustum overlapping the slab may be —
+// within the capsule around its projected axis whose radius reaches every vertex of its
+// bounding pyramid (skin.h), grown by the slab's drift and half a cell's diagonal. A
+// photon whose lateral position at every slab's middle falls on a clear bit cannot hit a
+// frustum. The bits of a cell sit in one word (a photon drifts over a few neighbouring
+// cells, so its test touches a cache line or two), and a coarse bitmap (8×8 cells per
+// bit, grown by the whole depth's drift) that fits in L1 answers most photons first.
+// The tests check that the mask changes no shadow vector.
+class SunMask {
+ public:
+  SunMask(std::span<const Frustum> frusta, const SunEmitter& e, unsigned threads) : frame_(axis_frame(e.to_sun)), e_(e) {
+    struct Capsule {
+      glm::dvec2 a, b;
+      double radius, z0, z1;
+    };
+    std::vector<Capsule> capsules;
+    capsules.reserve(frusta.size());
+    glm::dvec2 lo(kInf), hi(-kInf);
+    double z_lo = kInf, z_hi = -kInf;
+    for (const Frustum& f : frusta) {
+      const BoundingPyramid pyramid = bounding_pyramid(f.shape);
+      Capsule c;
+      c.a = lateral(f.shape.base);
+      c.b = lateral(f.shape.base + f.shape.length * f.shape.axis);
+      c.radius = 0;
+      c.z0 = kInf, c.z1 = -kInf;
+      for (const glm::dvec3& v : pyramid.vertices) {
+        c.radius = std::max(c.radius, segment_distance(lateral(v), c.a, c.b));
+        c.z0 = std::min(c.z0, depth(v));
+        c.z1 = std::max(c.z1, depth(v));
+      }
+      c.radius = c.radius * (1 + 1e-9) + 1e-9;
+      lo = glm::min(lo, glm::min(c.a, c.b) - c.radius);
+      hi = glm::max(hi, glm::max(c.a, c.b) + c.radius);
+      z_lo = std::min(z_lo, c.z0);
+      z_hi = std::max(z_hi, c.z1);
+      capsules.push_back(c);
+    }
+    if (capsules.empty()) return;
+    // Cells: the larger extent in kCells, at least a hair (a single thin frustum).
+    const double extent = std::max({hi.x - lo.x, hi.y - lo.y, 1e-6});
+    cell_ = extent / kCells;
+    // A border as wide as the drift over half the depth range: a photon outside the grid
+    // at the middle depth cannot reach an occupied cell at any depth.
+    const double tan_a = std::tan(e.sun_radius_rad);
+    const double border = 0.5 * (z_hi - z_lo) * tan_a * 1.001 + cell_;
+    lo_ = lo - border;
+    nx_ = static_cast<uint32_t>((hi.x + border - lo_.x) / cell_) + 2;
+    ny_ = static_cast<uint32_t>((hi.y + border - lo_.y) / cell_) + 2;
+    slabs_ = static_cast<uint32_t>(std::clamp(std::ceil((z_hi - z_lo) * tan_a / (0.5 * cell_)), 1.0, double(kMaxSlabs)));
+    z0_ = z_lo;
+    thickness_ = std::max(1e-9, (z_hi - z_lo) / slabs_) * (1 + 1e-9);
+    const double drift = 0.5 * thickness_ * tan_a * 1.001 + 1e-9;
+    cells_.assign(size_t(nx_) * ny_, 0);
+    // Rows of cells in bands, one band per thread (every band reads every capsule).
+    const unsigned bands = std::max(1u, std::min(threads, ny_ / 16 + 1));
+    auto rasterise = [&](uint32_t row_begin, uint32_t row_end) {
+      for (const Capsule& c : capsules) {
+        const uint32_t s0 = slab_of(c.z0), s1 = slab_of(c.z1);
+        const uint32_t bits = static_cast<uint32_t>(((uint64_t(1) << (s1 + 1)) - 1) & ~((uint64_t(1) << s0) - 1));
+        const double r = c.radius + drift + cell_ * 0.7072;
+        const glm::dvec2 box_lo = glm::min(c.a, c.b) - r, box_hi = glm::max(c.a, c.b) + r;
+        const uint32_t y0 = std::max(row_begin, cell_y(box_lo.y)), y1 = std::min(row_end - 1, cell_y(box_hi.y));
+        if (y0 > y1 || cell_y(box_lo.y) >= row_end || cell_y(box_hi.y) < row_begin) continue;
+        const uint32_t x0 = cell_x(box_lo.x), x1 = cell_x(box_hi.x);
+        for (uint32_t y = y0; y <= y1; ++y)
+          for (uint32_t x = x0; x <= x1; ++x) {
+            const glm::dvec2 centre = lo_ + (glm::dvec2(x, y) + 0.5) * cell_;
+            if (segment_distance(centre, c.a, c.b) <= r) cells_[size_t(y) * nx_ + x] |= bits;
+          }
+      }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned b = 1; b < bands; ++b)
+      pool.emplace_back(rasterise, uint32_t(uint64_t(ny_) * b / bands), uint32_t(uint64_t(ny_) * (b + 1) / bands));
+    rasterise(0, uint32_t(uint64_t(ny_) / bands));
+    for (std::thread& t : pool) t.join();
+    // The coarse bitmap, keyed by the position at the middle depth: grown by the drift
+    // from there to either end of the depth range, in coarse cells, and one more.
+    z_mid_ = 0.5 * (z_lo + z_hi);
+    cx_ = (nx_ + kCoarse - 1) / kCoarse;
+    cy_ = (ny_ + kCoarse - 1) / kCoarse;
+    coarse_words_ = (cx_ + 63) / 64;
+    coarse_.assign(size_t(cy_) * coarse_words_, 0);
+    const int grow = static_cast<int>(std::ceil(0.5 * (z_hi - z_lo) * tan_a * 1.001 / cell_ / kCoarse)) + 1;
+    std::vector<uint8_t> occupied(size_t(cx_) * cy_, 0);
+    for (uint32_t y = 0; y < ny_; ++y)
+      for (uint32_t x = 0; x < nx_; ++x)
+        if (cells_[size_t(y) * nx_ + x]) occupied[size_t(y / kCoarse) * cx_ + x / kCoarse] = 1;
+    for (int gy = 0; gy < int(cy_); ++gy)
+      for (int gx = 0; gx < int(cx_); ++gx) {
+        if (!occupied[size_t(gy) * cx_ + gx]) continue;
+        for (int yy = std::max(0, gy - grow); yy <= std::min(int(cy_) - 1, gy + grow); ++yy)
+          for (int xx = std::max(0, gx - grow); xx <= std::min(int(cx_) - 1, gx + grow); ++xx)
+            coarse_[size_t(yy) * coarse_words_ + xx / 64] |= 1ull << (xx % 64);
+      }
+  }
+
+  // Whether a photon from `origin` (on the emitter plane) along `direction` may hit.
+  bool may_hit(const glm::dvec3& origin, const glm::dvec3& direction) const {
+    if (cells_.empty()) return false;
+    const double dz = -glm::dot(direction, e_.to_sun);
+    const glm::dvec2 o = (lateral(origin) - lo_) / cell_, d = lateral_direction(direction) / (dz * cell_);
+    const double z_origin = depth(origin);
+    // The coarse test at the middle depth.
+    const glm::dvec2 m = (o + (z_mid_ - z_origin) * d) / double(kCoarse);
+    if (!(m.x >= 0 && m.y >= 0 && m.x < cx_ && m.y < cy_)) return false;
+    const uint32_t mx = static_cast<uint32_t>(m.x), my = static_cast<uint32_t>(m.y);
+    if (!(coarse_[size_t(my) * coarse_words_ + mx / 64] >> (mx % 64) & 1)) return false;
+    // The slabs, at each one's middle.
+    glm::dvec2 p = o + (z0_ + 0.5 * thickness_ - z_origin) * d;
+    const glm::dvec2 step = thickness_ * d;
+    for (uint32_t s = 0; s < slabs_; ++s, p += step) {
+      if (!(p.x >= 0 && p.y >= 0 && p.x < nx_ && p.y < ny_)) continue;
+      const uint32_t x = static_cast<uint32_t>(p.x), y = static_cast<uint32_t>(p.y);
+      if (cells_[size_t(y) * nx_ + x] >> s & 1) return true;
+    }
+    return false;
+  }
+
+  size_t bytes() const { return cells_.size() * sizeof(uint32_t) + coarse_.size() * sizeof(uint64_t); }
+
+ private:
+  static constexpr uint32_t kCells = 2048;
+  static constexpr uint32_t kMaxSlabs = 32;
+  static constexpr uint32_t kCoarse = 8;
+
+  glm::dvec2 lateral(const glm::dvec3& p) const {
+    const glm::dvec3 q = p - e_.disc_centre;
+    return {glm::dot(q, frame_.e0), glm::dot(q, frame_.e1)};
+  }
+  glm::dvec2 lateral_direction(const glm::dvec3& d) const { return {glm::dot(d, frame_.e0), glm::dot(d, frame_.e1)}; }
+  double depth(const glm::dvec3& p) const { return -glm::dot(p - e_.disc_centre, e_.to_sun); }
+  static double segment_distance(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b) {
+    const glm::dvec2 ab = b - a;
+    const double len2 = glm::dot(ab, ab);
+    const double t = len2 > 0 ? std::clamp(glm::dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
+    return glm::length(p - (a + t * ab));
+  }
+  uint32_t cell_x(double x) const { return static_cast<uint32_t>(std::clamp((x - lo_.x) / cell_, 0.0, nx_ - 1.0)); }
+  uint32_t cell_y(double y) const { return static_cast<uint32_t>(std::clamp((y - lo_.y) / cell_, 0.0, ny_ - 1.0)); }
+  uint32_t slab_of(double z) const {
+    return static_cast<uint32_t>(std::clamp((z - z0_) / thickness_, 0.0, slabs_ - 1.0));
+  }
+
+  AxisFrame frame_;
+  SunEmitter e_;
+  glm::dvec2 lo_{0, 0};
+  double cell_ = 1, z0_ = 0, thickness_ = 1, z_mid_ = 0;
+  uint32_t nx_ = 0, ny_ = 0, slabs_ = 0, cx_ = 0, cy_ = 0;
+  size_t coarse_words_ = 0;
+  std::vector<uint32_t> cells_;  // per cell: bit s = slab s may hold a frustum
+  std::vector<uint64_t> coarse_;
+};
+
+}  // namespace
+
+SunEmitter sun_emitter(std::span<const Frustum> frusta, const Sun& sun) {
+  SunEmitter e;
+  glm::dvec3 lo(kInf), hi(-kInf);
+  for (const Frustum& f : frusta) {
+    const Aabb b = frustum_bounds(f.shape);
+    lo = glm::min(lo, b.lo);
+    hi = glm::max(hi, b.hi);
+  }
+  if (!frusta.empty()) {
+    e.centre = 0.5 * (lo + hi);
+    e.sphere_radius_m = 0.5 * glm::length(hi - lo);
+  }
+  e.to_sun = glm::normalize(sun.direction);
+  e.sun_radius_rad = std::max(0.0, sun.angular_radius_deg) * kRadPerDeg;
+  // Every line through the sphere within α of the sun's axis crosses the tangent plane
+  // within R/cos α + 2R·tan α of the disc's centre (its point nearest the centre is within
+  // R of it, and it travels at most 2R/cos α along itself to the plane, drifting sideways
+  // by tan α per unit of depth); a hair more for rounding.
+  const double tan_a = std::tan(e.sun_radius_rad), cos_a = std::cos(e.sun_radius_rad);
+  e.disc_centre = e.centre + e.sphere_radius_m * 1.001 * e.to_sun;
+  e.disc_radius_m = e.sphere_radius_m * (1 + 2 * tan_a) / cos_a * 1.001;
+  return e;
+}
+
+namespace {
+
+// The photons of `e` through `accel` (built over `frusta`), those `mask` clears skipped.
+SunPhotons trace_photons(const FrustumAccel& accel, const SunMask& mask, std::span<const Frustum> frusta,
+                         const SunEmitter& e, const SunPhotonOptions& options) {
+  SunPhotons out;
+  out.emitter = e;
+  out.vectors.origin = e.centre;
+  if (frusta.empty() || options.photons == 0) return out;
+  const Clock::time_point start = Clock::now();
+  const double cpu_start = process_cpu_seconds();
+  const AxisFrame frame = axis_frame(e.to_sun);
+  const double one_minus_cos = 2 * std::pow(std::sin(0.5 * e.sun_radius_rad), 2);
+  const uint64_t offset0 = lsys::mix_pair(options.seed, 0x52325f6f666673ULL);  // the rotation
+  const uint64_t offset1 = lsys::mix_pair(options.seed, 0x52325f6f666674ULL);
+  const uint64_t chunks = (options.photons + kChunk - 1) / kChunk;
+  std::vector<std::vector<ShadowVector>> per_chunk(chunks);
+  std::vector<uint8_t> ran(chunks, 0);
+
+  auto trace_chunk = [&](uint64_t c) {
+    std::vector<ShadowVector>& local = per_chunk[c];
+    const uint64_t end = std::min(options.photons, (c + 1) * kChunk);
+    for (uint64_t i = c * kChunk; i < end; ++i) {
+      const glm::dvec2 q = concentric_disc(unit_from_fixed(offset0 + i * kR2Step0), unit_from_fixed(offset1 + i * kR2Step1));
+      lsys::Rng rng(lsys::mix_pair(options.seed, i));
+      Ray ray;
+      ray.origin = e.disc_centre + e.disc_radius_m * (q.x * frame.e0 + q.y * frame.e1);
+      ray.direction = photon_direction(e.to_sun, frame, one_minus_cos, rng);
+      if (options.occupancy_mask && !mask.may_hit(ray.origin, ray.direction)) continue;
+      const BvhHit hit = accel.nearest(ray, 0, kInf);
+      if (!hit.hit_any()) continue;
+      // Fig. 2b: where the photon leaves the frustum it hit (its convex solid).
+      const SolidInterval solid = frustum_solid_interval(ray, frusta[hit.frustum].shape, 0, kInf);
+      const double t_exit = solid.hit ? std::max(solid.t_exit, hit.hit.t) : hit.hit.t;
+      const glm::dvec3 exit = ray.origin + t_exit * ray.direction;
+      local.push_back({glm::vec3(exit - e.centre), glm::vec3(ray.direction), hit.frustum});
+    }
+    ran[c] = 1;
+  };
+  out.cancelled = !parallel_chunks(chunks, thread_count(options.threads), options.cancel, trace_chunk);
+  size_t total = 0;
+  for (const auto& v : per_chunk) total += v.size();
+  out.vectors.vectors.reserve(total);
+  for (uint64_t c = 0; c < chunks; ++c) {
+    out.vectors.vectors.insert(out.vectors.vectors.end(), per_chunk[c].begin(), per_chunk[c].end());
+    if (ran[c]) out.traced += std::min(options.photons, (c + 1) * kChunk) - c * kChunk;
+  }
+  out.seconds = seconds_since(start);
+  out.cpu_seconds = process_cpu_seconds() - cpu_start;
+  return out;
+}
+
+}  // namespace
+
+struct SunPhotonTracer::Impl {
+  std::span<const Frustum> frusta;
+  SunEmitter emitter;
+  std::optional<FrustumAccel> accel;  // none without frusta
+  std::optional<SunMask> mask;
+  double build_seconds = 0;
+};
+
+SunPhotonTracer::SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun, unsigned threads)
+    : impl_(std::make_unique<Impl>()) {
+  const Clock::time_point start = Clock::now();
+  impl_->frusta = frusta;
+  impl_->emitter = sun_emitter(frusta, sun);
+  if (!frusta.empty()) {
+    impl_->accel.emplace(frusta);
+    impl_->mask.emplace(frusta, impl_->emitter, thread_count(threads));
+  }
+  impl_->build_seconds = seconds_since(start);
+}
+
+SunPhotonTracer::~SunPhotonTracer() = default;
+
+const SunEmitter& SunPhotonTracer::emitter() const { return impl_->emitter; }
+double SunPhotonTracer::build_seconds() const { return impl_->build_seconds; }
+std::span<const Frustum> SunPhotonTracer::frusta() const { return impl_->frusta; }
+
+SunPhotons SunPhotonTracer::trace(const SunPhotonOptions& options) const {
+  if (!impl_->accel) {
+    SunPhotons out;
+    out.emitter = impl_->emitter;
+    out.vectors.origin = impl_->emitter.centre;
+    return out;
+  }
+  return trace_photons(*impl_->accel, *impl_->mask, impl_->frusta, impl_->emitter, options);
+}
+
+bool SunPhotonTracer::toward_sun_blocked(const glm::dvec3& point) const {
+  return impl_->accel && impl_->accel->any({point, impl_->emitter.to_sun}, 0, kInf);
+}
+
+SunPhotons trace_sun_photons(std::span<const Frustum> frusta, const Sun& sun, const SunPhotonOptions& options) {
+  const SunPhotonTracer tracer(frusta, sun, options.threads);
+  SunPhotons out = tracer.trace(options);
+  out.build_seconds = tracer.build_seconds();
+  return out;
+}
+
+// ---- Coverage and the automatic choice -------------------------------------------------
+
+namespace {
+
+// Sample points of a shadow region and whether each is in the exact shadow.
+struct ShadowSamples {
+  std::vector<glm::dvec3> points;
+  std::vector<uint8_t> shadowed;
+  uint64_t shadowed_count = 0;
+};
+
+// A square window of the emitter plane (centre (a, b) in the emitter's frame, half size),
+// or the sphere's whole cross-section (half_size <= 0).
+struct Window {
+  double a = 0, b = 0, half_size = 0;
+};
+
+// Points uniform in the region `window` sweeps along the sun from the sphere's sunward
+// tangent plane to 2R beyond its far side, above the ground; drawn until `min_shadowed`
+// are in the exact shadow (a ray toward the sun's centre hits a frustum) or `max_points`
+// were drawn. Deterministic for `seed`.
+ShadowSamples sample_shadow_region(const SunPhotonTracer& tracer, const Window& w, double ground,
+                                   uint64_t max_points, uint64_t min_shadowed, uint64_t seed) {
+  ShadowSamples out;
+  const SunEmitter& e = tracer.emitter();
+  const AxisFrame f = axis_frame(e.to_sun);
+  const double depth = 4 * e.sphere_radius_m;
+  const glm::dvec3 top = e.centre + e.sphere_radius_m * e.to_sun;
+  lsys::Rng rng(lsys::mix_pair(seed, 0x636f766572616765ULL));
+  for (uint64_t i = 0; i < max_points && out.shadowed_count < min_shadowed; ++i) {
+    double a, b;
+    if (w.half_size > 0) {
+      a = w.a + w.half_size * (2 * rng.next_double() - 1);
+      b = w.b + w.half_size * (2 * rng.next_double() - 1);
+    } else {
+      const glm::dvec2 q = concentric_disc(rng.next_double(), rng.next_double());
+      a = e.sphere_radius_m * q.x;
+      b = e.sphere_radius_m * q.y;
+    }
+    const glm::dvec3 p = top + a * f.e0 + b * f.e1 - depth * rng.next_double() * e.to_sun;
+    if (p.y < ground) continue;
+    const bool shadowed = tracer.toward_sun_blocked(p);
+    out.points.push_back(p);
+    out.shadowed.push_back(shadowed);
+    out.shadowed_count += shadowed;
+  }
+  return out;
+}
+
+ConeCoverage measure_coverage(const ConeSet& cones, const ShadowSamples& samples) {
+  ConeCoverage c;
+  c.points = samples.points.size();
+  c.shadowed = samples.shadowed_count;
+  uint64_t missed = 0, covered_lit = 0;
+  for (size_t i = 0; i < samples.points.size(); ++i) {
+    const bool in = cones.contains(samples.points[i]);
+    if (samples.shadowed[i] && !in) ++missed;
+    if (!samples.shadowed[i] && in) ++covered_lit;
+  }
+  if (c.shadowed > 0) {
+    c.missed_shadow = double(missed) / c.shadowed;
+    c.covered_lit = double(covered_lit) / c.shadowed;
+  }
+  return c;
+}
+
+// The automatic choice's grid: p3 vectors per ring, p2 sectors, the threshold on the
+// index of dispersion, and p4 as a multiple of p3 (a cone takes at least that many new
+// vectors); five rings (p1 = 5·p3 + 1: measured on the pine, 2..8 rings changed the
+// error by less than its noise). Searched by coordinate descent from the middle, a move
+// only for a gain above the measurement's noise (kMinGain).
+constexpr uint32_t kP3[] = {6, 8, 12, 16, 24, 32};
+constexpr uint32_t kP2[] = {4, 6, 8, 12, 16};
+constexpr double kThreshold[] = {1.25, 1.5, 2, 2.5, 3, 4, 6};
+constexpr double kP4PerP3[] = {0.5, 1, 2};
+constexpr uint32_t kRings = 5;
+constexpr int kAxes = 4;
+constexpr int kAxisSize[kAxes] = {6, 5, 7, 3};
+constexpr int kStart[kAxes] = {3, 2, 3, 1};  // p3 16, p2 8, threshold 2.5, p4 = p3
+constexpr double kMinGain = 0.005;           // ≈ the error's noise on 2000 shadowed points
+
+ConeParams params_at(const std::array<int, kAxes>& g) {
+  ConeParams p;
+  p.p3 = kP3[g[0]];
+  p.p2 = kP2[g[1]];
+  p.variance_threshold = kThreshold[g[2]];
+  p.p1 = kRings * p.p3 + 1;
+  p.p4 = std::max(1u, static_cast<uint32_t>(kP4PerP3[g[3]] * p.p3));
+  return p;
+}
+
+// Sec. 6.1: the parameters that minimise the measured error (miss_weight·missed shadow +
+// covered lit space) on a window of about kWindowVectors vectors at the full density.
+constexpr uint64_t kWindowVectors = 8000;
+
+AutoConeReport choose_cone_params(const SunPhotonTracer& tracer, const ShadowVectors& vectors,
+                                  std::span<const uint32_t> plant_of_frustum, const ConeLimits& limits,
+                                  uint64_t photons, double ground, uint64_t seed,
+                                  double miss_weight, unsigned threads) {
+  AutoConeReport report;
+  report.miss_weight = miss_weight;
+  const SunEmitter& e = tracer.emitter();
+  const Clock::time_point start = Clock::now();
+  report.density_per_m2 = photons / (kPi * e.disc_radius_m * e.disc_radius_m);
+  report.spacing_m = report.density_per_m2 > 0 ? 1 / std::sqrt(report.density_per_m2) : 0;
+  const AxisFrame f = axis_frame(e.to_sun);
+  const size_t n = vectors.vectors.size();
+  std::vector<double> a(n), b(n);
+  for (size_t i = 0; i < n; ++i) {
+    const glm::dvec3 p(vectors.vectors[i].position);
+    a[i] = glm::dot(p, f.e0);
+    b[i] = glm::dot(p, f.e1);
+  }
+  // The window: around the median position, as large as kWindowVectors vectors need.
+  Window w;
+  {
+    std::vector<double> sa = a, sb = b;
+    std::nth_element(sa.begin(), sa.begin() + n / 2, sa.end());
+    std::nth_element(sb.begin(), sb.begin() + n / 2, sb.end());
+    w.a = sa[n / 2], w.b = sb[n / 2];
+    std::vector<double> reach(n);
+    for (size_t i = 0; i < n; ++i) reach[i] = std::max(std::abs(a[i] - w.a), std::abs(b[i] - w.b));
+    const size_t k = std::min<size_t>(n, kWindowVectors) - 1;
+    std::nth_element(reach.begin(), reach.begin() + k, reach.end());
+    w.half_size = reach[k];
+  }
+  ShadowVectors window;
+  window.origin = vectors.origin;
+  for (size_t i = 0; i < n; ++i)
+    if (std::abs(a[i] - w.a) <= w.half_size && std::abs(b[i] - w.b) <= w.half_size)
+      window.vectors.push_back(vectors.vectors[i]);
+  report.window_vectors = window.vectors.size();
+  // Points away from the window's border, where cones lack the neighbours outside it:
+  // a margin of twice the largest K's radius at this density (on a flat occluder).
+  const uint32_t p1_max = kRings * kP3[kAxisSize[0] - 1] + 1;
+  const double margin = 2 * report.spacing_m * std::sqrt(p1_max / kPi);
+  Window inner = w;
+  inner.half_size = std::max(0.5 * w.half_size, w.half_size - margin);
+  const ShadowSamples samples = sample_shadow_region(tracer, inner, ground, 40000, 2000, seed);
+  // Every candidate's K is a prefix of the largest: neighbours found once.
+  const ShadowVectorIndex index(window, plant_of_frustum, p1_max, threads);
+  std::map<std::array<int, kAxes>, size_t> tried;  // grid point → candidate
+  auto evaluate = [&](const std::array<int, kAxes>& g) {
+    if (auto it = tried.find(g); it != tried.end()) return it->second;
+    ConeCandidate c;
+    c.params = params_at(g);
+    const std::vector<ShadowCone> cones = index.cluster(c.params, limits, nullptr, nullptr, threads);
+    c.cones = cones.size();
+    c.coverage = measure_coverage(ConeSet(cones), samples);
+    report.candidates.push_back(c);
+    return tried[g] = report.candidates.size() - 1;
+  };
+  auto better = [&](size_t x, size_t y) {  // candidate x clearly better than y
+    return report.candidates[x].coverage.error(miss_weight) <
+           report.candidates[y].coverage.error(miss_weight) - kMinGain;
+  };
+  std::array<int, kAxes> at;
+  std::copy(std::begin(kStart), std::end(kStart), at.begin());
+  size_t best = evaluate(at);
+  for (bool moved = true; moved;) {
+    moved = false;
+    std::array<int, kAxes> next = at;
+    for (int axis = 0; axis < kAxes; ++axis)
+      for (int step : {-1, 1}) {
+        std::array<int, kAxes> g = at;
+        g[axis] += step;
+        if (g[axis] < 0 || g[axis] >= kAxisSize[axis]) continue;
+        const size_t c = evaluate(g);
+        if (better(c, best)) best = c, next = g, moved = true;  // the best neighbour
+      }
+    at = next;
+  }
+  report.chosen = best;
+  report.seconds = seconds_since(start);
+  return report;
+}
+
+std::string params_text(const ConeParams& p) {
+  char line[128];
+  std::snprintf(line, sizeof line, "p1 %u, p2 %u, p3 %u, p4 %u, threshold %.3g", p.p1, p.p2, p.p3, p.p4,
+                p.variance_threshold);
+  return line;
+}
+
+}  // namespace
+
+std::string AutoConeReport::describe() const {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "cone parameters (automatic): %.4g photons/m2 (spacing %.3g mm), %llu vectors in the trial window, "
+                "error = %.3g x missed shadow + covered lit\n",
+                density_per_m2, spacing_m * 1e3, static_cast<unsigned long long>(window_vectors), miss_weight);
+  out += line;
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    const ConeCandidate& c = candidates[i];
+    std::snprintf(line, sizeof line, "  %c %s: %llu cones, missed shadow %.4f, covered lit %.4f\n",
+                  i == chosen ? '*' : ' ', params_text(c.params).c_str(), static_cast<unsigned long long>(c.cones),
+                  c.coverage.missed_shadow, c.coverage.covered_lit);
+    out += line;
+  }
+  return out;
+}
+
+// ---- Photons and cones -----------------------------------------------------------------
+
+std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, const Scene& scene,
+                                                const SunConeOptions& options, const SunPhotonTracer* tracer) {
+  auto out = std::make_unique<SunCones>();
+  out->emitter = sun_emitter(geometry.frusta, scene.sun);
+  const SunEmitter& e = out->emitter;
+  out->params = options.params.value_or(ConeParams{});
+  if (!(e.to_sun.y > 0) || geometry.frusta.empty() || options.photons.photons == 0) return out;
+
+  const Clock::time_point start = Clock::now();
+  std::optional<SunPhotonTracer> own;
+  if (!tracer) tracer = &own.emplace(geometry.frusta, scene.sun, options.photons.threads);
+  SunPhotons photons = tracer->trace(options.photons);
+  out->photon_seconds = seconds_since(start);
+  out->photons = photons.traced;
+  out->cancelled = photons.cancelled;
+  out->vectors = std::move(photons.vectors);
+  char detail[160];
+  std::snprintf(detail, sizeof detail, "%llu photons, %zu shadow vectors, %s",
+                static_cast<unsigned long long>(out->photons), out->vectors.vectors.size(),
+                (std::to_string(thread_count(options.photons.threads)) + " threads").c_str());
+  out->passes.push_back({"photons", out->photon_seconds, detail});
+  if (out->cancelled) return out;
+
+  const Clock::time_point cones_start = Clock::now();
+  const double ground = scene.ground.height;
+  // Cones end below the ground; the length limit only matters for a sun near the
+  // horizon: the sweep from the sphere's top to the ground, and 2R more.
+  const double top = e.centre.y + e.sphere_radius_m;
+  out->limits.ground = true;
+  out->limits.ground_height = ground;
+  out->limits.max_length_m =
+      std::min(1e6, std::max(0.0, top - ground) / std::max(e.to_sun.y, 1e-3) + 2 * e.sphere_radius_m + 1e-3);
+  if (!options.params && !out->vectors.vectors.empty()) {
+    const Clock::time_point t = Clock::now();
+    out->automatic = choose_cone_params(*tracer, out->vectors, geometry.plant_of_frustum, out->limits,
+                                        out->photons, ground, options.photons.seed, options.miss_weight,
+                                        options.photons.threads);
+    out->params = out->automatic->candidates[out->automatic->chosen].params;
+    out->passes.push_back({"cone params", seconds_since(t),
+                           std::to_string(out->automatic->candidates.size()) + " candidates on " +
+                               std::to_string(out->automatic->window_vectors) + " vectors: " +
+                               params_text(out->params)});
+  }
+  {
+    const Clock::time_point t = Clock::now();
+    out->cones = ConeSet(cluster_shadow_cones(out->vectors, geometry.plant_of_frustum, out->params, out->limits,
+                                              &out->cluster, nullptr, options.photons.threads));
+    std::snprintf(detail, sizeof detail, "%llu cones from %llu of %llu vectors (%s)",
+                  static_cast<unsigned long long>(out->cluster.cones),
+                  static_cast<unsigned long long>(out->cluster.covered),
+                  static_cast<unsigned long long>(out->cluster.vectors), params_text(out->params).c_str());
+    out->passes.push_back({"cones", seconds_since(t), detail});
+  }
+  if (options.coverage_points > 0) {
+    const Clock::time_point t = Clock::now();
+    const ShadowSamples samples =
+        sample_shadow_region(*tracer, Window{}, ground, options.coverage_points, options.coverage_points,
+                             options.photons.seed + 1);
+    out->coverage = measure_coverage(out->cones, samples);
+    std::snprintf(detail, sizeof detail, "%llu points, %llu shadowed: missed shadow %.4f, covered lit %.4f",
+                  static_cast<unsigned long long>(out->coverage->points),
+                  static_cast<unsigned long long>(out->coverage->shadowed), out->coverage->missed_shadow,
+                  out->coverage->covered_lit);
+    out->passes.push_back({"cone coverage", seconds_since(t), detail});
+  }
+  out->cone_seconds = seconds_since(cones_start);
+  return out;
+}
+
+}  // namespace sylva

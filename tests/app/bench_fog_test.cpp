@@ -1,0 +1,54 @@
+// `sylva bench fog`: photons and cones end to end on a bundled scene, the CSVs' columns,
+// and its usage errors. (A smoke test on small sizes: speed targets live in the benchmark
+// and docs/benchmarks.md, never in tests.)
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <string>
+
+#include "tests/app/process.h"
+
+namespace {
+
+size_t count_lines_starting(const std::string& text, const std::string& prefix) {
+  std::istringstream in(text);
+  size_t n = 0;
+  for (std::string line; std::getline(in, line);) n += line.rfind(prefix, 0) == 0;
+  return n;
+}
+
+TEST(BenchFog, QuickRunWritesThePhotonAndConeRows) {
+  TempDir dir;
+  const std::string csv = dir.file("pine.fog.csv");
+  auto r = run_process({SYLVA_BINARY, "bench", "fog", "presets/scenes/pine.scene.json", "--quick", "--csv", csv},
+                       SYLVA_SOURCE_DIR, 240);
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.out.find("M photons/s per core"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("cone query"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("cone parameters (automatic)"), std::string::npos) << r.err;
+  const std::string rows = read_file(csv);
+  EXPECT_NE(rows.find("mode,steps,photons,seed,photon_s,cone_s,render_s,total_s,rmse,bias,cones\n"), std::string::npos)
+      << rows;
+  EXPECT_EQ(count_lines_starting(rows, "cones,0,10000,"), 2u) << rows;   // --quick: 2 seeds
+  EXPECT_EQ(count_lines_starting(rows, "cones,0,100000,"), 2u) << rows;
+  const std::string cones = read_file(dir.file("pine.fog-cones.csv"));
+  EXPECT_NE(cones.find("photons,seed,photon_s,cone_s,params_s,cpu_s,params,vectors,covered,cones,missed_shadow,"
+                       "covered_lit,coverage_points,shadowed_points\n"),
+            std::string::npos)
+      << cones;
+  EXPECT_EQ(count_lines_starting(cones, "100000,"), 2u) << cones;
+}
+
+TEST(BenchFog, BadConeParametersAndPhotonCountsAreUsageErrors) {
+  for (const std::vector<std::string>& bad :
+       {std::vector<std::string>{"--cone-params", "1,2,3"}, {"--cone-params", "16,8,24,4"},  // p1 < p3 + 1
+        {"--cone-params", "96,8,24,4,x"}, {"--photons", "0"}, {"--photons", "1e5"}, {"--seeds", "0"}}) {
+    std::vector<std::string> argv = {SYLVA_BINARY, "bench", "fog", "presets/scenes/pine.scene.json"};
+    argv.insert(argv.end(), bad.begin(), bad.end());
+    auto r = run_process(argv, SYLVA_SOURCE_DIR);
+    EXPECT_EQ(r.exit_code, 2) << bad[0] << " " << bad[1] << "\n" << describe(r);
+  }
+}
+
+}  // namespace
