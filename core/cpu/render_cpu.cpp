@@ -7,6 +7,7 @@
 #include "core/fog_integrator.h"
 #include "core/cpu/frustum_tracer.h"
 #include "core/cpu/mesh_accel.h"
+#include "core/cpu/photons.h"
 #include "core/render_common.h"
 #include "core/shading.h"
 #include "core/cpu/texture.h"
@@ -466,14 +467,30 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   if (options.aovs & kAovId) image.id.assign(pixels * 3, 0.0f);
   if ((options.aovs & kAovFog) && scene.fog) image.fog.assign(pixels * 4, 0.0f);
 
-  // The fog (spec/fog.md): only a scene with a `fog` key runs any of it.
+  // The fog (spec/fog.md): only a scene with a `fog` key runs any of it, and only the
+  // modes that read shadow cones trace sun photons (unless the caller brought cones).
   std::optional<FogIntegrator> fog;
+  std::unique_ptr<const SunCones> sun_cones;
+  std::optional<ConeSetFogSource> cone_source;
+  const FogConeSource* cones = options.fog.cones;
   if (scene.fog) {
     FogIntegratorOptions fog_options;
     fog_options.mode = options.fog.mode.value_or(scene.fog->mode);
     fog_options.steps = options.fog.steps.value_or(scene.fog->steps);
-    fog.emplace(fog_medium_of(scene), fog_sun_of(scene.sun), scene.sky, *geometry.tracer, options.fog.cones,
-                fog_options);
+    if (!cones && fog_mode_needs_cones(fog_options.mode)) {
+      sun_cones = build_sun_cones(
+          geometry, scene,
+          sun_cone_options_for(fog_options.mode, options.fog.photons.value_or(scene.fog->photons),
+                               options.fog.cone_params, options.threads, options.cancel));
+      result.passes.insert(result.passes.end(), sun_cones->passes.begin(), sun_cones->passes.end());
+      if (sun_cones->cancelled) {
+        result.cancelled = true;
+        return result;
+      }
+      cone_source.emplace(sun_cones->cones);
+      cones = &*cone_source;
+    }
+    fog.emplace(fog_medium_of(scene), fog_sun_of(scene.sun), scene.sky, *geometry.tracer, cones, fog_options);
   }
 
   const uint32_t tiles_x = (scene.width + kTile - 1) / kTile;
@@ -545,7 +562,10 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
     std::string detail = std::string(fog_mode_name(mode));
     if (options.fog.mode.value_or(scene.fog->mode) == FogMode::automatic) detail += " (auto)";
     detail += ", " + std::to_string(options.fog.steps.value_or(scene.fog->steps)) + " steps";
-    if (cone_mode) detail += options.fog.cones ? ", shadow cones" : ", no shadow cones (every ray searched whole)";
+    if (cone_mode)
+      detail += sun_cones ? ", " + std::to_string(sun_cones->cones.size()) + " shadow cones"
+                : cones   ? ", the caller's shadow cones"
+                          : ", no shadow cones (every ray searched whole)";
     detail += "; " + std::to_string(total.fog_rays) + " rays, " + std::to_string(total.fog_shadow_rays) +
               " shadow rays, " + std::to_string(total.fog_stopped) + " stopped at T < 4e-18";
     result.passes.push_back({"fog (thread time)", total.fog_s, detail});

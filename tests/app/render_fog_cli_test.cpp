@@ -101,9 +101,6 @@ TEST(RenderFogCli, BadFogFlagsAreUsageErrors) {
       {{"--fog-steps", "1000000"}, "--fog-steps 1000000"},
       {{"--fog-steps", "1.5"}, "--fog-steps 1.5"},
       {{"--fog-mode", "warp"}, "--fog-mode warp: expected auto, brute, medium, fast, refined or reference"},
-      {{"--fog-mode", "fast"}, "--fog-mode fast: needs the shadow cones"},
-      {{"--fog-mode", "medium"}, "needs the shadow cones"},
-      {{"--fog-mode", "refined"}, "needs the shadow cones"},
       {{"--cone-params", "96,8,24"}, "--cone-params 96,8,24: expected auto or p1,p2,p3,p4"},
       {{"--cone-params", "96,8,24,16,2"}, "expected auto or p1,p2,p3,p4"},
       {{"--cone-params", "0,0,0,0"}, "expected auto or p1,p2,p3,p4"},
@@ -154,14 +151,32 @@ TEST(RenderFogCli, FogFlagsOnASceneWithoutFogAreUsageErrors) {
   EXPECT_EQ(r.err.find("fog"), std::string::npos) << describe(r);
 }
 
-TEST(RenderFogCli, ASceneModeThatNeedsConesIsAnInputErrorUnlessOverridden) {
+TEST(RenderFogCli, OnlyTheConeModesTraceSunPhotons) {
   TempDir dir;
-  const std::string scene = write_scene(dir, R"({"mode": "fast", "top": 20, "steps": 2})");
-  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu"});
-  EXPECT_EQ(r.exit_code, 1) << describe(r);
-  EXPECT_NE(r.err.find("fog.mode \"fast\" needs the shadow cones"), std::string::npos) << describe(r);
-  r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--fog-mode", "brute"});
-  EXPECT_EQ(r.exit_code, 0) << describe(r);
+  const std::string scene = write_scene(dir, R"({"mode": "fast", "top": 20, "steps": 2, "photons": 20000})");
+  // The scene's own mode, then each mode from the flag: the cone modes (auto is refined on
+  // the CPU) list the photon and cone passes; brute and reference trace no photons.
+  struct Case {
+    std::vector<std::string> flags;
+    bool photons;
+    const char* mode;
+  };
+  const Case cases[] = {{{}, true, "fast"},
+                        {{"--fog-mode", "medium"}, true, "medium"},
+                        {{"--fog-mode", "refined"}, true, "refined"},
+                        {{"--fog-mode", "auto"}, true, "refined (auto)"},
+                        {{"--fog-mode", "brute"}, false, "brute"},
+                        {{"--fog-mode", "reference"}, false, "reference"}};
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose"};
+    args.insert(args.end(), c.flags.begin(), c.flags.end());
+    ProcessResult r = run_sylva(args);
+    ASSERT_EQ(r.exit_code, 0) << c.mode << ": " << describe(r);
+    EXPECT_EQ(r.err.find("  photons ") != std::string::npos, c.photons) << c.mode << ": " << describe(r);
+    EXPECT_EQ(r.err.find("shadow cones") != std::string::npos, c.photons) << c.mode << ": " << describe(r);
+    EXPECT_NE(r.err.find(std::string("fog (thread time)")), std::string::npos) << describe(r);
+    EXPECT_NE(r.err.find(std::string(c.mode) + ", 2 steps"), std::string::npos) << c.mode << ": " << describe(r);
+  }
 }
 
 TEST(RenderFogCli, BadFogKeyInASceneIsExitOneAtTheKey) {

@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -36,6 +38,15 @@ TEST_P(GlPreset, RendersWithOpenGlAndSeesThePlant) {
                                "--aov", "id", "--verbose"});
   if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 core context") != std::string::npos)
     GTEST_SKIP() << "no OpenGL context on this machine: " << r.err;
+  std::ifstream file(GetParam());
+  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (text.find("\"fog\"") != std::string::npos) {
+    // The fog scenes: the GL backend has no fog pass yet, and says so rather than drawing
+    // the scene without its fog (--backend auto renders them on the CPU).
+    EXPECT_EQ(r.exit_code, 1) << describe(r);
+    EXPECT_NE(r.err.find("fog is rendered by the CPU ray caster only"), std::string::npos) << describe(r);
+    return;
+  }
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_NE(r.err.find("OpenGL ray caster ("), std::string::npos) << describe(r);
   EXPECT_EQ(r.err.find("CPU ray caster"), std::string::npos) << describe(r);
