@@ -53,7 +53,7 @@ std::array<float, 3> plot_colour(size_t k);
 std::vector<float> draw_loglog_plot(const std::vector<PlotPanel>& panels, const PlotOptions& options = {});
 
 // Draws and writes the figure to `path` (PNG, or any format OpenImageIO writes).
-std::optional<FileError> write_loglog_plot(const std::vector<PlotPanel>& panels, const std::string& path,
-                                           const PlotOptions& options = {});
+Status write_loglog_plot(const std::vector<PlotPanel>& panels, const std::string& path,
+                         const PlotOptions& options = {});
 
 }  // namespace sylva

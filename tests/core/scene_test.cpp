@@ -29,11 +29,10 @@ const char* const kExample = R"({
   ]
 })";
 
-SceneError expect_error(std::string_view text) {
-  SceneReadResult r = parse_scene_json(text, "s.scene.json", "");
-  EXPECT_FALSE(r.scene.has_value());
-  EXPECT_TRUE(r.error.has_value());
-  return r.error.value_or(SceneError{});
+Diagnostic expect_error(std::string_view text) {
+  Expected<Scene> r = parse_scene_json(text, "s.scene.json", "");
+  EXPECT_FALSE(r.ok());
+  return r ? Diagnostic{} : r.error();
 }
 
 TEST(Scene, ReadsEveryKeyOfTheSpecExample) {
@@ -42,9 +41,9 @@ TEST(Scene, ReadsEveryKeyOfTheSpecExample) {
   std::filesystem::create_directories(dir.file("textures"));
   test::write_rgb_png(dir.file("textures/bark.png"), 2, 2, [](uint32_t, uint32_t) { return std::array<float, 3>{}; });
   test::write_rgb_png(dir.file("textures/bark_height.png"), 2, 2, [](uint32_t, uint32_t) { return std::array<float, 3>{}; });
-  SceneReadResult r = parse_scene_json(kExample, "dir/a.scene.json", dir.path());
-  ASSERT_TRUE(r.scene) << r.error->format();
-  const Scene& s = *r.scene;
+  Expected<Scene> r = parse_scene_json(kExample, "dir/a.scene.json", dir.path());
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  const Scene& s = *r;
   EXPECT_EQ(s.camera.eye, glm::dvec3(6, 3, 6));
   EXPECT_EQ(s.camera.target, glm::dvec3(0, 2, 0));
   EXPECT_EQ(s.camera.fov_y_deg, 40);
@@ -73,14 +72,14 @@ TEST(Scene, ReadsEveryKeyOfTheSpecExample) {
 
 TEST(Scene, BarkTextureThatDoesNotExistOrOpenIsAnErrorAtItsKey) {
   test::TempFolder dir;
-  SceneReadResult r = parse_scene_json(
+  Expected<Scene> r = parse_scene_json(
       "{\"plants\": [{\"grammar\": \"g.lsys\",\n  \"bark\": {\"u_repeat\": 2,\n   \"albedo\": \"nope.png\"}}]}",
       "s.scene.json", dir.path());
-  ASSERT_TRUE(r.error);
-  EXPECT_EQ(r.error->line, 3u);
-  EXPECT_EQ(r.error->column, 4u);
-  EXPECT_NE(r.error->message.find("plants[0].bark.albedo"), std::string::npos) << r.error->message;
-  EXPECT_NE(r.error->message.find(dir.file("nope.png")), std::string::npos) << r.error->message;
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().loc.line, 3u);
+  EXPECT_EQ(r.error().loc.column, 4u);
+  EXPECT_NE(r.error().message.find("plants[0].bark.albedo"), std::string::npos) << r.error().message;
+  EXPECT_NE(r.error().message.find(dir.file("nope.png")), std::string::npos) << r.error().message;
   // A file OpenImageIO cannot read, as the height map.
   {
     std::ofstream out(dir.file("text.png"));
@@ -88,48 +87,48 @@ TEST(Scene, BarkTextureThatDoesNotExistOrOpenIsAnErrorAtItsKey) {
   }
   r = parse_scene_json("{\"plants\": [{\"grammar\": \"g.lsys\", \"bark\": {\"height\": \"text.png\"}}]}",
                        "s.scene.json", dir.path());
-  ASSERT_TRUE(r.error);
-  EXPECT_EQ(r.error->line, 1u);
-  EXPECT_EQ(r.error->column, 44u);
-  EXPECT_NE(r.error->message.find("plants[0].bark.height: cannot open image"), std::string::npos) << r.error->message;
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().loc.line, 1u);
+  EXPECT_EQ(r.error().loc.column, 44u);
+  EXPECT_NE(r.error().message.find("plants[0].bark.height: cannot open image"), std::string::npos) << r.error().message;
 }
 
 TEST(Scene, OnlyPlantsIsRequiredAndTheRestDefaults) {
-  SceneReadResult r = parse_scene_json(R"({"plants": [{"grammar": "g.lsys"}]})", "s", "");
-  ASSERT_TRUE(r.scene) << r.error->format();
-  EXPECT_EQ(r.scene->width, 1024u);
-  EXPECT_EQ(r.scene->height, 768u);
-  EXPECT_FALSE(r.scene->fog);  // no fog key, no fog pass
-  EXPECT_NEAR(glm::length(r.scene->sun.direction), 1.0, 1e-15);
-  EXPECT_EQ(r.scene->plants[0].scale, 1);
-  EXPECT_FALSE(r.scene->plants[0].seed);
+  Expected<Scene> r = parse_scene_json(R"({"plants": [{"grammar": "g.lsys"}]})", "s", "");
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  EXPECT_EQ(r->width, 1024u);
+  EXPECT_EQ(r->height, 768u);
+  EXPECT_FALSE(r->fog);  // no fog key, no fog pass
+  EXPECT_NEAR(glm::length(r->sun.direction), 1.0, 1e-15);
+  EXPECT_EQ(r->plants[0].scale, 1);
+  EXPECT_FALSE(r->plants[0].seed);
 }
 
 TEST(Scene, UnknownTopLevelKeyNamesKeyFileLineAndColumn) {
-  SceneError e = expect_error("{\"plants\": [],\n  \"camra\": {}}");
-  EXPECT_EQ(e.line, 2u);
-  EXPECT_EQ(e.column, 3u);
+  Diagnostic e = expect_error("{\"plants\": [],\n  \"camra\": {}}");
+  EXPECT_EQ(e.loc.line, 2u);
+  EXPECT_EQ(e.loc.column, 3u);
   EXPECT_NE(e.message.find("\"camra\""), std::string::npos) << e.message;
   EXPECT_EQ(e.format().rfind("s.scene.json:2:3: error: unknown key \"camra\"", 0), 0u) << e.format();
 }
 
 TEST(Scene, UnknownNestedKeyIsLocatedAtTheKey) {
-  SceneError e = expect_error("{\"plants\": [{\"grammar\": \"g.lsys\",\n    \"bark\": {\"u_repeet\": 2}}]}");
-  EXPECT_EQ(e.line, 2u);
-  EXPECT_EQ(e.column, 14u);
+  Diagnostic e = expect_error("{\"plants\": [{\"grammar\": \"g.lsys\",\n    \"bark\": {\"u_repeet\": 2}}]}");
+  EXPECT_EQ(e.loc.line, 2u);
+  EXPECT_EQ(e.loc.column, 14u);
   EXPECT_NE(e.message.find("u_repeet"), std::string::npos);
   EXPECT_NE(e.message.find("plants[0].bark"), std::string::npos) << e.message;
 }
 
 TEST(Scene, MissingPlantsIsAnError) {
-  SceneError e = expect_error("{\"sky\": [1, 1, 1]}");
+  Diagnostic e = expect_error("{\"sky\": [1, 1, 1]}");
   EXPECT_NE(e.message.find("plants"), std::string::npos);
 }
 
 TEST(Scene, WrongTypesAndRangesAreLocated) {
-  SceneError e = expect_error("{\"plants\": [],\n \"camera\": {\"fov_y_deg\": 180}}");
-  EXPECT_EQ(e.line, 2u);
-  EXPECT_EQ(e.column, 26u);
+  Diagnostic e = expect_error("{\"plants\": [],\n \"camera\": {\"fov_y_deg\": 180}}");
+  EXPECT_EQ(e.loc.line, 2u);
+  EXPECT_EQ(e.loc.column, 26u);
   e = expect_error("{\"plants\": [], \"image\": {\"width\": 1.5}}");
   EXPECT_NE(e.message.find("image.width"), std::string::npos);
   e = expect_error("{\"plants\": [], \"sky\": [1, 2]}");
@@ -237,9 +236,9 @@ TEST(SceneFog, EveryKeyOutOfRangeIsAnErrorAtTheKey) {
 }
 
 TEST(Scene, MalformedJsonIsLocated) {
-  SceneError e = expect_error("{\"plants\": [],\n}");
-  EXPECT_EQ(e.line, 1u);  // the trailing comma
-  EXPECT_EQ(e.column, 14u);
+  Diagnostic e = expect_error("{\"plants\": [],\n}");
+  EXPECT_EQ(e.loc.line, 1u);  // the trailing comma
+  EXPECT_EQ(e.loc.column, 14u);
 }
 
 TEST(Scene, DefaultSceneFramesTheSkeletonFromAThreeQuarterView) {
