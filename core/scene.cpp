@@ -445,13 +445,19 @@ void write_vec3(JsonWriter& w, const glm::dvec3& v) {
   w.numbers(a, 3);
 }
 
-// A path as read relative to `base_dir` gives `path` back: relative to it where possible.
+// `path` as a scene file in `base_dir` names it: relative to base_dir where reading it
+// back (path_relative_to) gives exactly `path` again, so scenes stay movable; else an
+// absolute path as stored, or the absolute form of a relative one.
 std::string path_for_file(const std::string& path, const std::string& base_dir) {
-  const std::filesystem::path p(path);
-  if (base_dir.empty() || p.is_absolute()) return path;
-  const std::filesystem::path relative = p.lexically_relative(base_dir);
-  if (!relative.empty()) return relative.string();
-  return std::filesystem::absolute(p).lexically_normal().string();
+  namespace fs = std::filesystem;
+  const fs::path p(path), base(base_dir);
+  if (base_dir.empty()) return path;
+  if (p.is_absolute() == base.is_absolute()) {
+    const fs::path relative = p.lexically_relative(base);
+    if (!relative.empty() && !relative.is_absolute() && (base / relative).lexically_normal().string() == path)
+      return relative.string();
+  }
+  return p.is_absolute() ? path : fs::absolute(p).lexically_normal().string();
 }
 
 void write_camera(JsonWriter& w, const Camera& c) {
@@ -463,9 +469,31 @@ void write_camera(JsonWriter& w, const Camera& c) {
   w.end_object();
 }
 
+// The direction to write for the unit sun direction `unit`: the reader normalises what it
+// reads (unit_sun_direction), and normalising is not idempotent in floating point, so
+// `unit` itself may read back an ulp away. Of the vectors within 2 ulps
+// of it per component, the first (in a fixed order, `unit` first) that reads back as
+// exactly `unit` is written; in the unlikely case that none does, `unit` itself.
+glm::dvec3 sun_direction_to_write(const glm::dvec3& unit) {
+  auto read_back = [](const glm::dvec3& v) { return unit_sun_direction(v); };
+  auto step = [](double x, int ulps) {
+    for (; ulps > 0; --ulps) x = std::nextafter(x, std::numeric_limits<double>::infinity());
+    for (; ulps < 0; ++ulps) x = std::nextafter(x, -std::numeric_limits<double>::infinity());
+    return x;
+  };
+  constexpr int kOffsets[5] = {0, 1, -1, 2, -2};
+  for (int dx : kOffsets)
+    for (int dy : kOffsets)
+      for (int dz : kOffsets) {
+        const glm::dvec3 v(step(unit.x, dx), step(unit.y, dy), step(unit.z, dz));
+        if (read_back(v) == unit) return v;
+      }
+  return unit;
+}
+
 void write_sun(JsonWriter& w, const Sun& s) {
   w.key("sun").begin_object(Layout::spaced);
-  write_vec3(w.key("direction"), s.direction);
+  write_vec3(w.key("direction"), sun_direction_to_write(s.direction));
   w.key("angular_radius_deg").number(s.angular_radius_deg);
   write_vec3(w.key("radiance"), s.radiance);
   w.end_object();
@@ -518,6 +546,11 @@ void write_plant(JsonWriter& w, const ScenePlant& p, const std::string& base_dir
 }
 
 }  // namespace
+
+glm::dvec3 unit_sun_direction(const glm::dvec3& toward_sun) {
+  // read_sun normalises what it reads, and read_scene normalises sun.direction once more.
+  return glm::normalize(glm::normalize(toward_sun));
+}
 
 Expected<std::string> write_scene_json(const Scene& scene, const std::string& base_dir) {
   for (size_t i = 0; i < scene.plants.size(); ++i)

@@ -139,13 +139,21 @@ Expected<Scene> parse_scene_json(std::string_view text, std::string_view file, c
 Expected<Scene> read_scene_file(const std::string& path);
 
 // The scene as `.scene.json` text (scene.md) that parse_scene_json(text, file, base_dir)
-// reads back equal to `scene` (but for the places: file, grammar_loc): every key with its
+// reads back equal to `scene` (but for the places: file, grammar_loc) when its sun
+// direction is one the reader makes (unit_sun_direction; every scene read from a file
+// has one): every key with its
 // value, defaults included, optional keys (fog, seed, steps, bark textures) when set;
 // numbers as shortest round-trip decimals; paths relative to `base_dir` (the folder the
 // file will be in; "" = as stored) where they can be, else absolute. Deterministic:
 // identical scenes give identical bytes. Error: a plant without a grammar (a scene made
 // around a skeleton, default_scene_for, has nothing a scene file can name).
 Expected<std::string> write_scene_json(const Scene& scene, const std::string& base_dir = "");
+
+// The unit sun direction a scene file's `sun.direction` reads as: `toward_sun` normalised
+// as the reader does it. Normalising is not idempotent in floating point, so a direction
+// set in code (the studio's sun control) should go through this for the scene to write
+// and read back exactly (write_scene_json). Precondition: toward_sun is not zero.
+glm::dvec3 unit_sun_direction(const glm::dvec3& toward_sun);
 
 // The skeleton of `plant` placed in the world: p' = position + R_y(rotate_y_deg)·(scale·p),
 // radii scaled. Precondition: plant.skeleton is set.
