@@ -1,4 +1,4 @@
-// normal_map.h — a bark height map baked into a tangent-space normal map (issue 5: glTF
+// normal_map.h — a bark height map baked into a tangent-space normal map (gltf_export.h: glTF
 // 2.0 has no ratified height map, so the export carries the relief as a normalTexture).
 //
 // Texture axes: image column i is s (around the stem), image row j is t (along the stem),

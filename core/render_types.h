@@ -28,7 +28,7 @@ enum AovFlags : uint32_t {
   kAovFog = 1u << 4,     // fog.R fog.G fog.B fog.T (spec/fog.md, "Outputs")
 };
 
-// Which geometry stands for the plants (issue 3: the analytic frusta are the reference,
+// Which geometry stands for the plants (paper 000 sec. 4: the analytic frusta are the reference,
 // the tessellated meshes the polygon baseline).
 enum class GeometryKind : uint8_t {
   frusta,  // analytic conical frusta (frustum_tracer.h), relief-mapped where asked

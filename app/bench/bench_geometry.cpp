@@ -1,5 +1,5 @@
 // bench_geometry.cpp — `sylva bench geometry INPUT`: error against run time of every way
-// the CPU engine can stand for the plants (issue 3 §5).
+// the CPU engine can stand for the plants (docs/benchmarks.md, "Error against run time").
 //
 // Methods, each a full render_cpu of the same scene, camera and pixel samples (one per
 // pixel, through its centre, so differences are geometry, not sampling noise):

@@ -1,5 +1,5 @@
 // bench_gpu.cpp — `sylva bench gpu [INPUT...]`: error against GPU time of every way the
-// GL backend can draw the plants (issue 4 §4–5; paper 000 sec. 4, Table 1 and the
+// GL backend can draw the plants (docs/benchmarks.md, "Error against GPU time"; paper 000 sec. 4, Table 1 and the
 // dancing cacti of fig. 8).
 //
 // For each input and image size, each method builds one GlRenderer (render_gl.h), renders

@@ -1,4 +1,4 @@
-// plot.h — log–log error-against-time figures as PNG (issue 3 §5, issue 4 §4): the
+// plot.h — log–log error-against-time figures as PNG (docs/benchmarks.md, docs/plots/): the
 // benchmarks draw their own plots, so a report needs nothing but the sylva binary.
 //
 // A figure is one or more panels side by side; each panel has log10 axes with a tick and

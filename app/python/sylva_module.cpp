@@ -1,4 +1,4 @@
-// sylva_module.cpp — the `sylva` Python module (issue 5, sec. 2): grammars, growth,
+// sylva_module.cpp — the `sylva` Python module (app/python/README.md): grammars, growth,
 // skeletons as zero-copy numpy views, glTF export and the CPU renderer.
 //
 // Boundaries, as everywhere in sylva: errors are values in C++ and become Python

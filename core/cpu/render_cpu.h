@@ -1,4 +1,4 @@
-// render_cpu.h — the CPU reference ray caster (issue 3, sec. 2): one ray per sample
+// render_cpu.h — the CPU reference ray caster (paper 000 sec. 2, scene.md): one ray per sample
 // through a pinhole camera, conical frusta (skin.h) found through Embree (frustum_accel.h) and
 // intersected exactly (ray_frustum.h), shaded under the scene's sun and sky over a
 // ground plane. The GPU ray caster must match it.

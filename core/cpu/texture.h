@@ -1,5 +1,5 @@
 // texture.h — the bark textures of a scene (scene.md `bark`: albedo and height maps) read
-// with OpenImageIO's TextureSystem: MIP-mapped, filtered lookups (issue 3, sec. 2), and the
+// with OpenImageIO's TextureSystem: MIP-mapped, filtered lookups (paper 000 sec. 2.3), and the
 // ray-differential footprint that drives the filter.
 //
 // One TextureSystem per SceneTextures (created unshared, so renders do not share caches or

@@ -1,4 +1,4 @@
-// export_cli_test.cpp — `sylva export` (cli.md, issue 5): every export variant passes
+// export_cli_test.cpp — `sylva export` (cli.md, gltf_export.h): every export variant passes
 // the Khronos glTF validator (scripts/validate_gltf.mjs: no error, no warning), the
 // skeleton survives the round trip, usage errors exit 2; and batches (`--seed A..B`,
 // `-o out/p_{seed}.glb`) for export and grow: every seed written, a failing seed named

@@ -1,4 +1,4 @@
-// gl_mesh_test.cpp — the polygon baseline on the GPU (core/gl_mesh.h, issue 4 §3) against
+// gl_mesh_test.cpp — the polygon baseline on the GPU (core/gl/gl_mesh.h) against
 // the CPU's mesh path (render_cpu.h, GeometryKind::mesh through Embree): the same scene
 // and GeometryOptions through render_gl and render_cpu, compared pixel by pixel with the
 // tolerances of render_gl_test.cpp — hit/miss agreement >= 99.5 % of pixels, median

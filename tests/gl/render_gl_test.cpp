@@ -1,4 +1,4 @@
-// render_gl_test.cpp — the GL ray caster against the CPU reference (issue 4, sec. 2): the
+// render_gl_test.cpp — the GL ray caster against the CPU reference (render_gl.h): the
 // same scene through render_gl and render_cpu, compared pixel by pixel. Tolerances: hit/miss
 // agreement >= 99.5 % of pixels, median relative depth error <= 1e-4, mean absolute beauty
 // difference <= 1/255 on the sRGB-encoded values a PNG holds (stricter than linear). On a
