@@ -12,12 +12,9 @@
 #include "core/cpu/texture.h"
 #include "core/util/math.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <glm/geometric.hpp>
 #include <limits>
 #include <mutex>

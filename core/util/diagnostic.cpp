@@ -59,7 +59,7 @@ std::string Diagnostic::format() const {
   return out;
 }
 
-Diagnostic&& Diagnostic::with_note(Diagnostic note) && {
+Diagnostic Diagnostic::with_note(Diagnostic note) && {
   notes.push_back(std::move(note));
   return std::move(*this);
 }

@@ -54,7 +54,7 @@ struct Diagnostic {
   std::string format() const;
 
   // This diagnostic with `note` appended to its notes.
-  Diagnostic&& with_note(Diagnostic note) &&;
+  Diagnostic with_note(Diagnostic note) &&;
 };
 
 // A Diagnostic at `loc` in `file`, without source line.
