@@ -154,12 +154,12 @@ TEST(Scene, WrongTypesAndRangesAreLocated) {
 
 TEST(SceneFog, ReadsEveryFogKeyOfTheSpec) {
   // spec/fog.md's example.
-  SceneReadResult r = parse_scene_json(R"({"plants": [],
+  Expected<Scene> r = parse_scene_json(R"({"plants": [],
     "fog": {"sigma_s": 0.05, "sigma_a": 0.005, "g": 0.6, "height_falloff": 0.0, "top": 30,
             "mode": "auto", "steps": 64, "photons": 1000000}})",
                                        "s", "");
-  ASSERT_TRUE(r.scene) << r.error->format();
-  const Fog& f = *r.scene->fog;
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  const Fog& f = *r->fog;
   EXPECT_EQ(f.sigma_s, 0.05);
   EXPECT_EQ(f.sigma_a, 0.005);
   EXPECT_EQ(f.g, 0.6);
@@ -171,18 +171,18 @@ TEST(SceneFog, ReadsEveryFogKeyOfTheSpec) {
   r = parse_scene_json(R"({"plants": [], "fog": {"mode": "reference", "steps": 7, "photons": 12, "top": -0.5,
                            "height_falloff": 0.3}, "ground": {"height": -1}})",
                        "s", "");
-  ASSERT_TRUE(r.scene) << r.error->format();
-  EXPECT_EQ(r.scene->fog->mode, FogMode::reference);
-  EXPECT_EQ(r.scene->fog->steps, 7u);
-  EXPECT_EQ(r.scene->fog->photons, 12u);
-  EXPECT_EQ(r.scene->fog->top, -0.5);  // above a ground at -1
-  EXPECT_EQ(r.scene->fog->height_falloff, 0.3);
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  EXPECT_EQ(r->fog->mode, FogMode::reference);
+  EXPECT_EQ(r->fog->steps, 7u);
+  EXPECT_EQ(r->fog->photons, 12u);
+  EXPECT_EQ(r->fog->top, -0.5);  // above a ground at -1
+  EXPECT_EQ(r->fog->height_falloff, 0.3);
 }
 
 TEST(SceneFog, AbsentKeysDefault) {
-  SceneReadResult r = parse_scene_json(R"({"plants": [], "fog": {}})", "s", "");
-  ASSERT_TRUE(r.scene) << r.error->format();
-  const Fog& f = *r.scene->fog;
+  Expected<Scene> r = parse_scene_json(R"({"plants": [], "fog": {}})", "s", "");
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  const Fog& f = *r->fog;
   EXPECT_TRUE(std::isinf(f.top));  // no ceiling
   EXPECT_EQ(f.mode, FogMode::automatic);
   EXPECT_EQ(f.steps, 64u);
@@ -233,16 +233,16 @@ TEST(SceneFog, EveryKeyOutOfRangeIsAnErrorAtTheKey) {
   for (const Bad& b : bad) {
     // The fog object's key starts at line 2, column 10.
     const std::string text = std::string("{\"plants\": [],\n \"fog\": {") + b.member + "}}";
-    SceneError e = expect_error(text);
-    EXPECT_EQ(e.line, 2u) << b.member;
-    EXPECT_EQ(e.column, 10u) << b.member;
+    Diagnostic e = expect_error(text);
+    EXPECT_EQ(e.loc.line, 2u) << b.member;
+    EXPECT_EQ(e.loc.column, 10u) << b.member;
     EXPECT_NE(e.message.find(b.says), std::string::npos) << b.member << ": " << e.message;
     EXPECT_EQ(e.format().rfind("s.scene.json:2:10: error: ", 0), 0u) << e.format();
   }
   // The top is compared with the ground wherever the ground key stands.
-  SceneError e = expect_error("{\"fog\": {\"top\": 4},\n \"ground\": {\"height\": 5}, \"plants\": []}");
-  EXPECT_EQ(e.line, 1u);
-  EXPECT_EQ(e.column, 10u);
+  Diagnostic e = expect_error("{\"fog\": {\"top\": 4},\n \"ground\": {\"height\": 5}, \"plants\": []}");
+  EXPECT_EQ(e.loc.line, 1u);
+  EXPECT_EQ(e.loc.column, 10u);
   EXPECT_NE(e.message.find("fog.top 4 must be above the ground (ground.height 5)"), std::string::npos) << e.message;
 }
 
@@ -380,7 +380,8 @@ TEST(SceneWrite, WritesEveryKeyInScenemdOrderOneSectionPerLine) {
             "  \"sun\": {\"direction\": [0,1,0], \"angular_radius_deg\": 0.27, \"radiance\": [3,3,2.8]},\n"
             "  \"sky\": [0.25,0.3,0.4],\n"
             "  \"ground\": {\"height\": 0, \"albedo\": [0.35,0.3,0.25]},\n"
-            "  \"fog\": {\"sigma_s\": 0.05, \"sigma_a\": 0.005, \"g\": 0.6, \"height_falloff\": 0},\n"
+            "  \"fog\": {\"sigma_s\": 0.05, \"sigma_a\": 0.005, \"g\": 0.6, \"height_falloff\": 0, \"mode\": \"auto\", "
+            "\"steps\": 64, \"photons\": 1000000},\n"
             "  \"plants\": [\n"
             "    {\"grammar\": \"presets/saguaro.lsys\", \"seed\": 3, \"defines\": {\"N\": 5}, \"position\": [0,0,0], "
             "\"rotate_y_deg\": 0, \"scale\": 1, \"bark\": {\"relief_depth\": 0.02, \"u_repeat\": 1, \"v_per_metre\": 1}}\n"
@@ -400,7 +401,7 @@ TEST(SceneWrite, ASceneWithEveryKeySetReadsBackEqual) {
   s.sun = {unit_sun_direction({0.3, 0.9, -0.2}), 0.5, {10, 9.5, 8.25}};
   s.sky = {0.1, 0.2, 1e-3};
   s.ground = {-0.75, {0.5, 0.25, 0.125}};
-  s.fog = Fog{0.125, 0.01, -0.3, 0.05};
+  s.fog = Fog{0.125, 0.01, -0.3, 0.05, 12.5, FogMode::refined, 9, 4321};
   ScenePlant textured;
   textured.grammar = dir.file("g.lsys");
   textured.seed = 18446744073709551615u;
