@@ -489,7 +489,7 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
       sun_cones = build_sun_cones(
           geometry, scene,
           sun_cone_options_for(fog_options.mode, options.fog.photons.value_or(scene.fog->photons),
-                               options.fog.cone_params, options.threads, options.cancel));
+                               options.fog.cone_params, options.threads, options.progress.cancel_flag()));
       result.passes.insert(result.passes.end(), sun_cones->passes.begin(), sun_cones->passes.end());
       if (sun_cones->cancelled) {
         result.cancelled = true;

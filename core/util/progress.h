@@ -47,6 +47,8 @@ class Progress {
 
   // Whether the work should stop now. Thread-safe.
   bool cancelled() const { return cancel_ != nullptr && cancel_->load(std::memory_order_relaxed); }
+  // The cancellation flag itself (may be null), for work that polls a raw flag.
+  const std::atomic<bool>* cancel_flag() const { return cancel_; }
   // Whether report() reaches a callback (lets work skip computing fractions).
   bool reporting() const { return state_ != nullptr; }
   // Reports that `fraction` (clamped to [0, 1]) of this task or part is done. Thread-safe.
