@@ -2,15 +2,17 @@
 #include "app/studio/gl_viewport.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <future>
 
 #include "core/gl/gl_api.h"
 #include "core/gl/gl_context.h"
+#include "core/gl/gl_frame_stats.h"
+#include "core/gl/gl_target.h"
 #include "core/gl/render_gl.h"
 #include "core/render_output.h"
-#include "core/util/color.h"
 
 namespace sylva::studio {
 
@@ -36,21 +38,25 @@ struct Picture {
   double render_ms = 0;
 };
 
-// The picture of `scene` from `renderer` as 8-bit sRGB RGBA: GlRenderer::render()'s
-// readback, encoded. (A renderer that draws into a caller's framebuffer would draw into
-// a texture shared with the window instead.)
-Picture present(GlRenderer& renderer, const Scene& scene) {
+// The picture of `scene` from `renderer` as 8-bit sRGB RGBA through the frame API
+// (gl_target.h): the renderer draws into `target` (rgba8, resized to the view), whose
+// present pass encodes sRGB on the GPU, and only those 4 bytes a pixel come back — no
+// AOVs, no float beauty. The rows stay bottom-up as GL's (the view shows them flipped).
+// The render thread has its own context (a slow software frame never stalls the UI), so
+// the bytes cross to the window's context as an upload rather than a shared texture.
+Picture present(GlRenderer& renderer, const Scene& scene, std::unique_ptr<GlTextureTarget>& target) {
   const auto start = Clock::now();
-  RenderResult result = renderer.render(scene);
+  if (!target) target = std::make_unique<GlTextureTarget>(scene.width, scene.height, GlTextureTarget::Format::rgba8);
+  else target->resize(scene.width, scene.height);
+  renderer.draw(scene, target->target());
   Picture p;
-  p.width = result.image.width;
-  p.height = result.image.height;
+  p.width = scene.width;
+  p.height = scene.height;
   p.rgba.resize(static_cast<size_t>(p.width) * p.height * 4);
-  const std::vector<float>& src = result.image.beauty;
-  for (size_t i = 0; i < p.rgba.size(); ++i)
-    p.rgba[i] = (i % 4 == 3) ? 255
-                             : static_cast<uint8_t>(std::lround(std::clamp(linear_to_srgb(src[i]), 0.0f, 1.0f) * 255));
-  p.passes = std::move(result.passes);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(target->texture(), 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(p.rgba.size()),
+                    p.rgba.data());
+  p.passes = describe_frame(renderer.wait_for_frame());
   p.render_ms = ms_since(start);
   return p;
 }
@@ -63,6 +69,9 @@ struct GlViewport::Shared {
   std::condition_variable wake;
   bool quit = false;
   bool working = false;
+  // Set by set_plants while a renderer is being built: newer plants make the skinning in
+  // flight stop (GlRenderer checks it every 1024 chains) instead of finishing for nothing.
+  std::atomic<bool> cancel_build{false};
   std::function<void()> on_picture;
   // Requests (latest wins).
   struct Plants {
@@ -123,6 +132,7 @@ void GlViewport::run() {
   sh.wake.notify_all();
   if (!context.context) return;
   std::unique_ptr<GlRenderer> renderer;
+  std::unique_ptr<GlTextureTarget> target;  // the picture's, on this thread's context
   RenderOptions options;
   uint64_t version = 0;
   for (;;) {
@@ -135,6 +145,7 @@ void GlViewport::run() {
       if (sh.quit) break;
       plants = std::move(sh.plants);
       sh.plants.reset();
+      sh.cancel_build = false;
       task = std::move(sh.task);
       sh.task = nullptr;
       // A picture of older plants than those about to be built is not worth making.
@@ -146,10 +157,12 @@ void GlViewport::run() {
     }
     std::string error;
     double upload_ms = 0;
+    bool build_cancelled = false;
     if (plants) {
       const auto start = Clock::now();
       renderer.reset();
       options = plants->options;
+      options.progress = Progress(&sh.cancel_build);
       version = plants->version;
       bool any = false;
       for (const ScenePlant& p : plants->scene.plants) any |= p.skeleton && p.skeleton->segment_count() > 0;
@@ -158,6 +171,8 @@ void GlViewport::run() {
       else {
         try {
           renderer = std::make_unique<GlRenderer>(plants->scene, options);
+        } catch (const GlCancelled&) {
+          build_cancelled = true;  // newer plants wait in the mailbox
         } catch (const std::exception& e) {
           error = e.what();
         }
@@ -168,7 +183,7 @@ void GlViewport::run() {
     std::optional<Picture> picture;
     if (view && renderer && view->version == version) {
       try {
-        picture = present(*renderer, view->scene);
+        picture = present(*renderer, view->scene, target);
         picture->plants_version = version;
       } catch (const std::exception& e) {
         error = e.what();
@@ -177,7 +192,7 @@ void GlViewport::run() {
     {
       std::lock_guard<std::mutex> lock(sh.mutex);
       sh.working = false;
-      if (plants) {
+      if (plants && !build_cancelled) {
         sh.built_version = version;
         sh.error = error;
         sh.frusta = renderer ? renderer->frusta() : 0;
@@ -189,6 +204,7 @@ void GlViewport::run() {
     }
     if ((picture || !error.empty()) && sh.on_picture) sh.on_picture();
   }
+  target.reset();
   renderer.reset();
 }
 
@@ -197,6 +213,7 @@ void GlViewport::set_plants(const Scene& scene, const RenderOptions& options) {
   {
     std::lock_guard<std::mutex> lock(shared_->mutex);
     shared_->plants = Shared::Plants{scene, options, plants_version_};
+    if (shared_->working) shared_->cancel_build = true;
   }
   shared_->wake.notify_all();
 }
@@ -256,7 +273,7 @@ ViewImage GlViewport::image(const Scene& scene) {
     if (shared_->built_version == plants_version_ && !shared_->error.empty() && !shared_->working && !shared_->view)
       current = true;
   }
-  return ViewImage{reinterpret_cast<ImTextureID>(static_cast<intptr_t>(texture_)), false, texture_w_, texture_h_,
+  return ViewImage{reinterpret_cast<ImTextureID>(static_cast<intptr_t>(texture_)), true, texture_w_, texture_h_,
                    current};
 }
 
