@@ -36,7 +36,20 @@ struct Picture {
   uint64_t plants_version = 0;
   std::vector<RenderPass> passes;
   double render_ms = 0;
+  bool preview = false;
 };
+
+constexpr uint32_t kPreviewShadowTexels = 512;
+
+// The preview of `scene`: half the pixels a side (ImGui::Image stretches it to the panel)
+// and a 512² shadow map — on llvmpipe about a quarter of the fill of the full picture,
+// which dominates its cost (docs/benchmarks.md, the studio).
+Scene preview_of(const Scene& scene) {
+  Scene small = scene;
+  small.width = std::max<uint32_t>(1, scene.width / 2);
+  small.height = std::max<uint32_t>(1, scene.height / 2);
+  return small;
+}
 
 // The picture of `scene` from `renderer` as 8-bit sRGB RGBA through the frame API
 // (gl_target.h): the renderer draws into `target` (rgba8, resized to the view), whose
@@ -73,6 +86,8 @@ struct GlViewport::Shared {
   // flight stop (GlRenderer checks it every 1024 chains) instead of finishing for nothing.
   std::atomic<bool> cancel_build{false};
   std::function<void()> on_picture;
+  double preview_above_ms = 50;  // see the constructor
+  uint64_t previews = 0;         // made so far
   // Requests (latest wins).
   struct Plants {
     Scene scene;
@@ -97,8 +112,10 @@ struct GlViewport::Shared {
   std::string start_error;
 };
 
-GlViewport::GlViewport(std::function<void()> on_picture) : shared_(std::make_unique<Shared>()) {
+GlViewport::GlViewport(std::function<void()> on_picture, double preview_above_ms)
+    : shared_(std::make_unique<Shared>()) {
   shared_->on_picture = std::move(on_picture);
+  shared_->preview_above_ms = preview_above_ms;
   thread_ = std::thread([this] { run(); });
   std::unique_lock<std::mutex> lock(shared_->mutex);
   shared_->wake.wait(lock, [this] { return shared_->started; });
@@ -133,6 +150,8 @@ void GlViewport::run() {
   if (!context.context) return;
   std::unique_ptr<GlRenderer> renderer;
   std::unique_ptr<GlTextureTarget> target;  // the picture's, on this thread's context
+  double last_full_ms = 0;                   // the last full picture's time (preview_of)
+  bool unshown_plants = false;               // the renderer's plants have no full picture yet
   RenderOptions options;
   uint64_t version = 0;
   for (;;) {
@@ -178,31 +197,55 @@ void GlViewport::run() {
         }
       }
       upload_ms = ms_since(start);
+      unshown_plants = renderer != nullptr;
     }
     if (task) task(renderer.get(), options);
+    // Hands a picture (or the error) to the UI thread; `last`: the render thread is done.
+    auto publish = [&](std::optional<Picture> picture, bool last) {
+      const bool any = picture || !error.empty();
+      {
+        std::lock_guard<std::mutex> lock(sh.mutex);
+        if (last) sh.working = false;
+        if (plants && !build_cancelled) {
+          sh.built_version = version;
+          sh.error = error;
+          sh.frusta = renderer ? renderer->frusta() : 0;
+          sh.upload_ms = upload_ms;
+        } else if (!error.empty()) {
+          sh.error = error;
+        }
+        if (picture) sh.picture = std::move(picture);
+      }
+      if (any && sh.on_picture) sh.on_picture();
+    };
     std::optional<Picture> picture;
     if (view && renderer && view->version == version) {
       try {
-        picture = present(*renderer, view->scene, target);
-        picture->plants_version = version;
+        // New plants on a slow renderer: a quick preview first, so the edit shows at once;
+        // the full picture follows unless newer plants are already waiting.
+        bool newer_waiting = false;
+        if (unshown_plants && last_full_ms > sh.preview_above_ms) {
+          renderer->set_shadow_map_texels(kPreviewShadowTexels);
+          Picture quick = present(*renderer, preview_of(view->scene), target);
+          renderer->set_shadow_map_texels(0);
+          quick.plants_version = version;
+          quick.preview = true;
+          publish(std::move(quick), false);
+          std::lock_guard<std::mutex> lock(sh.mutex);
+          ++sh.previews;
+          newer_waiting = sh.plants.has_value();
+        }
+        if (!newer_waiting) {
+          picture = present(*renderer, view->scene, target);
+          picture->plants_version = version;
+          last_full_ms = picture->render_ms;
+          unshown_plants = false;
+        }
       } catch (const std::exception& e) {
         error = e.what();
       }
     }
-    {
-      std::lock_guard<std::mutex> lock(sh.mutex);
-      sh.working = false;
-      if (plants && !build_cancelled) {
-        sh.built_version = version;
-        sh.error = error;
-        sh.frusta = renderer ? renderer->frusta() : 0;
-        sh.upload_ms = upload_ms;
-      } else if (!error.empty()) {
-        sh.error = error;
-      }
-      if (picture) sh.picture = std::move(picture);
-    }
-    if ((picture || !error.empty()) && sh.on_picture) sh.on_picture();
+    publish(std::move(picture), true);
   }
   target.reset();
   renderer.reset();
@@ -232,6 +275,7 @@ void GlViewport::take_picture() {
     stats_.error = shared_->error;
     stats_.frusta = shared_->frusta;
     stats_.upload_ms = shared_->upload_ms;
+    stats_.previews = shared_->previews;
   }
   if (!p) return;
   if (!texture_ || texture_w_ != p->width || texture_h_ != p->height) {
@@ -251,6 +295,7 @@ void GlViewport::take_picture() {
   shown_version_ = p->plants_version;
   stats_.passes = std::move(p->passes);
   stats_.render_ms = p->render_ms;
+  stats_.preview = p->preview;
 }
 
 ViewImage GlViewport::image(const Scene& scene) {

@@ -139,6 +139,7 @@ struct GlRenderer::Frame {
 
 struct GlRenderer::State {
   RenderOptions options;
+  uint32_t shadow_texels_override = 0;  // set_shadow_map_texels; 0: shadow_map_texels()
   std::vector<RenderPass> setup_passes;
   size_t plant_count = 0;
   uint64_t frusta = 0;
@@ -397,6 +398,16 @@ GlRenderer::~GlRenderer() = default;
 
 void GlRenderer::set_conservative_depth(bool on) { state_->features.conservative_depth = on; }
 
+void GlRenderer::set_shadow_map_texels(uint32_t texels) {
+  if (texels == 0) {
+    state_->shadow_texels_override = 0;
+    return;
+  }
+  GLint max_size = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  state_->shadow_texels_override = std::clamp<uint32_t>(texels, 16, static_cast<uint32_t>(max_size));
+}
+
 uint64_t GlRenderer::frusta() const { return state_->frusta; }
 uint64_t GlRenderer::uploaded_bytes() const { return state_->uploaded_bytes; }
 const std::vector<RenderPass>& GlRenderer::setup_passes() const { return state_->setup_passes; }
@@ -510,7 +521,7 @@ void GlRenderer::begin_frame(const Scene& scene, Frame& f) {
   f.sun_on = sun_shines(scene);
   f.sun_radiance = scene.sun.radiance;
   if (f.sun_on) {
-    s.shadow_texels = st.shadow_map_texels(f.width, f.height);
+    s.shadow_texels = st.shadow_texels_override ? st.shadow_texels_override : st.shadow_map_texels(f.width, f.height);
     s.targets_allocated += st.shadow_map.resize(s.shadow_texels) ? 1 : 0;
   }
   s.target_bytes = st.targets.bytes() + (f.sun_on ? st.shadow_map.bytes() : 0);

@@ -156,6 +156,12 @@ class GlRenderer {
   // testing is worth.
   void set_conservative_depth(bool on);
 
+  // The shadow map's side in texels from the next frame on (clamped to [16, the driver's
+  // largest texture]); 0 (the default): chosen from the frame's size, at least 1024, as the
+  // CLI renders. A smaller map is a cheaper, blockier-shadowed picture: the studio's
+  // preview of new plants (app/studio/gl_viewport.cpp) before the full one.
+  void set_shadow_map_texels(uint32_t texels);
+
   uint64_t frusta() const;          // frusta uploaded
   uint64_t uploaded_bytes() const;  // bytes in the segment and id buffers (or the mesh's)
   // What was done once: "textures", "skin", "upload", "programs" (compile and link); the
