@@ -8,11 +8,14 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/util/file_io.h"
+
 namespace sylva {
 
 Expected<HeightMap> read_height_map(const std::string& path) {
   // ImageInput rather than a cached ImageBuf: the file is read once, now, as it is on
   // disk (a cache could hand back an older version of a file rewritten under the same name).
+  note_input_file(path);
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     std::string why = OIIO::geterror();

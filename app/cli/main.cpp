@@ -7,6 +7,7 @@
 
 #include "app/cli/cli.h"
 #include "app/studio/studio.h"
+#include "core/util/file_io.h"
 
 namespace {
 
@@ -30,6 +31,9 @@ void print_help(std::ostream& out) {
 
 int main(int argc, char** argv) {
   using namespace sylva::cli;
+  // An interrupt leaves no temporary, and outputs never land on an input (docs/limits.md,
+  // "Outputs") — except in the studio, which saves over the document it opened.
+  sylva::remove_temporaries_on_signals();
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) {
     std::cerr << "sylva: error: missing SUBCOMMAND\n\n";
@@ -38,6 +42,7 @@ int main(int argc, char** argv) {
   }
   const std::string sub = args[0];
   args.erase(args.begin());
+  if (sub == "derive" || sub == "grow" || sub == "render" || sub == "export") sylva::refuse_outputs_onto_inputs();
   try {
     if (sub == "-h" || sub == "--help" || sub == "help") {
       print_help(std::cout);
