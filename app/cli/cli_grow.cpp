@@ -22,7 +22,7 @@ const char* const kGrammarFlags =
     "      --seed S           random seed, an integer from 0 to 2^64-1 (overrides 'seed:')\n"
     "  -D NAME=VALUE          override '#define NAME' (repeatable)\n"
     "      --max-modules N    stop with an error if a word would exceed N modules\n"
-    "                         (default 50000000)\n"
+    "                         (each parameter counts as a module; default 50000000)\n"
     "  -h, --help             show this help\n";
 
 void print_derive_help() {

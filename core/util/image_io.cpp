@@ -9,6 +9,8 @@
 #include <cstring>
 #include <filesystem>
 
+#include "core/util/limits.h"
+
 namespace sylva {
 
 namespace {
@@ -93,7 +95,14 @@ Expected<PendingFile> write_pending_image(const std::string& path, uint32_t widt
 Status check_image_opens(const std::string& path) {
   note_input_file(path);  // a texture of the scene: never an output too
   auto input = OIIO::ImageInput::open(path);
-  if (input) return {};
+  if (input) {
+    // The header's size, before any renderer allocates for it (docs/limits.md).
+    const OIIO::ImageSpec& spec = input->spec();
+    if (auto problem = image_size_problem(static_cast<uint64_t>(std::max(spec.width, 0)),
+                                          static_cast<uint64_t>(std::max(spec.height, 0))))
+      return file_diagnostic(path, "the image is too large or empty: " + *problem);
+    return {};
+  }
   std::string reason = OIIO::geterror();
   if (reason.empty()) reason = "OpenImageIO cannot read it";
   return file_diagnostic(path, reason);

@@ -166,7 +166,7 @@ TEST_F(CliTest, LegalEdgeValuesOfFlagsAreAccepted) {
   EXPECT_EQ(derive({g, "-n", "0"}), "A(3)\n");
   EXPECT_EQ(derive({g, "--seed", "0"}), "A(3)\n");
   EXPECT_EQ(derive({g, "--seed", "18446744073709551615"}), "A(3)\n");
-  EXPECT_EQ(derive({g, "--max-modules", "1"}), "A(3)\n");
+  EXPECT_EQ(derive({g, "--max-modules", "2"}), "A(3)\n");  // a module and its parameter
   EXPECT_EQ(derive({g, "-D", "N=0"}), "A(0)\n");
 }
 

@@ -326,5 +326,27 @@ TEST(DeriveProgress, ACancelledFlagStopsInterpretationToo) {
   EXPECT_EQ(r.stages.back(), "interpret");
 }
 
+// docs/limits.md: --max-modules bounds the word's memory, so parameters count: a module
+// with 65,535 parameters cannot slip under a limit meant for modules.
+TEST(Limits, MaxModulesCountsEveryParameterAsAModule) {
+  auto g = parse_ok("axiom: A(1,2,3)\nA(x,y,z) -> A(x,y,z)A(x,y,z)\n");
+  DeriveOptions o = steps(3);
+  o.max_modules = 32;  // 8 modules of 4 units each
+  auto w = derive(g, o);
+  ASSERT_TRUE(w.ok()) << w.error().format();
+  EXPECT_EQ(w->size(), 8u);
+  o.max_modules = 31;
+  w = derive(g, o);
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.error().message.find("exceeds --max-modules (31 modules), each parameter counting as a module"),
+            std::string::npos)
+      << w.error().message;
+  o.max_modules = 3;  // the axiom alone is 4
+  w = derive(g, o);
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.error().message.find("the axiom exceeds --max-modules (3 modules)"), std::string::npos)
+      << w.error().message;
+}
+
 }  // namespace
 }  // namespace sylva::lsys
