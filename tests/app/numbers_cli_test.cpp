@@ -62,4 +62,17 @@ TEST_F(NumbersCliTest, AnImageTooLargeToAllocateIsRefusedAtOnce) {
   EXPECT_EQ(list_dir(dir_.path()), std::vector<std::string>{"ok.lsys"});
 }
 
+// A skeleton file may hold any double; a glTF accessor holds float32. Exporting a joint at
+// 1e300 is refused rather than written as null into an invalid file.
+TEST_F(NumbersCliTest, ExportingBeyondFloat32IsAnErrorNotAnInvalidFile) {
+  const std::string sk = dir_.write(
+      "far.skel.json",
+      R"({"format": "sylva-skeleton", "version": 1, "chains": [{"parent": null, "joints": [[0,0,0,0.1,0],[1e300,0,0,0.1,0]]}]})");
+  ProcessResult r = run_sylva({"export", sk, "-o", dir_.file("far.glb")});
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  EXPECT_EQ(r.exit_code, 1) << describe(r);
+  EXPECT_NE(r.err.find("beyond the limit of 1e12 m"), std::string::npos) << describe(r);
+  EXPECT_EQ(list_dir(dir_.path()), std::vector<std::string>{"far.skel.json"});
+}
+
 }  // namespace
