@@ -462,7 +462,13 @@ void python_export_gltf(const py::object& plants, const std::filesystem::path& p
     py::gil_scoped_release release;
     exported = export_gltf(gltf_plants, path_string(path), options);
   }
-  if (!exported) throw std::runtime_error(chomp(exported.error().format()));
+  // A file that could not be read or written raises OSError (by errno, as open() would);
+  // plants the export refuses (values beyond docs/limits.md) raise ValueError.
+  if (!exported) {
+    const Diagnostic& d = exported.error();
+    if (d.error_number != 0 || d.message.rfind("cannot ", 0) == 0) throw_file_error(d);
+    throw py::value_error(chomp(d.format()));
+  }
 }
 
 
