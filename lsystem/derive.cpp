@@ -274,6 +274,14 @@ class Rewriter {
       throw DeriveFailure{first.probability.loc,
                           "the probabilities of the matching productions sum to 0 (nothing to choose from)"};
     }
+    if (!std::isfinite(total)) {
+      // Finite weights whose sum overflows (1e308 + 1e308): the same choice, in proportion,
+      // from the weights divided by the largest; otherwise every seed would pick the last.
+      double largest = 0;
+      for (const auto& c : candidates_) largest = std::max(largest, c.second);
+      total = 0;
+      for (auto& c : candidates_) total += c.second /= largest;
+    }
     double u = rng.next_double() * total;
     const Production* pick = candidates_.back().first;
     for (const auto& [prod, w] : candidates_) {

@@ -125,6 +125,19 @@ TEST(Stochastic, WeightsAreNormalisedAndZeroWeightsNeverChosen) {
   EXPECT_NEAR(counts[b] / 2000.0, 0.75, 0.05);
 }
 
+// Finite weights whose sum overflows still choose in proportion, not always the last.
+TEST(Stochastic, WeightsWhoseSumOverflowsStillChooseInProportion) {
+  std::string axiom(2000, 'A');
+  auto g = parse_ok("axiom: " + axiom + "\nA -> B : 1.5e308\nA -> C : 1.5e308\n");
+  auto w = derive(g, steps(1));
+  ASSERT_TRUE(w.ok()) << w.error().format();
+  SymbolId b;
+  ASSERT_TRUE(g.symbols.find("B", &b));
+  int count_b = 0;
+  for (const Module& m : w->modules) count_b += m.symbol == b;
+  EXPECT_NEAR(count_b / 2000.0, 0.5, 0.05);
+}
+
 TEST(Stochastic, ProbabilitiesThatAllSumToZeroAreAnError) {
   auto g = parse_ok("axiom: A\nA -> B : 0\nA -> C : 0\n");
   auto w = derive(g, steps(1));
