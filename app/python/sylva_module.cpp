@@ -684,8 +684,9 @@ Keyword-only:
                    e.g. bark=dict(albedo="presets/textures/bark.png",
                    height="presets/textures/bark_height.png", u_repeat=2)
 The mesh has one material per material index the plants use. The file is written
-atomically; a failure (a missing texture among them) raises RuntimeError with the
-reason, naming the file, and writes nothing. The GIL is released while writing.)doc");
+atomically; a file that cannot be read or written (a missing texture, a missing folder,
+a FIFO or read-only target) raises OSError, plants beyond the limits (docs/limits.md)
+ValueError, each with the reason naming the file, and nothing is written. The GIL is released while writing.)doc");
   signatures.enable_function_signatures();
 
   bind_render(m);
