@@ -27,11 +27,6 @@ namespace {
 constexpr int kInterrupted = 130;  // 128 + SIGINT, the shell's convention
 constexpr uint32_t kMaxConeParam = 100000;  // --cone-params: any larger is a typo
 
-// The fog modes that need the shadow cones of sun photons (spec/fog.md). This build has no
-// photon tracer yet (core/cpu/photons.h): they run only from the tests, and auto refines
-// whole rays instead (fog_integrator.h).
-bool needs_cones(FogMode mode) { return mode == FogMode::medium || mode == FogMode::fast || mode == FogMode::refined; }
-
 std::atomic<bool> g_interrupted{false};
 extern "C" void on_sigint(int) { g_interrupted.store(true); }
 static_assert(std::atomic<bool>::is_always_lock_free, "the SIGINT handler needs a lock-free flag");
@@ -75,9 +70,8 @@ void print_render_help() {
          "      --fog-mode MODE    how the light the fog scatters is computed: auto (default:\n"
          "                         refined), brute (ray marching, a shadow ray per sample),\n"
          "                         reference (converged: every shadow edge bisected, 16 sun-\n"
-         "                         disc points); medium, fast and refined use the shadow cones\n"
-         "                         of sun photons, which this build cannot make yet (auto then\n"
-         "                         refines whole rays)\n"
+         "                         disc points); medium, fast, refined and auto use the shadow\n"
+         "                         cones of sun photons (traced once per render)\n"
          "      --fog-steps N      samples along each ray, 1 to " << kFogMaxSteps << " (default 64)\n"
          "      --photons N        sun photons for the shadow cones, 1 to " << kFogMaxPhotons << "\n"
          "                         (default 1000000)\n"
@@ -190,10 +184,6 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
       const std::string v = value();
       const std::optional<FogMode> mode = fog_mode_from_name(v);
       if (!mode) throw UsageError{"--fog-mode " + v + ": expected auto, brute, medium, fast, refined or reference"};
-      if (needs_cones(*mode))
-        throw UsageError{"--fog-mode " + v +
-                         ": needs the shadow cones of sun photons, which this build cannot make yet "
-                         "(use auto, brute or reference)"};
       out.fog.mode = *mode;
       out.fog_flags = true;
     } else if (a == "--fog-steps") {
@@ -277,13 +267,6 @@ int run_render(const std::vector<std::string>& args) {
   if (!scene.fog && (a.fog_flags || (a.aovs & kAovFog)))
     throw UsageError{"--fog-mode, --fog-steps, --photons, --cone-params and --aov fog apply to a scene with fog "
                      "only ('" + input + "' has no fog key)"};
-  if (scene.fog && !a.fog.mode && needs_cones(scene.fog->mode)) {
-    std::cerr << input << ": error: fog.mode \"" << fog_mode_name(scene.fog->mode)
-              << "\" needs the shadow cones of sun photons, which this build cannot make yet (use auto, brute or "
-                 "reference, or --fog-mode)\n";
-    return kInputError;
-  }
-
   RenderOptions options;
   options.spp = a.spp;
   options.aovs = a.aovs;
@@ -350,13 +333,14 @@ int run_render(const std::vector<std::string>& args) {
 
   if (a.verbose) {
     std::cerr << "sylva render: " << scene.width << "x" << scene.height << ", " << a.spp << " spp, " << backend_name
-              << (scene.fog ? "; fog without shadow cones (this build traces no sun photons)" : "") << "\n";
+              << "\n";
     auto print = [](const char* name, double seconds, const std::string& detail) {
       char line[256];
       std::snprintf(line, sizeof line, "  %-22s %9.3f ms", name, seconds * 1e3);
       std::cerr << line << (detail.empty() ? "" : "  " + detail) << "\n";
     };
     for (const RenderPass& p : passes) print(p.name.c_str(), p.seconds, p.detail);
+    if (!result.cone_report.empty()) std::cerr << result.cone_report;
     if (gl_result) {
       // The GL frame's totals (GlFrameStats): GPU time over its passes, what it sent, what it holds.
       print("GPU total", gl_stats.gpu_s(),

@@ -595,6 +595,13 @@ std::string AutoConeReport::describe() const {
 
 // ---- Photons and cones -----------------------------------------------------------------
 
+void ConeSetSource::intervals(const Ray& ray, double t_min, double t_max, std::vector<FogInterval>* out) const {
+  thread_local std::vector<ConeInterval> found;
+  set_.intervals(ray, t_min, t_max, &found);
+  out->clear();
+  for (const ConeInterval& i : found) out->push_back({i.t_enter, i.t_exit});
+}
+
 std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, const Scene& scene,
                                                 const SunConeOptions& options, const SunPhotonTracer* tracer) {
   auto out = std::make_unique<SunCones>();

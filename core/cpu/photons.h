@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "core/cpu/render_cpu.h"  // SceneGeometry
+#include "core/fog_integrator.h"     // FogConeSource
 #include "core/render_types.h"
 #include "core/scene.h"
 #include "core/shadow_cones.h"
@@ -173,6 +174,18 @@ struct SunCones {
   double cone_seconds = 0;    // clustering, the choice, the hierarchy, the coverage
   bool cancelled = false;
   std::vector<RenderPass> passes;  // "photons", "cone params", "cones", "cone coverage"
+};
+
+// A ConeSet as the fog integrator queries it (core/fog_integrator.h's FogConeSource: the
+// same sorted, disjoint intervals; t in units of the ray's direction, which the
+// integrator passes unit). `set` must outlive it. Thread-safe.
+class ConeSetSource final : public FogConeSource {
+ public:
+  explicit ConeSetSource(const ConeSet& set) : set_(set) {}
+  void intervals(const Ray& ray, double t_min, double t_max, std::vector<FogInterval>* out) const override;
+
+ private:
+  const ConeSet& set_;
 };
 
 // Traces the photons of `scene`'s sun through `geometry`'s frusta and clusters their

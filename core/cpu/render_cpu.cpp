@@ -7,6 +7,7 @@
 #include "core/fog_integrator.h"
 #include "core/cpu/frustum_tracer.h"
 #include "core/cpu/mesh_accel.h"
+#include "core/cpu/photons.h"
 #include "core/render_common.h"
 #include "core/shading.h"
 #include "core/cpu/texture.h"
@@ -468,12 +469,36 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
 
   // The fog (spec/fog.md): only a scene with a `fog` key runs any of it.
   std::optional<FogIntegrator> fog;
+  // The shadow cones of the modes that use them (medium, fast, refined and auto), built
+  // here from sun photons (core/cpu/photons.h) unless the caller brought a set
+  // (options.fog.cones: viewpoint independent, one set serves every camera and frame);
+  // brute and reference trace no photons.
+  std::unique_ptr<const SunCones> sun_cones;
+  std::optional<ConeSetSource> cone_source;
   if (scene.fog) {
     FogIntegratorOptions fog_options;
     fog_options.mode = options.fog.mode.value_or(scene.fog->mode);
     fog_options.steps = options.fog.steps.value_or(scene.fog->steps);
-    fog.emplace(fog_medium_of(scene), fog_sun_of(scene.sun), scene.sky, *geometry.tracer, options.fog.cones,
-                fog_options);
+    const FogConeSource* cones = options.fog.cones;
+    const bool cone_mode = fog_options.mode == FogMode::medium || fog_options.mode == FogMode::fast ||
+                           fog_options.mode == FogMode::refined || fog_options.mode == FogMode::automatic;
+    if (!cones && cone_mode) {
+      SunConeOptions cone_options;
+      cone_options.photons.photons = options.fog.photons.value_or(scene.fog->photons);
+      cone_options.photons.threads = options.threads;
+      cone_options.photons.cancel = options.cancel;
+      if (options.fog.cone_params) {
+        ConeParams p;
+        p.p1 = (*options.fog.cone_params)[0], p.p2 = (*options.fog.cone_params)[1];
+        p.p3 = (*options.fog.cone_params)[2], p.p4 = (*options.fog.cone_params)[3];
+        cone_options.params = p;
+      }
+      sun_cones = build_sun_cones(geometry, scene, cone_options);
+      result.passes.insert(result.passes.end(), sun_cones->passes.begin(), sun_cones->passes.end());
+      if (sun_cones->automatic) result.cone_report = sun_cones->automatic->describe();
+      cones = &cone_source.emplace(sun_cones->cones);
+    }
+    fog.emplace(fog_medium_of(scene), fog_sun_of(scene.sun), scene.sky, *geometry.tracer, cones, fog_options);
   }
 
   const uint32_t tiles_x = (scene.width + kTile - 1) / kTile;
@@ -545,7 +570,11 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
     std::string detail = std::string(fog_mode_name(mode));
     if (options.fog.mode.value_or(scene.fog->mode) == FogMode::automatic) detail += " (auto)";
     detail += ", " + std::to_string(options.fog.steps.value_or(scene.fog->steps)) + " steps";
-    if (cone_mode) detail += options.fog.cones ? ", shadow cones" : ", no shadow cones (every ray searched whole)";
+    if (cone_mode) {
+      if (options.fog.cones) detail += ", shadow cones (the caller's)";
+      else if (sun_cones) detail += ", " + std::to_string(sun_cones->cones.size()) + " shadow cones";
+      else detail += ", no shadow cones (every ray searched whole)";
+    }
     detail += "; " + std::to_string(total.fog_rays) + " rays, " + std::to_string(total.fog_shadow_rays) +
               " shadow rays, " + std::to_string(total.fog_stopped) + " stopped at T < 4e-18";
     result.passes.push_back({"fog (thread time)", total.fog_s, detail});

@@ -101,9 +101,6 @@ TEST(RenderFogCli, BadFogFlagsAreUsageErrors) {
       {{"--fog-steps", "1000000"}, "--fog-steps 1000000"},
       {{"--fog-steps", "1.5"}, "--fog-steps 1.5"},
       {{"--fog-mode", "warp"}, "--fog-mode warp: expected auto, brute, medium, fast, refined or reference"},
-      {{"--fog-mode", "fast"}, "--fog-mode fast: needs the shadow cones"},
-      {{"--fog-mode", "medium"}, "needs the shadow cones"},
-      {{"--fog-mode", "refined"}, "needs the shadow cones"},
       {{"--cone-params", "96,8,24"}, "--cone-params 96,8,24: expected auto or p1,p2,p3,p4"},
       {{"--cone-params", "96,8,24,16,2"}, "expected auto or p1,p2,p3,p4"},
       {{"--cone-params", "0,0,0,0"}, "expected auto or p1,p2,p3,p4"},
@@ -154,14 +151,53 @@ TEST(RenderFogCli, FogFlagsOnASceneWithoutFogAreUsageErrors) {
   EXPECT_EQ(r.err.find("fog"), std::string::npos) << describe(r);
 }
 
-TEST(RenderFogCli, ASceneModeThatNeedsConesIsAnInputErrorUnlessOverridden) {
+TEST(RenderFogCli, TheConeModesTraceSunPhotonsAndBruteAndReferenceDoNot) {
+  // spec/fog.md: medium, fast, refined and auto use the shadow cones of sun photons, built
+  // once per render (the "photons" and "cones" passes); brute and reference trace none.
   TempDir dir;
-  const std::string scene = write_scene(dir, R"({"mode": "fast", "top": 20, "steps": 2})");
-  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu"});
-  EXPECT_EQ(r.exit_code, 1) << describe(r);
-  EXPECT_NE(r.err.find("fog.mode \"fast\" needs the shadow cones"), std::string::npos) << describe(r);
-  r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--fog-mode", "brute"});
-  EXPECT_EQ(r.exit_code, 0) << describe(r);
+  const std::string scene = write_scene(dir, R"({"mode": "fast", "top": 20, "steps": 2, "photons": 20000})");
+  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.err.find("  photons "), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("20000 photons"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("  cones "), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("cone parameters (automatic)"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("fast, 2 steps"), std::string::npos) << describe(r);
+  for (const char* mode : {"medium", "refined", "auto"}) {
+    r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose", "--fog-mode", mode,
+                   "--cone-params", "41,8,8,8"});
+    ASSERT_EQ(r.exit_code, 0) << mode << ": " << describe(r);
+    EXPECT_NE(r.err.find("  photons "), std::string::npos) << mode << ": " << describe(r);
+    EXPECT_NE(r.err.find("p1 41, p2 8, p3 8, p4 8"), std::string::npos) << mode << ": " << describe(r);
+    EXPECT_EQ(r.err.find("cone parameters (automatic)"), std::string::npos) << mode << ": " << describe(r);
+  }
+  for (const char* mode : {"brute", "reference"}) {
+    r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose", "--fog-mode", mode});
+    ASSERT_EQ(r.exit_code, 0) << mode << ": " << describe(r);
+    EXPECT_EQ(r.err.find("  photons "), std::string::npos) << mode << ": " << describe(r);
+    EXPECT_EQ(r.err.find("  cones "), std::string::npos) << mode << ": " << describe(r);
+  }
+}
+
+TEST(RenderFogCli, EveryBundledFogSceneRendersOnTheCpuWithItsCones) {
+  // presets/scenes/'s fog scenes (crepuscular rays, height fog), small and quick: the
+  // default mode (auto: refined with the shadow cones of sun photons) and the fog AOV.
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes")) {
+    const std::string path = entry.path().string();
+    if (!path.ends_with(".scene.json") || read_file(path).find("\"fog\"") == std::string::npos) continue;
+    ++scenes;
+    TempDir dir;
+    ProcessResult r = run_sylva({"render", path, "-o", dir.file("f.exr"), "--backend", "cpu", "--width", "48",
+                                 "--height", "36", "--photons", "20000", "--fog-steps", "4", "--aov", "fog",
+                                 "--verbose"});
+    ASSERT_EQ(r.exit_code, 0) << path << ": " << describe(r);
+    EXPECT_NE(r.err.find("  cones "), std::string::npos) << path << ": " << describe(r);
+    EXPECT_NE(r.err.find("refined (auto)"), std::string::npos) << path << ": " << describe(r);
+    const std::vector<std::string> channels = channel_names(dir.file("f.exr"));
+    EXPECT_NE(std::find(channels.begin(), channels.end(), "fog.T"), channels.end()) << path;
+  }
+  EXPECT_GE(scenes, 2);
 }
 
 TEST(RenderFogCli, BadFogKeyInASceneIsExitOneAtTheKey) {
