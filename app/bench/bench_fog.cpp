@@ -475,7 +475,7 @@ int run_bench_fog(const std::vector<std::string>& args) {
           rows.push_back(row);
         }
         if (!fog_rows || !cone_modes) continue;
-        const ConeSetSource source(c->cones);
+        const ConeSetFogSource source(c->cones);
         const std::string suffix = automatic ? "-auto" : "-fixed";
         for (const char* mode_name : {"medium", "refined"}) {
           if (!wants(mode_name)) continue;
@@ -584,16 +584,17 @@ int run_bench_fog(const std::vector<std::string>& args) {
       for (const Point& p : sorted) s.points.push_back({p.time, p.rmse});
       s.connect = false;
     }
-    if (auto e = write_loglog_plot({{input_stem(a.grammar.grammar) + ": fog in-scatter against the reference",
-                                     "total time: photons + cones + fog (s)", "RMSE (linear RGB)", series}},
-                                   a.plot)) {
-      std::cerr << e->format() << "\n";
+    if (Status e = write_loglog_plot({{input_stem(a.grammar.grammar) + ": fog in-scatter against the reference",
+                                       "total time: photons + cones + fog (s)", "RMSE (linear RGB)", series}},
+                                     a.plot);
+        !e) {
+      std::cerr << e.error().format();
       return kInputError;
     }
   }
   for (const auto& [path, text] : {std::pair{a.csv, csv.str()}, std::pair{a.cones_csv, cones_csv.str()}}) {
-    if (auto e = write_file_atomically(path, text)) {
-      std::cerr << e->format() << "\n";
+    if (Status e = write_file_atomically(path, text); !e) {
+      std::cerr << e.error().format();
       return kInputError;
     }
   }

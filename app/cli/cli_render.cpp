@@ -11,6 +11,7 @@
 #include <iostream>
 
 #include "app/cli/cli.h"
+#include "app/cli/progress_bar.h"
 #include "app/cli/render_input.h"
 #include "core/render_output.h"
 #include "core/util/image_io.h"
@@ -70,8 +71,10 @@ void print_render_help() {
          "      --fog-mode MODE    how the light the fog scatters is computed: auto (default:\n"
          "                         refined), brute (ray marching, a shadow ray per sample),\n"
          "                         reference (converged: every shadow edge bisected, 16 sun-\n"
-         "                         disc points); medium, fast, refined and auto use the shadow\n"
-         "                         cones of sun photons (traced once per render)\n"
+         "                         disc points); medium (shadow rays only inside the shadow\n"
+         "                         cones), fast (no sunlight inside them, no shadow rays) and\n"
+         "                         refined (their edges bisected to the exact shadow) trace sun\n"
+         "                         photons into shadow cones first (paper 002)\n"
          "      --fog-steps N      samples along each ray, 1 to " << kFogMaxSteps << " (default 64)\n"
          "      --photons N        sun photons for the shadow cones, 1 to " << kFogMaxPhotons << "\n"
          "                         (default 1000000)\n"
@@ -267,13 +270,14 @@ int run_render(const std::vector<std::string>& args) {
   if (!scene.fog && (a.fog_flags || (a.aovs & kAovFog)))
     throw UsageError{"--fog-mode, --fog-steps, --photons, --cone-params and --aov fog apply to a scene with fog "
                      "only ('" + input + "' has no fog key)"};
+
   RenderOptions options;
   options.spp = a.spp;
   options.aovs = a.aovs;
   options.geometry = a.geometry;
   options.fog = a.fog;
-  options.cancel = &g_interrupted;
-  options.progress = ::isatty(STDERR_FILENO) == 1;
+  ProgressBar bar("sylva render", ::isatty(STDERR_FILENO) == 1);
+  options.progress = bar.progress(&g_interrupted);
   // The backend (cli.md): gl, or for auto OpenGL where a context can be made and the scene
   // needs nothing the GL backend lacks; otherwise the CPU, saying why.
   std::string backend_name = "CPU ray caster";
@@ -315,6 +319,7 @@ int run_render(const std::vector<std::string>& args) {
     }
   }
   RenderResult result = gl_result ? std::move(*gl_result) : render_cpu(scene, options);
+  bar.finish();
   if (result.cancelled || g_interrupted.load()) {
     std::cerr << "sylva render: interrupted; nothing written\n";
     return kInterrupted;
@@ -322,13 +327,13 @@ int run_render(const std::vector<std::string>& args) {
   passes.insert(passes.end(), result.passes.begin(), result.passes.end());
 
   start = std::chrono::steady_clock::now();
-  ImageWriteResult written = write_render(output, result.image);
-  if (written.error) {
-    std::cerr << written.error->format() << "\n";
+  Expected<std::vector<std::string>> written = write_render(output, result.image);
+  if (!written) {
+    std::cerr << written.error().format();
     return kInputError;
   }
   std::string files;
-  for (const std::string& f : written.written) files += (files.empty() ? "" : ", ") + f;
+  for (const std::string& f : *written) files += (files.empty() ? "" : ", ") + f;
   passes.push_back({"write", seconds_since(start), files});
 
   if (a.verbose) {

@@ -595,13 +595,6 @@ std::string AutoConeReport::describe() const {
 
 // ---- Photons and cones -----------------------------------------------------------------
 
-void ConeSetSource::intervals(const Ray& ray, double t_min, double t_max, std::vector<FogInterval>* out) const {
-  thread_local std::vector<ConeInterval> found;
-  set_.intervals(ray, t_min, t_max, &found);
-  out->clear();
-  for (const ConeInterval& i : found) out->push_back({i.t_enter, i.t_exit});
-}
-
 std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, const Scene& scene,
                                                 const SunConeOptions& options, const SunPhotonTracer* tracer) {
   auto out = std::make_unique<SunCones>();
@@ -669,6 +662,36 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
   }
   out->cone_seconds = seconds_since(cones_start);
   return out;
+}
+
+void ConeSetFogSource::intervals(const Ray& ray, double t_min, double t_max, std::vector<FogInterval>* out) const {
+  thread_local std::vector<ConeInterval> found;
+  set_.intervals(ray, t_min, t_max, &found);
+  out->clear();
+  for (const ConeInterval& i : found) out->push_back({i.t_enter, i.t_exit});
+}
+
+bool fog_mode_needs_cones(FogMode mode) {
+  return mode == FogMode::medium || mode == FogMode::fast || mode == FogMode::refined || mode == FogMode::automatic;
+}
+
+SunConeOptions sun_cone_options_for(FogMode mode, uint64_t photons, const std::optional<std::array<uint32_t, 4>>& params,
+                                    unsigned threads, const std::atomic<bool>* cancel, uint64_t seed) {
+  SunConeOptions o;
+  o.photons.photons = photons;
+  o.photons.seed = seed;
+  o.photons.threads = threads;
+  o.photons.cancel = cancel;
+  if (params) {
+    ConeParams p;
+    p.p1 = (*params)[0];
+    p.p2 = (*params)[1];
+    p.p3 = (*params)[2];
+    p.p4 = (*params)[3];
+    o.params = p;
+  }
+  o.miss_weight = mode == FogMode::fast ? 1.0 : 4.0;
+  return o;
 }
 
 }  // namespace sylva

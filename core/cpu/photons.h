@@ -24,6 +24,7 @@
 // relative to the bounding sphere's centre (ShadowVectors::origin).
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -33,7 +34,7 @@
 #include <vector>
 
 #include "core/cpu/render_cpu.h"  // SceneGeometry
-#include "core/fog_integrator.h"     // FogConeSource
+#include "core/fog_integrator.h"  // FogConeSource
 #include "core/render_types.h"
 #include "core/scene.h"
 #include "core/shadow_cones.h"
@@ -176,18 +177,6 @@ struct SunCones {
   std::vector<RenderPass> passes;  // "photons", "cone params", "cones", "cone coverage"
 };
 
-// A ConeSet as the fog integrator queries it (core/fog_integrator.h's FogConeSource: the
-// same sorted, disjoint intervals; t in units of the ray's direction, which the
-// integrator passes unit). `set` must outlive it. Thread-safe.
-class ConeSetSource final : public FogConeSource {
- public:
-  explicit ConeSetSource(const ConeSet& set) : set_(set) {}
-  void intervals(const Ray& ray, double t_min, double t_max, std::vector<FogInterval>* out) const override;
-
- private:
-  const ConeSet& set_;
-};
-
 // Traces the photons of `scene`'s sun through `geometry`'s frusta and clusters their
 // shadow vectors into cones ending at scene.ground (the length limit: the bounding
 // sphere's sweep, 2R beyond its far side or to the ground). A sun at or below the
@@ -197,5 +186,26 @@ class ConeSetSource final : public FogConeSource {
 std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, const Scene& scene,
                                                 const SunConeOptions& options,
                                                 const SunPhotonTracer* tracer = nullptr);
+
+// The cone set as the fog integrator queries it (fog_integrator.h's FogConeSource): the
+// same sorted, merged intervals. `set` must outlive the source. Thread-safe.
+class ConeSetFogSource final : public FogConeSource {
+ public:
+  explicit ConeSetFogSource(const ConeSet& set) : set_(set) {}
+  void intervals(const Ray& ray, double t_min, double t_max, std::vector<FogInterval>* out) const override;
+
+ private:
+  const ConeSet& set_;
+};
+
+// What the fog needs of photons and cones for a render (spec/fog.md's modes): whether
+// `mode` reads shadow cones (medium, fast, refined; auto is refined on the CPU) and the
+// options of build_sun_cones for it — `photons` sun photons (seeded by `seed`), the
+// clustering parameters p1..p4 given, or automatic (nullopt), the automatic choice
+// weighing a missed shadow 4× a covered lit point for medium and refined (a miss costs them
+// bias, a cover only shadow rays) and 1× for fast (both cost it bias).
+bool fog_mode_needs_cones(FogMode mode);
+SunConeOptions sun_cone_options_for(FogMode mode, uint64_t photons, const std::optional<std::array<uint32_t, 4>>& params,
+                                    unsigned threads, const std::atomic<bool>* cancel, uint64_t seed = 0);
 
 }  // namespace sylva

@@ -164,8 +164,19 @@ TEST(RenderFog, OptionsOverrideTheScenesModeAndSteps) {
                                 [](const RenderPass& p) { return p.name.rfind("fog", 0) == 0; });
   ASSERT_NE(fog, r.passes.end());
   EXPECT_EQ(fog->detail.rfind("brute, 3 steps", 0), 0u) << fog->detail;
-  o.fog.mode = FogMode::fast;  // V = 0 inside the cones: meaningless without them
-  EXPECT_THROW(render_cpu(s, o), std::invalid_argument);
+  // A cone mode traces sun photons into shadow cones first (and brute above traced none).
+  EXPECT_EQ(std::find_if(r.passes.begin(), r.passes.end(), [](const RenderPass& p) { return p.name == "photons"; }),
+            r.passes.end());
+  o.fog.mode = FogMode::fast;
+  o.fog.photons = 20000;
+  const RenderResult f = render_cpu(s, o);
+  EXPECT_NE(std::find_if(f.passes.begin(), f.passes.end(), [](const RenderPass& p) { return p.name == "photons"; }),
+            f.passes.end());
+  const auto fast = std::find_if(f.passes.begin(), f.passes.end(),
+                                 [](const RenderPass& p) { return p.name.rfind("fog", 0) == 0; });
+  ASSERT_NE(fast, f.passes.end());
+  EXPECT_EQ(fast->detail.rfind("fast, 3 steps", 0), 0u) << fast->detail;
+  EXPECT_NE(fast->detail.find("shadow cones"), std::string::npos) << fast->detail;
 }
 
 TEST(RenderFog, SurfacesReceiveSunlightAttenuatedByTheFog) {
