@@ -115,7 +115,8 @@ struct FogRayResult {
 // Integrates camera rays through one scene's fog. Thread-safe (const); cheap to build.
 class FogIntegrator {
  public:
-  // `tracer` (and `cones`, when not null) must outlive the integrator. `cones` is used by
+  // `tracer` (and `cones`, when not null) must outlive the integrator; its bounds() bound
+  // where shadow rays start (a point whose sun ray misses them is lit without one). `cones` is used by
   // medium, fast, refined and auto; fast needs it (std::invalid_argument without), medium
   // and refined treat a null set as one interval covering every ray.
   FogIntegrator(const FogMedium& medium, const FogSun& sun, const glm::dvec3& sky, const SceneTracer& tracer,
@@ -135,6 +136,9 @@ class FogIntegrator {
     glm::dvec3 origin, direction;
   };
   double visible(const CameraRay& ray, double t, const glm::dvec3& toward_sun, FogRayResult* result) const;
+  // The part of [a, b] that may lie in shadow: below the top of the casters' box when every
+  // direction of the sun's disc climbs (above it the sun is seen), else all of it.
+  FogInterval shadow_range(const CameraRay& ray, double a, double b) const;
   glm::dvec3 disc_direction(render_common::SampleRng& rng) const;
   double sun_brute(const CameraRay& ray, double a, double b, const std::vector<FogInterval>* cones,
                    render_common::SampleRng& rng, FogRayResult* result) const;
@@ -153,6 +157,8 @@ class FogIntegrator {
   double cos_alpha_ = 1;
   AxisFrame sun_frame_{};
   bool sunlit_ = false;  // the sun lights the fog at all (radiance > 0, above the horizon)
+  Aabb casters_;         // tracer.bounds(): only a sun ray that meets it can be blocked
+  bool disc_climbs_ = false;  // every direction of the sun's disc has y > 0
 };
 
 }  // namespace sylva
