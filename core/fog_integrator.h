@@ -61,8 +61,10 @@ namespace sylva {
 // Beyond this optical depth from the eye the sunlit in-scatter is not sampled (T < 4.2e-18).
 constexpr double kFogNegligibleDepth = 40;
 // Halvings of a probe gap that brackets a change of visibility in refined mode: the
-// transition is then placed within gap/2^13 (a gap holds 1/steps of the ray's weight).
-constexpr int kRefinedBisections = 12;
+// transition is then placed within gap/2^7 (a gap holds 1/steps of the ray's weight), an
+// error of at most 1/(128·steps) of the searched weight per edge and of either sign, far
+// below what one disc point per ray and shadows narrower than a gap leave (docs/fog.md).
+constexpr int kRefinedBisections = 6;
 // Halvings in reference mode (fewer where the bracket reaches the resolution of t): a
 // transition lands within gap/2^25 (the gap holding 1/(8·steps) of the weight), so each
 // contributes an error below 1e-10 of the ray's sunlit in-scatter at the default steps.

@@ -20,7 +20,10 @@
 //             or "fixed" follows the mode's name: medium-auto, refined-fixed, ...);
 //   fast      --photons × {auto, fixed} (steps 0: no samples).
 // rmse: over pixels and channels against the reference; bias: the same for the mean
-// image of the setting's seeds (what more seeds cannot remove; fast mode's floor).
+// image of the setting's seeds (what more seeds cannot remove; fast mode's floor). With
+// --reference-stride S the reference is computed, and both measured, on every S-th pixel
+// each way only (a uniform grid of the image: the same RMSE in expectation); every mode
+// still renders every pixel, so its times are the whole image's.
 // Outputs: the CSV, STEM.fog-cones.csv (the cones' coverage of the exact shadow), a
 // log-log plot of RMSE against total time (the plot module), and on stdout the time each
 // family needs to reach given RMSEs (interpolated on its fastest settings, log-log) and
@@ -56,7 +59,8 @@ namespace {
 void print_help() {
   std::cout << "usage: sylva bench fog SCENE [--modes LIST] [--brute-steps LIST] [--cone-steps LIST]\n"
                "                            [--photons LIST] [--seeds N] [--width W --height H]\n"
-               "                            [--reference-steps N] [--fixed-params p1,p2,p3,p4[,t]]\n"
+               "                            [--reference-steps N] [--reference-stride S]\n"
+               "                            [--fixed-params p1,p2,p3,p4[,t]]\n"
                "                            [--threads N] [--per-core-photons N] [--cones-only]\n"
                "                            [--csv FILE] [--plot FILE.png] [--quick]\n\n"
                "Error against run time of the fog modes on SCENE (a scene with a `fog` key): the fog\n"
@@ -72,6 +76,8 @@ void print_help() {
                "  --seeds N             seeds per setting (default 5)\n"
                "  --width W, --height H pixels (default 512x384)\n"
                "  --reference-steps N   the reference's steps (default 64: 512 probes per disc point)\n"
+               "  --reference-stride S  the reference, and the errors, on every S-th pixel each way\n"
+               "                        (default 1: every pixel); the modes still render them all\n"
                "  --fixed-params P      the fixed cone parameters (default 96,8,24,16,2.5)\n"
                "  --threads N           threads (default: every core)\n"
                "  --per-core-photons N  photons of the one-thread photon rate (default 1000000)\n"
@@ -92,6 +98,7 @@ struct Args {
   uint32_t seeds = 5;
   uint32_t width = 512, height = 384;
   uint32_t reference_steps = 64;
+  uint32_t reference_stride = 1;
   ConeParams fixed_params;
   unsigned threads = 0;
   uint64_t per_core_photons = 1'000'000;
@@ -173,6 +180,8 @@ Args parse_args(const std::vector<std::string>& args) {
     } else if (a == "--reference-steps") {
       out.reference_steps = parse_count(a, value(), 65536);
       reference_given = true;
+    } else if (a == "--reference-stride") {
+      out.reference_stride = parse_count(a, value(), 1024);
     } else if (a == "--fixed-params" || a == "--cone-params") {
       out.fixed_params = parse_cone_params(a, value());
     } else if (a == "--threads") {
@@ -282,10 +291,30 @@ std::vector<float> fog_image(const View& v, const FogIntegrator& integrator, uin
   return out;
 }
 
-double rmse(const std::vector<float>& a, const std::vector<double>& reference) {
+// The pixels `view` keeps of a `stride` grid: (x, y) with x, y ≡ stride/2 (mod stride).
+View strided(const View& v, uint32_t stride, std::vector<size_t>* pixels) {
+  View out;
+  pixels->clear();
+  for (uint32_t y = stride / 2; y < v.height; y += stride)
+    for (uint32_t x = stride / 2; x < v.width; x += stride) {
+      const size_t i = size_t(y) * v.width + x;
+      pixels->push_back(i);
+      out.origin.push_back(v.origin[i]), out.direction.push_back(v.direction[i]), out.t_end.push_back(v.t_end[i]);
+    }
+  out.width = static_cast<uint32_t>(pixels->size()), out.height = 1;
+  return out;
+}
+
+// Over `pixels` (of `a`, RGB) against `reference` (RGB, one per pixel in that order).
+template <typename T>
+double rmse(const std::vector<T>& a, const std::vector<double>& reference, const std::vector<size_t>& pixels) {
   double sum = 0;
-  for (size_t i = 0; i < a.size(); ++i) sum += (a[i] - reference[i]) * (a[i] - reference[i]);
-  return std::sqrt(sum / std::max<size_t>(1, a.size()));
+  for (size_t k = 0; k < pixels.size(); ++k)
+    for (int c = 0; c < 3; ++c) {
+      const double d = a[pixels[k] * 3 + c] - reference[k * 3 + c];
+      sum += d * d;
+    }
+  return std::sqrt(sum / std::max<size_t>(1, 3 * pixels.size()));
 }
 
 // One row of the CSV, and the setting it belongs to.
@@ -366,6 +395,7 @@ int run_bench_fog(const std::vector<std::string>& args) {
   const bool fog_rows = !a.cones_only;
   View view;
   std::vector<double> reference;
+  std::vector<size_t> reference_pixels;  // of the view, in the reference's order
   std::optional<FogMedium> medium;
   if (fog_rows) {
     view = pixel_rays(scene, *g.tracer);
@@ -375,13 +405,16 @@ int run_bench_fog(const std::vector<std::string>& args) {
     ro.steps = a.reference_steps;
     const FogIntegrator ref(*medium, fog_sun_of(scene.sun), scene.sky, *g.tracer, nullptr, ro);
     double seconds = 0;
-    const std::vector<float> image = fog_image(view, ref, 0, threads, &seconds);
+    const View sparse = strided(view, a.reference_stride, &reference_pixels);
+    const std::vector<float> image = fog_image(sparse, ref, 0, threads, &seconds);
     reference.assign(image.begin(), image.end());
     double mean = 0;
     for (double v : reference) mean += v;
     mean /= std::max<size_t>(1, reference.size());
-    std::printf("reference: %u steps (%u probes per disc point), %.2f s, mean in-scatter %.4g\n", a.reference_steps,
-                a.reference_steps * kReferenceProbesPerStep, seconds, mean);
+    std::printf("reference: %u steps (%u probes per disc point), %zu pixels (stride %u), %.2f s, mean in-scatter "
+                "%.4g\n",
+                a.reference_steps, a.reference_steps * kReferenceProbesPerStep, reference_pixels.size(),
+                a.reference_stride, seconds, mean);
     std::fflush(stdout);
   }
 
@@ -396,7 +429,7 @@ int run_bench_fog(const std::vector<std::string>& args) {
     const std::vector<float> image = fog_image(view, integrator, lsys::mix_pair(row.seed, 0x666f67), threads,
                                                &row.render_s);
     row.total_s = row.photon_s + row.cone_s + row.render_s;
-    row.rmse = rmse(image, reference);
+    row.rmse = rmse(image, reference, reference_pixels);
     std::vector<double>& sum = sums[row.setting()];
     if (sum.empty()) sum.assign(image.size(), 0.0);
     for (size_t i = 0; i < image.size(); ++i) sum[i] += image[i];
@@ -495,13 +528,14 @@ int run_bench_fog(const std::vector<std::string>& args) {
   // Bias: the mean image of each setting's seeds against the reference.
   std::map<std::string, double> bias;
   for (const auto& [setting, sum] : sums) {
-    std::vector<float> mean(sum.size());
-    for (size_t i = 0; i < sum.size(); ++i) mean[i] = static_cast<float>(sum[i] / counts[setting]);
-    bias[setting] = rmse(mean, reference);
+    std::vector<double> mean(sum.size());
+    for (size_t i = 0; i < sum.size(); ++i) mean[i] = sum[i] / counts[setting];
+    bias[setting] = rmse(mean, reference, reference_pixels);
   }
   std::ostringstream csv;
   csv << "# sylva bench fog " << a.grammar.grammar << ", " << scene.width << "x" << scene.height << ", " << threads
-      << " threads, reference " << a.reference_steps << " steps\n";
+      << " threads, reference " << a.reference_steps << " steps on every " << a.reference_stride
+      << "-th pixel each way\n";
   csv << "mode,steps,photons,seed,photon_s,cone_s,render_s,total_s,rmse,bias,cones\n";
   for (Row& r : rows) {
     char line[512];

@@ -54,11 +54,27 @@ TEST(BenchFog, QuickRunWritesEveryModesRowsTheTimeTableAndThePlot) {
   EXPECT_EQ(count_lines_starting(cones, "100000,"), 4u) << cones;  // 2 seeds × auto, fixed
 }
 
+TEST(BenchFog, AStridedReferenceMeasuresOnItsGridAndTimesTheWholeImage) {
+  TempDir dir;
+  const std::string csv = dir.file("grove.fog.csv");
+  auto r = run_process({SYLVA_BINARY, "bench", "fog", "presets/scenes/elm_grove_low_sun.scene.json", "--quick",
+                        "--modes", "brute", "--photons", "10000", "--reference-stride", "4", "--csv", csv, "--plot",
+                        dir.file("grove.fog.png")},
+                       SYLVA_SOURCE_DIR, 600);
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  // 64x48 every 4th pixel each way: 16 x 12.
+  EXPECT_NE(r.out.find("192 pixels (stride 4)"), std::string::npos) << r.out;
+  const std::string rows = read_file(csv);
+  EXPECT_NE(rows.find("64x48, "), std::string::npos) << rows;
+  EXPECT_NE(rows.find("on every 4-th pixel each way"), std::string::npos) << rows;
+  EXPECT_EQ(count_lines_starting(rows, "brute,8,0,"), 2u) << rows;
+}
+
 TEST(BenchFog, BadConeParametersAndPhotonCountsAreUsageErrors) {
   for (const std::vector<std::string>& bad :
        {std::vector<std::string>{"--cone-params", "1,2,3"}, {"--cone-params", "16,8,24,4"},  // p1 < p3 + 1
         {"--cone-params", "96,8,24,4,x"}, {"--photons", "0"}, {"--photons", "1e5"}, {"--seeds", "0"},
-        {"--modes", "brute,slow"}, {"--brute-steps", "0"}}) {
+        {"--modes", "brute,slow"}, {"--brute-steps", "0"}, {"--reference-stride", "0"}}) {
     std::vector<std::string> argv = {SYLVA_BINARY, "bench", "fog", "presets/scenes/pine.scene.json"};
     argv.insert(argv.end(), bad.begin(), bad.end());
     auto r = run_process(argv, SYLVA_SOURCE_DIR);

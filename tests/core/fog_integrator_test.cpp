@@ -218,8 +218,8 @@ TEST(FogIntegrator, RefinedAndReferenceFindTheExactShadowsOfAPointSun) {
   const CylinderCones cones(s.spheres, s.sun.direction, 0.05);  // conservative
   const double exact = s.exact_sun(), open = s.unshadowed_sun();
   const FogRayResult refined = run(s, FogMode::refined, 64, &cones, 3);
-  // Transitions to within a probe gap / 2^13 (a gap holds ~1/64 of the weight): 24 of them.
-  EXPECT_NEAR(s.sun_of(refined), exact, 24 * open / 64 / 8192);
+  // Transitions to within a probe gap / 2^7 (a gap holds ~1/64 of the weight): 24 of them.
+  EXPECT_NEAR(s.sun_of(refined), exact, 24 * open / 64 / 128);
   // Reference: 512 probes, transitions within a gap / 2^25.
   const FogRayResult reference = run(s, FogMode::reference, 64, nullptr, 3);
   EXPECT_NEAR(s.sun_of(reference), exact, 24 * open / 512 / (1 << 25));
@@ -228,7 +228,7 @@ TEST(FogIntegrator, RefinedAndReferenceFindTheExactShadowsOfAPointSun) {
   // Without cones refined searches the whole ray: a shadow narrower than a probe gap (which
   // holds 1/steps of the weight) can hide there, so it takes more steps for the same answer.
   EXPECT_GT(std::abs(s.sun_of(run(s, FogMode::refined, 16, nullptr, 3)) - exact), 1e-3 * open);
-  EXPECT_NEAR(s.sun_of(run(s, FogMode::refined, 2048, nullptr, 3)), exact, 24 * open / 2048 / 8192);
+  EXPECT_NEAR(s.sun_of(run(s, FogMode::refined, 2048, nullptr, 3)), exact, 24 * open / 2048 / 128);
 }
 
 // A SphereTracer that records where every shadow ray starts.
