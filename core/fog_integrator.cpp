@@ -39,6 +39,9 @@ FogIntegrator::FogIntegrator(const FogMedium& medium, const FogSun& sun, const g
   sun_frame_ = axis_frame(sun_.direction);
   const bool radiant = sun_.radiance.x > 0 || sun_.radiance.y > 0 || sun_.radiance.z > 0;
   sunlit_ = radiant && sun_.direction.y > 0 && medium_.albedo > 0 && medium_.sigma_t > 0;
+  casters_ = tracer_.bounds();
+  // The lowest direction of the disc rises at elevation asin(s_y) − α.
+  disc_climbs_ = std::asin(std::clamp(sun_.direction.y, -1.0, 1.0)) > sun_.angular_radius_rad;
 }
 
 namespace {
@@ -70,6 +73,23 @@ double integrate_lit(const FogMedium& m, const glm::dvec3& origin, const glm::dv
   return total;
 }
 
+// Whether the ray origin + u·direction, u >= 0, meets `box` (slabs; an empty box never).
+bool meets_box(const glm::dvec3& origin, const glm::dvec3& direction, const Aabb& box) {
+  double u0 = 0, u1 = kFogInfinity;
+  for (int i = 0; i < 3; ++i) {
+    if (!(box.lo[i] <= box.hi[i])) return false;
+    if (direction[i] == 0) {
+      if (origin[i] < box.lo[i] || origin[i] > box.hi[i]) return false;
+      continue;
+    }
+    double near = (box.lo[i] - origin[i]) / direction[i], far = (box.hi[i] - origin[i]) / direction[i];
+    if (near > far) std::swap(near, far);
+    u0 = std::max(u0, near), u1 = std::min(u1, far);
+    if (!(u0 <= u1)) return false;
+  }
+  return true;
+}
+
 // Appends [t0, t1] to a sorted list of lit pieces, merging with the last when they touch.
 void append_lit(std::vector<FogInterval>* lit, double t0, double t1) {
   if (!(t1 > t0)) return;
@@ -87,10 +107,22 @@ glm::dvec3 FogIntegrator::disc_direction(SampleRng& rng) const {
 }
 
 double FogIntegrator::visible(const CameraRay& ray, double t, const glm::dvec3& toward_sun, FogRayResult* result) const {
-  ++result->shadow_rays;
   // Only plants shadow the fog (the ground never lies between a point above it and a sun
-  // above the horizon).
-  return tracer_.any(Ray{ray.origin + t * ray.direction, toward_sun}, 0, kFogInfinity) ? 0.0 : 1.0;
+  // above the horizon), and only where the sun ray meets their box: elsewhere (a point of
+  // an unbounded ray far beyond the plants included, docs/fog.md) no shadow ray is cast.
+  const glm::dvec3 point = ray.origin + t * ray.direction;
+  if (!meets_box(point, toward_sun, casters_)) return 1.0;
+  ++result->shadow_rays;
+  return tracer_.any(Ray{point, toward_sun}, 0, kFogInfinity) ? 0.0 : 1.0;
+}
+
+FogInterval FogIntegrator::shadow_range(const CameraRay& ray, double a, double b) const {
+  if (!(casters_.lo.y <= casters_.hi.y)) return {a, a};  // nothing casts a shadow
+  if (!disc_climbs_) return {a, b};
+  const double dy = ray.direction.y, above = ray.origin.y - casters_.hi.y;  // y(t) − top = above + t·dy
+  if (dy > 0) return {a, std::clamp(-above / dy, a, b)};
+  if (dy < 0) return {std::clamp(-above / dy, a, b), b};
+  return above > 0 ? FogInterval{a, a} : FogInterval{a, b};
 }
 
 double FogIntegrator::sun_brute(const CameraRay& ray, double a, double b, const std::vector<FogInterval>* cones,
@@ -206,13 +238,16 @@ FogRayResult FogIntegrator::integrate(const glm::dvec3& origin, const glm::dvec3
   const CameraRay ray{origin, direction};
   const glm::dvec3& s = sun_.direction;
 
+  // Where a shadow can fall at all: finite even when [a, b] is not (height fog without a
+  // top, a climbing ray: b = kFogFar), so no probe lies far beyond the plants.
+  const FogInterval shade = shadow_range(ray, a, b);
   std::vector<FogInterval> cones;
   if (mode_ == FogMode::medium || mode_ == FogMode::fast || mode_ == FogMode::refined) {
     if (cones_) {
-      cones_->intervals(Ray{origin, direction}, a, b, &cones);
-      cones = clipped(cones, a, b);
-    } else {
-      cones.push_back({a, b});  // no cone set: every point may be in shadow
+      cones_->intervals(Ray{origin, direction}, shade.t0, shade.t1, &cones);
+      cones = clipped(cones, shade.t0, shade.t1);
+    } else if (shade.t1 > shade.t0) {
+      cones.push_back(shade);  // no cone set: every point that can be shadowed may be
     }
   }
   double sun = 0;
@@ -227,7 +262,8 @@ FogRayResult FogIntegrator::integrate(const glm::dvec3& origin, const glm::dvec3
       break;
     }
     case FogMode::reference: {
-      const std::vector<FogInterval> whole{{a, b}};
+      std::vector<FogInterval> whole;
+      if (shade.t1 > shade.t0) whole.push_back(shade);
       const int grid = sun_.angular_radius_rad > 0 ? 4 : 1;  // kReferenceDiscSamples = grid²
       const double one_minus_cos = 2 * std::pow(std::sin(0.5 * sun_.angular_radius_rad), 2);
       for (int i = 0; i < grid; ++i)

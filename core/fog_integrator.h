@@ -61,8 +61,10 @@ namespace sylva {
 // Beyond this optical depth from the eye the sunlit in-scatter is not sampled (T < 4.2e-18).
 constexpr double kFogNegligibleDepth = 40;
 // Halvings of a probe gap that brackets a change of visibility in refined mode: the
-// transition is then placed within gap/2^13 (a gap holds 1/steps of the ray's weight).
-constexpr int kRefinedBisections = 12;
+// transition is then placed within gap/2^7 (a gap holds 1/steps of the ray's weight), an
+// error of at most 1/(128·steps) of the searched weight per edge and of either sign, far
+// below what one disc point per ray and shadows narrower than a gap leave (docs/fog.md).
+constexpr int kRefinedBisections = 6;
 // Halvings in reference mode (fewer where the bracket reaches the resolution of t): a
 // transition lands within gap/2^25 (the gap holding 1/(8·steps) of the weight), so each
 // contributes an error below 1e-10 of the ray's sunlit in-scatter at the default steps.
@@ -115,7 +117,8 @@ struct FogRayResult {
 // Integrates camera rays through one scene's fog. Thread-safe (const); cheap to build.
 class FogIntegrator {
  public:
-  // `tracer` (and `cones`, when not null) must outlive the integrator. `cones` is used by
+  // `tracer` (and `cones`, when not null) must outlive the integrator; its bounds() bound
+  // where shadow rays start (a point whose sun ray misses them is lit without one). `cones` is used by
   // medium, fast, refined and auto; fast needs it (std::invalid_argument without), medium
   // and refined treat a null set as one interval covering every ray.
   FogIntegrator(const FogMedium& medium, const FogSun& sun, const glm::dvec3& sky, const SceneTracer& tracer,
@@ -135,6 +138,9 @@ class FogIntegrator {
     glm::dvec3 origin, direction;
   };
   double visible(const CameraRay& ray, double t, const glm::dvec3& toward_sun, FogRayResult* result) const;
+  // The part of [a, b] that may lie in shadow: below the top of the casters' box when every
+  // direction of the sun's disc climbs (above it the sun is seen), else all of it.
+  FogInterval shadow_range(const CameraRay& ray, double a, double b) const;
   glm::dvec3 disc_direction(render_common::SampleRng& rng) const;
   double sun_brute(const CameraRay& ray, double a, double b, const std::vector<FogInterval>* cones,
                    render_common::SampleRng& rng, FogRayResult* result) const;
@@ -153,6 +159,8 @@ class FogIntegrator {
   double cos_alpha_ = 1;
   AxisFrame sun_frame_{};
   bool sunlit_ = false;  // the sun lights the fog at all (radiance > 0, above the horizon)
+  Aabb casters_;         // tracer.bounds(): only a sun ray that meets it can be blocked
+  bool disc_climbs_ = false;  // every direction of the sun's disc has y > 0
 };
 
 }  // namespace sylva

@@ -97,6 +97,9 @@ struct RenderResult {
   uint64_t geometry_bytes = 0;  // what the traced geometry holds (SceneTracer::memory_bytes)
   uint64_t primary_rays = 0;
   uint64_t shadow_rays = 0;
+  std::string cone_report;      // the fog's automatic cone parameters, what they measured
+                                // (core/cpu/photons.h AutoConeReport::describe); empty when
+                                // none were chosen
 };
 
 }  // namespace sylva

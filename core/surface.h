@@ -16,6 +16,7 @@
 #include <string>
 
 #include "core/ray_frustum.h"
+#include "core/util/bounds.h"
 
 namespace sylva {
 
@@ -46,6 +47,9 @@ class SceneTracer {
   virtual SurfaceHit nearest(const Ray& ray, double t_min, double t_max) const = 0;
   // Whether any surface lies at t_min < t < t_max (shadow rays).
   virtual bool any(const Ray& ray, double t_min, double t_max) const = 0;
+  // A box holding every surface (empty_box() when there is none): a ray that misses it
+  // hits nothing (the fog's shadow rays start only where theirs meet it, docs/fog.md).
+  virtual Aabb bounds() const = 0;
   // Bytes held by the geometry and its acceleration structure.
   virtual size_t memory_bytes() const = 0;
   // One line for --verbose, e.g. "Embree user geometry, 17468 frusta".

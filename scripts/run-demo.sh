@@ -3,7 +3,9 @@
 # grow the bundled saguaro and elm presets (printing their summaries), and render the
 # saguaro with the OpenGL backend (a window-less EGL context: Mesa's llvmpipe on a machine
 # without a GPU, no X server) to out/saguaro.png, then its scene (bark texture, relief-mapped
-# ribs) to out/saguaro_ribs.png.
+# ribs) to out/saguaro_ribs.png, and a stand of pines toward a low sun in fog, with
+# crepuscular rays, on the CPU (sun photons, shadow cones, the fog's in-scatter: spec/fog.md)
+# to out/pine_stand_fog.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -19,4 +21,9 @@ build/release/app/sylva render presets/saguaro.lsys -o out/saguaro.png --width 8
 # The same plant in its scene: bark texture and relief-mapped ribs, marched in the shaders.
 build/release/app/sylva render presets/scenes/saguaro.scene.json -o out/saguaro_ribs.png --width 800 --height 600 \
   --spp 4 --backend gl
-echo "skeletons, out/saguaro.png and out/saguaro_ribs.png written to out/ (see docs/ for the formats and the other presets)"
+# Crepuscular rays: the fog's shafts between the crowns (paper 002; about half a minute on
+# two cores: one million sun photons, their shadow cones, refined in-scatter).
+build/release/app/sylva render presets/scenes/pine_stand_low_sun.scene.json -o out/pine_stand_fog.png --width 480 \
+  --height 360 --backend cpu
+echo "skeletons, out/saguaro.png, out/saguaro_ribs.png and out/pine_stand_fog.png written to out/" \
+  "(see docs/ for the formats and the other presets)"

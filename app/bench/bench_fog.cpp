@@ -1,22 +1,39 @@
-// bench_fog.cpp — `sylva bench fog SCENE`: the cost and quality of the fog's
-// viewpoint-independent half (sun photons, shadow cones; core/cpu/photons.h) against the
-// photon count, each setting with several seeds.
+// bench_fog.cpp — `sylva bench fog SCENE`: error against run time of the fog modes of
+// spec/fog.md (brute, medium, fast, refined) against the converged `reference`, with the
+// cost and quality of the sun photons and shadow cones they use (core/cpu/photons.h), each
+// setting with several seeds.
 //
-// Rows (CSV columns mode,steps,photons,seed,photon_s,cone_s,render_s,total_s,rmse,bias,cones,
-// the columns every fog mode's row will have once the fog integrator renders them):
-//   cones   photons traced (all threads) and clustered into cones, automatic parameters
-//           (or --cone-params); render_s 0, rmse and bias empty.
-// A second CSV (STEM.fog-cones.csv) has what the cones measure: the chosen parameters,
-// the vectors, how much of the exact shadow they miss and how much lit space they cover
-// (ConeCoverage, on random points of the plants' shadow region).
-// The photon rate per core: --per-core-photons photons traced on one thread.
-// The cone query: for each photon count (seed 1), the scene camera's pixel-centre rays
-// (512×384) collect their cone intervals (ConeSet::intervals, the hierarchy), timed on one
-// thread: microseconds per camera ray and merged intervals per ray.
+// What is measured: the fog AOV's in-scatter (fog.R fog.G fog.B, linear RGB) through each
+// pixel's centre, as render_cpu computes it (FogIntegrator::integrate up to the first
+// plant or the ground, the scene camera), at --width × --height. Plants are the exact
+// frusta (no relief: the same for every mode and the reference). The surfaces' shading is
+// not part of it: only the fog integral is timed (render_s: the fog of every pixel, wall,
+// on --threads threads); photon_s and cone_s are the cones' (build_sun_cones), built once
+// per (photon count, cone parameters, seed) and reused by every mode and step count, the
+// paper's point (the photon tracer's accelerator and mask, built once per scene and sun,
+// are reported apart).
+//
+// Rows (CSV mode,steps,photons,seed,photon_s,cone_s,render_s,total_s,rmse,bias,cones):
+//   cones-auto, cones-fixed  the photons and cones alone (render_s 0, rmse and bias empty);
+//   brute     --brute-steps, no cones;
+//   medium, refined  --cone-steps × --photons × {auto, fixed} cone parameters ("auto"
+//             or "fixed" follows the mode's name: medium-auto, refined-fixed, ...);
+//   fast      --photons × {auto, fixed} (steps 0: no samples).
+// rmse: over pixels and channels against the reference; bias: the same for the mean
+// image of the setting's seeds (what more seeds cannot remove; fast mode's floor). With
+// --reference-stride S the reference is computed, and both measured, on every S-th pixel
+// each way only (a uniform grid of the image: the same RMSE in expectation); every mode
+// still renders every pixel, so its times are the whole image's.
+// Outputs: the CSV, STEM.fog-cones.csv (the cones' coverage of the exact shadow), a
+// log-log plot of RMSE against total time (the plot module), and on stdout the time each
+// family needs to reach given RMSEs (interpolated on its fastest settings, log-log) and
+// fast mode's bias floor.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -24,45 +41,69 @@
 #include <vector>
 
 #include "app/bench/bench_metrics.h"
+#include "app/bench/plot.h"
 #include "app/cli/cli.h"
 #include "app/cli/render_input.h"
 #include "core/cpu/photons.h"
 #include "core/cpu/render_cpu.h"
+#include "core/fog_integrator.h"
 #include "core/render_common.h"
+#include "core/shading.h"
 #include "core/util/file_io.h"
+#include "lsystem/random.h"
 
 namespace sylva::cli {
 
 namespace {
 
 void print_help() {
-  std::cout << "usage: sylva bench fog SCENE [--photons N,N,...] [--seeds N] [--threads N]\n"
-               "                            [--cone-params auto|p1,p2,p3,p4[,threshold]]\n"
-               "                            [--per-core-photons N] [--csv FILE] [--quick]\n\n"
-               "Cost and quality of the fog's sun photons and shadow cones on SCENE (a scene,\n"
-               "grammar or skeleton, as for `sylva render`): for each photon count and seed, the\n"
-               "time to trace the photons and to cluster their shadow vectors into cones, the\n"
-               "cones made, and how much of the exact shadow the cones miss and how much lit\n"
-               "space they cover (random points of the plants' shadow region, exact shadow rays).\n\n"
+  std::cout << "usage: sylva bench fog SCENE [--modes LIST] [--brute-steps LIST] [--cone-steps LIST]\n"
+               "                            [--photons LIST] [--seeds N] [--width W --height H]\n"
+               "                            [--reference-steps N] [--reference-stride S]\n"
+               "                            [--fixed-params p1,p2,p3,p4[,t]]\n"
+               "                            [--threads N] [--per-core-photons N] [--cones-only]\n"
+               "                            [--csv FILE] [--plot FILE.png] [--quick]\n\n"
+               "Error against run time of the fog modes on SCENE (a scene with a `fog` key): the fog\n"
+               "AOV's in-scatter through every pixel centre by brute, medium, fast and refined,\n"
+               "against the reference mode; each setting with --seeds seeds; the shadow cones built\n"
+               "once per photon count, cone parameters (automatic and fixed) and seed, and reused by\n"
+               "every mode. Prints the time each mode needs to reach given RMSEs and fast mode's bias\n"
+               "floor; writes the rows as CSV, the cones' coverage as CSV, and a log-log plot.\n\n"
+               "  --modes LIST          of brute,medium,fast,refined (default all four)\n"
+               "  --brute-steps LIST    brute's samples per ray (default 8,16,32,64,128,256,512,1024)\n"
+               "  --cone-steps LIST     medium's and refined's (default 16,64,256)\n"
                "  --photons LIST        photon counts (default 10000,100000,1000000,10000000)\n"
-               "  --seeds N             seeds per photon count (default 5)\n"
+               "  --seeds N             seeds per setting (default 5)\n"
+               "  --width W, --height H pixels (default 512x384)\n"
+               "  --reference-steps N   the reference's steps (default 64: 512 probes per disc point)\n"
+               "  --reference-stride S  the reference, and the errors, on every S-th pixel each way\n"
+               "                        (default 1: every pixel); the modes still render them all\n"
+               "  --fixed-params P      the fixed cone parameters (default 96,8,24,16,2.5)\n"
                "  --threads N           threads (default: every core)\n"
-               "  --cone-params P       auto (default: chosen by measurement) or p1,p2,p3,p4 with an\n"
-               "                        optional variance threshold\n"
-               "  --per-core-photons N  photons of the one-thread rate (default 1000000)\n"
-               "  --csv FILE            rows as CSV (default SCENE-stem.fog.csv; the cones' coverage\n"
-               "                        goes to the same name with .fog-cones.csv)\n"
-               "  --quick               photons 10000,100000, 2 seeds (for tests)\n";
+               "  --per-core-photons N  photons of the one-thread photon rate (default 1000000)\n"
+               "  --cones-only          photons and cones only, no fog rows\n"
+               "  --csv FILE            rows (default SCENE-stem.fog.csv; the cones' coverage in\n"
+               "                        the same name with -cones.csv)\n"
+               "  --plot FILE           log-log RMSE against time (default SCENE-stem.fog.png)\n"
+               "  --quick               a smoke test: 64x48, brute 8,32, cone steps 16, photons\n"
+               "                        10000,100000, 2 seeds, reference steps 8\n";
 }
 
 struct Args {
   GrammarArgs grammar;
+  std::vector<std::string> modes = {"brute", "medium", "fast", "refined"};
+  std::vector<uint32_t> brute_steps = {8, 16, 32, 64, 128, 256, 512, 1024};
+  std::vector<uint32_t> cone_steps = {16, 64, 256};
   std::vector<uint64_t> photons = {10'000, 100'000, 1'000'000, 10'000'000};
   uint32_t seeds = 5;
+  uint32_t width = 512, height = 384;
+  uint32_t reference_steps = 64;
+  uint32_t reference_stride = 1;
+  ConeParams fixed_params;
   unsigned threads = 0;
-  std::optional<ConeParams> params;
   uint64_t per_core_photons = 1'000'000;
-  std::string csv, cones_csv;
+  bool cones_only = false;
+  std::string csv, cones_csv, plot;
   bool quick = false;
 };
 
@@ -77,7 +118,7 @@ std::vector<std::string> split(const std::string& text, char by) {
 ConeParams parse_cone_params(const std::string& flag, const std::string& text) {
   const std::vector<std::string> items = split(text, ',');
   if (items.size() != 4 && items.size() != 5)
-    throw UsageError{flag + " needs auto or p1,p2,p3,p4[,threshold], not '" + text + "'"};
+    throw UsageError{flag + " needs p1,p2,p3,p4[,threshold], not '" + text + "'"};
   ConeParams p;
   uint32_t* fields[4] = {&p.p1, &p.p2, &p.p3, &p.p4};
   for (int i = 0; i < 4; ++i) *fields[i] = parse_count(flag, items[i], 1u << 20);
@@ -90,10 +131,18 @@ ConeParams parse_cone_params(const std::string& flag, const std::string& text) {
   return p;
 }
 
+std::vector<uint32_t> parse_counts(const std::string& flag, const std::string& text, uint64_t max) {
+  std::vector<uint32_t> out;
+  for (const std::string& n : split(text, ',')) out.push_back(parse_count(flag, n, max));
+  if (out.empty()) throw UsageError{flag + " needs at least one value"};
+  return out;
+}
+
 Args parse_args(const std::vector<std::string>& args) {
   Args out;
   std::vector<std::string> rest;
-  bool photons_given = false, seeds_given = false;
+  bool photons_given = false, seeds_given = false, brute_given = false, cone_given = false, size_given = false,
+       reference_given = false;
   for (size_t i = 1; i < args.size(); ++i) {  // args[0] is "fog"
     const std::string& a = args[i];
     auto value = [&]() -> std::string {
@@ -108,18 +157,43 @@ Args parse_args(const std::vector<std::string>& args) {
         out.photons.push_back(*v);
       }
       photons_given = true;
+    } else if (a == "--modes") {
+      out.modes = split(value(), ',');
+      for (const std::string& m : out.modes)
+        if (m != "brute" && m != "medium" && m != "fast" && m != "refined")
+          throw UsageError{"--modes: '" + m + "' is not one of brute, medium, fast, refined"};
+    } else if (a == "--brute-steps") {
+      out.brute_steps = parse_counts(a, value(), 65536);
+      brute_given = true;
+    } else if (a == "--cone-steps") {
+      out.cone_steps = parse_counts(a, value(), 65536);
+      cone_given = true;
     } else if (a == "--seeds") {
       out.seeds = parse_count(a, value(), 1000);
       seeds_given = true;
+    } else if (a == "--width") {
+      out.width = parse_count(a, value(), 16384);
+      size_given = true;
+    } else if (a == "--height") {
+      out.height = parse_count(a, value(), 16384);
+      size_given = true;
+    } else if (a == "--reference-steps") {
+      out.reference_steps = parse_count(a, value(), 65536);
+      reference_given = true;
+    } else if (a == "--reference-stride") {
+      out.reference_stride = parse_count(a, value(), 1024);
+    } else if (a == "--fixed-params" || a == "--cone-params") {
+      out.fixed_params = parse_cone_params(a, value());
     } else if (a == "--threads") {
       out.threads = parse_count(a, value(), 4096);
-    } else if (a == "--cone-params") {
-      const std::string v = value();
-      if (v != "auto") out.params = parse_cone_params(a, v);
     } else if (a == "--per-core-photons") {
       out.per_core_photons = parse_count(a, value(), 1'000'000'000);
+    } else if (a == "--cones-only") {
+      out.cones_only = true;
     } else if (a == "--csv") {
       out.csv = value();
+    } else if (a == "--plot") {
+      out.plot = value();
     } else if (a == "--quick") {
       out.quick = true;
     } else {
@@ -133,10 +207,15 @@ Args parse_args(const std::vector<std::string>& args) {
   if (out.quick) {
     if (!photons_given) out.photons = {10'000, 100'000};
     if (!seeds_given) out.seeds = 2;
+    if (!brute_given) out.brute_steps = {8, 32};
+    if (!cone_given) out.cone_steps = {16};
+    if (!size_given) out.width = 64, out.height = 48;
+    if (!reference_given) out.reference_steps = 8;
     out.per_core_photons = std::min<uint64_t>(out.per_core_photons, 100'000);
   }
   const std::string stem = input_stem(out.grammar.grammar);
   if (out.csv.empty()) out.csv = stem + ".fog.csv";
+  if (out.plot.empty()) out.plot = stem + ".fog.png";
   const std::string suffix = ".csv";
   out.cones_csv = out.csv.size() > suffix.size() && out.csv.ends_with(suffix)
                       ? out.csv.substr(0, out.csv.size() - suffix.size()) + "-cones.csv"
@@ -158,6 +237,120 @@ std::string params_text(const ConeParams& p) {
   return line;
 }
 
+// The pixel-centre camera rays of the view and where each ends (the first plant or the
+// ground; +inf: the sky), as render_cpu's fog AOV takes them.
+struct View {
+  uint32_t width = 0, height = 0;
+  std::vector<glm::dvec3> origin, direction;  // direction unit
+  std::vector<double> t_end;
+};
+
+View pixel_rays(const Scene& scene, const SceneTracer& tracer) {
+  View v;
+  v.width = scene.width, v.height = scene.height;
+  const size_t n = size_t(v.width) * v.height;
+  v.origin.resize(n), v.direction.resize(n), v.t_end.resize(n);
+  for (uint32_t y = 0; y < v.height; ++y)
+    for (uint32_t x = 0; x < v.width; ++x) {
+      const size_t i = size_t(y) * v.width + x;
+      const Ray ray = camera_ray(scene, x + 0.5, y + 0.5);
+      const double length = glm::length(ray.direction);
+      const double surface = tracer.nearest(ray, 0, std::numeric_limits<double>::infinity()).t;
+      const double ground = shading::ground_distance(ray.origin.y - scene.ground.height, ray.direction.y);
+      v.origin[i] = ray.origin;
+      v.direction[i] = ray.direction / length;
+      v.t_end[i] = std::min(surface, ground) * length;
+    }
+  return v;
+}
+
+// The fog's in-scatter of every pixel (RGB, row-major) by `integrator`, on `threads`
+// threads; pixel i's random numbers from (seed, i) only.
+std::vector<float> fog_image(const View& v, const FogIntegrator& integrator, uint64_t seed, unsigned threads,
+                             double* seconds) {
+  const size_t n = v.origin.size();
+  std::vector<float> out(n * 3);
+  std::atomic<size_t> next{0};
+  const auto start = render_common::Clock::now();
+  auto worker = [&] {
+    for (;;) {
+      const size_t begin = next.fetch_add(256);
+      if (begin >= n) return;
+      for (size_t i = begin; i < std::min(n, begin + 256); ++i) {
+        render_common::SampleRng rng(lsys::mix_pair(seed, i));
+        const FogRayResult r = integrator.integrate(v.origin[i], v.direction[i], v.t_end[i], rng);
+        for (int c = 0; c < 3; ++c) out[i * 3 + c] = static_cast<float>(r.inscatter[c]);
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  *seconds = render_common::seconds_since(start);
+  return out;
+}
+
+// The pixels `view` keeps of a `stride` grid: (x, y) with x, y ≡ stride/2 (mod stride).
+View strided(const View& v, uint32_t stride, std::vector<size_t>* pixels) {
+  View out;
+  pixels->clear();
+  for (uint32_t y = stride / 2; y < v.height; y += stride)
+    for (uint32_t x = stride / 2; x < v.width; x += stride) {
+      const size_t i = size_t(y) * v.width + x;
+      pixels->push_back(i);
+      out.origin.push_back(v.origin[i]), out.direction.push_back(v.direction[i]), out.t_end.push_back(v.t_end[i]);
+    }
+  out.width = static_cast<uint32_t>(pixels->size()), out.height = 1;
+  return out;
+}
+
+// Over `pixels` (of `a`, RGB) against `reference` (RGB, one per pixel in that order).
+template <typename T>
+double rmse(const std::vector<T>& a, const std::vector<double>& reference, const std::vector<size_t>& pixels) {
+  double sum = 0;
+  for (size_t k = 0; k < pixels.size(); ++k)
+    for (int c = 0; c < 3; ++c) {
+      const double d = a[pixels[k] * 3 + c] - reference[k * 3 + c];
+      sum += d * d;
+    }
+  return std::sqrt(sum / std::max<size_t>(1, 3 * pixels.size()));
+}
+
+// One row of the CSV, and the setting it belongs to.
+struct Row {
+  std::string mode;  // brute, medium-auto, ...
+  uint32_t steps = 0;
+  uint64_t photons = 0;
+  uint32_t seed = 0;
+  double photon_s = 0, cone_s = 0, render_s = 0, total_s = 0, rmse = -1, bias = -1;
+  size_t cones = 0;
+  std::string setting() const { return mode + "/" + std::to_string(steps) + "/" + std::to_string(photons); }
+};
+
+// A setting's mean over its seeds.
+struct Point {
+  double time = 0, rmse = 0;
+};
+
+// The time a family's settings need to reach `target` RMSE: on the fastest settings (the
+// frontier of mean time against mean RMSE), interpolated log-log between the last point
+// above the target and the first at or below it; negative where none reaches it.
+double time_to_reach(std::vector<Point> points, double target) {
+  std::sort(points.begin(), points.end(), [](const Point& a, const Point& b) { return a.time < b.time; });
+  std::vector<Point> frontier;
+  for (const Point& p : points)
+    if (frontier.empty() || p.rmse < frontier.back().rmse) frontier.push_back(p);
+  for (size_t i = 0; i < frontier.size(); ++i) {
+    if (frontier[i].rmse > target) continue;
+    if (i == 0) return frontier[0].time;
+    const Point &a = frontier[i - 1], &b = frontier[i];
+    const double f = (std::log(target) - std::log(a.rmse)) / (std::log(b.rmse) - std::log(a.rmse));
+    return std::exp(std::log(a.time) + f * (std::log(b.time) - std::log(a.time)));
+  }
+  return -1;
+}
+
 }  // namespace
 
 int run_bench_fog(const std::vector<std::string>& args) {
@@ -167,16 +360,21 @@ int run_bench_fog(const std::vector<std::string>& args) {
     return kOk;
   }
   std::vector<RenderPass> passes;
-  auto loaded = load_render_input(a.grammar, std::nullopt, std::nullopt, passes);
+  auto loaded = load_render_input(a.grammar, a.width, a.height, passes);
   if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
   const Scene scene = std::move(std::get<Scene>(loaded));
+  if (!a.cones_only && !scene.fog) {
+    std::cerr << "sylva bench fog: " << a.grammar.grammar << " has no fog key (spec/fog.md); --cones-only measures "
+                 "its photons and cones alone\n";
+    return kInputError;
+  }
   const unsigned threads = a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency());
   GeometryOptions geometry;
   geometry.cull = false;     // a plant outside the view still casts shafts into it
-  geometry.relief = false;   // photons trace the exact frusta
+  geometry.relief = false;   // the exact frusta for photons, shadow rays and the reference alike
   const SceneGeometry g = build_scene_geometry(scene, {}, geometry);
-  std::cerr << "sylva bench fog: " << a.grammar.grammar << ", " << g.frusta.size() << " frusta, " << threads
-            << " threads\n";
+  std::cerr << "sylva bench fog: " << a.grammar.grammar << ", " << g.frusta.size() << " frusta, " << scene.width
+            << "x" << scene.height << ", " << threads << " threads\n";
 
   // The plants as the photons see them, built once for every photon count and seed.
   const SunPhotonTracer tracer(g.frusta, scene.sun, threads);
@@ -193,73 +391,248 @@ int run_bench_fog(const std::vector<std::string>& args) {
                 p.vectors.vectors.size(), 100.0 * p.vectors.vectors.size() / std::max<uint64_t>(1, p.traced));
   }
 
-  std::ostringstream csv, cones_csv;
-  csv << "# sylva bench fog " << a.grammar.grammar << ", " << threads << " threads\n";
-  csv << "mode,steps,photons,seed,photon_s,cone_s,render_s,total_s,rmse,bias,cones\n";
+  const auto wants = [&](const std::string& m) { return std::find(a.modes.begin(), a.modes.end(), m) != a.modes.end(); };
+  const bool fog_rows = !a.cones_only;
+  View view;
+  std::vector<double> reference;
+  std::vector<size_t> reference_pixels;  // of the view, in the reference's order
+  std::optional<FogMedium> medium;
+  if (fog_rows) {
+    view = pixel_rays(scene, *g.tracer);
+    medium = fog_medium_of(scene);
+    FogIntegratorOptions ro;
+    ro.mode = FogMode::reference;
+    ro.steps = a.reference_steps;
+    const FogIntegrator ref(*medium, fog_sun_of(scene.sun), scene.sky, *g.tracer, nullptr, ro);
+    double seconds = 0;
+    const View sparse = strided(view, a.reference_stride, &reference_pixels);
+    const std::vector<float> image = fog_image(sparse, ref, 0, threads, &seconds);
+    reference.assign(image.begin(), image.end());
+    double mean = 0;
+    for (double v : reference) mean += v;
+    mean /= std::max<size_t>(1, reference.size());
+    std::printf("reference: %u steps (%u probes per disc point), %zu pixels (stride %u), %.2f s, mean in-scatter "
+                "%.4g\n",
+                a.reference_steps, a.reference_steps * kReferenceProbesPerStep, reference_pixels.size(),
+                a.reference_stride, seconds, mean);
+    std::fflush(stdout);
+  }
+
+  std::vector<Row> rows;
+  std::map<std::string, std::vector<double>> sums;  // setting → sum of its seeds' images
+  std::map<std::string, uint32_t> counts;
+  auto render_row = [&](Row row, FogMode mode, const FogConeSource* cones) {
+    FogIntegratorOptions o;
+    o.mode = mode;
+    o.steps = std::max(1u, row.steps);
+    const FogIntegrator integrator(*medium, fog_sun_of(scene.sun), scene.sky, *g.tracer, cones, o);
+    const std::vector<float> image = fog_image(view, integrator, lsys::mix_pair(row.seed, 0x666f67), threads,
+                                               &row.render_s);
+    row.total_s = row.photon_s + row.cone_s + row.render_s;
+    row.rmse = rmse(image, reference, reference_pixels);
+    std::vector<double>& sum = sums[row.setting()];
+    if (sum.empty()) sum.assign(image.size(), 0.0);
+    for (size_t i = 0; i < image.size(); ++i) sum[i] += image[i];
+    ++counts[row.setting()];
+    std::printf("%-14s %5u %9llu %4u %9.3f %9.3f %9.3f %9.3f %11.4g %6zu\n", row.mode.c_str(), row.steps,
+                static_cast<unsigned long long>(row.photons), row.seed, row.photon_s, row.cone_s, row.render_s,
+                row.total_s, row.rmse, row.cones);
+    std::fflush(stdout);
+    rows.push_back(row);
+  };
+
+  std::printf("%-14s %5s %9s %4s %9s %9s %9s %9s %11s %6s\n", "mode", "steps", "photons", "seed", "photon_s", "cone_s",
+              "render_s", "total_s", "rmse", "cones");
+  if (fog_rows && wants("brute"))
+    for (uint32_t steps : a.brute_steps)
+      for (uint32_t seed = 1; seed <= a.seeds; ++seed) {
+        Row row;
+        row.mode = "brute", row.steps = steps, row.seed = seed;
+        render_row(row, FogMode::brute, nullptr);
+      }
+
+  std::ostringstream cones_csv;
   cones_csv << "# sylva bench fog " << a.grammar.grammar << ", " << threads << " threads\n";
-  cones_csv << "photons,seed,photon_s,cone_s,params_s,cpu_s,params,vectors,covered,cones,missed_shadow,covered_lit,"
-               "coverage_points,shadowed_points\n";
-  std::printf("%10s %5s %9s %9s %9s %9s %8s %9s %9s %8s %8s  %s\n", "photons", "seed", "photon_s", "cone_s",
-              "params_s", "cpu_s", "vectors", "covered", "cones", "missed", "lit_cov", "params");
+  cones_csv << "photons,seed,params_kind,photon_s,cone_s,params_s,cpu_s,params,vectors,covered,cones,missed_shadow,"
+               "covered_lit,coverage_points,shadowed_points,query_us\n";
+  const bool cone_modes = wants("medium") || wants("fast") || wants("refined");
   for (uint64_t photons : a.photons)
-    for (uint32_t seed = 1; seed <= a.seeds; ++seed) {
-      SunConeOptions o;
-      o.photons.photons = photons;
-      o.photons.seed = seed;
-      o.photons.threads = threads;
-      o.params = a.params;
-      const double cpu_start = process_cpu_seconds();
-      const auto c = build_sun_cones(g, scene, o, &tracer);
-      const double cpu_s = process_cpu_seconds() - cpu_start;
-      double params_s = 0;
-      for (const RenderPass& p : c->passes)
-        if (p.name == "cone params") params_s = p.seconds;
-      const ConeCoverage cov = c->coverage.value_or(ConeCoverage{});
-      char line[512];
-      std::snprintf(line, sizeof line, "cones,0,%llu,%u,%.6g,%.6g,0,%.6g,,,%zu\n", static_cast<unsigned long long>(photons),
-                    seed, c->photon_seconds, c->cone_seconds, c->photon_seconds + c->cone_seconds, c->cones.size());
-      csv << line;
-      std::snprintf(line, sizeof line, "%llu,%u,%.6g,%.6g,%.6g,%.6g,%s,%llu,%llu,%zu,%.6g,%.6g,%llu,%llu\n",
-                    static_cast<unsigned long long>(photons), seed, c->photon_seconds, c->cone_seconds, params_s, cpu_s,
-                    params_text(c->params).c_str(), static_cast<unsigned long long>(c->cluster.vectors),
-                    static_cast<unsigned long long>(c->cluster.covered), c->cones.size(), cov.missed_shadow,
-                    cov.covered_lit, static_cast<unsigned long long>(cov.points),
-                    static_cast<unsigned long long>(cov.shadowed));
-      cones_csv << line;
-      std::printf("%10llu %5u %9.4f %9.4f %9.4f %9.4f %8llu %9llu %9zu %8.4f %8.4f  %s\n",
-                  static_cast<unsigned long long>(photons), seed, c->photon_seconds, c->cone_seconds, params_s, cpu_s,
-                  static_cast<unsigned long long>(c->cluster.vectors),
-                  static_cast<unsigned long long>(c->cluster.covered), c->cones.size(), cov.missed_shadow,
-                  cov.covered_lit, params_text(c->params).c_str());
-      std::fflush(stdout);
-      if (seed == 1 && c->automatic) std::cerr << c->automatic->describe();
-      if (seed == 1) {
+    for (const bool automatic : {true, false})
+      for (uint32_t seed = 1; seed <= a.seeds; ++seed) {
+        SunConeOptions o;
+        o.photons.photons = photons;
+        o.photons.seed = seed;
+        o.photons.threads = threads;
+        if (!automatic) o.params = a.fixed_params;
+        const double cpu_start = process_cpu_seconds();
+        const auto c = build_sun_cones(g, scene, o, &tracer);
+        const double cpu_s = process_cpu_seconds() - cpu_start;
+        double params_s = 0;
+        for (const RenderPass& p : c->passes)
+          if (p.name == "cone params") params_s = p.seconds;
+        if (seed == 1 && c->automatic) std::cerr << c->automatic->describe();
         // The camera's rays against the cones, one thread.
-        Scene view = scene;
-        view.width = 512;
-        view.height = 384;
-        std::vector<ConeInterval> intervals;
-        uint64_t total = 0;
-        const auto start = render_common::Clock::now();
-        for (uint32_t y = 0; y < view.height; ++y)
-          for (uint32_t x = 0; x < view.width; ++x) {
-            c->cones.intervals(camera_ray(view, x + 0.5, y + 0.5), 0, 1e30, &intervals);
-            total += intervals.size();
+        double query_us = 0;
+        {
+          std::vector<ConeInterval> intervals;
+          Scene probe = scene;
+          probe.width = 256, probe.height = 192;
+          const auto start = render_common::Clock::now();
+          for (uint32_t y = 0; y < probe.height; ++y)
+            for (uint32_t x = 0; x < probe.width; ++x)
+              c->cones.intervals(camera_ray(probe, x + 0.5, y + 0.5), 0, 1e30, &intervals);
+          query_us = render_common::seconds_since(start) / (double(probe.width) * probe.height) * 1e6;
+        }
+        const ConeCoverage cov = c->coverage.value_or(ConeCoverage{});
+        char line[512];
+        std::snprintf(line, sizeof line, "%llu,%u,%s,%.6g,%.6g,%.6g,%.6g,%s,%llu,%llu,%zu,%.6g,%.6g,%llu,%llu,%.4g\n",
+                      static_cast<unsigned long long>(photons), seed, automatic ? "auto" : "fixed", c->photon_seconds,
+                      c->cone_seconds, params_s, cpu_s, params_text(c->params).c_str(),
+                      static_cast<unsigned long long>(c->cluster.vectors),
+                      static_cast<unsigned long long>(c->cluster.covered), c->cones.size(), cov.missed_shadow,
+                      cov.covered_lit, static_cast<unsigned long long>(cov.points),
+                      static_cast<unsigned long long>(cov.shadowed), query_us);
+        cones_csv << line;
+        Row base;
+        base.photons = photons, base.seed = seed, base.photon_s = c->photon_seconds, base.cone_s = c->cone_seconds;
+        base.cones = c->cones.size();
+        {
+          Row row = base;
+          row.mode = automatic ? "cones-auto" : "cones-fixed";
+          row.total_s = row.photon_s + row.cone_s;
+          std::printf("%-14s %5s %9llu %4u %9.3f %9.3f %9s %9.3f %11s %6zu  missed %.3f, covered lit %.3f, %s, "
+                      "query %.3g us/ray, cpu %.3f s\n",
+                      row.mode.c_str(), "-", static_cast<unsigned long long>(photons), seed, row.photon_s, row.cone_s,
+                      "-", row.total_s, "-", row.cones, cov.missed_shadow, cov.covered_lit,
+                      params_text(c->params).c_str(), query_us, cpu_s);
+          rows.push_back(row);
+        }
+        if (!fog_rows || !cone_modes) continue;
+        const ConeSetFogSource source(c->cones);
+        const std::string suffix = automatic ? "-auto" : "-fixed";
+        for (const char* mode_name : {"medium", "refined"}) {
+          if (!wants(mode_name)) continue;
+          for (uint32_t steps : a.cone_steps) {
+            Row row = base;
+            row.mode = mode_name + suffix, row.steps = steps;
+            render_row(row, std::string(mode_name) == "medium" ? FogMode::medium : FogMode::refined, &source);
           }
-        const double seconds = render_common::seconds_since(start);
-        const double rays = double(view.width) * view.height;
-        std::printf("%10s cone query: %.3g us per camera ray (512x384, 1 thread), %.3g intervals per ray, "
-                    "%zu cones, hierarchy depth %u\n",
-                    "", seconds / rays * 1e6, total / rays, c->cones.size(), c->cones.depth());
+        }
+        if (wants("fast")) {
+          Row row = base;
+          row.mode = "fast" + suffix;
+          render_row(row, FogMode::fast, &source);
+        }
+      }
+
+  // Bias: the mean image of each setting's seeds against the reference.
+  std::map<std::string, double> bias;
+  for (const auto& [setting, sum] : sums) {
+    std::vector<double> mean(sum.size());
+    for (size_t i = 0; i < sum.size(); ++i) mean[i] = sum[i] / counts[setting];
+    bias[setting] = rmse(mean, reference, reference_pixels);
+  }
+  std::ostringstream csv;
+  csv << "# sylva bench fog " << a.grammar.grammar << ", " << scene.width << "x" << scene.height << ", " << threads
+      << " threads, reference " << a.reference_steps << " steps on every " << a.reference_stride
+      << "-th pixel each way\n";
+  csv << "mode,steps,photons,seed,photon_s,cone_s,render_s,total_s,rmse,bias,cones\n";
+  for (Row& r : rows) {
+    char line[512];
+    const bool rendered = r.rmse >= 0;
+    if (rendered) r.bias = bias[r.setting()];
+    char rm[32] = "", bi[32] = "";
+    if (rendered) std::snprintf(rm, sizeof rm, "%.6g", r.rmse), std::snprintf(bi, sizeof bi, "%.6g", r.bias);
+    std::snprintf(line, sizeof line, "%s,%u,%llu,%u,%.6g,%.6g,%.6g,%.6g,%s,%s,%zu\n", r.mode.c_str(), r.steps,
+                  static_cast<unsigned long long>(r.photons), r.seed, r.photon_s, r.cone_s, r.render_s, r.total_s, rm,
+                  bi, r.cones);
+    csv << line;
+  }
+
+  if (fog_rows) {
+    // Each setting's mean time and RMSE; families: the mode (with its cone parameters).
+    std::map<std::string, std::map<std::string, Point>> families;  // family → setting → mean
+    std::map<std::string, std::map<std::string, double>> render_time;  // the same, render_s only
+    std::map<std::string, std::map<std::string, uint32_t>> n;
+    for (const Row& r : rows) {
+      if (r.rmse < 0) continue;
+      Point& p = families[r.mode][r.setting()];
+      p.time += r.total_s, p.rmse += r.rmse;
+      render_time[r.mode][r.setting()] += r.render_s;
+      ++n[r.mode][r.setting()];
+    }
+    std::map<std::string, std::vector<Point>> curves, render_curves;
+    for (auto& [family, settings] : families)
+      for (auto& [setting, p] : settings) {
+        const uint32_t k = n[family][setting];
+        curves[family].push_back({p.time / k, p.rmse / k});
+        render_curves[family].push_back({render_time[family][setting] / k, p.rmse / k});
+      }
+    // Targets: brute's mean RMSE at its settings' step counts (1024 the issue's).
+    std::vector<std::pair<std::string, double>> targets;
+    if (curves.count("brute"))
+      for (uint32_t steps : a.brute_steps) {
+        const std::string key = "brute/" + std::to_string(steps) + "/0";
+        if (families["brute"].count(key))
+          targets.push_back({"brute " + std::to_string(steps), families["brute"][key].rmse / n["brute"][key]});
+      }
+    // The time to reach each target, photons and cones included (one image), and the
+    // render alone (the cones amortised over every frame and camera that reuses them).
+    for (const bool with_cones : {true, false}) {
+      std::printf(with_cones ? "\ntime (s, mean over seeds, photons and cones included) to reach the RMSE of:\n%-16s"
+                             : "\nrender time alone (s, mean over seeds; the cones reused) to reach the RMSE of:\n%-16s",
+                  "family");
+      for (const auto& t : targets) std::printf(" %12s", t.first.c_str());
+      std::printf("\n%-16s", "");
+      for (const auto& t : targets) std::printf(" %12.4g", t.second);
+      std::printf("\n");
+      for (const auto& [family, points] : with_cones ? curves : render_curves) {
+        std::printf("%-16s", family.c_str());
+        for (const auto& t : targets) {
+          const double s = time_to_reach(points, t.second);
+          if (s < 0) std::printf(" %12s", "-");
+          else std::printf(" %12.4g", s);
+        }
+        std::printf("\n");
       }
     }
+    // Fast mode's bias floor: the smallest bias of its settings, and when brute gets there.
+    for (const char* kind : {"fast-auto", "fast-fixed"}) {
+      double floor = -1;
+      std::string at;
+      double time = 0;
+      for (const Row& r : rows)
+        if (r.mode == kind && r.bias >= 0 && (floor < 0 || r.bias < floor)) floor = r.bias, at = r.setting();
+      if (floor < 0) continue;
+      for (const auto& [setting, p] : families[kind])
+        if (setting == at) time = p.time / n[kind][setting];
+      const double brute_time = curves.count("brute") ? time_to_reach(curves["brute"], floor) : -1;
+      std::printf("%s bias floor: %.4g at %s (%.3g s); brute reaches that RMSE in %s\n", kind, floor, at.c_str(), time,
+                  brute_time < 0 ? "- (not within its settings)" : (std::to_string(brute_time) + " s").c_str());
+    }
+    std::vector<PlotSeries> series;
+    for (const auto& [family, points] : curves) {
+      PlotSeries& s = series_named(series, family);
+      std::vector<Point> sorted = points;
+      std::sort(sorted.begin(), sorted.end(), [](const Point& x, const Point& y) { return x.time < y.time; });
+      for (const Point& p : sorted) s.points.push_back({p.time, p.rmse});
+      s.connect = false;
+    }
+    if (Status e = write_loglog_plot({{input_stem(a.grammar.grammar) + ": fog in-scatter against the reference",
+                                       "total time: photons + cones + fog (s)", "RMSE (linear RGB)", series}},
+                                     a.plot);
+        !e) {
+      std::cerr << e.error().format();
+      return kInputError;
+    }
+  }
   for (const auto& [path, text] : {std::pair{a.csv, csv.str()}, std::pair{a.cones_csv, cones_csv.str()}}) {
     if (Status e = write_file_atomically(path, text); !e) {
       std::cerr << e.error().format();
       return kInputError;
     }
   }
-  std::cerr << "sylva bench fog: wrote " << a.csv << " and " << a.cones_csv << "\n";
+  std::cerr << "sylva bench fog: wrote " << a.csv << ", " << a.cones_csv << (fog_rows ? " and " + a.plot : "") << "\n";
   return kOk;
 }
 

@@ -356,6 +356,7 @@ int run_render(const std::vector<std::string>& args) {
       std::cerr << line << (detail.empty() ? "" : "  " + detail) << "\n";
     };
     for (const RenderPass& p : passes) print(p.name.c_str(), p.seconds, p.detail);
+    if (!result.cone_report.empty()) std::cerr << result.cone_report;
     if (gl_result) {
       // The GL frame's totals (GlFrameStats): GPU time over its passes, what it sent, what it holds.
       print("GPU total", gl_stats.gpu_s(),

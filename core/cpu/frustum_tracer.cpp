@@ -1,6 +1,8 @@
 // frustum_tracer.cpp — see frustum_tracer.h.
 #include "core/cpu/frustum_tracer.h"
 
+#include "core/cpu/bvh.h"  // frustum_bounds
+
 #include <glm/geometric.hpp>
 #include <numbers>
 #include <utility>
@@ -100,6 +102,12 @@ FrustumTracer::FrustumTracer(std::span<const Frustum> frusta, std::span<const ui
   for (size_t i = 0; i < shell_m_.size(); ++i)
     if (shell_m_[i] > 0) ++relief_frusta_, plant_has_relief[plant_of_frustum_[i]] = 1;
   for (char c : plant_has_relief) relief_plants_ += c;
+  for (size_t i = 0; i < frusta_.size(); ++i) {
+    Aabb b = frustum_bounds(frusta_[i].shape);
+    const double shell = i < shell_m_.size() ? shell_m_[i] : 0.0;
+    b.lo -= glm::dvec3(shell), b.hi += glm::dvec3(shell);
+    grow(bounds_, b);
+  }
 }
 
 SurfaceHit FrustumTracer::nearest(const Ray& ray, double t_min, double t_max) const {

@@ -40,6 +40,7 @@ class FrustumTracer final : public SceneTracer {
 
   SurfaceHit nearest(const Ray& ray, double t_min, double t_max) const override;
   bool any(const Ray& ray, double t_min, double t_max) const override;
+  Aabb bounds() const override { return bounds_; }
   size_t memory_bytes() const override;
   std::string describe() const override;
 
@@ -63,6 +64,7 @@ class FrustumTracer final : public SceneTracer {
   SceneRelief relief_;
   std::vector<double> shell_m_;  // per frustum: relief depth, 0 for exact frusta
   size_t relief_plants_ = 0, relief_frusta_ = 0;
+  Aabb bounds_ = empty_box();  // the frusta's boxes, each grown by its relief shell
   ReliefIntersector intersector_;
   FrustumAccel accel_;
 };

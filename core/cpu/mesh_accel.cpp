@@ -75,6 +75,7 @@ struct MeshTracer::Impl {
   int level = 0;
   bool displaced = false;
   glm::dvec3 centre{0, 0, 0};
+  Aabb bounds = empty_box();
   EmbreeScene embree{/*need_filter_functions=*/true};
 
   MeshQuery start_query(const Ray& ray, double t_min, double t_max) const {
@@ -112,6 +113,7 @@ MeshTracer::MeshTracer(TriangleMesh mesh, std::span<const Frustum> frusta, std::
   glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
   for (const glm::dvec3& p : tm.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
   m.centre = tm.positions.empty() ? glm::dvec3(0) : 0.5 * (lo + hi);
+  if (!tm.positions.empty()) m.bounds = {lo, hi};
   if (tm.triangle_count() > 0) {
     RTCGeometry geom = rtcNewGeometry(m.embree.device(), RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -195,6 +197,8 @@ bool MeshTracer::any(const Ray& ray, double t_min, double t_max) const {
   rtcOccluded1(m.embree.scene(), &q.embree, &r);
   return r.tfar == -kInfF;
 }
+
+Aabb MeshTracer::bounds() const { return impl_->bounds; }
 
 size_t MeshTracer::memory_bytes() const {
   return impl_->mesh.memory_bytes() + impl_->embree.memory_bytes();

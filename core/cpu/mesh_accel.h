@@ -59,6 +59,7 @@ class MeshTracer final : public SceneTracer {
   bool any(const Ray& ray, double t_min, double t_max) const override;
   // The mesh's arrays (capacity) plus what Embree allocated (its memory monitor); the
   // frusta and plant table, shared with the scene, are not counted.
+  Aabb bounds() const override;  // the vertices'
   size_t memory_bytes() const override;
   // "Embree triangles, N triangles (GS m)".
   std::string describe() const override;

@@ -491,6 +491,7 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
           sun_cone_options_for(fog_options.mode, options.fog.photons.value_or(scene.fog->photons),
                                options.fog.cone_params, options.threads, options.progress.cancel_flag()));
       result.passes.insert(result.passes.end(), sun_cones->passes.begin(), sun_cones->passes.end());
+      if (sun_cones->automatic) result.cone_report = sun_cones->automatic->describe();
       if (sun_cones->cancelled) {
         result.cancelled = true;
         return result;

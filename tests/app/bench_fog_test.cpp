@@ -17,33 +17,64 @@ size_t count_lines_starting(const std::string& text, const std::string& prefix) 
   return n;
 }
 
-TEST(BenchFog, QuickRunWritesThePhotonAndConeRows) {
+TEST(BenchFog, QuickRunWritesEveryModesRowsTheTimeTableAndThePlot) {
   TempDir dir;
-  const std::string csv = dir.file("pine.fog.csv");
-  auto r = run_process({SYLVA_BINARY, "bench", "fog", "presets/scenes/pine.scene.json", "--quick", "--csv", csv},
-                       SYLVA_SOURCE_DIR, 240);
+  const std::string csv = dir.file("grove.fog.csv"), plot = dir.file("grove.fog.png");
+  auto r = run_process({SYLVA_BINARY, "bench", "fog", "presets/scenes/elm_grove_low_sun.scene.json", "--quick",
+                        "--csv", csv, "--plot", plot},
+                       SYLVA_SOURCE_DIR, 600);
   ASSERT_FALSE(crashed(r)) << describe(r);
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_NE(r.out.find("M photons/s per core"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("cone query"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("us/ray"), std::string::npos) << r.out;  // the cone query
   EXPECT_NE(r.err.find("cone parameters (automatic)"), std::string::npos) << r.err;
   const std::string rows = read_file(csv);
   EXPECT_NE(rows.find("mode,steps,photons,seed,photon_s,cone_s,render_s,total_s,rmse,bias,cones\n"), std::string::npos)
       << rows;
-  EXPECT_EQ(count_lines_starting(rows, "cones,0,10000,"), 2u) << rows;   // --quick: 2 seeds
-  EXPECT_EQ(count_lines_starting(rows, "cones,0,100000,"), 2u) << rows;
-  const std::string cones = read_file(dir.file("pine.fog-cones.csv"));
-  EXPECT_NE(cones.find("photons,seed,photon_s,cone_s,params_s,cpu_s,params,vectors,covered,cones,missed_shadow,"
-                       "covered_lit,coverage_points,shadowed_points\n"),
+  // --quick: 2 seeds of brute 8 and 32, cones of 1e4 and 1e5 photons with automatic
+  // and fixed parameters, medium and refined at 16 steps and fast on each.
+  EXPECT_EQ(count_lines_starting(rows, "brute,8,0,"), 2u) << rows;
+  EXPECT_EQ(count_lines_starting(rows, "brute,32,0,"), 2u) << rows;
+  for (const char* kind : {"auto", "fixed"}) {
+    const std::string k = kind;
+    EXPECT_EQ(count_lines_starting(rows, "cones-" + k + ",0,10000,"), 2u) << rows;
+    EXPECT_EQ(count_lines_starting(rows, "medium-" + k + ",16,100000,"), 2u) << rows;
+    EXPECT_EQ(count_lines_starting(rows, "refined-" + k + ",16,100000,"), 2u) << rows;
+    EXPECT_EQ(count_lines_starting(rows, "fast-" + k + ",0,10000,"), 2u) << rows;
+  }
+  EXPECT_NE(r.out.find("time (s, mean over seeds, photons and cones included) to reach the RMSE of"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("fast-auto bias floor"), std::string::npos) << r.out;
+  EXPECT_FALSE(read_file(plot).empty());
+  const std::string cones = read_file(dir.file("grove.fog-cones.csv"));
+  EXPECT_NE(cones.find("photons,seed,params_kind,photon_s,cone_s,params_s,cpu_s,params,vectors,covered,cones,"
+                       "missed_shadow,covered_lit,coverage_points,shadowed_points,query_us\n"),
             std::string::npos)
       << cones;
-  EXPECT_EQ(count_lines_starting(cones, "100000,"), 2u) << cones;
+  EXPECT_EQ(count_lines_starting(cones, "100000,"), 4u) << cones;  // 2 seeds × auto, fixed
+}
+
+TEST(BenchFog, AStridedReferenceMeasuresOnItsGridAndTimesTheWholeImage) {
+  TempDir dir;
+  const std::string csv = dir.file("grove.fog.csv");
+  auto r = run_process({SYLVA_BINARY, "bench", "fog", "presets/scenes/elm_grove_low_sun.scene.json", "--quick",
+                        "--modes", "brute", "--photons", "10000", "--reference-stride", "4", "--csv", csv, "--plot",
+                        dir.file("grove.fog.png")},
+                       SYLVA_SOURCE_DIR, 600);
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  // 64x48 every 4th pixel each way: 16 x 12.
+  EXPECT_NE(r.out.find("192 pixels (stride 4)"), std::string::npos) << r.out;
+  const std::string rows = read_file(csv);
+  EXPECT_NE(rows.find("64x48, "), std::string::npos) << rows;
+  EXPECT_NE(rows.find("on every 4-th pixel each way"), std::string::npos) << rows;
+  EXPECT_EQ(count_lines_starting(rows, "brute,8,0,"), 2u) << rows;
 }
 
 TEST(BenchFog, BadConeParametersAndPhotonCountsAreUsageErrors) {
   for (const std::vector<std::string>& bad :
        {std::vector<std::string>{"--cone-params", "1,2,3"}, {"--cone-params", "16,8,24,4"},  // p1 < p3 + 1
-        {"--cone-params", "96,8,24,4,x"}, {"--photons", "0"}, {"--photons", "1e5"}, {"--seeds", "0"}}) {
+        {"--cone-params", "96,8,24,4,x"}, {"--photons", "0"}, {"--photons", "1e5"}, {"--seeds", "0"},
+        {"--modes", "brute,slow"}, {"--brute-steps", "0"}, {"--reference-stride", "0"}}) {
     std::vector<std::string> argv = {SYLVA_BINARY, "bench", "fog", "presets/scenes/pine.scene.json"};
     argv.insert(argv.end(), bad.begin(), bad.end());
     auto r = run_process(argv, SYLVA_SOURCE_DIR);

@@ -179,6 +179,45 @@ TEST(RenderFogCli, OnlyTheConeModesTraceSunPhotons) {
   }
 }
 
+TEST(RenderFogCli, TheConeParametersAreTheFlagsOrTheAutomaticChoiceWithItsReport) {
+  // --verbose prints the automatic choice's report (what it measured on random points,
+  // core/cpu/photons.h AutoConeReport) or the parameters --cone-params gave.
+  TempDir dir;
+  const std::string scene = write_scene(dir, R"({"mode": "fast", "top": 20, "steps": 2, "photons": 20000})");
+  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.err.find("20000 photons"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("cone parameters (automatic)"), std::string::npos) << describe(r);
+  for (const char* mode : {"medium", "refined", "auto"}) {
+    r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose", "--fog-mode", mode,
+                   "--cone-params", "41,8,8,8"});
+    ASSERT_EQ(r.exit_code, 0) << mode << ": " << describe(r);
+    EXPECT_NE(r.err.find("p1 41, p2 8, p3 8, p4 8"), std::string::npos) << mode << ": " << describe(r);
+    EXPECT_EQ(r.err.find("cone parameters (automatic)"), std::string::npos) << mode << ": " << describe(r);
+  }
+}
+
+TEST(RenderFogCli, EveryBundledFogSceneRendersOnTheCpuWithItsCones) {
+  // presets/scenes/'s fog scenes (crepuscular rays, height fog), small and quick: the
+  // default mode (auto: refined with the shadow cones of sun photons) and the fog AOV.
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes")) {
+    const std::string path = entry.path().string();
+    if (!path.ends_with(".scene.json") || read_file(path).find("\"fog\"") == std::string::npos) continue;
+    ++scenes;
+    TempDir dir;
+    ProcessResult r = run_sylva({"render", path, "-o", dir.file("f.exr"), "--backend", "cpu", "--width", "48",
+                                 "--height", "36", "--photons", "20000", "--fog-steps", "4", "--aov", "fog",
+                                 "--verbose"});
+    ASSERT_EQ(r.exit_code, 0) << path << ": " << describe(r);
+    EXPECT_NE(r.err.find("  cones "), std::string::npos) << path << ": " << describe(r);
+    EXPECT_NE(r.err.find("refined (auto)"), std::string::npos) << path << ": " << describe(r);
+    const std::vector<std::string> channels = channel_names(dir.file("f.exr"));
+    EXPECT_NE(std::find(channels.begin(), channels.end(), "fog.T"), channels.end()) << path;
+  }
+  EXPECT_GE(scenes, 2);
+}
+
 TEST(RenderFogCli, BadFogKeyInASceneIsExitOneAtTheKey) {
   TempDir dir;
   const std::string scene = write_scene(dir, R"({"g": 0.99})");

@@ -32,6 +32,10 @@ std::vector<std::string> bundled_inputs() {
 class GlPreset : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(GlPreset, RendersWithOpenGlAndSeesThePlant) {
+  // The GL backend draws no fog yet and refuses it (exit 1, tests/app/render_fog_cli_test.cpp);
+  // the fog scenes render on the CPU (render_fog_cli_test, bench_fog_test).
+  if (GetParam().ends_with(".scene.json") && read_file(GetParam()).find("\"fog\"") != std::string::npos)
+    GTEST_SKIP() << "a fog scene: the GL backend draws no fog yet";
   TempDir dir;
   const std::string out = dir.file("p.exr");
   ProcessResult r = run_sylva({"render", GetParam(), "-o", out, "--width", "96", "--height", "72", "--backend", "gl",

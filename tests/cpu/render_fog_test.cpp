@@ -143,6 +143,45 @@ TEST(RenderFog, ARayLeavingHeightFogWithoutATopSeesTheAttenuatedSky) {
   EXPECT_NEAR(fog_transmittance(m, ray.origin, d, 0, kInf), std::exp(-tau), 1e-12);
 }
 
+TEST(RenderFog, HeightFogWithoutATopRendersInEveryModeAndAgreesWithTheReference) {
+  // A climbing ray in height fog without a top integrates to kFogFar; its shadow rays start
+  // only near the plant (docs/fog.md "Where shadow rays start"), never far out, where
+  // Embree cannot trace. Every mode renders, and matches the reference; the reference
+  // matches a top so high (150 m: ρ = e^{−30}) that nothing above it counts.
+  Scene s = foggy_cylinder(FogMode::reference);
+  s.fog->top = kInf;
+  s.fog->height_falloff = 0.2;
+  s.fog->steps = 16;
+  s.fog->photons = 50000;
+  RenderOptions o;
+  o.aovs = kAovFog;
+  const RenderResult ref = render_cpu(s, o);
+  Scene capped = s;
+  capped.fog->top = 150;
+  const RenderResult high = render_cpu(capped, o);
+  // RMSE of the fog's RGB against the reference, relative to the reference's mean.
+  auto relative_rmse = [&](const RenderResult& r) {
+    double err = 0, mean = 0;
+    for (size_t p = 0; p < ref.image.fog.size(); p += 4)
+      for (int c = 0; c < 3; ++c) {
+        const double d = r.image.fog[p + c] - ref.image.fog[p + c];
+        err += d * d, mean += ref.image.fog[p + c];
+      }
+    const double n = 3.0 * ref.image.fog.size() / 4;
+    return std::sqrt(err / n) / (mean / n);
+  };
+  EXPECT_LT(relative_rmse(high), 1e-5);
+  for (FogMode mode : {FogMode::brute, FogMode::medium, FogMode::fast, FogMode::refined, FogMode::automatic}) {
+    RenderOptions m = o;
+    m.fog.mode = mode;
+    const RenderResult r = render_cpu(s, m);
+    ASSERT_EQ(r.image.fog.size(), ref.image.fog.size()) << fog_mode_name(mode);
+    // Brute and medium sample 16 points a ray, fast darkens every cone whole: looser.
+    const double tolerance = mode == FogMode::refined || mode == FogMode::automatic ? 0.01 : 0.05;
+    EXPECT_LT(relative_rmse(r), tolerance) << fog_mode_name(mode);
+  }
+}
+
 TEST(RenderFog, IdenticalForEveryThreadCount) {
   const Scene s = foggy_cylinder(FogMode::automatic);
   RenderOptions one, two;
