@@ -1,6 +1,6 @@
-// gltf_export.cpp — skeletons to glTF 2.0 and back (gltf_export.h, issue 5).
+// gltf_export.cpp — skeletons to glTF 2.0 and back (gltf_export.h).
 //
-// The glTF JSON is written with the json.h writers rather than tinygltf: the file then
+// The glTF JSON is written with json.h's JsonWriter rather than tinygltf: the file then
 // has the same guarantees as a skeleton file (fixed key order, shortest round-trip
 // numbers, byte-identical output for identical input), and none of tinygltf 2.7's
 // writer traps can reach it (mode -1 when Primitive::mode is unset, empty nodes as
@@ -125,84 +125,41 @@ class BufferBuilder {
   std::vector<Accessor> accessors_;
 };
 
-void append_vec(std::string& out, const double* v, size_t n) {
-  out += '[';
-  for (size_t i = 0; i < n; ++i) {
-    if (i) out += ',';
-    append_json_number(out, v[i]);
-  }
-  out += ']';
-}
-
-void append_vec(std::string& out, const glm::dvec3& v) {
+void write_vec3(JsonWriter& w, const glm::dvec3& v) {
   const double a[3] = {v.x, v.y, v.z};
-  append_vec(out, a, 3);
-}
-
-// The skeleton document of skeleton.md with the seed as a string (JSON consumers read
-// numbers as doubles, which cannot hold every 64-bit seed).
-void append_skeleton_document(std::string& out, const Skeleton& sk) {
-  out += "\"format\":\"sylva-skeleton\",\"version\":1,\"source\":{\"grammar\":";
-  append_json_string(out, sk.source.grammar);
-  out += ",\"seed\":\"" + std::to_string(sk.source.seed) + "\",\"steps\":";
-  append_json_int64(out, sk.source.steps);
-  out += ",\"defines\":{";
-  bool first = true;
-  for (const auto& [name, value] : sk.source.defines) {
-    if (!first) out += ',';
-    first = false;
-    append_json_string(out, name);
-    out += ':';
-    append_json_number(out, value);
-  }
-  out += "}},\"chains\":[";
-  for (size_t c = 0; c < sk.chains.size(); ++c) {
-    if (c) out += ',';
-    append_chain_json(out, sk, c, true);
-  }
-  out += ']';
+  w.numbers(a, 3);
 }
 
 // Per frustum of skin_skeleton (default options): what a renderer needs beyond the
 // skeleton to reproduce the surface parametrization.
-void append_skinning(std::string& out, const SkinnedSkeleton& skinned) {
+void write_skinning(JsonWriter& w, const SkinnedSkeleton& skinned) {
   const SkinOptions defaults;
-  out += "\"skinning\":{\"max_tilt_deg\":";
-  append_json_number(out, defaults.max_tilt_deg);
-  out += ",\"columns\":[\"chain\",\"segment\",\"knuckle\",\"lower_normal\",\"lower_offset_m\","
-         "\"upper_normal\",\"upper_offset_m\",\"u_offset\"],\"frusta\":[";
-  for (size_t f = 0; f < skinned.frusta.size(); ++f) {
-    const Frustum& fr = skinned.frusta[f];
-    if (f) out += ',';
-    out += '[';
-    append_json_uint64(out, fr.chain);
-    out += ',';
-    append_json_uint64(out, fr.segment);
-    out += fr.kind == FrustumKind::knuckle ? ",true," : ",false,";
-    append_vec(out, fr.shape.lower.normal);
-    out += ',';
-    append_json_number(out, fr.shape.lower.offset);
-    out += ',';
-    append_vec(out, fr.shape.upper.normal);
-    out += ',';
-    append_json_number(out, fr.shape.upper.offset);
-    out += ',';
-    append_json_number(out, fr.u_offset);
-    out += ']';
+  w.key("skinning").begin_object();
+  w.key("max_tilt_deg").number(defaults.max_tilt_deg);
+  w.key("columns").begin_array();
+  for (const char* column : {"chain", "segment", "knuckle", "lower_normal", "lower_offset_m", "upper_normal",
+                             "upper_offset_m", "u_offset"})
+    w.string(column);
+  w.end_array();
+  w.key("frusta").begin_array();
+  for (const Frustum& fr : skinned.frusta) {
+    w.begin_array().integer(fr.chain).integer(fr.segment).boolean(fr.kind == FrustumKind::knuckle);
+    write_vec3(w, fr.shape.lower.normal);
+    w.number(fr.shape.lower.offset);
+    write_vec3(w, fr.shape.upper.normal);
+    w.number(fr.shape.upper.offset).number(fr.u_offset).end_array();
   }
-  out += "]}";
+  w.end_array();
+  w.end_object();
 }
 
-void append_instance(std::string& out, const GltfPlant& p) {
-  out += "{\"name\":";
-  append_json_string(out, p.name);
-  out += ",\"position_m\":";
-  append_vec(out, p.position_m, 3);
-  out += ",\"rotate_y_deg\":";
-  append_json_number(out, p.rotate_y_deg);
-  out += ",\"scale\":";
-  append_json_number(out, p.scale);
-  out += '}';
+void write_instance(JsonWriter& w, const GltfPlant& p) {
+  w.begin_object();
+  w.key("name").string(p.name);
+  w.key("position_m").numbers(p.position_m, 3);
+  w.key("rotate_y_deg").number(p.rotate_y_deg);
+  w.key("scale").number(p.scale);
+  w.end_object();
 }
 
 // Unit quaternion (x, y, z, w) of a rotation about +Y.
@@ -252,13 +209,14 @@ struct PlantGroup {
   std::vector<size_t> plants;  // indices into the caller's vector, first one names the node
 };
 
-std::optional<std::string> check_plant(const GltfPlant& p, size_t index) {
+// Why plant `index` cannot be exported, or nothing.
+std::optional<std::string> plant_problem(const GltfPlant& p, size_t index) {
   const std::string which = "plant " + std::to_string(index) + " (" + json_excerpt(p.name) + ")";
   for (double v : p.position_m)
     if (!std::isfinite(v)) return which + ": the position is not finite";
   if (!std::isfinite(p.rotate_y_deg)) return which + ": rotate_y_deg is not finite";
   if (!std::isfinite(p.scale) || p.scale <= 0) return which + ": the scale must be a finite number > 0";
-  if (auto err = validate_skeleton(p.skeleton)) return which + ": " + err->message;
+  if (Status valid = validate_skeleton(p.skeleton); !valid) return which + ": " + valid.error().message;
   if (!std::isfinite(p.bark.u_repeat) || p.bark.u_repeat <= 0) return which + ": bark u_repeat must be a finite number > 0";
   if (!std::isfinite(p.bark.v_per_metre) || p.bark.v_per_metre <= 0)
     return which + ": bark v_per_metre must be a finite number > 0";
@@ -274,75 +232,74 @@ struct EmbeddedImage {
 };
 
 // Reads a bark albedo texture to embed it byte for byte: glTF takes PNG or JPEG only.
-std::optional<std::string> read_albedo_image(const std::string& path, EmbeddedImage* out) {
-  FileReadResult file = read_text_file(path);
-  if (!file.contents)
-    return path + ": error: cannot read the bark albedo texture: " +
-           (file.error ? file.error->message : std::string("unreadable"));
-  const std::string& bytes = *file.contents;
-  if (bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) out->mime = "image/png";
-  else if (bytes.compare(0, 3, "\xFF\xD8\xFF") == 0) out->mime = "image/jpeg";
-  else return path + ": error: the bark albedo texture must be a PNG or JPEG file to be embedded in glTF";
+Expected<EmbeddedImage> read_albedo_image(const std::string& path) {
+  Expected<std::string> file = read_text_file(path);
+  if (!file) return file_diagnostic(path, "cannot read the bark albedo texture: " + file.error().message);
+  EmbeddedImage image;
+  const std::string& bytes = *file;
+  if (bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) image.mime = "image/png";
+  else if (bytes.compare(0, 3, "\xFF\xD8\xFF") == 0) image.mime = "image/jpeg";
+  else return file_diagnostic(path, "the bark albedo texture must be a PNG or JPEG file to be embedded in glTF");
   // The header must decode too (a viewer, and the validator, read it).
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     const std::string why = OIIO::geterror();
-    return path + ": error: the bark albedo texture is not a readable image" + (why.empty() ? "" : ": " + why);
+    return file_diagnostic(path, "the bark albedo texture is not a readable image" + (why.empty() ? "" : ": " + why));
   }
-  out->bytes = bytes;
-  return std::nullopt;
+  image.bytes = std::move(*file);
+  return image;
 }
 
 // Identifies a bark for grouping identical plants (instancing).
 std::string bark_key(const Bark& b) {
   std::string key = "albedo:";
   if (b.albedo_texture) key += "file:" + *b.albedo_texture;
-  if (b.albedo_rgb) append_vec(key, *b.albedo_rgb);
+  if (b.albedo_rgb) {
+    JsonWriter rgb;
+    write_vec3(rgb, *b.albedo_rgb);
+    key += rgb.text();
+  }
   key += "\nheight:" + b.height_texture.value_or("") + "\n";
   for (double v : {b.relief_depth_m, b.u_repeat, b.v_per_metre}) append_json_number(key, v), key += ',';
   return key;
 }
 
-// The material of index `material` of a plant with bark `bark` (gltf_export.h).
+// The material of index `material` of a plant with bark `bark` (gltf_export.h), as JSON
+// text (identical materials are written once: the text is their key).
 std::string material_json(uint32_t material, const Bark& bark, std::optional<size_t> albedo_texture,
                           std::optional<size_t> normal_texture, double r_ref_m) {
-  std::string m = "{\"name\":\"sylva_material_" + std::to_string(material) + "\",\"pbrMetallicRoughness\":{";
+  JsonWriter w;
+  w.begin_object();
+  w.key("name").string("sylva_material_" + std::to_string(material));
+  w.key("pbrMetallicRoughness").begin_object();
   if (albedo_texture) {
-    m += "\"baseColorFactor\":[1,1,1,1],\"baseColorTexture\":{\"index\":" + std::to_string(*albedo_texture) + "},";
+    const double white[4] = {1, 1, 1, 1};
+    w.key("baseColorFactor").numbers(white, 4);
+    w.key("baseColorTexture").begin_object().key("index").integer(*albedo_texture).end_object();
   } else {
     const double* rgb = default_material_albedo(material);
     const glm::dvec3 colour = material == 0 && bark.albedo_rgb ? *bark.albedo_rgb : glm::dvec3(rgb[0], rgb[1], rgb[2]);
-    m += "\"baseColorFactor\":[";
-    for (int k = 0; k < 3; ++k) append_json_number(m, colour[k]), m += ',';
-    m += "1],";
+    const double factor[4] = {colour.x, colour.y, colour.z, 1};
+    w.key("baseColorFactor").numbers(factor, 4);
   }
-  m += "\"metallicFactor\":0,\"roughnessFactor\":0.9}";
-  if (normal_texture) m += ",\"normalTexture\":{\"index\":" + std::to_string(*normal_texture) + "}";
-  m += ",\"extras\":{\"sylva\":{\"material_index\":" + std::to_string(material);
-  if (bark.albedo_texture) {
-    m += ",\"albedo\":";
-    append_json_string(m, *bark.albedo_texture);
-  } else if (bark.albedo_rgb) {
-    m += ",\"albedo\":";
-    append_vec(m, *bark.albedo_rgb);
-  }
-  if (bark.height_texture) {
-    m += ",\"height\":";
-    append_json_string(m, *bark.height_texture);
-  }
-  m += ",\"relief_depth_m\":";
-  append_json_number(m, bark.relief_depth_m);
-  m += ",\"u_repeat\":";
-  append_json_number(m, bark.u_repeat);
-  m += ",\"v_per_metre\":";
-  append_json_number(m, bark.v_per_metre);
-  if (normal_texture) {
-    m += ",\"r_ref_m\":";
-    append_json_number(m, r_ref_m);
-  }
-  m += ",\"texcoord_0\":\"s = u * u_repeat with u in turns around the axis, t = v_m * v_per_metre with v_m the "
-       "arc length in metres\"}}}";
-  return m;
+  w.key("metallicFactor").number(0);
+  w.key("roughnessFactor").number(0.9);
+  w.end_object();
+  if (normal_texture) w.key("normalTexture").begin_object().key("index").integer(*normal_texture).end_object();
+  w.key("extras").begin_object().key("sylva").begin_object();
+  w.key("material_index").integer(material);
+  if (bark.albedo_texture) w.key("albedo").string(*bark.albedo_texture);
+  else if (bark.albedo_rgb) write_vec3(w.key("albedo"), *bark.albedo_rgb);
+  if (bark.height_texture) w.key("height").string(*bark.height_texture);
+  w.key("relief_depth_m").number(bark.relief_depth_m);
+  w.key("u_repeat").number(bark.u_repeat);
+  w.key("v_per_metre").number(bark.v_per_metre);
+  if (normal_texture) w.key("r_ref_m").number(r_ref_m);
+  w.key("texcoord_0").string("s = u * u_repeat with u in turns around the axis, t = v_m * v_per_metre with v_m the "
+                             "arc length in metres");
+  w.end_object().end_object();
+  w.end_object();
+  return w.take();
 }
 
 double median_segment_radius(const SkinnedSkeleton& skinned) {
@@ -387,39 +344,37 @@ std::vector<float> vertex_tangents(const TriangleMesh& tm, const SkinnedSkeleton
 class MaterialTable {
  public:
   // Reads every texture the plants' barks name (before anything is written).
-  std::optional<std::string> load(const std::vector<GltfPlant>& plants) {
+  Status load(const std::vector<GltfPlant>& plants) {
     for (const GltfPlant& p : plants) {
       if (p.bark.albedo_texture && !albedo_files_.count(*p.bark.albedo_texture)) {
-        EmbeddedImage image;
-        if (auto err = read_albedo_image(*p.bark.albedo_texture, &image)) return err;
-        albedo_files_.emplace(*p.bark.albedo_texture, std::move(image));
+        Expected<EmbeddedImage> image = read_albedo_image(*p.bark.albedo_texture);
+        if (!image) return std::move(image.error());
+        albedo_files_.emplace(*p.bark.albedo_texture, std::move(*image));
       }
       if (p.bark.height_texture && !height_files_.count(*p.bark.height_texture)) {
-        HeightMapReadResult r = read_height_map(*p.bark.height_texture);
-        if (!r.map) return r.error.value_or(*p.bark.height_texture + ": error: unreadable height map");
-        height_files_.emplace(*p.bark.height_texture, std::move(*r.map));
+        Expected<HeightMap> map = read_height_map(*p.bark.height_texture);
+        if (!map) return std::move(map.error());
+        height_files_.emplace(*p.bark.height_texture, std::move(*map));
       }
     }
-    return std::nullopt;
+    return {};
   }
 
   // The normal map texture of `bark` at radius r_ref_m (baked on first use), or nothing
   // when the bark has no height map or the plant no radius.
-  std::optional<size_t> normal_texture(const Bark& bark, double r_ref_m, std::string* error) {
-    if (!bark.height_texture || !(r_ref_m > 0)) return std::nullopt;
+  Expected<std::optional<size_t>> normal_texture(const Bark& bark, double r_ref_m) {
+    if (!bark.height_texture || !(r_ref_m > 0)) return std::optional<size_t>();
     std::string key = "normal:" + *bark.height_texture + "\n";
     for (double v : {r_ref_m, bark.u_repeat, bark.v_per_metre, bark.relief_depth_m}) append_json_number(key, v), key += ',';
-    if (auto it = image_of_.find(key); it != image_of_.end()) return it->second;
+    if (auto it = image_of_.find(key); it != image_of_.end()) return std::optional<size_t>(it->second);
     const HeightMap& map = height_files_.at(*bark.height_texture);
     const NormalMapMetric metric =
         bark_normal_map_metric(map.width, map.height, r_ref_m, bark.u_repeat, bark.v_per_metre, bark.relief_depth_m);
     std::optional<std::string> png =
         encode_png_in_memory(map.width, map.height, 3, encode_normals_rgb8(bake_tangent_normals(map, metric)));
-    if (!png) {
-      *error = *bark.height_texture + ": error: cannot encode the normal map baked from this height map as PNG";
-      return std::nullopt;
-    }
-    return add_image(key, {std::move(*png), "image/png"});
+    if (!png)
+      return file_diagnostic(*bark.height_texture, "cannot encode the normal map baked from this height map as PNG");
+    return std::optional<size_t>(add_image(key, {std::move(*png), "image/png"}));
   }
 
   std::optional<size_t> albedo_texture(const Bark& bark) {
@@ -456,33 +411,32 @@ class MaterialTable {
 
 }  // namespace
 
-std::optional<std::string> check_bark_textures(const Bark& bark) {
+Status check_bark_textures(const Bark& bark) {
   if (bark.albedo_texture) {
-    EmbeddedImage image;
-    if (auto err = read_albedo_image(*bark.albedo_texture, &image)) return err;
+    Expected<EmbeddedImage> image = read_albedo_image(*bark.albedo_texture);
+    if (!image) return std::move(image.error());
   }
   if (bark.height_texture) {
-    HeightMapReadResult r = read_height_map(*bark.height_texture);
-    if (!r.map) return r.error.value_or(*bark.height_texture + ": error: unreadable height map");
+    Expected<HeightMap> map = read_height_map(*bark.height_texture);
+    if (!map) return std::move(map.error());
   }
-  return std::nullopt;
+  return {};
 }
 
 double bark_reference_radius_m(const Skeleton& skeleton) { return median_segment_radius(skin_skeleton(skeleton)); }
 
-std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, const std::string& path,
-                                       const GltfExportOptions& options) {
+Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path, const GltfExportOptions& options) {
   const std::string ext = lower_case(path);
   const bool glb = ends_with(ext, ".glb");
-  if (!glb && !ends_with(ext, ".gltf")) return path + ": error: the output must end in .gltf or .glb";
-  if (plants.empty()) return path + ": error: no plants to export";
+  if (!glb && !ends_with(ext, ".gltf")) return file_diagnostic(path, "the output must end in .gltf or .glb");
+  if (plants.empty()) return file_diagnostic(path, "no plants to export");
   if (options.segments_around < 3 || options.segments_around > 4096)
-    return path + ": error: segments around must be an integer from 3 to 4096";
+    return file_diagnostic(path, "segments around must be an integer from 3 to 4096");
   for (size_t i = 0; i < plants.size(); ++i)
-    if (auto err = check_plant(plants[i], i)) return path + ": error: " + *err;
+    if (auto problem = plant_problem(plants[i], i)) return file_diagnostic(path, *problem);
   MaterialTable table;
   if (options.mesh)
-    if (auto err = table.load(plants)) return err;
+    if (Status loaded = table.load(plants); !loaded) return loaded;
 
   // Group identical skeletons when instancing (compared by their exact serialization,
   // and by their barks when those shape the mesh).
@@ -501,7 +455,7 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
   }
 
   BufferBuilder buffer;
-  std::vector<std::string> meshes, nodes;
+  std::vector<std::string> meshes, nodes;  // each one JSON object, written in order below
   bool any_instancing = false;
   for (const PlantGroup& group : groups) {
     const GltfPlant& plant = plants[group.plants.front()];
@@ -510,7 +464,9 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
 
     // The skeleton as LINES: vertex i is joint i; one (parent joint, child joint) pair
     // per segment, a branch's first segment starting at the joint it grows from.
-    std::string primitives;
+    JsonWriter primitives;
+    size_t primitive_count = 0;
+    primitives.begin_array();
     if (sk.segment_count() > 0) {
       std::vector<float> positions, radii;
       positions.reserve(sk.joints.size() * 3);
@@ -531,8 +487,12 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
       const size_t pos = buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer);
       const size_t rad = buffer.add_floats(radii, 1, "SCALAR", kTargetArrayBuffer);
       const size_t idx = buffer.add_indices(pairs);
-      primitives += "{\"attributes\":{\"POSITION\":" + std::to_string(pos) + ",\"_RADIUS\":" + std::to_string(rad) +
-                    "},\"indices\":" + std::to_string(idx) + ",\"mode\":" + std::to_string(kModeLines) + "}";
+      primitives.begin_object();
+      primitives.key("attributes").begin_object().key("POSITION").integer(pos).key("_RADIUS").integer(rad).end_object();
+      primitives.key("indices").integer(idx);
+      primitives.key("mode").integer(kModeLines);
+      primitives.end_object();
+      ++primitive_count;
     }
     if (options.mesh && !skinned.frusta.empty()) {
       TessellateOptions to;
@@ -541,9 +501,9 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
       if (!tm.indices.empty()) {
         const Bark& bark = plant.bark;
         const double r_ref_m = median_segment_radius(skinned);
-        std::string error;
-        const std::optional<size_t> normal_texture = table.normal_texture(bark, r_ref_m, &error);
-        if (!error.empty()) return error;
+        Expected<std::optional<size_t>> normal_map = table.normal_texture(bark, r_ref_m);
+        if (!normal_map) return std::move(normal_map.error());
+        const std::optional<size_t> normal_texture = *normal_map;
         const std::optional<size_t> albedo_texture = table.albedo_texture(bark);
 
         std::vector<float> positions, normals, texcoords;
@@ -561,12 +521,19 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
         for (const glm::dvec2& uv : tm.uvs)
           texcoords.insert(texcoords.end(),
                            {static_cast<float>(uv.x * bark.u_repeat), static_cast<float>(uv.y * bark.v_per_metre)});
-        std::string attributes = "{\"POSITION\":" + std::to_string(buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer)) +
-                                 ",\"NORMAL\":" + std::to_string(buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer));
+        // Accessor order NORMAL, POSITION, TANGENT, TEXCOORD_0: the order files written so
+        // far have (it came from GCC's right-to-left evaluation of a string concatenation),
+        // now fixed in code so that every compiler writes the same bytes.
+        const size_t normal_accessor = buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer);
+        const size_t position_accessor = buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer);
+        JsonWriter attributes;
+        attributes.begin_object();
+        attributes.key("POSITION").integer(position_accessor);
+        attributes.key("NORMAL").integer(normal_accessor);
         if (normal_texture)
-          attributes += ",\"TANGENT\":" +
-                        std::to_string(buffer.add_floats(vertex_tangents(tm, skinned), 4, "VEC4", kTargetArrayBuffer));
-        attributes += ",\"TEXCOORD_0\":" + std::to_string(buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer)) + "}";
+          attributes.key("TANGENT").integer(buffer.add_floats(vertex_tangents(tm, skinned), 4, "VEC4", kTargetArrayBuffer));
+        attributes.key("TEXCOORD_0").integer(buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer));
+        attributes.end_object();
 
         // One primitive per material index, in increasing order.
         std::map<uint32_t, std::vector<uint32_t>> triangles_of;
@@ -577,20 +544,29 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
         }
         for (const auto& [material, indices] : triangles_of) {
           const size_t m = table.material(material_json(material, bark, albedo_texture, normal_texture, r_ref_m));
-          if (!primitives.empty()) primitives += ',';
-          primitives += "{\"attributes\":" + attributes + ",\"indices\":" + std::to_string(buffer.add_indices(indices)) +
-                        ",\"material\":" + std::to_string(m) + ",\"mode\":" + std::to_string(kModeTriangles) + "}";
+          primitives.begin_object();
+          primitives.key("attributes").raw(attributes.text());
+          primitives.key("indices").integer(buffer.add_indices(indices));
+          primitives.key("material").integer(m);
+          primitives.key("mode").integer(kModeTriangles);
+          primitives.end_object();
+          ++primitive_count;
         }
       }
     }
+    primitives.end_array();
 
-    std::string node = "{\"name\":";
-    append_json_string(node, plant.name);
-    if (!primitives.empty()) {
-      meshes.push_back("{\"name\":");
-      append_json_string(meshes.back(), plant.name);
-      meshes.back() += ",\"primitives\":[" + primitives + "]}";
-      node += ",\"mesh\":" + std::to_string(meshes.size() - 1);
+    JsonWriter node;
+    node.begin_object();
+    node.key("name").string(plant.name);
+    if (primitive_count > 0) {
+      JsonWriter mesh;
+      mesh.begin_object();
+      mesh.key("name").string(plant.name);
+      mesh.key("primitives").raw(primitives.text());
+      mesh.end_object();
+      meshes.push_back(mesh.take());
+      node.key("mesh").integer(meshes.size() - 1);
     }
     const bool instanced = group.plants.size() > 1;
     if (instanced) {
@@ -606,109 +582,112 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
       const size_t t = buffer.add_floats(translation, 3, "VEC3", 0);
       const size_t r = buffer.add_floats(rotation, 4, "VEC4", 0);
       const size_t s = buffer.add_floats(scale, 3, "VEC3", 0);
-      node += ",\"extensions\":{\"EXT_mesh_gpu_instancing\":{\"attributes\":{\"TRANSLATION\":" + std::to_string(t) +
-              ",\"ROTATION\":" + std::to_string(r) + ",\"SCALE\":" + std::to_string(s) + "}}}";
+      node.key("extensions").begin_object().key("EXT_mesh_gpu_instancing").begin_object();
+      node.key("attributes").begin_object().key("TRANSLATION").integer(t).key("ROTATION").integer(r);
+      node.key("SCALE").integer(s).end_object();
+      node.end_object().end_object();
       any_instancing = true;
     } else {
-      if (plant.position_m[0] != 0 || plant.position_m[1] != 0 || plant.position_m[2] != 0) {
-        node += ",\"translation\":";
-        append_vec(node, plant.position_m, 3);
-      }
-      if (plant.rotate_y_deg != 0) {
-        const auto q = quaternion_about_y(plant.rotate_y_deg);
-        node += ",\"rotation\":";
-        append_vec(node, q.data(), 4);
-      }
+      if (plant.position_m[0] != 0 || plant.position_m[1] != 0 || plant.position_m[2] != 0)
+        node.key("translation").numbers(plant.position_m, 3);
+      if (plant.rotate_y_deg != 0) node.key("rotation").numbers(quaternion_about_y(plant.rotate_y_deg).data(), 4);
       if (plant.scale != 1) {
         const double s[3] = {plant.scale, plant.scale, plant.scale};
-        node += ",\"scale\":";
-        append_vec(node, s, 3);
+        node.key("scale").numbers(s, 3);
       }
     }
-    node += ",\"extras\":{\"sylva\":{";
-    append_skeleton_document(node, sk);
-    node += ',';
-    append_skinning(node, skinned);
-    node += ",\"instances\":[";
-    for (size_t k = 0; k < group.plants.size(); ++k) {
-      if (k) node += ',';
-      append_instance(node, plants[group.plants[k]]);
-    }
-    node += "]}}}";
-    nodes.push_back(std::move(node));
+    // The skeleton document of skeleton.md, the seed as a string (JSON consumers read
+    // numbers as doubles, which cannot hold every 64-bit seed).
+    node.key("extras").begin_object().key("sylva").begin_object();
+    write_skeleton_members(node, sk, {.compact = true, .seed_as_string = true});
+    write_skinning(node, skinned);
+    node.key("instances").begin_array();
+    for (size_t i : group.plants) write_instance(node, plants[i]);
+    node.end_array();
+    node.end_object().end_object();
+    node.end_object();
+    nodes.push_back(node.take());
   }
 
   // The document. Arrays that would be empty are left out (glTF forbids empty arrays).
-  std::string json = "{\"asset\":{\"version\":\"2.0\",\"generator\":\"sylva\"}";
-  if (any_instancing) json += ",\"extensionsUsed\":[\"EXT_mesh_gpu_instancing\"]";
-  json += ",\"scene\":0,\"scenes\":[{\"nodes\":[";
-  for (size_t i = 0; i < nodes.size(); ++i) json += (i ? "," : "") + std::to_string(i);
-  json += "]}],\"nodes\":[";
-  for (size_t i = 0; i < nodes.size(); ++i) json += (i ? "," : "") + nodes[i];
-  json += ']';
+  JsonWriter json;
+  json.begin_object();
+  json.key("asset").begin_object().key("version").string("2.0").key("generator").string("sylva").end_object();
+  if (any_instancing) json.key("extensionsUsed").begin_array().string("EXT_mesh_gpu_instancing").end_array();
+  json.key("scene").integer(0);
+  json.key("scenes").begin_array().begin_object().key("nodes").begin_array();
+  for (size_t i = 0; i < nodes.size(); ++i) json.integer(i);
+  json.end_array().end_object().end_array();
+  json.key("nodes").begin_array();
+  for (const std::string& node : nodes) json.raw(node);
+  json.end_array();
   if (!meshes.empty()) {
-    json += ",\"meshes\":[";
-    for (size_t i = 0; i < meshes.size(); ++i) json += (i ? "," : "") + meshes[i];
-    json += ']';
+    json.key("meshes").begin_array();
+    for (const std::string& mesh : meshes) json.raw(mesh);
+    json.end_array();
   }
   if (!table.materials().empty()) {
-    json += ",\"materials\":[";
-    for (size_t i = 0; i < table.materials().size(); ++i) json += (i ? "," : "") + table.materials()[i];
-    json += ']';
+    json.key("materials").begin_array();
+    for (const std::string& material : table.materials()) json.raw(material);
+    json.end_array();
   }
   if (!table.images().empty()) {
     // Texture i shows image i; one sampler: linear, mipmapped, repeating (the bark tiles).
-    json += ",\"samplers\":[{\"magFilter\":" + std::to_string(kFilterLinear) +
-            ",\"minFilter\":" + std::to_string(kFilterLinearMipmapLinear) + ",\"wrapS\":" + std::to_string(kWrapRepeat) +
-            ",\"wrapT\":" + std::to_string(kWrapRepeat) + "}],\"textures\":[";
+    json.key("samplers").begin_array().begin_object();
+    json.key("magFilter").integer(kFilterLinear).key("minFilter").integer(kFilterLinearMipmapLinear);
+    json.key("wrapS").integer(kWrapRepeat).key("wrapT").integer(kWrapRepeat);
+    json.end_object().end_array();
+    json.key("textures").begin_array();
     for (size_t i = 0; i < table.images().size(); ++i)
-      json += std::string(i ? "," : "") + "{\"sampler\":0,\"source\":" + std::to_string(i) + "}";
-    json += "],\"images\":[";
-    for (size_t i = 0; i < table.images().size(); ++i) {
-      const EmbeddedImage& image = table.images()[i];
-      if (i) json += ',';
+      json.begin_object().key("sampler").integer(0).key("source").integer(i).end_object();
+    json.end_array();
+    json.key("images").begin_array();
+    for (const EmbeddedImage& image : table.images()) {
+      json.begin_object();
       if (glb)
-        json += "{\"bufferView\":" + std::to_string(buffer.add_bytes(image.bytes)) + ",\"mimeType\":\"" + image.mime + "\"}";
+        json.key("bufferView").integer(buffer.add_bytes(image.bytes)).key("mimeType").string(image.mime);
       else
-        json += "{\"uri\":\"data:" + std::string(image.mime) + ";base64," + base64(image.bytes) + "\"}";
+        json.key("uri").string("data:" + std::string(image.mime) + ";base64," + base64(image.bytes));
+      json.end_object();
     }
-    json += ']';
+    json.end_array();
   }
   const std::string& bin = buffer.bytes();
   if (!buffer.accessors().empty()) {
-    json += ",\"accessors\":[";
-    for (size_t i = 0; i < buffer.accessors().size(); ++i) {
-      const Accessor& a = buffer.accessors()[i];
-      if (i) json += ',';
-      json += "{\"bufferView\":" + std::to_string(a.view) + ",\"componentType\":" + std::to_string(a.component) +
-              ",\"count\":" + std::to_string(a.count) + ",\"type\":\"" + a.type + "\",\"min\":";
-      append_vec(json, a.min.data(), a.min.size());
-      json += ",\"max\":";
-      append_vec(json, a.max.data(), a.max.size());
-      json += '}';
+    json.key("accessors").begin_array();
+    for (const Accessor& a : buffer.accessors()) {
+      json.begin_object();
+      json.key("bufferView").integer(a.view).key("componentType").integer(a.component).key("count").integer(a.count);
+      json.key("type").string(a.type);
+      json.key("min").numbers(a.min.data(), a.min.size());
+      json.key("max").numbers(a.max.data(), a.max.size());
+      json.end_object();
     }
-    json += "],\"bufferViews\":[";
-    for (size_t i = 0; i < buffer.views().size(); ++i) {
-      const BufferView& v = buffer.views()[i];
-      if (i) json += ',';
-      json += "{\"buffer\":0,\"byteOffset\":" + std::to_string(v.offset) + ",\"byteLength\":" + std::to_string(v.length);
-      if (v.target) json += ",\"target\":" + std::to_string(v.target);
-      json += '}';
+    json.end_array();
+    json.key("bufferViews").begin_array();
+    for (const BufferView& v : buffer.views()) {
+      json.begin_object();
+      json.key("buffer").integer(0).key("byteOffset").integer(v.offset).key("byteLength").integer(v.length);
+      if (v.target) json.key("target").integer(v.target);
+      json.end_object();
     }
-    json += "],\"buffers\":[{\"byteLength\":" + std::to_string(bin.size());
-    if (!glb) json += ",\"uri\":\"data:application/octet-stream;base64," + base64(bin) + "\"";
-    json += "}]";
+    json.end_array();
+    json.key("buffers").begin_array().begin_object().key("byteLength").integer(bin.size());
+    if (!glb) json.key("uri").string("data:application/octet-stream;base64," + base64(bin));
+    json.end_object().end_array();
   }
-  json += "}\n";
+  json.end_object();
+  const std::string text = json.take() + "\n";
 
   std::string file;
   if (glb) {
-    std::string json_chunk = json;
+    std::string json_chunk = text;
     while (json_chunk.size() % 4 != 0) json_chunk += ' ';
     std::string bin_chunk = bin;
     while (bin_chunk.size() % 4 != 0) bin_chunk += '\0';
     const size_t total = 12 + 8 + json_chunk.size() + (bin_chunk.empty() ? 0 : 8 + bin_chunk.size());
-    if (total > std::numeric_limits<uint32_t>::max()) return path + ": error: the model exceeds the 4 GiB of a GLB file";
+    if (total > std::numeric_limits<uint32_t>::max())
+      return file_diagnostic(path, "the model exceeds the 4 GiB of a GLB file");
     file.reserve(total);
     append_u32(file, kGlbMagic);
     append_u32(file, 2);
@@ -722,10 +701,9 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
       file += bin_chunk;
     }
   } else {
-    file = std::move(json);
+    file = text;
   }
-  if (auto err = write_file_atomically(path, file)) return err->format();
-  return std::nullopt;
+  return write_file_atomically(path, file);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -733,207 +711,172 @@ std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, con
 
 namespace {
 
-std::string place(const std::string& path, const JsonValue& v) {
-  return path + ":" + std::to_string(v.line) + ":" + std::to_string(v.column) + ": error: ";
+// An error at value `v` of the file at `path`.
+Diagnostic error_at(const std::string& path, const JsonValue& v, std::string message) {
+  return diagnostic_at(path, {v.line, v.column}, std::move(message));
 }
 
 // Writes a DOM value back as JSON text (numbers by their exact source text).
-void append_value(std::string& out, const JsonValue& v) {
+void write_value(JsonWriter& w, const JsonValue& v) {
   switch (v.kind) {
-    case JsonValue::Kind::Null: out += "null"; break;
-    case JsonValue::Kind::Bool: out += v.boolean ? "true" : "false"; break;
-    case JsonValue::Kind::Number: out += v.text; break;
-    case JsonValue::Kind::String: append_json_string(out, v.text); break;
+    case JsonValue::Kind::Null: w.null(); break;
+    case JsonValue::Kind::Bool: w.boolean(v.boolean); break;
+    case JsonValue::Kind::Number: w.raw(v.text); break;
+    case JsonValue::Kind::String: w.string(v.text); break;
     case JsonValue::Kind::Array:
-      out += '[';
-      for (size_t i = 0; i < v.elements.size(); ++i) {
-        if (i) out += ',';
-        append_value(out, v.elements[i]);
-      }
-      out += ']';
+      w.begin_array();
+      for (const JsonValue& element : v.elements) write_value(w, element);
+      w.end_array();
       break;
     case JsonValue::Kind::Object:
-      out += '{';
-      for (size_t i = 0; i < v.members.size(); ++i) {
-        if (i) out += ',';
-        append_json_string(out, v.members[i].key.name);
-        out += ':';
-        append_value(out, v.members[i].value);
-      }
-      out += '}';
+      w.begin_object();
+      for (const JsonMember& member : v.members) write_value(w.key(member.key.name), member.value);
+      w.end_object();
       break;
   }
 }
 
 // The JSON text of a .gltf, or the JSON chunk of a .glb (checked against the file size).
-std::optional<std::string> json_text_of(const std::string& path, const std::string& bytes, std::string_view* json) {
+Expected<std::string_view> json_text_of(const std::string& path, const std::string& bytes) {
   auto u32_at = [&](size_t offset) {
     uint32_t v = 0;
     std::memcpy(&v, bytes.data() + offset, 4);
     return v;
   };
   if (bytes.size() >= 4 && u32_at(0) == kGlbMagic) {
-    if (bytes.size() < 20) return path + ": error: truncated GLB file: " + std::to_string(bytes.size()) + " bytes, less than a header";
-    if (u32_at(4) != 2) return path + ": error: GLB version " + std::to_string(u32_at(4)) + " is not supported (only 2)";
+    if (bytes.size() < 20)
+      return file_diagnostic(path, "truncated GLB file: " + std::to_string(bytes.size()) + " bytes, less than a header");
+    if (u32_at(4) != 2)
+      return file_diagnostic(path, "GLB version " + std::to_string(u32_at(4)) + " is not supported (only 2)");
     if (u32_at(8) != bytes.size())
-      return path + ": error: GLB header says " + std::to_string(u32_at(8)) + " bytes but the file has " +
-             std::to_string(bytes.size()) + " (truncated or corrupt)";
+      return file_diagnostic(path, "GLB header says " + std::to_string(u32_at(8)) + " bytes but the file has " +
+                                       std::to_string(bytes.size()) + " (truncated or corrupt)");
     const uint64_t json_length = u32_at(12);
-    if (u32_at(16) != kGlbChunkJson) return path + ": error: the first GLB chunk is not JSON";
+    if (u32_at(16) != kGlbChunkJson) return file_diagnostic(path, "the first GLB chunk is not JSON");
     if (20 + json_length > bytes.size())
-      return path + ": error: the GLB JSON chunk (" + std::to_string(json_length) + " bytes) runs past the end of the file";
-    *json = std::string_view(bytes).substr(20, json_length);
-    return std::nullopt;
+      return file_diagnostic(path, "the GLB JSON chunk (" + std::to_string(json_length) +
+                                       " bytes) runs past the end of the file");
+    return std::string_view(bytes).substr(20, json_length);
   }
   size_t i = 0;
   if (bytes.compare(0, 3, "\xEF\xBB\xBF") == 0) i = 3;
   while (i < bytes.size() && (bytes[i] == ' ' || bytes[i] == '\t' || bytes[i] == '\n' || bytes[i] == '\r')) ++i;
   if (i == bytes.size() || bytes[i] != '{')
-    return path + ": error: not a glTF file (neither GLB nor a JSON object)";
-  *json = bytes;
-  return std::nullopt;
+    return file_diagnostic(path, "not a glTF file (neither GLB nor a JSON object)");
+  return std::string_view(bytes);
 }
 
 // One node's extras.sylva back into plants (one per instance).
-std::optional<std::string> read_sylva_extras(const std::string& path, const JsonValue& node, size_t node_index,
-                                             const JsonValue& sylva, std::vector<GltfPlant>* plants) {
+Status read_sylva_extras(const std::string& path, const JsonValue& node, size_t node_index, const JsonValue& sylva,
+                         std::vector<GltfPlant>* plants) {
   const JsonValue* name_value = node.find("name");
   const std::string node_name = name_value && name_value->is_string() ? name_value->text : "";
   const std::string where = "node " + std::to_string(node_index) +
                             (node_name.empty() ? "" : " (" + json_excerpt(node_name) + ")") + " extras.sylva";
-  if (!sylva.is_object()) return place(path, sylva) + where + " is " + sylva.kind_name() + ", expected an object";
+  if (!sylva.is_object()) return error_at(path, sylva, where + " is " + sylva.kind_name() + ", expected an object");
 
   // Rebuild the skeleton document (seed string back to an integer) and read it with the
   // skeleton reader, which checks every value.
-  std::string text = "{";
-  bool first = true;
+  JsonWriter text;
+  text.begin_object();
   for (const char* key : {"format", "version", "source", "chains"}) {
     const JsonValue* v = sylva.find(key);
-    if (!v) return place(path, sylva) + where + ": missing key \"" + key + "\"";
-    if (!first) text += ',';
-    first = false;
-    append_json_string(text, key);
-    text += ':';
+    if (!v) return error_at(path, sylva, where + ": missing key \"" + key + "\"");
+    text.key(key);
     if (std::string_view(key) != "source") {
-      append_value(text, *v);
+      write_value(text, *v);
       continue;
     }
-    if (!v->is_object()) return place(path, *v) + where + ".source is " + v->kind_name() + ", expected an object";
-    text += '{';
-    for (size_t m = 0; m < v->members.size(); ++m) {
-      const JsonMember& member = v->members[m];
-      if (m) text += ',';
-      append_json_string(text, member.key.name);
-      text += ':';
+    if (!v->is_object()) return error_at(path, *v, where + ".source is " + v->kind_name() + ", expected an object");
+    text.begin_object();
+    for (const JsonMember& member : v->members) {
+      text.key(member.key.name);
       if (member.key.name == "seed") {
         const JsonValue& seed = member.value;
         bool digits = seed.is_string() && !seed.text.empty() && seed.text.size() <= 20;
         for (char c : seed.text) digits = digits && c >= '0' && c <= '9';
-        if (!digits) return place(path, seed) + where + ".source.seed must be a string of decimal digits (a 64-bit seed)";
-        text += seed.text;  // range checked by the skeleton reader
+        if (!digits) return error_at(path, seed, where + ".source.seed must be a string of decimal digits (a 64-bit seed)");
+        text.raw(seed.text);  // range checked by the skeleton reader
       } else {
-        append_value(text, member.value);
+        write_value(text, member.value);
       }
     }
-    text += '}';
+    text.end_object();
   }
-  text += '}';
-  SkeletonReadResult read = read_skeleton_json(text, path);
-  if (!read.skeleton) {
-    const std::string message = read.error ? read.error->message : "unreadable skeleton";
-    return place(path, sylva) + where + ": " + message;
-  }
+  text.end_object();
+  Expected<Skeleton> read = read_skeleton_json(text.text(), path);
+  if (!read) return error_at(path, sylva, where + ": " + read.error().message);
 
   const JsonValue* instances = sylva.find("instances");
   if (!instances) {
     GltfPlant p;
     p.name = node_name;
-    p.skeleton = std::move(*read.skeleton);
+    p.skeleton = std::move(*read);
     plants->push_back(std::move(p));
-    return std::nullopt;
+    return {};
   }
   if (!instances->is_array() || instances->elements.empty())
-    return place(path, *instances) + where + ".instances must be a non-empty array";
+    return error_at(path, *instances, where + ".instances must be a non-empty array");
   for (size_t k = 0; k < instances->elements.size(); ++k) {
     const JsonValue& inst = instances->elements[k];
     const std::string iwhere = where + ".instances[" + std::to_string(k) + "]";
-    if (!inst.is_object()) return place(path, inst) + iwhere + " must be an object";
+    if (!inst.is_object()) return error_at(path, inst, iwhere + " must be an object");
     GltfPlant p;
-    p.skeleton = *read.skeleton;
+    p.skeleton = *read;
     const JsonValue* name = inst.find("name");
     const JsonValue* position = inst.find("position_m");
     const JsonValue* rotate = inst.find("rotate_y_deg");
     const JsonValue* scale = inst.find("scale");
-    if (!name || !name->is_string()) return place(path, inst) + iwhere + ".name must be a string";
+    if (!name || !name->is_string()) return error_at(path, inst, iwhere + ".name must be a string");
     p.name = name->text;
     if (!position || !position->is_array() || position->elements.size() != 3)
-      return place(path, inst) + iwhere + ".position_m must be an array of 3 numbers";
+      return error_at(path, inst, iwhere + ".position_m must be an array of 3 numbers");
     for (size_t c = 0; c < 3; ++c) {
-      if (!position->elements[c].is_number()) return place(path, position->elements[c]) + iwhere + ".position_m must hold numbers";
+      if (!position->elements[c].is_number())
+        return error_at(path, position->elements[c], iwhere + ".position_m must hold numbers");
       p.position_m[c] = position->elements[c].number;
     }
-    if (!rotate || !rotate->is_number()) return place(path, inst) + iwhere + ".rotate_y_deg must be a number";
+    if (!rotate || !rotate->is_number()) return error_at(path, inst, iwhere + ".rotate_y_deg must be a number");
     p.rotate_y_deg = rotate->number;
     if (!scale || !scale->is_number() || !(scale->number > 0))
-      return place(path, inst) + iwhere + ".scale must be a number > 0";
+      return error_at(path, inst, iwhere + ".scale must be a number > 0");
     p.scale = scale->number;
     plants->push_back(std::move(p));
   }
-  return std::nullopt;
+  return {};
 }
 
 }  // namespace
 
-GltfImportResult import_gltf_skeletons(const std::string& path) {
-  GltfImportResult result;
-  FileReadResult file = read_text_file(path);
-  if (!file.contents) {
-    result.error = file.error ? file.error->format() : path + ": error: cannot read";
-    return result;
-  }
-  std::string_view json;
-  if (auto err = json_text_of(path, *file.contents, &json)) {
-    result.error = *err;
-    return result;
-  }
-  JsonParseResult parsed = parse_json(json);
-  if (!parsed.value) {
-    const JsonError e = parsed.error.value_or(JsonError{});
-    result.error = path + ":" + std::to_string(e.line) + ":" + std::to_string(e.column) + ": error: " + e.message;
-    return result;
-  }
-  const JsonValue& root = *parsed.value;
-  if (!root.is_object()) {
-    result.error = place(path, root) + "a glTF document is a JSON object";
-    return result;
-  }
+Expected<std::vector<GltfPlant>> import_gltf_skeletons(const std::string& path) {
+  Expected<std::string> file = read_text_file(path);
+  if (!file) return std::move(file.error());
+  Expected<std::string_view> json = json_text_of(path, *file);
+  if (!json) return std::move(json.error());
+  Expected<JsonValue> parsed = parse_json(*json, path);
+  if (!parsed) return std::move(parsed.error());
+  const JsonValue& root = *parsed;
+  if (!root.is_object()) return error_at(path, root, "a glTF document is a JSON object");
   const JsonValue* asset = root.find("asset");
   const JsonValue* version = asset && asset->is_object() ? asset->find("version") : nullptr;
-  if (!version || !version->is_string() || version->text.rfind("2.", 0) != 0) {
-    result.error = place(path, asset ? *asset : root) + "not a glTF 2.0 file (asset.version \"2.x\" missing)";
-    return result;
-  }
+  if (!version || !version->is_string() || version->text.rfind("2.", 0) != 0)
+    return error_at(path, asset ? *asset : root, "not a glTF 2.0 file (asset.version \"2.x\" missing)");
   const JsonValue* nodes = root.find("nodes");
-  if (nodes && !nodes->is_array()) {
-    result.error = place(path, *nodes) + "\"nodes\" is " + nodes->kind_name() + ", expected an array";
-    return result;
-  }
+  if (nodes && !nodes->is_array())
+    return error_at(path, *nodes, std::string("\"nodes\" is ") + nodes->kind_name() + ", expected an array");
+  std::vector<GltfPlant> plants;
   for (size_t n = 0; nodes && n < nodes->elements.size(); ++n) {
     const JsonValue& node = nodes->elements[n];
     if (!node.is_object()) continue;
     const JsonValue* extras = node.find("extras");
     const JsonValue* sylva = extras && extras->is_object() ? extras->find("sylva") : nullptr;
     if (!sylva) continue;
-    if (auto err = read_sylva_extras(path, node, n, *sylva, &result.plants)) {
-      result.plants.clear();
-      result.error = *err;
-      return result;
-    }
+    if (Status read = read_sylva_extras(path, node, n, *sylva, &plants); !read) return std::move(read.error());
   }
-  if (result.plants.empty())
-    result.error = path + ": error: no sylva skeleton in this glTF file (no node has extras.sylva; "
-                          "files written by 'sylva export' have one per plant)";
-  return result;
+  if (plants.empty())
+    return file_diagnostic(path, "no sylva skeleton in this glTF file (no node has extras.sylva; "
+                                 "files written by 'sylva export' have one per plant)");
+  return plants;
 }
 
 }  // namespace sylva

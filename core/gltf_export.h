@@ -1,4 +1,4 @@
-// gltf_export.h — skeletons to glTF 2.0 (issue 5), and back.
+// gltf_export.h — skeletons to glTF 2.0, and back.
 //
 // What a file holds (Y up, metres): for each plant, a node named after it carrying
 //   - a mesh with one LINES primitive (mode 1): POSITION (with min/max), a float
@@ -61,12 +61,12 @@
 // warnings (checked in CI by scripts/validate_gltf.mjs).
 #pragma once
 
-#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/scene.h"
 #include "core/skeleton.h"
+#include "core/util/diagnostic.h"
 
 namespace sylva {
 
@@ -88,16 +88,15 @@ struct GltfExportOptions {
                                 // with EXT_mesh_gpu_instancing (listed in extensionsUsed)
 };
 
-// Writes `plants` to `path` (.glb or .gltf by extension). Returns an error message, or
-// nothing on success; an existing file is left untouched on failure.
-std::optional<std::string> export_gltf(const std::vector<GltfPlant>& plants, const std::string& path,
-                                       const GltfExportOptions& options = {});
+// Writes `plants` to `path` (.glb or .gltf by extension). An error is a Diagnostic naming
+// `path` (or the texture that cannot be read); an existing file is left untouched then.
+Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path,
+                   const GltfExportOptions& options = {});
 
 // Checks that the bark's textures can be embedded: the albedo (if a texture) is a
-// readable PNG or JPEG, the height map (if any) a readable image. Returns an error
-// naming the file, or nothing. export_gltf checks the same; a front end calls this once
-// before a batch.
-std::optional<std::string> check_bark_textures(const Bark& bark);
+// readable PNG or JPEG, the height map (if any) a readable image. An error names the
+// file. export_gltf checks the same; a front end calls this once before a batch.
+Status check_bark_textures(const Bark& bark);
 
 // r_ref of the baked normal map: the median over the skinned segments (knuckles left
 // out) of the mean of their two end radii, segments of radius 0 at both ends left out;
@@ -105,11 +104,8 @@ std::optional<std::string> check_bark_textures(const Bark& bark);
 double bark_reference_radius_m(const Skeleton& skeleton);
 
 // Reads the sylva skeletons back from a glTF file's node extras (for `sylva render
-// plant.glb`). A file without sylva extras is an error naming the file, not a crash.
-struct GltfImportResult {
-  std::vector<GltfPlant> plants;
-  std::optional<std::string> error;
-};
-GltfImportResult import_gltf_skeletons(const std::string& path);
+// plant.glb`): one plant per node and instance, in node order. A file without sylva
+// extras is an error naming the file, not a crash; a bad value is located in the JSON.
+Expected<std::vector<GltfPlant>> import_gltf_skeletons(const std::string& path);
 
 }  // namespace sylva

@@ -10,38 +10,29 @@
 
 namespace sylva {
 
-HeightMapReadResult read_height_map(const std::string& path) {
+Expected<HeightMap> read_height_map(const std::string& path) {
   // ImageInput rather than a cached ImageBuf: the file is read once, now, as it is on
   // disk (a cache could hand back an older version of a file rewritten under the same name).
-  HeightMapReadResult result;
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     std::string why = OIIO::geterror();
     if (why.empty()) why = "cannot open";
-    result.error = path + ": error: cannot read the height map: " + why;
-    return result;
+    return file_diagnostic(path, "cannot read the height map: " + why);
   }
   const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1) {
-    result.error = path + ": error: the height map must be a 2D image with at least one pixel";
-    return result;
-  }
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1)
+    return file_diagnostic(path, "the height map must be a 2D image with at least one pixel");
   HeightMap map;
   map.width = static_cast<uint32_t>(spec.width);
   map.height = static_cast<uint32_t>(spec.height);
   map.values.resize(static_cast<size_t>(map.width) * map.height);
   if (!in->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, map.values.data())) {
     std::string why = in->geterror();
-    result.error = path + ": error: cannot read the height map's pixels: " + (why.empty() ? "read failed" : why);
-    return result;
+    return file_diagnostic(path, "cannot read the height map's pixels: " + (why.empty() ? "read failed" : why));
   }
   for (float v : map.values)
-    if (!std::isfinite(v)) {
-      result.error = path + ": error: the height map holds a value that is not finite";
-      return result;
-    }
-  result.map = std::move(map);
-  return result;
+    if (!std::isfinite(v)) return file_diagnostic(path, "the height map holds a value that is not finite");
+  return map;
 }
 
 NormalMapMetric bark_normal_map_metric(uint32_t width, uint32_t height, double r_ref_m, double u_repeat,

@@ -1,4 +1,4 @@
-// normal_map.h — a bark height map baked into a tangent-space normal map (issue 5: glTF
+// normal_map.h — a bark height map baked into a tangent-space normal map (gltf_export.h: glTF
 // 2.0 has no ratified height map, so the export carries the relief as a normalTexture).
 //
 // Texture axes: image column i is s (around the stem), image row j is t (along the stem),
@@ -32,6 +32,8 @@
 
 #include <glm/vec3.hpp>
 
+#include "core/util/diagnostic.h"
+
 namespace sylva {
 
 // A height image as floats, row-major from the top-left corner.
@@ -42,16 +44,11 @@ struct HeightMap {
   float at(uint32_t column, uint32_t row) const { return values[static_cast<size_t>(row) * width + column]; }
 };
 
-struct HeightMapReadResult {
-  std::optional<HeightMap> map;
-  std::optional<std::string> error;  // "path: error: ..." naming the file
-};
-
 // Reads any image OpenImageIO reads (PNG 8/16-bit, EXR, TIFF, ...); the first channel of
 // its first subimage, integer formats scaled to [0, 1], float formats as stored. A
 // missing or unreadable file, an empty image, or a non-finite value is an error naming
-// `path`.
-HeightMapReadResult read_height_map(const std::string& path);
+// `path` (a Diagnostic for the file as a whole).
+Expected<HeightMap> read_height_map(const std::string& path);
 
 // What one texel measures on the surface, and how deep the relief is (metres, all > 0
 // except depth_m >= 0).

@@ -15,8 +15,8 @@ std::string aov_path(const std::string& image_path, const std::string& aov_name)
   return p.string() + "." + aov_name + ".exr";
 }
 
-ImageWriteResult write_render(const std::string& path, const RenderImage& image) {
-  ImageWriteResult result;
+Expected<std::vector<std::string>> write_render(const std::string& path, const RenderImage& image) {
+  std::vector<std::string> written;
   const std::string ext = lower_extension(path);
   const size_t pixels = static_cast<size_t>(image.width) * image.height;
   struct Aov {
@@ -48,23 +48,21 @@ ImageWriteResult write_render(const std::string& path, const RenderImage& image)
         if (!a.data->empty())
           for (size_t c = 0; c < a.channels.size(); ++c) *dst++ = (*a.data)[p * a.channels.size() + c];
     }
-    if (auto e = write_image_atomically(path, image.width, image.height, names, buffer, formats, false))
-      result.error = e;
-    else
-      result.written.push_back(path);
-    return result;
+    if (Status e = write_image_atomically(path, image.width, image.height, names, buffer, formats, false); !e)
+      return std::move(e.error());
+    written.push_back(path);
+    return written;
   }
 
   // AOVs first: the picture itself appears last, when everything else is in place.
   for (const Aov& a : aovs) {
     if (a.data->empty()) continue;
     const std::string side = aov_path(path, a.name);
-    if (auto e = write_image_atomically(side, image.width, image.height, a.channels, *a.data,
-                                        {ChannelFormat::float32}, false)) {
-      result.error = e;
-      return result;
-    }
-    result.written.push_back(side);
+    if (Status e = write_image_atomically(side, image.width, image.height, a.channels, *a.data,
+                                          {ChannelFormat::float32}, false);
+        !e)
+      return std::move(e.error());
+    written.push_back(side);
   }
   const bool linear = ext == ".hdr" || ext == ".pfm" || ext == ".tif" || ext == ".tiff";
   std::vector<float> beauty = image.beauty;
@@ -80,12 +78,12 @@ ImageWriteResult write_render(const std::string& path, const RenderImage& image)
   if (!linear)
     for (size_t i = 0; i < beauty.size(); ++i)
       if (names.size() == 3 || i % 4 != 3) beauty[i] = linear_to_srgb(beauty[i]);
-  if (auto e = write_image_atomically(path, image.width, image.height, names, beauty,
-                                      {linear ? ChannelFormat::float32 : ChannelFormat::uint8}, !linear))
-    result.error = e;
-  else
-    result.written.push_back(path);
-  return result;
+  if (Status e = write_image_atomically(path, image.width, image.height, names, beauty,
+                                        {linear ? ChannelFormat::float32 : ChannelFormat::uint8}, !linear);
+      !e)
+    return std::move(e.error());
+  written.push_back(path);
+  return written;
 }
 
 }  // namespace sylva

@@ -12,12 +12,11 @@
 //                    saguaro.uv.exr, saguaro.id.exr, saguaro.fog.exr
 #pragma once
 
-#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/render_types.h"
-#include "core/util/file_io.h"
+#include "core/util/diagnostic.h"
 
 namespace sylva {
 
@@ -26,10 +25,6 @@ std::string aov_path(const std::string& image_path, const std::string& aov_name)
 
 // Writes a render: the beauty and every AOV the image holds, as described above.
 // Returns the paths written, or the first error (files already renamed stay).
-struct ImageWriteResult {
-  std::vector<std::string> written;
-  std::optional<FileError> error;
-};
-ImageWriteResult write_render(const std::string& path, const RenderImage& image);
+Expected<std::vector<std::string>> write_render(const std::string& path, const RenderImage& image);
 
 }  // namespace sylva

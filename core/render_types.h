@@ -13,6 +13,7 @@
 #include "core/relief.h"
 #include "core/scene.h"
 #include "core/skin.h"
+#include "core/util/progress.h"
 
 namespace sylva {
 
@@ -27,7 +28,7 @@ enum AovFlags : uint32_t {
   kAovFog = 1u << 4,     // fog.R fog.G fog.B fog.T (spec/fog.md, "Outputs")
 };
 
-// Which geometry stands for the plants (issue 3: the analytic frusta are the reference,
+// Which geometry stands for the plants (paper 000 sec. 4: the analytic frusta are the reference,
 // the tessellated meshes the polygon baseline).
 enum class GeometryKind : uint8_t {
   frusta,  // analytic conical frusta (frustum_tracer.h), relief-mapped where asked
@@ -63,8 +64,8 @@ struct RenderOptions {
   uint32_t spp = 1;                             // samples per pixel, >= 1
   uint32_t aovs = 0;                            // AovFlags
   unsigned threads = 0;                         // 0: every core
-  const std::atomic<bool>* cancel = nullptr;    // set (e.g. by SIGINT) to stop early
-  bool progress = false;                        // progress bar on stderr after 1 s
+  Progress progress = {};                       // fraction done ("geometry", "render"),
+                                                //   cancellation (e.g. by SIGINT) between tiles
   SkinOptions skin;                             // how plants are skinned
   GeometryOptions geometry;                     // what stands for the plants
   FogRenderOptions fog;                         // how the scene's fog is rendered
@@ -91,7 +92,7 @@ struct RenderPass {
 struct RenderResult {
   RenderImage image;
   std::vector<RenderPass> passes;
-  bool cancelled = false;     // stopped by options.cancel: the image is incomplete
+  bool cancelled = false;     // stopped by options.progress: the image is incomplete
   uint64_t frusta = 0;
   uint64_t geometry_bytes = 0;  // what the traced geometry holds (SceneTracer::memory_bytes)
   uint64_t primary_rays = 0;

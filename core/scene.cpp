@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include "core/fog.h"
+#include "core/util/diagnostic.h"
 #include "core/util/file_io.h"
 #include "core/util/json.h"
 #include "core/util/image_io.h"
@@ -39,15 +40,9 @@ std::optional<FogMode> fog_mode_from_name(std::string_view name) {
   return std::nullopt;
 }
 
-std::string SceneError::format() const {
-  std::string out = file;
-  if (line > 0) out += ":" + std::to_string(line) + ":" + std::to_string(column);
-  return out + ": error: " + message;
-}
-
 namespace {
 
-// Thrown inside this file only; parse_scene_json turns it into a SceneError.
+// Thrown inside this file only; parse_scene_json turns it into a Diagnostic.
 struct Located {
   uint32_t line, column;
   std::string message;
@@ -161,8 +156,8 @@ void check_texture(const JsonValue& object, std::string_view key, const std::str
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw Located{line, column, what + ": no such image file '" + path + "'"};
-  if (auto reason = image_open_error(path))
-    throw Located{line, column, what + ": cannot open image '" + path + "': " + *reason};
+  if (Status opens = check_image_opens(path); !opens)
+    throw Located{line, column, what + ": cannot open image '" + path + "': " + opens.error().message};
 }
 
 Bark read_bark(const JsonValue& v, const std::string& base_dir, std::string_view what) {
@@ -195,6 +190,7 @@ ScenePlant read_plant(const JsonValue& v, const std::string& base_dir, size_t in
   const JsonValue* g = v.find("grammar");
   if (!g) fail(v, what + " needs a \"grammar\"");
   p.grammar = path_relative_to(base_dir, *g, what + ".grammar");
+  p.grammar_loc = {g->line, g->column};
   if (auto* x = v.find("seed")) {
     auto s = x->as_uint64();
     if (!s) fail(*x, what + ".seed must be an integer from 0 to 18446744073709551615");
@@ -319,30 +315,22 @@ Scene read_scene(const JsonValue& root, const std::string& base_dir) {
 
 }  // namespace
 
-SceneReadResult parse_scene_json(std::string_view text, std::string_view file,
-                                 const std::string& base_dir) {
-  SceneReadResult result;
-  JsonParseResult json = parse_json(text);
-  if (json.error) {
-    result.error = SceneError{std::string(file), json.error->line, json.error->column, json.error->message};
-    return result;
-  }
+Expected<Scene> parse_scene_json(std::string_view text, std::string_view file, const std::string& base_dir) {
+  Expected<JsonValue> json = parse_json(text, file);
+  if (!json) return std::move(json.error());
   try {
-    result.scene = read_scene(*json.value, base_dir);
+    Scene scene = read_scene(*json, base_dir);
+    scene.file = std::string(file);
+    return scene;
   } catch (const Located& e) {
-    result.error = SceneError{std::string(file), e.line, e.column, e.message};
+    return diagnostic_at(std::string(file), {e.line, e.column}, e.message);
   }
-  return result;
 }
 
-SceneReadResult read_scene_file(const std::string& path) {
-  FileReadResult file = read_text_file(path);
-  if (file.error) {
-    SceneReadResult r;
-    r.error = SceneError{path, 0, 0, file.error->message};
-    return r;
-  }
-  return parse_scene_json(*file.contents, path, std::filesystem::path(path).parent_path().string());
+Expected<Scene> read_scene_file(const std::string& path) {
+  Expected<std::string> file = read_text_file(path);
+  if (!file) return std::move(file.error());
+  return parse_scene_json(*file, path, std::filesystem::path(path).parent_path().string());
 }
 
 SkeletonBounds skeleton_bounds(const Skeleton& skeleton) {
@@ -410,22 +398,183 @@ Scene default_scene_for(const Skeleton& skeleton, uint32_t width, uint32_t heigh
 
 namespace sylva {
 
-std::optional<std::string> grow_scene_plants(Scene& scene, uint64_t max_modules) {
-  for (ScenePlant& plant : scene.plants) {
+Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& progress) {
+  size_t to_grow = 0, grown_so_far = 0;
+  for (const ScenePlant& plant : scene.plants) to_grow += plant.skeleton ? 0 : 1;
+  for (size_t i = 0; i < scene.plants.size(); ++i) {
+    ScenePlant& plant = scene.plants[i];
     if (plant.skeleton) continue;
+    if (progress.cancelled()) return cancelled_diagnostic();
+    // The grammar's own diagnostic, and where the scene named the grammar.
+    auto located = [&](Diagnostic d) {
+      if (d.cancelled) return d;
+      Diagnostic note =
+          diagnostic_at(scene.file, plant.grammar_loc, "plants[" + std::to_string(i) + "].grammar names this grammar");
+      return std::move(d).with_note(std::move(note));
+    };
     lsys::ParseOptions parse;
     parse.define_overrides = plant.defines;
     auto grammar = lsys::load_grammar(plant.grammar, parse);
-    if (!grammar) return grammar.error().format();
+    if (!grammar) return located(std::move(grammar.error()));
     lsys::DeriveOptions derive;
     derive.steps = plant.steps;
     derive.seed = plant.seed;
     derive.max_modules = max_modules;
+    const double share = 1.0 / static_cast<double>(to_grow);
+    derive.progress = progress.part(static_cast<double>(grown_so_far) * share,
+                                    static_cast<double>(grown_so_far + 1) * share);
     auto grown = grow(*grammar, derive, plant.grammar, plant.defines);
-    if (!grown) return grown.error().format();
+    if (!grown) return located(std::move(grown.error()));
     plant.skeleton = std::move(grown->skeleton);
+    ++grown_so_far;
   }
-  return std::nullopt;
+  progress.report(1, "grow");
+  return {};
+}
+
+// ---------------------------------------------------------------------------------------
+// Writing: one function per section, one line per key, in the order scene.md lists them,
+// so that a new key is one line here beside its line in the reader above.
+
+namespace {
+
+using Layout = JsonWriter::Layout;
+
+void write_vec3(JsonWriter& w, const glm::dvec3& v) {
+  const double a[3] = {v.x, v.y, v.z};
+  w.numbers(a, 3);
+}
+
+// `path` as a scene file in `base_dir` names it: relative to base_dir where reading it
+// back (path_relative_to) gives exactly `path` again, so scenes stay movable; else an
+// absolute path as stored, or the absolute form of a relative one.
+std::string path_for_file(const std::string& path, const std::string& base_dir) {
+  namespace fs = std::filesystem;
+  const fs::path p(path), base(base_dir);
+  if (base_dir.empty()) return path;
+  if (p.is_absolute() == base.is_absolute()) {
+    const fs::path relative = p.lexically_relative(base);
+    if (!relative.empty() && !relative.is_absolute() && (base / relative).lexically_normal().string() == path)
+      return relative.string();
+  }
+  return p.is_absolute() ? path : fs::absolute(p).lexically_normal().string();
+}
+
+void write_camera(JsonWriter& w, const Camera& c) {
+  w.key("camera").begin_object(Layout::spaced);
+  write_vec3(w.key("eye"), c.eye);
+  write_vec3(w.key("target"), c.target);
+  write_vec3(w.key("up"), c.up);
+  w.key("fov_y_deg").number(c.fov_y_deg);
+  w.end_object();
+}
+
+// The direction to write for the unit sun direction `unit`: the reader normalises what it
+// reads (unit_sun_direction), and normalising is not idempotent in floating point, so
+// `unit` itself may read back an ulp away. Of the vectors within 2 ulps
+// of it per component, the first (in a fixed order, `unit` first) that reads back as
+// exactly `unit` is written; in the unlikely case that none does, `unit` itself.
+glm::dvec3 sun_direction_to_write(const glm::dvec3& unit) {
+  auto read_back = [](const glm::dvec3& v) { return unit_sun_direction(v); };
+  auto step = [](double x, int ulps) {
+    for (; ulps > 0; --ulps) x = std::nextafter(x, std::numeric_limits<double>::infinity());
+    for (; ulps < 0; ++ulps) x = std::nextafter(x, -std::numeric_limits<double>::infinity());
+    return x;
+  };
+  constexpr int kOffsets[5] = {0, 1, -1, 2, -2};
+  for (int dx : kOffsets)
+    for (int dy : kOffsets)
+      for (int dz : kOffsets) {
+        const glm::dvec3 v(step(unit.x, dx), step(unit.y, dy), step(unit.z, dz));
+        if (read_back(v) == unit) return v;
+      }
+  return unit;
+}
+
+void write_sun(JsonWriter& w, const Sun& s) {
+  w.key("sun").begin_object(Layout::spaced);
+  write_vec3(w.key("direction"), sun_direction_to_write(s.direction));
+  w.key("angular_radius_deg").number(s.angular_radius_deg);
+  write_vec3(w.key("radiance"), s.radiance);
+  w.end_object();
+}
+
+void write_ground(JsonWriter& w, const Ground& g) {
+  w.key("ground").begin_object(Layout::spaced);
+  w.key("height").number(g.height);
+  write_vec3(w.key("albedo"), g.albedo);
+  w.end_object();
+}
+
+void write_fog(JsonWriter& w, const Fog& f) {
+  w.key("fog").begin_object(Layout::spaced);
+  w.key("sigma_s").number(f.sigma_s);
+  w.key("sigma_a").number(f.sigma_a);
+  w.key("g").number(f.g);
+  w.key("height_falloff").number(f.height_falloff);
+  if (std::isfinite(f.top)) w.key("top").number(f.top);  // +inf: no ceiling, no key
+  w.key("mode").string(fog_mode_name(f.mode));
+  w.key("steps").integer(f.steps);
+  w.key("photons").integer(f.photons);
+  w.end_object();
+}
+
+void write_bark(JsonWriter& w, const Bark& b, const std::string& base_dir) {
+  w.key("bark").begin_object(Layout::spaced);
+  if (b.albedo_texture) w.key("albedo").string(path_for_file(*b.albedo_texture, base_dir));
+  else if (b.albedo_rgb) write_vec3(w.key("albedo"), *b.albedo_rgb);
+  if (b.height_texture) w.key("height").string(path_for_file(*b.height_texture, base_dir));
+  w.key("relief_depth").number(b.relief_depth_m);
+  w.key("u_repeat").number(b.u_repeat);
+  w.key("v_per_metre").number(b.v_per_metre);
+  w.end_object();
+}
+
+void write_plant(JsonWriter& w, const ScenePlant& p, const std::string& base_dir) {
+  w.begin_object(Layout::spaced);
+  w.key("grammar").string(path_for_file(p.grammar, base_dir));
+  if (p.seed) w.key("seed").integer(*p.seed);
+  if (p.steps) w.key("steps").integer(*p.steps);
+  w.key("defines").begin_object(Layout::spaced);
+  for (const auto& [name, value] : p.defines) w.key(name).number(value);
+  w.end_object();
+  write_vec3(w.key("position"), p.position);
+  w.key("rotate_y_deg").number(p.rotate_y_deg);
+  w.key("scale").number(p.scale);
+  write_bark(w, p.bark, base_dir);
+  w.end_object();
+}
+
+}  // namespace
+
+glm::dvec3 unit_sun_direction(const glm::dvec3& toward_sun) {
+  // read_sun normalises what it reads, and read_scene normalises sun.direction once more.
+  return glm::normalize(glm::normalize(toward_sun));
+}
+
+Expected<std::string> write_scene_json(const Scene& scene, const std::string& base_dir) {
+  for (size_t i = 0; i < scene.plants.size(); ++i)
+    if (scene.plants[i].grammar.empty())
+      return file_diagnostic(scene.file, "plants[" + std::to_string(i) +
+                                             "] has no grammar; a scene file names each plant's grammar");
+  JsonWriter w;
+  w.begin_object(Layout::lines);
+  w.key("format").string("sylva-scene");
+  w.key("version").integer(1);
+  write_camera(w, scene.camera);
+  w.key("image").begin_object(Layout::spaced);
+  w.key("width").integer(scene.width);
+  w.key("height").integer(scene.height);
+  w.end_object();
+  write_sun(w, scene.sun);
+  write_vec3(w.key("sky"), scene.sky);
+  write_ground(w, scene.ground);
+  if (scene.fog) write_fog(w, *scene.fog);
+  w.key("plants").begin_array(Layout::lines);
+  for (const ScenePlant& plant : scene.plants) write_plant(w, plant, base_dir);
+  w.end_array();
+  w.end_object();
+  return w.take() + "\n";
 }
 
 Skeleton place_plant(const ScenePlant& plant) {

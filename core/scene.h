@@ -19,6 +19,8 @@
 
 #include "core/skeleton.h"
 #include "core/util/bounds.h"
+#include "core/util/diagnostic.h"
+#include "core/util/progress.h"
 
 namespace sylva {
 
@@ -28,6 +30,7 @@ struct Camera {
   glm::dvec3 target{0, 2, 0};
   glm::dvec3 up{0, 1, 0};
   double fov_y_deg = 40;  // full vertical field of view, (0, 180)
+  bool operator==(const Camera&) const = default;
 };
 
 // The sun: a disc light. angular_radius_deg 0 is a point sun (hard shadows).
@@ -39,11 +42,13 @@ struct Sun {
   // makes an angle θ with the sun receives radiance·cos θ whatever the disc's size
   // (core/shading.h E_sun).
   glm::dvec3 radiance{3, 3, 2.8};
+  bool operator==(const Sun&) const = default;
 };
 
 struct Ground {
   double height = 0;                    // the plane y = height
   glm::dvec3 albedo{0.35, 0.3, 0.25};
+  bool operator==(const Ground&) const = default;
 };
 
 // How the fog's single scattering is computed (spec/fog.md, "How the integral is computed";
@@ -72,6 +77,7 @@ struct Fog {
   FogMode mode = FogMode::automatic;
   uint32_t steps = 64;           // samples along a ray (brute, medium; probes of refined), >= 1
   uint64_t photons = 1'000'000;  // sun photons for the shadow cones, >= 1
+  bool operator==(const Fog&) const = default;
 };
 
 // The most samples along one camera ray (`steps`, --fog-steps) and the most photons
@@ -89,6 +95,7 @@ struct Bark {
   double relief_depth_m = 0.02;
   double u_repeat = 1;           // texture repeats around the stem
   double v_per_metre = 1;        // texture repeats per metre of arc length
+  bool operator==(const Bark&) const = default;
 };
 
 // One plant: a grammar grown with seed/steps/defines, or a ready skeleton, placed by
@@ -103,6 +110,9 @@ struct ScenePlant {
   double rotate_y_deg = 0;
   double scale = 1;
   Bark bark;
+  SourceLoc grammar_loc = {};              // where the scene file names the grammar ({0,0}:
+                                           //   not read from a file); grow_scene_plants' note
+  bool operator==(const ScenePlant&) const = default;
 };
 
 struct Scene {
@@ -114,29 +124,36 @@ struct Scene {
   Ground ground;
   std::optional<Fog> fog;          // none: no fog pass
   std::vector<ScenePlant> plants;
-};
-
-// "file:line:column: error: message" (place omitted where unknown).
-struct SceneError {
-  std::string file;
-  uint32_t line = 0;
-  uint32_t column = 0;
-  std::string message;
-  std::string format() const;
-};
-
-struct SceneReadResult {
-  std::optional<Scene> scene;
-  std::optional<SceneError> error;
+  std::string file = {};           // the file it was read from, for messages ("" if made
+                                   //   in code); like ScenePlant::grammar_loc, a place, not
+                                   //   part of what the scene describes (not written)
+  bool operator==(const Scene&) const = default;  // field by field, places included
 };
 
 // Parses scene JSON. `file` names it in messages; relative paths in it (grammar,
 // textures) are resolved against `base_dir` (the scene file's folder; "" = as written).
-SceneReadResult parse_scene_json(std::string_view text, std::string_view file,
-                                 const std::string& base_dir);
+// Errors: the first problem, a Diagnostic at the offending key or value (no source line).
+Expected<Scene> parse_scene_json(std::string_view text, std::string_view file, const std::string& base_dir);
 
 // Reads and parses a scene file; paths in it are relative to its folder.
-SceneReadResult read_scene_file(const std::string& path);
+Expected<Scene> read_scene_file(const std::string& path);
+
+// The scene as `.scene.json` text (scene.md) that parse_scene_json(text, file, base_dir)
+// reads back equal to `scene` (but for the places: file, grammar_loc) when its sun
+// direction is one the reader makes (unit_sun_direction; every scene read from a file
+// has one): every key with its
+// value, defaults included, optional keys (fog, seed, steps, bark textures) when set;
+// numbers as shortest round-trip decimals; paths relative to `base_dir` (the folder the
+// file will be in; "" = as stored) where they can be, else absolute. Deterministic:
+// identical scenes give identical bytes. Error: a plant without a grammar (a scene made
+// around a skeleton, default_scene_for, has nothing a scene file can name).
+Expected<std::string> write_scene_json(const Scene& scene, const std::string& base_dir = "");
+
+// The unit sun direction a scene file's `sun.direction` reads as: `toward_sun` normalised
+// as the reader does it. Normalising is not idempotent in floating point, so a direction
+// set in code (the studio's sun control) should go through this for the scene to write
+// and read back exactly (write_scene_json). Precondition: toward_sun is not zero.
+glm::dvec3 unit_sun_direction(const glm::dvec3& toward_sun);
 
 // The skeleton of `plant` placed in the world: p' = position + R_y(rotate_y_deg)·(scale·p),
 // radii scaled. Precondition: plant.skeleton is set.
@@ -158,9 +175,11 @@ Camera framing_camera(const glm::dvec3& lo, const glm::dvec3& hi, uint32_t width
 Scene default_scene_for(const Skeleton& skeleton, uint32_t width = 1024, uint32_t height = 768);
 
 // Grows every plant of `scene` that has no skeleton yet from its grammar (with its seed,
-// steps and defines) and stores the skeleton in the plant, untransformed. Returns the
-// first error as the full diagnostic text (grammar file, line, column, caret), or
-// nullopt when every plant has a skeleton.
-std::optional<std::string> grow_scene_plants(Scene& scene, uint64_t max_modules = 50'000'000);
+// steps and defines) and stores the skeleton in the plant, untransformed. The first
+// error is the grammar's own Diagnostic (its file, line, column and source line) with a
+// note at the scene key that named the grammar (scene.file at plants[i].grammar_loc:
+// "plants[i].grammar names this grammar"). Progress: one equal share per plant to grow;
+// cancelled: cancelled_diagnostic(), the plants grown so far keep their skeletons.
+Status grow_scene_plants(Scene& scene, uint64_t max_modules = 50'000'000, const Progress& progress = {});
 
 }  // namespace sylva

@@ -99,11 +99,11 @@ class SkeletonReader {
  public:
   explicit SkeletonReader(std::string_view file) : file_(file) {}
 
-  SkeletonReadResult read(std::string_view text);
+  Expected<Skeleton> read(std::string_view text);
 
  private:
   bool fail(uint32_t line, uint32_t column, std::string message) {
-    error_ = SkeletonError{file_, line, column, std::move(message)};
+    error_ = diagnostic_at(file_, {line, column}, std::move(message));
     return false;
   }
   bool fail(const JsonValue& where, std::string message) {
@@ -129,20 +129,17 @@ class SkeletonReader {
   bool read_joint(size_t chain, size_t index, const JsonValue& value, Joint& joint);
 
   std::string file_;
-  std::optional<SkeletonError> error_;
+  std::optional<Diagnostic> error_;
 };
 
-SkeletonReadResult SkeletonReader::read(std::string_view text) {
+Expected<Skeleton> SkeletonReader::read(std::string_view text) {
   // Non-finite numbers are let through the JSON layer so that the schema check below
   // can say which chain and joint holds them.
   JsonParseOptions options;
   options.allow_non_finite_numbers = true;
-  JsonParseResult parsed = parse_json(text, options);
-  if (parsed.error) {
-    return {std::nullopt,
-            SkeletonError{file_, parsed.error->line, parsed.error->column, parsed.error->message}};
-  }
-  const JsonValue& root = *parsed.value;
+  Expected<JsonValue> parsed = parse_json(text, file_, options);
+  if (!parsed) return std::move(parsed.error());
+  const JsonValue& root = *parsed;
   Skeleton skeleton;
   const bool ok = [&] {
     if (!root.is_object()) {
@@ -156,9 +153,9 @@ SkeletonReadResult SkeletonReader::read(std::string_view text) {
     const JsonValue* chains = require(root, "chains", "");
     return chains != nullptr && read_chains(*chains, skeleton);
   }();
-  if (!ok) return {std::nullopt, std::move(error_)};
-  assert(!validate_skeleton(skeleton) && "the reader accepted a skeleton that breaks an invariant");
-  return {std::move(skeleton), std::nullopt};
+  if (!ok) return std::move(*error_);
+  assert(validate_skeleton(skeleton).ok() && "the reader accepted a skeleton that breaks an invariant");
+  return skeleton;
 }
 
 bool SkeletonReader::check_keys(const JsonValue& object,
@@ -396,22 +393,8 @@ uint64_t Skeleton::segment_count() const {
   return segments;
 }
 
-std::string SkeletonError::format() const {
-  std::string out = file;
-  if (line != 0) {
-    if (!out.empty()) out += ':';
-    out += std::to_string(line);
-    if (column != 0) {
-      out += ':';
-      out += std::to_string(column);
-    }
-  }
-  if (!out.empty()) out += ": ";
-  return out + "error: " + message;
-}
-
-std::optional<SkeletonError> validate_skeleton(const Skeleton& skeleton) {
-  auto error = [](std::string message) { return SkeletonError{"", 0, 0, std::move(message)}; };
+Status validate_skeleton(const Skeleton& skeleton) {
+  auto error = [](std::string message) { return file_diagnostic("", std::move(message)); };
   if (skeleton.chains.size() > kMaxCount) {
     return error("too many chains (" + std::to_string(skeleton.chains.size()) + "); at most 4294967295");
   }
@@ -457,19 +440,19 @@ std::optional<SkeletonError> validate_skeleton(const Skeleton& skeleton) {
   // Joints between or after the chains' ranges belong to no chain; stages that scan the
   // flat array still see them, so they must be finite too.
   size_t next = 0;
-  auto check_unowned = [&](size_t end) -> std::optional<SkeletonError> {
+  auto check_unowned = [&](size_t end) -> Status {
     for (; next < end; ++next) {
       if (auto problem = joint_problem(skeleton.joints[next])) {
         return error("joint " + std::to_string(next) + " (in no chain): " + *problem);
       }
     }
-    return std::nullopt;
+    return {};
   };
   for (const Chain& chain : skeleton.chains) {
-    if (auto problem = check_unowned(chain.first_joint)) return problem;
+    if (Status problem = check_unowned(chain.first_joint); !problem) return problem;
     next = chain.first_joint + size_t{chain.joint_count};
   }
-  if (auto problem = check_unowned(skeleton.joints.size())) return problem;
+  if (Status problem = check_unowned(skeleton.joints.size()); !problem) return problem;
 
   if (skeleton.source.steps < 0) {
     return error("source: steps is " + std::to_string(skeleton.source.steps) + "; must be >= 0");
@@ -481,81 +464,62 @@ std::optional<SkeletonError> validate_skeleton(const Skeleton& skeleton) {
                    "; defines must be finite");
     }
   }
-  return std::nullopt;
+  return {};
 }
 
-void append_chain_json(std::string& out, const Skeleton& skeleton, size_t c, bool compact) {
-  const Chain& chain = skeleton.chains[c];
-  out += compact ? "{\"parent\":" : "{\"parent\": ";
-  if (chain.parent) {
-    out += '[';
-    append_json_uint64(out, chain.parent->chain);
-    out += ',';
-    append_json_uint64(out, chain.parent->joint);
-    out += ']';
-  } else {
-    out += "null";
-  }
-  out += compact ? ",\"joints\":[" : ", \"joints\": [";
-  for (uint32_t j = 0; j < chain.joint_count; ++j) {
-    const Joint& joint = skeleton.joints[chain.first_joint + j];
-    out += j == 0 ? "[" : ",[";
-    for (const double coordinate : joint.position_m) {
-      append_json_number(out, coordinate);
-      out += ',';
+void write_skeleton_members(JsonWriter& w, const Skeleton& skeleton, const SkeletonJsonStyle& style) {
+  assert(validate_skeleton(skeleton).ok() &&
+         "write_skeleton_members: the skeleton breaks an invariant; see validate_skeleton");
+  using Layout = JsonWriter::Layout;
+  const Layout inline_layout = style.compact ? Layout::compact : Layout::spaced;
+  const SkeletonSource& source = skeleton.source;
+  w.key("format").string(kFormatName);
+  w.key("version").integer(kFormatVersion);
+  w.key("source").begin_object(inline_layout);
+  w.key("grammar").string(source.grammar);
+  if (style.seed_as_string) w.key("seed").string(std::to_string(source.seed));
+  else w.key("seed").integer(source.seed);
+  w.key("steps").integer(source.steps);
+  w.key("defines").begin_object(inline_layout);
+  for (const auto& [name, value] : source.defines) w.key(name).number(value);  // std::map: sorted by name
+  w.end_object();
+  w.end_object();
+  // One chain per line in the file; its joints stay dense (they are most of the bytes).
+  w.key("chains").begin_array(style.compact ? Layout::compact : Layout::lines);
+  for (const Chain& chain : skeleton.chains) {
+    w.begin_object(inline_layout);
+    w.key("parent");
+    if (chain.parent) w.begin_array().integer(chain.parent->chain).integer(chain.parent->joint).end_array();
+    else w.null();
+    w.key("joints").begin_array();
+    for (uint32_t j = 0; j < chain.joint_count; ++j) {
+      const Joint& joint = skeleton.joints[chain.first_joint + j];
+      w.begin_array();
+      for (const double coordinate : joint.position_m) w.number(coordinate);
+      w.number(joint.radius_m).integer(joint.material).end_array();
     }
-    append_json_number(out, joint.radius_m);
-    out += ',';
-    append_json_uint64(out, joint.material);
-    out += ']';
+    w.end_array();
+    w.end_object();
   }
-  out += "]}";
+  w.end_array();
 }
 
 std::string write_skeleton_json(const Skeleton& skeleton) {
-  assert(!validate_skeleton(skeleton) &&
-         "write_skeleton_json: the skeleton breaks an invariant; see validate_skeleton");
-  const SkeletonSource& source = skeleton.source;
-  std::string out;
-  out.reserve(256 + skeleton.chains.size() * 48 + skeleton.joints.size() * 56);
-  out += "{\n  \"format\": ";
-  append_json_string(out, kFormatName);
-  out += ",\n  \"version\": ";
-  append_json_uint64(out, kFormatVersion);
-  out += ",\n  \"source\": {\"grammar\": ";
-  append_json_string(out, source.grammar);
-  out += ", \"seed\": ";
-  append_json_uint64(out, source.seed);
-  out += ", \"steps\": ";
-  append_json_int64(out, source.steps);
-  out += ", \"defines\": {";
-  bool first_define = true;
-  for (const auto& [name, value] : source.defines) {  // std::map: sorted by name
-    if (!first_define) out += ", ";
-    first_define = false;
-    append_json_string(out, name);
-    out += ": ";
-    append_json_number(out, value);
-  }
-  out += "}},\n  \"chains\": [";
-  if (!skeleton.chains.empty()) out += '\n';
-  for (size_t c = 0; c < skeleton.chains.size(); ++c) {
-    out += "    ";
-    append_chain_json(out, skeleton, c, false);
-    out += c + 1 < skeleton.chains.size() ? ",\n" : "\n";
-  }
-  out += skeleton.chains.empty() ? "]\n}\n" : "  ]\n}\n";
-  return out;
+  JsonWriter w;
+  w.begin_object(JsonWriter::Layout::lines);
+  write_skeleton_members(w, skeleton);
+  w.end_object();
+  return w.take() + "\n";
 }
 
-SkeletonReadResult read_skeleton_json(std::string_view text, std::string_view file) {
+Expected<Skeleton> read_skeleton_json(std::string_view text, std::string_view file) {
   return SkeletonReader(file).read(text);
 }
 
-SkeletonReadResult read_skeleton_file(const std::string& path) {
-  FileReadResult file = read_text_file(path);
-  if (file.error) return {std::nullopt, SkeletonError{path, 0, 0, file.error->message}};
-  return read_skeleton_json(*file.contents, path);
+Expected<Skeleton> read_skeleton_file(const std::string& path) {
+  Expected<std::string> file = read_text_file(path);
+  if (!file) return std::move(file.error());
+  return read_skeleton_json(*file, path);
 }
 
 }  // namespace sylva

@@ -20,6 +20,9 @@
 #include <string_view>
 #include <vector>
 
+#include "core/util/diagnostic.h"
+#include "core/util/json.h"
+
 namespace sylva {
 
 // One joint: where the chain passes, how thick it is there, and the material index of
@@ -28,6 +31,7 @@ struct Joint {
   double position_m[3];  // metres, Y up
   double radius_m;       // >= 0; 0 is a tip
   uint32_t material;     // material index in force for the segment ending here
+  bool operator==(const Joint&) const = default;
 };
 
 // Where a chain is attached: a joint of an earlier chain.
@@ -42,6 +46,7 @@ struct Chain {
   uint32_t first_joint;   // index into Skeleton::joints
   uint32_t joint_count;   // >= 1; segments = joint_count - 1
   std::optional<ChainParent> parent;  // none for a root chain
+  bool operator==(const Chain&) const = default;
 };
 
 // Where a skeleton came from, written into its file so it can be reproduced.
@@ -50,6 +55,7 @@ struct SkeletonSource {
   uint64_t seed = 1;                      // 64-bit seed, never passed through a double
   int64_t steps = 0;                      // derivation steps
   std::map<std::string, double> defines;  // -D overrides given by the user, by name
+  bool operator==(const SkeletonSource&) const = default;
 };
 
 struct Skeleton {
@@ -59,45 +65,40 @@ struct Skeleton {
 
   // Number of segments: sum over chains of (joint_count - 1).
   uint64_t segment_count() const;
+  bool operator==(const Skeleton&) const = default;
 };
 
-// A located problem in a skeleton file or value: "file:line:column: error: message".
-// line/column are 1-based; 0 where no place in a file is known.
-struct SkeletonError {
-  std::string file;
-  uint32_t line = 0;
-  uint32_t column = 0;
-  std::string message;
-  std::string format() const;  // "file:line:column: error: message" (place omitted if 0)
+// Checks the invariants above. Returns the first violation, naming chain and joint (a
+// Diagnostic without file or place: the skeleton is a value, not a file).
+Status validate_skeleton(const Skeleton& skeleton);
+
+// How write_skeleton_members lays the document out.
+struct SkeletonJsonStyle {
+  bool compact = false;         // no spaces or line breaks (for embedding, e.g. glTF extras)
+  bool seed_as_string = false;  // "seed": "18446744073709551615", for JSON consumers that
+                                //   read every number as a double (glTF extras)
 };
 
-// Checks the invariants above. Returns the first violation, naming chain and joint.
-std::optional<SkeletonError> validate_skeleton(const Skeleton& skeleton);
+// Writes the members of the sylva-skeleton document — "format", "version", "source"
+// {grammar, seed, steps, defines}, "chains" [{"parent": [chain,joint] | null, "joints":
+// [[x,y,z,radius,material],...]}] — into the object open in `w`. The one serialiser of
+// a skeleton: write_skeleton_json and the glTF node extras (gltf_export.h) both use it.
+// Precondition: validate_skeleton(skeleton) succeeds.
+void write_skeleton_members(JsonWriter& w, const Skeleton& skeleton, const SkeletonJsonStyle& style = {});
 
 // Serialises to the sylva-skeleton JSON format, version 1. Byte-identical output for
 // identical input on every machine: fixed key order, numbers in the shortest decimal
-// form that reads back to the same double (std::to_chars), "\n" line endings.
+// form that reads back to the same double (std::to_chars), "\n" line endings; one key
+// per line at the top, one chain per line.
 std::string write_skeleton_json(const Skeleton& skeleton);
-
-// Appends chain `c` as the skeleton document writes it —
-// {"parent": [chain,joint] | null, "joints": [[x,y,z,radius,material],...]} — with the
-// same numbers; `compact` drops the spaces after ':' and ',' (for embedding, e.g. in
-// glTF extras). One writer for every place a chain is serialised.
-void append_chain_json(std::string& out, const Skeleton& skeleton, size_t c, bool compact);
-
-// Result of reading a skeleton file: the skeleton, or the first error found.
-struct SkeletonReadResult {
-  std::optional<Skeleton> skeleton;
-  std::optional<SkeletonError> error;
-};
 
 // Parses sylva-skeleton JSON text. `file` is only used in messages. Rejects unknown
 // format or version, malformed JSON, NaN/infinity/out-of-range numbers, negative radii,
 // materials that are not non-negative integers, and dangling or forward parents, with a
-// message naming the chain and joint and the place in the text.
-SkeletonReadResult read_skeleton_json(std::string_view text, std::string_view file);
+// message naming the chain and joint and the place in the text (no source line).
+Expected<Skeleton> read_skeleton_json(std::string_view text, std::string_view file);
 
 // Reads a file from disk and parses it; an unreadable file is an error too.
-SkeletonReadResult read_skeleton_file(const std::string& path);
+Expected<Skeleton> read_skeleton_file(const std::string& path);
 
 }  // namespace sylva

@@ -18,6 +18,12 @@ namespace sylva {
 
 namespace {
 
+// Cancellation is checked, and progress reported, once per 1024 chains.
+constexpr uint32_t kProgressChunkMask = 1023;
+}  // namespace
+
+namespace {
+
 using glm::dvec2;
 using glm::dvec3;
 
@@ -417,7 +423,12 @@ int64_t frustum_at_joint(const std::vector<int64_t>& first_frustum_of_chain,
 }  // namespace
 
 SkinnedSkeleton skin_skeleton(const Skeleton& sk, const SkinOptions& options) {
-  assert(!validate_skeleton(sk) && "skin_skeleton: skeleton violates its invariants");
+  Expected<SkinnedSkeleton> skinned = skin_skeleton(sk, options, Progress{});
+  return std::move(*skinned);  // never cancelled without a flag
+}
+
+Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& options, const Progress& progress) {
+  assert(validate_skeleton(sk).ok() && "skin_skeleton: skeleton violates its invariants");
   assert(options.max_tilt_deg > 0 && options.max_tilt_deg <= 80);
   assert(options.knuckle_frusta >= 2);
   const double max_tilt_rad = deg_to_rad(options.max_tilt_deg);
@@ -426,6 +437,10 @@ SkinnedSkeleton skin_skeleton(const Skeleton& sk, const SkinOptions& options) {
   std::vector<std::vector<uint32_t>> segment_lower_joint(sk.chains.size());
 
   for (uint32_t c = 0; c < sk.chains.size(); ++c) {
+    if ((c & kProgressChunkMask) == 0 && c != 0) {  // between chunks of chains
+      if (progress.cancelled()) return cancelled_diagnostic();
+      progress.report(static_cast<double>(c) / static_cast<double>(sk.chains.size()), "skin");
+    }
     const Chain& chain = sk.chains[c];
     ChainPath path = chain_path(sk, chain, out.zero_length_skipped);
     const size_t n = path.points.size() < 2 ? 0 : path.points.size() - 1;  // segments
@@ -584,6 +599,7 @@ SkinnedSkeleton skin_skeleton(const Skeleton& sk, const SkinOptions& options) {
       }
     }
   }
+  progress.report(1, "skin");
   return out;
 }
 

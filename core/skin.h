@@ -53,6 +53,8 @@
 
 #include "core/frustum_shape.h"
 #include "core/skeleton.h"
+#include "core/util/diagnostic.h"
+#include "core/util/progress.h"
 
 namespace sylva {
 
@@ -109,6 +111,11 @@ struct SkinnedSkeleton {
 
 // Skins every chain (see the guarantees above). Deterministic.
 SkinnedSkeleton skin_skeleton(const Skeleton& skeleton, const SkinOptions& options = {});
+
+// The same, telling `progress` (core/util/progress.h) the fraction of chains skinned and
+// checking it every 1024 chains; cancelled: cancelled_diagnostic().
+Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& skeleton, const SkinOptions& options,
+                                        const Progress& progress);
 
 // The fixed frame around an axis from which raw u is measured (Duff et al. 2017, "Building
 // an orthonormal basis, revisited"): e0 is u = 0, e1 = axis × e0. The GPU rebuilds it

@@ -1,4 +1,5 @@
-// tessellate.h — the polygon baseline: skinned frusta as triangle meshes (issue 3 §3).
+// tessellate.h — the polygon baseline: skinned frusta as triangle meshes (paper 000 sec. 4,
+// the GS and GS+R columns).
 //
 // Each frustum becomes a grid on its own surface between its two cutting planes:
 // columns along generator lines and rows of equal v (eq. 7), every vertex exactly on the

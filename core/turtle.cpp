@@ -14,6 +14,9 @@ namespace {
 
 using glm::dvec3;
 
+// Cancellation is checked, and progress reported, once per 64 Ki modules.
+constexpr size_t kProgressChunkMask = (size_t{1} << 16) - 1;
+
 struct TurtleState {
   dvec3 position{0, 0, 0};
   dvec3 heading{0, 1, 0};
@@ -66,7 +69,8 @@ dvec3 rotate_about(const dvec3& v, const dvec3& k, double angle_rad) {
 
 }  // namespace
 
-Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g, TurtleStats* stats) {
+Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g, TurtleStats* stats,
+                                  const Progress& progress) {
   using namespace lsys;
   auto t0 = std::chrono::steady_clock::now();
   const TurtleDefaults& d = g.turtle;
@@ -101,6 +105,10 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   size_t i = 0;
   try {
     for (; i < n; ++i) {
+      if ((i & kProgressChunkMask) == 0 && i != 0) {  // between chunks of modules
+        if (progress.cancelled()) return cancelled_diagnostic();
+        progress.report(static_cast<double>(i) / static_cast<double>(n), "turtle");
+      }
       const Module& m = word.modules[i];
       const double* p = word.params_of(m);
       const bool has = m.param_count > 0;
@@ -247,6 +255,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
     stats->modules_read = n;
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
+  progress.report(1, "turtle");
   return sk;
 }
 
@@ -254,17 +263,24 @@ Expected<GrowResult> grow(const lsys::Grammar& g, const lsys::DeriveOptions& opt
                                 const std::string& grammar_path, const std::map<std::string, double>& defines) {
   auto t0 = std::chrono::steady_clock::now();
   GrowResult r;
-  auto word = lsys::derive(g, options, &r.derive);
+  // Shares of the whole for the progress bar: the derivation's last step usually
+  // dominates, the turtle reads every module once.
+  const bool interprets = !g.homomorphism.empty();
+  const double derive_end = interprets ? 0.6 : 0.7, interpret_end = 0.7;
+  lsys::DeriveOptions part = options;
+  part.progress = options.progress.part(0, derive_end);
+  auto word = lsys::derive(g, part, &r.derive);
   if (!word) return word.error();
   r.modules = word->size();
   const lsys::Word* turtle_word = &*word;
   Expected<lsys::Word> interpreted = lsys::Word{};
-  if (!g.homomorphism.empty()) {
-    interpreted = lsys::interpret(g, *word, options, &r.interpret);
+  if (interprets) {
+    part.progress = options.progress.part(derive_end, interpret_end);
+    interpreted = lsys::interpret(g, *word, part, &r.interpret);
     if (!interpreted) return interpreted.error();
     turtle_word = &*interpreted;
   }
-  auto sk = build_skeleton(*turtle_word, g, &r.turtle);
+  auto sk = build_skeleton(*turtle_word, g, &r.turtle, options.progress.part(interpret_end, 1));
   if (!sk) return sk.error();
   r.skeleton = std::move(*sk);
   r.skeleton.source.grammar = grammar_path;

@@ -12,11 +12,13 @@
 // Errors (a Diagnostic naming the module and its index in the word): a position that is
 // no longer finite, a negative radius, a material that is not a non-negative integer,
 // ']' without '['. Nothing recurses: the branch stack is an explicit array.
+// Long words: progress and cancellation through a Progress (core/util/progress.h).
 #pragma once
 
 #include <cstdint>
 
 #include "core/skeleton.h"
+#include "core/util/progress.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 
@@ -29,9 +31,10 @@ struct TurtleStats {
 };
 
 // Interprets `word` (the interpreted word: homomorphism already applied) with the turtle
-// settings of `grammar`.
+// settings of `grammar`. `progress` (progress.h) is checked and told the fraction of the
+// word read every 64 Ki modules; cancelled: cancelled_diagnostic().
 Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& grammar,
-                                        TurtleStats* stats = nullptr);
+                                  TurtleStats* stats = nullptr, const Progress& progress = {});
 
 // Everything `sylva grow` does: derive, interpret, build the skeleton, record the source.
 struct GrowResult {
@@ -45,7 +48,8 @@ struct GrowResult {
 
 // Grows `grammar` (already parsed with its define overrides). `grammar_path` and
 // `defines` are recorded in skeleton.source; seed and steps come from options or the
-// grammar.
+// grammar. options.progress covers the whole: derivation, interpretation and turtle as
+// its parts ("derive", "interpret", "turtle"); cancelled: cancelled_diagnostic().
 Expected<GrowResult> grow(const lsys::Grammar& grammar, const lsys::DeriveOptions& options,
                                 const std::string& grammar_path,
                                 const std::map<std::string, double>& defines);

@@ -26,6 +26,13 @@ struct DeriveFailure {
   std::string message;
 };
 
+// Thrown out of a rewrite when the Progress is cancelled; derive/interpret return
+// cancelled_diagnostic() for it.
+struct DeriveCancelled {};
+
+// Cancellation is checked, and progress reported, once per 64 Ki modules rewritten.
+constexpr size_t kProgressChunkMask = (size_t{1} << 16) - 1;
+
 std::string module_text(const Word& w, size_t i, const SymbolTable& symbols) {
   Word one;
   const Module& m = w.modules[i];
@@ -58,14 +65,19 @@ class Rewriter {
   // Rewrites `in` into `out` (cleared first). `stream` distinguishes steps/passes in the
   // random streams. With `active_in`, only modules flagged there are rewritten (the
   // others are copied) and `active_out` flags the modules produced by a production.
+  // `progress` is checked, and told the fraction of `in` rewritten, every 64 Ki modules.
   void rewrite(const Word& in, Word& out, uint64_t stream, const std::vector<uint8_t>* active_in,
-               std::vector<uint8_t>* active_out) {
+               std::vector<uint8_t>* active_out, const Progress& progress, const char* stage) {
     in_ = &in;
     out_ = &out;
     const bool keyed = !in.lineage.empty();
     if (uses_context_) compute_brackets(in);
     const size_t n = in.size();
     for (size_t i = 0; i < n; ++i) {
+      if ((i & kProgressChunkMask) == 0 && i != 0) {
+        if (progress.cancelled()) throw DeriveCancelled{};
+        progress.report(static_cast<double>(i) / static_cast<double>(n), stage);
+      }
       const Module& m = in.modules[i];
       const Production* chosen = nullptr;
       Rng rng;
@@ -401,21 +413,34 @@ Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStat
   uint64_t peak = cur.capacity_bytes();
   double growth = 2.0;
   int64_t step = 0;
-  if (options.on_step && !options.on_step(0, cur)) return g.error_at({}, "cancelled at step 0");
+  // on_step's "no" is a cancellation too: its Diagnostic has `cancelled` set.
+  auto stopped_at = [&](int64_t at) {
+    Diagnostic d = g.error_at({}, "cancelled at step " + std::to_string(at));
+    d.cancelled = true;
+    return d;
+  };
+  if (options.on_step && !options.on_step(0, cur)) return stopped_at(0);
   try {
     for (step = 1; step <= steps; ++step) {
+      if (options.progress.cancelled()) return cancelled_diagnostic();
       next.clear();
       reserve_for_growth(next, cur.size(), growth, options.max_modules);
       if (g.uses_random) next.lineage.reserve(next.modules.capacity());
       rewriter.current_production = nullptr;
-      rewriter.rewrite(cur, next, static_cast<uint64_t>(step), nullptr, nullptr);
+      // Step k is the k-th equal share of the whole (the last steps are the longest, so
+      // the bar slows down; it never goes back).
+      const Progress step_progress = options.progress.part(static_cast<double>(step - 1) / static_cast<double>(steps),
+                                                           static_cast<double>(step) / static_cast<double>(steps));
+      rewriter.rewrite(cur, next, static_cast<uint64_t>(step), nullptr, nullptr, step_progress, "derive");
       if (g.uses_cut) apply_cut(next);
+      if (step < steps) step_progress.report(1, "derive");  // the last step's 1 is the whole's
       peak = std::max<uint64_t>(peak, cur.capacity_bytes() + next.capacity_bytes());
       growth = cur.size() ? std::max(1.0, static_cast<double>(next.size()) / static_cast<double>(cur.size())) : 2.0;
       std::swap(cur, next);
-      if (options.on_step && !options.on_step(step, cur))
-        return g.error_at({}, "cancelled at step " + std::to_string(step));
+      if (options.on_step && !options.on_step(step, cur)) return stopped_at(step);
     }
+  } catch (const DeriveCancelled&) {
+    return cancelled_diagnostic();
   } catch (const DeriveFailure& f) {
     return failure_diagnostic(g, cur, rewriter, f.message, f.loc, "step", step);
   } catch (const EvalError& e) {
@@ -429,6 +454,7 @@ Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStat
     stats->peak_bytes = peak;
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
+  options.progress.report(1, "derive");
   return cur;
 }
 
@@ -446,15 +472,23 @@ Expected<Word> interpret(const Grammar& g, const Word& word, const DeriveOptions
   int depth = 0;
   try {
     for (depth = 1; depth <= g.max_depth; ++depth) {
+      if (options.progress.cancelled()) return cancelled_diagnostic();
       next.clear();
       next_active.clear();
       rewriter.current_production = nullptr;
-      rewriter.rewrite(cur, next, kHomomorphismStreamBase + static_cast<uint64_t>(depth), &active, &next_active);
+      // Passes until nothing expands: each reports within the pass only (how many
+      // passes there will be is not known), monotone across passes by the share scheme
+      // 1 - 2^-depth.
+      const double first = 1 - std::ldexp(1.0, -(depth - 1)), last = 1 - std::ldexp(1.0, -depth);
+      rewriter.rewrite(cur, next, kHomomorphismStreamBase + static_cast<uint64_t>(depth), &active, &next_active,
+                       options.progress.part(first, last), "interpret");
       bool changed = std::find(next_active.begin(), next_active.end(), 1) != next_active.end();
       std::swap(cur, next);
       std::swap(active, next_active);
       if (!changed) break;
     }
+  } catch (const DeriveCancelled&) {
+    return cancelled_diagnostic();
   } catch (const DeriveFailure& f) {
     return failure_diagnostic(g, cur, rewriter, f.message, f.loc, "interpretation depth", depth);
   } catch (const EvalError& e) {
@@ -470,6 +504,7 @@ Expected<Word> interpret(const Grammar& g, const Word& word, const DeriveOptions
   }
   cur.lineage.clear();
   cur.lineage.shrink_to_fit();
+  options.progress.report(1, "interpret");
   return cur;
 }
 

@@ -23,6 +23,7 @@
 #include <functional>
 #include <optional>
 
+#include "core/util/progress.h"
 #include "lsystem/grammar.h"
 
 namespace sylva::lsys {
@@ -32,9 +33,12 @@ struct DeriveOptions {
   std::optional<uint64_t> seed;     // overrides `seed:`
   uint64_t max_modules = 50'000'000;
   // Called with the word after the axiom (step 0) and after every step; returning false
-  // stops the derivation, which then fails with the message "cancelled at step N". Lets a
-  // front end keep each step's word and cancel a long derivation between steps.
+  // stops the derivation, which then fails with the message "cancelled at step N" (a
+  // Diagnostic with `cancelled` set). Lets a front end keep each step's word.
   std::function<bool(int64_t step, const Word& word)> on_step;
+  // Checked, and told the fraction done, after every step and every 64 Ki modules
+  // rewritten within one (core/util/progress.h); cancelled: cancelled_diagnostic().
+  Progress progress = {};
 };
 
 struct DeriveStats {

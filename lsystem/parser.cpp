@@ -1157,7 +1157,9 @@ std::string Grammar::source_line(uint32_t line) const {
 }
 
 Diagnostic Grammar::error_at(SourceLoc loc, std::string message) const {
-  return Diagnostic{file, loc, std::move(message), source_line(loc.line)};
+  Diagnostic d = diagnostic_at(file, loc, std::move(message));
+  if (loc.line) d.source_line = source_line(loc.line);
+  return d;
 }
 
 Expected<Grammar> parse_grammar(std::string_view text, std::string file, const ParseOptions& options) {
@@ -1175,10 +1177,10 @@ Expected<Grammar> parse_grammar(std::string_view text, std::string file, const P
 
 Expected<Grammar> load_grammar(const std::string& path, const ParseOptions& options) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) return Diagnostic{path, {}, std::string("cannot read the grammar: ") + std::strerror(errno), {}};
+  if (!in) return file_diagnostic(path, std::string("cannot read the grammar: ") + std::strerror(errno), errno);
   std::ostringstream ss;
   ss << in.rdbuf();
-  if (in.bad()) return Diagnostic{path, {}, "cannot read the grammar: read error", {}};
+  if (in.bad()) return file_diagnostic(path, "cannot read the grammar: read error");
   return parse_grammar(ss.str(), path, options);
 }
 
@@ -1198,7 +1200,9 @@ Expected<Word> parse_word(std::string_view text, Grammar& grammar) {
     grammar.homomorphism_by_symbol.resize(nsym);
     return w;
   } catch (const ParseFailure& f) {
-    return Diagnostic{"<word>", f.loc, f.message, std::string(text)};
+    Diagnostic d = diagnostic_at("<word>", f.loc, f.message);
+    if (f.loc.line) d.source_line = std::string(text);
+    return d;
   }
 }
 

@@ -254,8 +254,8 @@ int run_bench_fog(const std::vector<std::string>& args) {
       }
     }
   for (const auto& [path, text] : {std::pair{a.csv, csv.str()}, std::pair{a.cones_csv, cones_csv.str()}}) {
-    if (auto e = write_file_atomically(path, text)) {
-      std::cerr << e->format() << "\n";
+    if (Status e = write_file_atomically(path, text); !e) {
+      std::cerr << e.error().format();
       return kInputError;
     }
   }

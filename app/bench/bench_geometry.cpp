@@ -1,5 +1,5 @@
 // bench_geometry.cpp — `sylva bench geometry INPUT`: error against run time of every way
-// the CPU engine can stand for the plants (issue 3 §5).
+// the CPU engine can stand for the plants (docs/benchmarks.md, "Error against run time").
 //
 // Methods, each a full render_cpu of the same scene, camera and pixel samples (one per
 // pixel, through its centre, so differences are geometry, not sampling noise):
@@ -213,12 +213,12 @@ int run_bench_geometry(const std::vector<std::string>& args) {
   std::printf("%-16s %9.4f %9.4f %12s %12s %9s %12s %12s %10.0f\n", "reference", ref.build_s, ref.time_s, "-", "-", "-",
               "-", "-", ref.result.geometry_bytes / 1024.0);
 
-  if (auto e = write_file_atomically(a.csv, csv_text(rows, a.grammar.grammar, scene, threads))) {
-    std::cerr << e->format() << "\n";
+  if (Status e = write_file_atomically(a.csv, csv_text(rows, a.grammar.grammar, scene, threads)); !e) {
+    std::cerr << e.error().format();
     return kInputError;
   }
-  if (auto e = write_loglog_plot(plot_panels(rows, input_stem(a.grammar.grammar)), a.plot)) {
-    std::cerr << e->format() << "\n";
+  if (Status e = write_loglog_plot(plot_panels(rows, input_stem(a.grammar.grammar)), a.plot); !e) {
+    std::cerr << e.error().format();
     return kInputError;
   }
   std::cerr << "sylva bench geometry: wrote " << a.csv << " and " << a.plot << "\n";

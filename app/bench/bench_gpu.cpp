@@ -1,5 +1,5 @@
 // bench_gpu.cpp — `sylva bench gpu [INPUT...]`: error against GPU time of every way the
-// GL backend can draw the plants (issue 4 §4–5; paper 000 sec. 4, Table 1 and the
+// GL backend can draw the plants (docs/benchmarks.md, "Error against GPU time"; paper 000 sec. 4, Table 1 and the
 // dancing cacti of fig. 8).
 //
 // For each input and image size, each method builds one GlRenderer (render_gl.h), renders
@@ -472,12 +472,12 @@ int run_bench_gpu(const std::vector<std::string>& args) {
     }
   }
 
-  if (auto e = write_file_atomically(a.csv, csv_text(rows, device, gl.context->info(), frames, warmup))) {
-    std::cerr << e->format() << "\n";
+  if (Status e = write_file_atomically(a.csv, csv_text(rows, device, gl.context->info(), frames, warmup)); !e) {
+    std::cerr << e.error().format();
     return kInputError;
   }
-  if (auto e = write_loglog_plot(plot_panels(rows, device), a.plot)) {
-    std::cerr << e->format() << "\n";
+  if (Status e = write_loglog_plot(plot_panels(rows, device), a.plot); !e) {
+    std::cerr << e.error().format();
     return kInputError;
   }
   std::cerr << "sylva bench gpu: wrote " << a.csv << " and " << a.plot << "\n";

@@ -2,9 +2,10 @@
 // `sylva bench gpu`, OpenGL) share, so that their errors are measured the same way: the
 // converged reference, the image metrics, and a few argument and plot helpers.
 //
-// The reference (issue 3 §5): the CPU engine's analytic frusta, relief-mapped with many
-// uniform steps and bisection steps and exact v (RC+R 1024×24 by default), or RC itself
-// when no plant of the scene has a height map (the scene asks for no relief then).
+// The reference (docs/benchmarks.md, "Error against run time"): the CPU engine's
+// analytic frusta, relief-mapped with many uniform steps and bisection steps and exact v
+// (RC+R 1024×24 by default), or RC itself when no plant of the scene has a height map
+// (the scene asks for no relief then).
 #pragma once
 
 #include <cstdint>

@@ -1,7 +1,7 @@
 // bench_raycast.cpp — `sylva bench raycast`: primary rays per second on a preset, sylva's
 // own BVH + analytic frusta against Embree 3 in the same run.
 //
-// Methods (issue 3 §2 and §6), all tracing the same camera rays of the preset's default
+// Methods (docs/benchmarks.md, "Primary rays"), all tracing the same camera rays of the preset's default
 // scene, nearest hit only:
 //   sylva-bvh        sylva's SAH BVH (core/bvh.h) calling intersect_frustum (double)
 //   embree-user      Embree user geometry: Embree's BVH calling the same intersect_frustum

@@ -208,11 +208,10 @@ std::vector<float> draw_loglog_plot(const std::vector<PlotPanel>& panels, const 
   return draw(panels, options, nullptr);
 }
 
-std::optional<FileError> write_loglog_plot(const std::vector<PlotPanel>& panels, const std::string& path,
-                                           const PlotOptions& options) {
+Status write_loglog_plot(const std::vector<PlotPanel>& panels, const std::string& path, const PlotOptions& options) {
   std::string text_error;
   const std::vector<float> pixels = draw(panels, options, &text_error);
-  if (!text_error.empty()) return FileError{path, text_error};
+  if (!text_error.empty()) return file_diagnostic(path, text_error);
   const int n = std::max<int>(1, static_cast<int>(panels.size()));
   return write_image_atomically(path, static_cast<uint32_t>(n * options.panel_width),
                                 static_cast<uint32_t>(options.height), {"R", "G", "B"}, pixels,

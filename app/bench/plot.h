@@ -1,4 +1,4 @@
-// plot.h — log–log error-against-time figures as PNG (issue 3 §5, issue 4 §4): the
+// plot.h — log–log error-against-time figures as PNG (docs/benchmarks.md, docs/plots/): the
 // benchmarks draw their own plots, so a report needs nothing but the sylva binary.
 //
 // A figure is one or more panels side by side; each panel has log10 axes with a tick and
@@ -53,7 +53,7 @@ std::array<float, 3> plot_colour(size_t k);
 std::vector<float> draw_loglog_plot(const std::vector<PlotPanel>& panels, const PlotOptions& options = {});
 
 // Draws and writes the figure to `path` (PNG, or any format OpenImageIO writes).
-std::optional<FileError> write_loglog_plot(const std::vector<PlotPanel>& panels, const std::string& path,
-                                           const PlotOptions& options = {});
+Status write_loglog_plot(const std::vector<PlotPanel>& panels, const std::string& path,
+                         const PlotOptions& options = {});
 
 }  // namespace sylva

@@ -100,51 +100,44 @@ lsys::DeriveOptions derive_options_for(const GrammarArgs& a) {
   return o;
 }
 
-std::optional<std::string> create_parent_folder(const std::string& path) {
+Status create_parent_folder(const std::string& path) {
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (parent.empty()) return std::nullopt;
+  if (parent.empty()) return {};
   std::error_code ec;
   std::filesystem::create_directories(parent, ec);
-  if (ec) return parent.string() + ": error: cannot create the output folder: " + ec.message();
-  return std::nullopt;
+  if (ec) return file_diagnostic(parent.string(), "cannot create the output folder: " + ec.message(), ec.value());
+  return {};
 }
 
-int run_seed_batch(const std::string& subcommand, const SeedRange& range,
-                   const std::function<SeedTaskResult(uint64_t seed)>& task) {
+std::vector<uint64_t> run_seed_tasks(const SeedRange& range, unsigned threads,
+                                     const std::function<SeedTaskResult(uint64_t seed)>& task,
+                                     const std::function<void(uint64_t seed, const SeedTaskResult& result,
+                                                              uint64_t done, uint64_t total)>& on_done,
+                                     const Progress& progress) {
   const uint64_t total = range.count();
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  const unsigned workers = static_cast<unsigned>(std::min<uint64_t>(cores, total));
+  const unsigned workers = static_cast<unsigned>(std::min<uint64_t>(threads ? threads : cores, total));
   std::atomic<uint64_t> next{0};
-  std::mutex print_mutex;
+  std::mutex done_mutex;
   uint64_t done = 0;
   std::vector<uint64_t> failed;
 
   auto work = [&] {
-    for (uint64_t k; (k = next.fetch_add(1)) < total;) {
+    for (uint64_t k; !progress.cancelled() && (k = next.fetch_add(1)) < total;) {
       const uint64_t seed = range.first + k;
       SeedTaskResult r;
       try {
         r = task(seed);
       } catch (const std::bad_alloc&) {
-        r.error = "out of memory";
+        r.error = file_diagnostic("", "out of memory");
       } catch (const std::exception& e) {
-        r.error = std::string("internal error: ") + e.what();
+        r.error = file_diagnostic("", std::string("internal error: ") + e.what());
       }
-      std::lock_guard<std::mutex> lock(print_mutex);
-      std::cerr << r.warning;
+      std::lock_guard<std::mutex> lock(done_mutex);
       ++done;
-      std::string line = "sylva " + subcommand + ": [" + std::to_string(done) + "/" + std::to_string(total) +
-                         "] seed " + std::to_string(seed) + ": ";
-      if (r.error) {
-        failed.push_back(seed);
-        std::string message = *r.error;
-        while (!message.empty() && message.back() == '\n') message.pop_back();
-        line += "error: " + message;
-      } else {
-        line += "ok";
-        if (!r.summary.empty()) std::cout << r.summary << "\n" << std::flush;
-      }
-      std::cerr << line << "\n" << std::flush;
+      if (r.error) failed.push_back(seed);
+      on_done(seed, r, done, total);
+      progress.report(static_cast<double>(done) / static_cast<double>(total), "batch");
     }
   };
   std::vector<std::thread> pool;
@@ -152,8 +145,31 @@ int run_seed_batch(const std::string& subcommand, const SeedRange& range,
   for (unsigned i = 1; i < workers; ++i) pool.emplace_back(work);
   work();
   for (std::thread& t : pool) t.join();
-
   std::sort(failed.begin(), failed.end());
+  return failed;
+}
+
+int run_seed_batch(const std::string& subcommand, const SeedRange& range,
+                   const std::function<SeedTaskResult(uint64_t seed)>& task) {
+  const uint64_t total = range.count();
+  const std::vector<uint64_t> failed = run_seed_tasks(
+      range, 0, task, [&](uint64_t seed, const SeedTaskResult& r, uint64_t done, uint64_t) {
+        std::cerr << r.warning;
+        std::string line = "sylva " + subcommand + ": [" + std::to_string(done) + "/" + std::to_string(total) +
+                           "] seed " + std::to_string(seed) + ": ";
+        if (r.error) {
+          // The diagnostic as the single command prints it, after the seed (its place
+          // prefix, if any, included; a message without place reads "error: MESSAGE").
+          std::string message = r.error->format();
+          while (!message.empty() && message.back() == '\n') message.pop_back();
+          line += r.error->file.empty() && r.error->loc.line == 0 ? message : "error: " + message;
+        } else {
+          line += "ok";
+          if (!r.summary.empty()) std::cout << r.summary << "\n" << std::flush;
+        }
+        std::cerr << line << "\n" << std::flush;
+      });
+
   std::cerr << "sylva " << subcommand << ": " << total << (total == 1 ? " seed, " : " seeds, ")
             << (total - failed.size()) << " written, " << failed.size() << " failed";
   for (size_t i = 0; i < failed.size() && i < 100; ++i) std::cerr << (i ? ", " : ": seed ") << failed[i];

@@ -1,7 +1,7 @@
-// batch.h — many seeds of one grammar in one command (issue 5 §3): `--seed A..B` with an
-// output pattern `-o out/elm_{seed}.glb`, one derivation per task on a pool of threads
-// (one per core), progress on stderr, and a failure on one seed reported by its seed
-// without stopping or damaging the others. Shared by `sylva grow` and `sylva export`,
+// batch.h — many seeds of one grammar in one command (cli.md, `--seed A..B`): an output
+// pattern `-o out/elm_{seed}.glb`, one derivation per task on a pool of threads (one per
+// core), progress on stderr, and a failure on one seed reported by its seed without
+// stopping or damaging the others. Shared by `sylva grow` and `sylva export`,
 // together with the grammar loading both do.
 #pragma once
 
@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "app/cli/cli.h"
+#include "core/util/diagnostic.h"
+#include "core/util/progress.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 
@@ -50,23 +52,35 @@ std::optional<lsys::Grammar> load_grammar_for(const GrammarArgs& args, int* exit
 // The derivation options of the grammar flags (steps, seed, max modules).
 lsys::DeriveOptions derive_options_for(const GrammarArgs& args);
 
-// What one seed's task reports: an error (the message, without the seed), or a line of
-// summary for stdout.
+// What one seed's task reports: an error (printed after the seed), or a line of summary
+// for stdout.
 struct SeedTaskResult {
-  std::optional<std::string> error;
+  std::optional<Diagnostic> error;
   std::string summary;  // printed on stdout when not empty (one line, no newline)
   std::string warning;  // printed on stderr before the progress line when not empty
 };
 
-// Runs task(seed) for every seed of `range` on min(cores, seeds) threads. Each finished
-// seed prints "sylva SUBCOMMAND: [k/N] seed S: ok|error: ..." on stderr; the end prints
-// a tally naming the failed seeds. An exception in a task counts as that seed's failure.
-// Returns kOk when every seed succeeded, kInputError otherwise.
+// Runs task(seed) for every seed of `range` on `threads` threads (0: min(cores, seeds)),
+// without printing: on_done(seed, result, done, total) is called once per seed as it
+// finishes, serialised, with done counting 1..total. An exception in a task becomes
+// that seed's error ("out of memory", "internal error: ..."). `progress` is told
+// done/total ("batch") and checked before each seed starts; once cancelled no new seed
+// starts (those running finish). Returns the seeds that failed, in increasing order.
+std::vector<uint64_t> run_seed_tasks(const SeedRange& range, unsigned threads,
+                                     const std::function<SeedTaskResult(uint64_t seed)>& task,
+                                     const std::function<void(uint64_t seed, const SeedTaskResult& result,
+                                                              uint64_t done, uint64_t total)>& on_done,
+                                     const Progress& progress = {});
+
+// run_seed_tasks on every core, printing each finished seed as
+// "sylva SUBCOMMAND: [k/N] seed S: ok|error: ..." on stderr (summaries on stdout) and at
+// the end a tally naming the failed seeds. Returns kOk when every seed succeeded,
+// kInputError otherwise.
 int run_seed_batch(const std::string& subcommand, const SeedRange& range,
                    const std::function<SeedTaskResult(uint64_t seed)>& task);
 
 // Creates the folder that will hold `path` (for output patterns like out/{seed}.glb).
-// Returns an error message on failure.
-std::optional<std::string> create_parent_folder(const std::string& path);
+// The error names the folder.
+Status create_parent_folder(const std::string& path);
 
 }  // namespace sylva::cli

@@ -1,5 +1,5 @@
 // cli_export.cpp — `sylva export INPUT -o FILE.gltf|FILE.glb [--mesh] [--segments-around N]`
-// (cli.md, issue 5): a grammar, skeleton or scene to glTF 2.0 with the skeleton in the
+// (cli.md): a grammar, skeleton or scene to glTF 2.0 with the skeleton in the
 // node extras (core/gltf_export.h); `--seed A..B` with `-o out/p_{seed}.glb` exports a
 // batch in parallel (app/batch.h). The mesh's bark comes from each plant of a scene, or
 // for a grammar or skeleton from the --bark-* flags (scene.md's bark keys as flags).
@@ -180,37 +180,37 @@ int run_export(const std::vector<std::string>& raw_args) {
                      " writes one file per seed: -o must hold {seed}, e.g. -o out/plant_{seed}.glb"};
 
   // The textures are checked once, before any plant grows or any file is written.
-  if (auto err = check_bark_textures(bark)) {
-    std::cerr << *err << "\n";
+  if (Status textures = check_bark_textures(bark); !textures) {
+    std::cerr << textures.error().format();
     return kInputError;
   }
 
   if (kind == InputKind::skeleton) {
-    SkeletonReadResult read = read_skeleton_file(input);
-    if (!read.skeleton) {
-      std::cerr << (read.error ? read.error->format() : input + ": error: unreadable skeleton") << "\n";
+    Expected<Skeleton> read = read_skeleton_file(input);
+    if (!read) {
+      std::cerr << read.error().format();
       return kInputError;
     }
     GltfPlant plant;
     plant.name = plant_name(input);
-    plant.skeleton = std::move(*read.skeleton);
+    plant.skeleton = std::move(*read);
     plant.bark = bark;
-    if (auto err = export_gltf({plant}, a.output, options)) {
-      std::cerr << *err << "\n";
+    if (Status exported = export_gltf({plant}, a.output, options); !exported) {
+      std::cerr << exported.error().format();
       return kInputError;
     }
     return kOk;
   }
   if (kind == InputKind::scene) {
-    SceneReadResult read = read_scene_file(input);
-    if (!read.scene) {
-      std::cerr << (read.error ? read.error->format() : input + ": error: unreadable scene") << "\n";
+    Expected<Scene> read = read_scene_file(input);
+    if (!read) {
+      std::cerr << read.error().format();
       return kInputError;
     }
-    Scene& scene = *read.scene;
-    if (auto err = grow_scene_plants(scene, a.max_modules)) {
-      std::cerr << *err;
-      if (!err->empty() && err->back() != '\n') std::cerr << "\n";
+    Scene& scene = *read;
+    // A plant's grammar error: the grammar's place, and a note at the scene key naming it.
+    if (Status grown = grow_scene_plants(scene, a.max_modules); !grown) {
+      std::cerr << grown.error().format();
       return kInputError;
     }
     std::vector<GltfPlant> plants;
@@ -224,8 +224,8 @@ int run_export(const std::vector<std::string>& raw_args) {
       p.bark = sp.bark;
       plants.push_back(std::move(p));
     }
-    if (auto err = export_gltf(plants, a.output, options)) {
-      std::cerr << *err << "\n";
+    if (Status exported = export_gltf(plants, a.output, options); !exported) {
+      std::cerr << exported.error().format();
       return kInputError;
     }
     return kOk;
@@ -234,10 +234,10 @@ int run_export(const std::vector<std::string>& raw_args) {
   int code = kOk;
   auto g = load_grammar_for(a, &code);
   if (!g) return code;
-  // Grows with `one`'s seed and exports to `output`; the error text or nothing.
-  auto export_one = [&](const GrammarArgs& one, const std::string& output) -> std::optional<std::string> {
+  // Grows with `one`'s seed and exports to `output`.
+  auto export_one = [&](const GrammarArgs& one, const std::string& output) -> Status {
     auto grown = grow(*g, derive_options_for(one), one.grammar, one.defines);
-    if (!grown) return grown.error().format();
+    if (!grown) return std::move(grown.error());
     GltfPlant plant;
     plant.name = plant_name(input);
     plant.skeleton = std::move(grown->skeleton);
@@ -245,22 +245,22 @@ int run_export(const std::vector<std::string>& raw_args) {
     return export_gltf({plant}, output, options);
   };
   if (range) {
-    if (auto err = create_parent_folder(expand_seed_pattern(a.output, range->first))) {
-      std::cerr << *err << "\n";
+    if (Status folder = create_parent_folder(expand_seed_pattern(a.output, range->first)); !folder) {
+      std::cerr << folder.error().format();
       return kInputError;
     }
     return run_seed_batch("export", *range, [&](uint64_t seed) {
       GrammarArgs one = a;
       one.seed = seed;
       SeedTaskResult r;
-      r.error = export_one(one, expand_seed_pattern(a.output, seed));
+      if (Status exported = export_one(one, expand_seed_pattern(a.output, seed)); !exported)
+        r.error = std::move(exported.error());
       return r;
     });
   }
   const std::string output = has_seed_placeholder(a.output) && a.seed ? expand_seed_pattern(a.output, *a.seed) : a.output;
-  if (auto err = export_one(a, output)) {
-    std::cerr << *err;
-    if (!err->empty() && err->back() != '\n') std::cerr << "\n";
+  if (Status exported = export_one(a, output); !exported) {
+    std::cerr << exported.error().format();
     return kInputError;
   }
   return kOk;

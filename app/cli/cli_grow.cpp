@@ -80,7 +80,7 @@ namespace {
 // Grows one plant and writes it to `output`: the text grow prints on failure (a
 // diagnostic) or, on success, its summary line and any warning.
 struct GrowOutcome {
-  std::optional<std::string> error;  // as printed on stderr, ending in a newline
+  std::optional<Diagnostic> error;   // printed on stderr (format())
   std::string warning;               // stderr text, may be empty
   std::string summary;               // the stdout summary line, without newline
 };
@@ -89,7 +89,7 @@ GrowOutcome grow_to_file(const lsys::Grammar& g, const GrammarArgs& a, const std
   GrowOutcome out;
   auto result = grow(g, derive_options_for(a), a.grammar, a.defines);
   if (!result) {
-    out.error = result.error().format();
+    out.error = std::move(result.error());
     return out;
   }
   const Skeleton& sk = result->skeleton;
@@ -97,8 +97,8 @@ GrowOutcome grow_to_file(const lsys::Grammar& g, const GrammarArgs& a, const std
     out.warning = a.grammar + ": warning: the interpretation stopped at maximum depth " + std::to_string(g.max_depth) +
                   " with " + std::to_string(result->interpret.still_expandable) + " modules still expandable\n";
   std::string json = write_skeleton_json(sk);
-  if (auto err = write_file_atomically(output, json)) {
-    out.error = err->format() + "\n";
+  if (Status written = write_file_atomically(output, json); !written) {
+    out.error = std::move(written.error());
     return out;
   }
   double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
@@ -137,8 +137,8 @@ int run_grow(const std::vector<std::string>& raw_args) {
   auto g = load_grammar_for(a, &code);
   if (!g) return code;
   if (range) {
-    if (auto err = create_parent_folder(expand_seed_pattern(a.output, range->first))) {
-      std::cerr << *err << "\n";
+    if (Status folder = create_parent_folder(expand_seed_pattern(a.output, range->first)); !folder) {
+      std::cerr << folder.error().format();
       return kInputError;
     }
     return run_seed_batch("grow", *range, [&](uint64_t seed) {
@@ -156,7 +156,7 @@ int run_grow(const std::vector<std::string>& raw_args) {
                                           ? expand_seed_pattern(a.output, *a.seed) : a.output);
   std::cerr << o.warning;
   if (o.error) {
-    std::cerr << *o.error;
+    std::cerr << o.error->format();
     return kInputError;
   }
   std::cout << o.summary << "\n";

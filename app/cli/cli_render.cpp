@@ -11,6 +11,7 @@
 #include <iostream>
 
 #include "app/cli/cli.h"
+#include "app/cli/progress_bar.h"
 #include "app/cli/render_input.h"
 #include "core/render_output.h"
 #include "core/util/image_io.h"
@@ -275,8 +276,8 @@ int run_render(const std::vector<std::string>& args) {
   options.aovs = a.aovs;
   options.geometry = a.geometry;
   options.fog = a.fog;
-  options.cancel = &g_interrupted;
-  options.progress = ::isatty(STDERR_FILENO) == 1;
+  ProgressBar bar("sylva render", ::isatty(STDERR_FILENO) == 1);
+  options.progress = bar.progress(&g_interrupted);
   // The backend (cli.md): gl, or for auto OpenGL where a context can be made and the scene
   // needs nothing the GL backend lacks; otherwise the CPU, saying why.
   std::string backend_name = "CPU ray caster";
@@ -318,6 +319,7 @@ int run_render(const std::vector<std::string>& args) {
     }
   }
   RenderResult result = gl_result ? std::move(*gl_result) : render_cpu(scene, options);
+  bar.finish();
   if (result.cancelled || g_interrupted.load()) {
     std::cerr << "sylva render: interrupted; nothing written\n";
     return kInterrupted;
@@ -325,13 +327,13 @@ int run_render(const std::vector<std::string>& args) {
   passes.insert(passes.end(), result.passes.begin(), result.passes.end());
 
   start = std::chrono::steady_clock::now();
-  ImageWriteResult written = write_render(output, result.image);
-  if (written.error) {
-    std::cerr << written.error->format() << "\n";
+  Expected<std::vector<std::string>> written = write_render(output, result.image);
+  if (!written) {
+    std::cerr << written.error().format();
     return kInputError;
   }
   std::string files;
-  for (const std::string& f : written.written) files += (files.empty() ? "" : ", ") + f;
+  for (const std::string& f : *written) files += (files.empty() ? "" : ", ") + f;
   passes.push_back({"write", seconds_since(start), files});
 
   if (a.verbose) {

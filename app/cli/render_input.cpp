@@ -40,33 +40,33 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
   auto start = std::chrono::steady_clock::now();
   Scene scene;
   if (is_scene) {
-    SceneReadResult read = read_scene_file(input);
-    if (read.error) {
-      std::cerr << read.error->format() << "\n";
+    Expected<Scene> read = read_scene_file(input);
+    if (!read) {
+      std::cerr << read.error().format();
       return kInputError;
     }
-    scene = std::move(*read.scene);
+    scene = std::move(*read);
     passes.push_back({"read scene", seconds_since(start), ""});
     start = std::chrono::steady_clock::now();
-    if (auto error = grow_scene_plants(scene, grammar.max_modules)) {
-      std::cerr << *error;
-      if (!error->empty() && error->back() != '\n') std::cerr << "\n";
+    // A plant's grammar error: the grammar's place, and a note at the scene key naming it.
+    if (Status grown = grow_scene_plants(scene, grammar.max_modules); !grown) {
+      std::cerr << grown.error().format();
       return kInputError;
     }
     passes.push_back({"grow", seconds_since(start), std::to_string(scene.plants.size()) + " plants"});
   } else if (is_gltf) {
     // A file written by `sylva export`: its skeletons come back exactly from node extras.
-    GltfImportResult imported = import_gltf_skeletons(input);
-    if (imported.error) {
-      std::cerr << *imported.error << "\n";
+    Expected<std::vector<GltfPlant>> imported = import_gltf_skeletons(input);
+    if (!imported) {
+      std::cerr << imported.error().format();
       return kInputError;
     }
     const uint32_t w = width.value_or(1024), h = height.value_or(768);
-    scene = default_scene_for(imported.plants.front().skeleton, w, h);
+    scene = default_scene_for(imported->front().skeleton, w, h);
     scene.plants.clear();
     glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
     double lowest = 0;
-    for (GltfPlant& p : imported.plants) {
+    for (GltfPlant& p : *imported) {
       ScenePlant plant;
       plant.skeleton = std::move(p.skeleton);
       plant.position = {p.position_m[0], p.position_m[1], p.position_m[2]};
@@ -85,12 +85,12 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
   } else {
     Skeleton skeleton;
     if (is_skeleton) {
-      SkeletonReadResult read = read_skeleton_file(input);
-      if (read.error) {
-        std::cerr << read.error->format() << "\n";
+      Expected<Skeleton> read = read_skeleton_file(input);
+      if (!read) {
+        std::cerr << read.error().format();
         return kInputError;
       }
-      skeleton = std::move(*read.skeleton);
+      skeleton = std::move(*read);
       passes.push_back({"read skeleton", seconds_since(start), ""});
     } else {
       lsys::ParseOptions po;

@@ -1,4 +1,4 @@
-// sylva_module.cpp — the `sylva` Python module (issue 5, sec. 2): grammars, growth,
+// sylva_module.cpp — the `sylva` Python module (app/python/README.md): grammars, growth,
 // skeletons as zero-copy numpy views, glTF export and the CPU renderer.
 //
 // Boundaries, as everywhere in sylva: errors are values in C++ and become Python
@@ -61,14 +61,14 @@ std::string chomp(std::string text) {
   return text;
 }
 
-// Raises OSError from a FileError (FileNotFoundError etc. by errno, as open() would).
-[[noreturn]] void throw_file_error(const FileError& error) {
+// Raises OSError from a file's Diagnostic (FileNotFoundError etc. by errno, as open() would).
+[[noreturn]] void throw_file_error(const Diagnostic& error) {
+  const std::string text = chomp(error.format());
   if (error.error_number != 0) {
-    py::object exc = py::reinterpret_borrow<py::object>(PyExc_OSError)(error.error_number, error.format(),
-                                                                        error.path);
+    py::object exc = py::reinterpret_borrow<py::object>(PyExc_OSError)(error.error_number, text, error.file);
     PyErr_SetObject(reinterpret_cast<PyObject*>(Py_TYPE(exc.ptr())), exc.ptr());
   } else {
-    PyErr_SetString(PyExc_OSError, error.format().c_str());
+    PyErr_SetString(PyExc_OSError, text.c_str());
   }
   throw py::error_already_set();
 }
@@ -81,7 +81,7 @@ std::string path_string(const std::filesystem::path& path) { return path.string(
 GrammarFailure::GrammarFailure(sylva::Diagnostic d)
     : std::runtime_error(d.message), diagnostic(std::move(d)) {}
 
-SkeletonFailure::SkeletonFailure(SkeletonError e)
+SkeletonFailure::SkeletonFailure(sylva::Diagnostic e)
     : std::runtime_error(e.message), error(std::move(e)) {}
 
 std::optional<uint64_t> seed_from_python(const py::object& value) {
@@ -145,9 +145,9 @@ PyGrammar::PyGrammar(std::string grammar_text, std::string grammar_file)
 }
 
 PyGrammar PyGrammar::from_file(const std::string& path) {
-  FileReadResult read = read_text_file(path);
-  if (read.error) throw_file_error(*read.error);
-  return PyGrammar(std::move(*read.contents), path);
+  Expected<std::string> read = read_text_file(path);
+  if (!read) throw_file_error(read.error());
+  return PyGrammar(std::move(*read), path);
 }
 
 std::shared_ptr<const lsys::Grammar> PyGrammar::with_defines(const std::map<std::string, double>& defines) const {
@@ -319,26 +319,26 @@ py::array_t<ChainRecord> skeleton_chains(const Skeleton& sk) {
 }
 
 Skeleton skeleton_from_json(const std::string& text, const std::string& file) {
-  SkeletonReadResult read = read_skeleton_json(text, file);
-  if (!read.skeleton) throw SkeletonFailure(read.error.value_or(SkeletonError{file, 0, 0, "unreadable skeleton"}));
-  return std::move(*read.skeleton);
+  Expected<Skeleton> read = read_skeleton_json(text, file);
+  if (!read) throw SkeletonFailure(std::move(read.error()));
+  return std::move(*read);
 }
 
 Skeleton skeleton_from_file(const std::filesystem::path& path_in) {
   const std::string path = path_string(path_in);
-  FileReadResult read = read_text_file(path);
-  if (read.error) throw_file_error(*read.error);
-  return skeleton_from_json(*read.contents, path);
+  Expected<std::string> read = read_text_file(path);
+  if (!read) throw_file_error(read.error());
+  return skeleton_from_json(*read, path);
 }
 
 void skeleton_save(const Skeleton& sk, const std::filesystem::path& path) {
   const std::string json = write_skeleton_json(sk);
-  std::optional<FileError> error;
+  Status written;
   {
     py::gil_scoped_release release;
-    error = write_file_atomically(path_string(path), json);
+    written = write_file_atomically(path_string(path), json);
   }
-  if (error) throw_file_error(*error);
+  if (!written) throw_file_error(written.error());
 }
 
 std::string skeleton_repr(const Skeleton& sk) {
@@ -457,12 +457,12 @@ void python_export_gltf(const py::object& plants, const std::filesystem::path& p
   options.mesh = mesh;
   options.segments_around = segments_around;
   options.instancing = instancing;
-  std::optional<std::string> error;
+  Status exported;
   {
     py::gil_scoped_release release;
-    error = export_gltf(gltf_plants, path_string(path), options);
+    exported = export_gltf(gltf_plants, path_string(path), options);
   }
-  if (error) throw std::runtime_error(*error);
+  if (!exported) throw std::runtime_error(chomp(exported.error().format()));
 }
 
 
@@ -525,10 +525,11 @@ void bind_module(py::module_& m) {
       const sylva::Diagnostic& d = e.diagnostic;
       // A -D name the grammar lacks has no place: the message alone reads best.
       const std::string text = d.loc.line == 0 ? d.file + ": error: " + d.message : chomp(d.format());
-      set_located_error(g_grammar_error, text, d.message, d.file, d.loc.line, d.loc.column, d.source_line);
+      set_located_error(g_grammar_error, text, d.message, d.file, d.loc.line, d.loc.column,
+                        d.source_line.value_or(""));
     } catch (const SkeletonFailure& e) {
-      const SkeletonError& s = e.error;
-      set_located_error(g_skeleton_error, s.format(), s.message, s.file, s.line, s.column, "");
+      const sylva::Diagnostic& s = e.error;
+      set_located_error(g_skeleton_error, chomp(s.format()), s.message, s.file, s.loc.line, s.loc.column, "");
     }
   });
 

@@ -28,8 +28,8 @@ struct GrammarFailure : std::runtime_error {
 
 // Thrown for an invalid skeleton document; becomes sylva.SkeletonError.
 struct SkeletonFailure : std::runtime_error {
-  explicit SkeletonFailure(SkeletonError e);
-  SkeletonError error;
+  explicit SkeletonFailure(sylva::Diagnostic e);
+  sylva::Diagnostic error;
 };
 
 // The Python Grammar: the source text (re-parsed when defines are given, since -D

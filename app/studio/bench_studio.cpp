@@ -150,7 +150,7 @@ int run_bench_studio(const std::vector<std::string>& args) {
     char dir[] = "/tmp/sylva-bench-studio-XXXXXX";
     if (!::mkdtemp(dir)) return cli::kInternalError;
     const std::string path = std::string(dir) + "/fibonacci.lsys";
-    if (write_file_atomically(path, "derivation length: 34\naxiom: A\nproductions:\nA -> AB\nB -> A\n"))
+    if (!write_file_atomically(path, "derivation length: 34\naxiom: A\nproductions:\nA -> AB\nB -> A\n").ok())
       return cli::kInternalError;
     StudioOptions o;
     o.presets_dir = presets;

@@ -31,9 +31,9 @@ std::optional<std::string> restorable_autosave(const std::string& path, const st
   const FileStamp as = stamp_of(a), fs = stamp_of(path);
   if (as.size < 0) return std::nullopt;
   if (fs.size >= 0 && as.mtime_ns < fs.mtime_ns) return std::nullopt;
-  FileReadResult r = read_text_file(a);
-  if (!r.contents || *r.contents == file_text) return std::nullopt;
-  return r.contents;
+  Expected<std::string> r = read_text_file(a);
+  if (!r || *r == file_text) return std::nullopt;
+  return std::move(*r);
 }
 
 void remove_autosave(const std::string& path) { ::unlink(autosave_path(path).c_str()); }

@@ -277,8 +277,13 @@ std::optional<std::string> GlViewport::write_image(const Scene& scene, const Ren
           r = own.get();
         }
         RenderResult rendered = r->render(scene);
-        ImageWriteResult written = write_render(path, rendered.image);
-        done.set_value(written.error ? std::optional<std::string>(written.error->format()) : std::nullopt);
+        Expected<std::vector<std::string>> written = write_render(path, rendered.image);
+        std::optional<std::string> error;
+        if (!written) {
+          error = written.error().format();
+          error->pop_back();  // the one line, without format()'s newline
+        }
+        done.set_value(std::move(error));
       } catch (const std::exception& e) {
         done.set_value(std::string(e.what()));
       }

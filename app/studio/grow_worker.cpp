@@ -148,7 +148,7 @@ GrowOutcome GrowWorker::grow(const GrowRequest& request, uint64_t gen, bool* can
     out.worker_seconds = seconds_since(start);
     return out;
   };
-  if (request.plants.empty()) return fail(Diagnostic{request.file, {}, "no plant to grow", ""});
+  if (request.plants.empty()) return fail(file_diagnostic(request.file, "no plant to grow"));
 
   // plants[0]: from the cache when the text, defines, seed and limit are the same.
   Cache& cache = *cache_;

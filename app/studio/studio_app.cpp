@@ -18,6 +18,14 @@ namespace sylva::studio {
 
 namespace {
 
+// A one-line Diagnostic (a file's error: no source line, no notes) as the status bar and
+// the message box show it, without format()'s final newline.
+std::string one_line(const Diagnostic& d) {
+  std::string text = d.format();
+  if (!text.empty() && text.back() == '\n') text.pop_back();
+  return text;
+}
+
 using Clock = std::chrono::steady_clock;
 
 bool ends_with(const std::string& s, const std::string& suffix) {
@@ -90,9 +98,9 @@ void StudioApp::keep(const std::string& name) { rects_[name] = WidgetRect{ImGui:
 
 std::optional<std::string> StudioApp::open(const std::string& path) {
   if (ends_with(path, ".scene.json")) {
-    SceneReadResult read = read_scene_file(path);
-    if (!read.scene) return read.error ? read.error->format() : path + ": error: unreadable scene";
-    Scene scene = std::move(*read.scene);
+    Expected<Scene> read = read_scene_file(path);
+    if (!read) return one_line(read.error());
+    Scene scene = std::move(*read);
     // The editor shows the first plant's grammar; plants from other grammars (or ready
     // skeletons) grow once, here.
     std::string grammar;
@@ -105,17 +113,18 @@ std::optional<std::string> StudioApp::open(const std::string& path) {
     Scene others = scene;
     for (ScenePlant& p : others.plants)
       if (p.grammar == grammar) p.skeleton = Skeleton{};  // not grown here
-    if (auto err = grow_scene_plants(others, options_.max_modules)) return *err;
+    // A plant's grammar error: the grammar's place, and a note at the scene key naming it.
+    if (Status grown = grow_scene_plants(others, options_.max_modules); !grown) return grown.error().format();
     for (size_t i = 0; i < scene.plants.size(); ++i)
       if (scene.plants[i].grammar != grammar) scene.plants[i].skeleton = std::move(others.plants[i].skeleton);
-    FileReadResult r = read_text_file(grammar);
-    if (!r.contents) return r.error->format();
-    load_text(grammar, std::move(*r.contents), path, std::move(scene));
+    Expected<std::string> r = read_text_file(grammar);
+    if (!r) return one_line(r.error());
+    load_text(grammar, std::move(*r), path, std::move(scene));
     return std::nullopt;
   }
-  FileReadResult r = read_text_file(path);
-  if (!r.contents) return r.error->format();
-  load_text(path, std::move(*r.contents), "", Scene{});
+  Expected<std::string> r = read_text_file(path);
+  if (!r) return one_line(r.error());
+  load_text(path, std::move(*r), "", Scene{});
   return std::nullopt;
 }
 
@@ -162,8 +171,8 @@ std::optional<std::string> StudioApp::save() {
     dialog_path_ = "untitled.lsys";
     return std::nullopt;
   }
-  if (auto err = write_file_atomically(path_, text_)) {
-    status_ = err->format();
+  if (Status written = write_file_atomically(path_, text_); !written) {
+    status_ = one_line(written.error());
     return status_;
   }
   saved_text_ = text_;
@@ -389,7 +398,7 @@ void StudioApp::autosave(double now) {
   last_autosave_ = now;
   if (!dirty() || text_ == autosaved_text_) return;
   const std::string target = autosave_path(path_.empty() ? "untitled.lsys" : path_);
-  if (auto err = write_file_atomically(target, text_)) status_ = "autosave: " + err->format();
+  if (Status written = write_file_atomically(target, text_); !written) status_ = "autosave: " + one_line(written.error());
   else autosaved_text_ = text_;
 }
 
@@ -399,11 +408,11 @@ void StudioApp::watch_file(double now) {
   const FileStamp s = stamp_of(path_);
   if (s == disk_stamp_) return;
   disk_stamp_ = s;
-  FileReadResult r = read_text_file(path_);
-  if (!r.contents || *r.contents == saved_text_) return;
+  Expected<std::string> r = read_text_file(path_);
+  if (!r || *r == saved_text_) return;
   if (!dirty()) {
-    saved_text_ = *r.contents;
-    set_text(*r.contents);
+    saved_text_ = *r;
+    set_text(*r);
     autosaved_text_ = text_;
     snapshot();
     submit_regrow();
@@ -429,13 +438,14 @@ std::optional<std::string> StudioApp::export_gltf_file(const std::string& path, 
   }
   GltfExportOptions o;
   o.mesh = mesh;
-  return export_gltf(plants, path, o);
+  if (Status exported = export_gltf(plants, path, o); !exported) return one_line(exported.error());
+  return std::nullopt;
 }
 
 std::optional<std::string> StudioApp::export_skeleton_file(const std::string& path) {
   if (!plant_) return std::string("no plant to export yet");
   const Skeleton& sk = *scene_.plants[edited_plants_.front()].skeleton;
-  if (auto err = write_file_atomically(path, write_skeleton_json(sk))) return err->format();
+  if (Status written = write_file_atomically(path, write_skeleton_json(sk)); !written) return one_line(written.error());
   return std::nullopt;
 }
 
@@ -531,10 +541,10 @@ void StudioApp::draw_menu() {
     if (ImGui::MenuItem("Save as...", "Ctrl+Shift+S"))
       dialog_ = FileDialog::save_as, dialog_path_ = path_.empty() ? "untitled.lsys" : path_;
     if (ImGui::MenuItem("Reload from disk", nullptr, false, !path_.empty())) {
-      FileReadResult r = read_text_file(path_);
-      if (r.contents) {
-        saved_text_ = *r.contents;
-        set_text(*r.contents);
+      Expected<std::string> r = read_text_file(path_);
+      if (r) {
+        saved_text_ = *r;
+        set_text(*r);
         snapshot();
         submit_regrow();
       }
@@ -985,10 +995,10 @@ void StudioApp::draw_modals() {
     if (ImGui::BeginPopupModal("Changed on disk", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
       ImGui::Text("%s was changed by another program, and has unsaved edits here.", display_name().c_str());
       if (ImGui::Button("Reload (lose my edits)")) {
-        FileReadResult r = read_text_file(path_);
-        if (r.contents) {
-          saved_text_ = *r.contents;
-          set_text(*r.contents);
+        Expected<std::string> r = read_text_file(path_);
+        if (r) {
+          saved_text_ = *r;
+          set_text(*r);
           snapshot();
           submit_regrow();
         }
@@ -998,8 +1008,8 @@ void StudioApp::draw_modals() {
       keep("button:Reload");
       ImGui::SameLine();
       if (ImGui::Button("Keep mine")) {
-        FileReadResult r = read_text_file(path_);
-        if (r.contents) saved_text_ = *r.contents;  // the disk's text is what "saved" means now
+        Expected<std::string> r = read_text_file(path_);
+        if (r) saved_text_ = *r;  // the disk's text is what "saved" means now
         external_prompt_ = false;
         ImGui::CloseCurrentPopup();
       }

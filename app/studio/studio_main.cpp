@@ -110,9 +110,13 @@ std::optional<std::string> write_screenshot(const std::string& path, int w, int 
     for (int x = 0; x < w; ++x)
       for (int k = 0; k < 3; ++k)
         rgb[(static_cast<size_t>(y) * w + x) * 3 + k] = px[(static_cast<size_t>(h - 1 - y) * w + x) * 4 + k] / 255.0f;
-  if (auto err = write_image_atomically(path, static_cast<uint32_t>(w), static_cast<uint32_t>(h), {"R", "G", "B"}, rgb,
-                                        {ChannelFormat::uint8}, true))
-    return err->format();
+  if (Status written = write_image_atomically(path, static_cast<uint32_t>(w), static_cast<uint32_t>(h), {"R", "G", "B"},
+                                              rgb, {ChannelFormat::uint8}, true);
+      !written) {
+    std::string text = written.error().format();
+    text.pop_back();  // the one line, without format()'s newline
+    return text;
+  }
   return std::nullopt;
 }
 

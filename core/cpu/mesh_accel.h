@@ -1,4 +1,4 @@
-// mesh_accel.h — the polygon baseline traced by the same CPU engine (issue 3 §3): a
+// mesh_accel.h — the polygon baseline traced by the same CPU engine (paper 000 sec. 4): a
 // TriangleMesh (tessellate.h: the paper's GS level m, or GS+R when displaced) in Embree 3
 // triangle geometry, as a SceneTracer (surface.h), so the renderer shades, textures and
 // measures it exactly as it does the analytic frusta.

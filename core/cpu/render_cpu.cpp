@@ -13,12 +13,9 @@
 #include "core/cpu/texture.h"
 #include "core/util/math.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <glm/geometric.hpp>
 #include <limits>
 #include <mutex>
@@ -295,17 +292,6 @@ class Renderer {
   glm::dvec3 direction_dx_{0}, direction_dy_{0};  // ray differentials' direction offsets
 };
 
-void draw_progress(uint32_t done, uint32_t total, double elapsed_s) {
-  constexpr int kWidth = 40;
-  const int filled = static_cast<int>(kWidth * static_cast<double>(done) / total);
-  char bar[kWidth + 1];
-  for (int i = 0; i < kWidth; ++i) bar[i] = i < filled ? '#' : '.';
-  bar[kWidth] = 0;
-  std::fprintf(stderr, "\rsylva render: [%s] %3d%% %.1f s", bar, static_cast<int>(100.0 * done / total),
-               elapsed_s);
-  std::fflush(stderr);
-}
-
 // The relief of the frusta tracer (relief.h): every plant whose bark has a height map and
 // a relief depth > 0, when options.relief. Textures come from `textures`, else are opened
 // into g.own_textures. Adds the "relief" pass: its plants, or "none" (no marching).
@@ -321,9 +307,9 @@ SceneRelief scene_relief(const Scene& scene, const GeometryOptions& options, con
     if (options.relief && skinned[p] && scene.plants[p].bark.height_texture && scene.plants[p].bark.relief_depth_m > 0)
       plants.push_back(p);
   if (!plants.empty() && !textures) {
-    SceneTextures::OpenResult opened = SceneTextures::open(scene);
-    if (opened.error) throw std::runtime_error(*opened.error);
-    g.own_textures = std::move(opened.textures);
+    Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(scene);
+    if (!opened) throw std::runtime_error(opened.error().message);
+    g.own_textures = std::move(*opened);
     textures = g.own_textures.get();
   }
   if (!plants.empty()) {
@@ -345,7 +331,8 @@ SceneRelief scene_relief(const Scene& scene, const GeometryOptions& options, con
 }  // namespace
 
 SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, const GeometryOptions& options,
-                                   std::vector<RenderPass>* passes, const SceneTextures* textures) {
+                                   std::vector<RenderPass>* passes, const SceneTextures* textures,
+                                   const Progress& progress) {
   SceneGeometry g;
   const bool mesh = options.kind == GeometryKind::mesh;
   TessellateOptions tessellation;
@@ -355,9 +342,9 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, 
   for (const ScenePlant& plant : scene.plants) any_height = any_height || plant.bark.height_texture.has_value();
   std::unique_ptr<SceneTextures> own_textures;
   if (mesh && options.displace && any_height && !textures) {
-    SceneTextures::OpenResult opened = SceneTextures::open(scene);
-    if (opened.error) throw std::runtime_error(*opened.error);
-    own_textures = std::move(opened.textures);
+    Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(scene);
+    if (!opened) throw std::runtime_error(opened.error().message);
+    own_textures = std::move(*opened);
     textures = own_textures.get();
   }
   const ViewFrustum view = view_frustum(scene);
@@ -365,6 +352,11 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, 
   uint32_t culled = 0, displaced = 0;
   TriangleMesh triangles;
   for (uint32_t p = 0; p < scene.plants.size(); ++p) {
+    if (progress.cancelled()) {  // between plants
+      g.cancelled = true;
+      return g;
+    }
+    progress.report(static_cast<double>(p) / static_cast<double>(scene.plants.size()), "geometry");
     const ScenePlant& plant = scene.plants[p];
     Clock::time_point start = Clock::now();
     Skeleton placed = place_plant(plant);
@@ -381,7 +373,14 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, 
       }
     }
     start = Clock::now();
-    const SkinnedSkeleton skinned = skin_skeleton(placed, skin);
+    const double plant_count = static_cast<double>(scene.plants.size());
+    Expected<SkinnedSkeleton> skinned_or =
+        skin_skeleton(placed, skin, progress.part(p / plant_count, (p + 1) / plant_count));
+    if (!skinned_or) {  // cancelled
+      g.cancelled = true;
+      return g;
+    }
+    const SkinnedSkeleton& skinned = *skinned_or;
     const uint32_t first_frustum = static_cast<uint32_t>(g.frusta.size());
     g.frusta.insert(g.frusta.end(), skinned.frusta.begin(), skinned.frusta.end());
     g.plant_of_frustum.insert(g.plant_of_frustum.end(), skinned.frusta.size(), p);
@@ -428,6 +427,7 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, 
   if (passes)
     passes->push_back({"accel build", seconds_since(start),
                        g.tracer->describe() + ", " + std::to_string(g.tracer->memory_bytes() / 1024) + " KiB"});
+  progress.report(1, "geometry");
   return g;
 }
 
@@ -441,9 +441,9 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
         return p.bark.albedo_texture || p.bark.height_texture;
       })) {
     const Clock::time_point start = Clock::now();
-    SceneTextures::OpenResult opened = SceneTextures::open(scene);
-    if (opened.error) throw std::runtime_error(*opened.error);
-    textures = std::move(opened.textures);
+    Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(scene);
+    if (!opened) throw std::runtime_error(opened.error().message);
+    textures = std::move(*opened);
     result.passes.push_back({"textures", seconds_since(start), std::to_string(textures->file_count()) + " files"});
   }
   // The relief's shading normal is filtered over a pixel's footprint (relief.h): the
@@ -452,7 +452,15 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   geometry_options.relief_options.pixel_spread_rad =
       2 * std::tan(0.5 * scene.camera.fov_y_deg * kPi / 180) / scene.height /
       std::sqrt(static_cast<double>(std::max(1u, options.spp)));
-  SceneGeometry geometry = build_scene_geometry(scene, options.skin, geometry_options, &result.passes, textures.get());
+  // Progress: the geometry a small share, the tiles the rest.
+  constexpr double kGeometryShare = 0.05;
+  SceneGeometry geometry = build_scene_geometry(scene, options.skin, geometry_options, &result.passes, textures.get(),
+                                                options.progress.part(0, kGeometryShare));
+  if (geometry.cancelled) {
+    result.cancelled = true;
+    return result;
+  }
+  const Progress tile_progress = options.progress.part(kGeometryShare, 1);
   result.frusta = geometry.frusta.size();
   result.geometry_bytes = geometry.tracer->memory_bytes();
 
@@ -481,7 +489,7 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
       sun_cones = build_sun_cones(
           geometry, scene,
           sun_cone_options_for(fog_options.mode, options.fog.photons.value_or(scene.fog->photons),
-                               options.fog.cone_params, options.threads, options.cancel));
+                               options.fog.cone_params, options.threads, options.progress.cancel_flag()));
       result.passes.insert(result.passes.end(), sun_cones->passes.begin(), sun_cones->passes.end());
       if (sun_cones->cancelled) {
         result.cancelled = true;
@@ -506,11 +514,12 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   auto worker = [&] {
     TileCost mine;
     for (;;) {
-      if (options.cancel && options.cancel->load(std::memory_order_relaxed)) break;
+      if (options.progress.cancelled()) break;
       const uint32_t tile = next_tile.fetch_add(1, std::memory_order_relaxed);
       if (tile >= tiles) break;
       renderer.render_tile(tile, image, &mine);
-      done_tiles.fetch_add(1, std::memory_order_release);
+      const uint32_t done = done_tiles.fetch_add(1, std::memory_order_acq_rel) + 1;
+      if (done < tiles) tile_progress.report(static_cast<double>(done) / tiles, "render");
     }
     std::lock_guard lock(totals_mutex);
     total.trace_s += mine.trace_s;
@@ -525,27 +534,11 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   const Clock::time_point start = Clock::now();
   std::vector<std::thread> pool;
   for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
-  if (options.progress) {
-    // This thread draws the bar; the workers render.
-    pool.emplace_back(worker);
-    bool drawn = false;
-    while (done_tiles.load(std::memory_order_acquire) < tiles &&
-           !(options.cancel && options.cancel->load())) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      const double elapsed = seconds_since(start);
-      if (elapsed > 1.0) draw_progress(done_tiles.load(), tiles, elapsed), drawn = true;
-    }
-    for (std::thread& t : pool) t.join();
-    if (drawn) {
-      draw_progress(done_tiles.load(), tiles, seconds_since(start));
-      std::fputc('\n', stderr);
-    }
-  } else {
-    worker();
-    for (std::thread& t : pool) t.join();
-  }
+  worker();
+  for (std::thread& t : pool) t.join();
   const double wall = seconds_since(start);
   result.cancelled = done_tiles.load() < tiles;
+  if (!result.cancelled) tile_progress.report(1, "render");
   result.primary_rays = pixels * std::max(1u, options.spp);
   result.shadow_rays = total.shadow_rays + total.fog_shadow_rays;
   result.passes.push_back({"trace + shade (wall)", wall,

@@ -1,4 +1,4 @@
-// render_cpu.h — the CPU reference ray caster (issue 3, sec. 2): one ray per sample
+// render_cpu.h — the CPU reference ray caster (paper 000 sec. 2, scene.md): one ray per sample
 // through a pinhole camera, conical frusta (skin.h) found through Embree (frustum_accel.h) and
 // intersected exactly (ray_frustum.h), shaded under the scene's sun and sky over a
 // ground plane. The GPU ray caster must match it.
@@ -76,6 +76,7 @@ struct SceneGeometry {
   std::shared_ptr<const SceneTextures> own_textures;  // opened here when the caller gave
                                                       // none and the relief needs them
   std::unique_ptr<SceneTracer> tracer;     // over `frusta` (or a mesh made from them)
+  bool cancelled = false;                  // stopped by `progress` between plants: no tracer
 };
 
 // Skins and indexes every plant (each plant's skeleton must be set: grow_scene_plants)
@@ -86,12 +87,16 @@ struct SceneGeometry {
 // max_depth_per_radius thins it on twigs and needles). `textures` supplies the height maps; null: they are opened here
 // when a displaced mesh needs them (std::runtime_error naming the file if one cannot be).
 // Passes: "culling" (when on), "skin", "tessellate" and "displace" (mesh), "accel build".
+// `progress` ("geometry") is told the fraction of plants done and checked between plants.
 SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin,
                                    const GeometryOptions& geometry = {},
                                    std::vector<RenderPass>* passes = nullptr,
-                                   const SceneTextures* textures = nullptr);
+                                   const SceneTextures* textures = nullptr, const Progress& progress = {});
 
 // Renders `scene` (every plant's skeleton set). Deterministic for any thread count.
+// options.progress: "geometry" (the first 5%), then "render", the fraction of tiles done,
+// reported from the worker threads; checked before every tile. Cancelled: the result has
+// `cancelled` set and an incomplete image. Never prints.
 RenderResult render_cpu(const Scene& scene, const RenderOptions& options);
 
 }  // namespace sylva

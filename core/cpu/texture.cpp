@@ -137,17 +137,14 @@ struct SceneTextures::Impl {
 SceneTextures::SceneTextures() : impl_(std::make_unique<Impl>()) {}
 SceneTextures::~SceneTextures() = default;
 
-SceneTextures::OpenResult SceneTextures::open(const Scene& scene) {
+Expected<std::unique_ptr<SceneTextures>> SceneTextures::open(const Scene& scene) {
   static std::atomic<uint64_t> next_id{1};
-  OpenResult result;
+  std::optional<Diagnostic> error;
   std::unique_ptr<SceneTextures> textures(new SceneTextures());
   Impl& m = *textures->impl_;
   m.id = next_id.fetch_add(1);
   m.system = TextureSystem::create(/*shared=*/false);
-  if (!m.system) {
-    result.error = "OpenImageIO: cannot create a texture system";
-    return result;
-  }
+  if (!m.system) return file_diagnostic("", "OpenImageIO: cannot create a texture system");
   m.system->attribute("automip", 1);
   m.system->attribute("autotile", 0);
   m.system->attribute("gray_to_rgb", 1);
@@ -159,7 +156,7 @@ SceneTextures::OpenResult SceneTextures::open(const Scene& scene) {
     if (!h || !m.system->good(h) || !m.system->imagespec(h, m.perthread(), 0)) {
       std::string reason = m.system->geterror();
       if (reason.empty()) reason = "OpenImageIO cannot read it";
-      result.error = "cannot open texture '" + path + "': " + reason;
+      error = file_diagnostic(path, "cannot open texture '" + path + "': " + reason);
       return nullptr;
     }
     handles[path] = h;
@@ -172,9 +169,9 @@ SceneTextures::OpenResult SceneTextures::open(const Scene& scene) {
     plant.u_repeat = bark.u_repeat;
     plant.v_per_metre = bark.v_per_metre;
     plant.depth_m = bark.relief_depth_m;
-    if (bark.albedo_texture && !(plant.albedo = handle_of(*bark.albedo_texture))) return result;
+    if (bark.albedo_texture && !(plant.albedo = handle_of(*bark.albedo_texture))) return std::move(*error);
     if (bark.height_texture) {
-      if (!(plant.height = handle_of(*bark.height_texture))) return result;
+      if (!(plant.height = handle_of(*bark.height_texture))) return std::move(*error);
       if (!m.height_fields.count(plant.height)) {
         const OIIO::ImageSpec* spec = m.system->imagespec(plant.height, m.perthread(), 0);
         const int width = std::max(1, spec->width), height = std::max(1, spec->height);
@@ -182,8 +179,8 @@ SceneTextures::OpenResult SceneTextures::open(const Scene& scene) {
         TextureOpt options;
         if (!m.system->get_texels(plant.height, m.perthread(), options, 0, spec->x, spec->x + width, spec->y,
                                   spec->y + height, 0, 1, 0, 1, OIIO::TypeDesc::FLOAT, texels.data())) {
-          result.error = "cannot read texture '" + *bark.height_texture + "': " + m.system->geterror();
-          return result;
+          return file_diagnostic(*bark.height_texture,
+                                 "cannot read texture '" + *bark.height_texture + "': " + m.system->geterror());
         }
         m.height_fields[plant.height] =
             std::make_unique<Impl::HeightTexture>(&m, plant.height, width, height, std::move(texels));
@@ -191,8 +188,7 @@ SceneTextures::OpenResult SceneTextures::open(const Scene& scene) {
     }
   }
   m.files = handles.size();
-  result.textures = std::move(textures);
-  return result;
+  return textures;
 }
 
 bool SceneTextures::has_albedo(uint32_t plant) const {

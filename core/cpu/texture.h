@@ -1,5 +1,5 @@
 // texture.h — the bark textures of a scene (scene.md `bark`: albedo and height maps) read
-// with OpenImageIO's TextureSystem: MIP-mapped, filtered lookups (issue 3, sec. 2), and the
+// with OpenImageIO's TextureSystem: MIP-mapped, filtered lookups (paper 000 sec. 2.3), and the
 // ray-differential footprint that drives the filter.
 //
 // One TextureSystem per SceneTextures (created unshared, so renders do not share caches or
@@ -70,12 +70,9 @@ UvFootprint uv_footprint(const SurfaceHit& hit, const Ray& ray_dx, const Ray& ra
 class SceneTextures {
  public:
   // Opens the bark textures of every plant of `scene` (plants naming the same file share
-  // one handle). On failure `error` names the file and OIIO's reason.
-  struct OpenResult {
-    std::unique_ptr<SceneTextures> textures;
-    std::optional<std::string> error;
-  };
-  static OpenResult open(const Scene& scene);
+  // one handle). On failure a Diagnostic for the file whose message names it and gives
+  // OIIO's reason ("cannot open texture 'bark.png': ...").
+  static Expected<std::unique_ptr<SceneTextures>> open(const Scene& scene);
   ~SceneTextures();
   SceneTextures(const SceneTextures&) = delete;
   SceneTextures& operator=(const SceneTextures&) = delete;

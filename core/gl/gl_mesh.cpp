@@ -135,9 +135,9 @@ struct GlMesh::State {
     });
     if (geometry.displace && any_height && !textures) {
       if (!own_textures) {
-        SceneTextures::OpenResult opened = SceneTextures::open(scene);
-        if (opened.error) throw std::runtime_error(*opened.error);
-        own_textures = std::move(opened.textures);
+        Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(scene);
+        if (!opened) throw std::runtime_error(opened.error().message);
+        own_textures = std::move(*opened);
       }
       textures = own_textures.get();
     }

@@ -1,4 +1,4 @@
-// gl_mesh.h — the polygon baseline on the GPU (issue 4 §3; paper 000 sec. 4, "GS" and
+// gl_mesh.h — the polygon baseline on the GPU (paper 000 sec. 4, "GS" and
 // "GS+R"): the tessellated meshes of the CPU reference's mesh path rasterised into the
 // G-buffer of the GL ray caster (render_gl.h), which then shades them exactly as it shades
 // the ray-cast frusta. GlRenderer uses it when RenderOptions::geometry.kind is mesh.

@@ -458,7 +458,7 @@ const GlFrameStats& GlRenderer::draw_frame(const Scene& scene, const GlTarget* t
   const float black[4] = {0, 0, 0, 0};
   glClearNamedFramebufferfv(st.targets.accumulation_fbo.id(), GL_COLOR, 0, black);
   for (uint32_t sample = 0; sample < f.spp; ++sample) {
-    if (st.options.cancel && st.options.cancel->load()) {
+    if (st.options.progress.cancelled()) {
       f.stats.cancelled = true;
       break;
     }

@@ -1,5 +1,7 @@
-// diagnostic.cpp — formatting of located errors (clang style: message, line, caret).
+// diagnostic.cpp — formatting of located errors (clang style: message, line, caret, notes).
 #include "core/util/diagnostic.h"
+
+#include <algorithm>
 
 namespace sylva {
 
@@ -16,31 +18,73 @@ bool valid_utf8(const std::string& s) {
   }
   return true;
 }
+
+// The source line and a caret under `column` (1-based bytes).
+void append_excerpt(std::string& out, const std::string& source_line, uint32_t column) {
+  // Long lines (a 10 MB axiom) are shown around the column only.
+  constexpr size_t kWindow = 160;
+  size_t col = column ? column - 1 : 0;
+  size_t begin = col > kWindow / 2 ? col - kWindow / 2 : 0;
+  std::string shown = source_line.substr(std::min(begin, source_line.size()), kWindow);
+  std::string prefix = begin ? "..." : "";
+  // Echo the line safely: control bytes (and, in a line that is not valid UTF-8, every
+  // non-ASCII byte) become '?', one byte for one byte so the caret stays aligned.
+  const bool utf8 = valid_utf8(shown);
+  for (char& c : shown) {
+    unsigned char b = static_cast<unsigned char>(c);
+    if (c == '\t') c = ' ';
+    else if (b < 0x20 || b == 0x7f || (!utf8 && b >= 0x80)) c = '?';
+  }
+  out += prefix + shown + (begin + kWindow < source_line.size() ? "..." : "") + "\n";
+  out += std::string(prefix.size() + (col - begin), ' ') + "^\n";
+}
+
+void append_formatted(std::string& out, const Diagnostic& d, const char* severity) {
+  std::string place = d.file;
+  if (d.loc.line) {
+    if (!place.empty()) place += ':';
+    place += std::to_string(d.loc.line);
+    if (d.loc.column) place += ":" + std::to_string(d.loc.column);
+  }
+  if (!place.empty()) out += place + ": ";
+  out += std::string(severity) + ": " + d.message + "\n";
+  if (d.source_line) append_excerpt(out, *d.source_line, d.loc.column);
+  for (const Diagnostic& note : d.notes) append_formatted(out, note, "note");
+}
 }  // namespace
 
 std::string Diagnostic::format() const {
-  std::string out = file;
-  if (loc.line) out += ":" + std::to_string(loc.line) + ":" + std::to_string(loc.column);
-  out += ": error: " + message + "\n";
-  if (loc.line) {
-    // Long lines (a 10 MB axiom) are shown around the column only.
-    constexpr size_t kWindow = 160;
-    size_t col = loc.column ? loc.column - 1 : 0;
-    size_t begin = col > kWindow / 2 ? col - kWindow / 2 : 0;
-    std::string shown = source_line.substr(begin, kWindow);
-    std::string prefix = begin ? "..." : "";
-    // Echo the line safely: control bytes (and, in a line that is not valid UTF-8, every
-    // non-ASCII byte) become '?', one byte for one byte so the caret stays aligned.
-    const bool utf8 = valid_utf8(shown);
-    for (char& c : shown) {
-      unsigned char b = static_cast<unsigned char>(c);
-      if (c == '\t') c = ' ';
-      else if (b < 0x20 || b == 0x7f || (!utf8 && b >= 0x80)) c = '?';
-    }
-    out += prefix + shown + (begin + kWindow < source_line.size() ? "..." : "") + "\n";
-    out += std::string(prefix.size() + (col - begin), ' ') + "^\n";
-  }
+  std::string out;
+  append_formatted(out, *this, "error");
   return out;
+}
+
+Diagnostic Diagnostic::with_note(Diagnostic note) && {
+  notes.push_back(std::move(note));
+  return std::move(*this);
+}
+
+Diagnostic diagnostic_at(std::string file, SourceLoc loc, std::string message) {
+  Diagnostic d;
+  d.file = std::move(file);
+  d.loc = loc;
+  d.message = std::move(message);
+  return d;
+}
+
+Diagnostic file_diagnostic(std::string file, std::string message, int error_number) {
+  Diagnostic d;
+  d.file = std::move(file);
+  d.message = std::move(message);
+  d.error_number = error_number;
+  return d;
+}
+
+Diagnostic cancelled_diagnostic() {
+  Diagnostic d;
+  d.message = "cancelled";
+  d.cancelled = true;
+  return d;
 }
 
 }  // namespace sylva

@@ -19,9 +19,8 @@
 namespace sylva {
 namespace {
 
-FileError errno_error(const std::string& path, const std::string& what, int error_number) {
-  return FileError{path, what + ": " + std::generic_category().message(error_number),
-                   error_number};
+Diagnostic errno_error(const std::string& path, const std::string& what, int error_number) {
+  return file_diagnostic(path, what + ": " + std::generic_category().message(error_number), error_number);
 }
 
 // Keeps the temporary name within NAME_MAX (255) however long the target's name is.
@@ -48,24 +47,22 @@ bool write_all(int fd, std::string_view bytes) {
 
 }  // namespace
 
-std::string FileError::format() const { return path + ": error: " + message; }
-
-FileReadResult read_text_file(const std::string& path) {
+Expected<std::string> read_text_file(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     const int error_number = errno;  // before anything that may allocate
-    return {std::nullopt, errno_error(path, "cannot open for reading", error_number)};
+    return errno_error(path, "cannot open for reading", error_number);
   }
 
   struct stat info {};
   if (::fstat(fd, &info) != 0) {
     const int error_number = errno;
     ::close(fd);
-    return {std::nullopt, errno_error(path, "cannot read", error_number)};
+    return errno_error(path, "cannot read", error_number);
   }
   if (S_ISDIR(info.st_mode)) {
     ::close(fd);
-    return {std::nullopt, errno_error(path, "cannot read", EISDIR)};
+    return errno_error(path, "cannot read", EISDIR);
   }
 
   std::string contents;
@@ -78,16 +75,16 @@ FileReadResult read_text_file(const std::string& path) {
       if (errno == EINTR) continue;
       const int error_number = errno;
       ::close(fd);
-      return {std::nullopt, errno_error(path, "cannot read", error_number)};
+      return errno_error(path, "cannot read", error_number);
     }
     contents.append(buffer, static_cast<size_t>(n));
   }
   ::close(fd);
-  return {std::move(contents), std::nullopt};
+  return contents;
 }
 
-std::optional<FileError> write_file_atomically(const std::string& path, std::string_view bytes) {
-  if (path.empty()) return FileError{path, "cannot write: the path is empty", 0};
+Status write_file_atomically(const std::string& path, std::string_view bytes) {
+  if (path.empty()) return file_diagnostic(path, "cannot write: the path is empty");
   if (path.back() == '/') return errno_error(path, "cannot write", EISDIR);
 
   const size_t slash = path.rfind('/');
@@ -140,7 +137,7 @@ std::optional<FileError> write_file_atomically(const std::string& path, std::str
     (void)::fsync(directory_fd);
     ::close(directory_fd);
   }
-  return std::nullopt;
+  return {};
 }
 
 }  // namespace sylva

@@ -42,19 +42,18 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
-std::optional<FileError> write_image_atomically(const std::string& path, uint32_t width, uint32_t height,
-                                                const std::vector<std::string>& channel_names,
-                                                const std::vector<float>& pixels,
-                                                const std::vector<ChannelFormat>& formats, bool srgb) {
+Status write_image_atomically(const std::string& path, uint32_t width, uint32_t height,
+                              const std::vector<std::string>& channel_names, const std::vector<float>& pixels,
+                              const std::vector<ChannelFormat>& formats, bool srgb) {
   const size_t channels = channel_names.size();
-  if (path.empty() || path.back() == '/') return FileError{path, "not a file name", 0};
+  if (path.empty() || path.back() == '/') return file_diagnostic(path, "not a file name");
   if (channels == 0 || pixels.size() != static_cast<size_t>(width) * height * channels ||
       (formats.size() != 1 && formats.size() != channels))
-    return FileError{path, "internal error: image buffer does not match its channels", 0};
+    return file_diagnostic(path, "internal error: image buffer does not match its channels");
 
   // The plugin is chosen by the target's extension; the temporary name has none.
   auto out = OIIO::ImageOutput::create(path);
-  if (!out) return FileError{path, "cannot write this image format: " + OIIO::geterror(), 0};
+  if (!out) return file_diagnostic(path, "cannot write this image format: " + OIIO::geterror());
   OIIO::ImageSpec spec(static_cast<int>(width), static_cast<int>(height), static_cast<int>(channels),
                        oiio_type(formats[0]));
   spec.channelnames = channel_names;
@@ -76,10 +75,10 @@ std::optional<FileError> write_image_atomically(const std::string& path, uint32_
   if (lower_extension(path) == ".exr") spec.attribute("compression", "zip");
 
   const std::string temp = temporary_path_for(path);
-  auto fail = [&](const std::string& what) {
+  auto fail = [&](const std::string& what, int error_number = 0) {
     std::error_code ignored;
     std::filesystem::remove(temp, ignored);
-    return FileError{path, what, 0};
+    return file_diagnostic(path, what, error_number);
   };
   if (!out->open(temp, spec)) return fail("cannot write: " + out->geterror());
   if (!out->write_image(OIIO::TypeDesc::FLOAT, pixels.data())) {
@@ -95,26 +94,22 @@ std::optional<FileError> write_image_atomically(const std::string& path, uint32_
   if (fd < 0 || ::fsync(fd) != 0) {
     int error = errno;
     if (fd >= 0) ::close(fd);
-    FileError e = fail(std::string("cannot sync the temporary file: ") + std::strerror(error));
-    e.error_number = error;
-    return e;
+    return fail(std::string("cannot sync the temporary file: ") + std::strerror(error), error);
   }
   ::close(fd);
   if (std::rename(temp.c_str(), path.c_str()) != 0) {
     int error = errno;
-    FileError e = fail(std::string("cannot rename the temporary file over it: ") + std::strerror(error));
-    e.error_number = error;
-    return e;
+    return fail(std::string("cannot rename the temporary file over it: ") + std::strerror(error), error);
   }
-  return std::nullopt;
+  return {};
 }
 
-std::optional<std::string> image_open_error(const std::string& path) {
+Status check_image_opens(const std::string& path) {
   auto input = OIIO::ImageInput::open(path);
-  if (input) return std::nullopt;
+  if (input) return {};
   std::string reason = OIIO::geterror();
   if (reason.empty()) reason = "OpenImageIO cannot read it";
-  return reason;
+  return file_diagnostic(path, reason);
 }
 
 bool can_write_image_format(const std::string& path) {

@@ -6,11 +6,10 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <string>
 #include <vector>
 
-#include "core/util/file_io.h"
+#include "core/util/diagnostic.h"
 
 namespace sylva {
 
@@ -22,18 +21,17 @@ enum class ChannelFormat : uint8_t { uint8, half, float32 };
 // atomically. `formats` gives each channel's storage (one entry: all channels); uint8
 // channels are expected already encoded in [0, 1] (values are clamped and rounded).
 // `srgb`: tag the file as sRGB (else linear).
-std::optional<FileError> write_image_atomically(const std::string& path, uint32_t width,
-                                                uint32_t height,
-                                                const std::vector<std::string>& channel_names,
-                                                const std::vector<float>& pixels,
-                                                const std::vector<ChannelFormat>& formats,
-                                                bool srgb);
+// Failure: a Diagnostic for `path` as a whole (with the errno where a system call failed).
+Status write_image_atomically(const std::string& path, uint32_t width, uint32_t height,
+                              const std::vector<std::string>& channel_names, const std::vector<float>& pixels,
+                              const std::vector<ChannelFormat>& formats, bool srgb);
 
 // The lower-case extension of `path`, with its dot (".png"; "" when there is none).
 std::string lower_extension(const std::string& path);
 
-// Whether OpenImageIO can open `path` as an image: nullopt if it can, else the reason.
-std::optional<std::string> image_open_error(const std::string& path);
+// Whether OpenImageIO can open `path` as an image; if not, a Diagnostic for `path` whose
+// message is OIIO's reason.
+Status check_image_opens(const std::string& path);
 
 // Whether OpenImageIO has a writer for `path`'s extension (checked before rendering).
 bool can_write_image_format(const std::string& path);

@@ -104,10 +104,10 @@ constexpr size_t kLinearKeyCheckLimit = 8;
 
 class Parser {
  public:
-  Parser(std::string_view text, const JsonParseOptions& options)
-      : text_(text), options_(options) {}
+  Parser(std::string_view text, std::string_view file, const JsonParseOptions& options)
+      : text_(text), file_(file), options_(options) {}
 
-  JsonParseResult parse();
+  Expected<JsonValue> parse();
 
  private:
   bool at_end() const { return pos_ >= text_.size(); }
@@ -139,7 +139,7 @@ class Parser {
   }
 
   bool fail(uint32_t line, uint32_t column, std::string message) {
-    error_ = JsonError{line, column, std::move(message)};
+    error_ = diagnostic_at(std::string(file_), {line, column}, std::move(message));
     return false;
   }
   bool fail_here(std::string message) { return fail(line_, column_, std::move(message)); }
@@ -173,14 +173,15 @@ class Parser {
   bool parse_word(JsonValue& value);
 
   std::string_view text_;
+  std::string_view file_;
   JsonParseOptions options_;
   size_t pos_ = 0;
   uint32_t line_ = 1;
   uint32_t column_ = 1;
-  std::optional<JsonError> error_;
+  std::optional<Diagnostic> error_;
 };
 
-JsonParseResult Parser::parse() {
+Expected<JsonValue> Parser::parse() {
   if (text_.substr(0, 3) == "\xEF\xBB\xBF") pos_ = 3;  // byte order mark, not counted
 
   std::vector<OpenContainer> open;  // innermost last; size() is the nesting depth
@@ -228,7 +229,7 @@ JsonParseResult Parser::parse() {
         fail_unexpected("the end of the input after the JSON value (a JSON text holds one value)");
         break;
       }
-      return {std::move(completed), std::nullopt};
+      return completed;
     }
     OpenContainer& top = open.back();
     const bool is_array = top.value.kind == JsonValue::Kind::Array;
@@ -273,7 +274,7 @@ JsonParseResult Parser::parse() {
     break;
   }
   assert(error_.has_value());
-  return {std::nullopt, std::move(error_)};
+  return std::move(*error_);
 }
 
 // Reads `"key" :` (whitespace skipped before the key already) and opens a member.
@@ -637,8 +638,8 @@ const char* JsonValue::kind_name() const {
   return "an unknown value";
 }
 
-JsonParseResult parse_json(std::string_view text, const JsonParseOptions& options) {
-  return Parser(text, options).parse();
+Expected<JsonValue> parse_json(std::string_view text, std::string_view file, const JsonParseOptions& options) {
+  return Parser(text, file, options).parse();
 }
 
 void append_json_number(std::string& out, double value) {
@@ -723,6 +724,101 @@ std::string json_excerpt(std::string_view utf8) {
   append_json_string(out, utf8.substr(0, end));
   if (end < utf8.size()) out += "...";
   return out;
+}
+
+void JsonWriter::before_value(bool is_key) {
+  if (open_.empty()) {
+    assert(out_.empty() && "JsonWriter: a document holds one value");
+    return;
+  }
+  Open& o = open_.back();
+  if (o.object && o.after_key) {  // the member's value follows its key directly
+    o.after_key = false;
+    return;
+  }
+  assert((!o.object || is_key) && "JsonWriter: a value in an object needs its key first");
+  (void)is_key;
+  switch (o.layout) {
+    case Layout::compact: if (o.count) out_ += ','; break;
+    case Layout::spaced: if (o.count) out_ += ", "; break;
+    case Layout::lines:
+      out_ += o.count ? ",\n" : "\n";
+      out_.append(2 * open_.size(), ' ');
+      break;
+  }
+  ++o.count;
+}
+
+JsonWriter& JsonWriter::open(char bracket, bool object, Layout layout) {
+  before_value();
+  out_ += bracket;
+  open_.push_back({layout, object});
+  return *this;
+}
+
+JsonWriter& JsonWriter::close(char bracket, bool object) {
+  assert(!open_.empty() && open_.back().object == object && !open_.back().after_key &&
+         "JsonWriter: end does not match the open container");
+  (void)object;
+  const Open o = open_.back();
+  open_.pop_back();
+  if (o.layout == Layout::lines && o.count) {
+    out_ += '\n';
+    out_.append(2 * open_.size(), ' ');
+  }
+  out_ += bracket;
+  return *this;
+}
+
+JsonWriter& JsonWriter::begin_object(Layout layout) { return open('{', true, layout); }
+JsonWriter& JsonWriter::end_object() { return close('}', true); }
+JsonWriter& JsonWriter::begin_array(Layout layout) { return open('[', false, layout); }
+JsonWriter& JsonWriter::end_array() { return close(']', false); }
+
+JsonWriter& JsonWriter::key(std::string_view name) {
+  assert(!open_.empty() && open_.back().object && !open_.back().after_key &&
+         "JsonWriter: a key belongs in an object, before its value");
+  before_value(true);
+  append_json_string(out_, name);
+  out_ += open_.back().layout == Layout::compact ? ":" : ": ";
+  open_.back().after_key = true;
+  return *this;
+}
+
+JsonWriter& JsonWriter::number(double value) {
+  before_value();
+  append_json_number(out_, value);
+  return *this;
+}
+
+JsonWriter& JsonWriter::string(std::string_view utf8) {
+  before_value();
+  append_json_string(out_, utf8);
+  return *this;
+}
+
+JsonWriter& JsonWriter::boolean(bool value) {
+  before_value();
+  out_ += value ? "true" : "false";
+  return *this;
+}
+
+JsonWriter& JsonWriter::null() {
+  before_value();
+  out_ += "null";
+  return *this;
+}
+
+JsonWriter& JsonWriter::raw(std::string_view json) {
+  before_value();
+  out_ += json;
+  return *this;
+}
+
+JsonWriter& JsonWriter::numbers(const double* values, size_t count, Layout layout) {
+  begin_array(layout);
+  for (size_t i = 0; i < count; ++i) number(values[i]);
+  return end_array();
 }
 
 }  // namespace sylva

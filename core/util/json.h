@@ -1,5 +1,5 @@
 // json.h — a small, strict JSON reader (RFC 8259) whose values know where they came
-// from, and the writing helpers every sylva writer uses.
+// from, and the writer every sylva document is written with (skeletons, scenes, glTF).
 //
 // Reading: parse_json builds a DOM in which every value records the 1-based line and
 // column of its first character, so a schema check (a skeleton, a scene) can report
@@ -22,7 +22,10 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
+
+#include "core/util/diagnostic.h"
 
 namespace sylva {
 
@@ -78,13 +81,6 @@ struct JsonMember {
   JsonValue value;
 };
 
-// Where and why the text is not the JSON we accept.
-struct JsonError {
-  uint32_t line = 0;    // 1-based
-  uint32_t column = 0;  // 1-based, in code points
-  std::string message;  // one sentence, no place prefix: "trailing comma before ']'"
-};
-
 struct JsonParseOptions {
   // Arrays/objects nested deeper than this are an error (located at the opening bracket).
   // Keep it modest: destroying a DOM recurses once per level.
@@ -96,15 +92,13 @@ struct JsonParseOptions {
   bool allow_non_finite_numbers = false;
 };
 
-// Result of parse_json: the root value, or the first error in the text.
-struct JsonParseResult {
-  std::optional<JsonValue> value;
-  std::optional<JsonError> error;
-};
-
 // Parses one JSON text (any value at the root, surrounded by optional whitespace).
 // Numbers that underflow a double read as zero of the same sign (correct rounding).
-JsonParseResult parse_json(std::string_view text, const JsonParseOptions& options = {});
+// The error is the first problem in the text: a Diagnostic naming `file`, with the line
+// and column (code points) of the problem and a one-sentence message without the place
+// ("trailing comma before ']' is not allowed in JSON"); no source line.
+Expected<JsonValue> parse_json(std::string_view text, std::string_view file = {},
+                               const JsonParseOptions& options = {});
 
 // Appends the shortest decimal that reads back to exactly `value` (std::to_chars):
 // integers as "1" not "1.0", large/small values with an exponent ("1e+300"), and -0.0
@@ -126,5 +120,60 @@ void append_json_string(std::string& out, std::string_view utf8);
 // For error messages: `utf8` quoted as by append_json_string, cut after 40 code points
 // with "..." after the closing quote, so a hostile megabyte-long key stays readable.
 std::string json_excerpt(std::string_view utf8);
+
+// Writes JSON text value by value with the number, integer and string forms above, so no
+// writer formats JSON by hand and every document gets the same byte-stable numbers.
+// Each array and object is laid out one of three ways, chosen where it is opened:
+//   compact  [1,2] {"a":1}
+//   spaced   [1, 2] {"a": 1}
+//   lines    one element or member per line, indented two spaces per open container,
+//            the closing bracket on its own line ("[]" / "{}" when empty)
+// so a document can be pretty at the top and dense in its long arrays (skeleton.md's
+// joints). Usage errors (a value without key in an object, unbalanced ends) are asserted.
+class JsonWriter {
+ public:
+  enum class Layout : uint8_t { compact, spaced, lines };
+
+  JsonWriter& begin_object(Layout layout = Layout::compact);
+  JsonWriter& end_object();
+  JsonWriter& begin_array(Layout layout = Layout::compact);
+  JsonWriter& end_array();
+  // The key of the next member of the open object (append_json_string).
+  JsonWriter& key(std::string_view name);
+
+  JsonWriter& number(double value);  // append_json_number: shortest round trip, finite
+  template <class Integer>
+  JsonWriter& integer(Integer value) {  // exact, never through a double
+    static_assert(std::is_integral_v<Integer> && !std::is_same_v<Integer, bool>);
+    before_value();
+    if constexpr (std::is_signed_v<Integer>) append_json_int64(out_, value);
+    else append_json_uint64(out_, value);
+    return *this;
+  }
+  JsonWriter& string(std::string_view utf8);  // append_json_string
+  JsonWriter& boolean(bool value);
+  JsonWriter& null();
+  // A value that is already JSON text (written by another JsonWriter), copied as it is.
+  JsonWriter& raw(std::string_view json);
+  // An array of numbers in `layout` (a vector, a colour, a min/max).
+  JsonWriter& numbers(const double* values, size_t count, Layout layout = Layout::compact);
+
+  const std::string& text() const { return out_; }  // what is written so far
+  std::string take() { return std::move(out_); }   // the text; the writer is spent
+
+ private:
+  struct Open {
+    Layout layout;
+    bool object;
+    size_t count = 0;        // elements or members written
+    bool after_key = false;  // object: a key was written, its value comes next
+  };
+  void before_value(bool is_key = false);  // the separator (and indentation) before a value or key
+  JsonWriter& open(char bracket, bool object, Layout layout);
+  JsonWriter& close(char bracket, bool object);
+
+  std::string out_;
+  std::vector<Open> open_;
+};
 
 }  // namespace sylva

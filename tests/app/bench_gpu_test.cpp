@@ -190,12 +190,12 @@ TEST(BenchGpu, ReliefRowsOnASceneWithAHeightMap) {
   const auto rows = run_bench_gpu(
       {kScene, "--quick", "--methods", "RC+R,GS+R", "--width", "64", "--height", "48", "--frames", "1", "--warmup", "1"});
   if (!rows) GTEST_SKIP() << "no OpenGL context on this machine";
-  const sylva::SceneReadResult read = sylva::read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/" + kScene);
-  ASSERT_TRUE(read.scene) << read.error->format();
+  const sylva::Expected<sylva::Scene> read = sylva::read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/" + kScene);
+  ASSERT_TRUE(read.ok()) << read.error().format();
   const std::vector<ExpectedMethod> methods = {{"RC+R 16x4", GeometryKind::frusta, true, 0, false},
                                                {"GS+R m=0", GeometryKind::mesh, false, 0, true},
                                                {"GS+R m=1", GeometryKind::mesh, false, 1, true}};
-  expect_rows(*rows, kScene, *read.scene, methods, "64", "48", "1");
+  expect_rows(*rows, kScene, *read, methods, "64", "48", "1");
   if (HasFailure() || rows->front().at("status") != "ok") return;
   EXPECT_EQ(rows->front().at("reference"), "RC+R 1024x24 exact v (CPU)");
   EXPECT_LT(number(rows->front(), "depth_rmse_m"), 0.02);

@@ -222,6 +222,28 @@ TEST(RenderCli, BadGrammarInSceneIsExitOneWithThePlace) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("s.png")));
 }
 
+TEST(RenderCli, AGrammarErrorInASceneShowsTheGrammarsPlaceThenTheSceneKeyThatNamedIt) {
+  // cli.md: the grammar's own file:line:column, source line and caret, then a note at
+  // the scene's "grammar" value, so an editor can underline both; nothing is written.
+  TempDir dir;
+  dir.write("bad.lsys", "axiom: A\nA -> F(foo(2))\n");
+  dir.write("forest.scene.json", "{\"plants\": [\n  {\"seed\": 2, \"grammar\": \"bad.lsys\"}\n]}");
+  const std::string expected = dir.file("bad.lsys") +
+                               ":2:8: error: unknown function 'foo'\n"
+                               "A -> F(foo(2))\n"
+                               "       ^\n" +
+                               dir.file("forest.scene.json") + ":2:26: note: plants[0].grammar names this grammar\n";
+  ProcessResult r = run_sylva({"render", dir.file("forest.scene.json"), "-o", dir.file("f.png"), "--backend", "cpu"});
+  EXPECT_EQ(r.exit_code, 1) << describe(r);
+  EXPECT_EQ(r.err, expected) << describe(r);
+  EXPECT_EQ(r.out, "");
+  EXPECT_FALSE(std::filesystem::exists(dir.file("f.png")));
+  // `sylva export` reports it the same way.
+  ProcessResult e = run_sylva({"export", dir.file("forest.scene.json"), "-o", dir.file("f.glb")});
+  EXPECT_EQ(e.exit_code, 1) << describe(e);
+  EXPECT_EQ(e.err, expected) << describe(e);
+}
+
 TEST(RenderCli, SkeletonInputRenders) {
   TempDir dir;
   ProcessResult g = run_sylva({"grow", kSaguaro, "-o", dir.file("s.skel.json")});

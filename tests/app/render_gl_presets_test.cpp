@@ -1,4 +1,4 @@
-// render_gl_presets_test.cpp — issue 4's "done": the GL backend renders every bundled
+// render_gl_presets_test.cpp — the GL backend (render_gl.h) renders every bundled
 // preset and scene from the command line on a machine without X or GPU (llvmpipe through
 // EGL), with no fallback to the CPU, and what it draws is a plant: the picture is not
 // only sky and ground.

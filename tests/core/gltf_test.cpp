@@ -103,8 +103,8 @@ Glb read_glb(const std::string& path) {
   const uint32_t json_length = u32_at(bytes, 12);
   EXPECT_EQ(json_length % 4, 0u);
   auto parsed = parse_json(std::string_view(bytes).substr(20, json_length));
-  EXPECT_TRUE(parsed.value) << parsed.error->message;
-  out.json = *parsed.value;
+  EXPECT_TRUE(parsed.ok()) << parsed.error().format();
+  if (parsed) out.json = std::move(*parsed);
   const size_t bin_header = 20 + json_length;
   if (bin_header + 8 <= bytes.size()) {
     EXPECT_EQ(u32_at(bytes, bin_header + 4), 0x004E4942u);
@@ -147,7 +147,7 @@ std::vector<double> accessor_values(const Glb& glb, size_t index) {
 TEST(GltfExport, SkeletonIsALinesPrimitiveWithOnePairPerSegmentFromParentToChildJoint) {
   TempFolder dir;
   const Skeleton sk = grow_text(kGrammar);
-  ASSERT_FALSE(export_gltf({{"plant", sk}}, dir.file("p.glb")));
+  ASSERT_TRUE(export_gltf({{"plant", sk}}, dir.file("p.glb")).ok());
   const Glb glb = read_glb(dir.file("p.glb"));
   const JsonValue& prim = at(at(glb.json, "meshes").elements.at(0), "primitives").elements.at(0);
   // Trap: tinygltf writes "mode": -1 unless Primitive::mode is set.
@@ -180,7 +180,7 @@ TEST(GltfExport, EveryAccessorHasExactMinAndMax) {
   TempFolder dir;
   GltfExportOptions o;
   o.mesh = true;
-  ASSERT_FALSE(export_gltf({{"plant", grow_text(kGrammar)}}, dir.file("p.glb"), o));
+  ASSERT_TRUE(export_gltf({{"plant", grow_text(kGrammar)}}, dir.file("p.glb"), o).ok());
   const Glb glb = read_glb(dir.file("p.glb"));
   const JsonValue& accessors = at(glb.json, "accessors");
   ASSERT_GE(accessors.elements.size(), 7u);
@@ -206,16 +206,16 @@ TEST(GltfExport, NoNullEntriesEvenForAPlantWithoutSegments) {
   Skeleton one_joint;
   one_joint.joints.push_back({{0, 0, 0}, 0.1, 0});
   one_joint.chains.push_back({0, 1, std::nullopt});
-  ASSERT_FALSE(export_gltf({{"empty", empty}, {"single", one_joint}, {"plant", grow_text(kGrammar)}}, dir.file("p.gltf")));
+  ASSERT_TRUE(export_gltf({{"empty", empty}, {"single", one_joint}, {"plant", grow_text(kGrammar)}}, dir.file("p.gltf")).ok());
   auto parsed = parse_json(slurp(dir.file("p.gltf")));
-  ASSERT_TRUE(parsed.value);
+  ASSERT_TRUE(parsed.ok());
   for (const char* array : {"scenes", "nodes", "meshes", "accessors", "bufferViews", "buffers"}) {
-    const JsonValue& v = at(*parsed.value, array);
+    const JsonValue& v = at(*parsed, array);
     ASSERT_TRUE(v.is_array()) << array;
     EXPECT_FALSE(v.elements.empty()) << array;  // glTF forbids empty arrays
     for (const JsonValue& e : v.elements) EXPECT_TRUE(e.is_object()) << array;
   }
-  const JsonValue& nodes = at(*parsed.value, "nodes");
+  const JsonValue& nodes = at(*parsed, "nodes");
   ASSERT_EQ(nodes.elements.size(), 3u);
   EXPECT_EQ(nodes.elements[0].find("mesh"), nullptr);
   EXPECT_EQ(at(nodes.elements[0], "name").text, "empty");
@@ -229,7 +229,7 @@ TEST(GltfExport, StringsStayStringsSeedIncluded) {
   Skeleton sk = grow_text(kGrammar);
   sk.source.seed = std::numeric_limits<uint64_t>::max();
   sk.source.grammar = "presets/ünïcode \"quoted\".lsys";
-  ASSERT_FALSE(export_gltf({{"elm \"1\"", sk}}, dir.file("p.glb")));
+  ASSERT_TRUE(export_gltf({{"elm \"1\"", sk}}, dir.file("p.glb")).ok());
   const Glb glb = read_glb(dir.file("p.glb"));
   const JsonValue& node = at(glb.json, "nodes").elements.at(0);
   EXPECT_EQ(at(node, "name").text, "elm \"1\"");
@@ -244,7 +244,7 @@ TEST(GltfExport, StringsStayStringsSeedIncluded) {
 TEST(GltfExport, ExtrasCarryTheSkinningDataOfEveryFrustum) {
   TempFolder dir;
   const Skeleton sk = grow_text(kGrammar);
-  ASSERT_FALSE(export_gltf({{"plant", sk}}, dir.file("p.glb")));
+  ASSERT_TRUE(export_gltf({{"plant", sk}}, dir.file("p.glb")).ok());
   const Glb glb = read_glb(dir.file("p.glb"));
   const JsonValue& skinning = at(at(at(at(glb.json, "nodes").elements.at(0), "extras"), "sylva"), "skinning");
   const SkinnedSkeleton skinned = skin_skeleton(sk);
@@ -269,7 +269,7 @@ TEST(GltfExport, MeshIsOneTrianglesPrimitivePerMaterialIndexWithUnitNormalsAndFr
   GltfExportOptions o;
   o.mesh = true;
   o.segments_around = 6;
-  ASSERT_FALSE(export_gltf({{"plant", sk}}, dir.file("p.glb"), o));
+  ASSERT_TRUE(export_gltf({{"plant", sk}}, dir.file("p.glb"), o).ok());
   const Glb glb = read_glb(dir.file("p.glb"));
   const JsonValue& prims = at(at(glb.json, "meshes").elements.at(0), "primitives");
   TessellateOptions to;
@@ -324,15 +324,16 @@ TEST(GltfImport, RoundTripGivesTheIdenticalSkeletonFileForGlbAndGltf) {
     for (bool mesh : {false, true}) {
       GltfExportOptions o;
       o.mesh = mesh;
-      ASSERT_FALSE(export_gltf({plant}, dir.file(name), o));
-      GltfImportResult r = import_gltf_skeletons(dir.file(name));
-      ASSERT_FALSE(r.error) << *r.error;
-      ASSERT_EQ(r.plants.size(), 1u);
-      EXPECT_EQ(write_skeleton_json(r.plants[0].skeleton), write_skeleton_json(sk)) << name;
-      EXPECT_EQ(r.plants[0].name, "plant");
-      for (int k = 0; k < 3; ++k) EXPECT_EQ(r.plants[0].position_m[k], plant.position_m[k]);
-      EXPECT_EQ(r.plants[0].rotate_y_deg, 33.3);
-      EXPECT_EQ(r.plants[0].scale, 0.75);
+      ASSERT_TRUE(export_gltf({plant}, dir.file(name), o).ok());
+      Expected<std::vector<GltfPlant>> r = import_gltf_skeletons(dir.file(name));
+      ASSERT_TRUE(r.ok()) << r.error().format();
+      ASSERT_EQ(r->size(), 1u);
+      EXPECT_EQ((*r)[0].skeleton, sk) << name;
+      EXPECT_EQ(write_skeleton_json((*r)[0].skeleton), write_skeleton_json(sk)) << name;
+      EXPECT_EQ((*r)[0].name, "plant");
+      for (int k = 0; k < 3; ++k) EXPECT_EQ((*r)[0].position_m[k], plant.position_m[k]);
+      EXPECT_EQ((*r)[0].rotate_y_deg, 33.3);
+      EXPECT_EQ((*r)[0].scale, 0.75);
     }
 }
 
@@ -341,8 +342,8 @@ TEST(GltfExport, SameInputGivesByteIdenticalFiles) {
   const Skeleton sk = grow_text(kGrammar);
   GltfExportOptions o;
   o.mesh = true;
-  ASSERT_FALSE(export_gltf({{"plant", sk}}, dir.file("a.glb"), o));
-  ASSERT_FALSE(export_gltf({{"plant", sk}}, dir.file("b.glb"), o));
+  ASSERT_TRUE(export_gltf({{"plant", sk}}, dir.file("a.glb"), o).ok());
+  ASSERT_TRUE(export_gltf({{"plant", sk}}, dir.file("b.glb"), o).ok());
   EXPECT_EQ(slurp(dir.file("a.glb")), slurp(dir.file("b.glb")));
 }
 
@@ -356,7 +357,7 @@ TEST(GltfExport, InstancingPutsIdenticalPlantsOnOneNodeWithExactPlacementsInExtr
   GltfExportOptions o;
   o.instancing = true;
   o.mesh = true;
-  ASSERT_FALSE(export_gltf(forest, dir.file("f.glb"), o));
+  ASSERT_TRUE(export_gltf(forest, dir.file("f.glb"), o).ok());
   const Glb glb = read_glb(dir.file("f.glb"));
   const JsonValue& used = at(glb.json, "extensionsUsed");
   ASSERT_EQ(used.elements.size(), 1u);
@@ -391,20 +392,21 @@ TEST(GltfExport, InstancingPutsIdenticalPlantsOnOneNodeWithExactPlacementsInExtr
     const JsonValue& view = at(glb.json, "bufferViews").elements.at(static_cast<size_t>(at(acc, "bufferView").number));
     EXPECT_EQ(view.find("target"), nullptr);
   }
-  GltfImportResult back = import_gltf_skeletons(dir.file("f.glb"));
-  ASSERT_FALSE(back.error) << *back.error;
-  ASSERT_EQ(back.plants.size(), 4u);
+  Expected<std::vector<GltfPlant>> imported = import_gltf_skeletons(dir.file("f.glb"));
+  ASSERT_TRUE(imported.ok()) << imported.error().format();
+  const std::vector<GltfPlant>& back = *imported;
+  ASSERT_EQ(back.size(), 4u);
   const char* names[4] = {"a0", "a1", "a2", "b0"};
   const GltfPlant* originals[4] = {&forest[0], &forest[2], &forest[3], &forest[1]};
   for (int i = 0; i < 4; ++i) {
-    EXPECT_EQ(back.plants[i].name, names[i]);
-    EXPECT_EQ(write_skeleton_json(back.plants[i].skeleton), write_skeleton_json(originals[i]->skeleton));
-    for (int k = 0; k < 3; ++k) EXPECT_EQ(back.plants[i].position_m[k], originals[i]->position_m[k]);
-    EXPECT_EQ(back.plants[i].rotate_y_deg, originals[i]->rotate_y_deg);
-    EXPECT_EQ(back.plants[i].scale, originals[i]->scale);
+    EXPECT_EQ(back[i].name, names[i]);
+    EXPECT_EQ(write_skeleton_json(back[i].skeleton), write_skeleton_json(originals[i]->skeleton));
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(back[i].position_m[k], originals[i]->position_m[k]);
+    EXPECT_EQ(back[i].rotate_y_deg, originals[i]->rotate_y_deg);
+    EXPECT_EQ(back[i].scale, originals[i]->scale);
   }
   // Without instancing every plant is its own node.
-  ASSERT_FALSE(export_gltf(forest, dir.file("g.glb")));
+  ASSERT_TRUE(export_gltf(forest, dir.file("g.glb")).ok());
   EXPECT_EQ(at(read_glb(dir.file("g.glb")).json, "nodes").elements.size(), 4u);
 }
 
@@ -416,7 +418,7 @@ TEST(GltfExport, TinygltfReadsOurFilesWithModeMinMaxAndStringExtras) {
   GltfExportOptions o;
   o.mesh = true;
   for (const char* name : {"p.glb", "p.gltf"}) {
-    ASSERT_FALSE(export_gltf({{"plant", sk, {1, 2, 3}, 30, 2}}, dir.file(name), o));
+    ASSERT_TRUE(export_gltf({{"plant", sk, {1, 2, 3}, 30, 2}}, dir.file(name), o).ok());
     tinygltf::TinyGLTF loader;
     tinygltf::Model model;
     std::string err, warn;
@@ -447,21 +449,22 @@ TEST(GltfExport, RefusesBadInputAndLeavesAnExistingFileUntouched) {
   TempFolder dir;
   const std::string path = dir.write("keep.glb", "old contents");
   const Skeleton sk = grow_text(kGrammar);
-  EXPECT_TRUE(export_gltf({}, path));
-  EXPECT_TRUE(export_gltf({{"p", sk, {0, 0, 0}, 0, 0}}, path));  // scale 0
-  EXPECT_TRUE(export_gltf({{"p", sk, {NAN, 0, 0}, 0, 1}}, path));
+  EXPECT_FALSE(export_gltf({}, path).ok());
+  EXPECT_FALSE(export_gltf({{"p", sk, {0, 0, 0}, 0, 0}}, path).ok());  // scale 0
+  EXPECT_FALSE(export_gltf({{"p", sk, {NAN, 0, 0}, 0, 1}}, path).ok());
   Skeleton bad = sk;
   bad.joints[1].radius_m = -1;
-  auto err = export_gltf({{"p", bad}}, path);
-  ASSERT_TRUE(err);
-  EXPECT_NE(err->find("joint"), std::string::npos) << *err;
+  Status err = export_gltf({{"p", bad}}, path);
+  ASSERT_FALSE(err.ok());
+  EXPECT_EQ(err.error().file, path);
+  EXPECT_NE(err.error().message.find("joint"), std::string::npos) << err.error().format();
   GltfExportOptions o;
   o.segments_around = 2;
-  EXPECT_TRUE(export_gltf({{"p", sk}}, path, o));
+  EXPECT_FALSE(export_gltf({{"p", sk}}, path, o).ok());
   EXPECT_EQ(slurp(path), "old contents");
-  EXPECT_TRUE(export_gltf({{"p", sk}}, dir.file("p.obj")));
+  EXPECT_FALSE(export_gltf({{"p", sk}}, dir.file("p.obj")).ok());
   EXPECT_FALSE(fs::exists(dir.file("p.obj")));
-  EXPECT_TRUE(export_gltf({{"p", sk}}, dir.file("no/such/folder/p.glb")));
+  EXPECT_FALSE(export_gltf({{"p", sk}}, dir.file("no/such/folder/p.glb")).ok());
   // Only the result is in the folder: no temporary file left behind.
   size_t entries = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir.file(""))) ++entries;
@@ -531,7 +534,7 @@ TEST(GltfExport, BarkTexturesGiveOneMaterialPerIndexWithAlbedoNormalMapAndUnitTa
   const TriangleMesh tm = tessellate(skinned, to);
   const std::string albedo_bytes = slurp(kBarkAlbedo);
   for (const char* name : {"p.glb", "p.gltf"}) {
-    ASSERT_FALSE(export_gltf({plant}, dir.file(name), o));
+    ASSERT_TRUE(export_gltf({plant}, dir.file(name), o).ok());
     tinygltf::Model model;
     ASSERT_TRUE(load_with_tinygltf(dir.file(name), &model));
     // One material per material index used, all showing the same two images.
@@ -623,7 +626,7 @@ TEST(GltfExport, TheBakedNormalMapShadesLikeTheReliefInAGltfViewer) {
   std::vector<float> heights;
   for (uint32_t j = 0; j < height; ++j)
     for (uint32_t i = 0; i < width; ++i) heights.push_back(static_cast<float>(h((i + 0.5) / width, (j + 0.5) / height)));
-  ASSERT_FALSE(write_image_atomically(dir.file("h.exr"), width, height, {"Y"}, heights, {ChannelFormat::float32}, false));
+  ASSERT_TRUE(write_image_atomically(dir.file("h.exr"), width, height, {"Y"}, heights, {ChannelFormat::float32}, false).ok());
   GltfPlant plant{"cylinder", cylinder(0.1, 50)};  // rows every 4 cm: t sampled at 100 values
   plant.bark.height_texture = dir.file("h.exr");
   plant.bark.relief_depth_m = 0.01;
@@ -632,7 +635,7 @@ TEST(GltfExport, TheBakedNormalMapShadesLikeTheReliefInAGltfViewer) {
   GltfExportOptions o;
   o.mesh = true;
   o.segments_around = 64;
-  ASSERT_FALSE(export_gltf({plant}, dir.file("c.glb"), o));
+  ASSERT_TRUE(export_gltf({plant}, dir.file("c.glb"), o).ok());
   tinygltf::Model model;
   ASSERT_TRUE(load_with_tinygltf(dir.file("c.glb"), &model));
   ASSERT_EQ(model.materials.size(), 1u);
@@ -693,7 +696,7 @@ TEST(GltfExport, WithoutTexturesMaterialsTakeTheTableColourAndABarkColourReplace
   plant.bark.albedo_rgb = glm::dvec3(0.5, 0.4, 0.3);
   GltfExportOptions o;
   o.mesh = true;
-  ASSERT_FALSE(export_gltf({plant}, dir.file("p.glb"), o));
+  ASSERT_TRUE(export_gltf({plant}, dir.file("p.glb"), o).ok());
   const Glb glb = read_glb(dir.file("p.glb"));
   for (const char* absent : {"images", "textures", "samplers"}) EXPECT_EQ(glb.json.find(absent), nullptr) << absent;
   const JsonValue& materials = at(glb.json, "materials");
@@ -741,23 +744,25 @@ TEST(GltfExport, MissingOrUnusableTexturesAreErrorsNamingTheFileAndNothingIsWrit
     GltfPlant plant{"p", sk};
     plant.bark.albedo_texture = c.albedo;
     plant.bark.height_texture = c.height;
-    auto err = export_gltf({plant}, path, o);
-    ASSERT_TRUE(err) << c.file;
-    EXPECT_NE(err->find(c.file), std::string::npos) << *err;
-    EXPECT_NE(err->find(c.message), std::string::npos) << *err;
-    auto checked = check_bark_textures(plant.bark);
-    ASSERT_TRUE(checked);
-    EXPECT_EQ(*checked, *err);
+    Status err = export_gltf({plant}, path, o);
+    ASSERT_FALSE(err.ok()) << c.file;
+    EXPECT_EQ(err.error().file, c.file);
+    const std::string text = err.error().format();
+    EXPECT_NE(text.find(c.file), std::string::npos) << text;
+    EXPECT_NE(text.find(c.message), std::string::npos) << text;
+    Status checked = check_bark_textures(plant.bark);
+    ASSERT_FALSE(checked.ok());
+    EXPECT_EQ(checked.error().format(), text);
     EXPECT_EQ(slurp(path), "old contents");
   }
   // Without a mesh the bark is not used and its textures are not read.
   GltfPlant plant{"p", sk};
   plant.bark.albedo_texture = dir.file("missing.png");
-  EXPECT_FALSE(export_gltf({plant}, dir.file("lines.glb")));
+  EXPECT_TRUE(export_gltf({plant}, dir.file("lines.glb")).ok());
   // Bark numbers out of range are refused too.
   plant.bark = Bark{};
   plant.bark.u_repeat = 0;
-  EXPECT_TRUE(export_gltf({plant}, path, o));
+  EXPECT_FALSE(export_gltf({plant}, path, o).ok());
   EXPECT_EQ(slurp(path), "old contents");
 }
 
@@ -767,8 +772,8 @@ TEST(GltfExport, TexturedExportsAreByteIdenticalAndInstancingComparesBarks) {
   plant.bark = textured_bark();
   GltfExportOptions o;
   o.mesh = true;
-  ASSERT_FALSE(export_gltf({plant}, dir.file("a.glb"), o));
-  ASSERT_FALSE(export_gltf({plant}, dir.file("b.glb"), o));
+  ASSERT_TRUE(export_gltf({plant}, dir.file("a.glb"), o).ok());
+  ASSERT_TRUE(export_gltf({plant}, dir.file("b.glb"), o).ok());
   EXPECT_EQ(slurp(dir.file("a.glb")), slurp(dir.file("b.glb")));
   // Two identical plants share a node; the same skeleton with another bark does not, and
   // its material is a new one while the images are shared.
@@ -777,7 +782,7 @@ TEST(GltfExport, TexturedExportsAreByteIdenticalAndInstancingComparesBarks) {
   GltfPlant moved = plant;
   moved.position_m[0] = 3;
   o.instancing = true;
-  ASSERT_FALSE(export_gltf({plant, moved, other}, dir.file("f.glb"), o));
+  ASSERT_TRUE(export_gltf({plant, moved, other}, dir.file("f.glb"), o).ok());
   const Glb glb = read_glb(dir.file("f.glb"));
   EXPECT_EQ(at(glb.json, "nodes").elements.size(), 2u);
   std::set<uint32_t> used;
@@ -791,11 +796,12 @@ TEST(GltfExport, TexturedExportsAreByteIdenticalAndInstancingComparesBarks) {
 // Imports `bytes` written as `name` and expects an error containing `expected`.
 void expect_import_error(const TempFolder& dir, const std::string& name, const std::string& bytes,
                          const std::string& expected) {
-  GltfImportResult r = import_gltf_skeletons(dir.write(name, bytes));
-  ASSERT_TRUE(r.error) << name << " was accepted";
-  EXPECT_TRUE(r.plants.empty());
-  EXPECT_NE(r.error->find(dir.file(name)), std::string::npos) << *r.error;
-  EXPECT_NE(r.error->find(expected), std::string::npos) << name << ": " << *r.error;
+  Expected<std::vector<GltfPlant>> r = import_gltf_skeletons(dir.write(name, bytes));
+  ASSERT_FALSE(r.ok()) << name << " was accepted";
+  EXPECT_EQ(r.error().file, dir.file(name));
+  const std::string text = r.error().format();
+  EXPECT_NE(text.find(dir.file(name)), std::string::npos) << text;
+  EXPECT_NE(text.find(expected), std::string::npos) << name << ": " << text;
 }
 
 std::string u32_bytes(uint32_t v) {
@@ -817,9 +823,9 @@ TEST(GltfImport, AGltfWithoutSylvaExtrasIsAClearError) {
 TEST(GltfImport, BrokenFilesGiveLocatedErrorsNotCrashes) {
   TempFolder dir;
   expect_import_error(dir, "missing.glb", "", "");  // empty file
-  GltfImportResult gone = import_gltf_skeletons(dir.file("does-not-exist.glb"));
-  ASSERT_TRUE(gone.error);
-  EXPECT_NE(gone.error->find("does-not-exist.glb"), std::string::npos);
+  Expected<std::vector<GltfPlant>> gone = import_gltf_skeletons(dir.file("does-not-exist.glb"));
+  ASSERT_FALSE(gone.ok());
+  EXPECT_NE(gone.error().format().find("does-not-exist.glb"), std::string::npos);
   expect_import_error(dir, "junk.glb", "this is not a model", "not a glTF file");
   expect_import_error(dir, "binary.glb", std::string("\x00\x01\x02\x03\xff", 5), "not a glTF file");
   expect_import_error(dir, "json_array.gltf", "[1,2]", "not a glTF file");
@@ -833,11 +839,11 @@ TEST(GltfImport, BrokenFilesGiveLocatedErrorsNotCrashes) {
   const std::string good_source = R"("source":{"grammar":"g.lsys","seed":"5","steps":1,"defines":{}})";
   const std::string doc = R"({"format":"sylva-skeleton","version":1,)";
   // The well-formed control, then one defect at a time.
-  GltfImportResult ok = import_gltf_skeletons(dir.write("ok.gltf", head + doc + good_source + "," + chains + "}}}]}"));
-  ASSERT_FALSE(ok.error) << *ok.error;
-  ASSERT_EQ(ok.plants.size(), 1u);
-  EXPECT_EQ(ok.plants[0].skeleton.source.seed, 5u);
-  EXPECT_EQ(ok.plants[0].name, "p");
+  Expected<std::vector<GltfPlant>> ok = import_gltf_skeletons(dir.write("ok.gltf", head + doc + good_source + "," + chains + "}}}]}"));
+  ASSERT_TRUE(ok.ok()) << ok.error().format();
+  ASSERT_EQ(ok->size(), 1u);
+  EXPECT_EQ((*ok)[0].skeleton.source.seed, 5u);
+  EXPECT_EQ((*ok)[0].name, "p");
   expect_import_error(dir, "seed_number.gltf",
                       head + doc + R"("source":{"grammar":"g","seed":5,"steps":1,"defines":{}},)" + chains + "}}}]}",
                       "seed must be a string");
@@ -885,12 +891,12 @@ TEST(GltfImport, BrokenFilesGiveLocatedErrorsNotCrashes) {
 
 TEST(GltfImport, EveryTruncationAndRandomCorruptionOfARealFileIsHandled) {
   TempFolder dir;
-  ASSERT_FALSE(export_gltf({{"plant", grow_text("angle: 30\naxiom: F[+F]F\n")}}, dir.file("p.glb")));
+  ASSERT_TRUE(export_gltf({{"plant", grow_text("angle: 30\naxiom: F[+F]F\n")}}, dir.file("p.glb")).ok());
   const std::string bytes = slurp(dir.file("p.glb"));
   // Every prefix: an error (the header's length no longer matches), never a crash.
   for (size_t n = 0; n < bytes.size(); ++n) {
-    GltfImportResult r = import_gltf_skeletons(dir.write("cut.glb", bytes.substr(0, n)));
-    ASSERT_TRUE(r.error) << "prefix of " << n << " bytes accepted";
+    Expected<std::vector<GltfPlant>> r = import_gltf_skeletons(dir.write("cut.glb", bytes.substr(0, n)));
+    ASSERT_FALSE(r.ok()) << "prefix of " << n << " bytes accepted";
   }
   // Random byte flips: either an error or plants, never a crash (ASan builds check).
   std::mt19937 rng(5);
@@ -898,8 +904,10 @@ TEST(GltfImport, EveryTruncationAndRandomCorruptionOfARealFileIsHandled) {
     std::string broken = bytes;
     for (int k = 0; k < 3; ++k)
       broken[std::uniform_int_distribution<size_t>(0, broken.size() - 1)(rng)] = static_cast<char>(rng());
-    GltfImportResult r = import_gltf_skeletons(dir.write("flip.glb", broken));
-    EXPECT_TRUE(r.error.has_value() != !r.plants.empty());
+    Expected<std::vector<GltfPlant>> r = import_gltf_skeletons(dir.write("flip.glb", broken));
+    if (r) {
+      EXPECT_FALSE(r->empty());  // plants, or else a located error
+    }
   }
 }
 

@@ -131,34 +131,33 @@ TEST(NormalMap, BarkMetricMeasuresTexelsOnTheReferenceStem) {
 }
 
 TEST(NormalMap, ReadsTheBundledSixteenBitHeightMap) {
-  HeightMapReadResult r = read_height_map(kSource + "/presets/textures/bark_height.png");
-  ASSERT_TRUE(r.map) << r.error.value_or("");
-  EXPECT_EQ(r.map->width, 512u);
-  EXPECT_EQ(r.map->height, 512u);
+  Expected<HeightMap> r = read_height_map(kSource + "/presets/textures/bark_height.png");
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  EXPECT_EQ(r->width, 512u);
+  EXPECT_EQ(r->height, 512u);
   float lo = 1, hi = 0;
-  for (float v : r.map->values) lo = std::min(lo, v), hi = std::max(hi, v);
+  for (float v : r->values) lo = std::min(lo, v), hi = std::max(hi, v);
   EXPECT_EQ(lo, 0.0f);  // scripts/make_textures.py spans the full range
   EXPECT_EQ(hi, 1.0f);
   // 16 bits survive: more distinct values than an 8-bit file could hold.
-  std::vector<float> sorted = r.map->values;
+  std::vector<float> sorted = r->values;
   std::sort(sorted.begin(), sorted.end());
   EXPECT_GT(std::unique(sorted.begin(), sorted.end()) - sorted.begin(), 256);
 }
 
 TEST(NormalMap, AMissingOrBrokenHeightMapIsAnErrorNamingTheFile) {
   const std::string missing = kSource + "/presets/textures/no_such_height.png";
-  HeightMapReadResult r = read_height_map(missing);
-  ASSERT_FALSE(r.map);
-  ASSERT_TRUE(r.error);
-  EXPECT_NE(r.error->find(missing), std::string::npos) << *r.error;
+  Expected<HeightMap> r = read_height_map(missing);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().file, missing);
+  EXPECT_NE(r.error().format().find(missing), std::string::npos) << r.error().format();
 
   const fs::path broken = fs::temp_directory_path() / ("sylva-broken-" + std::to_string(::getpid()) + ".png");
   std::ofstream(broken, std::ios::binary) << "\x89PNG\r\n\x1a\nnot really";
   r = read_height_map(broken.string());
   fs::remove(broken);
-  ASSERT_FALSE(r.map);
-  ASSERT_TRUE(r.error);
-  EXPECT_NE(r.error->find(broken.string()), std::string::npos) << *r.error;
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().format().find(broken.string()), std::string::npos) << r.error().format();
 }
 
 TEST(NormalMap, PngInMemoryReadsBackExactlyAndIsReproducible) {
@@ -171,11 +170,11 @@ TEST(NormalMap, PngInMemoryReadsBackExactlyAndIsReproducible) {
   EXPECT_EQ(encode_png_in_memory(w, h, 3, rgb), png);
   const fs::path file = fs::temp_directory_path() / ("sylva-png-" + std::to_string(::getpid()) + ".png");
   std::ofstream(file, std::ios::binary) << *png;
-  HeightMapReadResult r = read_height_map(file.string());  // channel 0 = red
+  Expected<HeightMap> r = read_height_map(file.string());  // channel 0 = red
   fs::remove(file);
-  ASSERT_TRUE(r.map) << r.error.value_or("");
-  ASSERT_EQ(r.map->values.size(), size_t{w} * h);
-  for (size_t k = 0; k < r.map->values.size(); ++k) EXPECT_EQ(std::lround(r.map->values[k] * 255), rgb[3 * k]) << k;
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  ASSERT_EQ(r->values.size(), size_t{w} * h);
+  for (size_t k = 0; k < r->values.size(); ++k) EXPECT_EQ(std::lround(r->values[k] * 255), rgb[3 * k]) << k;
   EXPECT_FALSE(encode_png_in_memory(w, h, 3, {1, 2, 3}));  // wrong size
 }
 

@@ -1,7 +1,7 @@
 // Tests for core/ray_frustum.h: ray against one conical frustum (paper 000 sec. 2.5).
 //
 // RayFrustum.* are specifications on hand-made shapes with hand-computed answers.
-// StiffCases.* is the stiff-case suite of issue 3 (section 4): a table of frusta and rays
+// StiffCases.* is the stiff-case suite of docs/accuracy.md: a table of frusta and rays
 // (r1/r0, angle to a generator line, origin inside/outside, offsets, radii, joint angles,
 // antiparallel axes) plus thousands of random ones, each compared with a reference
 // computed here in long double by a different algorithm: an exact re-centring by steps of

@@ -1,16 +1,27 @@
-// scene_test.cpp — scene.md's scene files: every key read, defaults, and located errors.
+// scene_test.cpp — scene.md's scene files: every key read, defaults, located errors, a
+// plant's grammar error named at its scene key, and write_scene_json read back equal.
 #include "core/scene.h"
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <glm/geometric.hpp>
+#include <random>
 
 #include "tests/core/test_textures.h"
 
 namespace sylva {
+
+// Failures show a scene as the text write_scene_json makes of it, and its places.
+void PrintTo(const Scene& s, std::ostream* os) {
+  Expected<std::string> text = write_scene_json(s);
+  *os << (text ? *text : text.error().format()) << "(file \"" << s.file << "\")";
+}
+
 namespace {
 
 const char* const kExample = R"({
@@ -29,11 +40,10 @@ const char* const kExample = R"({
   ]
 })";
 
-SceneError expect_error(std::string_view text) {
-  SceneReadResult r = parse_scene_json(text, "s.scene.json", "");
-  EXPECT_FALSE(r.scene.has_value());
-  EXPECT_TRUE(r.error.has_value());
-  return r.error.value_or(SceneError{});
+Diagnostic expect_error(std::string_view text) {
+  Expected<Scene> r = parse_scene_json(text, "s.scene.json", "");
+  EXPECT_FALSE(r.ok());
+  return r ? Diagnostic{} : r.error();
 }
 
 TEST(Scene, ReadsEveryKeyOfTheSpecExample) {
@@ -42,9 +52,9 @@ TEST(Scene, ReadsEveryKeyOfTheSpecExample) {
   std::filesystem::create_directories(dir.file("textures"));
   test::write_rgb_png(dir.file("textures/bark.png"), 2, 2, [](uint32_t, uint32_t) { return std::array<float, 3>{}; });
   test::write_rgb_png(dir.file("textures/bark_height.png"), 2, 2, [](uint32_t, uint32_t) { return std::array<float, 3>{}; });
-  SceneReadResult r = parse_scene_json(kExample, "dir/a.scene.json", dir.path());
-  ASSERT_TRUE(r.scene) << r.error->format();
-  const Scene& s = *r.scene;
+  Expected<Scene> r = parse_scene_json(kExample, "dir/a.scene.json", dir.path());
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  const Scene& s = *r;
   EXPECT_EQ(s.camera.eye, glm::dvec3(6, 3, 6));
   EXPECT_EQ(s.camera.target, glm::dvec3(0, 2, 0));
   EXPECT_EQ(s.camera.fov_y_deg, 40);
@@ -73,14 +83,14 @@ TEST(Scene, ReadsEveryKeyOfTheSpecExample) {
 
 TEST(Scene, BarkTextureThatDoesNotExistOrOpenIsAnErrorAtItsKey) {
   test::TempFolder dir;
-  SceneReadResult r = parse_scene_json(
+  Expected<Scene> r = parse_scene_json(
       "{\"plants\": [{\"grammar\": \"g.lsys\",\n  \"bark\": {\"u_repeat\": 2,\n   \"albedo\": \"nope.png\"}}]}",
       "s.scene.json", dir.path());
-  ASSERT_TRUE(r.error);
-  EXPECT_EQ(r.error->line, 3u);
-  EXPECT_EQ(r.error->column, 4u);
-  EXPECT_NE(r.error->message.find("plants[0].bark.albedo"), std::string::npos) << r.error->message;
-  EXPECT_NE(r.error->message.find(dir.file("nope.png")), std::string::npos) << r.error->message;
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().loc.line, 3u);
+  EXPECT_EQ(r.error().loc.column, 4u);
+  EXPECT_NE(r.error().message.find("plants[0].bark.albedo"), std::string::npos) << r.error().message;
+  EXPECT_NE(r.error().message.find(dir.file("nope.png")), std::string::npos) << r.error().message;
   // A file OpenImageIO cannot read, as the height map.
   {
     std::ofstream out(dir.file("text.png"));
@@ -88,48 +98,48 @@ TEST(Scene, BarkTextureThatDoesNotExistOrOpenIsAnErrorAtItsKey) {
   }
   r = parse_scene_json("{\"plants\": [{\"grammar\": \"g.lsys\", \"bark\": {\"height\": \"text.png\"}}]}",
                        "s.scene.json", dir.path());
-  ASSERT_TRUE(r.error);
-  EXPECT_EQ(r.error->line, 1u);
-  EXPECT_EQ(r.error->column, 44u);
-  EXPECT_NE(r.error->message.find("plants[0].bark.height: cannot open image"), std::string::npos) << r.error->message;
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().loc.line, 1u);
+  EXPECT_EQ(r.error().loc.column, 44u);
+  EXPECT_NE(r.error().message.find("plants[0].bark.height: cannot open image"), std::string::npos) << r.error().message;
 }
 
 TEST(Scene, OnlyPlantsIsRequiredAndTheRestDefaults) {
-  SceneReadResult r = parse_scene_json(R"({"plants": [{"grammar": "g.lsys"}]})", "s", "");
-  ASSERT_TRUE(r.scene) << r.error->format();
-  EXPECT_EQ(r.scene->width, 1024u);
-  EXPECT_EQ(r.scene->height, 768u);
-  EXPECT_FALSE(r.scene->fog);  // no fog key, no fog pass
-  EXPECT_NEAR(glm::length(r.scene->sun.direction), 1.0, 1e-15);
-  EXPECT_EQ(r.scene->plants[0].scale, 1);
-  EXPECT_FALSE(r.scene->plants[0].seed);
+  Expected<Scene> r = parse_scene_json(R"({"plants": [{"grammar": "g.lsys"}]})", "s", "");
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  EXPECT_EQ(r->width, 1024u);
+  EXPECT_EQ(r->height, 768u);
+  EXPECT_FALSE(r->fog);  // no fog key, no fog pass
+  EXPECT_NEAR(glm::length(r->sun.direction), 1.0, 1e-15);
+  EXPECT_EQ(r->plants[0].scale, 1);
+  EXPECT_FALSE(r->plants[0].seed);
 }
 
 TEST(Scene, UnknownTopLevelKeyNamesKeyFileLineAndColumn) {
-  SceneError e = expect_error("{\"plants\": [],\n  \"camra\": {}}");
-  EXPECT_EQ(e.line, 2u);
-  EXPECT_EQ(e.column, 3u);
+  Diagnostic e = expect_error("{\"plants\": [],\n  \"camra\": {}}");
+  EXPECT_EQ(e.loc.line, 2u);
+  EXPECT_EQ(e.loc.column, 3u);
   EXPECT_NE(e.message.find("\"camra\""), std::string::npos) << e.message;
   EXPECT_EQ(e.format().rfind("s.scene.json:2:3: error: unknown key \"camra\"", 0), 0u) << e.format();
 }
 
 TEST(Scene, UnknownNestedKeyIsLocatedAtTheKey) {
-  SceneError e = expect_error("{\"plants\": [{\"grammar\": \"g.lsys\",\n    \"bark\": {\"u_repeet\": 2}}]}");
-  EXPECT_EQ(e.line, 2u);
-  EXPECT_EQ(e.column, 14u);
+  Diagnostic e = expect_error("{\"plants\": [{\"grammar\": \"g.lsys\",\n    \"bark\": {\"u_repeet\": 2}}]}");
+  EXPECT_EQ(e.loc.line, 2u);
+  EXPECT_EQ(e.loc.column, 14u);
   EXPECT_NE(e.message.find("u_repeet"), std::string::npos);
   EXPECT_NE(e.message.find("plants[0].bark"), std::string::npos) << e.message;
 }
 
 TEST(Scene, MissingPlantsIsAnError) {
-  SceneError e = expect_error("{\"sky\": [1, 1, 1]}");
+  Diagnostic e = expect_error("{\"sky\": [1, 1, 1]}");
   EXPECT_NE(e.message.find("plants"), std::string::npos);
 }
 
 TEST(Scene, WrongTypesAndRangesAreLocated) {
-  SceneError e = expect_error("{\"plants\": [],\n \"camera\": {\"fov_y_deg\": 180}}");
-  EXPECT_EQ(e.line, 2u);
-  EXPECT_EQ(e.column, 26u);
+  Diagnostic e = expect_error("{\"plants\": [],\n \"camera\": {\"fov_y_deg\": 180}}");
+  EXPECT_EQ(e.loc.line, 2u);
+  EXPECT_EQ(e.loc.column, 26u);
   e = expect_error("{\"plants\": [], \"image\": {\"width\": 1.5}}");
   EXPECT_NE(e.message.find("image.width"), std::string::npos);
   e = expect_error("{\"plants\": [], \"sky\": [1, 2]}");
@@ -144,12 +154,12 @@ TEST(Scene, WrongTypesAndRangesAreLocated) {
 
 TEST(SceneFog, ReadsEveryFogKeyOfTheSpec) {
   // spec/fog.md's example.
-  SceneReadResult r = parse_scene_json(R"({"plants": [],
+  Expected<Scene> r = parse_scene_json(R"({"plants": [],
     "fog": {"sigma_s": 0.05, "sigma_a": 0.005, "g": 0.6, "height_falloff": 0.0, "top": 30,
             "mode": "auto", "steps": 64, "photons": 1000000}})",
                                        "s", "");
-  ASSERT_TRUE(r.scene) << r.error->format();
-  const Fog& f = *r.scene->fog;
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  const Fog& f = *r->fog;
   EXPECT_EQ(f.sigma_s, 0.05);
   EXPECT_EQ(f.sigma_a, 0.005);
   EXPECT_EQ(f.g, 0.6);
@@ -161,18 +171,18 @@ TEST(SceneFog, ReadsEveryFogKeyOfTheSpec) {
   r = parse_scene_json(R"({"plants": [], "fog": {"mode": "reference", "steps": 7, "photons": 12, "top": -0.5,
                            "height_falloff": 0.3}, "ground": {"height": -1}})",
                        "s", "");
-  ASSERT_TRUE(r.scene) << r.error->format();
-  EXPECT_EQ(r.scene->fog->mode, FogMode::reference);
-  EXPECT_EQ(r.scene->fog->steps, 7u);
-  EXPECT_EQ(r.scene->fog->photons, 12u);
-  EXPECT_EQ(r.scene->fog->top, -0.5);  // above a ground at -1
-  EXPECT_EQ(r.scene->fog->height_falloff, 0.3);
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  EXPECT_EQ(r->fog->mode, FogMode::reference);
+  EXPECT_EQ(r->fog->steps, 7u);
+  EXPECT_EQ(r->fog->photons, 12u);
+  EXPECT_EQ(r->fog->top, -0.5);  // above a ground at -1
+  EXPECT_EQ(r->fog->height_falloff, 0.3);
 }
 
 TEST(SceneFog, AbsentKeysDefault) {
-  SceneReadResult r = parse_scene_json(R"({"plants": [], "fog": {}})", "s", "");
-  ASSERT_TRUE(r.scene) << r.error->format();
-  const Fog& f = *r.scene->fog;
+  Expected<Scene> r = parse_scene_json(R"({"plants": [], "fog": {}})", "s", "");
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  const Fog& f = *r->fog;
   EXPECT_TRUE(std::isinf(f.top));  // no ceiling
   EXPECT_EQ(f.mode, FogMode::automatic);
   EXPECT_EQ(f.steps, 64u);
@@ -223,23 +233,23 @@ TEST(SceneFog, EveryKeyOutOfRangeIsAnErrorAtTheKey) {
   for (const Bad& b : bad) {
     // The fog object's key starts at line 2, column 10.
     const std::string text = std::string("{\"plants\": [],\n \"fog\": {") + b.member + "}}";
-    SceneError e = expect_error(text);
-    EXPECT_EQ(e.line, 2u) << b.member;
-    EXPECT_EQ(e.column, 10u) << b.member;
+    Diagnostic e = expect_error(text);
+    EXPECT_EQ(e.loc.line, 2u) << b.member;
+    EXPECT_EQ(e.loc.column, 10u) << b.member;
     EXPECT_NE(e.message.find(b.says), std::string::npos) << b.member << ": " << e.message;
     EXPECT_EQ(e.format().rfind("s.scene.json:2:10: error: ", 0), 0u) << e.format();
   }
   // The top is compared with the ground wherever the ground key stands.
-  SceneError e = expect_error("{\"fog\": {\"top\": 4},\n \"ground\": {\"height\": 5}, \"plants\": []}");
-  EXPECT_EQ(e.line, 1u);
-  EXPECT_EQ(e.column, 10u);
+  Diagnostic e = expect_error("{\"fog\": {\"top\": 4},\n \"ground\": {\"height\": 5}, \"plants\": []}");
+  EXPECT_EQ(e.loc.line, 1u);
+  EXPECT_EQ(e.loc.column, 10u);
   EXPECT_NE(e.message.find("fog.top 4 must be above the ground (ground.height 5)"), std::string::npos) << e.message;
 }
 
 TEST(Scene, MalformedJsonIsLocated) {
-  SceneError e = expect_error("{\"plants\": [],\n}");
-  EXPECT_EQ(e.line, 1u);  // the trailing comma
-  EXPECT_EQ(e.column, 14u);
+  Diagnostic e = expect_error("{\"plants\": [],\n}");
+  EXPECT_EQ(e.loc.line, 1u);  // the trailing comma
+  EXPECT_EQ(e.loc.column, 14u);
 }
 
 TEST(Scene, DefaultSceneFramesTheSkeletonFromAThreeQuarterView) {
@@ -273,6 +283,205 @@ TEST(Scene, DefaultSceneFramesTheSkeletonFromAThreeQuarterView) {
   }
   EXPECT_LE(fill, 1 / 1.08 + 1e-9);
   EXPECT_GT(fill, 1 / 1.08 - 1e-9);
+}
+
+// ---- a plant's grammar error: the grammar's place, and a note at the scene's key -------
+
+TEST(SceneGrow, AGrammarErrorIsTheGrammarsDiagnosticWithANoteAtTheSceneKey) {
+  test::TempFolder dir;
+  std::ofstream(dir.file("bad.lsys")) << "axiom: A\nA -> F(foo(2))\n";
+  const std::string scene_text =
+      "{\"plants\": [\n  {\"grammar\": \"" + std::string(SYLVA_SOURCE_DIR) + "/presets/saguaro.lsys\"},\n"
+      "  {\"seed\": 2, \"grammar\": \"bad.lsys\"}\n]}";
+  Expected<Scene> scene = parse_scene_json(scene_text, dir.file("forest.scene.json"), dir.path());
+  ASSERT_TRUE(scene.ok()) << scene.error().format();
+  EXPECT_EQ(scene->plants[1].grammar_loc, (SourceLoc{3, 26}));
+  const Status grown = grow_scene_plants(*scene);
+  ASSERT_FALSE(grown.ok());
+  const Diagnostic& d = grown.error();
+  EXPECT_EQ(d.file, dir.file("bad.lsys"));  // the grammar's own file and place
+  EXPECT_EQ(d.loc, (SourceLoc{2, 8}));
+  EXPECT_EQ(d.source_line, "A -> F(foo(2))");
+  ASSERT_EQ(d.notes.size(), 1u);
+  EXPECT_EQ(d.notes[0].file, dir.file("forest.scene.json"));  // and where the scene named it
+  EXPECT_EQ(d.notes[0].loc, (SourceLoc{3, 26}));
+  EXPECT_EQ(d.notes[0].message, "plants[1].grammar names this grammar");
+  EXPECT_EQ(d.format(), dir.file("bad.lsys") + ":2:8: error: unknown function 'foo'\nA -> F(foo(2))\n       ^\n" +
+                            dir.file("forest.scene.json") + ":3:26: note: plants[1].grammar names this grammar\n");
+  EXPECT_TRUE(scene->plants[0].skeleton.has_value());  // the plant before it grew
+}
+
+TEST(SceneGrow, AnUnreadableGrammarIsNamedWithTheSceneKeyToo) {
+  Expected<Scene> scene = parse_scene_json(R"({"plants": [{"grammar": "no/such.lsys"}]})", "s.scene.json", "");
+  ASSERT_TRUE(scene.ok());
+  const Status grown = grow_scene_plants(*scene);
+  ASSERT_FALSE(grown.ok());
+  EXPECT_EQ(grown.error().file, "no/such.lsys");
+  EXPECT_EQ(grown.error().loc, SourceLoc{});
+  EXPECT_EQ(grown.error().error_number, ENOENT);
+  ASSERT_EQ(grown.error().notes.size(), 1u);
+  EXPECT_EQ(grown.error().notes[0].loc, (SourceLoc{1, 25}));
+}
+
+TEST(SceneGrow, ReportsProgressPerPlantAndStopsWhenCancelled) {
+  Scene scene;
+  for (int i = 0; i < 3; ++i) {
+    ScenePlant plant;
+    plant.grammar = std::string(SYLVA_SOURCE_DIR) + "/presets/saguaro.lsys";
+    plant.seed = static_cast<uint64_t>(i);
+    scene.plants.push_back(plant);
+  }
+  std::vector<double> fractions;
+  std::atomic<bool> cancel{false};
+  Scene copy = scene;
+  ASSERT_TRUE(grow_scene_plants(copy, 50'000'000, Progress([&](double f, std::string_view) { fractions.push_back(f); }))
+                  .ok());
+  ASSERT_FALSE(fractions.empty());
+  for (size_t i = 1; i < fractions.size(); ++i) EXPECT_LE(fractions[i - 1], fractions[i]);
+  EXPECT_EQ(fractions.back(), 1.0);
+  // Cancelled once the first plant is done: the rest stay ungrown, the result says so.
+  const Status stopped = grow_scene_plants(scene, 50'000'000, Progress([&](double f, std::string_view) {
+    if (f >= 1.0 / 3) cancel.store(true);
+  }, &cancel));
+  EXPECT_TRUE(stopped.cancelled());
+  EXPECT_TRUE(stopped.error().notes.empty());
+  EXPECT_TRUE(scene.plants[0].skeleton.has_value());
+  EXPECT_FALSE(scene.plants[2].skeleton.has_value());
+}
+
+// ---- write_scene_json: what it writes reads back equal ---------------------------------
+
+// `s` without the places it was read from (file, grammar_loc): not what the scene is.
+Scene without_places(Scene s) {
+  s.file.clear();
+  for (ScenePlant& p : s.plants) p.grammar_loc = {};
+  return s;
+}
+
+TEST(SceneWrite, WritesEveryKeyInScenemdOrderOneSectionPerLine) {
+  Scene s;
+  s.width = 320;
+  s.height = 200;
+  s.sun.direction = {0, 1, 0};
+  s.fog = Fog{};
+  ScenePlant p;
+  p.grammar = "presets/saguaro.lsys";
+  p.seed = 3;
+  p.defines = {{"N", 5}};
+  s.plants.push_back(p);
+  Expected<std::string> text = write_scene_json(s);
+  ASSERT_TRUE(text.ok()) << text.error().format();
+  EXPECT_EQ(*text,
+            "{\n"
+            "  \"format\": \"sylva-scene\",\n"
+            "  \"version\": 1,\n"
+            "  \"camera\": {\"eye\": [6,3,6], \"target\": [0,2,0], \"up\": [0,1,0], \"fov_y_deg\": 40},\n"
+            "  \"image\": {\"width\": 320, \"height\": 200},\n"
+            "  \"sun\": {\"direction\": [0,1,0], \"angular_radius_deg\": 0.27, \"radiance\": [3,3,2.8]},\n"
+            "  \"sky\": [0.25,0.3,0.4],\n"
+            "  \"ground\": {\"height\": 0, \"albedo\": [0.35,0.3,0.25]},\n"
+            "  \"fog\": {\"sigma_s\": 0.05, \"sigma_a\": 0.005, \"g\": 0.6, \"height_falloff\": 0, \"mode\": \"auto\", "
+            "\"steps\": 64, \"photons\": 1000000},\n"
+            "  \"plants\": [\n"
+            "    {\"grammar\": \"presets/saguaro.lsys\", \"seed\": 3, \"defines\": {\"N\": 5}, \"position\": [0,0,0], "
+            "\"rotate_y_deg\": 0, \"scale\": 1, \"bark\": {\"relief_depth\": 0.02, \"u_repeat\": 1, \"v_per_metre\": 1}}\n"
+            "  ]\n"
+            "}\n");
+}
+
+TEST(SceneWrite, ASceneWithEveryKeySetReadsBackEqual) {
+  test::TempFolder dir;
+  std::filesystem::create_directories(dir.file("textures"));
+  test::write_rgb_png(dir.file("textures/bark.png"), 2, 2, [](uint32_t, uint32_t) { return std::array<float, 3>{}; });
+  test::write_rgb_png(dir.file("textures/h.png"), 2, 2, [](uint32_t, uint32_t) { return std::array<float, 3>{}; });
+  Scene s;
+  s.camera = {{1.5, 2.25, -7}, {0.1, 1, 0.3}, {0, 1, 0.01}, 33.3};
+  s.width = 1920;
+  s.height = 1080;
+  s.sun = {unit_sun_direction({0.3, 0.9, -0.2}), 0.5, {10, 9.5, 8.25}};
+  s.sky = {0.1, 0.2, 1e-3};
+  s.ground = {-0.75, {0.5, 0.25, 0.125}};
+  s.fog = Fog{0.125, 0.01, -0.3, 0.05, 12.5, FogMode::refined, 9, 4321};
+  ScenePlant textured;
+  textured.grammar = dir.file("g.lsys");
+  textured.seed = 18446744073709551615u;
+  textured.steps = 7;
+  textured.defines = {{"N", 4}, {"ANGLE", 22.5}, {"tiny", 1e-300}};
+  textured.position = {1, -2, 3.5};
+  textured.rotate_y_deg = -45;
+  textured.scale = 0.3;
+  textured.bark.albedo_texture = dir.file("textures/bark.png");
+  textured.bark.height_texture = dir.file("textures/h.png");
+  textured.bark.relief_depth_m = 0.015;
+  textured.bark.u_repeat = 3;
+  textured.bark.v_per_metre = 0.5;
+  ScenePlant coloured;
+  coloured.grammar = dir.file("other.lsys");
+  coloured.bark.albedo_rgb = glm::dvec3(0.3, 0.2, 0.1);
+  s.plants = {textured, coloured};
+  const std::string folder = dir.file("scenes");
+  std::filesystem::create_directories(folder);
+  Expected<std::string> text = write_scene_json(s, folder);
+  ASSERT_TRUE(text.ok()) << text.error().format();
+  EXPECT_NE(text->find("\"albedo\": \"../textures/bark.png\""), std::string::npos) << *text;  // relative to the file
+  EXPECT_NE(text->find("\"seed\": 18446744073709551615"), std::string::npos) << *text;
+  Expected<Scene> back = parse_scene_json(*text, "every.scene.json", folder);
+  ASSERT_TRUE(back.ok()) << back.error().format() << *text;
+  EXPECT_EQ(without_places(*back), s);
+  // Written into a file and read from there, too.
+  const std::string path = folder + "/every.scene.json";
+  std::ofstream(path) << *text;
+  Expected<Scene> from_file = read_scene_file(path);
+  ASSERT_TRUE(from_file.ok()) << from_file.error().format();
+  EXPECT_EQ(without_places(*from_file), s);
+  EXPECT_EQ(from_file->file, path);
+}
+
+TEST(SceneWrite, EveryBundledSceneReadsBackEqualAndWritesTheSameBytesAgain) {
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes")) {
+    const std::string path = entry.path().string();
+    if (path.size() < 11 || path.substr(path.size() - 11) != ".scene.json") continue;
+    ++scenes;
+    const std::string folder = entry.path().parent_path().string();
+    Expected<Scene> read = read_scene_file(path);
+    ASSERT_TRUE(read.ok()) << read.error().format();
+    Expected<std::string> text = write_scene_json(*read, folder);
+    ASSERT_TRUE(text.ok()) << text.error().format();
+    Expected<Scene> back = parse_scene_json(*text, path, folder);
+    ASSERT_TRUE(back.ok()) << back.error().format();
+    EXPECT_EQ(without_places(*back), without_places(*read)) << path;
+    EXPECT_EQ(write_scene_json(*back, folder).value(), *text) << path;
+  }
+  EXPECT_GE(scenes, 2);
+}
+
+TEST(SceneWrite, SunDirectionsMadeAsTheReaderMakesThemReadBackExactly) {
+  // Normalising twice need not give the same bits as once; the writer finds a vector the
+  // reader normalises to exactly the stored one.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 500; ++trial) {
+    glm::dvec3 d(u(rng), u(rng), u(rng));
+    if (glm::length(d) < 1e-3) continue;
+    Scene s;
+    s.sun.direction = unit_sun_direction(d);
+    ScenePlant p;
+    p.grammar = "g.lsys";
+    s.plants.push_back(p);
+    Expected<Scene> back = parse_scene_json(write_scene_json(s).value(), "s.scene.json", "");
+    ASSERT_TRUE(back.ok()) << back.error().format();
+    ASSERT_EQ(back->sun.direction, s.sun.direction) << trial;
+  }
+}
+
+TEST(SceneWrite, APlantWithoutAGrammarCannotBeWritten) {
+  Skeleton sk;
+  sk.joints = {{{0, 0, 0}, 0.1, 0}, {{0, 1, 0}, 0.1, 0}};
+  sk.chains = {{0, 2, std::nullopt}};
+  const Expected<std::string> text = write_scene_json(default_scene_for(sk));
+  ASSERT_FALSE(text.ok());
+  EXPECT_NE(text.error().message.find("plants[0] has no grammar"), std::string::npos) << text.error().format();
 }
 
 }  // namespace

@@ -67,23 +67,30 @@ std::string file_with_source(const std::string& source) {
          "}\n";
 }
 
+// A diagnostic's one line (these errors have no source line or notes).
+std::string one_line(const Diagnostic& d) {
+  std::string text = d.format();
+  EXPECT_EQ(text.find('\n'), text.size() - 1) << text;
+  text.pop_back();
+  return text;
+}
+
 // The formatted error reading `text`, or "no error".
 std::string read_error(const std::string& text) {
-  const SkeletonReadResult result = read_skeleton_json(text, kFile);
-  if (!result.error) return "no error";
-  EXPECT_FALSE(result.skeleton.has_value());
-  return result.error->format();
+  const Expected<Skeleton> result = read_skeleton_json(text, kFile);
+  if (result) return "no error";
+  return one_line(result.error());
 }
 
 Skeleton read_ok(const std::string& text) {
-  SkeletonReadResult result = read_skeleton_json(text, kFile);
-  EXPECT_FALSE(result.error.has_value()) << result.error->format();
-  return result.skeleton ? std::move(*result.skeleton) : Skeleton{};
+  Expected<Skeleton> result = read_skeleton_json(text, kFile);
+  EXPECT_TRUE(result.ok()) << result.error().format();
+  return result ? std::move(*result) : Skeleton{};
 }
 
 std::string validate_error(const Skeleton& skeleton) {
-  const std::optional<SkeletonError> error = validate_skeleton(skeleton);
-  return error ? error->format() : "no error";
+  const Status valid = validate_skeleton(skeleton);
+  return valid ? "no error" : one_line(valid.error());
 }
 
 void expect_same_bits(double a, double b) {
@@ -104,6 +111,20 @@ TEST(SkeletonWrite, WritesTheDocumentedLayoutByteForByte) {
             "    {\"parent\": [0,1], \"joints\": [[0,1,0,0.1,0],[0.7,1.7,0,0.08,0]]}\n"
             "  ]\n"
             "}\n");
+}
+
+TEST(SkeletonWrite, TheCompactFormForEmbeddingIsTheSameDocumentWithTheSeedAsAString) {
+  Skeleton skeleton = documented_skeleton();
+  skeleton.source.seed = 18446744073709551615u;
+  JsonWriter w;
+  w.begin_object();
+  write_skeleton_members(w, skeleton, {.compact = true, .seed_as_string = true});
+  w.end_object();
+  EXPECT_EQ(w.text(),
+            "{\"format\":\"sylva-skeleton\",\"version\":1,\"source\":{\"grammar\":\"presets/saguaro.lsys\","
+            "\"seed\":\"18446744073709551615\",\"steps\":6,\"defines\":{\"N\":5}},\"chains\":["
+            "{\"parent\":null,\"joints\":[[0,0,0,0.3,0],[0,1,0,0.28,0]]},"
+            "{\"parent\":[0,1],\"joints\":[[0,1,0,0.1,0],[0.7,1.7,0,0.08,0]]}]}");
 }
 
 TEST(SkeletonWrite, AnEmptySkeletonWritesEmptyDefinesAndChains) {
@@ -556,10 +577,14 @@ TEST(SkeletonValidate, SegmentCountIsJointsMinusOnePerChain) {
 
 // ---- errors and files -------------------------------------------------------------
 
-TEST(SkeletonErrorFormat, OmitsThePlaceWhenItIsUnknown) {
-  EXPECT_EQ((SkeletonError{"a.json", 3, 7, "bad"}).format(), "a.json:3:7: error: bad");
-  EXPECT_EQ((SkeletonError{"a.json", 0, 0, "bad"}).format(), "a.json: error: bad");
-  EXPECT_EQ((SkeletonError{"", 0, 0, "bad"}).format(), "error: bad");
+TEST(SkeletonErrors, AreDiagnosticsAtTheOffendingValueWithoutSourceLine) {
+  const Expected<Skeleton> result = read_skeleton_json("{\"format\": \"sylva-skeleton\",\n \"version\": 2}", kFile);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.error().file, kFile);
+  EXPECT_EQ(result.error().loc, (SourceLoc{2, 13}));
+  EXPECT_FALSE(result.error().source_line.has_value());
+  EXPECT_TRUE(result.error().notes.empty());
+  EXPECT_FALSE(result.cancelled());
 }
 
 class SkeletonFileTest : public ::testing::Test {
@@ -576,28 +601,27 @@ class SkeletonFileTest : public ::testing::Test {
 TEST_F(SkeletonFileTest, ReadsAWrittenFileBackExactly) {
   const std::string path = directory_ + "/plant.skel.json";
   const std::string text = write_skeleton_json(varied_skeleton());
-  ASSERT_EQ(write_file_atomically(path, text), std::nullopt);
-  const SkeletonReadResult result = read_skeleton_file(path);
-  ASSERT_TRUE(result.skeleton.has_value()) << result.error->format();
-  EXPECT_EQ(write_skeleton_json(*result.skeleton), text);
+  ASSERT_TRUE(write_file_atomically(path, text).ok());
+  const Expected<Skeleton> result = read_skeleton_file(path);
+  ASSERT_TRUE(result.ok()) << result.error().format();
+  EXPECT_EQ(*result, varied_skeleton());
+  EXPECT_EQ(write_skeleton_json(*result), text);
 }
 
 TEST_F(SkeletonFileTest, AMissingFileIsAnErrorNamingThePath) {
   const std::string path = directory_ + "/missing.skel.json";
-  const SkeletonReadResult result = read_skeleton_file(path);
-  ASSERT_TRUE(result.error.has_value());
-  EXPECT_FALSE(result.skeleton.has_value());
-  EXPECT_EQ(result.error->format(), path + ": error: cannot open for reading: No such file or directory");
+  const Expected<Skeleton> result = read_skeleton_file(path);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.error().format(), path + ": error: cannot open for reading: No such file or directory\n");
 }
 
 TEST_F(SkeletonFileTest, ErrorsInAFileNameTheFileAndPlace) {
   const std::string path = directory_ + "/bad.skel.json";
-  ASSERT_EQ(write_file_atomically(path, "{\"format\": \"sylva-skeleton\", \"version\": 3, \"chains\": []}"),
-            std::nullopt);
-  const SkeletonReadResult result = read_skeleton_file(path);
-  ASSERT_TRUE(result.error.has_value());
-  EXPECT_EQ(result.error->format(), path + ":1:41: error: unsupported version 3 of \"sylva-skeleton\"; "
-                                           "this reader reads version 1");
+  ASSERT_TRUE(write_file_atomically(path, "{\"format\": \"sylva-skeleton\", \"version\": 3, \"chains\": []}").ok());
+  const Expected<Skeleton> result = read_skeleton_file(path);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.error().format(), path + ":1:41: error: unsupported version 3 of \"sylva-skeleton\"; "
+                                            "this reader reads version 1\n");
 }
 
 }  // namespace

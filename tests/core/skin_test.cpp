@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <glm/geometric.hpp>
@@ -495,6 +496,27 @@ TEST(SkinPrecision, ChainAtAMillionMetresMatchesTheChainAtTheOriginTo1e9Relative
   if (far.frusta.size() >= 2) {
     EXPECT_LT(seam_error(far.frusta[0], far.frusta[1]), 1e-9);
   }
+}
+
+TEST(SkinProgress, ReportsTheChainsSkinnedAndStopsWhenCancelled) {
+  // 3000 two-joint chains: checked every 1024 chains.
+  Skeleton sk;
+  for (uint32_t c = 0; c < 3000; ++c) {
+    sk.joints.push_back({{double(c), 0, 0}, 0.1, 0});
+    sk.joints.push_back({{double(c), 1, 0}, 0.1, 0});
+    sk.chains.push_back({2 * c, 2, std::nullopt});
+  }
+  std::vector<double> fractions;
+  Expected<SkinnedSkeleton> all =
+      skin_skeleton(sk, {}, Progress([&](double f, std::string_view) { fractions.push_back(f); }));
+  ASSERT_TRUE(all.ok());
+  EXPECT_EQ(all->frusta.size(), 3000u);
+  EXPECT_EQ(all->frusta.size(), skin_skeleton(sk).frusta.size());
+  ASSERT_EQ(fractions.size(), 3u);  // after 1024 and 2048 chains, then 1
+  EXPECT_DOUBLE_EQ(fractions[0], 1024.0 / 3000);
+  EXPECT_EQ(fractions.back(), 1.0);
+  std::atomic<bool> cancel{true};
+  EXPECT_TRUE(skin_skeleton(sk, {}, Progress(&cancel)).cancelled());
 }
 
 }  // namespace

@@ -44,7 +44,7 @@ inline void write_rgb_png(const std::string& path, uint32_t width, uint32_t heig
       for (float c : encoded(x, y)) pixels.push_back(c);
   const auto error = write_image_atomically(path, width, height, {"R", "G", "B"}, pixels,
                                             {ChannelFormat::uint8}, true);
-  ASSERT_FALSE(error.has_value()) << error->message;
+  ASSERT_TRUE(error.ok()) << error.error().message;
 }
 
 // A one-channel float image (EXR, TIFF, ...) with value(x, y) at texel (x, y).
@@ -55,7 +55,7 @@ inline void write_gray_float(const std::string& path, uint32_t width, uint32_t h
     for (uint32_t x = 0; x < width; ++x) pixels.push_back(value(x, y));
   const auto error = write_image_atomically(path, width, height, {"Y"}, pixels,
                                             {ChannelFormat::float32}, false);
-  ASSERT_FALSE(error.has_value()) << error->message;
+  ASSERT_TRUE(error.ok()) << error.error().message;
 }
 
 }  // namespace sylva::test

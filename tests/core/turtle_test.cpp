@@ -10,12 +10,14 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace sylva {
 namespace {
@@ -579,7 +581,7 @@ TEST(TurtleChains, ParentsComeBeforeChildrenAndSegmentsAreOnePerF) {
   EXPECT_EQ(next_joint, skeleton.joints.size());
   EXPECT_EQ(skeleton.segment_count(), segments);
   EXPECT_EQ(skeleton.segment_count(), f_count);
-  EXPECT_FALSE(validate_skeleton(skeleton).has_value());
+  EXPECT_TRUE(validate_skeleton(skeleton).ok());
 }
 
 TEST(TurtleChains, GrowRecordsTheSourceOfTheSkeleton) {
@@ -652,6 +654,43 @@ TEST(TurtleLimits, MillionNestedBranchesGrowWithoutRecursion) {
   EXPECT_EQ(skeleton.chains[last].parent, parent(last - 1, 1));
   EXPECT_EQ(position_at(skeleton, last, 0), (Position{0, static_cast<double>(last), 0}));
   EXPECT_EQ(position_at(skeleton, last, 1), (Position{0, static_cast<double>(kDepth), 0}));
+}
+
+// ---- progress and cancellation (core/util/progress.h) ---------------------------------
+
+TEST(GrowProgress, DeriveInterpretAndTurtleReportInOrderEndingAtOne) {
+  auto grammar = lsys::parse_grammar("derivation length: 14\naxiom: A\nA -> AB\nB -> A\nhomomorphism:\nA -> F\n"
+                                     "B -> +F\n", "test.lsys", {});
+  ASSERT_TRUE(grammar.ok()) << grammar.error().format();
+  std::vector<double> fractions;
+  std::vector<std::string> stages;
+  lsys::DeriveOptions options;
+  options.progress = Progress([&](double f, std::string_view stage) {
+    fractions.push_back(f);
+    if (stages.empty() || stages.back() != stage) stages.emplace_back(stage);
+  });
+  ASSERT_TRUE(grow(*grammar, options, "test.lsys", {}).ok());
+  for (size_t i = 1; i < fractions.size(); ++i) EXPECT_LE(fractions[i - 1], fractions[i]);
+  EXPECT_EQ(fractions.back(), 1.0);
+  EXPECT_EQ(stages, (std::vector<std::string>{"derive", "interpret", "turtle"}));
+}
+
+TEST(GrowProgress, CancellingMidTurtleStopsWithTheCancelledResult) {
+  // 2^18 F: the turtle checks the flag every 64 Ki modules.
+  auto grammar = lsys::parse_grammar("derivation length: 18\naxiom: F\nF -> FF\n", "test.lsys", {});
+  ASSERT_TRUE(grammar.ok());
+  auto word = lsys::derive(*grammar);
+  ASSERT_TRUE(word.ok());
+  std::atomic<bool> cancel{false};
+  double last = 0;
+  const Progress progress([&](double f, std::string_view) {
+    last = f;
+    cancel.store(true);
+  }, &cancel);
+  Expected<Skeleton> sk = build_skeleton(*word, *grammar, nullptr, progress);
+  EXPECT_TRUE(sk.cancelled());
+  EXPECT_EQ(last, 0.25);  // the first chunk of four, then stopped
+  EXPECT_TRUE(build_skeleton(*word, *grammar).ok());
 }
 
 }  // namespace

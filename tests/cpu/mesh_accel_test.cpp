@@ -308,7 +308,7 @@ Scene saguaro_scene(uint32_t width, uint32_t height) {
   ScenePlant plant;
   plant.grammar = std::string(SYLVA_SOURCE_DIR) + "/presets/saguaro.lsys";
   scene.plants.push_back(plant);
-  EXPECT_FALSE(grow_scene_plants(scene).has_value());
+  EXPECT_TRUE(grow_scene_plants(scene).ok());
   return default_scene_for(*scene.plants[0].skeleton, width, height);
 }
 
@@ -357,12 +357,12 @@ TEST(MeshTracer, HeightFunctionIsTheReliefDepthTimesTheReliefField) {
   Scene scene = ribbed_saguaro_scene(16, 12);
   scene.plants.push_back(scene.plants[0]);
   scene.plants[1].bark = Bark{};  // no height map
-  SceneTextures::OpenResult opened = SceneTextures::open(scene);
-  ASSERT_FALSE(opened.error) << *opened.error;
-  const HeightFn height = height_function_for(*opened.textures, 0);
+  Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(scene);
+  ASSERT_TRUE(opened.ok()) << opened.error().format();
+  const HeightFn height = height_function_for(**opened, 0);
   ASSERT_TRUE(height);
-  EXPECT_FALSE(height_function_for(*opened.textures, 1));
-  const ReliefMap map = opened.textures->relief_map(0);
+  EXPECT_FALSE(height_function_for(**opened, 1));
+  const ReliefMap map = (*opened)->relief_map(0);
   for (double u : {0.0, 0.013, 0.025, 0.4, 0.999})
     for (double v_m : {0.0, 0.3, 2.71}) {
       const double h = std::clamp(map.field->height(u * 20, v_m * 13), 0.0, 1.0);

@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include "tests/core/test_scenes.h"
 
@@ -95,8 +98,47 @@ TEST(RenderCpu, CancelledRenderSaysSo) {
   Scene s = cylinder_scene();
   std::atomic<bool> cancel{true};
   RenderOptions o;
-  o.cancel = &cancel;
+  o.progress = Progress(&cancel);
   EXPECT_TRUE(render_cpu(s, o).cancelled);
+}
+
+TEST(RenderCpu, ProgressRisesMonotonicallyToOneAndLeavesTheImageAlone) {
+  Scene s = test::scene_around(test::cylinder(0.5, 0, 2), {0, 1, 5}, {0, 1, 0}, 256, 192, -10);  // 48 tiles
+  std::vector<double> fractions;
+  std::vector<std::string> stages;
+  RenderOptions o;
+  o.threads = 4;
+  o.progress = Progress([&](double f, std::string_view stage) {
+    fractions.push_back(f);
+    stages.emplace_back(stage);
+  });
+  const RenderResult with = render_cpu(s, o);
+  ASSERT_FALSE(with.cancelled);
+  ASSERT_GE(fractions.size(), 10u);
+  for (size_t i = 1; i < fractions.size(); ++i) EXPECT_LE(fractions[i - 1], fractions[i]);
+  EXPECT_EQ(fractions.back(), 1.0);
+  EXPECT_EQ(stages.front(), "geometry");
+  EXPECT_EQ(stages.back(), "render");
+  RenderOptions plain;
+  plain.threads = 4;
+  EXPECT_EQ(render_cpu(s, plain).image.beauty, with.image.beauty);
+}
+
+TEST(RenderCpu, CancellingMidRenderStopsBeforeTheLastTile) {
+  Scene s = test::scene_around(test::cylinder(0.5, 0, 2), {0, 1, 5}, {0, 1, 0}, 512, 384, -10);  // 192 tiles
+  std::atomic<bool> cancel{false};
+  double last = 0;
+  RenderOptions o;
+  o.threads = 2;
+  o.progress = Progress([&](double f, std::string_view stage) {
+    last = f;
+    if (stage == "render" && f > 0.3) cancel.store(true);
+  }, &cancel);
+  const RenderResult r = render_cpu(s, o);
+  EXPECT_TRUE(r.cancelled);
+  EXPECT_LT(last, 0.5);  // each worker finishes the tile it is on, then stops
+  // The tiles left undone are still black (the image is incomplete, not garbage).
+  EXPECT_EQ(r.image.beauty[r.image.beauty.size() - 4], 0.0f);
 }
 
 TEST(RenderCpu, PlacementRotatesScalesAndMoves) {
@@ -121,7 +163,7 @@ TEST(RenderCpu, SaguaroPresetIsLitAndShaded) {
   ScenePlant plant;
   plant.grammar = std::string(SYLVA_SOURCE_DIR) + "/presets/saguaro.lsys";
   scene.plants.push_back(plant);
-  ASSERT_FALSE(grow_scene_plants(scene).has_value());
+  ASSERT_TRUE(grow_scene_plants(scene).ok());
   scene = default_scene_for(*scene.plants[0].skeleton, 160, 120);
   RenderOptions o;
   o.aovs = kAovId;

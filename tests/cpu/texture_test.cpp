@@ -72,9 +72,9 @@ TEST(Texture, HeightTextureIsChannelZeroPeriodicAndATexelApart) {
   s.plants[1].bark.relief_depth_m = 0.03;
   s.plants[1].bark.u_repeat = 5;
   s.plants[1].bark.v_per_metre = 2;
-  SceneTextures::OpenResult opened = SceneTextures::open(s);
-  ASSERT_FALSE(opened.error) << *opened.error;
-  const SceneTextures& t = *opened.textures;
+  Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(s);
+  ASSERT_TRUE(opened.ok()) << opened.error().format();
+  const SceneTextures& t = **opened;
   EXPECT_FALSE(t.has_height(0));
   ASSERT_TRUE(t.has_height(1));
   EXPECT_FALSE(t.has_albedo(1));
@@ -107,9 +107,9 @@ TEST(Texture, HeightSamplerEqualsTheTextureSystemsBilinearFinestLevel) {
   Scene s;
   s.plants.resize(1);
   s.plants[0].bark.height_texture = path;
-  SceneTextures::OpenResult opened = SceneTextures::open(s);
-  ASSERT_FALSE(opened.error) << *opened.error;
-  const HeightField& field = *opened.textures->relief_map(0).field;
+  Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(s);
+  ASSERT_TRUE(opened.ok()) << opened.error().format();
+  const HeightField& field = *(*opened)->relief_map(0).field;
   uint64_t state = 1;
   auto next = [&] { return static_cast<double>((state = state * 6364136223846793005ull + 1442695040888963407ull) >> 11) * 0x1.0p-53; };
   for (int i = 0; i < 2000; ++i) {
@@ -127,12 +127,12 @@ TEST(Texture, PlantsNamingOneFileShareOneHandle) {
   s.plants[0].bark.albedo_texture = path;
   s.plants[2].bark.albedo_texture = path;
   s.plants[2].bark.height_texture = path;
-  SceneTextures::OpenResult opened = SceneTextures::open(s);
-  ASSERT_FALSE(opened.error) << *opened.error;
-  EXPECT_EQ(opened.textures->file_count(), 1u);
-  EXPECT_TRUE(opened.textures->has_albedo(0));
-  EXPECT_FALSE(opened.textures->has_albedo(1));
-  EXPECT_TRUE(opened.textures->has_height(2));
+  Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(s);
+  ASSERT_TRUE(opened.ok()) << opened.error().format();
+  EXPECT_EQ((*opened)->file_count(), 1u);
+  EXPECT_TRUE((*opened)->has_albedo(0));
+  EXPECT_FALSE((*opened)->has_albedo(1));
+  EXPECT_TRUE((*opened)->has_height(2));
 }
 
 TEST(Texture, ATextureThatCannotBeOpenedIsAnErrorNamingTheFile) {
@@ -140,11 +140,11 @@ TEST(Texture, ATextureThatCannotBeOpenedIsAnErrorNamingTheFile) {
   Scene s;
   s.plants.resize(1);
   s.plants[0].bark.albedo_texture = dir.file("missing.png");
-  SceneTextures::OpenResult opened = SceneTextures::open(s);
-  ASSERT_TRUE(opened.error);
-  EXPECT_FALSE(opened.textures);
-  EXPECT_NE(opened.error->find(dir.file("missing.png")), std::string::npos) << *opened.error;
-  EXPECT_TRUE(image_open_error(dir.file("missing.png")).has_value());
+  Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(s);
+  ASSERT_FALSE(opened.ok());
+  EXPECT_EQ(opened.error().file, dir.file("missing.png"));
+  EXPECT_NE(opened.error().message.find(dir.file("missing.png")), std::string::npos) << opened.error().message;
+  EXPECT_FALSE(check_image_opens(dir.file("missing.png")).ok());
 }
 
 TEST(Texture, ConstantAlbedoTextureCoversEveryMaterialAndDecodesSrgb) {

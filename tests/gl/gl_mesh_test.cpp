@@ -1,4 +1,4 @@
-// gl_mesh_test.cpp — the polygon baseline on the GPU (core/gl_mesh.h, issue 4 §3) against
+// gl_mesh_test.cpp — the polygon baseline on the GPU (core/gl/gl_mesh.h) against
 // the CPU's mesh path (render_cpu.h, GeometryKind::mesh through Embree): the same scene
 // and GeometryOptions through render_gl and render_cpu, compared pixel by pixel with the
 // tolerances of render_gl_test.cpp — hit/miss agreement >= 99.5 % of pixels, median
@@ -55,10 +55,10 @@ Agreement expect_mesh_matches_cpu(const std::string& name, const Scene& scene, c
 // The bundled ribbed saguaro (presets/scenes), small: a bark albedo texture and a height
 // map (GS+R displaces by it).
 Scene saguaro_scene(uint32_t width, uint32_t height) {
-  SceneReadResult read = read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes/saguaro.scene.json");
-  if (!read.scene) throw std::runtime_error(read.error ? read.error->format() : "saguaro.scene.json");
-  Scene scene = std::move(*read.scene);
-  if (auto error = grow_scene_plants(scene)) throw std::runtime_error(*error);
+  Expected<Scene> read = read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes/saguaro.scene.json");
+  if (!read) throw std::runtime_error(read.error().format());
+  Scene scene = std::move(*read);
+  if (Status grown = grow_scene_plants(scene); !grown) throw std::runtime_error(grown.error().format());
   scene.width = width;
   scene.height = height;
   return scene;

@@ -39,7 +39,7 @@ Skeleton grow_preset(const std::string& name) {
   ScenePlant plant;
   plant.grammar = std::string(SYLVA_SOURCE_DIR) + "/presets/" + name + ".lsys";
   scene.plants.push_back(plant);
-  if (auto error = grow_scene_plants(scene)) throw std::runtime_error(*error);
+  if (Status grown = grow_scene_plants(scene); !grown) throw std::runtime_error(grown.error().format());
   return *scene.plants.front().skeleton;
 }
 
@@ -94,8 +94,8 @@ std::string write_diff_images(const std::string& name, const RenderImage& gl, co
     std::vector<float> encoded(static_cast<size_t>(cpu.width) * cpu.height * 3);
     for (size_t p = 0; p * 3 < encoded.size(); ++p)
       for (int k = 0; k < 3; ++k) encoded[p * 3 + k] = linear_to_srgb(rgba[p * 4 + k]);
-    write_image_atomically((dir / file).string(), cpu.width, cpu.height, {"R", "G", "B"}, encoded,
-                           {ChannelFormat::uint8}, true);
+    (void)write_image_atomically((dir / file).string(), cpu.width, cpu.height, {"R", "G", "B"}, encoded,
+                                 {ChannelFormat::uint8}, true);  // a diagnostic picture: best effort
   };
   png("cpu.png", cpu.beauty);
   png("gl.png", gl.beauty);

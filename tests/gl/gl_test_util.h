@@ -50,7 +50,7 @@ Agreement compare(const RenderImage& gl, const RenderImage& cpu);
 
 // Renders `scene` on both backends with `options`, prints and records the agreement as
 // `name`, and adds a failure (writing the images, write_diff_images) unless it is within
-// issue 4's tolerances: hit/miss >= 99.5 %, median relative depth error <= 1e-4, sRGB
+// the GL backend's tolerances (render_gl_test.cpp): hit/miss >= 99.5 %, median relative depth error <= 1e-4, sRGB
 // beauty MAD <= 1/255, no NaN, some plant seen. The GL result goes to *gl when given.
 Agreement expect_matches_cpu(const std::string& name, const Scene& scene, const RenderOptions& options,
                              RenderResult* gl = nullptr);

@@ -1,4 +1,4 @@
-// render_gl_test.cpp — the GL ray caster against the CPU reference (issue 4, sec. 2): the
+// render_gl_test.cpp — the GL ray caster against the CPU reference (render_gl.h): the
 // same scene through render_gl and render_cpu, compared pixel by pixel. Tolerances: hit/miss
 // agreement >= 99.5 % of pixels, median relative depth error <= 1e-4, mean absolute beauty
 // difference <= 1/255 on the sRGB-encoded values a PNG holds (stricter than linear). On a
@@ -317,12 +317,12 @@ TEST(RenderGl, GrazingReliefHasNoNaNAndMatchesTheCpu) {
 
 // A bundled scene (presets/scenes/) at a small size.
 Scene preset_scene(const std::string& name, uint32_t width, uint32_t height) {
-  SceneReadResult read = read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes/" + name + ".scene.json");
-  if (!read.scene) throw std::runtime_error("cannot read scene " + name);
-  Scene scene = *read.scene;
+  Expected<Scene> read = read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes/" + name + ".scene.json");
+  if (!read) throw std::runtime_error("cannot read scene " + name);
+  Scene scene = *read;
   scene.width = width;
   scene.height = height;
-  if (auto error = grow_scene_plants(scene)) throw std::runtime_error(*error);
+  if (Status grown = grow_scene_plants(scene); !grown) throw std::runtime_error(grown.error().format());
   return scene;
 }
 

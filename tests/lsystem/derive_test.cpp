@@ -1,7 +1,10 @@
 // Derivation: parallel rewriting, identity, bracket-aware context (ABOP 1.8), ignore
 // lists, stochastic choice, determinism, cut, homomorphism, limits.
+#include <atomic>
 #include <cmath>
 #include <map>
+#include <string>
+#include <vector>
 
 #include "tests/lsystem/lsystem_test_util.h"
 
@@ -242,6 +245,85 @@ TEST(Words, PrintingAndReparsingRoundTrips) {
 TEST(Words, NumbersPrintInShortestRoundTripForm) {
   EXPECT_EQ(derive_text("axiom: F(0.1*3)F(1/3)F(100)F(1e21)F(-0)\nsteps: 0\n"),
             "F(0.30000000000000004)F(0.3333333333333333)F(100)F(1e+21)F(-0)");
+}
+
+// ---- progress and cancellation (core/util/progress.h) ---------------------------------
+
+// Every fraction a Progress reported, in order.
+struct Reports {
+  std::vector<double> fractions;
+  std::vector<std::string> stages;
+  Progress progress(const std::atomic<bool>* cancel = nullptr) {
+    return Progress([this](double f, std::string_view stage) {
+      fractions.push_back(f);
+      stages.emplace_back(stage);
+    }, cancel);
+  }
+};
+
+TEST(DeriveProgress, DerivationReportsMonotoneFractionsEndingAtOne) {
+  auto g = parse_ok("axiom: A\nA -> AB\nB -> A\n");  // Fibonacci growth: 196418 modules at step 26
+  Reports r;
+  DeriveOptions o = steps(26);
+  o.progress = r.progress();
+  ASSERT_TRUE(derive(g, o).ok());
+  ASSERT_GE(r.fractions.size(), 3u);  // within the long last steps too
+  for (size_t i = 1; i < r.fractions.size(); ++i) EXPECT_LE(r.fractions[i - 1], r.fractions[i]);
+  EXPECT_EQ(r.fractions.back(), 1.0);
+  EXPECT_EQ(r.stages.back(), "derive");
+}
+
+TEST(DeriveProgress, CancellingMidDerivationStopsEarlyWithTheCancelledResult) {
+  auto g = parse_ok("axiom: A\nA -> AA\n");
+  std::atomic<bool> cancel{false};
+  double last = 0;
+  // Cancels as soon as a tenth is done; 2^24 modules at step 24 would follow.
+  Progress progress([&](double f, std::string_view) {
+    last = f;
+    if (f >= 0.1) cancel.store(true);
+  }, &cancel);
+  DeriveOptions o = steps(24);
+  o.progress = progress;
+  DeriveStats st;
+  auto w = derive(g, o, &st);
+  ASSERT_FALSE(w.ok());
+  EXPECT_TRUE(w.cancelled());
+  EXPECT_TRUE(w.error().cancelled);
+  EXPECT_EQ(w.error().message, "cancelled");
+  EXPECT_LT(last, 1.0);
+  EXPECT_EQ(st.modules, 0u);  // no stats: the derivation did not finish
+}
+
+TEST(DeriveProgress, CancellingMidStepStopsWithinTheStep) {
+  auto g = parse_ok("axiom: A\nA -> AA\n");
+  std::atomic<bool> cancel{false};
+  int calls_after_cancel = 0;
+  Progress progress([&](double f, std::string_view) {
+    if (cancel.load()) ++calls_after_cancel;
+    if (f > 21.5 / 22) cancel.store(true);  // half way through the last step (2^21 modules)
+  }, &cancel);
+  DeriveOptions o = steps(22);
+  o.progress = progress;
+  auto w = derive(g, o);
+  EXPECT_TRUE(w.cancelled());
+  EXPECT_EQ(calls_after_cancel, 0);  // checked at the very next chunk
+}
+
+TEST(DeriveProgress, ACancelledFlagStopsInterpretationToo) {
+  auto g = parse_ok("axiom: A\nA -> AA\nhomomorphism:\nA -> FF\n");
+  auto w = derive(g, steps(18));
+  ASSERT_TRUE(w.ok());
+  std::atomic<bool> cancel{true};
+  DeriveOptions o;
+  o.progress = Progress(&cancel);
+  auto t = interpret(g, *w, o);
+  EXPECT_TRUE(t.cancelled());
+  cancel.store(false);
+  Reports r;
+  o.progress = r.progress(&cancel);
+  ASSERT_TRUE(interpret(g, *w, o).ok());
+  EXPECT_EQ(r.fractions.back(), 1.0);
+  EXPECT_EQ(r.stages.back(), "interpret");
 }
 
 }  // namespace

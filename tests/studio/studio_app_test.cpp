@@ -28,7 +28,7 @@ const char* const kTree =
 struct Fixture : ::testing::Test {
   Fixture() : dir(::testing::UnitTest::GetInstance()->current_test_info()->name()) {
     path = dir.file("tree.lsys");
-    EXPECT_FALSE(write_file_atomically(path, kTree));
+    EXPECT_TRUE(write_file_atomically(path, kTree).ok());
   }
   std::unique_ptr<StudioApp> make_app(StudioOptions o = {}) {
     o.presets_dir = std::string(SYLVA_SOURCE_DIR) + "/presets";
@@ -198,9 +198,9 @@ TEST_F(Fixture, AutosavesAndOffersToRestore) {
     ui.type(*app, "F");
     ui.advance(2);
     ui.frames(*app, 2);
-    FileReadResult saved = read_text_file(autosave_path(path));
-    ASSERT_TRUE(saved.contents) << "autosave beside the file";
-    EXPECT_EQ(*saved.contents, app->text());
+    Expected<std::string> saved = read_text_file(autosave_path(path));
+    ASSERT_TRUE(saved.ok()) << "autosave beside the file";
+    EXPECT_EQ(*saved, app->text());
   }  // "crash": the app goes away with unsaved edits
   auto app = make_app(o);
   ASSERT_FALSE(app->open(path));
@@ -215,7 +215,7 @@ TEST_F(Fixture, AutosavesAndOffersToRestore) {
   EXPECT_TRUE(app->dirty());
   ASSERT_FALSE(app->save());
   EXPECT_FALSE(std::filesystem::exists(autosave_path(path))) << "a save removes the autosave";
-  EXPECT_EQ(*read_text_file(path).contents, app->text());
+  EXPECT_EQ(read_text_file(path).value(), app->text());
 }
 
 TEST_F(Fixture, ClosingWithUnsavedEditsAsksFirst) {
@@ -237,7 +237,7 @@ TEST_F(Fixture, ClosingWithUnsavedEditsAsksFirst) {
   ASSERT_TRUE(save);
   ui.click(*app, save->centre());
   EXPECT_TRUE(app->quit_requested());
-  EXPECT_EQ(*read_text_file(path).contents, app->text()) << "saved, atomically, before closing";
+  EXPECT_EQ(read_text_file(path).value(), app->text()) << "saved, atomically, before closing";
 }
 
 TEST_F(Fixture, ReloadsAFileChangedOnDisk) {
@@ -247,13 +247,13 @@ TEST_F(Fixture, ReloadsAFileChangedOnDisk) {
   std::string changed = kTree;
   changed.replace(changed.find("#define N 4"), 11, "#define N 2");
   std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  ASSERT_FALSE(write_file_atomically(path, changed));
+  ASSERT_TRUE(write_file_atomically(path, changed).ok());
   ASSERT_TRUE(ui.until(*app, [&] { return app->text() == changed && viewport.segments == 3u; }));
   EXPECT_FALSE(app->dirty());
   // With unsaved edits the user is asked instead.
   click_line_end(*app, 8);
   ui.type(*app, "F");
-  ASSERT_FALSE(write_file_atomically(path, kTree));
+  ASSERT_TRUE(write_file_atomically(path, kTree).ok());
   ASSERT_TRUE(ui.until(*app, [&] { return app->external_change_prompt_open(); }));
   EXPECT_NE(app->text(), kTree);
 }
@@ -329,15 +329,15 @@ TEST_F(Fixture, ExportsTheShownPlantThroughTheCliWriters) {
   const std::string glb = dir.file("tree.glb"), skel = dir.file("tree.skel.json");
   ASSERT_FALSE(app->export_gltf_file(glb, /*mesh=*/true));
   ASSERT_FALSE(app->export_skeleton_file(skel));
-  GltfImportResult back = import_gltf_skeletons(glb);
-  ASSERT_FALSE(back.error) << *back.error;
-  ASSERT_EQ(back.plants.size(), 1u);
-  EXPECT_EQ(back.plants[0].name, "tree");
-  EXPECT_EQ(back.plants[0].skeleton.segment_count(), 7u) << "the plant on screen, with the override";
-  EXPECT_EQ(back.plants[0].skeleton.source.defines.at("N"), 3);
-  SkeletonReadResult read = read_skeleton_file(skel);
-  ASSERT_TRUE(read.skeleton);
-  EXPECT_EQ(read.skeleton->segment_count(), 7u);
+  Expected<std::vector<GltfPlant>> back = import_gltf_skeletons(glb);
+  ASSERT_TRUE(back.ok()) << back.error().format();
+  ASSERT_EQ(back->size(), 1u);
+  EXPECT_EQ((*back)[0].name, "tree");
+  EXPECT_EQ((*back)[0].skeleton.segment_count(), 7u) << "the plant on screen, with the override";
+  EXPECT_EQ((*back)[0].skeleton.source.defines.at("N"), 3);
+  Expected<Skeleton> read = read_skeleton_file(skel);
+  ASSERT_TRUE(read.ok());
+  EXPECT_EQ(read->segment_count(), 7u);
   EXPECT_FALSE(app->export_png_file(dir.file("tree.png"), 64, 64).value_or("").empty())
       << "the fake viewport renders nothing: the error comes back, nothing is written";
   EXPECT_FALSE(std::filesystem::exists(dir.file("tree.png")));

@@ -89,42 +89,42 @@ class FileIoTest : public ::testing::Test {
 TEST_F(FileIoTest, ReadsEveryByteUntranslated) {
   const std::string bytes = "a\0b\r\nc\xFF\n"s;
   put(path("f"), bytes);
-  const FileReadResult result = read_text_file(path("f"));
-  ASSERT_FALSE(result.error.has_value()) << result.error->format();
-  EXPECT_EQ(*result.contents, bytes);
+  const Expected<std::string> result = read_text_file(path("f"));
+  ASSERT_TRUE(result.ok()) << result.error().format();
+  EXPECT_EQ(*result, bytes);
 }
 
 TEST_F(FileIoTest, ReadsEmptyAndLargeFiles) {
   put(path("empty"), "");
-  EXPECT_EQ(read_text_file(path("empty")).contents, std::optional<std::string>(""));
+  EXPECT_EQ(read_text_file(path("empty")).value(), "");
   std::string large;
   for (int i = 0; i < 300'000; ++i) large += static_cast<char>('a' + i % 26);
   put(path("large"), large);
-  EXPECT_EQ(read_text_file(path("large")).contents, std::optional<std::string>(large));
+  EXPECT_EQ(read_text_file(path("large")).value(), large);
 }
 
 TEST_F(FileIoTest, AMissingFileIsAnErrorNamingThePathAndTheReason) {
-  const FileReadResult result = read_text_file(path("missing.json"));
-  EXPECT_FALSE(result.contents.has_value());
-  ASSERT_TRUE(result.error.has_value());
-  EXPECT_EQ(result.error->path, path("missing.json"));
-  EXPECT_EQ(result.error->error_number, ENOENT);
-  EXPECT_EQ(result.error->format(),
-            path("missing.json") + ": error: cannot open for reading: No such file or directory");
+  const Expected<std::string> result = read_text_file(path("missing.json"));
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.error().file, path("missing.json"));
+  EXPECT_EQ(result.error().loc, SourceLoc{});
+  EXPECT_EQ(result.error().error_number, ENOENT);
+  EXPECT_EQ(result.error().format(),
+            path("missing.json") + ": error: cannot open for reading: No such file or directory\n");
 }
 
 TEST_F(FileIoTest, ADirectoryIsNotReadable) {
-  const FileReadResult result = read_text_file(directory_);
-  ASSERT_TRUE(result.error.has_value());
-  EXPECT_EQ(result.error->error_number, EISDIR);
-  EXPECT_EQ(result.error->format(), directory_ + ": error: cannot read: Is a directory");
+  const Expected<std::string> result = read_text_file(directory_);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.error().error_number, EISDIR);
+  EXPECT_EQ(result.error().format(), directory_ + ": error: cannot read: Is a directory\n");
 }
 
 // ---- write_file_atomically --------------------------------------------------------
 
 TEST_F(FileIoTest, WritingCreatesAFileWithExactlyTheBytes) {
   const std::string bytes = "{\n\0\r\n}"s;
-  EXPECT_EQ(write_file_atomically(path("plant.skel.json"), bytes), std::nullopt);
+  EXPECT_TRUE(write_file_atomically(path("plant.skel.json"), bytes).ok());
   EXPECT_EQ(contents(path("plant.skel.json")), bytes);
   EXPECT_EQ(entries(directory_), std::vector<std::string>{"plant.skel.json"});
 }
@@ -132,7 +132,7 @@ TEST_F(FileIoTest, WritingCreatesAFileWithExactlyTheBytes) {
 TEST_F(FileIoTest, WritingReplacesAnExistingFileAndLeavesNoTemporaryFile) {
   put(path("plant.skel.json"), "old contents, longer than the new ones");
   for (int i = 0; i < 5; ++i) {
-    EXPECT_EQ(write_file_atomically(path("plant.skel.json"), "new " + std::to_string(i)), std::nullopt);
+    EXPECT_TRUE(write_file_atomically(path("plant.skel.json"), "new " + std::to_string(i)).ok());
   }
   EXPECT_EQ(contents(path("plant.skel.json")), "new 4");
   EXPECT_EQ(entries(directory_), std::vector<std::string>{"plant.skel.json"});
@@ -140,16 +140,16 @@ TEST_F(FileIoTest, WritingReplacesAnExistingFileAndLeavesNoTemporaryFile) {
 
 TEST_F(FileIoTest, NewFilesGetTheUsualPermissionsLessTheUmask) {
   const mode_t previous = ::umask(022);
-  const std::optional<FileError> error = write_file_atomically(path("new.json"), "x");
+  const Status error = write_file_atomically(path("new.json"), "x");
   ::umask(previous);
-  EXPECT_EQ(error, std::nullopt);
+  EXPECT_TRUE(error.ok());
   EXPECT_EQ(permissions(path("new.json")), 0644u);
 }
 
 TEST_F(FileIoTest, ReplacingAFileKeepsItsPermissions) {
   put(path("private.json"), "old");
   ::chmod(path("private.json").c_str(), 0600);
-  EXPECT_EQ(write_file_atomically(path("private.json"), "new"), std::nullopt);
+  EXPECT_TRUE(write_file_atomically(path("private.json"), "new").ok());
   EXPECT_EQ(permissions(path("private.json")), 0600u);
   EXPECT_EQ(contents(path("private.json")), "new");
 }
@@ -164,10 +164,10 @@ TEST_F(FileIoTest, AnUnwritableDirectoryLeavesTheExistingFileUntouched) {
   std::string message;
   int error_number = 0;
   if (::geteuid() != 0) {
-    const std::optional<FileError> error = write_file_atomically(target, "new contents");
-    ASSERT_TRUE(error.has_value());
-    message = error->format();
-    error_number = error->error_number;
+    const Status error = write_file_atomically(target, "new contents");
+    ASSERT_FALSE(error.ok());
+    message = error.error().format();
+    error_number = error.error().error_number;
   } else {
     // Root ignores directory permissions: try as the unprivileged user "nobody".
     int pipe_fds[2];
@@ -177,9 +177,9 @@ TEST_F(FileIoTest, AnUnwritableDirectoryLeavesTheExistingFileUntouched) {
     if (child == 0) {
       ::close(pipe_fds[0]);
       if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(2);
-      const std::optional<FileError> error = write_file_atomically(target, "new contents");
-      if (!error) ::_exit(1);
-      const std::string report = std::to_string(error->error_number) + " " + error->format();
+      const Status error = write_file_atomically(target, "new contents");
+      if (error.ok()) ::_exit(1);
+      const std::string report = std::to_string(error.error().error_number) + " " + error.error().format();
       if (::write(pipe_fds[1], report.data(), report.size()) < 0) ::_exit(3);
       ::_exit(0);
     }
@@ -199,7 +199,7 @@ TEST_F(FileIoTest, AnUnwritableDirectoryLeavesTheExistingFileUntouched) {
   }
   EXPECT_EQ(error_number, EACCES);
   EXPECT_EQ(message, target + ": error: cannot create a temporary file in directory '" + dir +
-                         "': Permission denied");
+                         "': Permission denied\n");
   EXPECT_EQ(contents(target), "old contents");
   EXPECT_EQ(entries(dir), std::vector<std::string>{"plant.skel.json"});
 }
@@ -214,16 +214,16 @@ TEST_F(FileIoTest, AFailedWriteLeavesTheExistingFileUntouchedAndNoTemporaryFile)
   small_limit.rlim_cur = 16;
   auto* previous_handler = ::signal(SIGXFSZ, SIG_IGN);
   ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small_limit), 0);
-  const std::optional<FileError> error = write_file_atomically(target, std::string(4096, 'x'));
+  const Status error = write_file_atomically(target, std::string(4096, 'x'));
   ::setrlimit(RLIMIT_FSIZE, &previous_limit);
   ::signal(SIGXFSZ, previous_handler);
 
-  ASSERT_TRUE(error.has_value());
-  EXPECT_EQ(error->path, target);
-  EXPECT_EQ(error->error_number, EFBIG);
-  EXPECT_TRUE(is_temporary_failure(error->message, "cannot write temporary file", directory_,
+  ASSERT_FALSE(error.ok());
+  EXPECT_EQ(error.error().file, target);
+  EXPECT_EQ(error.error().error_number, EFBIG);
+  EXPECT_TRUE(is_temporary_failure(error.error().message, "cannot write temporary file", directory_,
                                    "plant.skel.json", ": File too large"))
-      << error->message;
+      << error.error().message;
   EXPECT_EQ(contents(target), "old contents");
   EXPECT_EQ(entries(directory_), std::vector<std::string>{"plant.skel.json"});
 }
@@ -233,49 +233,49 @@ TEST_F(FileIoTest, AFailedRenameRemovesTheTemporaryFile) {
   const std::string target = path("plant.skel.json");
   ASSERT_EQ(::mkdir(target.c_str(), 0755), 0);
   put(target + "/inside", "kept");
-  const std::optional<FileError> error = write_file_atomically(target, "new contents");
-  ASSERT_TRUE(error.has_value());
-  EXPECT_EQ(error->error_number, EISDIR);
-  EXPECT_TRUE(is_temporary_failure(error->message, "cannot rename temporary file", directory_,
+  const Status error = write_file_atomically(target, "new contents");
+  ASSERT_FALSE(error.ok());
+  EXPECT_EQ(error.error().error_number, EISDIR);
+  EXPECT_TRUE(is_temporary_failure(error.error().message, "cannot rename temporary file", directory_,
                                    "plant.skel.json", " over it: Is a directory"))
-      << error->message;
+      << error.error().message;
   EXPECT_EQ(contents(target + "/inside"), "kept");
   EXPECT_EQ(entries(directory_), std::vector<std::string>{"plant.skel.json"});
 }
 
 TEST_F(FileIoTest, AMissingDirectoryIsAnErrorNamingIt) {
   const std::string target = path("no-such-dir/plant.skel.json");
-  const std::optional<FileError> error = write_file_atomically(target, "x");
-  ASSERT_TRUE(error.has_value());
-  EXPECT_EQ(error->error_number, ENOENT);
-  EXPECT_EQ(error->format(), target + ": error: cannot create a temporary file in directory '" +
-                                 path("no-such-dir") + "': No such file or directory");
+  const Status error = write_file_atomically(target, "x");
+  ASSERT_FALSE(error.ok());
+  EXPECT_EQ(error.error().error_number, ENOENT);
+  EXPECT_EQ(error.error().format(), target + ": error: cannot create a temporary file in directory '" +
+                                 path("no-such-dir") + "': No such file or directory\n");
   EXPECT_TRUE(entries(directory_).empty());
 }
 
 TEST_F(FileIoTest, AnEmptyPathOrADirectoryPathIsAnError) {
-  const std::optional<FileError> empty = write_file_atomically("", "x");
-  ASSERT_TRUE(empty.has_value());
-  EXPECT_EQ(empty->format(), ": error: cannot write: the path is empty");
-  const std::optional<FileError> slash = write_file_atomically(directory_ + "/", "x");
-  ASSERT_TRUE(slash.has_value());
-  EXPECT_EQ(slash->format(), directory_ + "/: error: cannot write: Is a directory");
+  const Status empty = write_file_atomically("", "x");
+  ASSERT_FALSE(empty.ok());
+  EXPECT_EQ(empty.error().format(), "error: cannot write: the path is empty\n");
+  const Status slash = write_file_atomically(directory_ + "/", "x");
+  ASSERT_FALSE(slash.ok());
+  EXPECT_EQ(slash.error().format(), directory_ + "/: error: cannot write: Is a directory\n");
   EXPECT_TRUE(entries(directory_).empty());
 }
 
 TEST_F(FileIoTest, ARelativePathIsWrittenInTheCurrentDirectory) {
   const fs::path previous = fs::current_path();
   fs::current_path(directory_);
-  const std::optional<FileError> error = write_file_atomically("relative.json", "here");
+  const Status error = write_file_atomically("relative.json", "here");
   fs::current_path(previous);
-  EXPECT_EQ(error, std::nullopt);
+  EXPECT_TRUE(error.ok());
   EXPECT_EQ(contents(path("relative.json")), "here");
   EXPECT_EQ(entries(directory_), std::vector<std::string>{"relative.json"});
 }
 
 TEST_F(FileIoTest, ALongFileNameStillFitsItsTemporaryName) {
   const std::string name = std::string(250, 'n') + ".json";  // 255 bytes, the limit
-  EXPECT_EQ(write_file_atomically(path(name), "long"), std::nullopt);
+  EXPECT_TRUE(write_file_atomically(path(name), "long").ok());
   EXPECT_EQ(contents(path(name)), "long");
   EXPECT_EQ(entries(directory_), std::vector<std::string>{name});
 }
@@ -283,7 +283,7 @@ TEST_F(FileIoTest, ALongFileNameStillFitsItsTemporaryName) {
 TEST_F(FileIoTest, ASymbolicLinkIsReplacedNotWrittenThrough) {
   put(path("real.json"), "real");
   fs::create_symlink(path("real.json"), path("link.json"));
-  EXPECT_EQ(write_file_atomically(path("link.json"), "new"), std::nullopt);
+  EXPECT_TRUE(write_file_atomically(path("link.json"), "new").ok());
   EXPECT_FALSE(fs::is_symlink(path("link.json")));
   EXPECT_EQ(contents(path("link.json")), "new");
   EXPECT_EQ(contents(path("real.json")), "real");

@@ -1,4 +1,4 @@
-// Tests for core/json.h: the strict located reader and the writing helpers.
+// Tests for core/util/json.h: the strict located reader, the writing helpers and JsonWriter.
 //
 // Places are written "line:column", 1-based, columns in code points; the comments over
 // the longer inputs show how a column was counted.
@@ -20,20 +20,19 @@ namespace {
 using namespace std::string_literals;
 
 JsonValue parse_ok(std::string_view text, const JsonParseOptions& options = {}) {
-  JsonParseResult result = parse_json(text, options);
-  EXPECT_FALSE(result.error.has_value())
-      << "unexpected error " << result.error->line << ":" << result.error->column << ": "
-      << result.error->message;
-  return result.value ? std::move(*result.value) : JsonValue{};
+  Expected<JsonValue> result = parse_json(text, "t.json", options);
+  EXPECT_TRUE(result.ok()) << "unexpected error " << result.error().format();
+  return result ? std::move(*result) : JsonValue{};
 }
 
 // "line:column: message" for the error in `text`, or "no error".
 std::string parse_error(std::string_view text, const JsonParseOptions& options = {}) {
-  JsonParseResult result = parse_json(text, options);
-  if (!result.error) return "no error";
-  EXPECT_FALSE(result.value.has_value());
-  return std::to_string(result.error->line) + ":" + std::to_string(result.error->column) + ": " +
-         result.error->message;
+  Expected<JsonValue> result = parse_json(text, "t.json", options);
+  if (result) return "no error";
+  EXPECT_EQ(result.error().file, "t.json");
+  EXPECT_FALSE(result.error().source_line.has_value());
+  return std::to_string(result.error().loc.line) + ":" + std::to_string(result.error().loc.column) + ": " +
+         result.error().message;
 }
 
 std::string number_text(double value) {
@@ -461,6 +460,64 @@ TEST(JsonWrite, ExcerptsAreQuotedAndCutAfterFortyCodePoints) {
   std::string expected = "\"";
   for (int i = 0; i < 40; ++i) expected += "\xC3\xA9";
   EXPECT_EQ(json_excerpt(accents), expected + "\"...");
+}
+
+// ---- JsonWriter ----------------------------------------------------------------------
+
+TEST(JsonWriter, CompactLayoutHasNoSpaces) {
+  JsonWriter w;
+  w.begin_object().key("a").integer(1).key("b").begin_array().number(0.5).string("x").boolean(true).null();
+  w.end_array().key("c").begin_object().end_object().end_object();
+  EXPECT_EQ(w.text(), R"({"a":1,"b":[0.5,"x",true,null],"c":{}})");
+}
+
+TEST(JsonWriter, SpacedLayoutPutsASpaceAfterEachSeparator) {
+  JsonWriter w;
+  w.begin_object(JsonWriter::Layout::spaced).key("a").integer(1).key("v");
+  const double v[3] = {1, -2.5, 1e300};
+  w.numbers(v, 3, JsonWriter::Layout::spaced).end_object();
+  EXPECT_EQ(w.text(), R"({"a": 1, "v": [1, -2.5, 1e+300]})");
+}
+
+TEST(JsonWriter, LinesLayoutIndentsTwoSpacesPerOpenContainer) {
+  JsonWriter w;
+  w.begin_object(JsonWriter::Layout::lines).key("k").string("v").key("list").begin_array(JsonWriter::Layout::lines);
+  w.begin_array().integer(1).integer(2).end_array().begin_object(JsonWriter::Layout::spaced).end_object();
+  w.end_array().key("empty").begin_array(JsonWriter::Layout::lines).end_array().end_object();
+  EXPECT_EQ(w.text(), "{\n  \"k\": \"v\",\n  \"list\": [\n    [1,2],\n    {}\n  ],\n  \"empty\": []\n}");
+}
+
+TEST(JsonWriter, NumbersAndIntegersUseTheByteStableForms) {
+  JsonWriter w;
+  w.begin_array().number(-0.0).number(0.1).integer(uint64_t{18446744073709551615u}).integer(int64_t{-5});
+  w.integer(uint32_t{7}).integer(-3).end_array();
+  EXPECT_EQ(w.text(), "[0,0.1,18446744073709551615,-5,7,-3]");
+}
+
+TEST(JsonWriter, KeysAndStringsAreEscaped) {
+  JsonWriter w;
+  w.begin_object().key("a\"b").string("line\nbreak").end_object();
+  EXPECT_EQ(w.text(), R"({"a\"b":"line\nbreak"})");
+}
+
+TEST(JsonWriter, RawInsertsAValueWrittenElsewhere) {
+  JsonWriter inner;
+  inner.begin_object().key("x").integer(1).end_object();
+  JsonWriter w;
+  w.begin_array().raw(inner.text()).raw(inner.text()).end_array();
+  EXPECT_EQ(w.take(), R"([{"x":1},{"x":1}])");
+}
+
+TEST(JsonWriter, WhatItWritesReadsBack) {
+  JsonWriter w;
+  w.begin_object(JsonWriter::Layout::lines).key("n").number(0.1 + 0.2).key("s").string("\xC3\xA9\t");
+  w.key("a").begin_array(JsonWriter::Layout::spaced).integer(1).begin_object().key("k").null().end_object();
+  w.end_array().end_object();
+  const JsonValue v = parse_ok(w.text());
+  EXPECT_EQ(v.find("n")->number, 0.1 + 0.2);
+  EXPECT_EQ(v.find("s")->text, "\xC3\xA9\t");
+  ASSERT_EQ(v.find("a")->elements.size(), 2u);
+  EXPECT_TRUE(v.find("a")->elements[1].find("k")->is_null());
 }
 
 }  // namespace
