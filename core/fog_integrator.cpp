@@ -14,6 +14,10 @@ namespace sylva {
 
 using render_common::SampleRng;
 
+// Where shadow rays stop being castable: Embree's rays are float (3.4e38), and a point this
+// far is beyond every plant.
+constexpr double kFogFloatRange = 1e30;
+
 FogSun fog_sun_of(const Sun& sun) {
   FogSun s;
   s.direction = glm::normalize(sun.direction);
@@ -87,10 +91,14 @@ glm::dvec3 FogIntegrator::disc_direction(SampleRng& rng) const {
 }
 
 double FogIntegrator::visible(const CameraRay& ray, double t, const glm::dvec3& toward_sun, FogRayResult* result) const {
+  // An unbounded ray's far probes (t up to kFogFar) lie beyond float's range, where Embree's
+  // rays are invalid, and far outside every plant: nothing shadows them.
+  const glm::dvec3 p = ray.origin + t * ray.direction;
+  if (!(std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) < kFogFloatRange)) return 1.0;
   ++result->shadow_rays;
   // Only plants shadow the fog (the ground never lies between a point above it and a sun
   // above the horizon).
-  return tracer_.any(Ray{ray.origin + t * ray.direction, toward_sun}, 0, kFogInfinity) ? 0.0 : 1.0;
+  return tracer_.any(Ray{p, toward_sun}, 0, kFogInfinity) ? 0.0 : 1.0;
 }
 
 double FogIntegrator::sun_brute(const CameraRay& ray, double a, double b, const std::vector<FogInterval>* cones,

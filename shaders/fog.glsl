@@ -264,3 +264,10 @@ float fog_sample_lit_segment(FogMedium medium, vec3 origin, vec3 direction, vec3
   float t = fog_distance_at_depth(medium, origin, direction, clip.t0, tau);
   return clamp(t, clip.t0, min(clip.t1, kFogFar));
 }
+
+// Not in fog.h: shading.glsl's ground_distance for the fog's own programs (fog.frag.glsl,
+// fog_cones.frag.glsl), which include no shading.glsl: t where origin + t·direction meets
+// the ground, +inf where it never does.
+float fog_ground_distance(float above_ground, float direction_y) {
+  return direction_y < 0.0 && above_ground > 0.0 ? -above_ground / direction_y : kInfinity;
+}

@@ -50,7 +50,7 @@ void print_render_help() {
          "      --backend B        auto (default): OpenGL on a window-less EGL context (the GPU,\n"
          "                         or Mesa's llvmpipe without one), else the CPU ray caster,\n"
          "                         saying why; gl: OpenGL or exit 1 saying why; cpu: the CPU\n"
-         "                         reference (bark textures, relief and fog are CPU-only for now)\n"
+         "                         reference (fog modes but brute are CPU-only for now)\n"
          "      --width W          image width in pixels (default: the scene's, else 1024)\n"
          "      --height H         image height in pixels (default: the scene's, else 768)\n"
          "      --aov LIST         extra outputs, comma-separated: depth (channel Z, distance\n"
@@ -286,10 +286,7 @@ int run_render(const std::vector<std::string>& args) {
   if (a.backend != "cpu") {
     std::string why_not;
     const char* fallback = "OpenGL unavailable";
-    if (scene.fog) {
-      why_not = "fog is rendered by the CPU ray caster only, for now";
-      fallback = "the OpenGL backend cannot draw this";
-    } else if (auto unsupported = gl_unsupported(scene, options)) {
+    if (auto unsupported = gl_unsupported(scene, options)) {
       why_not = *unsupported;
       fallback = "the OpenGL backend cannot draw this";
     } else {

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <stdexcept>
 
+#include "core/fog_integrator.h"
 #include "core/shading.h"
 
 namespace sylva {
@@ -159,13 +160,26 @@ ShaderProgramSource present_program(bool srgb) {
   return p;
 }
 
-ShaderProgramSource shade_program(bool sun) {
+ShaderProgramSource shade_program(bool sun, bool fog) {
   ShaderProgramSource p;
   std::vector<std::string> defines = shading_defines();
   if (sun) defines.push_back("SUN");
-  p.name = sun ? "shade[SUN]" : "shade[]";
+  if (fog) defines.push_back("FOG");
+  p.name = std::string("shade[") + (sun ? "SUN" : "") + (sun && fog ? " " : "") + (fog ? "FOG" : "") + "]";
   p.vertex = {ShaderStage::vertex, {"fullscreen.vert.glsl"}, {}};
-  p.fragment = {ShaderStage::fragment, {"bark.glsl", "shading.glsl", "shade.frag.glsl"}, defines};
+  std::vector<std::string> files = {"bark.glsl", "shading.glsl"};
+  if (fog) files.push_back("fog.glsl");
+  p.fragment = {ShaderStage::fragment, with(files, "shade.frag.glsl"), defines};
+  return p;
+}
+
+ShaderProgramSource fog_program(bool sun) {
+  ShaderProgramSource p;
+  std::vector<std::string> defines = {"FOG_BRUTE", "FOG_NEGLIGIBLE_DEPTH " + glsl_float(kFogNegligibleDepth)};
+  if (sun) defines.push_back("SUN");
+  p.name = sun ? "fog[FOG_BRUTE SUN]" : "fog[FOG_BRUTE]";
+  p.vertex = {ShaderStage::vertex, {"fullscreen.vert.glsl"}, {}};
+  p.fragment = {ShaderStage::fragment, {"fog.glsl", "fog.frag.glsl"}, defines};
   return p;
 }
 
@@ -193,7 +207,9 @@ std::vector<ShaderProgramSource> all_shader_programs() {
   }
   for (MeshPass pass : {MeshPass::gbuffer, MeshPass::shadow}) all.push_back(mesh_program(pass));
   all.push_back(mesh_program(MeshPass::gbuffer, 1));  // with the bark albedo
-  for (bool sun : {false, true}) all.push_back(shade_program(sun));
+  for (bool sun : {false, true})
+    for (bool fog : {false, true}) all.push_back(shade_program(sun, fog));
+  for (bool sun : {false, true}) all.push_back(fog_program(sun));
   for (bool srgb : {false, true}) all.push_back(present_program(srgb));
   return all;
 }

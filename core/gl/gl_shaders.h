@@ -100,8 +100,15 @@ std::vector<std::string> shading_defines();
 
 // The deferred shading program (fullscreen.vert.glsl + bark.glsl's per-plant maps +
 // shading.glsl's model + shade.frag.glsl), with shading_defines(); `sun` false leaves out
-// the sun and its shadow map (black or absent sun: sky only).
-ShaderProgramSource shade_program(bool sun);
+// the sun and its shadow map (black or absent sun: sky only); `fog` (a scene with fog)
+// adds fog.glsl and FOG: sunlight × T_sun, what is seen × T(0, t_end) (spec/fog.md).
+ShaderProgramSource shade_program(bool sun, bool fog = false);
+
+// The fog pass (fullscreen.vert.glsl + fog.glsl + fog.frag.glsl): the light the fog
+// scatters toward the eye, added into the accumulated beauty, and the fog AOV. FOG_BRUTE:
+// spec/fog.md's `brute` with the shadow map for shadow rays; `sun` false: the sky's share
+// and T alone. FOG_NEGLIGIBLE_DEPTH is fog_integrator.h's kFogNegligibleDepth.
+ShaderProgramSource fog_program(bool sun);
 
 // The present program (fullscreen.vert.glsl + present.frag.glsl): the accumulated beauty
 // divided by the sample count into the caller's target (render_gl.h), as linear values or,

@@ -109,7 +109,22 @@ ShadowFrame shadow_frame(const std::vector<Sphere>& spheres, const glm::dvec3& d
 
 }  // namespace
 
+namespace {
+
+// Why the fog pass cannot draw `scene`'s fog in the mode `options` or the scene ask for,
+// or nullopt when it can (or there is no fog).
+std::optional<std::string> gl_fog_unsupported(const Scene& scene, const RenderOptions& options) {
+  if (!scene.fog) return std::nullopt;
+  const FogMode mode = options.fog.mode.value_or(scene.fog->mode);
+  if (mode == FogMode::brute) return std::nullopt;
+  return std::string("the GL backend's fog pass runs the brute mode only, for now (the fog asks for ") +
+         fog_mode_name(mode) + "; --fog-mode brute draws it with OpenGL)";
+}
+
+}  // namespace
+
 std::optional<std::string> gl_unsupported(const Scene& scene, const RenderOptions& options) {
+  if (auto why = gl_fog_unsupported(scene, options)) return why;
   const size_t images = bark_image_files(scene, options).size();  // what GlBarkMaps uploads
   if (images > gl::kMaxBarkImages)
     return "the GL backend binds at most " + std::to_string(gl::kMaxBarkImages) +
@@ -129,8 +144,11 @@ struct GlRenderer::Frame {
   glm::dvec3 ray_dx{0}, ray_dy{0};  // the next sample's direction to the right / below
   bool sun_on = false;
   glm::dvec3 sun_radiance{0};
+  bool fog_on = false;     // the scene has fog: shade[FOG] and the fog pass
+  uint32_t fog_steps = 0;  // the fog's samples along each ray (brute)
   std::vector<uint32_t> eye_inside;  // frusta whose pyramid may reach the eye's near plane
-  GLuint gbuffer_program = 0, inside_program = 0, shadow_program = 0, shade_program = 0, present_program = 0;
+  GLuint gbuffer_program = 0, inside_program = 0, shadow_program = 0, shade_program = 0, fog_program = 0,
+         present_program = 0;
   GlCameraView camera_view;  // this sample's (its jitter set per geometry pass)
   ShadowFrame shadow;  // the last shadow pass's view: the shade passes look it up
 };
@@ -146,6 +164,7 @@ struct GlRenderer::State {
   uint64_t pending_plant_bytes = 0;  // plant data sent since the last frame
   std::vector<Sphere> spheres;       // around each frustum's bounding pyramid (or its triangles)
   FrustaFeatures features;           // the frusta program's switches for this scene (gl_shaders.h)
+  uint32_t shadow_texels_asked = 0;  // set_shadow_map_texels; 0: by the frame's size
   std::unique_ptr<GlBarkMaps> bark_maps;
   std::unique_ptr<GlMesh> mesh;      // GeometryKind::mesh: the polygon baseline, drawn instead of the frusta
 
@@ -204,11 +223,12 @@ struct GlRenderer::State {
 
   // The shadow map's side for a w × h frame: a texel about a pixel where the plants fill
   // the picture (the default framing); the map's fill dominates a frame on llvmpipe.
-  static uint32_t shadow_map_texels(uint32_t w, uint32_t h) {
+  uint32_t shadow_map_texels(uint32_t w, uint32_t h) const {
     GLint max_size = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
     int texels = kShadowTexelsMin;
     while (texels < static_cast<int>(std::max(w, h)) && texels < kShadowTexelsMax) texels *= 2;
+    if (shadow_texels_asked > 0) texels = static_cast<int>(std::min<uint32_t>(shadow_texels_asked, 1u << 30));
     return static_cast<uint32_t>(std::min(texels, max_size));
   }
 
@@ -246,9 +266,11 @@ struct GlRenderer::State {
     f.inside_program =
         f.eye_inside.empty() ? 0 : program(frusta_variant(FrustaPass::gbuffer_eye_inside), &s.compile_s, &s.compiled);
     f.shadow_program = f.sun_on && !mesh ? program(frusta_variant(FrustaPass::shadow), &s.compile_s, &s.compiled) : 0;
-    f.shade_program = program(shade_program(f.sun_on), &s.compile_s, &s.compiled);
+    f.shade_program = program(shade_program(f.sun_on, f.fog_on), &s.compile_s, &s.compiled);
+    f.fog_program = f.fog_on ? program(fog_program(f.sun_on), &s.compile_s, &s.compiled) : 0;
     s.pass(GlPass::geometry).program = mesh ? mesh->gbuffer_variant() : frusta_variant(FrustaPass::gbuffer).name;
-    s.pass(GlPass::shade).program = shade_program(f.sun_on).name;
+    s.pass(GlPass::shade).program = shade_program(f.sun_on, f.fog_on).name;
+    if (f.fog_on) s.pass(GlPass::fog).program = fog_program(f.sun_on).name;
     if (f.sun_on)
       s.pass(GlPass::shadow).program = (mesh ? mesh_program(MeshPass::shadow) : frusta_variant(FrustaPass::shadow)).name;
   }
@@ -256,7 +278,7 @@ struct GlRenderer::State {
   // The programs' uniforms that stay for the frame: the camera (but its jitter), the ray
   // differentials and the relief's sampling, the sky, ground and materials.
   void frame_uniforms(const Scene& scene, const Frame& f) const {
-    for (GLuint p : {f.gbuffer_program, f.inside_program, f.shade_program})
+    for (GLuint p : {f.gbuffer_program, f.inside_program, f.shade_program, f.fog_program})
       if (p) set_camera_uniforms(p, f.camera_view);
     const ReliefOptions& relief = options.geometry.relief_options;
     for (GLuint p : {f.gbuffer_program, f.inside_program, f.shadow_program}) {
@@ -284,6 +306,24 @@ struct GlRenderer::State {
     }
     set_uniform_vec3_array(shade, "u_material_albedo", count, albedo);
     set_uniform_int(shade, "u_material_count", count);
+    if (f.fog_on) fog_uniforms(scene, f);
+  }
+
+  // The medium (heights above the ground: fog.glsl's convention) for shade[FOG] and the fog
+  // pass, and the fog pass's frame uniforms.
+  void fog_uniforms(const Scene& scene, const Frame& f) const {
+    const Fog& fog = *scene.fog;
+    const glm::dvec3 sun_centre = glm::normalize(scene.sun.direction);
+    for (GLuint p : {f.shade_program, f.fog_program}) {
+      set_uniform(p, "u_fog_medium", fog.sigma_s, fog.sigma_a, fog.g, fog.height_falloff);
+      set_uniform(p, "u_fog_top", fog.top - scene.ground.height);  // +inf stays +inf
+      set_uniform(p, "u_fog_sun_dir", sun_centre);
+    }
+    const GLuint p = f.fog_program;
+    set_uniform(p, "u_eye_above_ground", f.camera.eye.y - scene.ground.height);
+    set_uniform(p, "u_sky", scene.sky);
+    set_uniform(p, "u_sun_radiance", f.sun_radiance);
+    set_uniform_uint(p, "u_steps", f.fog_steps);
   }
 
   // The buffers and textures every pass reads (bindings.h), and the state every pass
@@ -377,9 +417,11 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options) : state
   double compile_s = 0;
   const bool sun_on = sun_shines(scene);
   std::string names;
-  std::vector<ShaderProgramSource> needed = {st.frusta_variant(FrustaPass::gbuffer), shade_program(sun_on)};
+  const bool fog_on = scene.fog.has_value();
+  std::vector<ShaderProgramSource> needed = {st.frusta_variant(FrustaPass::gbuffer), shade_program(sun_on, fog_on)};
   if (sun_on) needed.push_back(st.frusta_variant(FrustaPass::shadow));
-  if (st.mesh) needed = {shade_program(sun_on)};  // the mesh built its own
+  if (st.mesh) needed = {shade_program(sun_on, fog_on)};  // the mesh built its own
+  if (fog_on) needed.push_back(fog_program(sun_on));
   for (const ShaderProgramSource& source : needed) st.program(source, &compile_s, &names);
   st.setup_passes.push_back({"programs", compile_s, names});
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
@@ -389,6 +431,7 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options) : state
 GlRenderer::~GlRenderer() = default;
 
 void GlRenderer::set_conservative_depth(bool on) { state_->features.conservative_depth = on; }
+void GlRenderer::set_shadow_map_texels(uint32_t texels) { state_->shadow_texels_asked = texels; }
 
 uint64_t GlRenderer::frusta() const { return state_->frusta; }
 uint64_t GlRenderer::uploaded_bytes() const { return state_->uploaded_bytes; }
@@ -473,9 +516,14 @@ const GlFrameStats& GlRenderer::draw_frame(const Scene& scene, const GlTarget* t
     if (f.sun_on && (sample == 0 || sun_per_sample)) shadow_pass(f, l);
     geometry_pass(f, jitter_x, jitter_y);
     shade_pass(f, l);
+    if (f.fog_on) fog_pass(f, sample, false);
   }
-  // AOVs describe the pixel centres: the last G-buffer already is that at 1 spp.
-  if (!f.stats.cancelled && st.options.aovs && f.spp > 1) geometry_pass(f, 0.5, 0.5);
+  // AOVs describe the pixel centres: the last G-buffer (and fog AOV) already is that at 1
+  // spp. Else the fog AOV's stream is sample spp's, as on the CPU.
+  if (!f.stats.cancelled && st.options.aovs && f.spp > 1) {
+    geometry_pass(f, 0.5, 0.5);
+    if (f.fog_on && (st.options.aovs & kAovFog)) fog_pass(f, f.spp, true);
+  }
   if (target && !f.stats.cancelled) present_pass(f, *target);
   end_frame(f);
   return st.last;
@@ -499,7 +547,15 @@ void GlRenderer::begin_frame(const Scene& scene, Frame& f) {
   s.triangles = st.mesh ? st.mesh->triangles() : 0;
   s.geometry_bytes = st.uploaded_bytes;
   s.plant_bytes_uploaded = std::exchange(st.pending_plant_bytes, 0);
-  s.targets_allocated += st.targets.resize(f.width, f.height) ? 2 : 0;  // G-buffer, accumulation
+  if (auto why = gl_fog_unsupported(scene, st.options)) throw GlError(*why);
+  f.fog_on = scene.fog.has_value();
+  if (f.fog_on) {
+    f.fog_steps = std::clamp(st.options.fog.steps.value_or(scene.fog->steps), 1u, kFogMaxSteps);
+    s.fog_mode = fog_mode_name(FogMode::brute);
+    s.fog_steps = f.fog_steps;
+  }
+  // G-buffer, accumulation (and the fog AOV)
+  s.targets_allocated += st.targets.resize(f.width, f.height, f.fog_on) ? (f.fog_on ? 3 : 2) : 0;
   f.sun_on = sun_shines(scene);
   f.sun_radiance = scene.sun.radiance;
   if (f.sun_on) {
@@ -602,6 +658,38 @@ void GlRenderer::shade_pass(Frame& f, const glm::dvec3& l) {
   glEnable(GL_BLEND);
   glBlendFunc(GL_ONE, GL_ONE);
   glUseProgram(shade);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDisable(GL_BLEND);
+  st.timers.end();
+}
+
+// The fog's in-scatter along each pixel's ray of this sample (its G-buffer, the last shadow
+// map) added into the accumulation, and its fog AOV; `aov_only`: the AOV alone (the pixel
+// centres' pass at spp > 1). `sample` picks the jitter's random stream.
+void GlRenderer::fog_pass(Frame& f, uint32_t sample, bool aov_only) {
+  State& st = *state_;
+  const GLuint fog = f.fog_program;
+  set_jitter_uniform(fog, f.camera_view.jitter);
+  set_uniform_uint(fog, "u_seed", sample);
+  if (f.sun_on) {
+    const ShadowFrame& v = f.shadow;
+    set_sun_view_uniforms(fog, sun_view(v, f.stats.shadow_texels));
+    set_uniform(fog, "u_eye_rel_light", f.camera.eye - v.centre);
+    set_uniform(fog, "u_depth_bias", kShadowDepthBiasTexels * v.texel_m / v.s_range);
+  }
+  st.timers.begin(GlPass::fog);
+  ++f.stats.pass(GlPass::fog).runs;
+  const GLuint fbo = st.targets.fog_fbo.id();
+  const GLenum both[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1}, aov[2] = {GL_NONE, GL_COLOR_ATTACHMENT1};
+  glNamedFramebufferDrawBuffers(fbo, 2, aov_only ? aov : both);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glViewport(0, 0, static_cast<GLsizei>(f.width), static_cast<GLsizei>(f.height));
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
+  glEnablei(GL_BLEND, 0);  // in-scatter added to the beauty; the AOV written
+  glBlendFunci(0, GL_ONE, GL_ONE);
+  glDisablei(GL_BLEND, 1);
+  glUseProgram(fog);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glDisable(GL_BLEND);
   st.timers.end();
@@ -730,6 +818,15 @@ RenderImage GlRenderer::read_back() {
           image.id[dst * 3 + 2] = hit ? static_cast<float>(g2[src * 4 + 2]) : -1.0f;
         }
       }
+  }
+  if ((aovs & kAovFog) && st.targets.fog) {
+    std::vector<float> fog(pixels * 4);
+    glGetTextureImage(st.targets.fog_aov.id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(fog.size() * sizeof(float)),
+                      fog.data());
+    image.fog.resize(pixels * 4);
+    for (uint32_t y = 0; y < h; ++y)
+      std::memcpy(&image.fog[static_cast<size_t>(y) * w * 4], &fog[static_cast<size_t>(h - 1 - y) * w * 4],
+                  w * 4 * sizeof(float));
   }
   check_gl("readback");
   return image;
