@@ -156,6 +156,7 @@ void main() {
     float sun = 0.0;
 #if defined(FOG_MEDIUM) || defined(FOG_FAST)
     float starts[FOG_MAX_INTERVALS], ends[FOG_MAX_INTERVALS];
+    for (int i = 0; i < FOG_MAX_INTERVALS; ++i) starts[i] = ends[i] = 0.0;  // (inout below)
     int count = 0;
     bool whole = !u_cones || fog_overflowed[pixel_index] != 0u;
     for (uint node = fog_heads[pixel_index]; !whole && node != FOG_LIST_END;) {

@@ -14,9 +14,12 @@
 #include <map>
 #include <stdexcept>
 
+#include "core/cpu/photons.h"
+#include "core/cpu/render_cpu.h"
 #include "core/gl/bindings.h"
 #include "core/gl/gl_api.h"
 #include "core/gl/gl_bark_maps.h"
+#include "core/gl/gl_fog.h"
 #include "core/gl/gl_frame_targets.h"
 #include "core/gl/gl_mesh.h"
 #include "core/gl/gl_objects.h"
@@ -111,14 +114,31 @@ ShadowFrame shadow_frame(const std::vector<Sphere>& spheres, const glm::dvec3& d
 
 namespace {
 
+// The fog pass's mode for the mode `options` or the scene ask for (auto: the cone-interval
+// pass, fast; spec/fog.md), or nullopt where the GPU has none: refined, reference, and
+// medium, whose resolve (fog.frag.glsl FOG_MEDIUM) agrees with brute on small scenes but
+// is darker than it on the dense canopy (docs/gl-fog.md, "Not done").
+std::optional<GlFogMode> gl_fog_mode_of(FogMode mode) {
+  switch (mode) {
+    case FogMode::brute: return GlFogMode::brute;
+    case FogMode::fast:
+    case FogMode::automatic: return GlFogMode::fast;
+    default: return std::nullopt;
+  }
+}
+
+FogMode requested_fog_mode(const Scene& scene, const RenderOptions& options) {
+  return options.fog.mode.value_or(scene.fog->mode);
+}
+
 // Why the fog pass cannot draw `scene`'s fog in the mode `options` or the scene ask for,
 // or nullopt when it can (or there is no fog).
 std::optional<std::string> gl_fog_unsupported(const Scene& scene, const RenderOptions& options) {
   if (!scene.fog) return std::nullopt;
-  const FogMode mode = options.fog.mode.value_or(scene.fog->mode);
-  if (mode == FogMode::brute) return std::nullopt;
-  return std::string("the GL backend's fog pass runs the brute mode only, for now (the fog asks for ") +
-         fog_mode_name(mode) + "; --fog-mode brute draws it with OpenGL)";
+  const FogMode mode = requested_fog_mode(scene, options);
+  if (gl_fog_mode_of(mode)) return std::nullopt;
+  return std::string("the GL backend's fog pass runs brute and fast (auto) only, for now (the fog asks for ") +
+         fog_mode_name(mode) + "; --fog-mode brute or fast draws it with OpenGL)";
 }
 
 }  // namespace
@@ -145,10 +165,12 @@ struct GlRenderer::Frame {
   bool sun_on = false;
   glm::dvec3 sun_radiance{0};
   bool fog_on = false;     // the scene has fog: shade[FOG] and the fog pass
-  uint32_t fog_steps = 0;  // the fog's samples along each ray (brute)
+  GlFogMode fog_mode = GlFogMode::brute;
+  bool fog_cones = false;  // a cone mode with cones uploaded: the cone pass runs
+  uint32_t fog_steps = 0;  // the fog's samples along each ray (brute; medium inside the cones)
   std::vector<uint32_t> eye_inside;  // frusta whose pyramid may reach the eye's near plane
   GLuint gbuffer_program = 0, inside_program = 0, shadow_program = 0, shade_program = 0, fog_program = 0,
-         present_program = 0;
+         fog_cones_program = 0, present_program = 0;
   GlCameraView camera_view;  // this sample's (its jitter set per geometry pass)
   ShadowFrame shadow;  // the last shadow pass's view: the shade passes look it up
 };
@@ -165,6 +187,9 @@ struct GlRenderer::State {
   std::vector<Sphere> spheres;       // around each frustum's bounding pyramid (or its triangles)
   FrustaFeatures features;           // the frusta program's switches for this scene (gl_shaders.h)
   uint32_t shadow_texels_asked = 0;  // set_shadow_map_texels; 0: by the frame's size
+  std::optional<GlFogCones> fog_cones;  // set_fog_cones: once per (plants, sun)
+  GlFogLists fog_lists;                 // the cone intervals per pixel (cone modes)
+  uint32_t fog_nodes_wanted = 0;        // the most list nodes a cone pass asked for so far
   std::unique_ptr<GlBarkMaps> bark_maps;
   std::unique_ptr<GlMesh> mesh;      // GeometryKind::mesh: the polygon baseline, drawn instead of the frusta
 
@@ -267,10 +292,12 @@ struct GlRenderer::State {
         f.eye_inside.empty() ? 0 : program(frusta_variant(FrustaPass::gbuffer_eye_inside), &s.compile_s, &s.compiled);
     f.shadow_program = f.sun_on && !mesh ? program(frusta_variant(FrustaPass::shadow), &s.compile_s, &s.compiled) : 0;
     f.shade_program = program(shade_program(f.sun_on, f.fog_on), &s.compile_s, &s.compiled);
-    f.fog_program = f.fog_on ? program(fog_program(f.sun_on), &s.compile_s, &s.compiled) : 0;
+    f.fog_program = f.fog_on ? program(fog_program(f.sun_on, f.fog_mode), &s.compile_s, &s.compiled) : 0;
+    f.fog_cones_program = f.fog_cones ? program(fog_cones_program(), &s.compile_s, &s.compiled) : 0;
     s.pass(GlPass::geometry).program = mesh ? mesh->gbuffer_variant() : frusta_variant(FrustaPass::gbuffer).name;
     s.pass(GlPass::shade).program = shade_program(f.sun_on, f.fog_on).name;
-    if (f.fog_on) s.pass(GlPass::fog).program = fog_program(f.sun_on).name;
+    if (f.fog_on) s.pass(GlPass::fog).program = fog_program(f.sun_on, f.fog_mode).name;
+    if (f.fog_cones) s.pass(GlPass::fog_cones).program = fog_cones_program().name;
     if (f.sun_on)
       s.pass(GlPass::shadow).program = (mesh ? mesh_program(MeshPass::shadow) : frusta_variant(FrustaPass::shadow)).name;
   }
@@ -278,7 +305,7 @@ struct GlRenderer::State {
   // The programs' uniforms that stay for the frame: the camera (but its jitter), the ray
   // differentials and the relief's sampling, the sky, ground and materials.
   void frame_uniforms(const Scene& scene, const Frame& f) const {
-    for (GLuint p : {f.gbuffer_program, f.inside_program, f.shade_program, f.fog_program})
+    for (GLuint p : {f.gbuffer_program, f.inside_program, f.shade_program, f.fog_program, f.fog_cones_program})
       if (p) set_camera_uniforms(p, f.camera_view);
     const ReliefOptions& relief = options.geometry.relief_options;
     for (GLuint p : {f.gbuffer_program, f.inside_program, f.shadow_program}) {
@@ -324,6 +351,13 @@ struct GlRenderer::State {
     set_uniform(p, "u_sky", scene.sky);
     set_uniform(p, "u_sun_radiance", f.sun_radiance);
     set_uniform_uint(p, "u_steps", f.fog_steps);
+    if (f.fog_mode == GlFogMode::brute) return;
+    set_uniform_int(p, "u_cones", f.fog_cones ? 1 : 0);
+    if (!f.fog_cones) return;
+    const GLuint c = f.fog_cones_program;
+    set_uniform(c, "u_eye_rel_cones", f.camera.eye - fog_cones->origin);
+    set_uniform(c, "u_eye_above_ground", f.camera.eye.y - scene.ground.height);
+    set_uniform_uint(c, "u_fog_capacity", fog_lists.capacity);
   }
 
   // The buffers and textures every pass reads (bindings.h), and the state every pass
@@ -433,6 +467,12 @@ GlRenderer::~GlRenderer() = default;
 void GlRenderer::set_conservative_depth(bool on) { state_->features.conservative_depth = on; }
 void GlRenderer::set_shadow_map_texels(uint32_t texels) { state_->shadow_texels_asked = texels; }
 
+uint64_t GlRenderer::set_fog_cones(const ConeSet& cones) {
+  state_->fog_cones = upload_fog_cones(cones);
+  check_gl("set_fog_cones");
+  return state_->fog_cones->bytes;
+}
+
 uint64_t GlRenderer::frusta() const { return state_->frusta; }
 uint64_t GlRenderer::uploaded_bytes() const { return state_->uploaded_bytes; }
 const std::vector<RenderPass>& GlRenderer::setup_passes() const { return state_->setup_passes; }
@@ -516,13 +556,17 @@ const GlFrameStats& GlRenderer::draw_frame(const Scene& scene, const GlTarget* t
     if (f.sun_on && (sample == 0 || sun_per_sample)) shadow_pass(f, l);
     geometry_pass(f, jitter_x, jitter_y);
     shade_pass(f, l);
+    if (f.fog_cones) fog_cones_pass(f);
     if (f.fog_on) fog_pass(f, sample, false);
   }
   // AOVs describe the pixel centres: the last G-buffer (and fog AOV) already is that at 1
   // spp. Else the fog AOV's stream is sample spp's, as on the CPU.
   if (!f.stats.cancelled && st.options.aovs && f.spp > 1) {
     geometry_pass(f, 0.5, 0.5);
-    if (f.fog_on && (st.options.aovs & kAovFog)) fog_pass(f, f.spp, true);
+    if (f.fog_on && (st.options.aovs & kAovFog)) {
+      if (f.fog_cones) fog_cones_pass(f);
+      fog_pass(f, f.spp, true);
+    }
   }
   if (target && !f.stats.cancelled) present_pass(f, *target);
   end_frame(f);
@@ -550,9 +594,20 @@ void GlRenderer::begin_frame(const Scene& scene, Frame& f) {
   if (auto why = gl_fog_unsupported(scene, st.options)) throw GlError(*why);
   f.fog_on = scene.fog.has_value();
   if (f.fog_on) {
+    f.fog_mode = *gl_fog_mode_of(requested_fog_mode(scene, st.options));
+    if (f.fog_mode == GlFogMode::fast && !st.fog_cones)
+      throw GlError("the GL fog pass's fast mode needs shadow cones (GlRenderer::set_fog_cones; render_gl builds them)");
+    f.fog_cones = f.fog_mode != GlFogMode::brute && st.fog_cones;
     f.fog_steps = std::clamp(st.options.fog.steps.value_or(scene.fog->steps), 1u, kFogMaxSteps);
-    s.fog_mode = fog_mode_name(FogMode::brute);
+    s.fog_mode = gl_fog_mode_name(f.fog_mode);
     s.fog_steps = f.fog_steps;
+    if (f.fog_cones) {
+      // Two nodes a pixel to start with, then what the largest pass so far asked for.
+      const uint32_t pixels = f.width * f.height;
+      s.targets_allocated += st.fog_lists.reserve(pixels, std::max({2 * pixels, st.fog_nodes_wanted, 1u}));
+      s.fog_cones = st.fog_cones->count;
+      s.fog_list_capacity = st.fog_lists.capacity;
+    }
   }
   // G-buffer, accumulation (and the fog AOV)
   s.targets_allocated += st.targets.resize(f.width, f.height, f.fog_on) ? (f.fog_on ? 3 : 2) : 0;
@@ -562,11 +617,16 @@ void GlRenderer::begin_frame(const Scene& scene, Frame& f) {
     s.shadow_texels = st.shadow_map_texels(f.width, f.height);
     s.targets_allocated += st.shadow_map.resize(s.shadow_texels) ? 1 : 0;
   }
-  s.target_bytes = st.targets.bytes() + (f.sun_on ? st.shadow_map.bytes() : 0);
+  s.target_bytes = st.targets.bytes() + (f.sun_on ? st.shadow_map.bytes() : 0) + (f.fog_cones ? st.fog_lists.bytes() : 0);
   st.frame_views(scene, f);
   st.frame_programs(f);
   st.frame_uniforms(scene, f);
   st.bind_frame(f);
+  if (f.fog_cones) {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kFogConesBinding, st.fog_cones->records.id());
+    st.fog_lists.bind();
+    st.fog_lists.clear_frame();
+  }
   st.timers.begin_frame(s.frame);
 }
 
@@ -660,6 +720,33 @@ void GlRenderer::shade_pass(Frame& f, const glm::dvec3& l) {
   glUseProgram(shade);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glDisable(GL_BLEND);
+  st.timers.end();
+}
+
+// The shadow cones' intervals along each pixel's ray of this sample, clipped to what its
+// G-buffer sees, appended to the pixel's list: every cone's bounding pyramid drawn from its
+// back faces (fog_cones.frag.glsl says why), no depth test, no colour.
+void GlRenderer::fog_cones_pass(Frame& f) {
+  State& st = *state_;
+  const GLuint cones = f.fog_cones_program;
+  set_jitter_uniform(cones, f.camera_view.jitter);
+  st.fog_lists.clear_pass();
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  st.timers.begin(GlPass::fog_cones);
+  ++f.stats.pass(GlPass::fog_cones).runs;
+  const GLuint fbo = st.targets.fog_fbo.id();
+  const GLenum none[2] = {GL_NONE, GL_NONE};
+  glNamedFramebufferDrawBuffers(fbo, 2, none);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glViewport(0, 0, static_cast<GLsizei>(f.width), static_cast<GLsizei>(f.height));
+  glDisable(GL_DEPTH_TEST);
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_FRONT);
+  glUseProgram(cones);
+  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(st.fog_cones->count * gl::kPyramidVertices));
+  glDisable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   st.timers.end();
 }
 
@@ -757,6 +844,16 @@ const GlFrameStats& GlRenderer::wait_for_frame() {
   State& st = *state_;
   if (st.frames == 0) throw std::logic_error("GlRenderer::wait_for_frame: no frame drawn yet");
   if (!st.last.gpu_times_ready) take_timed_frames(true);
+  if (st.last.fog_cones > 0 && !st.last.fog_counted) {
+    // The GPU is done with the frame: its counters are the last frame's.
+    const gl::GlFogCounters c = st.fog_lists.read_counters();
+    st.last.fog_fragments = c.fragments;
+    st.last.fog_overflow_fragments = c.overflow_fragments;
+    st.last.fog_overflow_pixels = c.overflow_pixels;
+    st.last.fog_largest_pass = c.largest_pass;
+    st.last.fog_counted = true;
+    st.fog_nodes_wanted = std::max(st.fog_nodes_wanted, c.largest_pass + c.largest_pass / 4);
+  }
   return st.last;
 }
 
@@ -858,7 +955,29 @@ RenderResult GlRenderer::render(const Scene& scene) {
 RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrameStats* stats) {
   if (auto why = gl_unsupported(scene, options)) throw GlError(*why);
   GlRenderer renderer(scene, options);
+  std::vector<RenderPass> cone_passes;
+  if (scene.fog && requested_fog_mode(scene, options) != FogMode::brute) {
+    // The cone modes: sun photons and shadow cones on the CPU (as render_cpu builds them),
+    // uploaded once.
+    const FogMode mode = FogMode::fast;
+    const SceneGeometry geometry = build_scene_geometry(scene, options.skin, GeometryOptions{}, &cone_passes);
+    const std::unique_ptr<const SunCones> cones = build_sun_cones(
+        geometry, scene,
+        sun_cone_options_for(mode, options.fog.photons.value_or(scene.fog->photons), options.fog.cone_params,
+                             options.threads, options.progress.cancel_flag()));
+    cone_passes.insert(cone_passes.end(), cones->passes.begin(), cones->passes.end());
+    if (cones->cancelled) {
+      RenderResult cancelled;
+      cancelled.cancelled = true;
+      return cancelled;
+    }
+    const Clock::time_point start = Clock::now();
+    const uint64_t bytes = renderer.set_fog_cones(cones->cones);
+    cone_passes.push_back({"cone upload", seconds_since(start),
+                           std::to_string(cones->cones.size()) + " cones, " + std::to_string(bytes / 1024) + " KiB"});
+  }
   RenderResult result = renderer.render(scene);
+  result.passes.insert(result.passes.begin(), cone_passes.begin(), cone_passes.end());
   if (stats) *stats = renderer.wait_for_frame();
   result.passes.insert(result.passes.begin(), renderer.setup_passes().begin(), renderer.setup_passes().end());
   return result;

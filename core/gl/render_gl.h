@@ -30,8 +30,10 @@
 //                  T(0, t_end); one fullscreen pass (fog.frag.glsl) adds the in-scatter —
 //                  `brute`: N jittered samples of the unshadowed in-scatter's distribution
 //                  along the ray to the G-buffer's depth, each looked up in the shadow map —
-//                  and writes the fog AOV (fog.R fog.G fog.B fog.T). Other modes: refused
-//                  (gl_unsupported).
+//                  and writes the fog AOV (fog.R fog.G fog.B fog.T). `fast` (and
+//                  `auto`): first a cone pass draws the shadow cones (set_fog_cones) as
+//                  frusta, their intervals into per-pixel lists; the resolve integrates
+//                  in closed form outside them. Other modes: refused (gl_unsupported).
 //   present        only when the caller gives a target (gl_target.h): the accumulated
 //                  beauty ÷ spp into it, linear or sRGB-encoded.
 // --spp N repeats shadow map (if the sun is a disc), frusta and shade N times with the
@@ -79,6 +81,7 @@
 #include "core/gl/gl_target.h"
 #include "core/render_types.h"
 #include "core/scene.h"
+#include "core/shadow_cones.h"
 
 namespace sylva {
 
@@ -168,6 +171,12 @@ class GlRenderer {
   // 8192. Clamped to the driver's largest texture.
   void set_shadow_map_texels(uint32_t texels);
 
+  // The shadow cones of this scene's plants and sun (core/cpu/photons.h build_sun_cones),
+  // uploaded once for every frame in a cone mode (medium, fast, auto) until the next call
+  // (a new sun). Returns the bytes uploaded. Without them fast is refused (GlError) and
+  // medium marches every ray whole.
+  uint64_t set_fog_cones(const ConeSet& cones);
+
   uint64_t frusta() const;          // frusta uploaded
   uint64_t uploaded_bytes() const;  // bytes in the segment and id buffers (or the mesh's)
   // What was done once: "textures", "skin", "upload", "programs" (compile and link); the
@@ -183,6 +192,7 @@ class GlRenderer {
   void shadow_pass(Frame& f, const glm::dvec3& sun_direction);   // GlPass::shadow
   void geometry_pass(Frame& f, double jitter_x, double jitter_y);  // GlPass::geometry
   void shade_pass(Frame& f, const glm::dvec3& sun_direction);    // GlPass::shade
+  void fog_cones_pass(Frame& f);                                 // GlPass::fog_cones
   void fog_pass(Frame& f, uint32_t sample, bool aov_only);       // GlPass::fog
   void present_pass(Frame& f, const GlTarget& target);           // GlPass::present
   void end_frame(Frame& f);                                      // submit, stats

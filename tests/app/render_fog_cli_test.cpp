@@ -92,14 +92,14 @@ TEST(RenderFogCli, PngPutsTheFogAovInASideFile) {
 TEST(RenderFogCli, TheGlBackendRefusesTheFogModesItLacksWithStatusOneAndAutoFallsBackToTheCpu) {
   TempDir dir;
   const std::string scene = write_scene(dir, kFog);
-  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "gl", "--fog-mode", "fast"});
+  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "gl", "--fog-mode", "medium"});
   EXPECT_EQ(r.exit_code, 1) << describe(r);
-  EXPECT_NE(r.err.find("fog pass runs the brute mode only, for now (the fog asks for fast"), std::string::npos)
+  EXPECT_NE(r.err.find("fog pass runs brute and fast (auto) only, for now (the fog asks for medium"), std::string::npos)
       << describe(r);
   EXPECT_FALSE(std::filesystem::exists(dir.file("f.png")));
   r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--fog-mode", "reference", "--fog-steps", "2", "--verbose"});
   EXPECT_EQ(r.exit_code, 0) << describe(r);
-  EXPECT_NE(r.err.find("the OpenGL backend cannot draw this (the GL backend's fog pass runs the brute mode only"),
+  EXPECT_NE(r.err.find("the OpenGL backend cannot draw this (the GL backend's fog pass runs brute and fast (auto) only"),
             std::string::npos)
       << describe(r);
   EXPECT_NE(r.err.find("fog (thread time)"), std::string::npos) << describe(r);
