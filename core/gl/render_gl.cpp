@@ -940,7 +940,18 @@ RenderResult GlRenderer::render(const Scene& scene) {
     return result;
   }
   // After the GPU's answer: "readback" is the transfer alone.
-  const GlFrameStats& stats = wait_for_frame();
+  const GlFrameStats* waited = &wait_for_frame();
+  if (waited->fog_overflow_fragments > 0) {
+    // The cone intervals overflowed their lists (those pixels were marched whole, as
+    // brute): drawn once more, the lists now sized by what the first frame asked for.
+    const GlFrameStats& again = draw(scene);
+    if (again.cancelled) {
+      result.cancelled = true;
+      return result;
+    }
+    waited = &wait_for_frame();
+  }
+  const GlFrameStats& stats = *waited;
   const Clock::time_point readback_start = Clock::now();
   result.image = read_back();
   const double readback_s = seconds_since(readback_start);

@@ -148,7 +148,9 @@ class GlRenderer {
   // the CLI and `bench gpu` do after each frame). Throws std::logic_error before any draw.
   const GlFrameStats& wait_for_frame();
 
-  // One frame as the CLI and render_gl() need it: draw(scene), wait_for_frame, read_back.
+  // One frame as the CLI and render_gl() need it: draw(scene), wait_for_frame, read_back;
+  // drawn a second time when its fog cone intervals overflowed their lists (then sized by
+  // what the first asked for), so that a one-shot render marches no pixel whole.
   // Passes: describe_frame's, then "readback" (the transfer alone) and "frame (wall)".
   RenderResult render(const Scene& scene);
 

@@ -355,5 +355,34 @@ TEST(GlFog, FastOnTheGpuMatchesTheCpusFastWithTheSameCones) {
   EXPECT_LE(e.relative_rmse(), 1e-3);
 }
 
+// A dense canopy's cone intervals overflow the lists' first size (2 nodes a pixel): the
+// overflowed pixels are marched as brute and counted, the lists grow to what was asked
+// for, and a one-shot render (GlRenderer::render) draws again so that none is left.
+TEST(GlFog, OverflowingIntervalListsAreCountedMarchedWholeAndGrown) {
+  SYLVA_REQUIRE_GL();
+  const Scene grove = elm_grove(120, 90, 16);
+  const auto cones = cones_for(grove, FogMode::fast, 200000);
+  RenderOptions options;
+  options.aovs = kAovFog;
+  options.fog.mode = FogMode::fast;
+  GlRenderer renderer(grove, options);
+  renderer.set_fog_cones(cones->cones);
+  renderer.draw(grove);
+  const GlFrameStats first = renderer.wait_for_frame();
+  std::printf("[ fog ] grove fast: %llu intervals for %u nodes, %llu overflowed fragments, %llu pixels\n",
+              static_cast<unsigned long long>(first.fog_fragments), first.fog_list_capacity,
+              static_cast<unsigned long long>(first.fog_overflow_fragments),
+              static_cast<unsigned long long>(first.fog_overflow_pixels));
+  ASSERT_GT(first.fog_overflow_fragments, 0u) << "the test needs a scene that overflows";
+  EXPECT_GT(first.fog_overflow_pixels, 0u);
+  EXPECT_EQ(first.fog_fragments, first.fog_largest_pass) << "one cone pass at 1 spp";
+  EXPECT_GT(first.fog_largest_pass, first.fog_list_capacity);
+  const RenderResult r = renderer.render(grove);
+  const GlFrameStats& last = renderer.wait_for_frame();
+  EXPECT_EQ(last.fog_overflow_pixels, 0u);
+  EXPECT_GE(last.fog_list_capacity, first.fog_largest_pass);
+  EXPECT_EQ(r.image.fog.size(), size_t{120} * 90 * 4);
+}
+
 }  // namespace
 }  // namespace sylva
