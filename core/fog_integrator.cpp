@@ -14,6 +14,10 @@ namespace sylva {
 
 using render_common::SampleRng;
 
+// Where shadow rays stop being castable: Embree's rays are float (3.4e38), and a point this
+// far is beyond every plant.
+constexpr double kFogFloatRange = 1e30;
+
 FogSun fog_sun_of(const Sun& sun) {
   FogSun s;
   s.direction = glm::normalize(sun.direction);
@@ -110,7 +114,10 @@ double FogIntegrator::visible(const CameraRay& ray, double t, const glm::dvec3& 
   // Only plants shadow the fog (the ground never lies between a point above it and a sun
   // above the horizon), and only where the sun ray meets their box: elsewhere (a point of
   // an unbounded ray far beyond the plants included, docs/fog.md) no shadow ray is cast.
+  // Beyond float's range (an unbounded ray's far probes) Embree's rays are invalid; such a
+  // point is far outside every plant anyway.
   const glm::dvec3 point = ray.origin + t * ray.direction;
+  if (!(std::max({std::abs(point.x), std::abs(point.y), std::abs(point.z)}) < kFogFloatRange)) return 1.0;
   if (!meets_box(point, toward_sun, casters_)) return 1.0;
   ++result->shadow_rays;
   return tracer_.any(Ray{point, toward_sun}, 0, kFogInfinity) ? 0.0 : 1.0;

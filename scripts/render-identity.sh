@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Renders every bundled preset and scene on both backends (and the scenes' mesh baseline;
-# fog scenes on the CPU, which alone renders fog for now)
+# fog scenes on the CPU, which alone renders their default fog mode, auto, for now)
 # into a folder, so that two builds can be compared byte for byte: a refactor that must not
 # change behaviour shows `identical` for every file.
 #

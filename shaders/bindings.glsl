@@ -13,6 +13,11 @@
 #define PLANT_MAPS_BINDING 4      // bark.glsl PlantMapsBuffer: a PlantMaps per plant
 #define HEIGHT_TEXELS_BINDING 5   // bark.glsl HeightTexels: height maps' finest levels
 #define MESH_FRUSTA_BINDING 6     // mesh.vert.glsl MeshFrusta: a MeshFrustum per frustum
+#define FOG_CONES_BINDING 7       // shadow_cones.glsl FogCones: a GpuShadowCone per shadow cone
+#define FOG_NODES_BINDING 8       // fog_lists.glsl FogNodes: the cone intervals' list nodes
+#define FOG_HEADS_BINDING 9       // fog_lists.glsl FogHeads: per pixel, its list's first node
+#define FOG_OVERFLOW_BINDING 10   // fog_lists.glsl FogOverflow: per pixel, 1 = list incomplete
+#define FOG_COUNTERS_BINDING 11   // fog_lists.glsl FogCounters: the frame's counts
 
 // Texture units. Bark images take units BARK_TEXTURES_UNIT .. + MAX_BARK_IMAGES − 1; the
 // G-buffer, the shadow map and the accumulated beauty sit above them, so no pass rebinds
@@ -31,6 +36,8 @@
 #define PLANT_INDEX_BITS 24       // G-buffer ids.x: plant | material << PLANT_INDEX_BITS
 #define PLANT_INDEX_MASK 0xFFFFFFu
 #define PYRAMID_VERTICES 36       // a frustum's bounding pyramid: 12 triangles (skin.glsl)
+#define FOG_LIST_END 0xFFFFFFFFu  // the end of a pixel's interval list (fog_lists.glsl)
+#define FOG_MAX_INTERVALS 16      // merged intervals the fog resolve holds per pixel (fog.frag.glsl)
 
 // Uniform blocks (std140): none. The views (views.glsl's camera and sun uniforms) and the
 // shading parameters are default-block uniforms set by name (core/gl/gl_views.h,

@@ -12,6 +12,11 @@
 //
 // Albedo: g_albedo where the geometry pass decided it (a = 1: a bark texture, already
 // linear), else the material table, material 0 replaced by the plant's bark colour.
+//
+// FOG (a scene with fog; fog.glsl comes before this file): as render_cpu.cpp's lit() and
+// shade(), the sunlight reaching a surface is E_sun·T_sun(p) (toward the sun's centre), and
+// what the pixel sees, surface or sky, arrives multiplied by T(0, t_end); the fog's own
+// light is added by the fog pass (fog.frag.glsl).
 
 layout(binding = G_NORMAL_DISTANCE_UNIT) uniform sampler2D g_normal_distance;
 layout(binding = G_GEOMETRIC_U_UNIT) uniform sampler2D g_geometric_u;
@@ -49,6 +54,15 @@ uniform float u_normal_offset_m;   // receiver offset along its geometric normal
 uniform float u_depth_bias;        // in map depth units (0..1)
 uniform float u_pixel_step_rad;    // |∂direction/∂y|: a pixel footprint per unit of t
 #endif
+#ifdef FOG
+uniform vec4 u_fog_medium;         // sigma_s, sigma_a, g, height_falloff (fog.frag.glsl's)
+uniform float u_fog_top;           // top − ground.height (+inf: none)
+uniform vec3 u_fog_sun_dir;        // unit, toward the sun's centre (T_sun)
+
+FogMedium shade_fog_medium() {
+  return fog_medium(u_fog_medium.x, u_fog_medium.y, u_fog_medium.z, u_fog_medium.w, 0.0, u_fog_top);
+}
+#endif
 
 layout(location = 0) out vec4 colour;
 
@@ -76,9 +90,22 @@ vec3 lit(vec3 albedo, vec3 n, vec3 n_geometric, vec3 p_rel_eye, vec3 view, bool 
 #ifdef SUN
   vec3 l = u_sun_dir;
   float cos_sun = sun_cosine(n, n_geometric, l);
+#ifdef FOG
+  // Through fog the sunlight arrives attenuated by T_sun; where none arrives nothing is looked up.
+  float sun_transmittance =
+      cos_sun > 0.0 ? fog_sun_transmittance(shade_fog_medium(), vec3(0.0, u_eye_above_ground + p_rel_eye.y, 0.0),
+                                            u_fog_sun_dir)
+                    : 1.0;
+  float visibility = cos_sun <= 0.0 || sun_transmittance == 0.0
+                         ? 0.0
+                         : sun_visibility(u_eye_rel_light + p_rel_eye, n_geometric, shadow_offset_m);
+  return surface_radiance(albedo, n, l, view, specular, u_sky, u_sun_radiance * sun_transmittance, cos_sun,
+                          visibility);
+#else
   float visibility =
       cos_sun <= 0.0 ? 0.0 : sun_visibility(u_eye_rel_light + p_rel_eye, n_geometric, shadow_offset_m);
   return surface_radiance(albedo, n, l, view, specular, u_sky, u_sun_radiance, cos_sun, visibility);
+#endif
 #else
   return sky_ambient(albedo, n, u_sky);
 #endif
@@ -93,10 +120,20 @@ void main() {
   bool plant_hit = normal_distance.w >= 0.0;
   float plant_t = plant_hit ? normal_distance.w / length(dir) : kInfinity;
   float ground_t = ground_distance(u_eye_above_ground, dir.y);
+#ifdef FOG
+  // T(0, t_end) along the unit direction, t_end in metres (+inf for the sky).
+  float fog_t_end = min(plant_t, ground_t) * length(dir);
+  float transmittance = fog_transmittance(shade_fog_medium(), vec3(0.0, u_eye_above_ground, 0.0), -view, 0.0, fog_t_end);
+  if (!plant_hit && !(ground_t < kInfinity)) {
+    colour = vec4(transmittance * sky_radiance(u_sky), 1.0);
+    return;
+  }
+#else
   if (!plant_hit && !(ground_t < kInfinity)) {
     colour = vec4(sky_radiance(u_sky), 1.0);
     return;
   }
+#endif
   // What is seen, then one call of lit(): a SIMD rasteriser (llvmpipe) runs both sides of
   // a branch, so the shadow lookup is written once.
   vec3 albedo, n, n_geometric;
@@ -125,5 +162,9 @@ void main() {
     if (plant_maps[plant].relief_depth_m > 0.0) shadow_offset_m = t * u_pixel_step_rad;
 #endif
   }
+#ifdef FOG
+  colour = vec4(transmittance * lit(albedo, n, n_geometric, t * dir, view, specular, shadow_offset_m), 1.0);
+#else
   colour = vec4(lit(albedo, n, n_geometric, t * dir, view, specular, shadow_offset_m), 1.0);
+#endif
 }

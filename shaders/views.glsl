@@ -1,11 +1,12 @@
 // views.glsl — the two views every geometry pass draws into, shared by the frusta
 // (frusta.vert.glsl) and the meshes (mesh.vert.glsl) so that both fill one G-buffer and
-// one shadow map alike: the camera (GBUFFER_PASS) and the sun's orthographic view
+// one shadow map alike: the camera (GBUFFER_PASS, or CAMERA_VIEW for the fog's cone pass,
+// which draws in the camera's view but is no G-buffer pass) and the sun's orthographic view
 // (SHADOW_PASS), their uniforms, and the projection of a point given relative to the
 // view's origin (eye or map centre; the caller forms that difference from hi + lo floats,
 // frusta_common.glsl "Frames").
 
-#ifdef GBUFFER_PASS
+#if defined(GBUFFER_PASS) || defined(CAMERA_VIEW)
 uniform vec3 u_eye_hi;        // the eye, rounded to float
 uniform vec3 u_eye_lo;        // eye − u_eye_hi
 uniform vec3 u_right;         // camera frame (render_common.h's CameraFrame), unit

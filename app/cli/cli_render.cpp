@@ -51,7 +51,7 @@ void print_render_help() {
          "      --backend B        auto (default): OpenGL on a window-less EGL context (the GPU,\n"
          "                         or Mesa's llvmpipe without one), else the CPU ray caster,\n"
          "                         saying why; gl: OpenGL or exit 1 saying why; cpu: the CPU\n"
-         "                         reference (bark textures, relief and fog are CPU-only for now)\n"
+         "                         reference (fog's medium, refined, reference: CPU only)\n"
          "      --width W          image width in pixels (default: the scene's, else 1024)\n"
          "      --height H         image height in pixels (default: the scene's, else 768)\n"
          "      --aov LIST         extra outputs, comma-separated: depth (channel Z, distance\n"
@@ -70,8 +70,9 @@ void print_render_help() {
          "                         segment (default 2)\n"
          "a scene with fog only (each overrides the scene's fog key of the same name):\n"
          "      --fog-mode MODE    how the light the fog scatters is computed: auto (default:\n"
-         "                         refined), brute (ray marching, a shadow ray per sample),\n"
-         "                         reference (converged: every shadow edge bisected, 16 sun-\n"
+         "                         refined on the CPU, fast with OpenGL), brute (ray marching,\n"
+         "                         a shadow ray per sample), reference (converged: every\n"
+         "                         shadow edge bisected, 16 sun-\n"
          "                         disc points); medium (shadow rays only inside the shadow\n"
          "                         cones), fast (no sunlight inside them, no shadow rays) and\n"
          "                         refined (their edges bisected to the exact shadow) trace sun\n"
@@ -297,10 +298,7 @@ int run_render(const std::vector<std::string>& args) {
   if (a.backend != "cpu") {
     std::string why_not;
     const char* fallback = "OpenGL unavailable";
-    if (scene.fog) {
-      why_not = "fog is rendered by the CPU ray caster only, for now";
-      fallback = "the OpenGL backend cannot draw this";
-    } else if (auto unsupported = gl_unsupported(scene, options)) {
+    if (auto unsupported = gl_unsupported(scene, options)) {
       why_not = *unsupported;
       fallback = "the OpenGL backend cannot draw this";
     } else {

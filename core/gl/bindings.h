@@ -23,6 +23,11 @@ inline constexpr uint32_t kPlantBarkBinding = 3;     // PlantBarkRecord per plan
 inline constexpr uint32_t kPlantMapsBinding = 4;     // PlantMapsRecord per plant
 inline constexpr uint32_t kHeightTexelsBinding = 5;  // float height texels
 inline constexpr uint32_t kMeshFrustaBinding = 6;    // MeshFrustumRecord per frustum (gl_mesh.h)
+inline constexpr uint32_t kFogConesBinding = 7;      // GpuShadowConeRecord per shadow cone (fog)
+inline constexpr uint32_t kFogNodesBinding = 8;      // the cone intervals' list nodes (fog_lists.glsl)
+inline constexpr uint32_t kFogHeadsBinding = 9;      // uint32 per pixel: its list's first node
+inline constexpr uint32_t kFogOverflowBinding = 10;  // uint32 per pixel: 1 = its list is incomplete
+inline constexpr uint32_t kFogCountersBinding = 11;  // GlFogCounters
 
 // Texture units.
 inline constexpr uint32_t kBarkTexturesUnit = 0;  // bark image i at kBarkTexturesUnit + i
@@ -40,6 +45,8 @@ inline constexpr uint32_t kPlantIndexBits = 24;  // G-buffer ids.x = plant | mat
 inline constexpr uint32_t kPlantIndexMask = (1u << kPlantIndexBits) - 1;
 inline constexpr uint32_t kMaxPlants = 1u << kPlantIndexBits;
 inline constexpr uint32_t kPyramidVertices = 36;  // vertex pulling: 36 vertices a frustum
+inline constexpr uint32_t kFogListEnd = 0xFFFFFFFFu;  // the end of a pixel's interval list
+inline constexpr uint32_t kFogMaxIntervals = 16;      // merged intervals the resolve holds per pixel
 
 static_assert(kBarkTexturesUnit + kMaxBarkImages <= kGNormalDistanceUnit,
               "the bark images' units must not reach the G-buffer's");
@@ -72,6 +79,13 @@ inline constexpr GlslConstant kGlslConstants[] = {
     {"PLANT_INDEX_BITS", kPlantIndexBits},
     {"PLANT_INDEX_MASK", kPlantIndexMask},
     {"PYRAMID_VERTICES", kPyramidVertices},
+    {"FOG_CONES_BINDING", kFogConesBinding},
+    {"FOG_NODES_BINDING", kFogNodesBinding},
+    {"FOG_HEADS_BINDING", kFogHeadsBinding},
+    {"FOG_OVERFLOW_BINDING", kFogOverflowBinding},
+    {"FOG_COUNTERS_BINDING", kFogCountersBinding},
+    {"FOG_LIST_END", kFogListEnd},
+    {"FOG_MAX_INTERVALS", kFogMaxIntervals},
 };
 
 // ---- Records (std430 arrays in shader storage) ----------------------------------------
@@ -104,6 +118,31 @@ struct MeshFrustumRecord {
   uint32_t ids[4];     // plant | material << kPlantIndexBits, chain, segment, 0
 };
 static_assert(sizeof(MeshFrustumRecord) == 32 && offsetof(MeshFrustumRecord, ids) == 16);
+
+// shadow_cones.glsl's GpuShadowCone: one shadow cone (shadow_cones.h cone_geometry) as an
+// apex-free conical frustum, positions relative to the cone set's origin.
+struct GpuShadowConeRecord {
+  float base_radius0[4];  // base, r(0)
+  float axis_end[4];      // unit axis away from the sun, end (the solid's length along it)
+  float slope_plant[4];   // dr/ds, the occluder's plant (as a float), 0, 0
+};
+static_assert(sizeof(GpuShadowConeRecord) == 48 && offsetof(GpuShadowConeRecord, axis_end) == 16 &&
+              offsetof(GpuShadowConeRecord, slope_plant) == 32);
+
+// fog_lists.glsl's FogNode (12 bytes) and FogCounters.
+struct FogNodeRecord {
+  float t_in = 0, t_out = 0;
+  uint32_t next = kFogListEnd;
+};
+static_assert(sizeof(FogNodeRecord) == 12);
+struct GlFogCounters {
+  uint32_t next_node = 0;          // nodes taken in the last cone pass (may exceed the capacity)
+  uint32_t fragments = 0;          // interval fragments over the frame
+  uint32_t overflow_fragments = 0; // of them, those that found the node buffer full
+  uint32_t overflow_pixels = 0;    // pixels the resolve marched whole
+  uint32_t largest_pass = 0;       // the most nodes one pass asked for
+};
+static_assert(sizeof(GlFogCounters) == 20);
 
 // ---- Uniform blocks (std140): none ----------------------------------------------------
 // The views every geometry pass draws in (views.glsl: the camera, the sun's orthographic

@@ -8,6 +8,8 @@ const char* gl_pass_name(GlPass pass, GeometryKind geometry) {
     case GlPass::shadow: return "shadow map";
     case GlPass::geometry: return geometry == GeometryKind::mesh ? "mesh" : "frusta";
     case GlPass::shade: return "shade";
+    case GlPass::fog_cones: return "fog cones";
+    case GlPass::fog: return "fog";
     case GlPass::present: return "present";
   }
   return "?";
@@ -38,6 +40,17 @@ std::vector<RenderPass> describe_frame(const GlFrameStats& s) {
                    std::to_string(s.frusta) + " frusta, " + runs(GlPass::geometry) + geometry.program +
                        (s.eye_inside ? ", " + std::to_string(s.eye_inside) + " around the eye" : "")});
   out.push_back({gpu(GlPass::shade), s.pass(GlPass::shade).gpu_s, runs(GlPass::shade) + s.pass(GlPass::shade).program});
+  if (s.fog_cones > 0)
+    out.push_back({gpu(GlPass::fog_cones), s.pass(GlPass::fog_cones).gpu_s,
+                   std::to_string(s.fog_cones) + " cones, " + runs(GlPass::fog_cones) +
+                       (s.fog_counted ? std::to_string(s.fog_fragments) + " intervals, " +
+                                            std::to_string(s.fog_overflow_pixels) + " pixels overflowed, "
+                                      : std::string()) +
+                       s.pass(GlPass::fog_cones).program});
+  if (!s.fog_mode.empty())
+    out.push_back({gpu(GlPass::fog), s.pass(GlPass::fog).gpu_s,
+                   s.fog_mode + ", " + std::to_string(s.fog_steps) + " steps, " + runs(GlPass::fog) +
+                       s.pass(GlPass::fog).program});
   if (s.presented)
     out.push_back({gpu(GlPass::present), s.pass(GlPass::present).gpu_s,
                    std::to_string(s.width) + "x" + std::to_string(s.height) + ", " + s.pass(GlPass::present).program});

@@ -25,11 +25,14 @@ enum class GlPass : uint8_t {
   shadow,    // the shadow map, in the sun's orthographic view (when the sun shines)
   geometry,  // the G-buffer: the ray-cast frusta, or the rasterised mesh
   shade,     // deferred shading into the accumulated beauty
+  fog_cones, // the shadow cones' intervals into per-pixel lists (the fog's cone modes)
+  fog,       // the fog's in-scatter into the beauty and the fog AOV (a scene with fog only)
   present,   // the beauty into the caller's target (only when one is given)
 };
-inline constexpr size_t kGlPassCount = 4;
+inline constexpr size_t kGlPassCount = 6;
 
-// "shadow map", "frusta" or "mesh" (the geometry pass, by `geometry`), "shade", "present".
+// "shadow map", "frusta" or "mesh" (the geometry pass, by `geometry`), "shade",
+// "fog cones", "fog", "present".
 const char* gl_pass_name(GlPass pass, GeometryKind geometry = GeometryKind::frusta);
 
 struct GlPassStats {
@@ -51,6 +54,16 @@ struct GlFrameStats {
   uint64_t triangles = 0;      // mesh triangles uploaded; 0 for frusta
   uint32_t eye_inside = 0;     // frusta drawn again from inside their pyramid (EYE_INSIDE)
   uint32_t shadow_texels = 0;  // the shadow map's side; 0: no sun, no shadow pass
+  std::string fog_mode;        // the fog pass's mode ("brute", "medium", "fast"); empty: no fog
+  uint32_t fog_steps = 0;      // its samples along each ray
+  uint32_t fog_cones = 0;      // shadow cones drawn by the cone pass (0: none ran)
+  uint32_t fog_list_capacity = 0;  // interval list nodes held
+  // The cone pass's counts, read by wait_for_frame (fog_counted) once the GPU is done:
+  bool fog_counted = false;
+  uint64_t fog_fragments = 0;           // intervals appended over the frame
+  uint64_t fog_overflow_fragments = 0;  // of them, those that found the node buffer full
+  uint64_t fog_overflow_pixels = 0;     // pixels marched whole instead (their list incomplete)
+  uint64_t fog_largest_pass = 0;        // the most nodes one cone pass asked for
 
   // Time.
   std::array<GlPassStats, kGlPassCount> passes{};  // indexed by GlPass
@@ -76,7 +89,7 @@ struct GlFrameStats {
 
 // The frame as `sylva render --verbose` lists it, one RenderPass per line: "programs" (when
 // some were built), "shadow map (GPU)", "frusta (GPU)" or "mesh (GPU)", "shade (GPU)",
-// "present (GPU)" (when it ran), with what each drew in the detail. GPU times are 0 until
+// "fog (GPU)" (a scene with fog), "present (GPU)" (when it ran), with what each drew in the detail. GPU times are 0 until
 // gpu_times_ready.
 std::vector<RenderPass> describe_frame(const GlFrameStats& stats);
 

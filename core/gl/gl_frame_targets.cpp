@@ -8,8 +8,8 @@
 
 namespace sylva {
 
-bool GlFrameTargets::resize(uint32_t w, uint32_t h) {
-  if (w == width && h == height) return false;
+bool GlFrameTargets::resize(uint32_t w, uint32_t h, bool with_fog) {
+  if (w == width && h == height && with_fog == fog) return false;
   const uint32_t max_size = max_gl_target_size();
   if (w > max_size || h > max_size)
     throw GlError("image " + std::to_string(w) + "x" + std::to_string(h) + " exceeds the driver's largest target (" +
@@ -36,6 +36,16 @@ bool GlFrameTargets::resize(uint32_t w, uint32_t h) {
   accumulation_fbo = make_gl_framebuffer();
   glNamedFramebufferTexture(accumulation_fbo.id(), GL_COLOR_ATTACHMENT0, accumulation.id(), 0);
   check_gl_framebuffer(accumulation_fbo.id(), "accumulation");
+  if (with_fog) {
+    fog_aov = make_gl_texture_2d(GL_RGBA32F, w, h);
+    glTextureParameteri(fog_aov.id(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(fog_aov.id(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    fog_fbo = make_gl_framebuffer();
+    glNamedFramebufferTexture(fog_fbo.id(), GL_COLOR_ATTACHMENT0, accumulation.id(), 0);
+    glNamedFramebufferTexture(fog_fbo.id(), GL_COLOR_ATTACHMENT1, fog_aov.id(), 0);
+    check_gl_framebuffer(fog_fbo.id(), "fog");
+  }
+  fog = with_fog;
   check_gl("render targets");
   width = w;
   height = h;

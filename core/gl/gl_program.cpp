@@ -96,6 +96,7 @@ void set_uniform(uint32_t p, const char* name, const glm::vec3& v) {
 }
 void set_uniform(uint32_t p, const char* name, const glm::dvec3& v) { set_uniform(p, name, glm::vec3(v)); }
 void set_uniform_int(uint32_t p, const char* name, int value) { glProgramUniform1i(p, location(p, name), value); }
+void set_uniform_uint(uint32_t p, const char* name, uint32_t value) { glProgramUniform1ui(p, location(p, name), value); }
 void set_uniform_vec3_array(uint32_t p, const char* name, int count, const float* xyz) {
   glProgramUniform3fv(p, location(p, name), count, xyz);
 }

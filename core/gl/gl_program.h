@@ -37,6 +37,7 @@ void set_uniform(uint32_t program, const char* name, double x, double y, double 
 void set_uniform(uint32_t program, const char* name, const glm::vec3& value);        // vec3
 void set_uniform(uint32_t program, const char* name, const glm::dvec3& value);       // vec3
 void set_uniform_int(uint32_t program, const char* name, int value);                 // int, bool, sampler
+void set_uniform_uint(uint32_t program, const char* name, uint32_t value);           // uint
 // vec3 name[count] from `count` consecutive x, y, z floats.
 void set_uniform_vec3_array(uint32_t program, const char* name, int count, const float* xyz);
 

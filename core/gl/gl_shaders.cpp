@@ -5,6 +5,7 @@
 #include <charconv>
 #include <stdexcept>
 
+#include "core/fog_integrator.h"
 #include "core/shading.h"
 
 namespace sylva {
@@ -159,13 +160,49 @@ ShaderProgramSource present_program(bool srgb) {
   return p;
 }
 
-ShaderProgramSource shade_program(bool sun) {
+ShaderProgramSource shade_program(bool sun, bool fog) {
   ShaderProgramSource p;
   std::vector<std::string> defines = shading_defines();
   if (sun) defines.push_back("SUN");
-  p.name = sun ? "shade[SUN]" : "shade[]";
+  if (fog) defines.push_back("FOG");
+  p.name = std::string("shade[") + (sun ? "SUN" : "") + (sun && fog ? " " : "") + (fog ? "FOG" : "") + "]";
   p.vertex = {ShaderStage::vertex, {"fullscreen.vert.glsl"}, {}};
-  p.fragment = {ShaderStage::fragment, {"bark.glsl", "shading.glsl", "shade.frag.glsl"}, defines};
+  std::vector<std::string> files = {"bark.glsl", "shading.glsl"};
+  if (fog) files.push_back("fog.glsl");
+  p.fragment = {ShaderStage::fragment, with(files, "shade.frag.glsl"), defines};
+  return p;
+}
+
+const char* gl_fog_mode_name(GlFogMode mode) {
+  switch (mode) {
+    case GlFogMode::brute: return "brute";
+    case GlFogMode::medium: return "medium";
+    case GlFogMode::fast: return "fast";
+  }
+  return "?";
+}
+
+ShaderProgramSource fog_program(bool sun, GlFogMode mode) {
+  ShaderProgramSource p;
+  const char* mode_define = mode == GlFogMode::brute ? "FOG_BRUTE" : mode == GlFogMode::medium ? "FOG_MEDIUM" : "FOG_FAST";
+  std::vector<std::string> defines = {mode_define, "FOG_NEGLIGIBLE_DEPTH " + glsl_float(kFogNegligibleDepth)};
+  if (sun) defines.push_back("SUN");
+  p.name = std::string("fog[") + mode_define + (sun ? " SUN]" : "]");
+  p.vertex = {ShaderStage::vertex, {"fullscreen.vert.glsl"}, {}};
+  std::vector<std::string> files = {"fog.glsl"};
+  if (mode != GlFogMode::brute) files.push_back("fog_lists.glsl");
+  p.fragment = {ShaderStage::fragment, with(files, "fog.frag.glsl"), defines};
+  return p;
+}
+
+ShaderProgramSource fog_cones_program() {
+  ShaderProgramSource p;
+  p.name = "fog_cones[CAMERA_VIEW]";
+  const std::vector<std::string> defines = {"CAMERA_VIEW"};
+  const std::vector<std::string> files = {"ray_frustum.glsl", "skin.glsl", "views.glsl", "fog.glsl", "fog_lists.glsl",
+                                          "shadow_cones.glsl"};
+  p.vertex = {ShaderStage::vertex, with(files, "fog_cones.vert.glsl"), defines};
+  p.fragment = {ShaderStage::fragment, with(files, "fog_cones.frag.glsl"), defines};
   return p;
 }
 
@@ -193,7 +230,11 @@ std::vector<ShaderProgramSource> all_shader_programs() {
   }
   for (MeshPass pass : {MeshPass::gbuffer, MeshPass::shadow}) all.push_back(mesh_program(pass));
   all.push_back(mesh_program(MeshPass::gbuffer, 1));  // with the bark albedo
-  for (bool sun : {false, true}) all.push_back(shade_program(sun));
+  for (bool sun : {false, true})
+    for (bool fog : {false, true}) all.push_back(shade_program(sun, fog));
+  for (bool sun : {false, true})
+    for (GlFogMode mode : {GlFogMode::brute, GlFogMode::medium, GlFogMode::fast}) all.push_back(fog_program(sun, mode));
+  all.push_back(fog_cones_program());
   for (bool srgb : {false, true}) all.push_back(present_program(srgb));
   return all;
 }

@@ -100,8 +100,30 @@ std::vector<std::string> shading_defines();
 
 // The deferred shading program (fullscreen.vert.glsl + bark.glsl's per-plant maps +
 // shading.glsl's model + shade.frag.glsl), with shading_defines(); `sun` false leaves out
-// the sun and its shadow map (black or absent sun: sky only).
-ShaderProgramSource shade_program(bool sun);
+// the sun and its shadow map (black or absent sun: sky only); `fog` (a scene with fog)
+// adds fog.glsl and FOG: sunlight × T_sun, what is seen × T(0, t_end) (spec/fog.md).
+ShaderProgramSource shade_program(bool sun, bool fog = false);
+
+// The fog pass's modes on the GPU (spec/fog.md, docs/gl-fog.md).
+enum class GlFogMode {
+  brute,   // FOG_BRUTE: the shadow map marched along the whole ray
+  medium,  // FOG_MEDIUM: closed form outside the cone intervals, the map marched inside
+  fast,    // FOG_FAST: closed form outside the cone intervals, V = 0 inside
+};
+const char* gl_fog_mode_name(GlFogMode mode);  // "brute", "medium", "fast" (spec/fog.md's)
+
+// The fog pass (fullscreen.vert.glsl + fog.glsl [+ fog_lists.glsl] + fog.frag.glsl): the
+// light the fog scatters toward the eye, added into the accumulated beauty, and the fog
+// AOV; the cone modes read the per-pixel interval lists the cone pass wrote. `sun` false:
+// the sky's share and T alone. FOG_NEGLIGIBLE_DEPTH is fog_integrator.h's
+// kFogNegligibleDepth.
+ShaderProgramSource fog_program(bool sun, GlFogMode mode = GlFogMode::brute);
+
+// The cone pass (ray_frustum.glsl + skin.glsl + views.glsl[CAMERA_VIEW] + fog.glsl +
+// fog_lists.glsl + shadow_cones.glsl + fog_cones.vert/frag.glsl): each shadow cone's
+// bounding pyramid rasterised in the camera's view, its interval along each pixel's ray
+// appended to that pixel's list.
+ShaderProgramSource fog_cones_program();
 
 // The present program (fullscreen.vert.glsl + present.frag.glsl): the accumulated beauty
 // divided by the sample count into the caller's target (render_gl.h), as linear values or,

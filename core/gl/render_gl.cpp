@@ -14,9 +14,12 @@
 #include <map>
 #include <stdexcept>
 
+#include "core/cpu/photons.h"
+#include "core/cpu/render_cpu.h"
 #include "core/gl/bindings.h"
 #include "core/gl/gl_api.h"
 #include "core/gl/gl_bark_maps.h"
+#include "core/gl/gl_fog.h"
 #include "core/gl/gl_frame_targets.h"
 #include "core/gl/gl_mesh.h"
 #include "core/gl/gl_objects.h"
@@ -109,7 +112,39 @@ ShadowFrame shadow_frame(const std::vector<Sphere>& spheres, const glm::dvec3& d
 
 }  // namespace
 
+namespace {
+
+// The fog pass's mode for the mode `options` or the scene ask for (auto: the cone-interval
+// pass, fast; spec/fog.md), or nullopt where the GPU has none: refined, reference, and
+// medium, whose resolve (fog.frag.glsl FOG_MEDIUM) agrees with brute on small scenes but
+// is darker than it on the dense canopy (docs/gl-fog.md, "Not done").
+std::optional<GlFogMode> gl_fog_mode_of(FogMode mode) {
+  switch (mode) {
+    case FogMode::brute: return GlFogMode::brute;
+    case FogMode::fast:
+    case FogMode::automatic: return GlFogMode::fast;
+    default: return std::nullopt;
+  }
+}
+
+FogMode requested_fog_mode(const Scene& scene, const RenderOptions& options) {
+  return options.fog.mode.value_or(scene.fog->mode);
+}
+
+// Why the fog pass cannot draw `scene`'s fog in the mode `options` or the scene ask for,
+// or nullopt when it can (or there is no fog).
+std::optional<std::string> gl_fog_unsupported(const Scene& scene, const RenderOptions& options) {
+  if (!scene.fog) return std::nullopt;
+  const FogMode mode = requested_fog_mode(scene, options);
+  if (gl_fog_mode_of(mode)) return std::nullopt;
+  return std::string("the GL backend's fog pass runs brute and fast (auto) only, for now (the fog asks for ") +
+         fog_mode_name(mode) + "; --fog-mode brute or fast draws it with OpenGL)";
+}
+
+}  // namespace
+
 std::optional<std::string> gl_unsupported(const Scene& scene, const RenderOptions& options) {
+  if (auto why = gl_fog_unsupported(scene, options)) return why;
   const size_t images = bark_image_files(scene, options).size();  // what GlBarkMaps uploads
   if (images > gl::kMaxBarkImages)
     return "the GL backend binds at most " + std::to_string(gl::kMaxBarkImages) +
@@ -129,8 +164,13 @@ struct GlRenderer::Frame {
   glm::dvec3 ray_dx{0}, ray_dy{0};  // the next sample's direction to the right / below
   bool sun_on = false;
   glm::dvec3 sun_radiance{0};
+  bool fog_on = false;     // the scene has fog: shade[FOG] and the fog pass
+  GlFogMode fog_mode = GlFogMode::brute;
+  bool fog_cones = false;  // a cone mode with cones uploaded: the cone pass runs
+  uint32_t fog_steps = 0;  // the fog's samples along each ray (brute; medium inside the cones)
   std::vector<uint32_t> eye_inside;  // frusta whose pyramid may reach the eye's near plane
-  GLuint gbuffer_program = 0, inside_program = 0, shadow_program = 0, shade_program = 0, present_program = 0;
+  GLuint gbuffer_program = 0, inside_program = 0, shadow_program = 0, shade_program = 0, fog_program = 0,
+         fog_cones_program = 0, present_program = 0;
   GlCameraView camera_view;  // this sample's (its jitter set per geometry pass)
   ShadowFrame shadow;  // the last shadow pass's view: the shade passes look it up
 };
@@ -147,6 +187,9 @@ struct GlRenderer::State {
   uint64_t pending_plant_bytes = 0;  // plant data sent since the last frame
   std::vector<Sphere> spheres;       // around each frustum's bounding pyramid (or its triangles)
   FrustaFeatures features;           // the frusta program's switches for this scene (gl_shaders.h)
+  std::optional<GlFogCones> fog_cones;  // set_fog_cones: once per (plants, sun)
+  GlFogLists fog_lists;                 // the cone intervals per pixel (cone modes)
+  uint32_t fog_nodes_wanted = 0;        // the most list nodes a cone pass asked for so far
   std::unique_ptr<GlBarkMaps> bark_maps;
   std::unique_ptr<GlMesh> mesh;      // GeometryKind::mesh: the polygon baseline, drawn instead of the frusta
 
@@ -254,9 +297,13 @@ struct GlRenderer::State {
     f.inside_program =
         f.eye_inside.empty() ? 0 : program(frusta_variant(FrustaPass::gbuffer_eye_inside), &s.compile_s, &s.compiled);
     f.shadow_program = f.sun_on && !mesh ? program(frusta_variant(FrustaPass::shadow), &s.compile_s, &s.compiled) : 0;
-    f.shade_program = program(shade_program(f.sun_on), &s.compile_s, &s.compiled);
+    f.shade_program = program(shade_program(f.sun_on, f.fog_on), &s.compile_s, &s.compiled);
+    f.fog_program = f.fog_on ? program(fog_program(f.sun_on, f.fog_mode), &s.compile_s, &s.compiled) : 0;
+    f.fog_cones_program = f.fog_cones ? program(fog_cones_program(), &s.compile_s, &s.compiled) : 0;
     s.pass(GlPass::geometry).program = mesh ? mesh->gbuffer_variant() : frusta_variant(FrustaPass::gbuffer).name;
-    s.pass(GlPass::shade).program = shade_program(f.sun_on).name;
+    s.pass(GlPass::shade).program = shade_program(f.sun_on, f.fog_on).name;
+    if (f.fog_on) s.pass(GlPass::fog).program = fog_program(f.sun_on, f.fog_mode).name;
+    if (f.fog_cones) s.pass(GlPass::fog_cones).program = fog_cones_program().name;
     if (f.sun_on)
       s.pass(GlPass::shadow).program = (mesh ? mesh_program(MeshPass::shadow) : frusta_variant(FrustaPass::shadow)).name;
   }
@@ -264,7 +311,7 @@ struct GlRenderer::State {
   // The programs' uniforms that stay for the frame: the camera (but its jitter), the ray
   // differentials and the relief's sampling, the sky, ground and materials.
   void frame_uniforms(const Scene& scene, const Frame& f) const {
-    for (GLuint p : {f.gbuffer_program, f.inside_program, f.shade_program})
+    for (GLuint p : {f.gbuffer_program, f.inside_program, f.shade_program, f.fog_program, f.fog_cones_program})
       if (p) set_camera_uniforms(p, f.camera_view);
     const ReliefOptions& relief = options.geometry.relief_options;
     for (GLuint p : {f.gbuffer_program, f.inside_program, f.shadow_program}) {
@@ -292,6 +339,31 @@ struct GlRenderer::State {
     }
     set_uniform_vec3_array(shade, "u_material_albedo", count, albedo);
     set_uniform_int(shade, "u_material_count", count);
+    if (f.fog_on) fog_uniforms(scene, f);
+  }
+
+  // The medium (heights above the ground: fog.glsl's convention) for shade[FOG] and the fog
+  // pass, and the fog pass's frame uniforms.
+  void fog_uniforms(const Scene& scene, const Frame& f) const {
+    const Fog& fog = *scene.fog;
+    const glm::dvec3 sun_centre = glm::normalize(scene.sun.direction);
+    for (GLuint p : {f.shade_program, f.fog_program}) {
+      set_uniform(p, "u_fog_medium", fog.sigma_s, fog.sigma_a, fog.g, fog.height_falloff);
+      set_uniform(p, "u_fog_top", fog.top - scene.ground.height);  // +inf stays +inf
+      set_uniform(p, "u_fog_sun_dir", sun_centre);
+    }
+    const GLuint p = f.fog_program;
+    set_uniform(p, "u_eye_above_ground", f.camera.eye.y - scene.ground.height);
+    set_uniform(p, "u_sky", scene.sky);
+    set_uniform(p, "u_sun_radiance", f.sun_radiance);
+    set_uniform_uint(p, "u_steps", f.fog_steps);
+    if (f.fog_mode == GlFogMode::brute) return;
+    set_uniform_int(p, "u_cones", f.fog_cones ? 1 : 0);
+    if (!f.fog_cones) return;
+    const GLuint c = f.fog_cones_program;
+    set_uniform(c, "u_eye_rel_cones", f.camera.eye - fog_cones->origin);
+    set_uniform(c, "u_eye_above_ground", f.camera.eye.y - scene.ground.height);
+    set_uniform_uint(c, "u_fog_capacity", fog_lists.capacity);
   }
 
   // The buffers and textures every pass reads (bindings.h), and the state every pass
@@ -385,9 +457,11 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options) : state
   double compile_s = 0;
   const bool sun_on = sun_shines(scene);
   std::string names;
-  std::vector<ShaderProgramSource> needed = {st.frusta_variant(FrustaPass::gbuffer), shade_program(sun_on)};
+  const bool fog_on = scene.fog.has_value();
+  std::vector<ShaderProgramSource> needed = {st.frusta_variant(FrustaPass::gbuffer), shade_program(sun_on, fog_on)};
   if (sun_on) needed.push_back(st.frusta_variant(FrustaPass::shadow));
-  if (st.mesh) needed = {shade_program(sun_on)};  // the mesh built its own
+  if (st.mesh) needed = {shade_program(sun_on, fog_on)};  // the mesh built its own
+  if (fog_on) needed.push_back(fog_program(sun_on));
   for (const ShaderProgramSource& source : needed) st.program(source, &compile_s, &names);
   st.setup_passes.push_back({"programs", compile_s, names});
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
@@ -397,6 +471,12 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options) : state
 GlRenderer::~GlRenderer() = default;
 
 void GlRenderer::set_conservative_depth(bool on) { state_->features.conservative_depth = on; }
+
+uint64_t GlRenderer::set_fog_cones(const ConeSet& cones) {
+  state_->fog_cones = upload_fog_cones(cones);
+  check_gl("set_fog_cones");
+  return state_->fog_cones->bytes;
+}
 
 void GlRenderer::set_shadow_map_texels(uint32_t texels) {
   if (texels == 0) {
@@ -491,9 +571,18 @@ const GlFrameStats& GlRenderer::draw_frame(const Scene& scene, const GlTarget* t
     if (f.sun_on && (sample == 0 || sun_per_sample)) shadow_pass(f, l);
     geometry_pass(f, jitter_x, jitter_y);
     shade_pass(f, l);
+    if (f.fog_cones) fog_cones_pass(f);
+    if (f.fog_on) fog_pass(f, sample, false);
   }
-  // AOVs describe the pixel centres: the last G-buffer already is that at 1 spp.
-  if (!f.stats.cancelled && st.options.aovs && f.spp > 1) geometry_pass(f, 0.5, 0.5);
+  // AOVs describe the pixel centres: the last G-buffer (and fog AOV) already is that at 1
+  // spp. Else the fog AOV's stream is sample spp's, as on the CPU.
+  if (!f.stats.cancelled && st.options.aovs && f.spp > 1) {
+    geometry_pass(f, 0.5, 0.5);
+    if (f.fog_on && (st.options.aovs & kAovFog)) {
+      if (f.fog_cones) fog_cones_pass(f);
+      fog_pass(f, f.spp, true);
+    }
+  }
   if (target && !f.stats.cancelled) present_pass(f, *target);
   end_frame(f);
   return st.last;
@@ -517,18 +606,42 @@ void GlRenderer::begin_frame(const Scene& scene, Frame& f) {
   s.triangles = st.mesh ? st.mesh->triangles() : 0;
   s.geometry_bytes = st.uploaded_bytes;
   s.plant_bytes_uploaded = std::exchange(st.pending_plant_bytes, 0);
-  s.targets_allocated += st.targets.resize(f.width, f.height) ? 2 : 0;  // G-buffer, accumulation
+  if (auto why = gl_fog_unsupported(scene, st.options)) throw GlError(*why);
+  f.fog_on = scene.fog.has_value();
+  if (f.fog_on) {
+    f.fog_mode = *gl_fog_mode_of(requested_fog_mode(scene, st.options));
+    if (f.fog_mode == GlFogMode::fast && !st.fog_cones)
+      throw GlError("the GL fog pass's fast mode needs shadow cones (GlRenderer::set_fog_cones; render_gl builds them)");
+    f.fog_cones = f.fog_mode != GlFogMode::brute && st.fog_cones;
+    f.fog_steps = std::clamp(st.options.fog.steps.value_or(scene.fog->steps), 1u, kFogMaxSteps);
+    s.fog_mode = gl_fog_mode_name(f.fog_mode);
+    s.fog_steps = f.fog_steps;
+    if (f.fog_cones) {
+      // Two nodes a pixel to start with, then what the largest pass so far asked for.
+      const uint32_t pixels = f.width * f.height;
+      s.targets_allocated += st.fog_lists.reserve(pixels, std::max({2 * pixels, st.fog_nodes_wanted, 1u}));
+      s.fog_cones = st.fog_cones->count;
+      s.fog_list_capacity = st.fog_lists.capacity;
+    }
+  }
+  // G-buffer, accumulation (and the fog AOV)
+  s.targets_allocated += st.targets.resize(f.width, f.height, f.fog_on) ? (f.fog_on ? 3 : 2) : 0;
   f.sun_on = sun_shines(scene);
   f.sun_radiance = scene.sun.radiance;
   if (f.sun_on) {
     s.shadow_texels = st.shadow_texels_override ? st.shadow_texels_override : st.shadow_map_texels(f.width, f.height);
     s.targets_allocated += st.shadow_map.resize(s.shadow_texels) ? 1 : 0;
   }
-  s.target_bytes = st.targets.bytes() + (f.sun_on ? st.shadow_map.bytes() : 0);
+  s.target_bytes = st.targets.bytes() + (f.sun_on ? st.shadow_map.bytes() : 0) + (f.fog_cones ? st.fog_lists.bytes() : 0);
   st.frame_views(scene, f);
   st.frame_programs(f);
   st.frame_uniforms(scene, f);
   st.bind_frame(f);
+  if (f.fog_cones) {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kFogConesBinding, st.fog_cones->records.id());
+    st.fog_lists.bind();
+    st.fog_lists.clear_frame();
+  }
   st.timers.begin_frame(s.frame);
 }
 
@@ -625,6 +738,65 @@ void GlRenderer::shade_pass(Frame& f, const glm::dvec3& l) {
   st.timers.end();
 }
 
+// The shadow cones' intervals along each pixel's ray of this sample, clipped to what its
+// G-buffer sees, appended to the pixel's list: every cone's bounding pyramid drawn from its
+// back faces (fog_cones.frag.glsl says why), no depth test, no colour.
+void GlRenderer::fog_cones_pass(Frame& f) {
+  State& st = *state_;
+  const GLuint cones = f.fog_cones_program;
+  set_jitter_uniform(cones, f.camera_view.jitter);
+  st.fog_lists.clear_pass();
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  st.timers.begin(GlPass::fog_cones);
+  ++f.stats.pass(GlPass::fog_cones).runs;
+  const GLuint fbo = st.targets.fog_fbo.id();
+  const GLenum none[2] = {GL_NONE, GL_NONE};
+  glNamedFramebufferDrawBuffers(fbo, 2, none);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glViewport(0, 0, static_cast<GLsizei>(f.width), static_cast<GLsizei>(f.height));
+  glDisable(GL_DEPTH_TEST);
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_FRONT);
+  glUseProgram(cones);
+  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(st.fog_cones->count * gl::kPyramidVertices));
+  glDisable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  st.timers.end();
+}
+
+// The fog's in-scatter along each pixel's ray of this sample (its G-buffer, the last shadow
+// map) added into the accumulation, and its fog AOV; `aov_only`: the AOV alone (the pixel
+// centres' pass at spp > 1). `sample` picks the jitter's random stream.
+void GlRenderer::fog_pass(Frame& f, uint32_t sample, bool aov_only) {
+  State& st = *state_;
+  const GLuint fog = f.fog_program;
+  set_jitter_uniform(fog, f.camera_view.jitter);
+  set_uniform_uint(fog, "u_seed", sample);
+  if (f.sun_on) {
+    const ShadowFrame& v = f.shadow;
+    set_sun_view_uniforms(fog, sun_view(v, f.stats.shadow_texels));
+    set_uniform(fog, "u_eye_rel_light", f.camera.eye - v.centre);
+    set_uniform(fog, "u_depth_bias", kShadowDepthBiasTexels * v.texel_m / v.s_range);
+  }
+  st.timers.begin(GlPass::fog);
+  ++f.stats.pass(GlPass::fog).runs;
+  const GLuint fbo = st.targets.fog_fbo.id();
+  const GLenum both[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1}, aov[2] = {GL_NONE, GL_COLOR_ATTACHMENT1};
+  glNamedFramebufferDrawBuffers(fbo, 2, aov_only ? aov : both);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glViewport(0, 0, static_cast<GLsizei>(f.width), static_cast<GLsizei>(f.height));
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
+  glEnablei(GL_BLEND, 0);  // in-scatter added to the beauty; the AOV written
+  glBlendFunci(0, GL_ONE, GL_ONE);
+  glDisablei(GL_BLEND, 1);
+  glUseProgram(fog);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDisable(GL_BLEND);
+  st.timers.end();
+}
+
 // The accumulated beauty ÷ spp into the caller's target (gl_target.h).
 void GlRenderer::present_pass(Frame& f, const GlTarget& target) {
   State& st = *state_;
@@ -687,6 +859,16 @@ const GlFrameStats& GlRenderer::wait_for_frame() {
   State& st = *state_;
   if (st.frames == 0) throw std::logic_error("GlRenderer::wait_for_frame: no frame drawn yet");
   if (!st.last.gpu_times_ready) take_timed_frames(true);
+  if (st.last.fog_cones > 0 && !st.last.fog_counted) {
+    // The GPU is done with the frame: its counters are the last frame's.
+    const gl::GlFogCounters c = st.fog_lists.read_counters();
+    st.last.fog_fragments = c.fragments;
+    st.last.fog_overflow_fragments = c.overflow_fragments;
+    st.last.fog_overflow_pixels = c.overflow_pixels;
+    st.last.fog_largest_pass = c.largest_pass;
+    st.last.fog_counted = true;
+    st.fog_nodes_wanted = std::max(st.fog_nodes_wanted, c.largest_pass + c.largest_pass / 4);
+  }
   return st.last;
 }
 
@@ -749,6 +931,15 @@ RenderImage GlRenderer::read_back() {
         }
       }
   }
+  if ((aovs & kAovFog) && st.targets.fog) {
+    std::vector<float> fog(pixels * 4);
+    glGetTextureImage(st.targets.fog_aov.id(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(fog.size() * sizeof(float)),
+                      fog.data());
+    image.fog.resize(pixels * 4);
+    for (uint32_t y = 0; y < h; ++y)
+      std::memcpy(&image.fog[static_cast<size_t>(y) * w * 4], &fog[static_cast<size_t>(h - 1 - y) * w * 4],
+                  w * 4 * sizeof(float));
+  }
   check_gl("readback");
   return image;
 }
@@ -764,7 +955,18 @@ RenderResult GlRenderer::render(const Scene& scene) {
     return result;
   }
   // After the GPU's answer: "readback" is the transfer alone.
-  const GlFrameStats& stats = wait_for_frame();
+  const GlFrameStats* waited = &wait_for_frame();
+  if (waited->fog_overflow_fragments > 0) {
+    // The cone intervals overflowed their lists (those pixels were marched whole, as
+    // brute): drawn once more, the lists now sized by what the first frame asked for.
+    const GlFrameStats& again = draw(scene);
+    if (again.cancelled) {
+      result.cancelled = true;
+      return result;
+    }
+    waited = &wait_for_frame();
+  }
+  const GlFrameStats& stats = *waited;
   const Clock::time_point readback_start = Clock::now();
   result.image = read_back();
   const double readback_s = seconds_since(readback_start);
@@ -787,7 +989,29 @@ RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrame
     return cancelled;
   }
   GlRenderer& renderer = *built;
+  std::vector<RenderPass> cone_passes;
+  if (scene.fog && requested_fog_mode(scene, options) != FogMode::brute) {
+    // The cone modes: sun photons and shadow cones on the CPU (as render_cpu builds them),
+    // uploaded once.
+    const FogMode mode = FogMode::fast;
+    const SceneGeometry geometry = build_scene_geometry(scene, options.skin, GeometryOptions{}, &cone_passes);
+    const std::unique_ptr<const SunCones> cones = build_sun_cones(
+        geometry, scene,
+        sun_cone_options_for(mode, options.fog.photons.value_or(scene.fog->photons), options.fog.cone_params,
+                             options.threads, options.progress.cancel_flag()));
+    cone_passes.insert(cone_passes.end(), cones->passes.begin(), cones->passes.end());
+    if (cones->cancelled) {
+      RenderResult cancelled;
+      cancelled.cancelled = true;
+      return cancelled;
+    }
+    const Clock::time_point start = Clock::now();
+    const uint64_t bytes = renderer.set_fog_cones(cones->cones);
+    cone_passes.push_back({"cone upload", seconds_since(start),
+                           std::to_string(cones->cones.size()) + " cones, " + std::to_string(bytes / 1024) + " KiB"});
+  }
   RenderResult result = renderer.render(scene);
+  result.passes.insert(result.passes.begin(), cone_passes.begin(), cone_passes.end());
   if (stats) *stats = renderer.wait_for_frame();
   result.passes.insert(result.passes.begin(), renderer.setup_passes().begin(), renderer.setup_passes().end());
   return result;

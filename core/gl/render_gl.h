@@ -25,6 +25,15 @@
 //   shade          one fullscreen pass: ground plane, sky, sun (Lambert + normalised
 //                  Blinn-Phong) with the shadow map, sky ambient — render_cpu.cpp's lit() —
 //                  added into the renderer's accumulation target.
+//   fog            a scene with fog only (spec/fog.md; docs/gl-fog.md): shade[FOG] has
+//                  already multiplied the surfaces' sunlight by T_sun and what is seen by
+//                  T(0, t_end); one fullscreen pass (fog.frag.glsl) adds the in-scatter —
+//                  `brute`: N jittered samples of the unshadowed in-scatter's distribution
+//                  along the ray to the G-buffer's depth, each looked up in the shadow map —
+//                  and writes the fog AOV (fog.R fog.G fog.B fog.T). `fast` (and
+//                  `auto`): first a cone pass draws the shadow cones (set_fog_cones) as
+//                  frusta, their intervals into per-pixel lists; the resolve integrates
+//                  in closed form outside them. Other modes: refused (gl_unsupported).
 //   present        only when the caller gives a target (gl_target.h): the accumulated
 //                  beauty ÷ spp into it, linear or sRGB-encoded.
 // --spp N repeats shadow map (if the sun is a disc), frusta and shade N times with the
@@ -51,6 +60,9 @@
 //   - a relief plant's shadow lookups start a pixel footprint above the hit (as the
 //     CPU's shadow rays do), or two shadow-map texels where that is more.
 //   - at most 16 distinct bark images per scene (gl_unsupported says so).
+//   - fog: the shadow map stands for the fog's shadow rays (a texel moves a shadow edge by
+//     up to its size: docs/gl-fog.md measures the error), in float, and other random
+//     numbers than the CPU's; at --spp 1 the disc sun's centre casts the fog's shadows.
 //   - meshes are rasterised, not ray traced (gl_mesh.h): coverage rules instead of
 //     Embree's watertight test at silhouettes, and attributes interpolated from vertices
 //     snapped to the sub-pixel grid (normals ~1e-4, depth ~1e-7 relative); the bark
@@ -69,6 +81,7 @@
 #include "core/gl/gl_target.h"
 #include "core/render_types.h"
 #include "core/scene.h"
+#include "core/shadow_cones.h"
 
 namespace sylva {
 
@@ -84,8 +97,8 @@ std::optional<std::string> gl_unsupported(const Scene& scene, const RenderOption
 //     at a time. Failures throw GlError.
 //   - What is done when. The constructor loads the bark images, skins (or, for
 //     GeometryKind::mesh, tessellates) every plant and uploads it, and builds the programs
-//     the first frame needs. draw() reads only the camera, image size, sun, sky and ground of
-//     the scene it is given: a new camera or sun redraws the same buffers (0 plant bytes
+//     the first frame needs. draw() reads only the camera, image size, sun, sky, ground and
+//     fog of the scene it is given: a new camera or sun redraws the same buffers (0 plant bytes
 //     uploaded), a new image size reallocates the render targets and nothing else, a
 //     program variant is built the first time a frame needs it (EYE_INSIDE, a sun that
 //     starts shining). Only update_plants sends plant data again.
@@ -115,7 +128,7 @@ class GlRenderer {
   GlRenderer& operator=(const GlRenderer&) = delete;
 
   // ---- Frames ---------------------------------------------------------------------------
-  // Draws one frame of `scene` (its camera, image size, sun, sky and ground; its plants are
+  // Draws one frame of `scene` (its camera, image size, sun, sky, ground and fog; its plants are
   // not read: they are the ones uploaded) into the renderer's own targets, and, given a
   // target, presents it there (gl_target.h; the target's size must be the scene's, else
   // std::invalid_argument). Returns once the work is submitted: no glFinish, no readback,
@@ -137,7 +150,9 @@ class GlRenderer {
   // the CLI and `bench gpu` do after each frame). Throws std::logic_error before any draw.
   const GlFrameStats& wait_for_frame();
 
-  // One frame as the CLI and render_gl() need it: draw(scene), wait_for_frame, read_back.
+  // One frame as the CLI and render_gl() need it: draw(scene), wait_for_frame, read_back;
+  // drawn a second time when its fog cone intervals overflowed their lists (then sized by
+  // what the first asked for), so that a one-shot render marches no pixel whole.
   // Passes: describe_frame's, then "readback" (the transfer alone) and "frame (wall)".
   RenderResult render(const Scene& scene);
 
@@ -159,8 +174,14 @@ class GlRenderer {
   // The shadow map's side in texels from the next frame on (clamped to [16, the driver's
   // largest texture]); 0 (the default): chosen from the frame's size, at least 1024, as the
   // CLI renders. A smaller map is a cheaper, blockier-shadowed picture: the studio's
-  // preview of new plants (app/studio/gl_viewport.cpp) before the full one.
+  // preview of new plants (app/studio/gl_viewport.cpp) before the full one; the fog tests
+  // measure what the map's resolution costs the fog (docs/gl-fog.md).
   void set_shadow_map_texels(uint32_t texels);
+
+  // The shadow cones of this scene's plants and sun (core/cpu/photons.h build_sun_cones),
+  // uploaded once for every frame in a cone mode (fast, auto) until the next call (a new
+  // sun). Returns the bytes uploaded. Without them fast is refused (GlError).
+  uint64_t set_fog_cones(const ConeSet& cones);
 
   uint64_t frusta() const;          // frusta uploaded
   uint64_t uploaded_bytes() const;  // bytes in the segment and id buffers (or the mesh's)
@@ -177,6 +198,8 @@ class GlRenderer {
   void shadow_pass(Frame& f, const glm::dvec3& sun_direction);   // GlPass::shadow
   void geometry_pass(Frame& f, double jitter_x, double jitter_y);  // GlPass::geometry
   void shade_pass(Frame& f, const glm::dvec3& sun_direction);    // GlPass::shade
+  void fog_cones_pass(Frame& f);                                 // GlPass::fog_cones
+  void fog_pass(Frame& f, uint32_t sample, bool aov_only);       // GlPass::fog
   void present_pass(Frame& f, const GlTarget& target);           // GlPass::present
   void end_frame(Frame& f);                                      // submit, stats
   const GlFrameStats& draw_frame(const Scene& scene, const GlTarget* target);

@@ -45,11 +45,10 @@ TEST_P(GlPreset, RendersWithOpenGlAndSeesThePlant) {
   std::ifstream file(GetParam());
   const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
   if (text.find("\"fog\"") != std::string::npos) {
-    // The fog scenes: the GL backend has no fog pass yet, and says so rather than drawing
-    // the scene without its fog (--backend auto renders them on the CPU).
-    EXPECT_EQ(r.exit_code, 1) << describe(r);
-    EXPECT_NE(r.err.find("fog is rendered by the CPU ray caster only"), std::string::npos) << describe(r);
-    return;
+    // The fog scenes ask for the default mode, auto: on the GPU the cone-interval pass
+    // (fast), its cones built on the CPU first.
+    EXPECT_NE(r.err.find("fog cones (GPU)"), std::string::npos) << describe(r);
+    EXPECT_NE(r.err.find("fog (GPU)"), std::string::npos) << describe(r);
   }
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_NE(r.err.find("OpenGL ray caster ("), std::string::npos) << describe(r);

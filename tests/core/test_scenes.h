@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/scene.h"
@@ -34,6 +35,24 @@ inline Scene scene_around(const Skeleton& sk, glm::dvec3 eye, glm::dvec3 target,
   ScenePlant plant;
   plant.skeleton = sk;
   s.plants.push_back(plant);
+  return s;
+}
+
+// The fog tests' scene (tests/cpu/render_fog_test.cpp, tests/gl/render_gl_fog_test.cpp): a
+// cylinder of radius 0.5 and 2 m on the ground at the origin, seen from 6 m away and 1.5 m
+// up (ground below, sky above, the plant in the middle); a point sun from (0.4, 1, −0.3);
+// homogeneous fog (σ_s 0.05, σ_a 0.01, g 0.6) under a top at 30 m, `mode` with `steps`.
+inline Scene foggy_cylinder(FogMode mode, uint32_t steps, uint32_t width = 48, uint32_t height = 36) {
+  Scene s = scene_around(cylinder(0.5, 0, 2), {0, 1.5, 6}, {0, 1, 0}, width, height, 0);
+  s.sun.direction = glm::normalize(glm::dvec3(0.4, 1, -0.3));
+  Fog f;
+  f.sigma_s = 0.05;
+  f.sigma_a = 0.01;
+  f.g = 0.6;
+  f.top = 30;
+  f.mode = mode;
+  f.steps = steps;
+  s.fog = f;
   return s;
 }
 

@@ -23,22 +23,8 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// A cylinder of radius 0.5 and 2 m on the ground at the origin, seen from 6 m away and
-// 1.5 m up: ground below, sky above, the plant in the middle; a point sun; homogeneous fog
-// under a top at 30 m.
-Scene foggy_cylinder(FogMode mode = FogMode::brute) {
-  Scene s = test::scene_around(test::cylinder(0.5, 0, 2), {0, 1.5, 6}, {0, 1, 0}, 48, 36, 0);
-  s.sun.direction = glm::normalize(glm::dvec3(0.4, 1, -0.3));
-  Fog f;
-  f.sigma_s = 0.05;
-  f.sigma_a = 0.01;
-  f.g = 0.6;
-  f.top = 30;
-  f.mode = mode;
-  f.steps = 8;
-  s.fog = f;
-  return s;
-}
+// test_scenes.h's foggy cylinder, 48 × 36, 8 steps.
+Scene foggy_cylinder(FogMode mode = FogMode::brute) { return test::foggy_cylinder(mode, 8); }
 
 bool has_pass(const RenderResult& r, const std::string& prefix) {
   return std::any_of(r.passes.begin(), r.passes.end(),
