@@ -99,5 +99,8 @@ void set_uniform_int(uint32_t p, const char* name, int value) { glProgramUniform
 void set_uniform_vec3_array(uint32_t p, const char* name, int count, const float* xyz) {
   glProgramUniform3fv(p, location(p, name), count, xyz);
 }
+void set_uniform_float_array(uint32_t p, const char* name, int count, const float* x) {
+  glProgramUniform1fv(p, location(p, name), count, x);
+}
 
 }  // namespace sylva

@@ -39,5 +39,7 @@ void set_uniform(uint32_t program, const char* name, const glm::dvec3& value);  
 void set_uniform_int(uint32_t program, const char* name, int value);                 // int, bool, sampler
 // vec3 name[count] from `count` consecutive x, y, z floats.
 void set_uniform_vec3_array(uint32_t program, const char* name, int count, const float* xyz);
+// float name[count] from `count` floats.
+void set_uniform_float_array(uint32_t program, const char* name, int count, const float* x);
 
 }  // namespace sylva
