@@ -816,6 +816,7 @@ Status read_sylva_extras(const std::string& path, const JsonValue& node, size_t 
     }
     text.end_object();
   }
+  if (const JsonValue* leaves = sylva.find("leaves")) write_value(text.key("leaves"), *leaves);  // version 2
   text.end_object();
   Expected<Skeleton> read = read_skeleton_json(text.text(), path);
   if (!read) return error_at(path, sylva, where + ": " + read.error().message);

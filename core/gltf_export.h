@@ -6,7 +6,7 @@
 //     segment — the skeleton, visible in every viewer;
 //   - node extras {"sylva": {...}}: the whole skeleton document of skeleton.md (format,
 //     version, source with grammar, seed as a *string* (64-bit exact), steps, defines;
-//     chains with parents and joints) plus, per segment, the skinning data a renderer
+//     chains with parents and joints; leaves, version 2, when it has any) plus, per segment, the skinning data a renderer
 //     needs (cutting plane normals and u offset);
 //   - optionally (`mesh`) further TRIANGLES primitives of the same mesh (so instancing
 //     covers them too): the tessellated frusta (tessellate.h), one primitive per material

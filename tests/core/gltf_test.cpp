@@ -337,6 +337,21 @@ TEST(GltfImport, RoundTripGivesTheIdenticalSkeletonFileForGlbAndGltf) {
     }
 }
 
+TEST(GltfImport, LeavesRoundTripThroughTheNodeExtras) {
+  // skeleton.md version 2: a grammar's polygons are leaves, kept in extras.sylva.leaves.
+  TempFolder dir;
+  const Skeleton sk = grow_text("angle: 60\naxiom: F(2)[&F{.+f.-f.-f.+|+f.-f.}]F'(1){.+f.-f.-f.}\n");
+  ASSERT_EQ(sk.leaves.size(), 2u);
+  for (const char* name : {"p.glb", "p.gltf"}) {
+    ASSERT_TRUE(export_gltf({GltfPlant{"leafy", sk}}, dir.file(name)).ok());
+    Expected<std::vector<GltfPlant>> r = import_gltf_skeletons(dir.file(name));
+    ASSERT_TRUE(r.ok()) << r.error().format();
+    ASSERT_EQ(r->size(), 1u);
+    EXPECT_EQ((*r)[0].skeleton, sk) << name;
+    EXPECT_EQ(write_skeleton_json((*r)[0].skeleton), write_skeleton_json(sk)) << name;
+  }
+}
+
 TEST(GltfExport, SameInputGivesByteIdenticalFiles) {
   TempFolder dir;
   const Skeleton sk = grow_text(kGrammar);
