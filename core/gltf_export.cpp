@@ -217,6 +217,8 @@ std::optional<std::string> plant_problem(const GltfPlant& p, size_t index) {
   if (!std::isfinite(p.rotate_y_deg)) return which + ": rotate_y_deg is not finite";
   if (!std::isfinite(p.scale) || p.scale <= 0) return which + ": the scale must be a finite number > 0";
   if (Status valid = validate_skeleton(p.skeleton); !valid) return which + ": " + valid.error().message;
+  if (auto far = plant_extent_problem(p.skeleton, {p.position_m[0], p.position_m[1], p.position_m[2]}, p.scale))
+    return which + ": " + *far;
   if (!std::isfinite(p.bark.u_repeat) || p.bark.u_repeat <= 0) return which + ": bark u_repeat must be a finite number > 0";
   if (!std::isfinite(p.bark.v_per_metre) || p.bark.v_per_metre <= 0)
     return which + ": bark v_per_metre must be a finite number > 0";

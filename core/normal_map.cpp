@@ -8,11 +8,15 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/util/file_io.h"
+#include "core/util/limits.h"
+
 namespace sylva {
 
 Expected<HeightMap> read_height_map(const std::string& path) {
   // ImageInput rather than a cached ImageBuf: the file is read once, now, as it is on
   // disk (a cache could hand back an older version of a file rewritten under the same name).
+  note_input_file(path);
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     std::string why = OIIO::geterror();
@@ -22,6 +26,8 @@ Expected<HeightMap> read_height_map(const std::string& path) {
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1)
     return file_diagnostic(path, "the height map must be a 2D image with at least one pixel");
+  if (auto problem = image_size_problem(static_cast<uint64_t>(spec.width), static_cast<uint64_t>(spec.height)))
+    return file_diagnostic(path, "the height map is too large: " + *problem);
   HeightMap map;
   map.width = static_cast<uint32_t>(spec.width);
   map.height = static_cast<uint32_t>(spec.height);

@@ -2,6 +2,7 @@
 #include "core/render_output.h"
 
 #include <filesystem>
+#include <utility>
 
 #include "core/util/color.h"
 #include "core/util/image_io.h"
@@ -13,6 +14,17 @@ std::string aov_path(const std::string& image_path, const std::string& aov_name)
   std::filesystem::path p(image_path);
   p.replace_extension();
   return p.string() + "." + aov_name + ".exr";
+}
+
+std::vector<std::string> render_output_paths(const std::string& image_path, uint32_t aovs) {
+  std::vector<std::string> paths;
+  const std::pair<uint32_t, const char*> names[] = {
+      {kAovDepth, "depth"}, {kAovNormal, "normal"}, {kAovUv, "uv"}, {kAovId, "id"}, {kAovFog, "fog"}};
+  if (lower_extension(image_path) != ".exr")
+    for (const auto& [bit, name] : names)
+      if (aovs & bit) paths.push_back(aov_path(image_path, name));
+  paths.push_back(image_path);
+  return paths;
 }
 
 Expected<std::vector<std::string>> write_render(const std::string& path, const RenderImage& image) {
@@ -54,14 +66,16 @@ Expected<std::vector<std::string>> write_render(const std::string& path, const R
     return written;
   }
 
-  // AOVs first: the picture itself appears last, when everything else is in place.
+  // Every file is written to its temporary before any is renamed (all or nothing); the
+  // AOVs are renamed first, so the picture itself appears last, when the rest is in place.
+  std::vector<PendingFile> pending;
   for (const Aov& a : aovs) {
     if (a.data->empty()) continue;
     const std::string side = aov_path(path, a.name);
-    if (Status e = write_image_atomically(side, image.width, image.height, a.channels, *a.data,
-                                          {ChannelFormat::float32}, false);
-        !e)
-      return std::move(e.error());
+    Expected<PendingFile> file =
+        write_pending_image(side, image.width, image.height, a.channels, *a.data, {ChannelFormat::float32}, false);
+    if (!file) return std::move(file.error());
+    pending.push_back(std::move(*file));
     written.push_back(side);
   }
   const bool linear = ext == ".hdr" || ext == ".pfm" || ext == ".tif" || ext == ".tiff";
@@ -78,11 +92,12 @@ Expected<std::vector<std::string>> write_render(const std::string& path, const R
   if (!linear)
     for (size_t i = 0; i < beauty.size(); ++i)
       if (names.size() == 3 || i % 4 != 3) beauty[i] = linear_to_srgb(beauty[i]);
-  if (Status e = write_image_atomically(path, image.width, image.height, names, beauty,
-                                        {linear ? ChannelFormat::float32 : ChannelFormat::uint8}, !linear);
-      !e)
-    return std::move(e.error());
+  Expected<PendingFile> file = write_pending_image(path, image.width, image.height, names, beauty,
+                                                  {linear ? ChannelFormat::float32 : ChannelFormat::uint8}, !linear);
+  if (!file) return std::move(file.error());
+  pending.push_back(std::move(*file));
   written.push_back(path);
+  if (Status e = commit_files(pending); !e) return std::move(e.error());
   return written;
 }
 

@@ -23,8 +23,12 @@ namespace sylva {
 // The file each AOV goes to for `image_path` (itself for an EXR; a side file otherwise).
 std::string aov_path(const std::string& image_path, const std::string& aov_name);
 
-// Writes a render: the beauty and every AOV the image holds, as described above.
-// Returns the paths written, or the first error (files already renamed stay).
+// Every file write_render writes for `image_path` and the AOV bits `aovs` (render_types.h).
+std::vector<std::string> render_output_paths(const std::string& image_path, uint32_t aovs);
+
+// Writes a render: the beauty and every AOV the image holds, as described above, all or
+// nothing (docs/limits.md "Outputs"): every file is complete in its temporary before the
+// first replaces its target. Returns the paths written, or the first error.
 Expected<std::vector<std::string>> write_render(const std::string& path, const RenderImage& image);
 
 }  // namespace sylva

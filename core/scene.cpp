@@ -15,6 +15,7 @@
 #include "core/util/diagnostic.h"
 #include "core/util/file_io.h"
 #include "core/util/json.h"
+#include "core/util/limits.h"
 #include "core/util/image_io.h"
 #include "core/turtle.h"
 #include "lsystem/derive.h"
@@ -94,6 +95,16 @@ glm::dvec3 vec3(const JsonValue& v, std::string_view what) {
   return {number(v.elements[0], what), number(v.elements[1], what), number(v.elements[2], what)};
 }
 
+// A point in the world: each coordinate within kMaxCoordinateM (docs/limits.md).
+glm::dvec3 point(const JsonValue& v, std::string_view what) {
+  glm::dvec3 p = vec3(v, what);
+  for (int k = 0; k < 3; ++k)
+    if (!(std::abs(p[k]) <= kMaxCoordinateM))
+      fail(v.elements[k], std::string(what) + " coordinates must be within ±1e12 m (docs/limits.md), not " +
+                              v.elements[k].text);
+  return p;
+}
+
 glm::dvec3 colour(const JsonValue& v, std::string_view what) {
   glm::dvec3 c = vec3(v, what);
   for (int k = 0; k < 3; ++k)
@@ -103,7 +114,7 @@ glm::dvec3 colour(const JsonValue& v, std::string_view what) {
 
 uint32_t image_size(const JsonValue& v, std::string_view what) {
   auto n = v.as_uint64();
-  if (!n || *n == 0 || *n > 65536) fail(v, std::string(what) + " must be an integer from 1 to 65536");
+  if (!n || *n == 0 || *n > kMaxImageSide) fail(v, std::string(what) + " must be an integer from 1 to 65536");
   return static_cast<uint32_t>(*n);
 }
 
@@ -118,15 +129,19 @@ Camera read_camera(const JsonValue& v) {
   expect_object(v, "camera");
   check_keys(v, "camera", {"eye", "target", "up", "fov_y_deg"});
   Camera c;
-  if (auto* x = v.find("eye")) c.eye = vec3(*x, "camera.eye");
-  if (auto* x = v.find("target")) c.target = vec3(*x, "camera.target");
+  if (auto* x = v.find("eye")) c.eye = point(*x, "camera.eye");
+  if (auto* x = v.find("target")) c.target = point(*x, "camera.target");
   if (auto* x = v.find("up")) c.up = vec3(*x, "camera.up");
   if (auto* x = v.find("fov_y_deg")) c.fov_y_deg = number_in(*x, "camera.fov_y_deg", 0, 180, true, true);
   glm::dvec3 forward = c.target - c.eye;
   if (!(glm::length(forward) > 0)) fail(v, "camera.eye and camera.target must differ");
-  glm::dvec3 side = glm::cross(forward, c.up);
-  if (!(glm::length(side) > 1e-9 * glm::length(forward) * glm::length(c.up)))
-    fail(v, "camera.up must not be parallel to the view direction (or zero)");
+  // Compared as unit vectors, so that an up of [0, 1e300, 0] is not taken for parallel.
+  const std::optional<glm::dvec3> up = rescaled_direction(c.up);
+  if (!up) fail(v, "camera.up must not be zero");
+  c.up = *up;
+  glm::dvec3 side = glm::cross(glm::normalize(forward), glm::normalize(*up));
+  if (!(glm::length(side) > 1e-9))
+    fail(v, "camera.up must not be parallel to the view direction");
   return c;
 }
 
@@ -135,8 +150,9 @@ Sun read_sun(const JsonValue& v) {
   check_keys(v, "sun", {"direction", "angular_radius_deg", "radiance"});
   Sun s;
   if (auto* x = v.find("direction")) {
-    s.direction = vec3(*x, "sun.direction");
-    if (!(glm::length(s.direction) > 0)) fail(*x, "sun.direction must not be zero");
+    const std::optional<glm::dvec3> direction = rescaled_direction(vec3(*x, "sun.direction"));
+    if (!direction) fail(*x, "sun.direction must not be zero");
+    s.direction = *direction;
   }
   s.direction = glm::normalize(s.direction);
   if (auto* x = v.find("angular_radius_deg"))
@@ -231,7 +247,7 @@ ScenePlant read_plant(const JsonValue& v, const std::string& base_dir, size_t in
     expect_object(*x, what + ".defines");
     for (const JsonMember& m : x->members) p.defines[m.key.name] = number(m.value, what + ".defines." + m.key.name);
   }
-  if (auto* x = v.find("position")) p.position = vec3(*x, what + ".position");
+  if (auto* x = v.find("position")) p.position = point(*x, what + ".position");
   if (auto* x = v.find("rotate_y_deg")) p.rotate_y_deg = number(*x, what + ".rotate_y_deg");
   if (auto* x = v.find("scale")) p.scale = number_in(*x, what + ".scale", 0, 1e9, true, false);
   if (auto* x = v.find("bark")) p.bark = read_bark(*x, base_dir, what + ".bark");
@@ -320,6 +336,7 @@ Scene read_scene(const JsonValue& root, const std::string& base_dir) {
     check_keys(*x, "image", {"width", "height"});
     if (auto* w = x->find("width")) s.width = image_size(*w, "image.width");
     if (auto* h = x->find("height")) s.height = image_size(*h, "image.height");
+    if (auto problem = image_size_problem(s.width, s.height)) fail(*x, "image: " + *problem);
   }
   if (auto* x = root.find("sun")) s.sun = read_sun(*x);
   s.sun.direction = glm::normalize(s.sun.direction);
@@ -425,6 +442,20 @@ Scene default_scene_for(const Skeleton& skeleton, uint32_t width, uint32_t heigh
 
 namespace sylva {
 
+std::optional<std::string> plant_extent_problem(const Skeleton& skeleton, const glm::dvec3& position, double scale) {
+  double reach = 0;  // bounds |x|, |y|, |z| of a joint after the rotation about y
+  for (const Joint& j : skeleton.joints)
+    reach = std::max({reach, std::abs(j.position_m[0]) + std::abs(j.position_m[2]) + j.radius_m,
+                      std::abs(j.position_m[1]) + j.radius_m});
+  const double extent =
+      std::max({std::abs(position.x), std::abs(position.y), std::abs(position.z)}) + scale * reach;
+  if (extent <= kMaxCoordinateM) return std::nullopt;
+  char reaches[64];
+  std::snprintf(reaches, sizeof reaches, "%g", extent);
+  return std::string("the plant reaches ") + reaches +
+         " m from the origin once placed and scaled, beyond the limit of 1e12 m (docs/limits.md)";
+}
+
 Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& progress) {
   size_t to_grow = 0, grown_so_far = 0;
   for (const ScenePlant& plant : scene.plants) to_grow += plant.skeleton ? 0 : 1;
@@ -454,6 +485,11 @@ Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& pro
     if (!grown) return located(std::move(grown.error()));
     plant.skeleton = std::move(grown->skeleton);
     ++grown_so_far;
+  }
+  for (size_t i = 0; i < scene.plants.size(); ++i) {
+    const ScenePlant& plant = scene.plants[i];
+    if (auto problem = plant_extent_problem(*plant.skeleton, plant.position, plant.scale))
+      return diagnostic_at(scene.file, plant.grammar_loc, "plants[" + std::to_string(i) + "]: " + *problem);
   }
   progress.report(1, "grow");
   return {};

@@ -207,4 +207,11 @@ Scene default_scene_for(const Skeleton& skeleton, uint32_t width = 1024, uint32_
 // cancelled: cancelled_diagnostic(), the plants grown so far keep their skeletons.
 Status grow_scene_plants(Scene& scene, uint64_t max_modules = 50'000'000, const Progress& progress = {});
 
+// Why `skeleton`, placed at `position` and scaled by `scale` (rotated about y), reaches
+// beyond kMaxCoordinateM (core/util/limits.h, docs/limits.md) — which neither renderer
+// nor a glTF float accessor can represent — or nullopt. grow_scene_plants checks every
+// plant, export_gltf every plant, the render front ends a lone skeleton.
+std::optional<std::string> plant_extent_problem(const Skeleton& skeleton, const glm::dvec3& position = {0, 0, 0},
+                                                double scale = 1);
+
 }  // namespace sylva

@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include "core/util/limits.h"
 #include "lsystem/expr.h"
 
 namespace sylva {
@@ -46,6 +47,14 @@ struct PendingJoint {
 struct TurtleFailure {
   std::string message;
 };
+
+// Positions stay within the coordinate limit (docs/limits.md), finite a fortiori.
+void check_position(const dvec3& p) {
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+    throw TurtleFailure{"the turtle's position is no longer finite"};
+  if (std::abs(p.x) > kMaxCoordinateM || std::abs(p.y) > kMaxCoordinateM || std::abs(p.z) > kMaxCoordinateM)
+    throw TurtleFailure{"the turtle's position exceeds the limit of 1e12 m from the origin (docs/limits.md)"};
+}
 
 // Keeps the frame orthonormal and right-handed after a rotation (cheap Gram–Schmidt).
 void orthonormalize(TurtleState& t) {
@@ -151,8 +160,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
       }
       if (m.symbol == sym_move) {  // G: move without drawing and without ending the chain
         t.position += t.heading * (has ? p[0] : d.step);
-        if (!std::isfinite(t.position.x) || !std::isfinite(t.position.y) || !std::isfinite(t.position.z))
-          throw TurtleFailure{"the turtle's position is no longer finite"};
+        check_position(t.position);
         continue;
       }
       switch (m.symbol) {
@@ -177,8 +185,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
             t.branch_pending = false;
           }
           t.position += t.heading * len;
-          if (!std::isfinite(t.position.x) || !std::isfinite(t.position.y) || !std::isfinite(t.position.z))
-            throw TurtleFailure{"the turtle's position is no longer finite"};
+          check_position(t.position);
           if (chain_joint_count[t.chain] == 0xFFFFFFFFu) throw TurtleFailure{"a chain has too many joints"};
           joints.push_back({static_cast<uint32_t>(t.chain),
                             Joint{{t.position.x, t.position.y, t.position.z}, t.radius, t.material}});
@@ -202,8 +209,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           const double len = has ? p[0] : d.step;
           if (len == 0) ++zero_moves;
           t.position += t.heading * len;
-          if (!std::isfinite(t.position.x) || !std::isfinite(t.position.y) || !std::isfinite(t.position.z))
-            throw TurtleFailure{"the turtle's position is no longer finite"};
+          check_position(t.position);
           if (!polygons.empty()) break;  // inside a polygon f does not end the chain (grammar.md)
           t.chain = -1;
           t.joint = -1;
@@ -252,6 +258,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           if (has) t.radius = p[0];
           else t.radius *= d.width_decrement;
           if (!(t.radius >= 0) || !std::isfinite(t.radius)) throw TurtleFailure{"the radius must be finite and not negative"};
+          if (t.radius > kMaxCoordinateM) throw TurtleFailure{"the radius exceeds the limit of 1e12 m (docs/limits.md)"};
           break;
         case kSymMaterial:
           if (has) {

@@ -107,7 +107,7 @@ class Rewriter {
  private:
   void copy_module(const Word& in, size_t i, Word& out) {
     const Module& m = in.modules[i];
-    if (out.modules.size() + 1 > max_modules_) too_many();
+    if (out.modules.size() + out.params.size() + 1 + m.param_count > max_modules_) too_many();
     if (out.params.size() > kMaxParams) too_many_params();
     out.modules.push_back(Module{m.symbol, m.param_count, static_cast<uint32_t>(out.params.size())});
     if (m.param_count) out.params.insert(out.params.end(), in.params.begin() + m.param_begin,
@@ -117,7 +117,8 @@ class Rewriter {
 
   [[noreturn]] void too_many() {
     throw DeriveFailure{{}, "the word exceeds --max-modules (" + std::to_string(max_modules_) +
-                                " modules); raise --max-modules or lower the derivation length"};
+                                " modules), each parameter counting as a module; raise --max-modules or lower "
+                                "the derivation length"};
   }
   [[noreturn]] void too_many_params() {
     throw DeriveFailure{{}, "the word holds more than 4 billion parameters"};
@@ -273,6 +274,14 @@ class Rewriter {
       throw DeriveFailure{first.probability.loc,
                           "the probabilities of the matching productions sum to 0 (nothing to choose from)"};
     }
+    if (!std::isfinite(total)) {
+      // Finite weights whose sum overflows (1e308 + 1e308): the same choice, in proportion,
+      // from the weights divided by the largest; otherwise every seed would pick the last.
+      double largest = 0;
+      for (const auto& c : candidates_) largest = std::max(largest, c.second);
+      total = 0;
+      for (auto& c : candidates_) total += c.second /= largest;
+    }
     double u = rng.next_double() * total;
     const Production* pick = candidates_.back().first;
     for (const auto& [prod, w] : candidates_) {
@@ -290,7 +299,7 @@ class Rewriter {
   void apply(const Production& p, size_t i, Rng& rng, bool keyed) {
     Word& out = *out_;
     const Successor& s = p.successor;
-    if (out.modules.size() + s.modules.size() > max_modules_) too_many();
+    if (out.modules.size() + out.params.size() + s.modules.size() + s.args.size() > max_modules_) too_many();
     if (out.params.size() > kMaxParams) too_many_params();
     const size_t first_new = out.modules.size();
     if (s.all_constant) {
@@ -388,8 +397,9 @@ Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStat
   auto t0 = std::chrono::steady_clock::now();
   const int64_t steps = options.steps.value_or(g.steps);
   const uint64_t seed = options.seed.value_or(g.seed);
-  if (g.axiom.size() > options.max_modules)
-    return g.error_at(g.axiom_loc, "the axiom exceeds --max-modules");
+  if (g.axiom.size() + g.axiom.params.size() > options.max_modules)
+    return g.error_at(g.axiom_loc, "the axiom exceeds --max-modules (" + std::to_string(options.max_modules) +
+                                       " modules), each parameter counting as a module");
   Word cur = g.axiom;
   if (g.axiom_successor) {
     // The axiom draws random numbers: evaluate its arguments from this seed's stream.

@@ -12,10 +12,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <unordered_map>
 
+#include "core/util/file_io.h"
 #include "lsystem/grammar.h"
 
 namespace sylva::lsys {
@@ -1176,12 +1175,10 @@ Expected<Grammar> parse_grammar(std::string_view text, std::string file, const P
 }
 
 Expected<Grammar> load_grammar(const std::string& path, const ParseOptions& options) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return file_diagnostic(path, std::string("cannot read the grammar: ") + std::strerror(errno), errno);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) return file_diagnostic(path, "cannot read the grammar: read error");
-  return parse_grammar(ss.str(), path, options);
+  // Bounded, regular files and pipes only (docs/limits.md): a directory is not "no axiom".
+  Expected<std::string> text = read_text_file(path);
+  if (!text) return std::move(text.error());
+  return parse_grammar(*text, path, options);
 }
 
 Expected<Word> parse_word(std::string_view text, Grammar& grammar) {

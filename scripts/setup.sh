@@ -12,6 +12,7 @@ packages=(
   libglm-dev libglfw3-dev libimgui-dev libopenimageio-dev libtinygltf-dev
   # The Python module (built for /usr/bin/python3) and its tests.
   python3 python3-dev pybind11-dev python3-numpy python3-pytest
+  python3-distributed  # sylva_dask: batches of seeds on a dask.distributed cluster
   fonts-dejavu-core  # the text of the benchmarks' plots (core/plot.h)
   # The GL backend: OpenGL 4.5 + EGL through libglvnd, Mesa's llvmpipe for a machine
   # without a GPU (surfaceless EGL, no X), glslangValidator for the shader tests.

@@ -222,9 +222,11 @@ int run_bench(const std::vector<std::string>& args) {
   std::vector<char*> gb_argv;
   for (std::string& s : gb_args) gb_argv.push_back(s.data());
   benchmark::Initialize(&gb_argc, gb_argv.data());
+  if (gb_argc > 1) throw UsageError{"unknown option '" + std::string(gb_argv[1]) + "'"};
   CapturingReporter reporter;
-  benchmark::RunSpecifiedBenchmarks(&reporter);
+  const size_t ran = benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
+  if (ran == 0) throw UsageError{"no benchmark matches the --benchmark_filter given"};
 
   const double memcpy_s = reporter.seconds("memcpy/real_time");
   const double bandwidth = memcpy_s > 0 ? static_cast<double>(copy_bytes) / memcpy_s : 0;

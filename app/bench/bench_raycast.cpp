@@ -32,6 +32,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/bench/bench_metrics.h"
 #include "app/cli/cli.h"
 #include "core/cpu/bvh.h"
 #include "core/cpu/frustum_accel.h"
@@ -169,8 +170,8 @@ int run_bench_raycast(const std::vector<std::string>& args) {
       return args[++i];
     };
     if (args[i] == "--quick") width = 256, height = 192, max_level = 1, repeats = 1;
-    else if (args[i] == "--width") width = static_cast<uint32_t>(std::stoul(value()));
-    else if (args[i] == "--height") height = static_cast<uint32_t>(std::stoul(value()));
+    else if (const std::string flag = args[i]; flag == "--width") width = parse_count(flag, value(), 16384);
+    else if (flag == "--height") height = parse_count(flag, value(), 16384);
     else if (args[i] == "--csv") csv = value();
     else if (!args[i].empty() && args[i][0] == '-') throw UsageError{"unknown option '" + args[i] + "'"};
     else preset = args[i];

@@ -109,6 +109,12 @@ Status create_parent_folder(const std::string& path) {
   return {};
 }
 
+Expected<std::string> seed_output_path(const std::string& pattern, uint64_t seed) {
+  std::string path = expand_seed_pattern(pattern, seed);
+  if (Status folder = create_parent_folder(path); !folder) return std::move(folder.error());
+  return path;
+}
+
 std::vector<uint64_t> run_seed_tasks(const SeedRange& range, unsigned threads,
                                      const std::function<SeedTaskResult(uint64_t seed)>& task,
                                      const std::function<void(uint64_t seed, const SeedTaskResult& result,

@@ -83,4 +83,8 @@ int run_seed_batch(const std::string& subcommand, const SeedRange& range,
 // The error names the folder.
 Status create_parent_folder(const std::string& path);
 
+// The output for `seed` of an -o `pattern` holding "{seed}", its folder created (each seed's
+// own where the folder part holds {seed}: out/{seed}/plant.glb); the error names the folder.
+Expected<std::string> seed_output_path(const std::string& pattern, uint64_t seed);
+
 }  // namespace sylva::cli

@@ -254,13 +254,21 @@ int run_export(const std::vector<std::string>& raw_args) {
       GrammarArgs one = a;
       one.seed = seed;
       SeedTaskResult r;
-      if (Status exported = export_one(one, expand_seed_pattern(a.output, seed)); !exported)
+      Expected<std::string> output = seed_output_path(a.output, seed);
+      if (!output)
+        r.error = std::move(output.error());
+      else if (Status exported = export_one(one, *output); !exported)
         r.error = std::move(exported.error());
       return r;
     });
   }
-  const std::string output = has_seed_placeholder(a.output) && a.seed ? expand_seed_pattern(a.output, *a.seed) : a.output;
-  if (Status exported = export_one(a, output); !exported) {
+  Expected<std::string> output = has_seed_placeholder(a.output) && a.seed ? seed_output_path(a.output, *a.seed)
+                                                                          : Expected<std::string>(a.output);
+  if (!output) {
+    std::cerr << output.error().format();
+    return kInputError;
+  }
+  if (Status exported = export_one(a, *output); !exported) {
     std::cerr << exported.error().format();
     return kInputError;
   }

@@ -22,7 +22,7 @@ const char* const kGrammarFlags =
     "      --seed S           random seed, an integer from 0 to 2^64-1 (overrides 'seed:')\n"
     "  -D NAME=VALUE          override '#define NAME' (repeatable)\n"
     "      --max-modules N    stop with an error if a word would exceed N modules\n"
-    "                         (default 50000000)\n"
+    "                         (each parameter counts as a module; default 50000000)\n"
     "  -h, --help             show this help\n";
 
 void print_derive_help() {
@@ -144,16 +144,26 @@ int run_grow(const std::vector<std::string>& raw_args) {
     return run_seed_batch("grow", *range, [&](uint64_t seed) {
       GrammarArgs one = a;
       one.seed = seed;
-      GrowOutcome o = grow_to_file(*g, one, expand_seed_pattern(a.output, seed));
       SeedTaskResult r;
+      Expected<std::string> output = seed_output_path(a.output, seed);
+      if (!output) {
+        r.error = std::move(output.error());
+        return r;
+      }
+      GrowOutcome o = grow_to_file(*g, one, *output);
       r.error = o.error;
       r.summary = o.summary;
       r.warning = o.warning;
       return r;
     });
   }
-  GrowOutcome o = grow_to_file(*g, a, has_seed_placeholder(a.output) && a.seed
-                                          ? expand_seed_pattern(a.output, *a.seed) : a.output);
+  Expected<std::string> output = has_seed_placeholder(a.output) && a.seed ? seed_output_path(a.output, *a.seed)
+                                                                          : Expected<std::string>(a.output);
+  if (!output) {
+    std::cerr << output.error().format();
+    return kInputError;
+  }
+  GrowOutcome o = grow_to_file(*g, a, *output);
   std::cerr << o.warning;
   if (o.error) {
     std::cerr << o.error->format();

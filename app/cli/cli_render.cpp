@@ -15,6 +15,7 @@
 #include "app/cli/render_input.h"
 #include "core/render_output.h"
 #include "core/util/image_io.h"
+#include "core/util/limits.h"
 #include "core/gl/gl_context.h"
 #include "core/render_common.h"
 #include "core/cpu/render_cpu.h"
@@ -266,6 +267,16 @@ int run_render(const std::vector<std::string>& args) {
   auto loaded = load_render_input(a.grammar, a.width, a.height, passes);
   if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
   Scene scene = std::move(std::get<Scene>(loaded));
+  if (auto problem = image_size_problem(scene.width, scene.height, a.spp)) {
+    std::cerr << "sylva render: error: " << *problem << "\n";
+    return kInputError;
+  }
+  // Every output is checked now, with the inputs read, rather than after the render.
+  for (const std::string& target : render_output_paths(output, a.aovs))
+    if (Status allowed = check_output_path(target); !allowed) {
+      std::cerr << allowed.error().format();
+      return kInputError;
+    }
   auto start = std::chrono::steady_clock::now();
   if (!scene.fog && (a.fog_flags || (a.aovs & kAovFog)))
     throw UsageError{"--fog-mode, --fog-steps, --photons, --cone-params and --aov fog apply to a scene with fog "

@@ -7,6 +7,7 @@
 
 #include "app/cli/cli.h"
 #include "app/studio/studio.h"
+#include "core/util/file_io.h"
 
 namespace {
 
@@ -21,8 +22,12 @@ void print_help(std::ostream& out) {
                "  export INPUT -o FILE.gltf|FILE.glb [--mesh]   glTF 2.0 with the skeleton in extras\n"
                "  studio [INPUT] [--screenshot OUT.png]   edit a grammar and watch the plant regrow\n"
                "  bench  lsystem [--quick]            derivation and turtle benchmarks\n"
+               "  bench  raycast                      primary rays per second: sylva's BVH against Embree\n"
+               "  bench  geometry                     error against run time of frusta, relief, meshes\n"
+               "  bench  gpu                          GPU time per frame and error of the GL backend\n"
+               "  bench  fog                          sun photons and shadow cones against the photon count\n"
                "  bench  studio [--quick]             the studio's edit-to-picture latency, frame time, memory\n\n"
-               "'sylva SUBCOMMAND --help' describes every flag.\n"
+               "'sylva SUBCOMMAND --help' describes every flag; 'sylva --version' prints the version.\n"
                "Exit status: 0 success, 1 bad input, 2 usage error, 3 internal error.\n";
 }
 
@@ -30,6 +35,9 @@ void print_help(std::ostream& out) {
 
 int main(int argc, char** argv) {
   using namespace sylva::cli;
+  // An interrupt leaves no temporary, and outputs never land on an input (docs/limits.md,
+  // "Outputs") — except in the studio, which saves over the document it opened.
+  sylva::remove_temporaries_on_signals();
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) {
     std::cerr << "sylva: error: missing SUBCOMMAND\n\n";
@@ -38,9 +46,14 @@ int main(int argc, char** argv) {
   }
   const std::string sub = args[0];
   args.erase(args.begin());
+  if (sub == "derive" || sub == "grow" || sub == "render" || sub == "export") sylva::refuse_outputs_onto_inputs();
   try {
     if (sub == "-h" || sub == "--help" || sub == "help") {
       print_help(std::cout);
+      return kOk;
+    }
+    if (sub == "--version" || sub == "version") {
+      std::cout << "sylva " SYLVA_VERSION "\n";
       return kOk;
     }
     if (sub == "derive") return run_derive(args);

@@ -9,6 +9,7 @@
 #include "core/gltf_export.h"
 #include "core/render_common.h"
 #include "core/turtle.h"
+#include "core/util/json.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 
@@ -61,6 +62,12 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
       std::cerr << imported.error().format();
       return kInputError;
     }
+    for (const GltfPlant& p : *imported)
+      if (auto problem = plant_extent_problem(p.skeleton, {p.position_m[0], p.position_m[1], p.position_m[2]},
+                                              p.scale)) {
+        std::cerr << file_diagnostic(input, "plant " + json_excerpt(p.name) + ": " + *problem).format();
+        return kInputError;
+      }
     const uint32_t w = width.value_or(1024), h = height.value_or(768);
     scene = default_scene_for(imported->front().skeleton, w, h);
     scene.plants.clear();
@@ -116,6 +123,10 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
       }
       skeleton = std::move(grown->skeleton);
       passes.push_back({"grow", seconds_since(start), std::to_string(grown->modules) + " modules"});
+    }
+    if (auto problem = plant_extent_problem(skeleton)) {
+      std::cerr << file_diagnostic(input, *problem).format();
+      return kInputError;
     }
     scene = default_scene_for(skeleton, width.value_or(1024), height.value_or(768));
   }

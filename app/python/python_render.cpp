@@ -9,6 +9,7 @@
 
 #include "app/python/sylva_python.h"
 #include "core/cpu/render_cpu.h"
+#include "core/util/limits.h"
 #include "core/scene.h"
 
 namespace py = pybind11;
@@ -26,6 +27,9 @@ py::array_t<float> python_render(const Skeleton& skeleton, uint32_t width, uint3
   }
   if (width == 0 || height == 0) throw py::value_error("width and height must be > 0");
   if (spp == 0) throw py::value_error("spp must be >= 1");
+  // The documented limits (docs/limits.md), checked before anything is allocated.
+  if (auto problem = image_size_problem(width, height, spp)) throw py::value_error(*problem);
+  if (auto problem = plant_extent_problem(skeleton)) throw py::value_error("render: " + *problem);
   RenderResult result;
   {
     py::gil_scoped_release release;

@@ -503,7 +503,13 @@ void python_export_gltf(const py::object& plants, const std::filesystem::path& p
     py::gil_scoped_release release;
     exported = export_gltf(gltf_plants, path_string(path), options);
   }
-  if (!exported) throw std::runtime_error(chomp(exported.error().format()));
+  // A file that could not be read or written raises OSError (by errno, as open() would);
+  // plants the export refuses (values beyond docs/limits.md) raise ValueError.
+  if (!exported) {
+    const Diagnostic& d = exported.error();
+    if (d.error_number != 0 || d.message.rfind("cannot ", 0) == 0) throw_file_error(d);
+    throw py::value_error(chomp(d.format()));
+  }
 }
 
 
@@ -732,8 +738,9 @@ Keyword-only:
                    e.g. bark=dict(albedo="presets/textures/bark.png",
                    height="presets/textures/bark_height.png", u_repeat=2)
 The mesh has one material per material index the plants use. The file is written
-atomically; a failure (a missing texture among them) raises RuntimeError with the
-reason, naming the file, and writes nothing. The GIL is released while writing.)doc");
+atomically; a file that cannot be read or written (a missing texture, a missing folder,
+a FIFO or read-only target) raises OSError, plants beyond the limits (docs/limits.md)
+ValueError, each with the reason naming the file, and nothing is written. The GIL is released while writing.)doc");
   signatures.enable_function_signatures();
 
   bind_render(m);

@@ -2,15 +2,17 @@
 #include "app/studio/gl_viewport.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <future>
 
 #include "core/gl/gl_api.h"
 #include "core/gl/gl_context.h"
+#include "core/gl/gl_frame_stats.h"
+#include "core/gl/gl_target.h"
 #include "core/gl/render_gl.h"
 #include "core/render_output.h"
-#include "core/util/color.h"
 
 namespace sylva::studio {
 
@@ -34,23 +36,40 @@ struct Picture {
   uint64_t plants_version = 0;
   std::vector<RenderPass> passes;
   double render_ms = 0;
+  bool preview = false;
 };
 
-// The picture of `scene` from `renderer` as 8-bit sRGB RGBA: GlRenderer::render()'s
-// readback, encoded. (A renderer that draws into a caller's framebuffer would draw into
-// a texture shared with the window instead.)
-Picture present(GlRenderer& renderer, const Scene& scene) {
+constexpr uint32_t kPreviewShadowTexels = 512;
+
+// The preview of `scene`: half the pixels a side (ImGui::Image stretches it to the panel)
+// and a 512² shadow map — on llvmpipe about a quarter of the fill of the full picture,
+// which dominates its cost (docs/benchmarks.md, the studio).
+Scene preview_of(const Scene& scene) {
+  Scene small = scene;
+  small.width = std::max<uint32_t>(1, scene.width / 2);
+  small.height = std::max<uint32_t>(1, scene.height / 2);
+  return small;
+}
+
+// The picture of `scene` from `renderer` as 8-bit sRGB RGBA through the frame API
+// (gl_target.h): the renderer draws into `target` (rgba8, resized to the view), whose
+// present pass encodes sRGB on the GPU, and only those 4 bytes a pixel come back — no
+// AOVs, no float beauty. The rows stay bottom-up as GL's (the view shows them flipped).
+// The render thread has its own context (a slow software frame never stalls the UI), so
+// the bytes cross to the window's context as an upload rather than a shared texture.
+Picture present(GlRenderer& renderer, const Scene& scene, std::unique_ptr<GlTextureTarget>& target) {
   const auto start = Clock::now();
-  RenderResult result = renderer.render(scene);
+  if (!target) target = std::make_unique<GlTextureTarget>(scene.width, scene.height, GlTextureTarget::Format::rgba8);
+  else target->resize(scene.width, scene.height);
+  renderer.draw(scene, target->target());
   Picture p;
-  p.width = result.image.width;
-  p.height = result.image.height;
+  p.width = scene.width;
+  p.height = scene.height;
   p.rgba.resize(static_cast<size_t>(p.width) * p.height * 4);
-  const std::vector<float>& src = result.image.beauty;
-  for (size_t i = 0; i < p.rgba.size(); ++i)
-    p.rgba[i] = (i % 4 == 3) ? 255
-                             : static_cast<uint8_t>(std::lround(std::clamp(linear_to_srgb(src[i]), 0.0f, 1.0f) * 255));
-  p.passes = std::move(result.passes);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(target->texture(), 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(p.rgba.size()),
+                    p.rgba.data());
+  p.passes = describe_frame(renderer.wait_for_frame());
   p.render_ms = ms_since(start);
   return p;
 }
@@ -63,7 +82,12 @@ struct GlViewport::Shared {
   std::condition_variable wake;
   bool quit = false;
   bool working = false;
+  // Set by set_plants while a renderer is being built: newer plants make the skinning in
+  // flight stop (GlRenderer checks it every 1024 chains) instead of finishing for nothing.
+  std::atomic<bool> cancel_build{false};
   std::function<void()> on_picture;
+  double preview_above_ms = 50;  // see the constructor
+  uint64_t previews = 0;         // made so far
   // Requests (latest wins).
   struct Plants {
     Scene scene;
@@ -88,8 +112,10 @@ struct GlViewport::Shared {
   std::string start_error;
 };
 
-GlViewport::GlViewport(std::function<void()> on_picture) : shared_(std::make_unique<Shared>()) {
+GlViewport::GlViewport(std::function<void()> on_picture, double preview_above_ms)
+    : shared_(std::make_unique<Shared>()) {
   shared_->on_picture = std::move(on_picture);
+  shared_->preview_above_ms = preview_above_ms;
   thread_ = std::thread([this] { run(); });
   std::unique_lock<std::mutex> lock(shared_->mutex);
   shared_->wake.wait(lock, [this] { return shared_->started; });
@@ -123,6 +149,9 @@ void GlViewport::run() {
   sh.wake.notify_all();
   if (!context.context) return;
   std::unique_ptr<GlRenderer> renderer;
+  std::unique_ptr<GlTextureTarget> target;  // the picture's, on this thread's context
+  double last_full_ms = 0;                   // the last full picture's time (preview_of)
+  bool unshown_plants = false;               // the renderer's plants have no full picture yet
   RenderOptions options;
   uint64_t version = 0;
   for (;;) {
@@ -135,6 +164,7 @@ void GlViewport::run() {
       if (sh.quit) break;
       plants = std::move(sh.plants);
       sh.plants.reset();
+      sh.cancel_build = false;
       task = std::move(sh.task);
       sh.task = nullptr;
       // A picture of older plants than those about to be built is not worth making.
@@ -146,10 +176,12 @@ void GlViewport::run() {
     }
     std::string error;
     double upload_ms = 0;
+    bool build_cancelled = false;
     if (plants) {
       const auto start = Clock::now();
       renderer.reset();
       options = plants->options;
+      options.progress = Progress(&sh.cancel_build);
       version = plants->version;
       bool any = false;
       for (const ScenePlant& p : plants->scene.plants) any |= p.skeleton && p.skeleton->segment_count() > 0;
@@ -158,37 +190,64 @@ void GlViewport::run() {
       else {
         try {
           renderer = std::make_unique<GlRenderer>(plants->scene, options);
+        } catch (const GlCancelled&) {
+          build_cancelled = true;  // newer plants wait in the mailbox
         } catch (const std::exception& e) {
           error = e.what();
         }
       }
       upload_ms = ms_since(start);
+      unshown_plants = renderer != nullptr;
     }
     if (task) task(renderer.get(), options);
+    // Hands a picture (or the error) to the UI thread; `last`: the render thread is done.
+    auto publish = [&](std::optional<Picture> picture, bool last) {
+      const bool any = picture || !error.empty();
+      {
+        std::lock_guard<std::mutex> lock(sh.mutex);
+        if (last) sh.working = false;
+        if (plants && !build_cancelled) {
+          sh.built_version = version;
+          sh.error = error;
+          sh.frusta = renderer ? renderer->frusta() : 0;
+          sh.upload_ms = upload_ms;
+        } else if (!error.empty()) {
+          sh.error = error;
+        }
+        if (picture) sh.picture = std::move(picture);
+      }
+      if (any && sh.on_picture) sh.on_picture();
+    };
     std::optional<Picture> picture;
     if (view && renderer && view->version == version) {
       try {
-        picture = present(*renderer, view->scene);
-        picture->plants_version = version;
+        // New plants on a slow renderer: a quick preview first, so the edit shows at once;
+        // the full picture follows unless newer plants are already waiting.
+        bool newer_waiting = false;
+        if (unshown_plants && last_full_ms > sh.preview_above_ms) {
+          renderer->set_shadow_map_texels(kPreviewShadowTexels);
+          Picture quick = present(*renderer, preview_of(view->scene), target);
+          renderer->set_shadow_map_texels(0);
+          quick.plants_version = version;
+          quick.preview = true;
+          publish(std::move(quick), false);
+          std::lock_guard<std::mutex> lock(sh.mutex);
+          ++sh.previews;
+          newer_waiting = sh.plants.has_value();
+        }
+        if (!newer_waiting) {
+          picture = present(*renderer, view->scene, target);
+          picture->plants_version = version;
+          last_full_ms = picture->render_ms;
+          unshown_plants = false;
+        }
       } catch (const std::exception& e) {
         error = e.what();
       }
     }
-    {
-      std::lock_guard<std::mutex> lock(sh.mutex);
-      sh.working = false;
-      if (plants) {
-        sh.built_version = version;
-        sh.error = error;
-        sh.frusta = renderer ? renderer->frusta() : 0;
-        sh.upload_ms = upload_ms;
-      } else if (!error.empty()) {
-        sh.error = error;
-      }
-      if (picture) sh.picture = std::move(picture);
-    }
-    if ((picture || !error.empty()) && sh.on_picture) sh.on_picture();
+    publish(std::move(picture), true);
   }
+  target.reset();
   renderer.reset();
 }
 
@@ -197,6 +256,7 @@ void GlViewport::set_plants(const Scene& scene, const RenderOptions& options) {
   {
     std::lock_guard<std::mutex> lock(shared_->mutex);
     shared_->plants = Shared::Plants{scene, options, plants_version_};
+    if (shared_->working) shared_->cancel_build = true;
   }
   shared_->wake.notify_all();
 }
@@ -215,6 +275,7 @@ void GlViewport::take_picture() {
     stats_.error = shared_->error;
     stats_.frusta = shared_->frusta;
     stats_.upload_ms = shared_->upload_ms;
+    stats_.previews = shared_->previews;
   }
   if (!p) return;
   if (!texture_ || texture_w_ != p->width || texture_h_ != p->height) {
@@ -234,6 +295,7 @@ void GlViewport::take_picture() {
   shown_version_ = p->plants_version;
   stats_.passes = std::move(p->passes);
   stats_.render_ms = p->render_ms;
+  stats_.preview = p->preview;
 }
 
 ViewImage GlViewport::image(const Scene& scene) {
@@ -256,7 +318,7 @@ ViewImage GlViewport::image(const Scene& scene) {
     if (shared_->built_version == plants_version_ && !shared_->error.empty() && !shared_->working && !shared_->view)
       current = true;
   }
-  return ViewImage{reinterpret_cast<ImTextureID>(static_cast<intptr_t>(texture_)), false, texture_w_, texture_h_,
+  return ViewImage{reinterpret_cast<ImTextureID>(static_cast<intptr_t>(texture_)), true, texture_w_, texture_h_,
                    current};
 }
 

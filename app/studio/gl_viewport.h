@@ -33,8 +33,11 @@ namespace sylva::studio {
 class GlViewport : public Viewport {
  public:
   // `on_picture` is called on the render thread when a picture is ready (the window loop
-  // wakes itself with it). Throws GlError when the render thread gets no GL context.
-  explicit GlViewport(std::function<void()> on_picture = {});
+  // wakes itself with it). New plants are first shown as a preview (half the pixels a side,
+  // a 512² shadow map; ViewStats::preview) when the last full picture took longer than
+  // `preview_above_ms`, then in full. Throws GlError when the render thread gets no GL
+  // context.
+  explicit GlViewport(std::function<void()> on_picture = {}, double preview_above_ms = 50);
   ~GlViewport() override;
   GlViewport(const GlViewport&) = delete;
   GlViewport& operator=(const GlViewport&) = delete;

@@ -196,6 +196,29 @@ std::optional<std::string> StudioApp::save_as(const std::string& path) {
   return std::nullopt;
 }
 
+std::optional<std::string> StudioApp::save_scene(const std::string& path) {
+  const std::string target = path.empty() ? scene_path_ : path;
+  if (target.empty()) return std::string("no scene file name");
+  if (path_.empty()) return std::string("save the grammar first: a scene names its grammar's file");
+  Scene s = scene_;
+  s.camera = orbit_.camera();
+  s.sun.direction = unit_sun_direction(scene_.sun.direction);
+  for (ScenePlant& p : s.plants) p.skeleton.reset();  // plants are named, never embedded
+  for (size_t i : edited_plants_) {
+    s.plants[i].grammar = path_;
+    for (const auto& [name, value] : overrides_) s.plants[i].defines[name] = value;
+    if (seed_) s.plants[i].seed = *seed_;
+    if (steps_) s.plants[i].steps = *steps_;
+  }
+  const std::string folder = std::filesystem::path(target).parent_path().string();
+  Expected<std::string> json = write_scene_json(s, folder);
+  if (!json) return one_line(json.error());
+  if (Status written = write_file_atomically(target, *json); !written) return one_line(written.error());
+  scene_path_ = target;
+  status_ = "saved " + target;
+  return std::nullopt;
+}
+
 bool StudioApp::request_close() {
   if (!dirty()) {
     quit_ = true;
@@ -540,6 +563,15 @@ void StudioApp::draw_menu() {
     if (ImGui::MenuItem("Save", "Ctrl+S")) save();
     if (ImGui::MenuItem("Save as...", "Ctrl+Shift+S"))
       dialog_ = FileDialog::save_as, dialog_path_ = path_.empty() ? "untitled.lsys" : path_;
+    if (ImGui::MenuItem("Save scene", nullptr, false, !scene_path_.empty())) {
+      if (auto err = save_scene()) status_ = *err;
+    }
+    if (ImGui::MenuItem("Save scene as...")) {
+      dialog_ = FileDialog::save_scene_as;
+      dialog_path_ = !scene_path_.empty() ? scene_path_
+                     : path_.empty()      ? std::string("untitled.scene.json")
+                                          : (std::filesystem::path(path_).replace_extension("").string() + ".scene.json");
+    }
     if (ImGui::MenuItem("Reload from disk", nullptr, false, !path_.empty())) {
       Expected<std::string> r = read_text_file(path_);
       if (r) {
@@ -616,7 +648,7 @@ void StudioApp::draw_viewport(ImVec2 size) {
   const uint32_t scale = view_half_res_ ? 2 : 1;
   scene_.width = std::max<uint32_t>(1, static_cast<uint32_t>(image_size.x) / scale);
   scene_.height = std::max<uint32_t>(1, static_cast<uint32_t>(image_size.y) / scale);
-  scene_.camera = orbit_.camera();
+  if (camera_set_) scene_.camera = orbit_.camera();  // before the first plant: the file's camera
   const ImVec2 origin = ImGui::GetCursorScreenPos();
   ImGui::InvisibleButton("##view", image_size,
                          ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonMiddle);
@@ -631,7 +663,7 @@ void StudioApp::draw_viewport(ImVec2 size) {
   view_half_res_ = active;
   if (hovered && io.MouseWheel != 0) orbit_.zoom(io.MouseWheel);
   if (hovered && !io.WantTextInput && key_pressed('F') && !io.KeyCtrl) frame_plant();
-  scene_.camera = orbit_.camera();
+  if (camera_set_) scene_.camera = orbit_.camera();  // before the first plant: the file's camera
 
   ImDrawList* dl = ImGui::GetWindowDrawList();
   ViewImage img;
@@ -878,7 +910,7 @@ void StudioApp::draw_presets() {
 
 void StudioApp::draw_file_dialog() {
   if (dialog_ == FileDialog::none) return;
-  const char* titles[] = {"", "Open", "Save as", "Export glTF", "Export PNG", "Export skeleton"};
+  const char* titles[] = {"", "Open", "Save as", "Export glTF", "Export PNG", "Export skeleton", "Save scene as"};
   const char* title = titles[static_cast<int>(dialog_)];
   if (!ImGui::IsPopupOpen(title)) ImGui::OpenPopup(title);
   if (!ImGui::BeginPopupModal(title, nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
@@ -912,10 +944,12 @@ void StudioApp::draw_file_dialog() {
         err = export_png_file(dialog_path_, static_cast<uint32_t>(export_width_), static_cast<uint32_t>(export_height_));
         break;
       case FileDialog::export_skeleton: err = export_skeleton_file(dialog_path_); break;
+      case FileDialog::save_scene_as: err = save_scene(dialog_path_); break;
       case FileDialog::none: break;
     }
     if (err) status_ = *err;
-    else if (dialog_ != FileDialog::open && dialog_ != FileDialog::save_as) status_ = "wrote " + dialog_path_;
+    else if (dialog_ != FileDialog::open && dialog_ != FileDialog::save_as && dialog_ != FileDialog::save_scene_as)
+      status_ = "wrote " + dialog_path_;
   }
   if (go || cancel) {
     dialog_ = FileDialog::none;

@@ -75,6 +75,14 @@ class StudioApp {
   bool wants_frames() const;
   std::optional<std::string> save();                        // to the document's path
   std::optional<std::string> save_as(const std::string& path);
+  // Writes the scene as the viewport shows it — its plants (the edited ones naming the
+  // document's grammar, with the parameter controls' values as their defines), the orbit
+  // camera, the sun control's direction, the rest as opened — through the scene writer
+  // (write_scene_json: paths relative to the scene's folder), atomically. An empty path:
+  // the scene the document came with. A grammar opened alone makes a new scene with its
+  // one plant. Returns the error text, writing nothing, when it cannot (an untitled
+  // grammar, a folder that is not there).
+  std::optional<std::string> save_scene(const std::string& path = "");
 
   // State, for the window's --screenshot and for tests.
   const std::string& text() const { return text_; }
@@ -114,7 +122,7 @@ class StudioApp {
   std::optional<std::string> export_png_file(const std::string& path, uint32_t width, uint32_t height);
 
  private:
-  enum class FileDialog { none, open, save_as, export_gltf, export_png, export_skeleton };
+  enum class FileDialog { none, open, save_as, export_gltf, export_png, export_skeleton, save_scene_as };
 
   void load_text(const std::string& path, std::string text, const std::string& scene_path, Scene scene);
   void submit_regrow();

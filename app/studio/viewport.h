@@ -36,6 +36,10 @@ struct ViewStats {
   uint64_t frusta = 0;
   std::string renderer;            // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   std::string error;               // why nothing is drawn (gl_unsupported, GlError)
+  bool preview = false;            // the picture shown is new plants' quick first one (half
+                                   //   the pixels a side, a small shadow map); the full
+                                   //   one follows unless newer plants come first
+  uint64_t previews = 0;           // previews made so far
 };
 
 class Viewport {

@@ -32,6 +32,13 @@ struct GlError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Work stopped by RenderOptions::progress (core/util/progress.h) where there is no result
+// to flag it on: a GlRenderer whose skinning was cancelled is never constructed. Not a
+// failure: a front end that cancelled simply goes on with its newer request.
+struct GlCancelled : std::runtime_error {
+  GlCancelled() : std::runtime_error("cancelled") {}
+};
+
 struct GlContextInfo {
   std::string platform;  // "EGL device 0 (hardware)", "EGL surfaceless (Mesa)", ...
   std::string vendor;    // GL_VENDOR

@@ -139,6 +139,7 @@ struct GlRenderer::Frame {
 
 struct GlRenderer::State {
   RenderOptions options;
+  uint32_t shadow_texels_override = 0;  // set_shadow_map_texels; 0: shadow_map_texels()
   std::vector<RenderPass> setup_passes;
   size_t plant_count = 0;
   uint64_t frusta = 0;
@@ -178,11 +179,17 @@ struct GlRenderer::State {
 
   // Skins every plant of `scene` into one record and one id quadruple (plant, chain,
   // segment, 0) per frustum, and replaces `spheres` with the frusta's bounding spheres.
+  // Cancelled (options.progress): throws GlCancelled with `spheres` as they were.
   void skin_plants(const Scene& scene, std::vector<GpuSegment>* records, std::vector<uint32_t>* ids) {
-    spheres.clear();
+    std::vector<Sphere> fresh;
     for (uint32_t p = 0; p < scene.plants.size(); ++p) {
       if (!scene.plants[p].skeleton) throw std::logic_error("GlRenderer: a plant has no skeleton (call grow_scene_plants)");
-      const SkinnedSkeleton skinned = skin_skeleton(place_plant(scene.plants[p]), options.skin);
+      if (options.progress.cancelled()) throw GlCancelled();  // between plants
+      const double plants = static_cast<double>(scene.plants.size());
+      Expected<SkinnedSkeleton> skinned_or =
+          skin_skeleton(place_plant(scene.plants[p]), options.skin, options.progress.part(p / plants, (p + 1) / plants));
+      if (!skinned_or) throw GlCancelled();  // the only error skin_skeleton returns
+      const SkinnedSkeleton& skinned = *skinned_or;
       for (const Frustum& f : skinned.frusta) {
         records->push_back(pack_gpu_segment(f));
         ids->insert(ids->end(), {p, f.chain, f.segment, 0u});
@@ -197,9 +204,10 @@ struct GlRenderer::State {
         double radius = 0;
         for (const glm::dvec3& v : pyramid.vertices) radius = std::max(radius, glm::length(v - centre));
         // The shader grows the pyramid by ~1e-4 of the frustum's size (frusta.vert.glsl).
-        spheres.push_back({centre, radius * 1.001 + 1e-3 * (f.shape.length + std::max(f.shape.radius0, f.shape.radius1))});
+        fresh.push_back({centre, radius * 1.001 + 1e-3 * (f.shape.length + std::max(f.shape.radius0, f.shape.radius1))});
       }
     }
+    spheres = std::move(fresh);
   }
 
   // The shadow map's side for a w × h frame: a texel about a pixel where the plants fill
@@ -395,6 +403,16 @@ GlRenderer::~GlRenderer() = default;
 
 void GlRenderer::set_conservative_depth(bool on) { state_->features.conservative_depth = on; }
 
+void GlRenderer::set_shadow_map_texels(uint32_t texels) {
+  if (texels == 0) {
+    state_->shadow_texels_override = 0;
+    return;
+  }
+  GLint max_size = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  state_->shadow_texels_override = std::clamp<uint32_t>(texels, 16, static_cast<uint32_t>(max_size));
+}
+
 uint64_t GlRenderer::frusta() const { return state_->frusta; }
 uint64_t GlRenderer::uploaded_bytes() const { return state_->uploaded_bytes; }
 const std::vector<RenderPass>& GlRenderer::setup_passes() const { return state_->setup_passes; }
@@ -508,7 +526,7 @@ void GlRenderer::begin_frame(const Scene& scene, Frame& f) {
   f.sun_on = sun_shines(scene);
   f.sun_radiance = scene.sun.radiance;
   if (f.sun_on) {
-    s.shadow_texels = st.shadow_map_texels(f.width, f.height);
+    s.shadow_texels = st.shadow_texels_override ? st.shadow_texels_override : st.shadow_map_texels(f.width, f.height);
     s.targets_allocated += st.shadow_map.resize(s.shadow_texels) ? 1 : 0;
   }
   s.target_bytes = st.targets.bytes() + (f.sun_on ? st.shadow_map.bytes() : 0);
@@ -765,7 +783,15 @@ RenderResult GlRenderer::render(const Scene& scene) {
 
 RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrameStats* stats) {
   if (auto why = gl_unsupported(scene, options)) throw GlError(*why);
-  GlRenderer renderer(scene, options);
+  std::optional<GlRenderer> built;
+  try {
+    built.emplace(scene, options);
+  } catch (const GlCancelled&) {  // cancelled while skinning: flagged, as render_cpu does
+    RenderResult cancelled;
+    cancelled.cancelled = true;
+    return cancelled;
+  }
+  GlRenderer& renderer = *built;
   RenderResult result = renderer.render(scene);
   if (stats) *stats = renderer.wait_for_frame();
   result.passes.insert(result.passes.begin(), renderer.setup_passes().begin(), renderer.setup_passes().end());

@@ -106,7 +106,9 @@ std::optional<std::string> gl_unsupported(const Scene& scene, const RenderOption
 class GlRenderer {
  public:
   // Preconditions: every plant's skeleton is set. Throws GlError (gl_unsupported's cases
-  // included), std::logic_error for a plant without a skeleton.
+  // included), std::logic_error for a plant without a skeleton, GlCancelled when
+  // options.progress is cancelled while the plants are skinned (checked before each plant
+  // and every 1024 chains; the fraction skinned is reported as "skin").
   GlRenderer(const Scene& scene, const RenderOptions& options);
   ~GlRenderer();
   GlRenderer(const GlRenderer&) = delete;
@@ -144,7 +146,8 @@ class GlRenderer {
   // same plants as the constructor's, their skeletons moved — and re-uploads only the
   // segment records (the ids too where the number of frusta changed; the polygon baseline
   // its whole mesh). Returns the bytes uploaded (the next frame's plant_bytes_uploaded).
-  // Throws std::invalid_argument for a different number of plants.
+  // Throws std::invalid_argument for a different number of plants, GlCancelled (nothing
+  // uploaded, the last plants still drawn) when options.progress is cancelled.
   uint64_t update_plants(const Scene& scene);
 
   // Whether the frusta programs declare conservative depth (layout(depth_less) /
@@ -152,6 +155,12 @@ class GlRenderer {
   // variants from the next frame on, the same pictures, for timing what early depth
   // testing is worth.
   void set_conservative_depth(bool on);
+
+  // The shadow map's side in texels from the next frame on (clamped to [16, the driver's
+  // largest texture]); 0 (the default): chosen from the frame's size, at least 1024, as the
+  // CLI renders. A smaller map is a cheaper, blockier-shadowed picture: the studio's
+  // preview of new plants (app/studio/gl_viewport.cpp) before the full one.
+  void set_shadow_map_texels(uint32_t texels);
 
   uint64_t frusta() const;          // frusta uploaded
   uint64_t uploaded_bytes() const;  // bytes in the segment and id buffers (or the mesh's)
@@ -178,7 +187,8 @@ class GlRenderer {
 
 // Renders `scene` on the current context: GlRenderer(scene, options).render(scene), with
 // the setup passes first; the frame's stats (GPU times in) go to *stats when given.
-// Throws GlError (gl_unsupported's reason included).
+// Throws GlError (gl_unsupported's reason included). Cancelled by options.progress: a
+// result with `cancelled` set (and no image), as render_cpu's.
 RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrameStats* stats = nullptr);
 
 }  // namespace sylva

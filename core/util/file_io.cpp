@@ -10,11 +10,18 @@
 #include <sys/types.h>
 #include <unistd.h>
 
+#include <signal.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <climits>
 #include <cstdint>
+#include <cstring>
+#include <mutex>
+#include <set>
 #include <system_error>
+#include <utility>
 
 namespace sylva {
 namespace {
@@ -45,9 +52,245 @@ bool write_all(int fd, std::string_view bytes) {
   return true;
 }
 
+// What kind of file a stat() describes, for messages ("a FIFO").
+const char* kind_of(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+std::string mib(size_t bytes) {
+  return bytes % (size_t{1} << 20) == 0 ? std::to_string(bytes >> 20) + " MiB" : std::to_string(bytes) + " bytes";
+}
+
+// The inputs of this run by (device, inode), once refuse_outputs_onto_inputs() was called.
+struct InputFiles {
+  std::mutex mutex;
+  bool enabled = false;
+  std::set<std::pair<dev_t, ino_t>> files;
+};
+InputFiles& input_files() {
+  static InputFiles* files = new InputFiles;  // never destroyed: used until exit
+  return *files;
+}
+
+// Pending temporaries, for the signal handler: fixed slots, so that the handler only reads
+// memory that is never freed and calls nothing but unlink() (async-signal-safe).
+constexpr int kTemporarySlots = 128;
+struct TemporarySlot {
+  std::atomic<int> state{0};  // 0 free, 1 being filled, 2 holds a path
+  char path[PATH_MAX];
+};
+TemporarySlot g_temporaries[kTemporarySlots];
+
+int remember_temporary(const std::string& path) {
+  if (path.size() >= PATH_MAX) return -1;
+  for (int i = 0; i < kTemporarySlots; ++i) {
+    int expected = 0;
+    if (!g_temporaries[i].state.compare_exchange_strong(expected, 1)) continue;
+    std::memcpy(g_temporaries[i].path, path.c_str(), path.size() + 1);
+    g_temporaries[i].state.store(2);
+    return i;
+  }
+  return -1;  // more pending at once than slots: still removed on every path but a signal
+}
+
+void forget_temporary(int slot) {
+  if (slot >= 0) g_temporaries[slot].state.store(0);
+}
+
+extern "C" void remove_temporaries_and_reraise(int signal_number) {
+  const int saved_errno = errno;
+  for (TemporarySlot& slot : g_temporaries)
+    if (slot.state.load() == 2) ::unlink(slot.path);
+  errno = saved_errno;
+  ::signal(signal_number, SIG_DFL);
+  ::raise(signal_number);
+}
+
+void split_path(const std::string& path, std::string* directory_prefix, std::string* directory, std::string* name) {
+  const size_t slash = path.rfind('/');
+  *directory_prefix = slash == std::string::npos ? "" : path.substr(0, slash + 1);
+  *directory = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+  *name = path.substr(directory_prefix->size());
+}
+
+void sync_directory(const std::string& directory) {
+  // Makes a rename durable; the data is already safe, so failure here is not reported
+  // (some file systems refuse fsync on directories).
+  const int directory_fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (directory_fd >= 0) {
+    (void)::fsync(directory_fd);
+    ::close(directory_fd);
+  }
+}
+
 }  // namespace
 
-Expected<std::string> read_text_file(const std::string& path) {
+void refuse_outputs_onto_inputs() {
+  InputFiles& inputs = input_files();
+  std::lock_guard<std::mutex> lock(inputs.mutex);
+  inputs.enabled = true;
+}
+
+void note_input_file(const std::string& path) {
+  InputFiles& inputs = input_files();
+  std::lock_guard<std::mutex> lock(inputs.mutex);
+  struct stat info {};
+  if (inputs.enabled && ::stat(path.c_str(), &info) == 0) inputs.files.insert({info.st_dev, info.st_ino});
+}
+
+Status check_output_path(const std::string& path) {
+  if (path.empty()) return file_diagnostic(path, "cannot write: the path is empty");
+  if (path.back() == '/') return errno_error(path, "cannot write", EISDIR);
+  struct stat info {};
+  if (::lstat(path.c_str(), &info) != 0) {
+    if (errno == ENOENT) return {};  // a new file (a missing folder fails when it is created)
+    return errno_error(path, "cannot write", errno);
+  }
+  {
+    InputFiles& inputs = input_files();
+    std::lock_guard<std::mutex> lock(inputs.mutex);
+    if (inputs.files.count({info.st_dev, info.st_ino}))
+      return file_diagnostic(path, "cannot write: it is an input of this command, which writing would destroy");
+  }
+  if (S_ISLNK(info.st_mode)) return {};
+  if (S_ISDIR(info.st_mode)) return errno_error(path, "cannot write", EISDIR);
+  if (!S_ISREG(info.st_mode))
+    return file_diagnostic(path, std::string("cannot write: it is ") + kind_of(info.st_mode) +
+                                     ", and sylva writes regular files only (docs/limits.md, \"Outputs\")");
+  if ((info.st_mode & 0222) == 0 || ::access(path.c_str(), W_OK) != 0)
+    return file_diagnostic(path, "cannot write: the file is read-only (" +
+                                     std::generic_category().message(EACCES) + ")", EACCES);
+  return {};
+}
+
+PendingFile::PendingFile(PendingFile&& other) noexcept
+    : target_(std::move(other.target_)), temporary_(std::move(other.temporary_)),
+      slot_(std::exchange(other.slot_, -1)) {
+  other.temporary_.clear();
+}
+
+PendingFile& PendingFile::operator=(PendingFile&& other) noexcept {
+  if (this != &other) {
+    discard();
+    target_ = std::move(other.target_);
+    temporary_ = std::move(other.temporary_);
+    other.temporary_.clear();
+    slot_ = std::exchange(other.slot_, -1);
+  }
+  return *this;
+}
+
+PendingFile::~PendingFile() { discard(); }
+
+void PendingFile::discard() {
+  if (!temporary_.empty()) ::unlink(temporary_.c_str());
+  forget_temporary(slot_);
+  slot_ = -1;
+  temporary_.clear();
+}
+
+Expected<PendingFile> PendingFile::create(const std::string& target) {
+  if (Status allowed = check_output_path(target); !allowed) return std::move(allowed.error());
+  std::string directory_prefix, directory, name;
+  split_path(target, &directory_prefix, &directory, &name);
+
+  // Keep the permission bits (not set-user/group-ID) of the file being replaced.
+  struct stat existing {};
+  const bool replaces_regular_file = ::lstat(target.c_str(), &existing) == 0 && S_ISREG(existing.st_mode);
+
+  static std::atomic<uint64_t> counter{0};
+  PendingFile pending;
+  pending.target_ = target;
+  std::string temporary;
+  int fd = -1;
+  for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
+    temporary = directory_prefix + "." + name.substr(0, kMaxNameInTemporary) + ".tmp-" +
+                std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1));
+    fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0 && errno != EEXIST) break;
+  }
+  if (fd < 0) {
+    const int error_number = errno;
+    return errno_error(target, "cannot create a temporary file in directory '" + directory + "'", error_number);
+  }
+  pending.temporary_ = temporary;
+  pending.slot_ = remember_temporary(temporary);
+  if (replaces_regular_file) (void)::fchmod(fd, existing.st_mode & 0777);  // before any data
+  if (::close(fd) != 0) return errno_error(target, "cannot close temporary file '" + temporary + "'", errno);
+  return pending;
+}
+
+Status PendingFile::sync() const {
+  const int fd = ::open(temporary_.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0 || ::fsync(fd) != 0) {
+    const int error_number = errno;
+    if (fd >= 0) ::close(fd);
+    return errno_error(target_, "cannot flush temporary file '" + temporary_ + "' to disk", error_number);
+  }
+  ::close(fd);
+  return {};
+}
+
+Expected<PendingFile> write_pending_file(const std::string& target, std::string_view bytes) {
+  Expected<PendingFile> pending = PendingFile::create(target);
+  if (!pending) return pending;
+  const std::string& temporary = pending->temporary();
+  // `error_number` is errno read right after the failing call, before any allocation.
+  auto fail = [&](int error_number, const char* what, const char* after_name) {
+    return errno_error(target, std::string(what) + " '" + temporary + "'" + after_name, error_number);
+  };
+  const int fd = ::open(temporary.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+  if (fd < 0) return fail(errno, "cannot open temporary file", "");
+  if (!write_all(fd, bytes)) {
+    const int error_number = errno;
+    ::close(fd);
+    return fail(error_number, "cannot write temporary file", "");
+  }
+  if (::fsync(fd) != 0) {
+    const int error_number = errno;
+    ::close(fd);
+    return fail(error_number, "cannot flush temporary file", " to disk");
+  }
+  if (::close(fd) != 0) return fail(errno, "cannot close temporary file", "");
+  return pending;
+}
+
+Status commit_files(std::vector<PendingFile>& files) {
+  std::set<std::string> directories;
+  for (PendingFile& f : files) {
+    if (::rename(f.temporary_.c_str(), f.target_.c_str()) != 0) {
+      const int error_number = errno;
+      Diagnostic error = errno_error(f.target_, "cannot rename temporary file '" + f.temporary_ + "' over it",
+                                     error_number);
+      for (PendingFile& rest : files) rest.discard();
+      return error;
+    }
+    forget_temporary(f.slot_);
+    f.slot_ = -1;
+    f.temporary_.clear();
+    std::string prefix, directory, name;
+    split_path(f.target_, &prefix, &directory, &name);
+    directories.insert(directory);
+  }
+  for (const std::string& d : directories) sync_directory(d);
+  return {};
+}
+
+void remove_temporaries_on_signals() {
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction action {};
+    action.sa_handler = remove_temporaries_and_reraise;
+    sigemptyset(&action.sa_mask);
+    sigaction(signal_number, &action, nullptr);
+  }
+}
+
+Expected<std::string> read_text_file(const std::string& path, size_t max_bytes) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     const int error_number = errno;  // before anything that may allocate
@@ -64,6 +307,17 @@ Expected<std::string> read_text_file(const std::string& path) {
     ::close(fd);
     return errno_error(path, "cannot read", EISDIR);
   }
+  if (!S_ISREG(info.st_mode) && !S_ISFIFO(info.st_mode)) {
+    ::close(fd);
+    return file_diagnostic(path, std::string("cannot read: it is ") + kind_of(info.st_mode) +
+                                     ", not a regular file or a pipe (docs/limits.md)");
+  }
+  if (S_ISREG(info.st_mode) && static_cast<uint64_t>(info.st_size) > max_bytes) {
+    ::close(fd);
+    return file_diagnostic(path, "cannot read: the file has " + std::to_string(info.st_size) +
+                                     " bytes, more than the limit of " + mib(max_bytes) + " (docs/limits.md)");
+  }
+  note_input_file(path);
 
   std::string contents;
   if (S_ISREG(info.st_mode) && info.st_size > 0) contents.reserve(static_cast<size_t>(info.st_size));
@@ -77,6 +331,11 @@ Expected<std::string> read_text_file(const std::string& path) {
       ::close(fd);
       return errno_error(path, "cannot read", error_number);
     }
+    if (contents.size() + static_cast<size_t>(n) > max_bytes) {
+      ::close(fd);
+      return file_diagnostic(path, "cannot read: it holds more than the limit of " + mib(max_bytes) +
+                                       " (docs/limits.md)");
+    }
     contents.append(buffer, static_cast<size_t>(n));
   }
   ::close(fd);
@@ -84,60 +343,11 @@ Expected<std::string> read_text_file(const std::string& path) {
 }
 
 Status write_file_atomically(const std::string& path, std::string_view bytes) {
-  if (path.empty()) return file_diagnostic(path, "cannot write: the path is empty");
-  if (path.back() == '/') return errno_error(path, "cannot write", EISDIR);
-
-  const size_t slash = path.rfind('/');
-  const std::string directory_prefix = slash == std::string::npos ? "" : path.substr(0, slash + 1);
-  const std::string directory = slash == std::string::npos ? "."
-                                : slash == 0               ? "/"
-                                                           : path.substr(0, slash);
-  const std::string name = path.substr(directory_prefix.size());
-
-  // Keep the permission bits (not set-user/group-ID) of the file being replaced.
-  struct stat existing {};
-  const bool replaces_regular_file = ::lstat(path.c_str(), &existing) == 0 && S_ISREG(existing.st_mode);
-
-  static std::atomic<uint64_t> counter{0};
-  std::string temporary;
-  int fd = -1;
-  for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
-    temporary = directory_prefix + "." + name.substr(0, kMaxNameInTemporary) + ".tmp-" +
-                std::to_string(::getpid()) + "-" + std::to_string(counter.fetch_add(1));
-    fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0 && errno != EEXIST) break;
-  }
-  if (fd < 0) {
-    const int error_number = errno;
-    return errno_error(path, "cannot create a temporary file in directory '" + directory + "'",
-                       error_number);
-  }
-
-  // `error_number` is errno read right after the failing call, before any allocation.
-  auto fail = [&](int error_number, const char* what, const char* after_name) {
-    if (fd >= 0) ::close(fd);
-    ::unlink(temporary.c_str());
-    return errno_error(path, std::string(what) + " '" + temporary + "'" + after_name, error_number);
-  };
-
-  if (replaces_regular_file) (void)::fchmod(fd, existing.st_mode & 0777);  // before any data
-  if (!write_all(fd, bytes)) return fail(errno, "cannot write temporary file", "");
-  if (::fsync(fd) != 0) return fail(errno, "cannot flush temporary file", " to disk");
-  const int closed = ::close(fd);
-  fd = -1;
-  if (closed != 0) return fail(errno, "cannot close temporary file", "");
-  if (::rename(temporary.c_str(), path.c_str()) != 0) {
-    return fail(errno, "cannot rename temporary file", " over it");
-  }
-
-  // Make the rename itself durable; the data is already safe, so failure here is not
-  // reported (some file systems refuse fsync on directories).
-  const int directory_fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (directory_fd >= 0) {
-    (void)::fsync(directory_fd);
-    ::close(directory_fd);
-  }
-  return {};
+  Expected<PendingFile> pending = write_pending_file(path, bytes);
+  if (!pending) return std::move(pending.error());
+  std::vector<PendingFile> files;
+  files.push_back(std::move(*pending));
+  return commit_files(files);
 }
 
 }  // namespace sylva

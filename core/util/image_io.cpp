@@ -1,17 +1,15 @@
 // image_io.cpp — OpenImageIO output, made atomic by a temporary file and rename().
 #include "core/util/image_io.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <OpenImageIO/imageio.h>
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+
+#include "core/util/limits.h"
 
 namespace sylva {
 
@@ -26,14 +24,6 @@ OIIO::TypeDesc oiio_type(ChannelFormat f) {
   return OIIO::TypeDesc::FLOAT;
 }
 
-std::string temporary_path_for(const std::string& path) {
-  static std::atomic<uint64_t> counter{0};
-  std::filesystem::path p(path);
-  std::string name = "." + p.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                     std::to_string(counter.fetch_add(1));
-  return (p.parent_path() / name).string();
-}
-
 }  // namespace
 
 std::string lower_extension(const std::string& path) {
@@ -45,6 +35,17 @@ std::string lower_extension(const std::string& path) {
 Status write_image_atomically(const std::string& path, uint32_t width, uint32_t height,
                               const std::vector<std::string>& channel_names, const std::vector<float>& pixels,
                               const std::vector<ChannelFormat>& formats, bool srgb) {
+  Expected<PendingFile> pending = write_pending_image(path, width, height, channel_names, pixels, formats, srgb);
+  if (!pending) return std::move(pending.error());
+  std::vector<PendingFile> files;
+  files.push_back(std::move(*pending));
+  return commit_files(files);
+}
+
+Expected<PendingFile> write_pending_image(const std::string& path, uint32_t width, uint32_t height,
+                                          const std::vector<std::string>& channel_names,
+                                          const std::vector<float>& pixels,
+                                          const std::vector<ChannelFormat>& formats, bool srgb) {
   const size_t channels = channel_names.size();
   if (path.empty() || path.back() == '/') return file_diagnostic(path, "not a file name");
   if (channels == 0 || pixels.size() != static_cast<size_t>(width) * height * channels ||
@@ -74,12 +75,10 @@ Status write_image_atomically(const std::string& path, uint32_t width, uint32_t 
   spec.attribute("DateTime", "1970:01:01 00:00:00");
   if (lower_extension(path) == ".exr") spec.attribute("compression", "zip");
 
-  const std::string temp = temporary_path_for(path);
-  auto fail = [&](const std::string& what, int error_number = 0) {
-    std::error_code ignored;
-    std::filesystem::remove(temp, ignored);
-    return file_diagnostic(path, what, error_number);
-  };
+  Expected<PendingFile> pending = PendingFile::create(path);
+  if (!pending) return pending;
+  const std::string& temp = pending->temporary();
+  auto fail = [&](const std::string& what) { return file_diagnostic(path, what); };
   if (!out->open(temp, spec)) return fail("cannot write: " + out->geterror());
   if (!out->write_image(OIIO::TypeDesc::FLOAT, pixels.data())) {
     std::string why = out->geterror();
@@ -88,25 +87,22 @@ Status write_image_atomically(const std::string& path, uint32_t width, uint32_t 
   }
   if (!out->close()) return fail("cannot write: " + out->geterror());
   out.reset();
-
   // Make the bytes durable before the rename publishes them.
-  int fd = ::open(temp.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0 || ::fsync(fd) != 0) {
-    int error = errno;
-    if (fd >= 0) ::close(fd);
-    return fail(std::string("cannot sync the temporary file: ") + std::strerror(error), error);
-  }
-  ::close(fd);
-  if (std::rename(temp.c_str(), path.c_str()) != 0) {
-    int error = errno;
-    return fail(std::string("cannot rename the temporary file over it: ") + std::strerror(error), error);
-  }
-  return {};
+  if (Status synced = pending->sync(); !synced) return std::move(synced.error());
+  return pending;
 }
 
 Status check_image_opens(const std::string& path) {
+  note_input_file(path);  // a texture of the scene: never an output too
   auto input = OIIO::ImageInput::open(path);
-  if (input) return {};
+  if (input) {
+    // The header's size, before any renderer allocates for it (docs/limits.md).
+    const OIIO::ImageSpec& spec = input->spec();
+    if (auto problem = image_size_problem(static_cast<uint64_t>(std::max(spec.width, 0)),
+                                          static_cast<uint64_t>(std::max(spec.height, 0))))
+      return file_diagnostic(path, "the image is too large or empty: " + *problem);
+    return {};
+  }
   std::string reason = OIIO::geterror();
   if (reason.empty()) reason = "OpenImageIO cannot read it";
   return file_diagnostic(path, reason);

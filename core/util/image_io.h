@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/util/diagnostic.h"
+#include "core/util/file_io.h"
 
 namespace sylva {
 
@@ -22,9 +23,17 @@ enum class ChannelFormat : uint8_t { uint8, half, float32 };
 // channels are expected already encoded in [0, 1] (values are clamped and rounded).
 // `srgb`: tag the file as sRGB (else linear).
 // Failure: a Diagnostic for `path` as a whole (with the errno where a system call failed).
+// The target must pass check_output_path (file_io.h).
 Status write_image_atomically(const std::string& path, uint32_t width, uint32_t height,
                               const std::vector<std::string>& channel_names, const std::vector<float>& pixels,
                               const std::vector<ChannelFormat>& formats, bool srgb);
+
+// The first half of write_image_atomically: the complete image in a temporary next to
+// `path`, to be renamed with others by commit_files (file_io.h), all or nothing.
+Expected<PendingFile> write_pending_image(const std::string& path, uint32_t width, uint32_t height,
+                                          const std::vector<std::string>& channel_names,
+                                          const std::vector<float>& pixels,
+                                          const std::vector<ChannelFormat>& formats, bool srgb);
 
 // The lower-case extension of `path`, with its dot (".png"; "" when there is none).
 std::string lower_extension(const std::string& path);

@@ -23,4 +23,21 @@ TEST(BenchLsystem, AnUnknownBenchmarkIsAUsageError) {
   EXPECT_NE(r.err.find("unknown benchmark 'nope'"), std::string::npos) << r.err;
 }
 
+// Flags are checked as everywhere else (exit 2 with the flag named), before any work.
+TEST(BenchFlags, BadSizesAndFiltersAreUsageErrors) {
+  for (const char* width : {"abc", "0", "-5"}) {
+    auto r = run_process({SYLVA_BINARY, "bench", "raycast", "--width", width}, SYLVA_SOURCE_DIR);
+    ASSERT_FALSE(crashed(r)) << describe(r);
+    EXPECT_EQ(r.exit_code, 2) << width << "\n" << describe(r);
+    EXPECT_NE(r.err.find(std::string("--width ") + width + ": expected an integer from 1 to 16384"),
+              std::string::npos)
+        << describe(r);
+  }
+  auto r = run_process({SYLVA_BINARY, "bench", "lsystem", "--quick", "--benchmark_filter=no_such_case"},
+                       SYLVA_SOURCE_DIR, 240);
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  EXPECT_EQ(r.exit_code, 2) << describe(r);
+  EXPECT_NE(r.err.find("no benchmark matches"), std::string::npos) << describe(r);
+}
+
 }  // namespace

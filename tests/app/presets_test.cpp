@@ -67,6 +67,18 @@ std::optional<uint64_t> segments_in_summary(const std::string& out) {
   return std::stoull(m[1].str());
 }
 
+// The paper's plants cite its authors as the README does (Bhagvat, Jeschke, Cline,
+// Wonka 2009), and no preset names anyone else for it.
+TEST(PresetSources, ThePapersPlantsCiteItsAuthors) {
+  for (const Preset& p : kPresets) {
+    const std::string text = read_file(presets_dir() / (std::string(p.name) + ".lsys"));
+    EXPECT_EQ(text.find("Kinkelin"), std::string::npos) << p.name;
+    if (p.paper) {
+      EXPECT_NE(text.find("Bhagvat, Jeschke, Cline, Wonka 2009"), std::string::npos) << p.name;
+    }
+  }
+}
+
 class PresetTest : public ::testing::TestWithParam<Preset> {};
 
 TEST_P(PresetTest, GrowsWithThePinnedSegmentCount) {

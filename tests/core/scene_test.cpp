@@ -548,4 +548,39 @@ TEST(SceneWrite, APlantWithoutAGrammarCannotBeWritten) {
 }
 
 }  // namespace
+
+// docs/limits.md: world coordinates within 1e12 m; directions of any finite size.
+TEST(SceneLimits, CoordinatesBeyondTheLimitAreErrorsAtTheirNumber) {
+  Diagnostic e = expect_error("{\"plants\": [], \"camera\": {\"eye\": [0, 1e200, 5]}}");
+  EXPECT_EQ(e.message, "camera.eye coordinates must be within ±1e12 m (docs/limits.md), not 1e200");
+  EXPECT_EQ(e.loc.column, 38u);
+  e = expect_error("{\"plants\": [{\"grammar\": \"g.lsys\", \"position\": [-2e12, 0, 0]}]}");
+  EXPECT_NE(e.message.find("plants[0].position coordinates must be within"), std::string::npos) << e.message;
+}
+
+TEST(SceneLimits, HugeAndTinyDirectionsAreNormalisedSafely) {
+  Expected<Scene> r = parse_scene_json("{\"plants\": [], \"sun\": {\"direction\": [1e200, 1e200, 0]}}", "s.scene.json", "");
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  EXPECT_NEAR(r->sun.direction.x, std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(r->sun.direction.y, std::sqrt(0.5), 1e-15);
+  EXPECT_EQ(r->sun.direction.z, 0);
+  r = parse_scene_json("{\"plants\": [], \"sun\": {\"direction\": [0, 1e-300, 0]}}", "s.scene.json", "");
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  EXPECT_EQ(r->sun.direction, glm::dvec3(0, 1, 0));
+  // An up vector too long to square is still not parallel to the view direction.
+  r = parse_scene_json("{\"plants\": [], \"camera\": {\"eye\": [0, 1, 5], \"up\": [0, 1e300, 0]}}",
+                       "s.scene.json", "");
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  EXPECT_TRUE(std::isfinite(glm::length(r->camera.up)));
+  Diagnostic e = expect_error("{\"plants\": [], \"sun\": {\"direction\": [0, 0, 0]}}");
+  EXPECT_NE(e.message.find("sun.direction must not be zero"), std::string::npos) << e.message;
+}
+
+TEST(SceneLimits, AnImageOverThePixelLimitIsRefusedBeforeAnythingIsAllocated) {
+  Diagnostic e = expect_error("{\"plants\": [], \"image\": {\"width\": 65536, \"height\": 65536}}");
+  EXPECT_EQ(e.message,
+            "image: the image has 4294967296 pixels (65536x65536), more than the limit of 67108864 (8192x8192; "
+            "docs/limits.md)");
+}
+
 }  // namespace sylva

@@ -604,6 +604,18 @@ TEST(TurtleErrors, NegativeRadiusIsAnErrorNamingTheModule) {
   EXPECT_NE(message.find("module 1"), std::string::npos) << message;  // its index in the word
 }
 
+// docs/limits.md: a length like 1e300 is finite, but no renderer can place it.
+TEST(TurtleErrors, PositionsAndRadiiBeyondTheLimitAreErrorsNamingTheModule) {
+  std::string message = grow_error("axiom: F(1e300)\n");
+  EXPECT_NE(message.find("exceeds the limit of 1e12 m"), std::string::npos) << message;
+  EXPECT_NE(message.find("F(1e+300)"), std::string::npos) << message;
+  message = grow_error("axiom: f(2e12)F\n");
+  EXPECT_NE(message.find("exceeds the limit of 1e12 m"), std::string::npos) << message;
+  message = grow_error("axiom: !(1e13)F\n");
+  EXPECT_NE(message.find("radius exceeds the limit"), std::string::npos) << message;
+  EXPECT_TRUE(grow_text("axiom: F(1e11)!(1e11)F\n").ok());
+}
+
 TEST(TurtleErrors, FractionalMaterialIsAnErrorNamingTheModule) {
   const std::string message = grow_error("axiom: F'(1.5)F\n");
   EXPECT_NE(message.find("material"), std::string::npos) << message;
@@ -617,15 +629,16 @@ TEST(TurtleErrors, NegativeMaterialIsAnError) {
 }
 
 TEST(TurtleErrors, PositionThatOverflowsToInfinityIsAnError) {
+  // Stopped at the coordinate limit (docs/limits.md), before the sum overflows.
   const std::string message = grow_error("axiom: F(1e308)F(1e308)\n");
   EXPECT_NE(message.find("position"), std::string::npos) << message;
-  EXPECT_NE(message.find("finite"), std::string::npos) << message;
-  EXPECT_NE(message.find("module 1"), std::string::npos) << message;  // the second F
+  EXPECT_NE(message.find("limit"), std::string::npos) << message;
+  EXPECT_NE(message.find("module 0"), std::string::npos) << message;  // the first F
 }
 
 TEST(TurtleErrors, MoveThatOverflowsWithSmallfIsAnErrorToo) {
   const std::string message = grow_error("axiom: f(1e308)f(1e308)F\n");
-  EXPECT_NE(message.find("finite"), std::string::npos) << message;
+  EXPECT_NE(message.find("limit"), std::string::npos) << message;
 }
 
 TEST(TurtleErrors, AtTWithoutSusceptibilityIsAnError) {

@@ -6,6 +6,7 @@
 // default framebuffer) draws into an EGL pbuffer's.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -186,6 +187,34 @@ TEST(GlFrame, PassTimesArriveAFrameLaterWithoutWaitingAndAreNonNegative) {
   ASSERT_TRUE(newest);
   EXPECT_EQ(newest->frame, 8u);
   EXPECT_FALSE(renderer.timed_frame()) << "each timed frame is handed out once";
+}
+
+TEST(GlFrame, SkinningStopsWhenCancelledAndRenderGlFlagsIt) {
+  SYLVA_REQUIRE_GL();
+  const Scene scene = saguaro();
+  std::atomic<bool> cancel{true};
+  RenderOptions options;
+  options.progress = Progress(&cancel);
+  EXPECT_THROW(GlRenderer(scene, options), GlCancelled);
+  const RenderResult flagged = render_gl(scene, options);
+  EXPECT_TRUE(flagged.cancelled);
+  EXPECT_TRUE(flagged.image.beauty.empty());
+
+  // A renderer whose update is cancelled keeps drawing the plants it has.
+  cancel = false;
+  GlRenderer renderer(scene, options);
+  renderer.draw(scene);
+  const RenderImage before = renderer.read_back();
+  cancel = true;
+  Scene moved = scene;
+  moved.plants[0].position.x += 0.5;
+  EXPECT_THROW(renderer.update_plants(moved), GlCancelled);
+  cancel = false;
+  renderer.draw(scene);
+  EXPECT_EQ(renderer.read_back().beauty, before.beauty);
+  EXPECT_GT(renderer.update_plants(moved), 0u);  // not cancelled: uploaded
+  renderer.draw(moved);
+  EXPECT_NE(renderer.read_back().beauty, before.beauty);
 }
 
 TEST(GlFrame, ATargetOfAnotherSizeOrNoDefaultFramebufferIsRefused) {

@@ -125,6 +125,19 @@ TEST(Stochastic, WeightsAreNormalisedAndZeroWeightsNeverChosen) {
   EXPECT_NEAR(counts[b] / 2000.0, 0.75, 0.05);
 }
 
+// Finite weights whose sum overflows still choose in proportion, not always the last.
+TEST(Stochastic, WeightsWhoseSumOverflowsStillChooseInProportion) {
+  std::string axiom(2000, 'A');
+  auto g = parse_ok("axiom: " + axiom + "\nA -> B : 1.5e308\nA -> C : 1.5e308\n");
+  auto w = derive(g, steps(1));
+  ASSERT_TRUE(w.ok()) << w.error().format();
+  SymbolId b;
+  ASSERT_TRUE(g.symbols.find("B", &b));
+  int count_b = 0;
+  for (const Module& m : w->modules) count_b += m.symbol == b;
+  EXPECT_NEAR(count_b / 2000.0, 0.5, 0.05);
+}
+
 TEST(Stochastic, ProbabilitiesThatAllSumToZeroAreAnError) {
   auto g = parse_ok("axiom: A\nA -> B : 0\nA -> C : 0\n");
   auto w = derive(g, steps(1));
@@ -324,6 +337,28 @@ TEST(DeriveProgress, ACancelledFlagStopsInterpretationToo) {
   ASSERT_TRUE(interpret(g, *w, o).ok());
   EXPECT_EQ(r.fractions.back(), 1.0);
   EXPECT_EQ(r.stages.back(), "interpret");
+}
+
+// docs/limits.md: --max-modules bounds the word's memory, so parameters count: a module
+// with 65,535 parameters cannot slip under a limit meant for modules.
+TEST(Limits, MaxModulesCountsEveryParameterAsAModule) {
+  auto g = parse_ok("axiom: A(1,2,3)\nA(x,y,z) -> A(x,y,z)A(x,y,z)\n");
+  DeriveOptions o = steps(3);
+  o.max_modules = 32;  // 8 modules of 4 units each
+  auto w = derive(g, o);
+  ASSERT_TRUE(w.ok()) << w.error().format();
+  EXPECT_EQ(w->size(), 8u);
+  o.max_modules = 31;
+  w = derive(g, o);
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.error().message.find("exceeds --max-modules (31 modules), each parameter counting as a module"),
+            std::string::npos)
+      << w.error().message;
+  o.max_modules = 3;  // the axiom alone is 4
+  w = derive(g, o);
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.error().message.find("the axiom exceeds --max-modules (3 modules)"), std::string::npos)
+      << w.error().message;
 }
 
 }  // namespace

@@ -3,10 +3,12 @@
 // that records what it was asked to do.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 
 #include "app/studio/document_files.h"
 #include "core/gltf_export.h"
+#include "core/scene.h"
 #include "core/skeleton.h"
 #include "core/util/file_io.h"
 #include "tests/studio/headless_ui.h"
@@ -47,6 +49,19 @@ struct Fixture : ::testing::Test {
     const float lh = app.editor().line_height();
     ui.click(app, ImVec2(o.x + 2, o.y + (static_cast<float>(line) - 0.5f) * lh));
     ui.key(app, kKeyEnd);
+  }
+  // Drags the viewport 50 pixels to the right with the left button (an orbit).
+  bool orbit_by_dragging(StudioApp& app) {
+    auto view = app.rect("viewport");
+    if (!view) return false;
+    ImGuiIO& io = ImGui::GetIO();
+    io.MousePos = view->centre();
+    ui.frame(app);
+    io.MouseDown[0] = true;
+    for (int i = 0; i < 5; ++i) io.MousePos.x += 10, ui.frame(app);
+    io.MouseDown[0] = false;
+    ui.frames(app, 2);
+    return true;
   }
   TempDir dir;
   std::string path;
@@ -261,15 +276,7 @@ TEST_F(Fixture, ReloadsAFileChangedOnDisk) {
 TEST_F(Fixture, CameraAndSunReRenderWithoutRegrowing) {
   auto app = opened();
   const int plants = viewport.set_plants_calls, renders = viewport.renders;
-  auto view = app->rect("viewport");
-  ASSERT_TRUE(view);
-  ImGuiIO& io = ImGui::GetIO();
-  io.MousePos = view->centre();
-  ui.frame(*app);
-  io.MouseDown[0] = true;
-  for (int i = 0; i < 5; ++i) io.MousePos.x += 10, ui.frame(*app);
-  io.MouseDown[0] = false;
-  ui.frames(*app, 2);
+  ASSERT_TRUE(orbit_by_dragging(*app));
   EXPECT_EQ(viewport.set_plants_calls, plants) << "orbiting never re-skins";
   EXPECT_GT(viewport.renders, renders);
   EXPECT_EQ(app->worker().counts().submitted, 1u) << "nor derives";
@@ -319,6 +326,42 @@ TEST_F(Fixture, OpensAScene) {
   EXPECT_NE(app->path().find("saguaro.lsys"), std::string::npos);
   EXPECT_GT(viewport.segments, 0u);
   EXPECT_EQ(app->scene().plants.size(), 1u);
+}
+
+TEST_F(Fixture, SavesTheSceneAsShownAndItReopensSo) {
+  auto app = opened();
+  app->set_define("N", 3);
+  ASSERT_TRUE(ui.settle(*app));
+  // Orbit the camera: the saved scene keeps the view, not the default framing.
+  ASSERT_TRUE(orbit_by_dragging(*app));
+  const Camera shown = app->camera().camera();
+
+  const std::string scene_path = dir.file("tree.scene.json");
+  EXPECT_FALSE(app->save_scene(scene_path));
+  Expected<Scene> read = read_scene_file(scene_path);
+  ASSERT_TRUE(read) << read.error().format();
+  ASSERT_EQ(read->plants.size(), 1u);
+  EXPECT_EQ(std::filesystem::weakly_canonical(read->plants[0].grammar), std::filesystem::weakly_canonical(path));
+  EXPECT_EQ(read->plants[0].defines.at("N"), 3.0) << "the control's value, though the text says 4";
+  EXPECT_EQ(read->camera.eye, shown.eye);
+  EXPECT_EQ(read->camera.target, shown.target);
+  EXPECT_EQ(read->sun.direction, app->scene().sun.direction);
+  EXPECT_EQ(app->text(), kTree) << "saving a scene leaves the grammar alone";
+
+  // Reopened, the scene grows the same plant (7 segments at N = 3) under the same camera.
+  FakeViewport other;
+  StudioOptions o;
+  o.presets_dir = std::string(SYLVA_SOURCE_DIR) + "/presets";
+  StudioApp again(o, &other);
+  ASSERT_FALSE(again.open(scene_path));
+  ASSERT_TRUE(ui.until(again, [&] { return again.plant_drawn(); }));
+  EXPECT_EQ(other.segments, 7u);
+  EXPECT_EQ(again.scene().camera.eye, shown.eye) << "the file's camera, not the default framing";
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(again.camera().camera().eye[k], shown.eye[k], 1e-9);
+
+  // Nowhere to write: an error, nothing written.
+  EXPECT_TRUE(app->save_scene(dir.file("missing/folder/x.scene.json")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("missing")));
 }
 
 TEST_F(Fixture, ExportsTheShownPlantThroughTheCliWriters) {

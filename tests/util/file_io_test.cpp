@@ -5,10 +5,12 @@
 // (RLIMIT_FSIZE) that makes write() fail part way, and a directory in the way of rename().
 #include "core/util/file_io.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -18,6 +20,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace sylva {
@@ -159,6 +162,7 @@ TEST_F(FileIoTest, AnUnwritableDirectoryLeavesTheExistingFileUntouched) {
   ASSERT_EQ(::mkdir(dir.c_str(), 0755), 0);
   const std::string target = dir + "/plant.skel.json";
   put(target, "old contents");
+  ::chmod(target.c_str(), 0666);  // the file is writable to anyone: the folder is what refuses
   ASSERT_EQ(::chmod(dir.c_str(), 0555), 0);
 
   std::string message;
@@ -229,17 +233,32 @@ TEST_F(FileIoTest, AFailedWriteLeavesTheExistingFileUntouchedAndNoTemporaryFile)
 }
 
 TEST_F(FileIoTest, AFailedRenameRemovesTheTemporaryFile) {
-  // A non-empty directory where the file should go: rename() cannot replace it.
+  // A non-empty directory appears where the file should go after its temporary was
+  // written: rename() cannot replace it.
   const std::string target = path("plant.skel.json");
+  Expected<PendingFile> pending = write_pending_file(target, "new contents");
+  ASSERT_TRUE(pending.ok());
   ASSERT_EQ(::mkdir(target.c_str(), 0755), 0);
   put(target + "/inside", "kept");
-  const Status error = write_file_atomically(target, "new contents");
+  std::vector<PendingFile> files;
+  files.push_back(std::move(*pending));
+  const Status error = commit_files(files);
   ASSERT_FALSE(error.ok());
   EXPECT_EQ(error.error().error_number, EISDIR);
   EXPECT_TRUE(is_temporary_failure(error.error().message, "cannot rename temporary file", directory_,
                                    "plant.skel.json", " over it: Is a directory"))
       << error.error().message;
   EXPECT_EQ(contents(target + "/inside"), "kept");
+  EXPECT_EQ(entries(directory_), std::vector<std::string>{"plant.skel.json"});
+}
+
+TEST_F(FileIoTest, ADirectoryAtTheTargetIsRefusedBeforeAnythingIsWritten) {
+  const std::string target = path("plant.skel.json");
+  ASSERT_EQ(::mkdir(target.c_str(), 0755), 0);
+  const Status error = write_file_atomically(target, "new contents");
+  ASSERT_FALSE(error.ok());
+  EXPECT_EQ(error.error().error_number, EISDIR);
+  EXPECT_EQ(error.error().format(), target + ": error: cannot write: Is a directory\n");
   EXPECT_EQ(entries(directory_), std::vector<std::string>{"plant.skel.json"});
 }
 
@@ -287,6 +306,164 @@ TEST_F(FileIoTest, ASymbolicLinkIsReplacedNotWrittenThrough) {
   EXPECT_FALSE(fs::is_symlink(path("link.json")));
   EXPECT_EQ(contents(path("link.json")), "new");
   EXPECT_EQ(contents(path("real.json")), "real");
+}
+
+
+// ---- hostile targets and inputs (docs/limits.md) ------------------------------------
+
+TEST_F(FileIoTest, AFifoAtTheTargetIsRefusedAndStaysAFifo) {
+  const std::string target = path("out.skel.json");
+  ASSERT_EQ(::mkfifo(target.c_str(), 0644), 0);
+  const Status error = write_file_atomically(target, "x");
+  ASSERT_FALSE(error.ok());
+  EXPECT_NE(error.error().message.find("it is a FIFO, and sylva writes regular files only"), std::string::npos)
+      << error.error().message;
+  EXPECT_TRUE(fs::is_fifo(target));
+  EXPECT_EQ(entries(directory_), std::vector<std::string>{"out.skel.json"});
+}
+
+TEST_F(FileIoTest, ADeviceAtTheTargetIsRefused) {
+  const Status error = write_file_atomically("/dev/null", "x");
+  ASSERT_FALSE(error.ok());
+  EXPECT_EQ(error.error().file, "/dev/null");
+  EXPECT_NE(error.error().message.find("a character device"), std::string::npos) << error.error().message;
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
+}
+
+TEST_F(FileIoTest, AReadOnlyFileIsNotReplaced) {
+  const std::string target = path("kept.skel.json");
+  put(target, "old");
+  ::chmod(target.c_str(), 0444);
+  const Status error = write_file_atomically(target, "new");
+  ASSERT_FALSE(error.ok());
+  EXPECT_EQ(error.error().error_number, EACCES);
+  EXPECT_EQ(error.error().format(), target + ": error: cannot write: the file is read-only (Permission denied)\n");
+  EXPECT_EQ(contents(target), "old");
+  EXPECT_EQ(entries(directory_), std::vector<std::string>{"kept.skel.json"});
+}
+
+// In a child process: refuse_outputs_onto_inputs() holds for the whole process.
+TEST_F(FileIoTest, AnInputIsNeverOverwrittenUnderAnyOfItsNames) {
+  put(path("a.lsys"), "axiom: A\n");
+  ASSERT_EQ(::link(path("a.lsys").c_str(), path("hard.lsys").c_str()), 0);
+  put(path("other.lsys"), "other");
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    refuse_outputs_onto_inputs();
+    if (!read_text_file(path("a.lsys")).ok()) ::_exit(10);
+    if (write_file_atomically(directory_ + "/./a.lsys", "x").ok()) ::_exit(11);
+    const Status via_link = write_file_atomically(path("hard.lsys"), "x");
+    if (via_link.ok() || via_link.error().message.find("it is an input of this command") == std::string::npos)
+      ::_exit(12);
+    if (!write_file_atomically(path("other.lsys"), "new").ok()) ::_exit(13);  // not read: writable
+    ::_exit(0);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  EXPECT_EQ(contents(path("a.lsys")), "axiom: A\n");
+  EXPECT_EQ(contents(path("other.lsys")), "new");
+}
+
+TEST_F(FileIoTest, WithoutTheRefusalAFileReadMayBeSavedOver) {  // the studio saving its document
+  put(path("doc.lsys"), "old");
+  ASSERT_TRUE(read_text_file(path("doc.lsys")).ok());
+  EXPECT_TRUE(write_file_atomically(path("doc.lsys"), "new").ok());
+  EXPECT_EQ(contents(path("doc.lsys")), "new");
+}
+
+TEST_F(FileIoTest, ADeviceIsNotReadWithoutBound) {
+  const Expected<std::string> zero = read_text_file("/dev/zero");
+  ASSERT_FALSE(zero.ok());
+  EXPECT_EQ(zero.error().format(),
+            "/dev/zero: error: cannot read: it is a character device, not a regular file or a pipe "
+            "(docs/limits.md)\n");
+}
+
+TEST_F(FileIoTest, AFileOverTheLimitIsRefusedBeforeReading) {
+  put(path("big.lsys"), std::string(2000, 'x'));
+  const Expected<std::string> big = read_text_file(path("big.lsys"), 1000);
+  ASSERT_FALSE(big.ok());
+  EXPECT_EQ(big.error().message,
+            "cannot read: the file has 2000 bytes, more than the limit of 1000 bytes (docs/limits.md)");
+  EXPECT_TRUE(read_text_file(path("big.lsys"), 2000).ok());
+}
+
+TEST_F(FileIoTest, APipeIsReadUpToTheLimitOnly) {
+  const std::string fifo = path("pipe.lsys");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  // A writer that never stops (a pipe from /dev/zero): the reader must give up by itself.
+  std::thread writer([&] {
+    const int fd = ::open(fifo.c_str(), O_WRONLY);
+    if (fd < 0) return;
+    ::signal(SIGPIPE, SIG_IGN);
+    const std::string chunk(4096, 'z');
+    while (::write(fd, chunk.data(), chunk.size()) > 0) {
+    }
+    ::close(fd);
+  });
+  const Expected<std::string> read = read_text_file(fifo, 1 << 20);
+  writer.join();
+  ASSERT_FALSE(read.ok());
+  EXPECT_EQ(read.error().message, "cannot read: it holds more than the limit of 1 MiB (docs/limits.md)");
+}
+
+TEST_F(FileIoTest, SeveralOutputsAreAllWrittenBeforeAnyIsReplaced) {
+  put(path("a.png"), "old a");
+  put(path("b.exr"), "old b");
+  ::chmod(path("b.exr").c_str(), 0444);
+  std::vector<PendingFile> files;
+  Expected<PendingFile> a = write_pending_file(path("a.png"), "new a");
+  ASSERT_TRUE(a.ok());
+  files.push_back(std::move(*a));
+  Expected<PendingFile> b = write_pending_file(path("b.exr"), "new b");
+  EXPECT_FALSE(b.ok());  // read-only: the run stops before any rename
+  files.clear();         // dropped uncommitted: the temporaries go
+  EXPECT_EQ(contents(path("a.png")), "old a");
+  EXPECT_EQ(entries(directory_), (std::vector<std::string>{"a.png", "b.exr"}));
+
+  ::chmod(path("b.exr").c_str(), 0644);
+  for (const char* name : {"a.png", "b.exr"}) {
+    Expected<PendingFile> f = write_pending_file(path(name), std::string("new ") + name[0]);
+    ASSERT_TRUE(f.ok());
+    files.push_back(std::move(*f));
+  }
+  EXPECT_TRUE(commit_files(files).ok());
+  EXPECT_EQ(contents(path("a.png")), "new a");
+  EXPECT_EQ(contents(path("b.exr")), "new b");
+  EXPECT_EQ(entries(directory_), (std::vector<std::string>{"a.png", "b.exr"}));
+}
+
+TEST_F(FileIoTest, ASignalDuringAWriteRemovesTheTemporary) {
+  for (int signal_number : {SIGINT, SIGTERM}) {
+    int report[2];
+    ASSERT_EQ(::pipe(report), 0);
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      remove_temporaries_on_signals();
+      Expected<PendingFile> pending = write_pending_file(path("out.glb"), "half");
+      if (!pending.ok()) ::_exit(10);
+      const std::string name = pending->temporary();
+      if (::write(report[1], name.data(), name.size()) != static_cast<ssize_t>(name.size())) ::_exit(11);
+      ::close(report[1]);
+      ::raise(signal_number);
+      ::_exit(12);  // not reached: the handler ends the process by the signal
+    }
+    ::close(report[1]);
+    char name[4096] = {};
+    const ssize_t n = ::read(report[0], name, sizeof name - 1);
+    ::close(report[0]);
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_GT(n, 0);
+    ASSERT_TRUE(WIFSIGNALED(status)) << status;
+    EXPECT_EQ(WTERMSIG(status), signal_number);
+    EXPECT_FALSE(fs::exists(name)) << name;
+    EXPECT_TRUE(entries(directory_).empty());
+  }
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 """sylva.export_gltf: files the Khronos validator accepts, with the skeleton in extras."""
 import json
+import os
 import struct
 
 import pytest
@@ -66,8 +67,19 @@ def test_bad_arguments_raise_before_writing(saguaro, tmp_path):
 
 
 def test_export_failure_raises_with_the_reason(saguaro, tmp_path):
-    with pytest.raises(RuntimeError):
+    # The README's promise: OSError for files, ValueError for values, never RuntimeError.
+    with pytest.raises(FileNotFoundError):
         sylva.export_gltf(saguaro, tmp_path / "no_such_dir" / "x.glb")
+    fifo = tmp_path / "fifo.glb"
+    os.mkfifo(fifo)
+    with pytest.raises(OSError, match="it is a FIFO"):
+        sylva.export_gltf(saguaro, fifo)
+    far = sylva.Skeleton.from_json(
+        '{"format": "sylva-skeleton", "version": 1, "chains": '
+        '[{"parent": null, "joints": [[0,0,0,0.1,0],[1e300,0,0,0.1,0]]}]}')
+    with pytest.raises(ValueError, match="beyond the limit of 1e12 m"):
+        sylva.export_gltf(far, tmp_path / "far.glb")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fifo.glb"]
 
 
 def test_instancing_of_identical_plants_is_valid(saguaro, tmp_path, validate_gltf):
@@ -106,7 +118,7 @@ def test_bark_colour_and_bark_errors(saguaro, tmp_path):
     assert materials[0]["pbrMetallicRoughness"]["baseColorFactor"] == [0.5, 0.4, 0.3, 1]
     assert materials[1]["pbrMetallicRoughness"]["baseColorFactor"] == [0.16, 0.34, 0.1, 1]  # the table's
     out = tmp_path / "x.glb"
-    with pytest.raises(RuntimeError, match="no_such_bark.png"):
+    with pytest.raises(OSError, match="no_such_bark.png"):
         sylva.export_gltf(saguaro, out, mesh=True, bark={"albedo": str(tmp_path / "no_such_bark.png")})
     with pytest.raises(ValueError):
         sylva.export_gltf(saguaro, out, bark={"u_repeat": 2})  # needs mesh=True

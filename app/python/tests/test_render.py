@@ -29,3 +29,13 @@ def test_render_rejects_unknown_backends_and_empty_images(saguaro):
         sylva.render(saguaro, backend="vulkan")
     with pytest.raises(ValueError):
         sylva.render(saguaro, width=0, height=10)
+
+
+def test_render_refuses_sizes_and_samples_beyond_the_limits_before_allocating(saguaro):
+    # docs/limits.md: 65536 per side, 2**26 pixels, 65536 samples per pixel.
+    with pytest.raises(ValueError, match="pixels"):
+        sylva.render(saguaro, width=65536, height=65536)
+    with pytest.raises(ValueError, match="on each side"):
+        sylva.render(saguaro, width=65537, height=1)
+    with pytest.raises(ValueError, match="samples per pixel"):
+        sylva.render(saguaro, width=4, height=4, spp=4_000_000_000)

@@ -1,0 +1,89 @@
+"""sylva_dask on a LocalCluster of two worker processes writes, seed for seed, the bytes
+that the command line's batch (``--seed A..B``) writes, and refuses bad batches before
+sending a task."""
+import pathlib
+import subprocess
+
+import pytest
+
+distributed = pytest.importorskip("distributed", reason="python3-distributed (scripts/setup.sh installs it)")
+
+import sylva  # noqa: E402
+import sylva_dask  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    with cluster, distributed.Client(cluster) as c:
+        assert len(c.scheduler_info()["workers"]) == 2
+        yield c
+
+
+def cli_batch(sylva_binary, *args):
+    done = subprocess.run([sylva_binary, *args], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+
+
+def assert_same_files(a, b):
+    assert len(a) == len(b)
+    for x, y in zip(a, b):
+        assert pathlib.Path(x).read_bytes() == pathlib.Path(y).read_bytes(), f"{x} differs from {y}"
+
+
+def test_grow_on_two_workers_writes_the_local_batchs_files(tmp_path, client, sylva_binary):
+    cli_batch(sylva_binary, "grow", "presets/elm.lsys", "--seed", "1..6", "-o", str(tmp_path / "cli/elm_{seed}.skel.json"))
+    with distributed.get_task_stream(client) as stream:
+        written = sylva_dask.batch(client, "grow", "presets/elm.lsys", range(1, 7),
+                                   str(tmp_path / "dask/elm_{seed}.skel.json"))
+    assert written == [str(tmp_path / f"dask/elm_{s}.skel.json") for s in range(1, 7)]
+    assert_same_files(written, [str(tmp_path / f"cli/elm_{s}.skel.json") for s in range(1, 7)])
+    # The seeds matter (the elm is stochastic), so equal files are not a coincidence.
+    assert len({pathlib.Path(p).read_bytes() for p in written}) == 6
+    # The tasks were spread over both workers (idle workers each take a share).
+    assert len({task["worker"] for task in stream.data}) == 2
+
+
+def test_export_with_defines_and_a_seed_folder(tmp_path, client, sylva_binary):
+    cli_batch(sylva_binary, "export", "presets/elm.lsys", "--seed", "3..5", "-D", "LIMBS=5", "--mesh",
+              "-o", str(tmp_path / "cli/elm_{seed}.glb"))
+    written = sylva_dask.batch(client, "export", "presets/elm.lsys", [5, 3, 4], str(tmp_path / "dask/s{seed}/elm.glb"),
+                               defines={"LIMBS": 5}, mesh=True)
+    assert written == [str(tmp_path / f"dask/s{s}/elm.glb") for s in (5, 3, 4)]  # the folders made
+    assert_same_files(written, [str(tmp_path / f"cli/elm_{s}.glb") for s in (5, 3, 4)])
+
+
+def test_bad_batches_are_refused_before_any_task(tmp_path, client):
+    bad = tmp_path / "bad.lsys"
+    bad.write_text("axiom: A\nproductions:\nA -> B(\n")
+    with pytest.raises(sylva.GrammarError) as e:
+        sylva_dask.batch(client, "grow", str(bad), [1, 2], str(tmp_path / "x_{seed}.skel.json"))
+    assert e.value.line == 3
+    with pytest.raises(ValueError, match="no \\{seed\\}"):
+        sylva_dask.batch(client, "grow", "presets/elm.lsys", [1, 2], str(tmp_path / "same.skel.json"))
+    with pytest.raises(ValueError, match="repeated"):
+        sylva_dask.batch(client, "grow", "presets/elm.lsys", [1, 1], str(tmp_path / "x_{seed}.skel.json"))
+    with pytest.raises(ValueError, match="unknown kind"):
+        sylva_dask.batch(client, "render", "presets/elm.lsys", [1], str(tmp_path / "x_{seed}.png"))
+    with pytest.raises(TypeError):
+        sylva_dask.batch(client, "grow", "presets/elm.lsys", [1.5], str(tmp_path / "x_{seed}.skel.json"))
+    with pytest.raises(OverflowError):
+        sylva_dask.batch(client, "grow", "presets/elm.lsys", [2**64], str(tmp_path / "x_{seed}.skel.json"))
+    with pytest.raises(sylva.GrammarError):
+        sylva_dask.batch(client, "grow", "presets/elm.lsys", [1], str(tmp_path / "x_{seed}.skel.json"),
+                         defines={"NO_SUCH_DEFINE": 1})
+    assert not list(tmp_path.glob("x_*")) and not (tmp_path / "same.skel.json").exists()
+
+
+def test_the_example_runs_a_local_cluster(tmp_path, sylva_binary):
+    import os
+    import sys
+    example = pathlib.Path(__file__).resolve().parents[1] / "examples" / "dask_batch.py"
+    done = subprocess.run([sys.executable, str(example), "--seeds", "7..9", "--workers", "2",
+                           "-o", str(tmp_path / "d/elm_{seed}.skel.json")], capture_output=True, text=True,
+                          env=dict(os.environ), timeout=300)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "3 files from 2 workers" in done.stdout
+    cli_batch(sylva_binary, "grow", "presets/elm.lsys", "--seed", "7..9", "-o", str(tmp_path / "c_{seed}.skel.json"))
+    assert_same_files([str(tmp_path / f"d/elm_{s}.skel.json") for s in (7, 8, 9)],
+                      [str(tmp_path / f"c_{s}.skel.json") for s in (7, 8, 9)])

@@ -1,0 +1,80 @@
+// gl_viewport_test.cpp — the studio's GL viewport (app/studio/gl_viewport.h) on a headless
+// context standing in for the window's: the first picture of a document is full size; new
+// plants on a slow renderer show first as a preview (half the pixels a side), then in full;
+// a fast renderer shows them in full at once. No window, no X.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+#include "app/studio/gl_viewport.h"
+#include "core/gl/gl_context.h"
+#include "core/scene.h"
+
+namespace sylva::studio {
+namespace {
+
+Scene saguaro(uint32_t width, uint32_t height) {
+  Scene grown;
+  ScenePlant plant;
+  plant.grammar = std::string(SYLVA_SOURCE_DIR) + "/presets/saguaro.lsys";
+  grown.plants.push_back(plant);
+  EXPECT_TRUE(grow_scene_plants(grown).ok());
+  Scene scene = default_scene_for(*grown.plants[0].skeleton, width, height);
+  scene.plants[0] = grown.plants[0];
+  return scene;
+}
+
+// Asks for `scene`'s picture until the viewport is idle; the last image asked.
+ViewImage settle(GlViewport& viewport, const Scene& scene) {
+  ViewImage image;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  do {
+    image = viewport.image(scene);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  } while ((viewport.busy() || !image.current || !image.texture) && std::chrono::steady_clock::now() < give_up);
+  return viewport.image(scene);
+}
+
+struct Viewports : ::testing::Test {
+  void SetUp() override {
+    context = create_headless_gl_context();  // the window's context, for the UI texture
+    if (!context.context) GTEST_SKIP() << "no OpenGL 4.5 context: " << context.error;
+  }
+  GlContextResult context;
+};
+
+TEST_F(Viewports, NewPlantsOnASlowRendererShowAPreviewThenTheFullPicture) {
+  GlViewport viewport({}, /*preview_above_ms=*/0);  // every renderer counts as slow
+  Scene scene = saguaro(96, 64);
+  viewport.set_plants(scene, RenderOptions{});
+  ViewImage first = settle(viewport, scene);
+  EXPECT_EQ(first.width, 96u) << "a document's first picture is full size";
+  EXPECT_EQ(first.height, 64u);
+  EXPECT_TRUE(first.flip_v) << "GL rows are bottom-up";
+  EXPECT_EQ(viewport.stats().previews, 0u);
+
+  scene.plants[0].position.x += 0.3;
+  viewport.set_plants(scene, RenderOptions{});
+  const ViewImage full = settle(viewport, scene);
+  EXPECT_EQ(viewport.stats().previews, 1u) << "new plants: one preview";
+  EXPECT_FALSE(viewport.stats().preview) << "then the full picture";
+  EXPECT_EQ(full.width, 96u);
+  EXPECT_EQ(full.height, 64u);
+  EXPECT_TRUE(viewport.stats().error.empty()) << viewport.stats().error;
+}
+
+TEST_F(Viewports, AFastRendererShowsNewPlantsInFullAtOnce) {
+  GlViewport viewport({}, /*preview_above_ms=*/1e9);
+  Scene scene = saguaro(96, 64);
+  viewport.set_plants(scene, RenderOptions{});
+  settle(viewport, scene);
+  scene.plants[0].position.x += 0.3;
+  viewport.set_plants(scene, RenderOptions{});
+  const ViewImage full = settle(viewport, scene);
+  EXPECT_EQ(viewport.stats().previews, 0u);
+  EXPECT_EQ(full.width, 96u);
+}
+
+}  // namespace
+}  // namespace sylva::studio
