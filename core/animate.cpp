@@ -90,6 +90,18 @@ Skeleton sway_skeleton(const Skeleton& rest, double t_s, const SwayParameters& p
   }
   for (size_t i = 0; i < out.joints.size(); ++i)
     for (int k = 0; k < 3; ++k) out.joints[i].position_m[k] += moved[i][k];
+  // A leaf moves with its joint (skeleton.md "Leaves"): rigidly, as the segment that
+  // leaves that joint turns, by the angle there; a leaf on no joint stays.
+  for (Leaf& leaf : out.leaves) {
+    if (!leaf.joint) continue;
+    const uint32_t anchor = rest.chains[leaf.joint->chain].first_joint + leaf.joint->joint;
+    const double angle = bend_at(rest.joints[anchor]) + flutter_rad[leaf.joint->chain];
+    for (auto& v : leaf.vertices_m) {
+      const glm::dvec3 offset = glm::dvec3(v[0], v[1], v[2]) - position_of(rest.joints[anchor]);
+      const glm::dvec3 d = moved[anchor] + rotation_offset(axis, angle, offset);
+      for (int k = 0; k < 3; ++k) v[static_cast<size_t>(k)] += d[k];
+    }
+  }
   return out;
 }
 

@@ -17,7 +17,10 @@
 //     joint moving with the parent joint it hangs from (one that coincides with that
 //     joint at rest still coincides), root chains keep their first joint.
 //
-// What stays: the joint and chain arrays' sizes and order, parents, radii, materials and
+// Leaves (skeleton.md): each turns rigidly with the joint it hangs from, by that joint's
+// angle (as the segment leaving the joint does), and follows its motion; a leaf on no
+// joint stays where it is.
+// What stays: the joint, chain and leaf arrays' sizes and order, parents, radii, materials and
 // the source record (topology unchanged, so the skinning's frustum count changes only
 // where a joint's bend crosses the splitting threshold of skin.h). At t = 0, with both
 // amplitudes 0, or with a wind that has no horizontal part, the result equals the rest

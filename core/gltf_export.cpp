@@ -268,8 +268,9 @@ std::string bark_key(const Bark& b) {
 
 // The material of index `material` of a plant with bark `bark` (gltf_export.h), as JSON
 // text (identical materials are written once: the text is their key).
-std::string material_json(uint32_t material, const Bark& bark, std::optional<size_t> albedo_texture,
-                          std::optional<size_t> normal_texture, double r_ref_m) {
+std::string material_json(uint32_t material, const Bark& bark, const std::map<uint32_t, SceneMaterial>& materials,
+                          std::optional<size_t> albedo_texture, std::optional<size_t> normal_texture, double r_ref_m) {
+  const MaterialLook look = material_look(materials, &bark, material);
   JsonWriter w;
   w.begin_object();
   w.key("name").string("sylva_material_" + std::to_string(material));
@@ -279,9 +280,7 @@ std::string material_json(uint32_t material, const Bark& bark, std::optional<siz
     w.key("baseColorFactor").numbers(white, 4);
     w.key("baseColorTexture").begin_object().key("index").integer(*albedo_texture).end_object();
   } else {
-    const double* rgb = default_material_albedo(material);
-    const glm::dvec3 colour = material == 0 && bark.albedo_rgb ? *bark.albedo_rgb : glm::dvec3(rgb[0], rgb[1], rgb[2]);
-    const double factor[4] = {colour.x, colour.y, colour.z, 1};
+    const double factor[4] = {look.albedo.x, look.albedo.y, look.albedo.z, 1};
     w.key("baseColorFactor").numbers(factor, 4);
   }
   w.key("metallicFactor").number(0);
@@ -290,6 +289,14 @@ std::string material_json(uint32_t material, const Bark& bark, std::optional<siz
   if (normal_texture) w.key("normalTexture").begin_object().key("index").integer(*normal_texture).end_object();
   w.key("extras").begin_object().key("sylva").begin_object();
   w.key("material_index").integer(material);
+  if (materials.count(material)) {  // an entry of the scene's table (docs/materials.md)
+    w.key("specular").number(look.specular);
+  }
+  if (material != 0) {  // the bark is the wood's alone (materials.h)
+    w.end_object().end_object();
+    w.end_object();
+    return w.take();
+  }
   if (bark.albedo_texture) w.key("albedo").string(*bark.albedo_texture);
   else if (bark.albedo_rgb) write_vec3(w.key("albedo"), *bark.albedo_rgb);
   if (bark.height_texture) w.key("height").string(*bark.height_texture);
@@ -501,12 +508,23 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
       to.segments_around = options.segments_around;
       const TriangleMesh tm = tessellate(skinned, to);
       if (!tm.indices.empty()) {
+        // One primitive per material index, in increasing order.
+        std::map<uint32_t, std::vector<uint32_t>> triangles_of;
+        for (size_t t = 0; t < tm.triangle_count(); ++t) {
+          std::vector<uint32_t>& list = triangles_of[skinned.frusta[tm.triangle_frustum[t]].material];
+          list.insert(list.end(), tm.indices.begin() + static_cast<std::ptrdiff_t>(3 * t),
+                      tm.indices.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
+        }
+        // The bark's textures are the wood's (material 0, materials.h): a plant without
+        // wood embeds none.
+        const bool has_wood = triangles_of.count(0) > 0;
         const Bark& bark = plant.bark;
         const double r_ref_m = median_segment_radius(skinned);
-        Expected<std::optional<size_t>> normal_map = table.normal_texture(bark, r_ref_m);
+        Expected<std::optional<size_t>> normal_map =
+            has_wood ? table.normal_texture(bark, r_ref_m) : Expected<std::optional<size_t>>(std::optional<size_t>());
         if (!normal_map) return std::move(normal_map.error());
         const std::optional<size_t> normal_texture = *normal_map;
-        const std::optional<size_t> albedo_texture = table.albedo_texture(bark);
+        const std::optional<size_t> albedo_texture = has_wood ? table.albedo_texture(bark) : std::nullopt;
 
         std::vector<float> positions, normals, texcoords;
         positions.reserve(tm.positions.size() * 3);
@@ -536,16 +554,11 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
           attributes.key("TANGENT").integer(buffer.add_floats(vertex_tangents(tm, skinned), 4, "VEC4", kTargetArrayBuffer));
         attributes.key("TEXCOORD_0").integer(buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer));
         attributes.end_object();
-
-        // One primitive per material index, in increasing order.
-        std::map<uint32_t, std::vector<uint32_t>> triangles_of;
-        for (size_t t = 0; t < tm.triangle_count(); ++t) {
-          std::vector<uint32_t>& list = triangles_of[skinned.frusta[tm.triangle_frustum[t]].material];
-          list.insert(list.end(), tm.indices.begin() + static_cast<std::ptrdiff_t>(3 * t),
-                      tm.indices.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
-        }
         for (const auto& [material, indices] : triangles_of) {
-          const size_t m = table.material(material_json(material, bark, albedo_texture, normal_texture, r_ref_m));
+          const bool wood = material == 0;  // the bark's textures are the wood's (materials.h)
+          const size_t m = table.material(material_json(material, bark, options.materials,
+                                                        wood ? albedo_texture : std::nullopt,
+                                                        wood ? normal_texture : std::nullopt, r_ref_m));
           primitives.begin_object();
           primitives.key("attributes").raw(attributes.text());
           primitives.key("indices").integer(buffer.add_indices(indices));
@@ -805,6 +818,7 @@ Status read_sylva_extras(const std::string& path, const JsonValue& node, size_t 
     }
     text.end_object();
   }
+  if (const JsonValue* leaves = sylva.find("leaves")) write_value(text.key("leaves"), *leaves);  // version 2
   text.end_object();
   Expected<Skeleton> read = read_skeleton_json(text.text(), path);
   if (!read) return error_at(path, sylva, where + ": " + read.error().message);

@@ -6,7 +6,7 @@
 //     segment — the skeleton, visible in every viewer;
 //   - node extras {"sylva": {...}}: the whole skeleton document of skeleton.md (format,
 //     version, source with grammar, seed as a *string* (64-bit exact), steps, defines;
-//     chains with parents and joints) plus, per segment, the skinning data a renderer
+//     chains with parents and joints; leaves, version 2, when it has any) plus, per segment, the skinning data a renderer
 //     needs (cutting plane normals and u offset);
 //   - optionally (`mesh`) further TRIANGLES primitives of the same mesh (so instancing
 //     covers them too): the tessellated frusta (tessellate.h), one primitive per material
@@ -15,18 +15,21 @@
 //     the bark has a height map, TANGENT — and one material each (below).
 //
 // Bark and materials (with `mesh`; without it the bark is ignored and no texture read).
-// A plant's `bark` (scene.h, scene.md) covers every segment of the plant, whatever its
-// material index:
+// A plant's `bark` (scene.h, scene.md) covers its wood only, the segments of material 0
+// (materials.h); the other materials are plain colours:
 //   - TEXCOORD_0 = (u · u_repeat, v_m · v_per_metre): u in turns around the axis, v_m the
 //     arc length in metres (skin.h) — the texture repeats as in the renderer. (The
 //     defaults u_repeat = v_per_metre = 1 give the raw (u, v_m).)
 //   - material "sylva_material_<k>" per material index k used, pbrMetallicRoughness with
-//     metallic 0, roughness 0.9. With a bark albedo texture: baseColorTexture = that
+//     metallic 0, roughness 0.9. Material 0 with a bark albedo texture: baseColorTexture = that
 //     image, embedded byte for byte (a bufferView in .glb, a data URI in .gltf; PNG or
 //     JPEG only, as glTF requires), baseColorFactor 1. Without: baseColorFactor = the
-//     linear colour default_material_albedo(k) (materials.h), a bark albedo colour
-//     replacing material 0's.
-//   - with a bark height map: normalTexture = a tangent-space normal map baked from it
+//     linear colour material_look(options.materials, bark, k) (scene.h): a bark albedo
+//     colour for material 0, else the scene table's albedo, else
+//     default_material_albedo(k) (materials.h). A material the table describes also has
+//     extras.sylva "specular" (its Blinn–Phong weight, which glTF's metallic–roughness
+//     model has no slot for).
+//   - material 0 with a bark height map: normalTexture = a tangent-space normal map baked from it
 //     (normal_map.h, 8-bit RGB PNG, glTF's "+X right, +Y up in the image" convention,
 //     i.e. X toward increasing s, Y toward decreasing t). glTF cannot follow a radius
 //     that changes along the plant, so one texel is measured at r_ref = the plant's
@@ -39,10 +42,10 @@
 //     map's +Y does (w = −1 on the lateral surface, where u grows counter-clockwise
 //     about the axis). The flat caps carry a tangent ⊥ their normal and the texture's
 //     rim coordinates; their relief is not meaningful.
-//   - the material's extras.sylva holds the raw relief parameters: "material_index",
-//     "albedo" (path as given, or [r, g, b]) and "height" (path as given) when the bark
-//     has them, "relief_depth_m", "u_repeat", "v_per_metre", "r_ref_m" (with a height
-//     map), and "texcoord_0", the UV convention in words.
+//   - the material's extras.sylva holds "material_index" and, for material 0, the raw
+//     relief parameters: "albedo" (path as given, or [r, g, b]) and "height" (path as
+//     given) when the bark has them, "relief_depth_m", "u_repeat", "v_per_metre",
+//     "r_ref_m" (with a height map), and "texcoord_0", the UV convention in words.
 //   Identical materials and images are written once. A missing or unreadable texture,
 //   or an albedo that is neither PNG nor JPEG, is an error naming the file, and nothing
 //   is written.
@@ -86,6 +89,7 @@ struct GltfExportOptions {
   bool instancing = false;      // repeated identical plants (equal skeletons and, with
                                 // `mesh`, equal barks) as one node
                                 // with EXT_mesh_gpu_instancing (listed in extensionsUsed)
+  std::map<uint32_t, SceneMaterial> materials = {};  // the scene's table (with `mesh`)
 };
 
 // Writes `plants` to `path` (.glb or .gltf by extension). An error is a Diagnostic naming

@@ -1,6 +1,7 @@
 // materials.h — what a skeleton's material index means to the renderers and the glTF
-// export: its default albedo (linear RGB). A plant's bark (scene.h) refines it: a bark
-// albedo texture covers every material index, a bark albedo colour replaces material 0.
+// export: its default albedo (linear RGB). A plant's bark (scene.h) is its wood's, material
+// 0's, only: its albedo (texture or colour) and height map (relief, displacement) apply
+// to material 0 and never to needles, leaves or fronds (materials 1 and up).
 #pragma once
 
 #include <cstdint>

@@ -30,6 +30,11 @@ std::vector<double> displacement_scale(const TriangleMesh& mesh, std::span<const
       scale[v] = (d.lower_m + (d.upper_m - d.lower_m) * y) / depth_m;
     }
   }
+  // The bark covers the wood only (material 0, materials.h): other materials keep their
+  // smooth surface, and a vertex shared with the wood stays where both put it.
+  for (size_t t = 0; t < mesh.triangle_count(); ++t)
+    if (frusta[mesh.triangle_frustum[t]].material != 0)
+      for (int c = 0; c < 3; ++c) scale[mesh.indices[3 * t + c]] = 0.0;
   return scale;
 }
 

@@ -13,7 +13,8 @@ namespace sylva {
 // (height_function_for), displaced by it (GS+R) as deep as the relief shell is thick —
 // relief.h's min(relief_depth_m, max_depth_per_radius·r) at each end of a vertex's
 // frustum, linear between — so that GS+R lifts a twig or needle no more than the relief
-// marcher's shell does. Adds the seconds spent to *tessellate_s and *displace_s.
+// marcher's shell does. The bark is the wood's (material 0): vertices of other materials'
+// frusta are not displaced. Adds the seconds spent to *tessellate_s and *displace_s.
 TriangleMesh plant_mesh(const SkinnedSkeleton& skinned, const TessellateOptions& tessellation, const HeightFn& height,
                         double relief_depth_m, double max_depth_per_radius, double* tessellate_s, double* displace_s);
 

@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include "core/fog.h"
+#include "core/materials.h"
 #include "core/util/diagnostic.h"
 #include "core/util/file_io.h"
 #include "core/util/json.h"
@@ -198,6 +199,31 @@ Bark read_bark(const JsonValue& v, const std::string& base_dir, std::string_view
   return b;
 }
 
+// The `materials` table (docs/materials.md): an array of entries, each naming its index
+// once.
+std::map<uint32_t, SceneMaterial> read_materials(const JsonValue& v) {
+  if (!v.is_array()) fail(v, std::string("materials must be an array, not ") + v.kind_name());
+  std::map<uint32_t, SceneMaterial> table;
+  for (size_t i = 0; i < v.elements.size(); ++i) {
+    const JsonValue& e = v.elements[i];
+    const std::string what = "materials[" + std::to_string(i) + "]";
+    expect_object(e, what);
+    check_keys(e, what, {"index", "albedo", "specular"});
+    const JsonValue* index = e.find("index");
+    if (!index) fail(e, what + " needs an \"index\" (the material index it describes)");
+    const std::optional<uint64_t> k = index->as_uint64();
+    if (!k || *k >= kMaterialSlots)
+      fail(*index, what + ".index must be an integer from 0 to " + std::to_string(kMaterialSlots - 1));
+    if (table.count(static_cast<uint32_t>(*k)))
+      fail(*index, what + ".index " + std::to_string(*k) + " is described twice");
+    SceneMaterial m;
+    if (auto* x = e.find("albedo")) m.albedo_rgb = colour(*x, what + ".albedo");
+    if (auto* x = e.find("specular")) m.specular = number_in(*x, what + ".specular", 0, 1, false, false);
+    table.emplace(static_cast<uint32_t>(*k), m);
+  }
+  return table;
+}
+
 ScenePlant read_plant(const JsonValue& v, const std::string& base_dir, size_t index) {
   const std::string what = "plants[" + std::to_string(index) + "]";
   expect_object(v, what);
@@ -298,7 +324,7 @@ Fog read_fog(const JsonValue& v, double ground_height) {
 Scene read_scene(const JsonValue& root, const std::string& base_dir) {
   expect_object(root, "a scene");
   check_keys(root, "the scene",
-             {"format", "version", "camera", "image", "sun", "sky", "ground", "fog", "plants"});
+             {"format", "version", "camera", "image", "sun", "sky", "ground", "fog", "materials", "plants"});
   Scene s;
   if (auto* x = root.find("format"); x && !(x->is_string() && x->text == "sylva-scene"))
     fail(*x, "format must be \"sylva-scene\"");
@@ -322,6 +348,7 @@ Scene read_scene(const JsonValue& root, const std::string& base_dir) {
     if (auto* a = x->find("albedo")) s.ground.albedo = colour(*a, "ground.albedo");
   }
   if (auto* x = root.find("fog")) s.fog = read_fog(*x, s.ground.height);
+  if (auto* x = root.find("materials")) s.materials = read_materials(*x);
   const JsonValue* plants = root.find("plants");
   if (!plants) fail(root, "a scene needs \"plants\" (an array of plants)");
   if (!plants->is_array()) fail(*plants, std::string("plants must be an array, not ") + plants->kind_name());
@@ -566,6 +593,18 @@ void write_bark(JsonWriter& w, const Bark& b, const std::string& base_dir) {
   w.end_object();
 }
 
+void write_materials(JsonWriter& w, const std::map<uint32_t, SceneMaterial>& table) {
+  w.key("materials").begin_array(Layout::lines);
+  for (const auto& [index, m] : table) {
+    w.begin_object(Layout::spaced);
+    w.key("index").integer(index);
+    if (m.albedo_rgb) write_vec3(w.key("albedo"), *m.albedo_rgb);
+    w.key("specular").number(m.specular);
+    w.end_object();
+  }
+  w.end_array();
+}
+
 void write_plant(JsonWriter& w, const ScenePlant& p, const std::string& base_dir) {
   w.begin_object(Layout::spaced);
   w.key("grammar").string(path_for_file(p.grammar, base_dir));
@@ -606,11 +645,22 @@ Expected<std::string> write_scene_json(const Scene& scene, const std::string& ba
   write_vec3(w.key("sky"), scene.sky);
   write_ground(w, scene.ground);
   if (scene.fog) write_fog(w, *scene.fog);
+  if (!scene.materials.empty()) write_materials(w, scene.materials);
   w.key("plants").begin_array(Layout::lines);
   for (const ScenePlant& plant : scene.plants) write_plant(w, plant, base_dir);
   w.end_array();
   w.end_object();
   return w.take() + "\n";
+}
+
+MaterialLook material_look(const std::map<uint32_t, SceneMaterial>& table, const Bark* bark, uint32_t material) {
+  const auto entry = table.find(material);
+  const SceneMaterial* m = entry == table.end() ? nullptr : &entry->second;
+  const double* fallback = default_material_albedo(material);
+  MaterialLook look{{fallback[0], fallback[1], fallback[2]}, m ? m->specular : 1.0};
+  if (material == 0 && bark && bark->albedo_rgb) look.albedo = *bark->albedo_rgb;
+  else if (m && m->albedo_rgb) look.albedo = *m->albedo_rgb;
+  return look;
 }
 
 Skeleton place_plant(const ScenePlant& plant) {

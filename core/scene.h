@@ -98,6 +98,30 @@ struct Bark {
   bool operator==(const Bark&) const = default;
 };
 
+// One entry of the scene's `materials` table (docs/materials.md): how material index k
+// (the grammar's `'`, a joint's material) looks on every plant of the scene. Material 0
+// is the wood, which a plant's bark refines (materials.h).
+struct SceneMaterial {
+  std::optional<glm::dvec3> albedo_rgb;  // linear albedo; none: default_material_albedo(k)
+  double specular = 1;                   // weight of the Blinn–Phong lobe (shading.h), [0, 1]
+  bool operator==(const SceneMaterial&) const = default;
+};
+
+// The highest material index the `materials` table may name (the GL shade pass's table
+// holds kMaterialSlots entries; higher indices look like the default table's last).
+constexpr uint32_t kMaterialSlots = 16;
+
+// What material `material` looks like (but for bark textures, which the renderers look up
+// themselves on material 0): albedo = `bark`'s colour for material 0 where it has one,
+// else the table's entry, else default_material_albedo(material); specular = the table
+// entry's, else 1. `bark` may be null (the scene-wide table alone).
+struct MaterialLook {
+  glm::dvec3 albedo;
+  double specular;
+};
+MaterialLook material_look(const std::map<uint32_t, SceneMaterial>& table, const Bark* bark,
+                           uint32_t material);
+
 // One plant: a grammar grown with seed/steps/defines, or a ready skeleton, placed by
 // p_world = position + R_y(rotate_y_deg) · (scale · p).
 struct ScenePlant {
@@ -123,6 +147,7 @@ struct Scene {
   glm::dvec3 sky{0.25, 0.3, 0.4};  // uniform sky radiance, linear RGB
   Ground ground;
   std::optional<Fog> fog;          // none: no fog pass
+  std::map<uint32_t, SceneMaterial> materials;  // by material index (< kMaterialSlots)
   std::vector<ScenePlant> plants;
   std::string file = {};           // the file it was read from, for messages ("" if made
                                    //   in code); like ScenePlant::grammar_loc, a place, not

@@ -10,7 +10,7 @@
 // normal n facing the eye, unit geometric normal n_g facing the eye, unit direction l toward
 // the sun, unit view direction v (toward the eye), h = normalize(l + v):
 //   L = ρ · L_sky · (1 + n_y)/2                              sky_ambient
-//     + (ρ/π + k_s · (s + 8)/(8π) · max(n·h, 0)^s)           surface_brdf: Lambert +
+//     + (ρ/π + w · k_s · (s + 8)/(8π) · max(n·h, 0)^s)       surface_brdf: Lambert +
 //         · E_sun · cos θ · V                                  normalised Blinn-Phong
 // with
 //   - L_sky = Scene::sky, the uniform sky radiance (W/(m²·sr) per channel). The ambient term
@@ -27,7 +27,8 @@
 //     (cos θ = l_y ≤ 0), a plant face turned toward it, yes.
 //   - k_s = kSpecular = 0.04 (a dielectric's reflectance at normal incidence), s =
 //     kShininess = 40; (s + 8)/(8π) normalises the lobe so it reflects about k_s of what
-//     arrives near normal incidence. Plants are specular, the ground is not.
+//     arrives near normal incidence. w ∈ [0, 1] weighs the lobe: a plant's material's
+//     `specular` (scene.h SceneMaterial, 1 by default), 0 for the ground.
 //   - the ground: the plane y = Ground::height, n = n_g = +Y (kGroundNormal), ρ =
 //     Ground::albedo, no specular term; ground_distance finds it along a ray.
 //   - a ray that hits nothing sees the sky: sky_radiance (the sun's disc is not drawn).
@@ -76,12 +77,12 @@ inline double blinn_phong(const glm::dvec3& n, const glm::dvec3& l, const glm::d
   return kSpecular * (kShininess + 8) / (8 * kPi) * std::pow(std::max(0.0, glm::dot(n, h)), kShininess);
 }
 
-// The BRDF (1/sr, per channel): Lambert ρ/π, plus blinn_phong where `specular` (plants;
-// the ground is not).
+// The BRDF (1/sr, per channel): Lambert ρ/π, plus `specular` (the weight w, 0 for the
+// ground) times blinn_phong.
 inline glm::dvec3 surface_brdf(const glm::dvec3& albedo, const glm::dvec3& n, const glm::dvec3& l,
-                               const glm::dvec3& view, bool specular) {
+                               const glm::dvec3& view, double specular) {
   glm::dvec3 brdf = albedo / kPi;
-  if (specular) brdf += glm::dvec3(blinn_phong(n, l, view));
+  if (specular > 0) brdf += glm::dvec3(specular * blinn_phong(n, l, view));
   return brdf;
 }
 
@@ -97,7 +98,7 @@ inline glm::dvec3 sun_reflected(const glm::dvec3& brdf, const glm::dvec3& sun_ir
 // where the sun reaches it (cos_sun > 0 and visibility > 0; otherwise the ambient term
 // alone, exactly). Arguments as above; `cos_sun` = sun_cosine(n, n_geometric, l).
 inline glm::dvec3 surface_radiance(const glm::dvec3& albedo, const glm::dvec3& n, const glm::dvec3& l,
-                                   const glm::dvec3& view, bool specular, const glm::dvec3& sky,
+                                   const glm::dvec3& view, double specular, const glm::dvec3& sky,
                                    const glm::dvec3& sun_irradiance, double cos_sun, double visibility) {
   const glm::dvec3 ambient = sky_ambient(albedo, n, sky);
   if (cos_sun <= 0 || visibility == 0) return ambient;

@@ -1,11 +1,12 @@
-// skeleton.cpp — the skeleton's invariants and its file format, sylva-skeleton version 1
-// (../shared/spec/skeleton.md).
+// skeleton.cpp — the skeleton's invariants and its file format, sylva-skeleton versions 1
+// and 2 (leaves) (../shared/spec/skeleton.md).
 //
 // The reader checks the file against the schema value by value and reports the first
 // problem at the place of the offending value, naming the chain and joint; anything it
 // accepts also passes validate_skeleton, so later stages never re-check a file.
 #include "core/skeleton.h"
 
+#include <algorithm>
 #include <cassert>
 #include <charconv>
 #include <cmath>
@@ -21,7 +22,8 @@ namespace sylva {
 namespace {
 
 constexpr std::string_view kFormatName = "sylva-skeleton";
-constexpr uint64_t kFormatVersion = 1;
+constexpr uint64_t kFormatVersion = 1;        // without leaves
+constexpr uint64_t kLeavesFormatVersion = 2;  // with leaves
 // Chain and joint indices are uint32 in memory, so are counts of chains and joints.
 constexpr uint64_t kMaxCount = std::numeric_limits<uint32_t>::max();
 constexpr const char* kJointFieldNames[5] = {"x", "y", "z", "radius", "material"};
@@ -94,6 +96,23 @@ std::optional<std::string> joint_problem(const Joint& joint) {
   return std::nullopt;
 }
 
+std::string leaf_place(size_t leaf) { return "leaf " + std::to_string(leaf); }
+
+// Why a leaf's joint is not one of the skeleton's, or nullopt.
+std::optional<std::string> leaf_joint_problem(const Leaf& leaf, const Skeleton& skeleton) {
+  if (!leaf.joint) return std::nullopt;
+  if (leaf.joint->chain >= skeleton.chains.size())
+    return "joint [" + std::to_string(leaf.joint->chain) + ", " + std::to_string(leaf.joint->joint) +
+           "] refers to chain " + std::to_string(leaf.joint->chain) + " of " +
+           count_of(skeleton.chains.size(), "chain", "chains");
+  const uint32_t count = skeleton.chains[leaf.joint->chain].joint_count;
+  if (leaf.joint->joint >= count)
+    return "joint [" + std::to_string(leaf.joint->chain) + ", " + std::to_string(leaf.joint->joint) +
+           "] is past the end of chain " + std::to_string(leaf.joint->chain) + " (" +
+           count_of(count, "joint", "joints") + ")";
+  return std::nullopt;
+}
+
 // Reads a parsed sylva-skeleton document; the first problem found stops it.
 class SkeletonReader {
  public:
@@ -127,8 +146,11 @@ class SkeletonReader {
   bool read_chain(size_t index, const JsonValue& value, Skeleton& skeleton);
   bool read_parent(size_t index, const JsonValue& value, const Skeleton& skeleton, Chain& chain);
   bool read_joint(size_t chain, size_t index, const JsonValue& value, Joint& joint);
+  bool read_leaves(const JsonValue& value, Skeleton& skeleton);
+  bool read_leaf(size_t index, const JsonValue& value, const Skeleton& skeleton, Leaf& leaf);
 
   std::string file_;
+  uint64_t version_ = kFormatVersion;
   std::optional<Diagnostic> error_;
 };
 
@@ -146,12 +168,16 @@ Expected<Skeleton> SkeletonReader::read(std::string_view text) {
       return fail(root, std::string("a skeleton file holds a JSON object, found ") + describe(root));
     }
     if (!read_format_and_version(root)) return false;
-    if (!check_keys(root, {"format", "version", "source", "chains"}, "")) return false;
+    if (version_ == kFormatVersion ? !check_keys(root, {"format", "version", "source", "chains"}, "")
+                                   : !check_keys(root, {"format", "version", "source", "chains", "leaves"}, ""))
+      return false;
     if (const JsonValue* source = root.find("source")) {
       if (!read_source(*source, skeleton.source)) return false;
     }
     const JsonValue* chains = require(root, "chains", "");
-    return chains != nullptr && read_chains(*chains, skeleton);
+    if (chains == nullptr || !read_chains(*chains, skeleton)) return false;
+    const JsonValue* leaves = root.find("leaves");
+    return leaves == nullptr || read_leaves(*leaves, skeleton);
   }();
   if (!ok) return std::move(*error_);
   assert(validate_skeleton(skeleton).ok() && "the reader accepted a skeleton that breaks an invariant");
@@ -202,10 +228,11 @@ bool SkeletonReader::read_format_and_version(const JsonValue& root) {
   if (version != nullptr) {
     const std::optional<uint64_t> number = version->as_uint64();
     if (!number) return fail(*version, "version must be an integer, got " + describe(*version));
-    if (*number != kFormatVersion) {
+    if (*number != kFormatVersion && *number != kLeavesFormatVersion) {
       return fail(*version, "unsupported version " + version->text + " of \"sylva-skeleton\"; " +
-                                "this reader reads version " + std::to_string(kFormatVersion));
+                                "this reader reads versions 1 and 2");
     }
+    version_ = *number;
   }
   if (format == nullptr) {
     return fail(root, "missing required key \"format\" (a skeleton file starts with "
@@ -383,7 +410,110 @@ bool SkeletonReader::read_joint(size_t chain, size_t index, const JsonValue& val
   return true;
 }
 
+bool SkeletonReader::read_leaves(const JsonValue& value, Skeleton& skeleton) {
+  if (!value.is_array()) return fail(value, "leaves must be an array, got " + describe(value));
+  if (value.elements.size() > kMaxCount) return fail(value, "too many leaves; a skeleton holds at most 4294967295");
+  skeleton.leaves.resize(value.elements.size());
+  for (size_t i = 0; i < value.elements.size(); ++i)
+    if (!read_leaf(i, value.elements[i], skeleton, skeleton.leaves[i])) return false;
+  return true;
+}
+
+bool SkeletonReader::read_leaf(size_t index, const JsonValue& value, const Skeleton& skeleton, Leaf& leaf) {
+  const std::string prefix = leaf_place(index);
+  if (!value.is_object()) {
+    return fail(value, prefix + " must be an object {\"joint\": ..., \"material\": ..., \"vertices\": [...]}, got " +
+                           describe(value));
+  }
+  if (!check_keys(value, {"joint", "material", "vertices"}, prefix)) return false;
+  const JsonValue* joint = require(value, "joint", prefix);
+  const JsonValue* material = joint ? require(value, "material", prefix) : nullptr;
+  const JsonValue* vertices = material ? require(value, "vertices", prefix) : nullptr;
+  if (vertices == nullptr) return false;
+  if (!joint->is_null()) {
+    const bool pair = joint->is_array() && joint->elements.size() == 2;
+    const std::optional<uint64_t> c = pair ? joint->elements[0].as_uint64() : std::nullopt;
+    const std::optional<uint64_t> j = pair ? joint->elements[1].as_uint64() : std::nullopt;
+    if (!c || !j || *c > kMaxCount || *j > kMaxCount)
+      return fail(*joint, prefix + ": joint must be null or [chain index, joint index], got " + describe(*joint));
+    leaf.joint = ChainParent{static_cast<uint32_t>(*c), static_cast<uint32_t>(*j)};
+    if (auto problem = leaf_joint_problem(leaf, skeleton)) return fail(*joint, prefix + ": " + *problem);
+  }
+  const std::optional<uint64_t> m = material->as_uint64();
+  if (!m || *m > kMaxCount)
+    return fail(*material, prefix + ": material must be an integer from 0 to 4294967295, got " + describe(*material));
+  leaf.material = static_cast<uint32_t>(*m);
+  if (!vertices->is_array())
+    return fail(*vertices, prefix + ": vertices must be an array of [x, y, z], got " + describe(*vertices));
+  for (size_t v = 0; v < vertices->elements.size(); ++v) {
+    const JsonValue& e = vertices->elements[v];
+    if (!e.is_array() || e.elements.size() != 3)
+      return fail(e, prefix + ": vertex " + std::to_string(v) + " must be an array of 3 numbers [x, y, z], got " +
+                         describe(e));
+    std::array<double, 3> p{};
+    for (size_t k = 0; k < 3; ++k) {
+      if (!e.elements[k].is_number() || !std::isfinite(e.elements[k].number))
+        return fail(e.elements[k], prefix + ": vertex " + std::to_string(v) + ": " + kJointFieldNames[k] +
+                                       " must be a finite number, got " + describe(e.elements[k]));
+      p[k] = e.elements[k].number;
+    }
+    leaf.vertices_m.push_back(p);
+  }
+  if (auto problem = leaf_polygon_problem(leaf.vertices_m)) return fail(*vertices, prefix + ": " + *problem);
+  return true;
+}
+
 }  // namespace
+
+std::optional<std::string> leaf_polygon_problem(std::span<const std::array<double, 3>> vertices) {
+  for (size_t v = 0; v < vertices.size(); ++v)
+    for (size_t k = 0; k < 3; ++k)
+      if (!std::isfinite(vertices[v][k]))
+        return "vertex " + std::to_string(v) + " is not finite; a leaf's vertices must be";
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, centroid[3] = {0, 0, 0};
+  for (size_t k = 0; k < 3 && !vertices.empty(); ++k) lo[k] = hi[k] = vertices[0][k];
+  for (const auto& p : vertices)
+    for (size_t k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+      centroid[k] += p[k] / static_cast<double>(vertices.size());
+    }
+  const double diagonal = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  // Distinct vertices: each closer than 1e-9 of the diagonal to an earlier one is the same.
+  size_t distinct = 0;
+  for (size_t v = 0; v < vertices.size() && distinct < 3; ++v) {
+    bool seen = false;
+    for (size_t u = 0; u < v && !seen; ++u)
+      seen = std::hypot(vertices[v][0] - vertices[u][0], vertices[v][1] - vertices[u][1],
+                        vertices[v][2] - vertices[u][2]) <= 1e-9 * diagonal;
+    distinct += seen ? 0 : 1;
+  }
+  if (distinct < 3)
+    return "a leaf needs at least 3 distinct vertices, this polygon has " + std::to_string(distinct) + " (" +
+           count_of(vertices.size(), "vertex", "vertices") + ")";
+  // Newell's normal: twice the vector area of the polygon, whatever its shape.
+  double n[3] = {0, 0, 0};
+  for (size_t v = 0; v < vertices.size(); ++v) {
+    const auto& a = vertices[v];
+    const auto& b = vertices[(v + 1) % vertices.size()];
+    n[0] += (a[1] - b[1]) * (a[2] + b[2]);
+    n[1] += (a[2] - b[2]) * (a[0] + b[0]);
+    n[2] += (a[0] - b[0]) * (a[1] + b[1]);
+  }
+  const double length = std::hypot(n[0], n[1], n[2]);
+  if (!(length > 1e-12 * diagonal * diagonal)) return "the polygon has no area (its vertices lie on one line)";
+  double off = 0;
+  size_t worst = 0;
+  for (size_t v = 0; v < vertices.size(); ++v) {
+    double d = 0;
+    for (size_t k = 0; k < 3; ++k) d += (vertices[v][k] - centroid[k]) * n[k] / length;
+    if (std::abs(d) > off) off = std::abs(d), worst = v;
+  }
+  if (off > kLeafMaxNonPlanarity * diagonal)
+    return "the polygon is not planar: vertex " + std::to_string(worst) + " lies " + number_for_message(off) +
+           " m off its plane, more than " + number_for_message(kLeafMaxNonPlanarity * 100) + " % of its size " +
+           number_for_message(diagonal) + " m";
+  return std::nullopt;
+}
 
 uint64_t Skeleton::segment_count() const {
   uint64_t segments = 0;
@@ -454,6 +584,12 @@ Status validate_skeleton(const Skeleton& skeleton) {
   }
   if (Status problem = check_unowned(skeleton.joints.size()); !problem) return problem;
 
+  for (size_t l = 0; l < skeleton.leaves.size(); ++l) {
+    if (auto problem = leaf_joint_problem(skeleton.leaves[l], skeleton)) return error(leaf_place(l) + ": " + *problem);
+    if (auto problem = leaf_polygon_problem(skeleton.leaves[l].vertices_m))
+      return error(leaf_place(l) + ": " + *problem);
+  }
+
   if (skeleton.source.steps < 0) {
     return error("source: steps is " + std::to_string(skeleton.source.steps) + "; must be >= 0");
   }
@@ -474,7 +610,7 @@ void write_skeleton_members(JsonWriter& w, const Skeleton& skeleton, const Skele
   const Layout inline_layout = style.compact ? Layout::compact : Layout::spaced;
   const SkeletonSource& source = skeleton.source;
   w.key("format").string(kFormatName);
-  w.key("version").integer(kFormatVersion);
+  w.key("version").integer(skeleton.leaves.empty() ? kFormatVersion : kLeavesFormatVersion);
   w.key("source").begin_object(inline_layout);
   w.key("grammar").string(source.grammar);
   if (style.seed_as_string) w.key("seed").string(std::to_string(source.seed));
@@ -484,13 +620,17 @@ void write_skeleton_members(JsonWriter& w, const Skeleton& skeleton, const Skele
   for (const auto& [name, value] : source.defines) w.key(name).number(value);  // std::map: sorted by name
   w.end_object();
   w.end_object();
+  // A chain's parent and a leaf's joint: [chain, joint] or null.
+  auto write_joint_ref = [&w](const char* key, const std::optional<ChainParent>& ref) {
+    w.key(key);
+    if (ref) w.begin_array().integer(ref->chain).integer(ref->joint).end_array();
+    else w.null();
+  };
   // One chain per line in the file; its joints stay dense (they are most of the bytes).
   w.key("chains").begin_array(style.compact ? Layout::compact : Layout::lines);
   for (const Chain& chain : skeleton.chains) {
     w.begin_object(inline_layout);
-    w.key("parent");
-    if (chain.parent) w.begin_array().integer(chain.parent->chain).integer(chain.parent->joint).end_array();
-    else w.null();
+    write_joint_ref("parent", chain.parent);
     w.key("joints").begin_array();
     for (uint32_t j = 0; j < chain.joint_count; ++j) {
       const Joint& joint = skeleton.joints[chain.first_joint + j];
@@ -498,6 +638,18 @@ void write_skeleton_members(JsonWriter& w, const Skeleton& skeleton, const Skele
       for (const double coordinate : joint.position_m) w.number(coordinate);
       w.number(joint.radius_m).integer(joint.material).end_array();
     }
+    w.end_array();
+    w.end_object();
+  }
+  w.end_array();
+  if (skeleton.leaves.empty()) return;  // version 1
+  w.key("leaves").begin_array(style.compact ? Layout::compact : Layout::lines);
+  for (const Leaf& leaf : skeleton.leaves) {
+    w.begin_object(inline_layout);
+    write_joint_ref("joint", leaf.joint);
+    w.key("material").integer(leaf.material);
+    w.key("vertices").begin_array();
+    for (const auto& p : leaf.vertices_m) w.begin_array().number(p[0]).number(p[1]).number(p[2]).end_array();
     w.end_array();
     w.end_object();
   }

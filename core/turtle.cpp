@@ -31,6 +31,14 @@ struct TurtleState {
   bool branch_pending = false; // set by '[': the next F starts a new chain
 };
 
+// A polygon between `{` and `}` (grammar.md, ABOP 1.10 and 5.1): the joint the turtle
+// stood on at `{` and the positions `.` recorded.
+struct OpenPolygon {
+  size_t module;                          // the `{`'s index in the word, for messages
+  std::optional<ChainParent> joint;
+  std::vector<std::array<double, 3>> vertices;
+};
+
 struct PendingJoint {
   uint32_t chain;
   Joint joint;
@@ -92,6 +100,16 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   std::vector<uint32_t> chain_joint_count;
   std::vector<std::optional<ChainParent>> chain_parent;
   uint64_t zero_moves = 0;
+  // `{ . } G` are looked up by name: making them built-in symbols would renumber every
+  // grammar's own modules.
+  auto id_of = [&](const char* name) {
+    SymbolId id = 0;
+    return g.symbols.find(name, &id) ? std::optional<SymbolId>(id) : std::nullopt;
+  };
+  const std::optional<SymbolId> sym_open = id_of("{"), sym_vertex = id_of("."), sym_close = id_of("}"),
+                                sym_move = id_of("G");
+  std::vector<OpenPolygon> polygons;  // a stack: polygons nest
+  std::vector<Leaf> leaves;
   const size_t n = word.size();
   const Turn default_turn = turn_of(d.angle_deg);
   const Turn default_turn_back = turn_of(-d.angle_deg);
@@ -121,6 +139,30 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
       const Module& m = word.modules[i];
       const double* p = word.params_of(m);
       const bool has = m.param_count > 0;
+      if (m.symbol == sym_open) {
+        std::optional<ChainParent> joint;
+        if (t.chain >= 0) joint = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
+        polygons.push_back({i, joint, {}});
+        continue;
+      }
+      if (m.symbol == sym_vertex) {  // outside a polygon a '.' records nothing (as in cpfg)
+        if (!polygons.empty()) polygons.back().vertices.push_back({t.position.x, t.position.y, t.position.z});
+        continue;
+      }
+      if (m.symbol == sym_close) {
+        if (polygons.empty()) throw TurtleFailure{"'}' without matching '{'"};
+        OpenPolygon& polygon = polygons.back();
+        if (auto problem = leaf_polygon_problem(polygon.vertices)) throw TurtleFailure{"bad leaf: " + *problem};
+        if (leaves.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
+        leaves.push_back(Leaf{polygon.joint, t.material, std::move(polygon.vertices)});
+        polygons.pop_back();
+        continue;
+      }
+      if (m.symbol == sym_move) {  // G: move without drawing and without ending the chain
+        t.position += t.heading * (has ? p[0] : d.step);
+        check_position(t.position);
+        continue;
+      }
       switch (m.symbol) {
         case kSymF: {
           const double len = has ? p[0] : d.step;
@@ -168,6 +210,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           if (len == 0) ++zero_moves;
           t.position += t.heading * len;
           check_position(t.position);
+          if (!polygons.empty()) break;  // inside a polygon f does not end the chain (grammar.md)
           t.chain = -1;
           t.joint = -1;
           t.branch_pending = false;
@@ -235,6 +278,10 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           break;  // carried through, ignored by the turtle
       }
     }
+    if (!polygons.empty()) {
+      i = polygons.back().module;
+      throw TurtleFailure{"'{' without matching '}'"};
+    }
   } catch (const TurtleFailure& f) {
     Word one;
     const Module& m = word.modules[i];
@@ -253,6 +300,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
     sk.chains[c] = Chain{offset, 0, chain_parent[c]};
     offset += chain_joint_count[c];
   }
+  sk.leaves = std::move(leaves);
   sk.joints.resize(joints.size());
   for (const PendingJoint& pj : joints) {
     Chain& c = sk.chains[pj.chain];

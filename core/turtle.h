@@ -8,10 +8,16 @@
 // turtle continues its chain if its joint is still that chain's last, else branches.
 // Tropism (ABOP 2.2) bends H toward T by e·|H × T| after every F. Zero-length moves make
 // no joint and are counted.
+// Polygons (grammar.md, ABOP 1.10 and 5.1): `{` opens one (they nest), `.` records the
+// turtle's position as its next vertex (outside a polygon it records nothing), `}` closes
+// it into a Leaf hanging from the joint the turtle stood on at `{` with the material in
+// force at `}`; inside a polygon `f` does not end the chain. `G` moves without drawing
+// and without ending the chain.
 //
 // Errors (a Diagnostic naming the module and its index in the word): a position that is
 // no longer finite, a negative radius, a material that is not a non-negative integer,
-// ']' without '['. Nothing recurses: the branch stack is an explicit array.
+// ']' without '[', '}' without '{' (and the reverse), a polygon that cannot be a leaf
+// (leaf_polygon_problem: fewer than 3 distinct vertices, far from planar), named at its '}'. Nothing recurses: the branch stack is an explicit array.
 // Long words: progress and cancellation through a Progress (core/util/progress.h).
 #pragma once
 

@@ -56,7 +56,7 @@ void main() {
   uint plant = segment_ids[v_segment_info.x].x;
 #ifdef RELIEF
   ReliefMapF map = ReliefMapF(plant_maps[plant], plant_maps[plant].relief_depth_m);
-  bool relief = map.depth_m > 0.0 && !fr.knuckle;
+  bool relief = map.depth_m > 0.0 && !fr.knuckle && fr.material == 0u;  // bark: wood only
 #ifdef SHADOW_PASS
   const bool describe = false;
 #else
@@ -116,7 +116,7 @@ void main() {
   vec3 dp_dv = normalize(fr.shape.axis + fr.shape.slope * hit.radial);
   UvFootprint footprint = uv_footprint(position, hit.normal, dp_du, dp_dv, vec3(0.0), ray.direction + u_ray_dx,
                                        ray.direction + u_ray_dy);
-  albedo = bark_albedo(plant, u, v_m, footprint);
+  if (fr.material == 0u) albedo = bark_albedo(plant, u, v_m, footprint);  // bark: wood only
 #endif
   if (dot(n_geometric, view) < 0.0) n_geometric = -n_geometric;  // seen from inside
   if (dot(n_shading, view) < 0.0) n_shading = -n_shading;

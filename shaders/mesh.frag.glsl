@@ -58,7 +58,9 @@ void main() {
   bool cap = abs(duv_dx.y) + abs(duv_dy.y) <= 1e-5 * abs(v_uv.y);  // one v_m: rounding only
   UvFootprint footprint = cap ? UvFootprint(0.0, 0.0, 0.0, 0.0)
                               : UvFootprint(duv_dx.x, duv_dx.y, duv_dy.x, duv_dy.y);
-  g_albedo = bark_albedo(v_ids.x & PLANT_INDEX_MASK, u, v_uv.y, footprint);
+  // The bark covers the wood only (material 0, materials.h).
+  g_albedo = (v_ids.x >> PLANT_INDEX_BITS) == 0u ? bark_albedo(v_ids.x & PLANT_INDEX_MASK, u, v_uv.y, footprint)
+                                                 : vec4(0.0);
 #else
   g_albedo = vec4(0.0);
 #endif

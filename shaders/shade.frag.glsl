@@ -30,7 +30,8 @@ layout(binding = SHADOW_MAP_UNIT) uniform sampler2DShadow shadow_map;
 // Per plant: bark albedo (rgb) and w = 1 where it replaces material 0 (Bark::albedo_rgb).
 layout(std430, binding = PLANT_BARK_BINDING) readonly buffer PlantBark { vec4 plant_bark[]; };
 
-uniform vec3 u_material_albedo[MAX_MATERIALS];  // kMaterialAlbedo (materials.h)
+uniform vec3 u_material_albedo[MAX_MATERIALS];  // material_look (scene.h): the scene's table over materials.h's
+uniform float u_material_specular[MAX_MATERIALS];  // the Blinn–Phong lobe's weight per material
 uniform int u_material_count;
 
 uniform vec3 u_right;        // camera frame, as frusta_common.glsl
@@ -86,7 +87,7 @@ float sun_visibility(vec3 p, vec3 n_geometric, float offset_m) {
 #endif
 
 // The model at a surface point, the shadow map looked up only where the sun faces it.
-vec3 lit(vec3 albedo, vec3 n, vec3 n_geometric, vec3 p_rel_eye, vec3 view, bool specular, float shadow_offset_m) {
+vec3 lit(vec3 albedo, vec3 n, vec3 n_geometric, vec3 p_rel_eye, vec3 view, float specular, float shadow_offset_m) {
 #ifdef SUN
   vec3 l = u_sun_dir;
   float cos_sun = sun_cosine(n, n_geometric, l);
@@ -138,28 +139,29 @@ void main() {
   // a branch, so the shadow lookup is written once.
   vec3 albedo, n, n_geometric;
   float t;
-  bool specular;
+  float specular;
   float shadow_offset_m = 0.0;
   if (ground_t < plant_t) {
     albedo = u_ground_albedo;
     n = n_geometric = kGroundNormal;
     t = ground_t;
-    specular = false;
+    specular = 0.0;
   } else {
     vec4 geometric_u = texelFetch(g_geometric_u, texel, 0);
     uvec4 ids = texelFetch(g_ids, texel, 0);
     uint plant = ids.x & PLANT_INDEX_MASK;
     uint material = ids.x >> PLANT_INDEX_BITS;
     vec4 decided = texelFetch(g_albedo, texel, 0);
+    int slot = min(int(material), u_material_count - 1);
     albedo = decided.a > 0.0                               ? decided.rgb
              : material == 0u && plant_bark[plant].w > 0.0 ? plant_bark[plant].rgb
-                                                           : u_material_albedo[min(int(material), u_material_count - 1)];
+                                                           : u_material_albedo[slot];
     n = normal_distance.xyz;
     n_geometric = geometric_u.xyz;
     t = plant_t;
-    specular = true;
+    specular = u_material_specular[slot];
 #ifdef SUN
-    if (plant_maps[plant].relief_depth_m > 0.0) shadow_offset_m = t * u_pixel_step_rad;
+    if (material == 0u && plant_maps[plant].relief_depth_m > 0.0) shadow_offset_m = t * u_pixel_step_rad;
 #endif
   }
 #ifdef FOG

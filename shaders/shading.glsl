@@ -31,10 +31,10 @@ float blinn_phong(vec3 n, vec3 l, vec3 view) {
   return kSpecular * (kShininess + 8.0) / (8.0 * kPi) * pow(max(0.0, dot(n, h)), kShininess);
 }
 
-// ρ/π, plus blinn_phong where `specular`.
-vec3 surface_brdf(vec3 albedo, vec3 n, vec3 l, vec3 view, bool specular) {
+// ρ/π, plus `specular` (the lobe's weight) times blinn_phong.
+vec3 surface_brdf(vec3 albedo, vec3 n, vec3 l, vec3 view, float specular) {
   vec3 brdf = albedo / kPi;
-  if (specular) brdf += vec3(blinn_phong(n, l, view));
+  if (specular > 0.0) brdf += vec3(specular * blinn_phong(n, l, view));
   return brdf;
 }
 
@@ -44,7 +44,7 @@ vec3 sun_reflected(vec3 brdf, vec3 sun_irradiance, float cos_sun, float visibili
 }
 
 // sky_ambient, plus the sunlight where cos_sun > 0 and visibility > 0.
-vec3 surface_radiance(vec3 albedo, vec3 n, vec3 l, vec3 view, bool specular, vec3 sky, vec3 sun_irradiance,
+vec3 surface_radiance(vec3 albedo, vec3 n, vec3 l, vec3 view, float specular, vec3 sky, vec3 sun_irradiance,
                       float cos_sun, float visibility) {
   vec3 ambient = sky_ambient(albedo, n, sky);
   if (cos_sun <= 0.0 || visibility == 0.0) return ambient;

@@ -208,6 +208,7 @@ int run_export(const std::vector<std::string>& raw_args) {
       return kInputError;
     }
     Scene& scene = *read;
+    options.materials = scene.materials;  // one glTF material per entry (docs/materials.md)
     // A plant's grammar error: the grammar's place, and a note at the scene key naming it.
     if (Status grown = grow_scene_plants(scene, a.max_modules); !grown) {
       std::cerr << grown.error().format();

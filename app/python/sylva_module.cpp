@@ -244,6 +244,15 @@ struct ChainRecord {
   int32_t parent_joint;  // joint index within the parent chain; -1 for a root chain
 };
 
+// The leaves as numpy records (see the `leaves` docstring).
+struct LeafRecord {
+  int32_t first_vertex;  // into leaf_vertices
+  int32_t vertex_count;
+  int32_t chain;         // the joint it hangs from; -1: none
+  int32_t joint;
+  uint32_t material;
+};
+
 int32_t checked_index(uint64_t value, const char* what) {
   if (value > static_cast<uint64_t>(std::numeric_limits<int32_t>::max()))
     throw py::value_error(std::string("the skeleton has too many ") + what + " for int32 indices");
@@ -316,6 +325,38 @@ py::array_t<ChainRecord> skeleton_chains(const Skeleton& sk) {
     r.parent_joint = chain.parent ? static_cast<int32_t>(chain.parent->joint) : -1;
   }
   return chains;
+}
+
+py::array_t<LeafRecord> skeleton_leaves(const Skeleton& sk) {
+  checked_index(sk.leaves.size(), "leaves");
+  py::array_t<LeafRecord> leaves(static_cast<py::ssize_t>(sk.leaves.size()));
+  auto out = leaves.mutable_unchecked<1>();
+  uint64_t first = 0;
+  for (size_t l = 0; l < sk.leaves.size(); ++l) {
+    const Leaf& leaf = sk.leaves[l];
+    LeafRecord& r = out(static_cast<py::ssize_t>(l));
+    r.first_vertex = checked_index(first, "leaf vertices");
+    r.vertex_count = checked_index(leaf.vertices_m.size(), "leaf vertices");
+    r.chain = leaf.joint ? static_cast<int32_t>(leaf.joint->chain) : -1;
+    r.joint = leaf.joint ? static_cast<int32_t>(leaf.joint->joint) : -1;
+    r.material = leaf.material;
+    first += leaf.vertices_m.size();
+  }
+  return leaves;
+}
+
+py::array_t<double> skeleton_leaf_vertices(const Skeleton& sk) {
+  size_t count = 0;
+  for (const Leaf& leaf : sk.leaves) count += leaf.vertices_m.size();
+  py::array_t<double> vertices({static_cast<py::ssize_t>(count), py::ssize_t{3}});
+  auto out = vertices.mutable_unchecked<2>();
+  py::ssize_t v = 0;
+  for (const Leaf& leaf : sk.leaves)
+    for (const auto& p : leaf.vertices_m) {
+      for (py::ssize_t k = 0; k < 3; ++k) out(v, k) = p[static_cast<size_t>(k)];
+      ++v;
+    }
+  return vertices;
 }
 
 Skeleton skeleton_from_json(const std::string& text, const std::string& file) {
@@ -496,6 +537,7 @@ Growing, deriving, exporting and rendering release the GIL, so threads run in pa
 void bind_module(py::module_& m) {
   m.doc() = kModuleDoc;
   PYBIND11_NUMPY_DTYPE(ChainRecord, first_joint, joint_count, parent_chain, parent_joint);
+  PYBIND11_NUMPY_DTYPE(LeafRecord, first_vertex, vertex_count, chain, joint, material);
   m.attr("__version__") = "0.1.0";
 
   // --- exceptions -----------------------------------------------------------------------
@@ -556,6 +598,10 @@ Immutable. Array properties are numpy arrays:
   chains (C,) structured int32 records (first_joint, joint_count, parent_chain,
       parent_joint); parent_chain = parent_joint = -1 for a root chain.
 Chain c owns joints[first_joint : first_joint + joint_count].
+  leaves (L,) structured records (first_vertex, vertex_count, chain, joint int32, material
+      uint32): the grammar's polygons (skeleton.md "Leaves"); chain = joint = -1 for a
+      leaf on no joint. leaf_vertices (V, 3) float64 holds every leaf's vertices, leaf l
+      owning leaf_vertices[first_vertex : first_vertex + vertex_count].
 Make one with Grammar.grow(), Skeleton.from_file() or Skeleton.from_json().)doc");
 
   // --- Grammar --------------------------------------------------------------------------
@@ -640,6 +686,14 @@ released while growing. A RuntimeWarning reports an interpretation cut at max de
           "(C,) numpy structured array, fields first_joint, joint_count, parent_chain,\n"
           "parent_joint (int32; parents -1 for a root chain). Parents come before children.\n"
           "E.g. sk.chains['parent_chain'], or for c in sk.chains: c['first_joint'].")
+      .def_property_readonly(
+          "leaves", &skeleton_leaves,
+          "(L,) numpy structured array, fields first_vertex, vertex_count, chain, joint (int32;\n"
+          "-1 for a leaf on no joint) and material (uint32): the leaves (skeleton.md), one per\n"
+          "polygon of the grammar. A new array on every access.")
+      .def_property_readonly("leaf_vertices", &skeleton_leaf_vertices,
+                             "(V, 3) float64 every leaf's vertices in metres, leaf after leaf. A new array.")
+      .def_property_readonly("leaf_count", [](const Skeleton& sk) { return sk.leaves.size(); }, "Number of leaves L.")
       .def_property_readonly("joint_count", [](const Skeleton& sk) { return sk.joints.size(); }, "Number of joints J.")
       .def_property_readonly("chain_count", [](const Skeleton& sk) { return sk.chains.size(); }, "Number of chains C.")
       .def_property_readonly("segment_count", &Skeleton::segment_count, "Number of segments S = sum(joint_count - 1).")

@@ -87,7 +87,7 @@ FrustumTracer::FrustumTracer(std::span<const Frustum> frusta, std::span<const ui
         for (size_t i = 0; i < frusta.size(); ++i) {
           const uint32_t plant = plant_of_frustum[i];
           if (plant >= relief_.plants.size() || !has_relief(relief_.plants[plant]) ||
-              frusta[i].kind != FrustumKind::segment)
+              frusta[i].kind != FrustumKind::segment || frusta[i].material != 0)  // bark: wood only
             continue;
           // The accelerator grows the box by the thicker end's shell (0: a zero frustum).
           const ShellDepths d = relief_shell_depths(frusta[i].shape, relief_.plants[plant].depth_m,

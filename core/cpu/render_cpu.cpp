@@ -35,13 +35,6 @@ using Rng = render_common::SampleRng;
 constexpr uint32_t kTile = 32;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-glm::dvec3 material_albedo(const ScenePlant& plant, uint32_t material) {
-  if (material == 0 && plant.bark.albedo_rgb) return *plant.bark.albedo_rgb;
-  constexpr uint32_t n = sizeof kMaterialAlbedo / sizeof kMaterialAlbedo[0];
-  const double* a = kMaterialAlbedo[std::min(material, n - 1)];
-  return {a[0], a[1], a[2]};
-}
-
 using render_common::camera_frame;
 using render_common::frame_ray;
 
@@ -165,7 +158,7 @@ class Renderer {
   // The shading model (shading.h) at a surface point, its sun visibility from one shadow
   // ray toward a sample of the sun, cast only where the sun faces the point.
   glm::dvec3 lit(const glm::dvec3& albedo, const glm::dvec3& n, const glm::dvec3& n_geometric,
-                 const glm::dvec3& p, const glm::dvec3& view, bool specular, Rng& rng,
+                 const glm::dvec3& p, const glm::dvec3& view, double specular, Rng& rng,
                  uint64_t* shadow_rays, double shadow_offset_m = 0) {
     if (!sun_on_) return shading::sky_ambient(albedo, n, scene_.sky);
     const glm::dvec3 l = sun_sample(scene_.sun, sun_direction_, cos_alpha_, sun_frame_, rng);
@@ -213,7 +206,7 @@ class Renderer {
     const glm::dvec3 view = -glm::normalize(h.ray.direction);
     if (h.ground_t < kInf) {
       const glm::dvec3 p = h.ray.origin + h.ground_t * h.ray.direction;
-      return lit(scene_.ground.albedo, shading::kGroundNormal, shading::kGroundNormal, p, view, false, rng,
+      return lit(scene_.ground.albedo, shading::kGroundNormal, shading::kGroundNormal, p, view, 0.0, rng,
                  shadow_rays);
     }
     const SurfaceHit& s = h.surface;
@@ -223,19 +216,18 @@ class Renderer {
     if (glm::dot(ng, view) < 0) ng = -ng;   // seen from inside: light the side we see
     if (glm::dot(n, view) < 0) n = -n;
     const ScenePlant& plant = scene_.plants[s.plant];
-    glm::dvec3 albedo;
-    if (textures_ && textures_->has_albedo(s.plant)) {
+    const MaterialLook look = material_look(scene_.materials, &plant.bark, s.material);
+    glm::dvec3 albedo = look.albedo;
+    if (s.material == 0 && textures_ && textures_->has_albedo(s.plant)) {  // bark: wood only
       const UvFootprint footprint = uv_footprint(s, {h.ray.origin, h.ray.direction + direction_dx_},
                                                  {h.ray.origin, h.ray.direction + direction_dy_});
       albedo = textures_->albedo(s.plant, s.u, s.v_m, footprint);
-    } else {
-      albedo = material_albedo(plant, s.material);
     }
     // A relief hit's shadow ray starts a pixel footprint above it (render_cpu.h).
-    const bool relief = textures_ && options_.geometry.relief && textures_->has_height(s.plant) &&
+    const bool relief = s.material == 0 && textures_ && options_.geometry.relief && textures_->has_height(s.plant) &&
                         plant.bark.relief_depth_m > 0;
     const double shadow_offset_m = relief ? s.t * glm::length(direction_dy_) : 0.0;
-    return lit(albedo, n, ng, s.position, view, true, rng, shadow_rays, shadow_offset_m);
+    return lit(albedo, n, ng, s.position, view, look.specular, rng, shadow_rays, shadow_offset_m);
   }
 
   // The AOVs through pixel (x, y)'s centre: `centre_hit` and `centre_fog` are the sample's

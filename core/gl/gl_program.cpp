@@ -100,5 +100,8 @@ void set_uniform_uint(uint32_t p, const char* name, uint32_t value) { glProgramU
 void set_uniform_vec3_array(uint32_t p, const char* name, int count, const float* xyz) {
   glProgramUniform3fv(p, location(p, name), count, xyz);
 }
+void set_uniform_float_array(uint32_t p, const char* name, int count, const float* x) {
+  glProgramUniform1fv(p, location(p, name), count, x);
+}
 
 }  // namespace sylva

@@ -40,5 +40,7 @@ void set_uniform_int(uint32_t program, const char* name, int value);            
 void set_uniform_uint(uint32_t program, const char* name, uint32_t value);           // uint
 // vec3 name[count] from `count` consecutive x, y, z floats.
 void set_uniform_vec3_array(uint32_t program, const char* name, int count, const float* xyz);
+// float name[count] from `count` floats.
+void set_uniform_float_array(uint32_t program, const char* name, int count, const float* x);
 
 }  // namespace sylva

@@ -331,13 +331,18 @@ struct GlRenderer::State {
     set_uniform(shade, "u_eye_above_ground", f.camera.eye.y - scene.ground.height);
     set_uniform(shade, "u_sky", scene.sky);
     set_uniform(shade, "u_ground_albedo", scene.ground.albedo);
-    float albedo[gl::kMaxMaterials * 3];
-    const int count = static_cast<int>(kMaterialTableSize);
+    // Every slot the scene's table may fill (scene.h material_look); higher indices look
+    // like the last slot, as default_material_albedo's past its table.
+    static_assert(gl::kMaxMaterials == kMaterialSlots);
+    float albedo[gl::kMaxMaterials * 3], specular[gl::kMaxMaterials];
+    const int count = static_cast<int>(kMaterialSlots);
     for (int i = 0; i < count; ++i) {
-      const double* a = default_material_albedo(static_cast<uint32_t>(i));
-      for (int k = 0; k < 3; ++k) albedo[3 * i + k] = static_cast<float>(a[k]);
+      const MaterialLook look = material_look(scene.materials, nullptr, static_cast<uint32_t>(i));
+      for (int k = 0; k < 3; ++k) albedo[3 * i + k] = static_cast<float>(look.albedo[k]);
+      specular[i] = static_cast<float>(look.specular);
     }
     set_uniform_vec3_array(shade, "u_material_albedo", count, albedo);
+    set_uniform_float_array(shade, "u_material_specular", count, specular);
     set_uniform_int(shade, "u_material_count", count);
     if (f.fog_on) fog_uniforms(scene, f);
   }

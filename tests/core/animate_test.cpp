@@ -198,5 +198,41 @@ TEST(Animate, ScenePlantsSwayOutOfStepAndStartAtRest) {
       << "two identical plants must not move in lockstep";
 }
 
+// small_tree with a leaf on the first branch's tip (chain 1, joint 2) and one on no joint.
+Skeleton leafy_tree() {
+  Skeleton sk = small_tree();
+  sk.leaves = {Leaf{ChainParent{1, 2}, 1, {{1.3, 3.1, 0.3}, {1.5, 3.2, 0.3}, {1.4, 3.4, 0.35}}},
+               Leaf{std::nullopt, 1, {{2, 0, 0}, {2.2, 0, 0}, {2.1, 0.1, 0}}}};
+  return sk;
+}
+
+TEST(Animate, ALeafTurnsRigidlyWithItsJointAndALeafOnNoJointStays) {
+  const Skeleton rest = leafy_tree();
+  EXPECT_EQ(sway_skeleton(rest, 0.0, SwayParameters{}), rest);  // t = 0: bit for bit
+  SwayParameters strong;
+  strong.amplitude_deg = 20;
+  strong.branch_amplitude_deg = 25;
+  const Skeleton swayed = sway_skeleton(rest, 0.6, strong);
+  ASSERT_TRUE(validate_skeleton(swayed).ok()) << validate_skeleton(swayed).error().format();
+  ASSERT_EQ(swayed.leaves.size(), 2u);
+  const Joint& anchor_rest = rest.joints[rest.chains[1].first_joint + 2];
+  const Joint& anchor_swayed = swayed.joints[rest.chains[1].first_joint + 2];
+  ASSERT_GT(glm::length(position(anchor_swayed) - position(anchor_rest)), 1e-2) << "the joint must move";
+  const auto& before = rest.leaves[0].vertices_m;
+  const auto& after = swayed.leaves[0].vertices_m;
+  auto at = [](const std::array<double, 3>& v) { return dvec3(v[0], v[1], v[2]); };
+  for (size_t i = 0; i < before.size(); ++i) {
+    // Each vertex keeps its distance from the joint and from every other vertex.
+    EXPECT_NEAR(glm::length(at(after[i]) - position(anchor_swayed)), glm::length(at(before[i]) - position(anchor_rest)),
+                1e-12);
+    for (size_t j = i + 1; j < before.size(); ++j)
+      EXPECT_NEAR(glm::length(at(after[j]) - at(after[i])), glm::length(at(before[j]) - at(before[i])), 1e-12);
+  }
+  // The leaf's first vertex is the joint itself ('.' right after the F): it follows the
+  // joint exactly.
+  EXPECT_NEAR(glm::length(at(after[0]) - position(anchor_swayed)), 0, 1e-12);
+  EXPECT_EQ(swayed.leaves[1], rest.leaves[1]);
+}
+
 }  // namespace
 }  // namespace sylva

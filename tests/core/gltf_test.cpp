@@ -337,6 +337,21 @@ TEST(GltfImport, RoundTripGivesTheIdenticalSkeletonFileForGlbAndGltf) {
     }
 }
 
+TEST(GltfImport, LeavesRoundTripThroughTheNodeExtras) {
+  // skeleton.md version 2: a grammar's polygons are leaves, kept in extras.sylva.leaves.
+  TempFolder dir;
+  const Skeleton sk = grow_text("angle: 60\naxiom: F(2)[&F{.+f.-f.-f.+|+f.-f.}]F'(1){.+f.-f.-f.}\n");
+  ASSERT_EQ(sk.leaves.size(), 2u);
+  for (const char* name : {"p.glb", "p.gltf"}) {
+    ASSERT_TRUE(export_gltf({GltfPlant{"leafy", sk}}, dir.file(name)).ok());
+    Expected<std::vector<GltfPlant>> r = import_gltf_skeletons(dir.file(name));
+    ASSERT_TRUE(r.ok()) << r.error().format();
+    ASSERT_EQ(r->size(), 1u);
+    EXPECT_EQ((*r)[0].skeleton, sk) << name;
+    EXPECT_EQ(write_skeleton_json((*r)[0].skeleton), write_skeleton_json(sk)) << name;
+  }
+}
+
 TEST(GltfExport, SameInputGivesByteIdenticalFiles) {
   TempFolder dir;
   const Skeleton sk = grow_text(kGrammar);
@@ -517,7 +532,7 @@ std::vector<float> floats_of(const tinygltf::Model& model, int index) {
   return out;
 }
 
-TEST(GltfExport, BarkTexturesGiveOneMaterialPerIndexWithAlbedoNormalMapAndUnitTangents) {
+TEST(GltfExport, BarkTexturesGoToTheWoodMaterialOnlyWithAlbedoNormalMapAndUnitTangents) {
   TempFolder dir;
   const Skeleton sk = grow_text(kGrammar);
   const SkinnedSkeleton skinned = skin_skeleton(sk);
@@ -537,23 +552,34 @@ TEST(GltfExport, BarkTexturesGiveOneMaterialPerIndexWithAlbedoNormalMapAndUnitTa
     ASSERT_TRUE(export_gltf({plant}, dir.file(name), o).ok());
     tinygltf::Model model;
     ASSERT_TRUE(load_with_tinygltf(dir.file(name), &model));
-    // One material per material index used, all showing the same two images.
+    // One material per material index used; the wood's (0) shows the two images, the
+    // others (needles, leaves: materials.h) keep their own colour and no bark.
     ASSERT_EQ(model.materials.size(), used.size()) << name;
     ASSERT_EQ(model.images.size(), 2u) << name;
     ASSERT_EQ(model.textures.size(), 2u) << name;
     size_t k = 0;
     int albedo = -1, normal = -1;
+    ASSERT_EQ(*used.begin(), 0u);
     for (uint32_t m : used) {
       const tinygltf::Material& mat = model.materials[k++];
       EXPECT_EQ(mat.name, "sylva_material_" + std::to_string(m));
+      const tinygltf::Value& extras = mat.extras.Get("sylva");
+      EXPECT_EQ(extras.Get("material_index").GetNumberAsInt(), static_cast<int>(m));
+      if (m != 0) {
+        EXPECT_EQ(mat.pbrMetallicRoughness.baseColorTexture.index, -1) << m;
+        EXPECT_EQ(mat.normalTexture.index, -1) << m;
+        const double* rgb = default_material_albedo(m);
+        EXPECT_EQ(mat.pbrMetallicRoughness.baseColorFactor, std::vector<double>({rgb[0], rgb[1], rgb[2], 1})) << m;
+        EXPECT_FALSE(extras.Has("albedo")) << m;
+        EXPECT_FALSE(extras.Has("height")) << m;
+        continue;
+      }
       albedo = mat.pbrMetallicRoughness.baseColorTexture.index;
       normal = mat.normalTexture.index;
       ASSERT_GE(albedo, 0);
       ASSERT_GE(normal, 0);
       EXPECT_NE(albedo, normal);
       EXPECT_EQ(mat.pbrMetallicRoughness.baseColorFactor, std::vector<double>({1, 1, 1, 1}));
-      const tinygltf::Value& extras = mat.extras.Get("sylva");
-      EXPECT_EQ(extras.Get("material_index").GetNumberAsInt(), static_cast<int>(m));
       EXPECT_EQ(extras.Get("albedo").Get<std::string>(), kBarkAlbedo);
       EXPECT_EQ(extras.Get("height").Get<std::string>(), kBarkHeight);
       EXPECT_EQ(extras.Get("relief_depth_m").GetNumberAsDouble(), 0.01);
@@ -713,6 +739,49 @@ TEST(GltfExport, WithoutTexturesMaterialsTakeTheTableColourAndABarkColourReplace
     EXPECT_EQ(at(prim, "attributes").find("TANGENT"), nullptr);
 }
 
+TEST(GltfExport, TheScenesMaterialTableGivesOneSharedMaterialPerEntry) {
+  // docs/materials.md: a table entry's albedo and specular weight; a bark colour still
+  // comes first on the wood; two plants with different barks share every material the
+  // bark does not cover.
+  TempFolder dir;
+  GltfPlant plain{"plain", grow_text(kGrammar)};
+  GltfPlant barked = plain;
+  barked.name = "barked";
+  barked.position_m[0] = 3;
+  barked.bark.albedo_rgb = glm::dvec3(0.5, 0.4, 0.3);
+  GltfExportOptions o;
+  o.mesh = true;
+  o.materials = {{0, {glm::dvec3(0.1, 0.2, 0.3), 0.25}}, {1, {glm::dvec3(0.6, 0.1, 0.5), 0}}};
+  std::set<uint32_t> used;
+  for (const Frustum& f : skin_skeleton(plain.skeleton).frusta) used.insert(f.material);
+  ASSERT_TRUE(used.count(0) && used.count(1) && used.size() >= 3);
+  ASSERT_TRUE(export_gltf({plain, barked}, dir.file("p.glb"), o).ok());
+  const Glb glb = read_glb(dir.file("p.glb"));
+  const JsonValue& materials = at(glb.json, "materials");
+  ASSERT_EQ(materials.elements.size(), used.size() + 1);  // material 0 twice: table and bark
+  std::map<uint32_t, int> seen;
+  for (const JsonValue& m : materials.elements) {
+    const JsonValue& extras = at(at(m, "extras"), "sylva");
+    const uint32_t index = static_cast<uint32_t>(at(extras, "material_index").number);
+    ++seen[index];
+    const JsonValue& factor = at(at(m, "pbrMetallicRoughness"), "baseColorFactor");
+    const glm::dvec3 rgb(factor.elements.at(0).number, factor.elements.at(1).number, factor.elements.at(2).number);
+    if (index == 0) {
+      EXPECT_TRUE(rgb == glm::dvec3(0.1, 0.2, 0.3) || rgb == glm::dvec3(0.5, 0.4, 0.3)) << rgb.x;
+      EXPECT_EQ(at(extras, "specular").number, 0.25);
+    } else if (index == 1) {
+      EXPECT_EQ(rgb, glm::dvec3(0.6, 0.1, 0.5));
+      EXPECT_EQ(at(extras, "specular").number, 0);
+    } else {
+      const double* d = default_material_albedo(index);
+      EXPECT_EQ(rgb, glm::dvec3(d[0], d[1], d[2])) << index;
+      EXPECT_EQ(extras.find("specular"), nullptr) << index;  // not in the table
+    }
+  }
+  EXPECT_EQ(seen[0], 2);
+  EXPECT_EQ(seen[1], 1);
+}
+
 TEST(GltfExport, TheReferenceRadiusIsTheMedianSegmentRadius) {
   EXPECT_DOUBLE_EQ(bark_reference_radius_m(cylinder(0.1)), 0.1);
   Skeleton sk;
@@ -776,7 +845,8 @@ TEST(GltfExport, TexturedExportsAreByteIdenticalAndInstancingComparesBarks) {
   ASSERT_TRUE(export_gltf({plant}, dir.file("b.glb"), o).ok());
   EXPECT_EQ(slurp(dir.file("a.glb")), slurp(dir.file("b.glb")));
   // Two identical plants share a node; the same skeleton with another bark does not, and
-  // its material is a new one while the images are shared.
+  // its wood material is a new one while the images and the other materials (which the
+  // bark does not cover, materials.h) are shared.
   GltfPlant other = plant;
   other.bark.v_per_metre = 5;
   GltfPlant moved = plant;
@@ -787,7 +857,8 @@ TEST(GltfExport, TexturedExportsAreByteIdenticalAndInstancingComparesBarks) {
   EXPECT_EQ(at(glb.json, "nodes").elements.size(), 2u);
   std::set<uint32_t> used;
   for (const Frustum& f : skin_skeleton(plant.skeleton).frusta) used.insert(f.material);
-  EXPECT_EQ(at(glb.json, "materials").elements.size(), 2 * used.size());
+  ASSERT_TRUE(used.count(0));
+  EXPECT_EQ(at(glb.json, "materials").elements.size(), used.size() + 1);
   EXPECT_EQ(at(glb.json, "images").elements.size(), 3u);  // albedo, and a normal map per v_per_metre
 }
 

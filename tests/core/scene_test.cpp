@@ -1,6 +1,7 @@
 // scene_test.cpp — scene.md's scene files: every key read, defaults, located errors, a
 // plant's grammar error named at its scene key, and write_scene_json read back equal.
 #include "core/scene.h"
+#include "core/materials.h"
 
 #include <gtest/gtest.h>
 
@@ -246,6 +247,67 @@ TEST(SceneFog, EveryKeyOutOfRangeIsAnErrorAtTheKey) {
   EXPECT_NE(e.message.find("fog.top 4 must be above the ground (ground.height 5)"), std::string::npos) << e.message;
 }
 
+TEST(SceneMaterials, ReadsTheTableOfDocsMaterialsMd) {
+  Expected<Scene> s = parse_scene_json(R"({"plants": [], "materials": [
+      {"index": 1, "albedo": [0.05, 0.22, 0.06], "specular": 0.4},
+      {"index": 3, "albedo": [0.9, 0.8, 0.2]},
+      {"index": 0, "specular": 0}]})",
+                                       "m.scene.json", "");
+  ASSERT_TRUE(s.ok()) << s.error().format();
+  ASSERT_EQ(s->materials.size(), 3u);
+  EXPECT_EQ(s->materials.at(1), (SceneMaterial{glm::dvec3(0.05, 0.22, 0.06), 0.4}));
+  EXPECT_EQ(s->materials.at(3), (SceneMaterial{glm::dvec3(0.9, 0.8, 0.2), 1}));
+  EXPECT_EQ(s->materials.at(0), (SceneMaterial{std::nullopt, 0}));
+}
+
+TEST(SceneMaterials, TheBarkColourComesFirstOnWoodThenTheTableThenTheDefaults) {
+  std::map<uint32_t, SceneMaterial> table{{0, {glm::dvec3(0.5, 0.5, 0.5), 0.25}}, {2, {glm::dvec3(0.1, 0.2, 0.3), 1}},
+                                          {5, {std::nullopt, 0.5}}};
+  Bark bark;
+  bark.albedo_rgb = glm::dvec3(0.7, 0.1, 0.1);
+  const double* d1 = default_material_albedo(1);
+  const double* d5 = default_material_albedo(5);
+  EXPECT_EQ(material_look(table, &bark, 0).albedo, glm::dvec3(0.7, 0.1, 0.1));
+  EXPECT_EQ(material_look(table, &bark, 0).specular, 0.25);
+  EXPECT_EQ(material_look(table, nullptr, 0).albedo, glm::dvec3(0.5, 0.5, 0.5));
+  EXPECT_EQ(material_look(table, &bark, 2).albedo, glm::dvec3(0.1, 0.2, 0.3));  // the bark is the wood's only
+  EXPECT_EQ(material_look(table, &bark, 1).albedo, glm::dvec3(d1[0], d1[1], d1[2]));
+  EXPECT_EQ(material_look(table, &bark, 1).specular, 1);
+  EXPECT_EQ(material_look(table, &bark, 5).albedo, glm::dvec3(d5[0], d5[1], d5[2]));
+  EXPECT_EQ(material_look(table, &bark, 5).specular, 0.5);
+}
+
+TEST(SceneMaterials, EveryBadEntryIsAnErrorAtItsKey) {
+  struct Bad {
+    const char* entry;  // the table's one entry
+    const char* says;
+    uint32_t column;    // where the error points (the entry starts at column 16)
+  };
+  const Bad bad[] = {
+      {R"({"albedo": [1, 1, 1]})", "materials[0] needs an \"index\"", 16},
+      {R"({"index": 16})", "materials[0].index must be an integer from 0 to 15", 26},
+      {R"({"index": -1})", "materials[0].index must be an integer from 0 to 15", 26},
+      {R"({"index": 1.5})", "materials[0].index must be an integer", 26},
+      {R"({"index": 1, "specular": 1.5})", "materials[0].specular must be in [0, 1]", 41},
+      {R"({"index": 1, "albedo": [1, -1, 1]})", "materials[0].albedo components must be >= 0", 43},
+      {R"({"index": 1, "albedo": "leaf.png"})", "materials[0].albedo must be an array of 3 numbers", 39},
+      {R"({"index": 1, "colour": [1, 1, 1]})", "unknown key \"colour\" in materials[0]", 29},
+      {R"(7)", "materials[0] must be an object", 16},
+  };
+  for (const Bad& b : bad) {
+    const std::string text = std::string("{\"plants\": [],\n \"materials\": [") + b.entry + "]}";
+    Diagnostic e = expect_error(text);
+    EXPECT_EQ(e.loc.line, 2u) << b.entry;
+    EXPECT_EQ(e.loc.column, b.column) << b.entry << ": " << e.message;
+    EXPECT_NE(e.message.find(b.says), std::string::npos) << b.entry << ": " << e.message;
+  }
+  Diagnostic e = expect_error("{\"plants\": [], \"materials\": [{\"index\": 2},\n {\"index\": 2}]}");
+  EXPECT_EQ(e.loc.line, 2u);
+  EXPECT_NE(e.message.find("materials[1].index 2 is described twice"), std::string::npos) << e.message;
+  e = expect_error("{\"plants\": [], \"materials\": {\"1\": {}}}");
+  EXPECT_NE(e.message.find("materials must be an array"), std::string::npos) << e.message;
+}
+
 TEST(Scene, MalformedJsonIsLocated) {
   Diagnostic e = expect_error("{\"plants\": [],\n}");
   EXPECT_EQ(e.loc.line, 1u);  // the trailing comma
@@ -402,6 +464,7 @@ TEST(SceneWrite, ASceneWithEveryKeySetReadsBackEqual) {
   s.sky = {0.1, 0.2, 1e-3};
   s.ground = {-0.75, {0.5, 0.25, 0.125}};
   s.fog = Fog{0.125, 0.01, -0.3, 0.05, 12.5, FogMode::refined, 9, 4321};
+  s.materials = {{0, {std::nullopt, 0.125}}, {1, {glm::dvec3(0.05, 0.25, 1e-3), 0.5}}, {15, {glm::dvec3(1, 0, 0.5), 1}}};
   ScenePlant textured;
   textured.grammar = dir.file("g.lsys");
   textured.seed = 18446744073709551615u;

@@ -91,6 +91,19 @@ inline constexpr KnownPixel kLitCylinder{16, 16, {0.2889737715, 0.2050793988, 0.
 inline Scene specular_peak_scene() { return head_on_cylinder_scene({0, 0, 1}); }
 inline constexpr KnownPixel kSpecularPeak{16, 16, {0.5531620156, 0.4501690498, 0.3448563653}};
 
+// The same with the scene's `materials` table (docs/materials.md) describing material 0 as
+// ρ = (0.5, 0.4, 0.2) with half the lobe, specular 0.5:
+//   beauty = ρ·L_sky/2 + (ρ/π + 0.5·0.24/π) · E
+//     R: 0.0625 + 0.62/π·3    = 0.0625 + 0.592056 = 0.654556
+//     G: 0.06   + 0.52/π·3    = 0.06   + 0.496563 = 0.556563
+//     B: 0.04   + 0.32/π·2.8  = 0.04   + 0.285206 = 0.325206
+inline Scene material_table_scene() {
+  Scene s = specular_peak_scene();
+  s.materials[0] = SceneMaterial{glm::dvec3(0.5, 0.4, 0.2), 0.5};
+  return s;
+}
+inline constexpr KnownPixel kMaterialTablePeak{16, 16, {0.6545563883, 0.5565634224, 0.3252056580}};
+
 // lit_cylinder_scene with a second cylinder (radius 0.5, out of view at x = 3, z = 5)
 // standing in the sun's way: the shadow ray from (0, 0, 1) along l = (0.6, 0, 0.8) passes
 // its axis at t = 5. V = 0, so the centre is lit by the sky alone:

@@ -263,9 +263,9 @@ TEST(SkeletonRead, RejectsAnUnknownFormat) {
 }
 
 TEST(SkeletonRead, RejectsAnUnknownVersion) {
-  EXPECT_EQ(read_error(R"({"format": "sylva-skeleton", "version": 2, "chains": []})"),
-            "plant.skel.json:1:41: error: unsupported version 2 of \"sylva-skeleton\"; this "
-            "reader reads version 1");
+  EXPECT_EQ(read_error(R"({"format": "sylva-skeleton", "version": 3, "chains": []})"),
+            "plant.skel.json:1:41: error: unsupported version 3 of \"sylva-skeleton\"; this "
+            "reader reads versions 1 and 2");
   EXPECT_EQ(read_error(R"({"format": "sylva-skeleton", "version": 1.0, "chains": []})"),
             "plant.skel.json:1:41: error: version must be an integer, got 1.0");
   EXPECT_EQ(read_error(R"({"format": "sylva-skeleton", "version": "1", "chains": []})"),
@@ -578,7 +578,7 @@ TEST(SkeletonValidate, SegmentCountIsJointsMinusOnePerChain) {
 // ---- errors and files -------------------------------------------------------------
 
 TEST(SkeletonErrors, AreDiagnosticsAtTheOffendingValueWithoutSourceLine) {
-  const Expected<Skeleton> result = read_skeleton_json("{\"format\": \"sylva-skeleton\",\n \"version\": 2}", kFile);
+  const Expected<Skeleton> result = read_skeleton_json("{\"format\": \"sylva-skeleton\",\n \"version\": 3}", kFile);
   ASSERT_FALSE(result.ok());
   EXPECT_EQ(result.error().file, kFile);
   EXPECT_EQ(result.error().loc, (SourceLoc{2, 13}));
@@ -621,7 +621,92 @@ TEST_F(SkeletonFileTest, ErrorsInAFileNameTheFileAndPlace) {
   const Expected<Skeleton> result = read_skeleton_file(path);
   ASSERT_FALSE(result.ok());
   EXPECT_EQ(result.error().format(), path + ":1:41: error: unsupported version 3 of \"sylva-skeleton\"; "
-                                            "this reader reads version 1\n");
+                                            "this reader reads versions 1 and 2\n");
+}
+
+// ---- leaves (skeleton.md "Leaves", version 2) ---------------------------------------
+
+// documented_skeleton with two leaves: a triangle on joint [1, 1] and a square on none.
+Skeleton skeleton_with_leaves() {
+  Skeleton sk = documented_skeleton();
+  sk.leaves = {Leaf{ChainParent{1, 1}, 1, {{0.7, 1.7, 0}, {0.9, 1.8, 0.1}, {0.75, 2.0, -0.05}}},
+               Leaf{std::nullopt, 3, {{0, 0, 0}, {0.1, 0, 0}, {0.1, 0.1, 0}, {0, 0.1, 0}}}};
+  return sk;
+}
+
+TEST(SkeletonLeaves, WithLeavesTheFileIsVersion2WithOneLeafPerLineAndReadsBackEqual) {
+  const Skeleton sk = skeleton_with_leaves();
+  const std::string text = write_skeleton_json(sk);
+  EXPECT_NE(text.find("\"version\": 2,"), std::string::npos) << text;
+  EXPECT_NE(text.find("\n  ],\n  \"leaves\": [\n    {\"joint\": [1,1], \"material\": 1, \"vertices\": "
+                      "[[0.7,1.7,0],[0.9,1.8,0.1],[0.75,2,-0.05]]},\n    {\"joint\": null, \"material\": 3, "),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(read_ok(text), sk);
+  EXPECT_EQ(write_skeleton_json(read_ok(text)), text);
+}
+
+TEST(SkeletonLeaves, WithoutLeavesTheFileIsStillVersion1) {
+  const std::string text = write_skeleton_json(documented_skeleton());
+  EXPECT_NE(text.find("\"version\": 1,"), std::string::npos) << text;
+  EXPECT_EQ(text.find("leaves"), std::string::npos) << text;
+}
+
+TEST(SkeletonLeaves, Version1FilesHaveNoLeavesKey) {
+  const std::string e = read_error(R"({"format": "sylva-skeleton", "version": 1, "chains": [], "leaves": []})");
+  EXPECT_NE(e.find("plant.skel.json:1:58: error: unknown key \"leaves\" at the top level"), std::string::npos) << e;
+}
+
+TEST(SkeletonLeaves, BadLeavesAreLocatedAndNamed) {
+  auto file = [](const std::string& leaf) {
+    return "{\"format\": \"sylva-skeleton\", \"version\": 2,\n \"chains\": [{\"parent\": null, \"joints\": "
+           "[[0,0,0,0.1,0],[0,1,0,0.1,0]]}],\n \"leaves\": [" + leaf + "]}";
+  };
+  struct Bad {
+    std::string leaf, says;
+  };
+  const Bad bad[] = {
+      {R"({"joint": [0, 2], "material": 1, "vertices": [[0,0,0],[1,0,0],[0,1,0]]})",
+       "3:23: error: leaf 0: joint [0, 2] is past the end of chain 0 (2 joints)"},
+      {R"({"joint": [1, 0], "material": 1, "vertices": [[0,0,0],[1,0,0],[0,1,0]]})",
+       "3:23: error: leaf 0: joint [1, 0] refers to chain 1 of 1 chain"},
+      {R"({"joint": null, "material": 1, "vertices": [[0,0,0],[1,0,0]]})",
+       "3:56: error: leaf 0: a leaf needs at least 3 distinct vertices, this polygon has 2"},
+      {R"({"joint": null, "material": 1, "vertices": [[0,0,0],[1,0,0],[1,0,0]]})",
+       "this polygon has 2 (3 vertices)"},
+      {R"({"joint": null, "material": 1, "vertices": [[0,0,0],[1,0,0],[1,1,0],[0,1,1]]})",
+       "leaf 0: the polygon is not planar: vertex "},
+      {R"({"joint": null, "material": 1, "vertices": [[0,0,0],[1,0,0],[2,0,0]]})", "no area"},
+      {R"({"joint": null, "material": 1, "vertices": [[0,0,0],[1,0],[2,0,0]]})",
+       "leaf 0: vertex 1 must be an array of 3 numbers"},
+      {R"({"joint": null, "material": -1, "vertices": []})", "leaf 0: material must be an integer"},
+      {R"({"joint": null, "vertices": []})", "leaf 0: missing required key \"material\""},
+      {R"({"joint": null, "material": 0, "vertices": [], "colour": 1})", "unknown key \"colour\""},
+  };
+  for (const Bad& b : bad) EXPECT_NE(read_error(file(b.leaf)).find(b.says), std::string::npos) << read_error(file(b.leaf));
+}
+
+TEST(SkeletonLeaves, ValidateChecksLeavesToo) {
+  Skeleton sk = skeleton_with_leaves();
+  EXPECT_EQ(validate_error(sk), "no error");
+  sk.leaves[0].joint = ChainParent{2, 0};
+  EXPECT_NE(validate_error(sk).find("leaf 0: joint [2, 0] refers to chain 2 of 2 chains"), std::string::npos)
+      << validate_error(sk);
+  sk = skeleton_with_leaves();
+  sk.leaves[1].vertices_m[2][1] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(validate_error(sk).find("leaf 1: vertex 2 is not finite"), std::string::npos) << validate_error(sk);
+}
+
+TEST(SkeletonLeaves, APlanarPolygonPassesAndAFoldedOneDoesNot) {
+  using V = std::array<double, 3>;
+  const std::vector<V> square{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  EXPECT_FALSE(leaf_polygon_problem(square).has_value());
+  std::vector<V> twisted = square;
+  twisted[3][2] = 0.01;  // 0.25 % of the diagonal off the plane (as a fitted plane sees it)
+  EXPECT_FALSE(leaf_polygon_problem(twisted).has_value());
+  twisted[3][2] = 0.5;
+  ASSERT_TRUE(leaf_polygon_problem(twisted).has_value());
+  EXPECT_NE(leaf_polygon_problem(twisted)->find("not planar"), std::string::npos);
 }
 
 }  // namespace

@@ -18,6 +18,16 @@ inline Skeleton cylinder(double radius, double y0, double y1, uint32_t material 
   return sk;
 }
 
+// A wood stem (material 0, radius 0.3 m at x = −0.7) and a needle-coloured one (material
+// 1, radius 0.2 m at x = +0.7), each a root chain from y = 0 to 2: the sun (from +x, +y)
+// throws neither's shadow on the other, so a bark on the wood changes no needle pixel.
+inline Skeleton wood_and_needle() {
+  Skeleton sk;
+  sk.joints = {{{-0.7, 0, 0}, 0.3, 0}, {{-0.7, 2, 0}, 0.3, 0}, {{0.7, 0, 0}, 0.2, 1}, {{0.7, 2, 0}, 0.2, 1}};
+  sk.chains = {{0, 2, std::nullopt}, {2, 2, std::nullopt}};
+  return sk;
+}
+
 // One plant `sk` at the origin, width × height pixels, the camera at `eye` looking at
 // `target` (40° vertical field of view, +Y up), the ground at `ground_height` (far below
 // by default), a point sun (angular radius 0) in the default direction.

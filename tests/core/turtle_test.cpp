@@ -706,5 +706,81 @@ TEST(GrowProgress, CancellingMidTurtleStopsWithTheCancelledResult) {
   EXPECT_TRUE(build_skeleton(*word, *grammar).ok());
 }
 
+// ---- Polygons and leaves (grammar.md `{ . }`, `G`; skeleton.md "Leaves") ---------------
+
+TEST(TurtleLeaves, GrammarMdsPolygonIsOneLeafOnTheJointTheTurtleStoodOnAndfDoesNotEndTheChain) {
+  const Skeleton sk = skeleton_of("angle: 45\naxiom: F{.-f.+f.+f.-|-f.+f.+f.}F\n");
+  ASSERT_EQ(sk.leaves.size(), 1u);
+  const Leaf& leaf = sk.leaves[0];
+  EXPECT_EQ(leaf.joint, parent(0, 1));
+  EXPECT_EQ(leaf.material, 0u);
+  ASSERT_EQ(leaf.vertices_m.size(), 7u);  // one per '.'
+  EXPECT_TRUE(near(leaf.vertices_m[0], {0, 1, 0}));  // '.' right after F: the joint's position
+  for (const auto& v : leaf.vertices_m) EXPECT_NEAR(v[2], 0, kTolerance);  // turns about U: the XY plane
+  EXPECT_FALSE(leaf_polygon_problem(leaf.vertices_m).has_value());
+  // The f moves inside the polygon did not end chain 0: the last F continues it.
+  ASSERT_EQ(sk.chains.size(), 1u);
+  EXPECT_EQ(sk.chains[0].joint_count, 3u);
+}
+
+TEST(TurtleLeaves, TheMaterialIsTheOneInForceAtTheClosingBrace) {
+  const Skeleton sk = skeleton_of("axiom: F'(1){.f.+f.'(3)}\n");
+  ASSERT_EQ(sk.leaves.size(), 1u);
+  EXPECT_EQ(sk.leaves[0].material, 3u);
+}
+
+TEST(TurtleLeaves, APolygonBeforeTheFirstFHangsFromNoJoint) {
+  const Skeleton sk = skeleton_of("axiom: {.f.+f.}\n");
+  ASSERT_EQ(sk.leaves.size(), 1u);
+  EXPECT_EQ(sk.leaves[0].joint, std::nullopt);
+  EXPECT_TRUE(sk.chains.empty());
+}
+
+TEST(TurtleLeaves, PolygonsNestAndTheInnerClosesFirst) {
+  const Skeleton sk = skeleton_of("axiom: F{.f.{.+f.+f.}f.}\n");
+  ASSERT_EQ(sk.leaves.size(), 2u);
+  EXPECT_EQ(sk.leaves[0].vertices_m.size(), 3u);  // the inner one
+  EXPECT_TRUE(near(sk.leaves[0].vertices_m[0], {0, 2, 0}));
+  EXPECT_EQ(sk.leaves[1].vertices_m.size(), 3u);
+  EXPECT_TRUE(near(sk.leaves[1].vertices_m[0], {0, 1, 0}));
+  EXPECT_EQ(sk.leaves[0].joint, sk.leaves[1].joint);
+}
+
+TEST(TurtleLeaves, InABranchTheLeafHangsFromTheBranchPoint) {
+  const Skeleton sk = skeleton_of("axiom: FF[+F{.f.+f.}]F\n");
+  ASSERT_EQ(sk.leaves.size(), 1u);
+  EXPECT_EQ(sk.leaves[0].joint, parent(1, 1));  // the lateral chain's tip
+}
+
+TEST(TurtleLeaves, GMovesWithoutDrawingAndWithoutEndingTheChain) {
+  const Skeleton sk = skeleton_of("axiom: FG(2)F\n");
+  ASSERT_EQ(sk.chains.size(), 1u);
+  ASSERT_EQ(sk.chains[0].joint_count, 3u);
+  EXPECT_TRUE(near(position_at(sk, 0, 2), {0, 4, 0}));
+  EXPECT_EQ(sk.segment_count(), 2u);  // the G gap is no segment of its own: F's segment spans it
+}
+
+TEST(TurtleLeaves, PolygonsThatCannotBeLeavesAreErrorsNamingTheClosingModule) {
+  struct Bad {
+    const char* word;
+    const char* says;
+    const char* module;  // "module N (...)" of the interpreted word
+  };
+  const Bad bad[] = {
+      {"F{.f.}", "at least 3 distinct vertices, this polygon has 2", "module 5 (})"},
+      {"F{...}", "at least 3 distinct vertices, this polygon has 1", "module 5 (})"},
+      {"{.f.f.}", "no area", "module 6 (})"},
+      {"{.f.+f.+f&f.}", "not planar: vertex", "module 12 (})"},
+      {"F}", "'}' without matching '{'", "module 1 (})"},
+      {"F{.f.+f.", "'{' without matching '}'", "module 1 ({)"},
+  };
+  for (const Bad& b : bad) {
+    const std::string message = grow_error(std::string("angle: 90\naxiom: ") + b.word + "\n");
+    EXPECT_NE(message.find("test.lsys"), std::string::npos) << b.word << ": " << message;
+    EXPECT_NE(message.find(b.says), std::string::npos) << b.word << ": " << message;
+    EXPECT_NE(message.find(b.module), std::string::npos) << b.word << ": " << message;
+  }
+}
+
 }  // namespace
 }  // namespace sylva

@@ -47,6 +47,10 @@ TEST(RenderShading, TheSpecularPeakWithTheSunBehindTheCamera) {
   expect_pixels(test::specular_peak_scene(), {test::kSpecularPeak});
 }
 
+TEST(RenderShading, TheScenesMaterialTableGivesAlbedoAndSpecularWeight) {
+  expect_pixels(test::material_table_scene(), {test::kMaterialTablePeak});
+}
+
 TEST(RenderShading, AShadowedPointIsLitByTheSkyAlone) {
   expect_pixels(test::shadowed_cylinder_scene(), {test::kShadowedCylinder});
 }

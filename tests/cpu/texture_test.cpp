@@ -147,15 +147,14 @@ TEST(Texture, ATextureThatCannotBeOpenedIsAnErrorNamingTheFile) {
   EXPECT_FALSE(check_image_opens(dir.file("missing.png")).ok());
 }
 
-TEST(Texture, ConstantAlbedoTextureCoversEveryMaterialAndDecodesSrgb) {
+TEST(Texture, ConstantAlbedoTextureDecodesSrgb) {
   // An sRGB texture of one colour renders exactly like that colour given as a linear
-  // constant: filtering a constant changes nothing, decoding happens after filtering, and
-  // the texture replaces the material colour of material 1 too.
+  // constant: filtering a constant changes nothing, decoding happens after filtering.
   test::TempFolder dir;
   const std::string path = dir.file("bark.png");
   const std::array<float, 3> encoded{128 / 255.0f, 64 / 255.0f, 200 / 255.0f};
   test::write_rgb_png(path, 8, 4, [&](uint32_t, uint32_t) { return encoded; });
-  Scene textured = scene_around(cylinder(0.5, 0, 2, 1), {0, 1, 5}, {0, 1, 0}, 64, 48);
+  Scene textured = scene_around(cylinder(0.5, 0, 2, 0), {0, 1, 5}, {0, 1, 0}, 64, 48);
   textured.plants[0].bark.albedo_texture = path;
   textured.plants[0].bark.u_repeat = 3;
   Scene constant = scene_around(cylinder(0.5, 0, 2, 0), {0, 1, 5}, {0, 1, 0}, 64, 48);
@@ -215,6 +214,44 @@ TEST(Texture, CheckerTextureShowsInTheRenderAndItsFootprintBlursWithDistance) {
   const double far = spread(1, 4000);     // ~90 squares per pixel
   EXPECT_GT(near, 0.2);
   EXPECT_LT(far, 0.25 * near);
+}
+
+TEST(Texture, BarkCoversTheWoodOnlyAndNeedlesKeepTheirColour) {
+  // materials.h: a plant's bark (albedo texture, colour, height map) is material 0's. With
+  // every bark key set, each needle pixel (material 1) is what it is without a bark —
+  // on the frusta (relief marching) and on the displaced mesh — while the wood changes.
+  const std::string textures = std::string(SYLVA_SOURCE_DIR) + "/presets/textures/";
+  const Scene plain = scene_around(test::wood_and_needle(), {0, 1, 5}, {0, 1, 0}, 96, 72);
+  for (const bool textured : {true, false}) {
+    Scene barked = plain;
+    Bark& bark = barked.plants[0].bark;
+    if (textured) bark.albedo_texture = textures + "bark.png";
+    else bark.albedo_rgb = glm::dvec3(0.9, 0.1, 0.1);
+    bark.height_texture = textures + "bark_height.png";
+    bark.relief_depth_m = 0.04;
+    bark.u_repeat = 3;
+    for (const GeometryKind kind : {GeometryKind::frusta, GeometryKind::mesh}) {
+      RenderOptions o;
+      o.threads = 2;
+      o.aovs = kAovDepth | kAovId;
+      o.geometry.kind = kind;
+      o.geometry.displace = true;
+      const RenderResult a = render_cpu(barked, o), b = render_cpu(plain, o);
+      size_t needle = 0, wood_changed = 0;
+      for (size_t p = 0; p < a.image.depth.size(); ++p) {
+        if (a.image.id[3 * p + 1] == 1) {
+          ++needle;
+          ASSERT_EQ(b.image.id[3 * p + 1], 1) << p;
+          EXPECT_EQ(a.image.depth[p], b.image.depth[p]) << p;
+          for (int k = 0; k < 3; ++k) EXPECT_EQ(a.image.beauty[4 * p + k], b.image.beauty[4 * p + k]) << p;
+        } else if (a.image.id[3 * p + 1] == 0) {
+          wood_changed += std::abs(a.image.beauty[4 * p] - b.image.beauty[4 * p]) > 0.01f;
+        }
+      }
+      EXPECT_GT(needle, 300u);
+      EXPECT_GT(wood_changed, 300u) << "the bark shows on the wood";
+    }
+  }
 }
 
 }  // namespace

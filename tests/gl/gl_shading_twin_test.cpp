@@ -39,13 +39,13 @@ void main() {
   for (uint k = 0u; k < 7u; ++k) c[k] = cases[7u * i + k];
   vec3 albedo = c[0].xyz, n = c[1].xyz, n_geometric = c[2].xyz, l = c[3].xyz, view = c[4].xyz;
   vec3 sky = c[5].xyz, sun = c[6].xyz;
-  bool specular = c[0].w > 0.5;
+  float specular = c[0].w;
   float visibility = c[1].w;
   float cos_sun = sun_cosine(n, n_geometric, l);
-  vec3 brdf = surface_brdf(albedo, n, l, view, true);
+  vec3 brdf = surface_brdf(albedo, n, l, view, 1.0);
   results[6u * i + 0u] = vec4(sky_ambient(albedo, n, sky), cos_sun);
   results[6u * i + 1u] = vec4(brdf, blinn_phong(n, l, view));
-  results[6u * i + 2u] = vec4(surface_brdf(albedo, n, l, view, false), ground_distance(c[2].w, c[3].w));
+  results[6u * i + 2u] = vec4(surface_brdf(albedo, n, l, view, 0.0), ground_distance(c[2].w, c[3].w));
   results[6u * i + 3u] = vec4(sun_reflected(brdf, sun, cos_sun, visibility), 0.0);
   results[6u * i + 4u] =
       vec4(surface_radiance(albedo, n, l, view, specular, sky, sun, cos_sun, visibility), 0.0);
@@ -79,7 +79,7 @@ GLuint compute_program(std::string* log) {
 
 struct Case {
   glm::vec3 albedo, n, n_geometric, l, view, sky, sun;
-  bool specular = true;
+  float specular = 1;  // the lobe's weight (a material's `specular`, 0 for the ground)
   float visibility = 1, above_ground = 1, direction_y = -1;
 };
 
@@ -153,7 +153,8 @@ TEST(GlShadingTwin, EveryShadingFunctionMatchesItsCppTwin) {
     c.view = glm::vec3(view);
     c.sky = glm::vec3(uniform(), uniform(), uniform());
     c.sun = glm::vec3(10 * uniform(), 10 * uniform(), 10 * uniform());
-    c.specular = uniform() < 0.7;
+    const double w = uniform();
+    c.specular = static_cast<float>(w < 0.3 ? 0.0 : w < 0.7 ? 1.0 : uniform());
     const double v = uniform();
     c.visibility = static_cast<float>(v < 0.2 ? 0.0 : v < 0.6 ? 1.0 : uniform());
     c.above_ground = static_cast<float>(20 * uniform() - 2);
@@ -162,7 +163,7 @@ TEST(GlShadingTwin, EveryShadingFunctionMatchesItsCppTwin) {
   }
   std::vector<glm::vec4> in;
   for (const Case& c : cases)
-    in.insert(in.end(), {glm::vec4(c.albedo, c.specular ? 1 : 0), glm::vec4(c.n, c.visibility),
+    in.insert(in.end(), {glm::vec4(c.albedo, c.specular), glm::vec4(c.n, c.visibility),
                          glm::vec4(c.n_geometric, c.above_ground), glm::vec4(c.l, c.direction_y),
                          glm::vec4(c.view, 0), glm::vec4(c.sky, 0), glm::vec4(c.sun, 0)});
 

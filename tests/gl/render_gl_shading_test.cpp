@@ -50,6 +50,11 @@ TEST(RenderGlShading, TheSpecularPeakWithTheSunBehindTheCamera) {
   expect_pixels(test::specular_peak_scene(), {test::kSpecularPeak});
 }
 
+TEST(RenderGlShading, TheScenesMaterialTableGivesAlbedoAndSpecularWeight) {
+  SYLVA_REQUIRE_GL();
+  expect_pixels(test::material_table_scene(), {test::kMaterialTablePeak});
+}
+
 TEST(RenderGlShading, AShadowedPointIsLitByTheSkyAlone) {
   SYLVA_REQUIRE_GL();
   expect_pixels(test::shadowed_cylinder_scene(), {test::kShadowedCylinder});

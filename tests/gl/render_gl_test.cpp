@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <map>
 
+#include "tests/core/test_scenes.h"
 #include "tests/gl/gl_test_util.h"
 
 namespace sylva {
@@ -313,6 +314,65 @@ TEST(RenderGl, GrazingReliefHasNoNaNAndMatchesTheCpu) {
     const Agreement a = expect_matches_cpu(name, scene);
     EXPECT_EQ(a.nan_pixels, 0u) << name;
   }
+}
+
+TEST(RenderGl, BarkCoversTheWoodOnlyAndNeedlesKeepTheirColour) {
+  SYLVA_REQUIRE_GL();
+  // materials.h: the bark (albedo texture, height map) is material 0's. On the frusta
+  // (relief marching) and on the displaced mesh, every needle pixel (material 1) is what
+  // it is without a bark while the wood changes, and the barked scene matches the CPU.
+  const Scene plain = gl_test::scene_around(test::wood_and_needle(), 128, 96);
+  Scene barked = plain;
+  Bark& bark = barked.plants.front().bark;
+  bark.albedo_texture = texture_path("bark.png");
+  bark.height_texture = texture_path("bark_height.png");
+  bark.relief_depth_m = 0.04;
+  bark.u_repeat = 3;
+  for (const GeometryKind kind : {GeometryKind::frusta, GeometryKind::mesh}) {
+    RenderOptions o;
+    o.aovs = kAovDepth | kAovId;
+    o.geometry.kind = kind;
+    const RenderResult a = render_gl(barked, o), b = render_gl(plain, o);
+    size_t needle = 0, needle_changed = 0, wood_changed = 0;
+    for (size_t p = 0; p < a.image.depth.size(); ++p) {
+      if (a.image.id[3 * p + 1] == 1 && b.image.id[3 * p + 1] == 1) {
+        ++needle;
+        // The RELIEF program variant rounds the exact intersection its own way (float).
+        EXPECT_NEAR(a.image.depth[p], b.image.depth[p], 1e-5f * b.image.depth[p]) << p;
+        float d = 0;
+        for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(a.image.beauty[4 * p + k] - b.image.beauty[4 * p + k]));
+        needle_changed += d > 1e-4f;
+      } else if (a.image.id[3 * p + 1] == 0) {
+        wood_changed += std::abs(a.image.beauty[4 * p] - b.image.beauty[4 * p]) > 0.01f;
+      }
+    }
+    EXPECT_GT(needle, 400u);
+    EXPECT_EQ(needle_changed, 0u) << "needle pixels changed by the bark";
+    EXPECT_GT(wood_changed, 400u) << "the bark shows on the wood";
+  }
+  expect_matches_cpu("bark_wood_only", barked);
+}
+
+TEST(RenderGl, TheScenesMaterialTableMatchesTheCpu) {
+  SYLVA_REQUIRE_GL();
+  // docs/materials.md: the table's albedo and specular weight on the needle (material 1)
+  // and the wood (0) under a bark colour, which comes first on the wood.
+  Scene scene = gl_test::scene_around(test::wood_and_needle(), 128, 96);
+  scene.materials[1] = SceneMaterial{glm::dvec3(0.6, 0.1, 0.5), 0.2};
+  scene.materials[0] = SceneMaterial{glm::dvec3(0.1, 0.1, 0.9), 0};
+  scene.plants.front().bark.albedo_rgb = glm::dvec3(0.8, 0.7, 0.1);
+  RenderOptions o;
+  o.aovs = kAovDepth | kAovId;
+  const RenderResult gl = render_gl(scene, o);
+  size_t needle = 0, wood = 0;
+  for (size_t p = 0; p < gl.image.depth.size(); ++p) {
+    const float* px = &gl.image.beauty[4 * p];
+    if (gl.image.id[3 * p + 1] == 1) needle += px[0] > 2 * px[1] && px[2] > 2 * px[1];  // magenta
+    if (gl.image.id[3 * p + 1] == 0) wood += px[0] > 4 * px[2] && px[1] > 4 * px[2];    // the bark's yellow
+  }
+  EXPECT_GT(needle, 400u);
+  EXPECT_GT(wood, 400u);
+  expect_matches_cpu("material_table", scene);
 }
 
 // A bundled scene (presets/scenes/) at a small size.

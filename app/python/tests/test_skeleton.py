@@ -123,3 +123,25 @@ def test_missing_skeleton_file_raises_file_not_found(tmp_path):
 def test_repr_names_grammar_seed_and_counts(elm):
     r = repr(elm)
     assert "elm.lsys" in r and "seed=7" in r and f"{elm.segment_count} segments" in r
+
+
+def test_leaves_are_arrays_matching_the_json():
+    # grammar.md's polygons become leaves (skeleton.md "Leaves", version 2).
+    sk = sylva.Grammar("angle: 60\naxiom: F[&F'(1){.+f.-f.-f.}]F{.+f.-f.-f.+|+f.-f.}\n").grow()
+    assert sk.leaf_count == 2
+    assert sk.leaves.dtype.names == ("first_vertex", "vertex_count", "chain", "joint", "material")
+    assert sk.leaves.dtype["material"] == np.uint32
+    doc = json.loads(sk.to_json())
+    assert doc["version"] == 2
+    np.testing.assert_array_equal(sk.leaves["vertex_count"], [len(leaf["vertices"]) for leaf in doc["leaves"]])
+    np.testing.assert_array_equal(sk.leaves["first_vertex"], [0, len(doc["leaves"][0]["vertices"])])
+    np.testing.assert_array_equal(sk.leaves["material"], [leaf["material"] for leaf in doc["leaves"]])
+    joints = [leaf["joint"] or [-1, -1] for leaf in doc["leaves"]]
+    np.testing.assert_array_equal(np.stack([sk.leaves["chain"], sk.leaves["joint"]], 1), joints)
+    np.testing.assert_array_equal(sk.leaf_vertices, [v for leaf in doc["leaves"] for v in leaf["vertices"]])
+    assert sk.leaf_vertices.shape == (sum(sk.leaves["vertex_count"]), 3)
+
+
+def test_a_skeleton_without_leaves_has_empty_leaf_arrays(elm):
+    assert elm.leaf_count == 0
+    assert elm.leaves.shape == (0,) and elm.leaf_vertices.shape == (0, 3)
