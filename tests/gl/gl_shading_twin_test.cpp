@@ -57,24 +57,7 @@ GLuint compute_program(std::string* log) {
   std::string text = "#version 450 core\n";
   for (const std::string& define : shading_defines()) text += "#define " + define + "\n";
   text += "#line 1 0\n" + std::string(embedded_shader("shading.glsl")) + "#line 1 1\n" + kTwinMain;
-  const GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
-  const char* pointer = text.c_str();
-  glShaderSource(shader, 1, &pointer, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  char buffer[4096] = {0};
-  glGetShaderInfoLog(shader, sizeof buffer, nullptr, buffer);
-  *log = buffer;
-  const GLuint program = glCreateProgram();
-  glAttachShader(program, shader);
-  glLinkProgram(program);
-  glDeleteShader(shader);
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    glDeleteProgram(program);
-    return 0;
-  }
-  return program;
+  return gl_test::compile_compute_program(text, log);
 }
 
 struct Case {

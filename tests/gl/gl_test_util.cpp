@@ -10,6 +10,7 @@
 
 #include "core/util/color.h"
 #include "core/util/image_io.h"
+#include "core/gl/gl_api.h"
 #include "core/gl/render_gl.h"
 
 namespace sylva::gl_test {
@@ -19,6 +20,27 @@ GlContext* shared_context(std::string* why) {
   if (!made.context && why) *why = made.error;
   if (made.context) made.context->make_current();
   return made.context.get();
+}
+
+unsigned compile_compute_program(const std::string& text, std::string* log) {
+  const GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
+  const char* pointer = text.c_str();
+  glShaderSource(shader, 1, &pointer, nullptr);
+  glCompileShader(shader);
+  char buffer[4096] = {0};
+  glGetShaderInfoLog(shader, sizeof buffer, nullptr, buffer);
+  *log = buffer;
+  const GLuint program = glCreateProgram();
+  glAttachShader(program, shader);
+  glLinkProgram(program);
+  glDeleteShader(shader);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    glDeleteProgram(program);
+    return 0;
+  }
+  return program;
 }
 
 Scene scene_around(const Skeleton& skeleton, uint32_t width, uint32_t height) {

@@ -26,6 +26,11 @@ GlContext* shared_context(std::string* why);
       GTEST_SKIP() << "no OpenGL 4.5 core context through EGL: " << why_no_gl;         \
   } while (0)
 
+// A compute program from the whole GLSL `text` (the GlTwin tests: shader files under test
+// plus a main that runs them case by case); 0 when it does not compile or link, with the
+// compiler's log in *log either way.
+unsigned compile_compute_program(const std::string& text, std::string* log);
+
 // A scene around `skeleton`: 256×192 unless given, the default scene's camera and sun.
 Scene scene_around(const Skeleton& skeleton, uint32_t width = 256, uint32_t height = 192);
 

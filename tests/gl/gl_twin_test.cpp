@@ -43,25 +43,7 @@ void main() {
 GLuint compute_program(std::string* log) {
   const std::string text = "#version 450 core\n#line 1 0\n" + std::string(embedded_shader("ray_frustum.glsl")) +
                            "#line 1 1\n" + std::string(embedded_shader("skin.glsl")) + "#line 1 2\n" + kTwinMain;
-  const GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
-  const char* pointer = text.c_str();
-  glShaderSource(shader, 1, &pointer, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  char buffer[4096] = {0};
-  glGetShaderInfoLog(shader, sizeof buffer, nullptr, buffer);
-  *log = buffer;
-  const GLuint program = glCreateProgram();
-  glAttachShader(program, shader);
-  glLinkProgram(program);
-  glDeleteShader(shader);
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    glDeleteProgram(program);
-    return 0;
-  }
-  return program;
+  return gl_test::compile_compute_program(text, log);
 }
 
 TEST(GlTwin, UnpackAndIntersectMatchTheCppFloatTwin) {
