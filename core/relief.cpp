@@ -16,6 +16,7 @@
 #include <numbers>
 
 #include "core/recentre.h"
+#include "core/solid_bounds.h"
 #include "core/util/math.h"
 
 namespace sylva {
@@ -44,26 +45,7 @@ LocalRay local_ray(const Ray& ray, const FrustumShape& shape) {
   return {recentred.origin, ray.direction, recentred.shift};
 }
 
-// A half-line or interval bound with the boundary that made it.
-struct Bounds {
-  double lo = -kInf, hi = kInf;
-  SolidBoundary lo_by = SolidBoundary::range, hi_by = SolidBoundary::range;
-  void at_least(double t, SolidBoundary by) {
-    if (t > lo) lo = t, lo_by = by;
-  }
-  void at_most(double t, SolidBoundary by) {
-    if (t < hi) hi = t, hi_by = by;
-  }
-  bool empty() const { return !(lo <= hi); }
-};
-
-// Restricts `b` to a·t >= c (a linear constraint); false when nothing is left.
-bool linear_at_least(Bounds& b, double a, double c, SolidBoundary by) {
-  if (a > 0) b.at_least(c / a, by);
-  else if (a < 0) b.at_most(c / a, by);
-  else if (!(0 >= c)) return false;  // 0 >= c everywhere or nowhere
-  return !b.empty();
-}
+using solid_bounds::Bounds;
 
 // The solid interval in local t (before clamping to the caller's range).
 struct LocalInterval {
@@ -79,10 +61,10 @@ LocalInterval local_solid_interval(const FrustumShape& s, const LocalRay& r, dou
   const glm::dvec3& d = r.dir;
   Bounds b;
   // Slab: dot(nl, p) >= lower_offset, dot(nu, p) <= upper_offset.
-  if (!linear_at_least(b, glm::dot(s.lower.normal, d), lower_offset - glm::dot(s.lower.normal, o),
+  if (!b.linear_at_least(glm::dot(s.lower.normal, d), lower_offset - glm::dot(s.lower.normal, o),
                        SolidBoundary::lower))
     return out;
-  if (!linear_at_least(b, -glm::dot(s.upper.normal, d), glm::dot(s.upper.normal, o) - upper_offset,
+  if (!b.linear_at_least(-glm::dot(s.upper.normal, d), glm::dot(s.upper.normal, o) - upper_offset,
                        SolidBoundary::upper))
     return out;
   // Nappe: r(y) = ρ + k·dy·t >= 0.
@@ -91,7 +73,7 @@ LocalInterval local_solid_interval(const FrustumShape& s, const LocalRay& r, dou
   const double dir_y = glm::dot(d, s.axis);
   const double rho = s.radius0 + slope * origin_y;
   const double slope_dir_y = slope * dir_y;
-  if (!linear_at_least(b, slope_dir_y, -rho, SolidBoundary::side)) return out;
+  if (!b.linear_at_least(slope_dir_y, -rho, SolidBoundary::side)) return out;
   // Cone: f(t) = A t² + 2 half_b t + C <= 0, coefficients exactly as intersect_frustum's.
   const glm::dvec3 origin_perp = o - origin_y * s.axis;
   const glm::dvec3 dir_perp = d - dir_y * s.axis;
@@ -103,7 +85,7 @@ LocalInterval local_solid_interval(const FrustumShape& s, const LocalRay& r, dou
   const double discriminant = glm::dot(radial_term, radial_term) - glm::dot(moment, moment);
   if (A == 0) {
     // Linear: 2 half_b t + C <= 0.
-    if (!linear_at_least(b, -2 * half_b, C, SolidBoundary::side)) return out;
+    if (!b.linear_at_least(-2 * half_b, C, SolidBoundary::side)) return out;
   } else if (!(discriminant >= 0)) {
     // No real root: f keeps A's sign. A < 0 here means the whole line (rounding near
     // the apex; the nappe bound above keeps one nappe).
@@ -129,21 +111,7 @@ LocalInterval local_solid_interval(const FrustumShape& s, const LocalRay& r, dou
     const double direct_bound = (eps * (std::abs(half_b) + root) + half_b_error + root_error) / std::abs(A);
     double r1 = pair_bound <= direct_bound ? C / q : (-half_b + sign_b * root) / A;
     if (r1 < r0) std::swap(r0, r1);
-    if (A > 0) {
-      b.at_least(r0, SolidBoundary::side);
-      b.at_most(r1, SolidBoundary::side);
-      if (b.empty()) return out;
-    } else {
-      // Outside the roots: (−∞, r0] ∪ [r1, ∞). The nappe bound leaves one of them (both
-      // only for a ray through the apex, where the longer is kept).
-      Bounds first = b, second = b;
-      first.at_most(r0, SolidBoundary::side);
-      second.at_least(r1, SolidBoundary::side);
-      const bool first_ok = !first.empty(), second_ok = !second.empty();
-      if (!first_ok && !second_ok) return out;
-      if (first_ok && second_ok) b = (first.hi - first.lo >= second.hi - second.lo) ? first : second;
-      else b = first_ok ? first : second;
-    }
+    if (!b.inside_quadric(A, r0, r1)) return out;
   }
   if (!std::isfinite(b.lo) || !std::isfinite(b.hi)) return out;  // degenerate (NaN, unbounded)
   out.hit = true;

@@ -15,6 +15,7 @@
 
 #include "core/relief.h"
 #include "core/skin.h"
+#include "core/solid_bounds.h"
 #include "core/util/math.h"
 
 namespace sylva {
@@ -65,25 +66,7 @@ FrustumShape cone_local_shape(const ShadowCone& cone) {
 
 namespace {
 
-// A half-line or interval bound of t with the boundary that made it (relief.cpp's).
-struct Bounds {
-  double lo = -kInf, hi = kInf;
-  SolidBoundary lo_by = SolidBoundary::range, hi_by = SolidBoundary::range;
-  void at_least(double t, SolidBoundary by) {
-    if (t > lo) lo = t, lo_by = by;
-  }
-  void at_most(double t, SolidBoundary by) {
-    if (t < hi) hi = t, hi_by = by;
-  }
-  bool empty() const { return !(lo <= hi); }
-  // Restricts to a·t >= c; false when nothing is left.
-  bool linear_at_least(double a, double c, SolidBoundary by) {
-    if (a > 0) at_least(c / a, by);
-    else if (a < 0) at_most(c / a, by);
-    else if (!(0 >= c)) return false;
-    return !empty();
-  }
-};
+using solid_bounds::Bounds;
 
 }  // namespace
 
@@ -144,20 +127,7 @@ SolidInterval ShadowConeGeometry::interval(const Ray& ray, double t_min, double 
     }
     double r1 = pair ? C / q : (-half_b + sign_b * root) / A;
     if (r1 < r0) std::swap(r0, r1);
-    if (A > 0) {
-      b.at_least(r0, SolidBoundary::side);
-      b.at_most(r1, SolidBoundary::side);
-      if (b.empty()) return out;
-    } else {
-      // Outside the roots; the nappe bound leaves one half-line (the longer where both).
-      Bounds first = b, second = b;
-      first.at_most(r0, SolidBoundary::side);
-      second.at_least(r1, SolidBoundary::side);
-      const bool first_ok = !first.empty(), second_ok = !second.empty();
-      if (!first_ok && !second_ok) return out;
-      if (first_ok && second_ok) b = (first.hi - first.lo >= second.hi - second.lo) ? first : second;
-      else b = first_ok ? first : second;
-    }
+    if (!b.inside_quadric(A, r0, r1)) return out;
   }
   if (!std::isfinite(b.lo) || !std::isfinite(b.hi)) return out;
   out.t_enter = shift + b.lo, out.enter = b.lo_by;
