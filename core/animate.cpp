@@ -116,4 +116,19 @@ void sway_scene_plants(Scene& scene, const std::vector<Skeleton>& rest, double t
   }
 }
 
+SwayParameters sway_parameters_of(const SceneAnimation& animation) {
+  SwayParameters p;
+  p.wind_direction = animation.wind;
+  p.amplitude_deg = animation.amplitude_deg;
+  p.frequency_hz = animation.frequency_hz;
+  p.branch_amplitude_deg = animation.branch_amplitude_deg;
+  p.branch_frequency_hz = animation.branch_frequency_hz;
+  p.seed = animation.seed;
+  return p;
+}
+
+double animation_frame_time_s(const SceneAnimation& animation, uint64_t frame) {
+  return static_cast<double>(frame) / animation.fps;
+}
+
 }  // namespace sylva

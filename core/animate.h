@@ -60,4 +60,11 @@ Skeleton sway_skeleton(const Skeleton& rest, double t_s, const SwayParameters& p
 void sway_scene_plants(Scene& scene, const std::vector<Skeleton>& rest, double t_s,
                        const SwayParameters& parameters);
 
+// The sway of a scene's `animation` key (docs/animation.md): its wind, amplitudes,
+// frequencies and seed.
+SwayParameters sway_parameters_of(const SceneAnimation& animation);
+
+// The time of frame `frame` of an animation: frame / fps seconds.
+double animation_frame_time_s(const SceneAnimation& animation, uint64_t frame);
+
 }  // namespace sylva

@@ -321,10 +321,50 @@ Fog read_fog(const JsonValue& v, double ground_height) {
   return f;
 }
 
+// The `animation` object (docs/animation.md): `motion` first sets the defaults, then each
+// key present replaces its own; every value out of range is reported at the value.
+SceneAnimation read_animation(const JsonValue& v) {
+  expect_object(v, "animation");
+  check_keys(v, "animation",
+             {"motion", "fps", "duration_s", "wind", "amplitude_deg", "frequency_hz", "branch_amplitude_deg",
+              "branch_frequency_hz", "seed"});
+  SceneAnimation a;
+  if (auto* m = v.find("motion")) {
+    if (!m->is_string() || (m->text != "sway" && m->text != "dance"))
+      fail(*m, std::string("animation.motion must be \"sway\" or \"dance\", not ") +
+                   (m->is_string() ? json_excerpt(m->text) : std::string(m->kind_name())));
+    a = animation_defaults(m->text == "dance" ? AnimationMotion::dance : AnimationMotion::sway);
+  }
+  if (auto* x = v.find("fps")) a.fps = number_in(*x, "animation.fps", 0, 1000, true, false);
+  if (auto* x = v.find("duration_s")) a.duration_s = number_in(*x, "animation.duration_s", 0, 1e6, true, false);
+  if (auto* x = v.find("wind")) {
+    a.wind = vec3(*x, "animation.wind");
+    for (int k = 0; k < 3; ++k)
+      if (!(std::abs(a.wind[k]) <= 1e6))
+        fail(x->elements[k], "animation.wind components must be within ±1e6, not " + x->elements[k].text);
+  }
+  if (auto* x = v.find("amplitude_deg")) a.amplitude_deg = number_in(*x, "animation.amplitude_deg", 0, 90, false, false);
+  if (auto* x = v.find("frequency_hz")) a.frequency_hz = number_in(*x, "animation.frequency_hz", 0, 100, false, false);
+  if (auto* x = v.find("branch_amplitude_deg"))
+    a.branch_amplitude_deg = number_in(*x, "animation.branch_amplitude_deg", 0, 90, false, false);
+  if (auto* x = v.find("branch_frequency_hz"))
+    a.branch_frequency_hz = number_in(*x, "animation.branch_frequency_hz", 0, 100, false, false);
+  if (auto* x = v.find("seed")) {
+    auto n = x->as_uint64();
+    if (!n) fail(*x, "animation.seed must be an integer from 0 to 18446744073709551615");
+    a.seed = *n;
+  }
+  if (!(a.duration_s * a.fps <= static_cast<double>(kMaxAnimationFrames)))
+    fail(v, "animation: duration_s × fps asks for more than " + std::to_string(kMaxAnimationFrames) +
+                " frames (docs/limits.md)");
+  return a;
+}
+
 Scene read_scene(const JsonValue& root, const std::string& base_dir) {
   expect_object(root, "a scene");
   check_keys(root, "the scene",
-             {"format", "version", "camera", "image", "sun", "sky", "ground", "fog", "materials", "plants"});
+             {"format", "version", "camera", "image", "sun", "sky", "ground", "fog", "animation", "materials",
+              "plants"});
   Scene s;
   if (auto* x = root.find("format"); x && !(x->is_string() && x->text == "sylva-scene"))
     fail(*x, "format must be \"sylva-scene\"");
@@ -348,6 +388,7 @@ Scene read_scene(const JsonValue& root, const std::string& base_dir) {
     if (auto* a = x->find("albedo")) s.ground.albedo = colour(*a, "ground.albedo");
   }
   if (auto* x = root.find("fog")) s.fog = read_fog(*x, s.ground.height);
+  if (auto* x = root.find("animation")) s.animation = read_animation(*x);
   if (auto* x = root.find("materials")) s.materials = read_materials(*x);
   const JsonValue* plants = root.find("plants");
   if (!plants) fail(root, "a scene needs \"plants\" (an array of plants)");
@@ -582,6 +623,20 @@ void write_fog(JsonWriter& w, const Fog& f) {
   w.end_object();
 }
 
+void write_animation(JsonWriter& w, const SceneAnimation& a) {
+  w.key("animation").begin_object(Layout::spaced);
+  w.key("motion").string(animation_motion_name(a.motion));
+  w.key("fps").number(a.fps);
+  w.key("duration_s").number(a.duration_s);
+  write_vec3(w.key("wind"), a.wind);
+  w.key("amplitude_deg").number(a.amplitude_deg);
+  w.key("frequency_hz").number(a.frequency_hz);
+  w.key("branch_amplitude_deg").number(a.branch_amplitude_deg);
+  w.key("branch_frequency_hz").number(a.branch_frequency_hz);
+  w.key("seed").integer(a.seed);
+  w.end_object();
+}
+
 void write_bark(JsonWriter& w, const Bark& b, const std::string& base_dir) {
   w.key("bark").begin_object(Layout::spaced);
   if (b.albedo_texture) w.key("albedo").string(path_for_file(*b.albedo_texture, base_dir));
@@ -622,6 +677,26 @@ void write_plant(JsonWriter& w, const ScenePlant& p, const std::string& base_dir
 
 }  // namespace
 
+SceneAnimation animation_defaults(AnimationMotion motion) {
+  SceneAnimation a;
+  a.motion = motion;
+  if (motion == AnimationMotion::dance) {
+    a.amplitude_deg = 12;
+    a.frequency_hz = 1.2;
+    a.branch_amplitude_deg = 8;
+    a.branch_frequency_hz = 2.5;
+  }
+  return a;
+}
+
+const char* animation_motion_name(AnimationMotion motion) {
+  return motion == AnimationMotion::dance ? "dance" : "sway";
+}
+
+uint64_t animation_frame_count(const SceneAnimation& a) {
+  return std::max<uint64_t>(1, static_cast<uint64_t>(std::ceil(a.duration_s * a.fps - 1e-9)));
+}
+
 glm::dvec3 unit_sun_direction(const glm::dvec3& toward_sun) {
   // read_sun normalises what it reads, and read_scene normalises sun.direction once more.
   return glm::normalize(glm::normalize(toward_sun));
@@ -645,6 +720,7 @@ Expected<std::string> write_scene_json(const Scene& scene, const std::string& ba
   write_vec3(w.key("sky"), scene.sky);
   write_ground(w, scene.ground);
   if (scene.fog) write_fog(w, *scene.fog);
+  if (scene.animation) write_animation(w, *scene.animation);
   if (!scene.materials.empty()) write_materials(w, scene.materials);
   w.key("plants").begin_array(Layout::lines);
   for (const ScenePlant& plant : scene.plants) write_plant(w, plant, base_dir);

@@ -85,6 +85,33 @@ struct Fog {
 constexpr uint32_t kFogMaxSteps = 65536;
 constexpr uint64_t kFogMaxPhotons = 1'000'000'000;
 
+// The `animation` key (docs/animation.md): how the plants move over time, for
+// `sylva render --frames` and the studio. Frame k is at time k / fps seconds; the motion
+// is core/animate.h's sway (bend away from the wind, lateral chains fluttering), with
+// `dance`'s defaults those of the paper's dancing cacti (paper 000, fig. 8): a stronger,
+// faster bend. Keys a scene leaves out keep the motion's defaults (animation_defaults).
+enum class AnimationMotion { sway, dance };
+struct SceneAnimation {
+  AnimationMotion motion = AnimationMotion::sway;
+  double fps = 24;                   // frames per second, (0, 1000]
+  double duration_s = 4;             // `--frames all` renders frames 0 .. ceil(duration·fps) − 1
+  glm::dvec3 wind{1, 0, 0};          // where the wind blows to (its horizontal part counts)
+  double amplitude_deg = 4;          // the top's bend at the sway's extreme, [0, 90]
+  double frequency_hz = 0.4;         // [0, 100]
+  double branch_amplitude_deg = 3;   // each lateral chain's swing, [0, 90]
+  double branch_frequency_hz = 1.1;  // [0, 100]
+  uint64_t seed = 0;                 // the chains' flutter frequencies, the plants' phases
+  bool operator==(const SceneAnimation&) const = default;
+};
+// The defaults of a motion: sway's are SceneAnimation's; dance bends 12° at 1.2 Hz with the
+// chains swinging 8° at 2.5 Hz.
+SceneAnimation animation_defaults(AnimationMotion motion);
+const char* animation_motion_name(AnimationMotion motion);  // "sway", "dance"
+// The frames `--frames all` renders: ceil(duration_s · fps), at least 1.
+uint64_t animation_frame_count(const SceneAnimation& animation);
+// The most frames one command renders (docs/limits.md).
+inline constexpr uint64_t kMaxAnimationFrames = 100'000;
+
 // The bark of a plant. albedo is a texture path or a constant colour. Texture paths are
 // checked when the scene is read: a file that does not exist or that OpenImageIO cannot
 // open is an error at its key. Textures: texture.h; relief: relief.h.
@@ -147,6 +174,7 @@ struct Scene {
   glm::dvec3 sky{0.25, 0.3, 0.4};  // uniform sky radiance, linear RGB
   Ground ground;
   std::optional<Fog> fog;          // none: no fog pass
+  std::optional<SceneAnimation> animation;  // none: the plants stand still
   std::map<uint32_t, SceneMaterial> materials;  // by material index (< kMaterialSlots)
   std::vector<ScenePlant> plants;
   std::string file = {};           // the file it was read from, for messages ("" if made

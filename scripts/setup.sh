@@ -19,6 +19,7 @@ packages=(
   libgl-dev libegl-dev libgl1-mesa-dri libegl-mesa0 glslang-tools
   # The studio's window tests: a virtual X server (xvfb-run) and simulated input.
   xvfb xauth xdotool
+  ffmpeg  # `sylva render --frames ... --video` encodes with it; its ffprobe checks the tests' videos
 )
 # Node.js runs the Khronos glTF validator; any npm already on the machine will do.
 command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)

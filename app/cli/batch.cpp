@@ -61,16 +61,36 @@ std::optional<SeedRange> take_seed_range(std::vector<std::string>& args, const s
   return range;
 }
 
+namespace {
+
+// `pattern` with every `placeholder` replaced by `text`.
+std::string expand_placeholder(const std::string& pattern, std::string_view placeholder, const std::string& text) {
+  std::string out;
+  size_t from = 0;
+  for (size_t at; (at = pattern.find(placeholder, from)) != std::string::npos; from = at + placeholder.size())
+    out.append(pattern, from, at - from).append(text);
+  out.append(pattern, from);
+  return out;
+}
+
+constexpr std::string_view kFramePlaceholder = "{frame}";
+
+}  // namespace
+
 bool has_seed_placeholder(const std::string& pattern) { return pattern.find(kPlaceholder) != std::string::npos; }
 
 std::string expand_seed_pattern(const std::string& pattern, uint64_t seed) {
-  std::string out;
-  const std::string digits = std::to_string(seed);
-  size_t from = 0;
-  for (size_t at; (at = pattern.find(kPlaceholder, from)) != std::string::npos; from = at + kPlaceholder.size())
-    out.append(pattern, from, at - from).append(digits);
-  out.append(pattern, from);
-  return out;
+  return expand_placeholder(pattern, kPlaceholder, std::to_string(seed));
+}
+
+bool has_frame_placeholder(const std::string& pattern) {
+  return pattern.find(kFramePlaceholder) != std::string::npos;
+}
+
+std::string expand_frame_pattern(const std::string& pattern, uint64_t frame) {
+  std::string digits = std::to_string(frame);
+  if (digits.size() < kFramePatternDigits) digits.insert(0, kFramePatternDigits - digits.size(), '0');
+  return expand_placeholder(pattern, kFramePlaceholder, digits);
 }
 
 std::optional<lsys::Grammar> load_grammar_for(const GrammarArgs& a, int* exit_code) {
@@ -111,6 +131,12 @@ Status create_parent_folder(const std::string& path) {
 
 Expected<std::string> seed_output_path(const std::string& pattern, uint64_t seed) {
   std::string path = expand_seed_pattern(pattern, seed);
+  if (Status folder = create_parent_folder(path); !folder) return std::move(folder.error());
+  return path;
+}
+
+Expected<std::string> frame_output_path(const std::string& pattern, uint64_t frame) {
+  std::string path = expand_frame_pattern(pattern, frame);
   if (Status folder = create_parent_folder(path); !folder) return std::move(folder.error());
   return path;
 }

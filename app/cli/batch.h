@@ -79,6 +79,15 @@ std::vector<uint64_t> run_seed_tasks(const SeedRange& range, unsigned threads,
 int run_seed_batch(const std::string& subcommand, const SeedRange& range,
                    const std::function<SeedTaskResult(uint64_t seed)>& task);
 
+// Frames (`sylva render --frames`, docs/animation.md): "{frame}" in an output pattern
+// stands for the frame number, zero-padded to kFramePatternDigits digits (f_0007.png), so
+// that the files sort in frame order; a longer number keeps all its digits.
+inline constexpr size_t kFramePatternDigits = 4;
+bool has_frame_placeholder(const std::string& pattern);
+std::string expand_frame_pattern(const std::string& pattern, uint64_t frame);
+// expand_frame_pattern with the file's folder created (the error names the folder).
+Expected<std::string> frame_output_path(const std::string& pattern, uint64_t frame);
+
 // Creates the folder that will hold `path` (for output patterns like out/{seed}.glb).
 // The error names the folder.
 Status create_parent_folder(const std::string& path);

@@ -10,13 +10,17 @@
 #include <cstdio>
 #include <iostream>
 
+#include "app/cli/batch.h"
 #include "app/cli/cli.h"
 #include "app/cli/progress_bar.h"
 #include "app/cli/render_input.h"
+#include "app/cli/video.h"
+#include "core/animate.h"
 #include "core/render_output.h"
 #include "core/util/image_io.h"
 #include "core/util/limits.h"
 #include "core/gl/gl_context.h"
+#include "core/gl/gl_program.h"
 #include "core/render_common.h"
 #include "core/cpu/render_cpu.h"
 #include "core/gl/render_gl.h"
@@ -39,7 +43,8 @@ void print_render_help() {
          "                    [--aov depth,normal,uv,id,fog] [--spp N] [--verbose]\n"
          "                    [--geometry frusta|mesh] [--mesh-level M]\n"
          "                    [--fog-mode MODE] [--fog-steps N] [--photons N] [--cone-params P]\n"
-         "                    [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n\n"
+         "                    [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n"
+         "                    [--frames all|A..B [--fps F] [--video VIDEO]]\n\n"
          "Renders INPUT — a .scene.json scene, a .lsys grammar, a .skel.json skeleton or a .glb/.gltf\n"
          "written by `sylva export` (its skeletons are read back from node extras) (all but\n"
          "the scene in a default scene: the plant at the origin, the sun from (0.5, 1, 0.3), a\n"
@@ -83,6 +88,18 @@ void print_render_help() {
          "      --cone-params P    the cones' clustering: p1,p2,p3,p4 (neighbours >= p3 + 1,\n"
          "                         sectors >= 2, vectors per ring >= 1, least vectors per cone\n"
          "                         >= 1; each at most " << kMaxConeParam << ") or auto (default)\n"
+         "animation (docs/animation.md):\n"
+         "      --frames A..B      render frames A to B (or one frame N, or all: the scene's\n"
+         "                         animation duration) to -o, which must hold {frame} (its\n"
+         "                         number with 4 digits: -o frames/f_{frame}.png); a scene\n"
+         "                         moves its plants as its animation key says (frame k at k/fps\n"
+         "                         seconds), a grammar grows: frame k is k derivation steps\n"
+         "                         (all: 0 to its derivation length), seen by the last frame's\n"
+         "                         camera. Each frame is written atomically as it finishes\n"
+         "      --fps F            frames per second of the video (and of a scene's time):\n"
+         "                         default the scene's animation fps, 4 for a grammar\n"
+         "      --video VIDEO      also encode the PNG frames into VIDEO (.mp4, .mkv, .webm,\n"
+         "                         .mov or .gif) with ffmpeg, which must be installed\n"
          "grammar input only:\n"
          "  -n, --steps N          derivation steps (overrides 'derivation length:')\n"
          "      --seed S           random seed, an integer from 0 to 2^64-1\n"
@@ -104,6 +121,9 @@ struct RenderArgs {
   FogRenderOptions fog;        // --fog-mode, --fog-steps, --photons, --cone-params
   bool fog_flags = false;      // any of them given
   bool grammar_flags = false;  // -n, --seed, -D or --max-modules given
+  std::optional<std::string> frames;  // --frames, as given
+  std::optional<double> fps;          // --fps
+  std::optional<std::string> video;   // --video
 };
 
 uint32_t parse_size(const std::string& flag, const std::string& v, uint32_t max) {
@@ -204,6 +224,17 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
     } else if (a == "--cone-params") {
       out.fog.cone_params = parse_cone_params(value());
       out.fog_flags = true;
+    } else if (a == "--frames") {
+      out.frames = value();
+    } else if (a == "--fps") {
+      const std::string v = value();
+      char* end = nullptr;
+      const double fps = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end != '\0' || !(fps > 0 && fps <= 1000))
+        throw UsageError{"--fps " + v + ": expected a number of frames per second in (0, 1000]"};
+      out.fps = fps;
+    } else if (a == "--video") {
+      out.video = value();
     } else if (a == "--verbose" || a == "-v") {
       out.verbose = true;
     } else {
@@ -245,6 +276,231 @@ class SigintGuard {
   struct sigaction previous_ {};
 };
 
+// --frames: all, one frame N, or A..B.
+struct FrameRange {
+  uint64_t first = 0, last = 0;
+  bool all = false;  // the animation's duration, or 0 .. the grammar's derivation length
+  uint64_t count() const { return last - first + 1; }
+};
+
+constexpr uint64_t kMaxFrameNumber = 1'000'000'000;
+
+FrameRange parse_frames(const std::string& v) {
+  if (v == "all") return {0, 0, true};
+  const size_t dots = v.find("..");
+  const auto first = parse_u64(v.substr(0, dots));
+  const auto last = dots == std::string::npos ? first : parse_u64(v.substr(dots + 2));
+  if (!first || !last || *last > kMaxFrameNumber)
+    throw UsageError{"--frames " + v + ": expected all, a frame N or a range A..B of integers from 0 to " +
+                     std::to_string(kMaxFrameNumber)};
+  if (*first > *last) throw UsageError{"--frames " + v + ": the range is empty (the first frame is after the last)"};
+  if (*last - *first >= kMaxAnimationFrames)
+    throw UsageError{"--frames " + v + ": at most " + std::to_string(kMaxAnimationFrames) + " frames in one command"};
+  return {*first, *last, false};
+}
+
+bool ends_with(const std::string& s, std::string_view suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string seconds_text(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, s < 10 ? "%.2f s" : "%.0f s", s);
+  return buf;
+}
+
+// `sylva render INPUT --frames ...` (docs/animation.md): one image per frame, each written
+// atomically as it finishes. A scene's plants move (sway_scene_plants at frame / fps); on
+// the GL backend the renderer is made once and every later frame re-skins and re-uploads
+// only the segment records (GlRenderer::update_plants) — with fog, whose photons and cones
+// depend on where the plants are, every frame is rendered whole. A grammar grows: frame k
+// is k derivation steps, each a new renderer sharing the context's programs.
+int run_render_frames(const RenderArgs& a) {
+  const std::string& input = a.grammar.grammar;
+  const std::string& pattern = a.grammar.output;
+  const bool growth = is_grammar_input(input);
+  if (!growth && !ends_with(input, ".scene.json"))
+    throw UsageError{"--frames applies to a .scene.json scene with an animation key (its plants move) or a .lsys "
+                     "grammar (frame k is k derivation steps)"};
+  if (growth && a.grammar.steps) throw UsageError{"--frames on a grammar sets the derivation steps: leave out -n"};
+  if (!has_frame_placeholder(pattern))
+    throw UsageError{"-o " + pattern + ": with --frames the output must hold {frame}, e.g. -o frames/f_{frame}.png"};
+  FrameRange range = parse_frames(*a.frames);
+  std::optional<std::string> ffmpeg;
+  if (a.video) {
+    if (!ends_with(pattern, ".png")) throw UsageError{"--video encodes PNG frames: -o must end in .png"};
+    if (!video_container_for(*a.video))
+      throw UsageError{"--video " + *a.video + ": expected a .mp4, .mkv, .webm, .mov or .gif file"};
+    ffmpeg = find_ffmpeg();
+    if (!ffmpeg) {
+      std::cerr << "sylva render: --video needs ffmpeg, which is not installed (Debian: apt-get install ffmpeg); "
+                   "nothing rendered\n";
+      return kInputError;
+    }
+    if (Status allowed = check_output_path(*a.video); !allowed) {
+      std::cerr << allowed.error().format();
+      return kInputError;
+    }
+  }
+
+  SigintGuard sigint;
+  g_interrupted.store(false);
+  std::vector<RenderPass> passes;
+  // The scene whose plants move, or the grammar's last frame (its camera and ground frame
+  // every frame, so the plant grows in a still view).
+  GrammarArgs last_args = a.grammar;
+  if (growth) {
+    int code = kOk;
+    const std::optional<lsys::Grammar> g = load_grammar_for(a.grammar, &code);
+    if (!g) return code;
+    if (range.all) range = {0, static_cast<uint64_t>(std::max<int64_t>(0, g->steps)), false};
+    last_args.steps = static_cast<int64_t>(range.last);
+  }
+  auto loaded = load_render_input(last_args, a.width, a.height, passes);
+  if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
+  const Scene base = std::move(std::get<Scene>(loaded));
+  if (!growth && !base.animation)
+    throw UsageError{"--frames: " + input + " has no animation key, so its plants stand still (docs/animation.md)"};
+  if (range.all) range = {0, animation_frame_count(*base.animation) - 1, false};
+  const double fps = a.fps.value_or(growth ? 4.0 : base.animation->fps);
+  if (auto problem = image_size_problem(base.width, base.height, a.spp)) {
+    std::cerr << "sylva render: error: " << *problem << "\n";
+    return kInputError;
+  }
+  if (!base.fog && (a.fog_flags || (a.aovs & kAovFog)))
+    throw UsageError{"--fog-mode, --fog-steps, --photons, --cone-params and --aov fog apply to a scene with fog "
+                     "only ('" + input + "' has no fog key)"};
+  // Every frame's outputs are checked before the first is rendered.
+  for (uint64_t f = range.first; f <= range.last; ++f)
+    for (const std::string& target : render_output_paths(expand_frame_pattern(pattern, f), a.aovs))
+      if (Status allowed = check_output_path(target); !allowed) {
+        std::cerr << allowed.error().format();
+        return kInputError;
+      }
+
+  RenderOptions options;
+  options.spp = a.spp;
+  options.aovs = a.aovs;
+  options.geometry = a.geometry;
+  options.fog = a.fog;
+  options.progress = Progress(&g_interrupted);
+  // The backend, chosen once for every frame as a single render chooses it.
+  std::unique_ptr<GlContext> context;
+  if (a.backend != "cpu") {
+    std::string why_not;
+    if (auto unsupported = gl_unsupported(base, options)) {
+      why_not = *unsupported;
+    } else {
+      GlContextResult made = create_headless_gl_context();
+      if (made.context) context = std::move(made.context);
+      else why_not = made.error;
+    }
+    if (!context) {
+      if (a.backend == "gl") {
+        std::cerr << "sylva render: --backend gl: " << why_not << "\n";
+        return kInputError;
+      }
+      std::cerr << "sylva render: OpenGL unavailable (" << why_not << "); using the CPU ray caster\n";
+    }
+  }
+  std::cerr << "sylva render: " << range.count() << (range.count() == 1 ? " frame" : " frames") << " (" << range.first
+            << ".." << range.last << ") of " << base.width << "x" << base.height << ", "
+            << (context ? "OpenGL ray caster (" + context->info().renderer + ")" : std::string("CPU ray caster"))
+            << "\n";
+
+  std::vector<Skeleton> rest;
+  for (const ScenePlant& p : base.plants) rest.push_back(*p.skeleton);
+  const SwayParameters sway = base.animation ? sway_parameters_of(*base.animation) : SwayParameters{};
+  auto programs = std::make_shared<GlProgramCache>();
+  std::unique_ptr<GlRenderer> renderer;  // the moving scene's, made at its first frame
+  double update_s = 0, uploaded_bytes = 0;
+  uint64_t updates = 0, done = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (uint64_t f = range.first; f <= range.last; ++f) {
+    if (g_interrupted.load()) break;
+    const auto frame_start = std::chrono::steady_clock::now();
+    Scene scene = base;
+    if (growth) {
+      GrammarArgs step = a.grammar;
+      step.steps = static_cast<int64_t>(f);
+      std::vector<RenderPass> ignored;
+      auto grown = load_render_input(step, a.width, a.height, ignored);
+      if (auto* code = std::get_if<ExitCode>(&grown)) return *code;
+      scene = std::move(std::get<Scene>(grown));
+      scene.camera = base.camera;
+      scene.ground = base.ground;
+    } else {
+      sway_scene_plants(scene, rest, animation_frame_time_s(*base.animation, f), sway);
+    }
+    bool any_segment = false;
+    for (const ScenePlant& p : scene.plants) any_segment |= p.skeleton->segment_count() > 0;
+    RenderResult result;
+    try {
+    if (!context || !any_segment) {
+      // The CPU draws a frame without segments too (a grammar's axiom: sky and ground).
+      result = render_cpu(scene, options);
+    } else {
+      context->make_current();
+      if (scene.fog) {
+        result = render_gl(scene, options);
+      } else if (growth || !renderer) {
+        renderer = std::make_unique<GlRenderer>(scene, options, programs);
+        result = renderer->render(scene);
+      } else {
+        const auto t0 = std::chrono::steady_clock::now();
+        uploaded_bytes += static_cast<double>(renderer->update_plants(scene));
+        update_s += seconds_since(t0);
+        ++updates;
+        result = renderer->render(scene);
+      }
+    }
+    } catch (const GlCancelled&) {
+      break;  // Ctrl-C while the plants were skinned
+    }
+    if (result.cancelled || g_interrupted.load()) break;
+    Expected<std::string> path = frame_output_path(pattern, f);
+    if (!path) {
+      std::cerr << path.error().format();
+      return kInputError;
+    }
+    Expected<std::vector<std::string>> written = write_render(*path, result.image);
+    if (!written) {
+      std::cerr << written.error().format();
+      return kInputError;
+    }
+    ++done;
+    const double elapsed = seconds_since(start);
+    const double left = elapsed / static_cast<double>(done) * static_cast<double>(range.count() - done);
+    std::cerr << "sylva render: [" << done << "/" << range.count() << "] frame " << f << ": " << *path << " ("
+              << seconds_text(seconds_since(frame_start))
+              << (done < range.count() ? "; about " + seconds_text(left) + " left)" : ")") << "\n";
+  }
+  if (done < range.count()) {
+    std::cerr << "sylva render: interrupted after " << done << " of " << range.count()
+              << " frames (the frames written stay; the frame in progress was not written"
+              << (a.video ? "; no video" : "") << ")\n";
+    return kInterrupted;
+  }
+  std::cerr << "sylva render: " << done << (done == 1 ? " frame" : " frames") << " in "
+            << seconds_text(seconds_since(start)) << " (" << seconds_text(seconds_since(start) / static_cast<double>(done))
+            << " a frame)";
+  if (updates > 0) {
+    char line[160];
+    std::snprintf(line, sizeof line, "; re-skin + upload %.2f ms and %.0f KiB a frame", update_s * 1e3 / updates,
+                  uploaded_bytes / 1024 / updates);
+    std::cerr << line;
+  }
+  std::cerr << "\n";
+  if (a.video) {
+    if (Status encoded = encode_video(*ffmpeg, pattern, range.first, range.count(), fps, *a.video); !encoded) {
+      std::cerr << encoded.error().format();
+      return kInputError;
+    }
+    std::cerr << "sylva render: wrote " << *a.video << " (" << done << " frames at " << fps << " fps)\n";
+  }
+  return kOk;
+}
+
 }  // namespace
 
 int run_render(const std::vector<std::string>& args) {
@@ -261,6 +517,10 @@ int run_render(const std::vector<std::string>& args) {
     throw UsageError{"-n, --seed, -D and --max-modules apply to a .lsys grammar only"};
   if (!can_write_image_format(output))
     throw UsageError{"-o " + output + ": OpenImageIO cannot write this format (use .png, .exr, ...)"};
+  if (a.frames) return run_render_frames(a);
+  if (a.fps || a.video) throw UsageError{"--fps and --video apply with --frames only"};
+  if (has_frame_placeholder(output))
+    throw UsageError{"-o " + output + " holds {frame}: give --frames A..B to render frames"};
 
   SigintGuard sigint;
   g_interrupted.store(false);

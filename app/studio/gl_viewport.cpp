@@ -10,6 +10,7 @@
 #include "core/gl/gl_api.h"
 #include "core/gl/gl_context.h"
 #include "core/gl/gl_frame_stats.h"
+#include "core/gl/gl_program.h"
 #include "core/gl/gl_target.h"
 #include "core/gl/render_gl.h"
 #include "core/render_output.h"
@@ -148,6 +149,9 @@ void GlViewport::run() {
   }
   sh.wake.notify_all();
   if (!context.context) return;
+  // Every renderer of this thread's context shares its programs: a regrown plant's
+  // renderer draws its first picture without recompiling (gl_program.h).
+  auto programs = std::make_shared<GlProgramCache>();
   std::unique_ptr<GlRenderer> renderer;
   std::unique_ptr<GlTextureTarget> target;  // the picture's, on this thread's context
   double last_full_ms = 0;                   // the last full picture's time (preview_of)
@@ -189,7 +193,7 @@ void GlViewport::run() {
       else if (auto why = gl_unsupported(plants->scene, options)) error = *why;
       else {
         try {
-          renderer = std::make_unique<GlRenderer>(plants->scene, options);
+          renderer = std::make_unique<GlRenderer>(plants->scene, options, programs);
         } catch (const GlCancelled&) {
           build_cancelled = true;  // newer plants wait in the mailbox
         } catch (const std::exception& e) {
@@ -249,6 +253,7 @@ void GlViewport::run() {
   }
   target.reset();
   renderer.reset();
+  programs.reset();  // while the context is current
 }
 
 void GlViewport::set_plants(const Scene& scene, const RenderOptions& options) {

@@ -2,6 +2,7 @@
 #include "core/gl/gl_program.h"
 
 #include <algorithm>
+#include <chrono>
 
 #include "core/gl/gl_api.h"
 
@@ -102,6 +103,21 @@ void set_uniform_vec3_array(uint32_t p, const char* name, int count, const float
 }
 void set_uniform_float_array(uint32_t p, const char* name, int count, const float* x) {
   glProgramUniform1fv(p, location(p, name), count, x);
+}
+
+uint32_t GlProgramCache::get(const ShaderProgramSource& source, double* compile_s, std::string* compiled) {
+  std::string key = source.name;
+  key += '\0';
+  key += assemble_shader(source.vertex);
+  key += '\0';
+  key += assemble_shader(source.fragment);
+  auto found = programs_.find(key);
+  if (found != programs_.end()) return found->second.id();
+  const auto start = std::chrono::steady_clock::now();
+  GlProgramObject built(build_gl_program(source).id);
+  if (compile_s) *compile_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (compiled) *compiled += (compiled->empty() ? "" : ", ") + source.name;
+  return programs_.emplace(std::move(key), std::move(built)).first->second.id();
 }
 
 }  // namespace sylva

@@ -11,12 +11,14 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/gl/gl_context.h"
+#include "core/gl/gl_objects.h"
 #include "core/gl/gl_shaders.h"
 
 namespace sylva {
@@ -30,6 +32,27 @@ struct GlProgram {
 
 // Compiles both stages and links them. Throws GlError with the logs on failure.
 GlProgram build_gl_program(const ShaderProgramSource& source);
+
+// The program variants of one GL context, each built on first use and kept. Renderers
+// made one after another on the same context (the studio's, one per regrown plant) share
+// one cache, so a new renderer finds its variants linked — and, on llvmpipe, already
+// compiled to machine code: Mesa JITs a program's shaders at its first draw, which cost the
+// pine's first picture ~0.2 s on every regrow (docs/benchmarks.md, the studio). Keyed by
+// the variant's name and its assembled sources, so two variants never share a program.
+// Sharing is safe because the renderers set every uniform of a program before each frame
+// they draw with it. Preconditions: used on the context that built it, by one thread at a
+// time, and destroyed while that context is current.
+class GlProgramCache {
+ public:
+  // The program of `source`: the kept one, or built now (its compile and link time added
+  // to *compile_s and its name appended to *compiled, comma-separated). Throws GlError as
+  // build_gl_program does (nothing is kept then).
+  uint32_t get(const ShaderProgramSource& source, double* compile_s = nullptr, std::string* compiled = nullptr);
+  size_t size() const { return programs_.size(); }
+
+ private:
+  std::map<std::string, GlProgramObject> programs_;
+};
 
 void set_uniform(uint32_t program, const char* name, double value);                  // float
 void set_uniform(uint32_t program, const char* name, double x, double y);            // vec2

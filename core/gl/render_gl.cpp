@@ -195,7 +195,11 @@ struct GlRenderer::State {
 
   GlVertexArray vao;  // empty: the frusta pull their vertices from the records
   GlBuffer segment_buffer, id_buffer, list_buffer;
-  std::map<std::string, GlProgramObject> programs;  // by variant name, built on first use
+  // The context's programs (shared with other renderers on it, or this renderer's own) and
+  // this renderer's variants in them by name: the cache assembles a variant's sources to
+  // find it, done once per variant here rather than per frame.
+  std::shared_ptr<GlProgramCache> program_cache;
+  std::map<std::string, GLuint> programs;
 
   GlFrameTargets targets;
   GlShadowMap shadow_map;
@@ -212,12 +216,10 @@ struct GlRenderer::State {
   // its name to *compiled).
   GLuint program(const ShaderProgramSource& source, double* compile_s, std::string* compiled = nullptr) {
     auto found = programs.find(source.name);
-    if (found != programs.end()) return found->second.id();
-    const Clock::time_point start = Clock::now();
-    GlProgramObject built(build_gl_program(source).id);
-    if (compile_s) *compile_s += seconds_since(start);
-    if (compiled) *compiled += (compiled->empty() ? "" : ", ") + source.name;
-    return programs.emplace(source.name, std::move(built)).first->second.id();
+    if (found != programs.end()) return found->second;
+    const GLuint id = program_cache->get(source, compile_s, compiled);
+    programs.emplace(source.name, id);
+    return id;
   }
 
   // Skins every plant of `scene` into one record and one id quadruple (plant, chain,
@@ -403,9 +405,11 @@ struct GlRenderer::State {
 
 // ---- Construction: what is uploaded once -------------------------------------------------
 
-GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options) : state_(std::make_unique<State>()) {
+GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options, std::shared_ptr<GlProgramCache> programs)
+    : state_(std::make_unique<State>()) {
   State& st = *state_;
   st.options = options;
+  st.program_cache = programs ? std::move(programs) : std::make_shared<GlProgramCache>();
   if (scene.plants.size() >= gl::kMaxPlants) throw GlError("the GL backend draws at most 2^24 plants");
   if (auto why = gl_unsupported(scene, options)) throw GlError(*why);
   st.plant_count = scene.plants.size();

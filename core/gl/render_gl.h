@@ -116,13 +116,17 @@ std::optional<std::string> gl_unsupported(const Scene& scene, const RenderOption
 //               ImGui::Image((ImTextureID)(intptr_t)image.texture(), {w, h}, {0, 1}, {1, 0});
 //               if (auto timed = renderer.timed_frame()) stats = *timed;  // GPU ms, a frame late
 // or renderer.draw(scene, GlTarget{0, w, h, GlTargetEncoding::srgb}) into the back buffer.
+class GlProgramCache;  // gl_program.h
+
 class GlRenderer {
  public:
   // Preconditions: every plant's skeleton is set. Throws GlError (gl_unsupported's cases
   // included), std::logic_error for a plant without a skeleton, GlCancelled when
   // options.progress is cancelled while the plants are skinned (checked before each plant
   // and every 1024 chains; the fraction skinned is reported as "skin").
-  GlRenderer(const Scene& scene, const RenderOptions& options);
+  // `programs`: the context's program cache to share with renderers made before or after
+  // this one on the same context (gl_program.h); null: the renderer builds its own.
+  GlRenderer(const Scene& scene, const RenderOptions& options, std::shared_ptr<GlProgramCache> programs = nullptr);
   ~GlRenderer();
   GlRenderer(const GlRenderer&) = delete;
   GlRenderer& operator=(const GlRenderer&) = delete;

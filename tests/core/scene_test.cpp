@@ -465,6 +465,7 @@ TEST(SceneWrite, ASceneWithEveryKeySetReadsBackEqual) {
   s.ground = {-0.75, {0.5, 0.25, 0.125}};
   s.fog = Fog{0.125, 0.01, -0.3, 0.05, 12.5, FogMode::refined, 9, 4321};
   s.materials = {{0, {std::nullopt, 0.125}}, {1, {glm::dvec3(0.05, 0.25, 1e-3), 0.5}}, {15, {glm::dvec3(1, 0, 0.5), 1}}};
+  s.animation = SceneAnimation{AnimationMotion::dance, 29.97, 2.5, {0.5, 0, -1}, 7.5, 0.25, 1.5, 3.75, 18446744073709551615u};
   ScenePlant textured;
   textured.grammar = dir.file("g.lsys");
   textured.seed = 18446744073709551615u;
@@ -581,6 +582,78 @@ TEST(SceneLimits, AnImageOverThePixelLimitIsRefusedBeforeAnythingIsAllocated) {
   EXPECT_EQ(e.message,
             "image: the image has 4294967296 pixels (65536x65536), more than the limit of 67108864 (8192x8192; "
             "docs/limits.md)");
+}
+
+}  // namespace sylva
+
+namespace sylva {
+
+// ---- The animation key (docs/animation.md) ------------------------------------------------
+
+namespace {
+
+Expected<Scene> scene_with_animation(const std::string& animation) {
+  return parse_scene_json(R"({"animation": )" + animation + R"(, "plants": []})", "a.scene.json", "");
+}
+
+}  // namespace
+
+TEST(SceneAnimationKey, AbsentMeansStillAndMotionSetsTheDefaultsTheKeysReplace) {
+  auto still = parse_scene_json(R"({"plants": []})", "s.scene.json", "");
+  ASSERT_TRUE(still) << still.error().format();
+  EXPECT_FALSE(still->animation);
+
+  auto sway = scene_with_animation("{}");
+  ASSERT_TRUE(sway) << sway.error().format();
+  ASSERT_TRUE(sway->animation);
+  EXPECT_EQ(*sway->animation, SceneAnimation{});
+  EXPECT_EQ(animation_frame_count(*sway->animation), 96u);  // 4 s at 24 fps
+
+  auto dance = scene_with_animation(R"({"motion": "dance", "fps": 30, "duration_s": 0.5, "branch_amplitude_deg": 1})");
+  ASSERT_TRUE(dance) << dance.error().format();
+  SceneAnimation expected = animation_defaults(AnimationMotion::dance);
+  expected.fps = 30;
+  expected.duration_s = 0.5;
+  expected.branch_amplitude_deg = 1;
+  EXPECT_EQ(*dance->animation, expected);
+  EXPECT_GT(expected.amplitude_deg, SceneAnimation{}.amplitude_deg);  // dance bends further than sway
+  EXPECT_EQ(animation_frame_count(expected), 15u);
+  // A duration that is not a whole number of frames rounds up; a tiny one is one frame.
+  SceneAnimation odd;
+  odd.duration_s = 0.1;
+  odd.fps = 24;
+  EXPECT_EQ(animation_frame_count(odd), 3u);
+  odd.duration_s = 1e-9;
+  EXPECT_EQ(animation_frame_count(odd), 1u);
+}
+
+TEST(SceneAnimationKey, EveryBadValueIsALocatedError) {
+  struct Case {
+    const char* animation;
+    const char* message;
+  };
+  for (const Case& c : std::vector<Case>{
+           {R"({"motion": "jig"})", "animation.motion must be \"sway\" or \"dance\", not \"jig\""},
+           {R"({"motion": 3})", "animation.motion must be"},
+           {R"({"fps": 0})", "animation.fps must be in (0, 1000]"},
+           {R"({"fps": 1001})", "animation.fps must be in (0, 1000]"},
+           {R"({"duration_s": -1})", "animation.duration_s must be in (0, 1e+06]"},
+           {R"({"amplitude_deg": 90.5})", "animation.amplitude_deg must be in [0, 90]"},
+           {R"({"frequency_hz": -0.1})", "animation.frequency_hz must be in [0, 100]"},
+           {R"({"branch_amplitude_deg": "big"})", "animation.branch_amplitude_deg must be a number"},
+           {R"({"wind": [1, 0]})", "animation.wind must be an array of 3 numbers"},
+           {R"({"wind": [1e7, 0, 0]})", "animation.wind components must be within"},
+           {R"({"seed": -1})", "animation.seed must be an integer"},
+           {R"({"fps": 1000, "duration_s": 1000})", "more than 100000 frames"},
+           {R"({"speed": 2})", "unknown key \"speed\" in animation"},
+           {R"([1])", "animation must be an object"},
+       }) {
+    auto r = scene_with_animation(c.animation);
+    ASSERT_FALSE(r) << c.animation;
+    EXPECT_NE(r.error().message.find(c.message), std::string::npos) << c.animation << " -> " << r.error().format();
+    EXPECT_EQ(r.error().loc.line, 1u) << c.animation;
+    EXPECT_GT(r.error().loc.column, 14u) << c.animation;  // at the value, inside the animation object
+  }
 }
 
 }  // namespace sylva

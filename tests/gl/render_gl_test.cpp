@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <map>
 
+#include "core/gl/gl_program.h"
 #include "tests/core/test_scenes.h"
 #include "tests/gl/gl_test_util.h"
 
@@ -292,6 +293,51 @@ TEST(RenderGl, PlantsWithoutBarkCompileNoBarkOrReliefCode) {
   RenderOptions options;
   options.geometry.relief = false;
   EXPECT_EQ(program_names(render_gl(scene, options)).find("RELIEF"), std::string::npos);
+}
+
+// The programs a renderer built itself ("programs" setup pass, and any a frame added).
+std::string built_by(GlRenderer& renderer, const Scene& scene) {
+  std::string names;
+  for (const RenderPass& p : renderer.setup_passes())
+    if (p.name == "programs") names += p.detail;
+  const RenderResult r = renderer.render(scene);
+  for (const RenderPass& p : r.passes)
+    if (p.name == "programs") names += "; " + p.detail;
+  return names;
+}
+
+TEST(RenderGl, RenderersSharingAProgramCacheBuildEachVariantOnce) {
+  SYLVA_REQUIRE_GL();
+  // The studio makes a renderer per regrown plant on one context: the second renderer of
+  // the same kind of plant builds nothing, one of another kind only its own variants, and
+  // a shared program draws the same picture as a renderer's own.
+  const Scene relief = bark_segment(nullptr, "cactus_height.png");
+  const Scene plain = bark_segment(nullptr, nullptr);
+  auto cache = std::make_shared<GlProgramCache>();
+  std::vector<float> first_beauty;
+  {
+    GlRenderer first(relief, {}, cache);
+    EXPECT_NE(built_by(first, relief).find("frusta[GBUFFER_PASS RELIEF TEXTURE_UNITS=1]"), std::string::npos);
+    first_beauty = first.render(relief).image.beauty;
+  }
+  const size_t after_first = cache->size();
+  EXPECT_GE(after_first, 3u);  // frusta G-buffer and shadow, shade (and present)
+  {
+    GlRenderer other(plain, {}, cache);
+    const std::string names = built_by(other, plain);
+    EXPECT_NE(names.find("frusta[GBUFFER_PASS]"), std::string::npos) << names;
+    EXPECT_EQ(names.find("shade["), std::string::npos) << names;  // the shade program is shared
+  }
+  const size_t after_other = cache->size();
+  EXPECT_GT(after_other, after_first);
+  GlRenderer again(relief, {}, cache);
+  EXPECT_EQ(built_by(again, relief), "");
+  EXPECT_EQ(cache->size(), after_other);
+  EXPECT_EQ(again.render(relief).image.beauty, first_beauty);
+  // Against a renderer with its own programs, at the same frame: the same bytes.
+  GlRenderer own(relief, {});
+  own.render(relief);
+  EXPECT_EQ(own.render(relief).image.beauty, first_beauty);
 }
 
 TEST(RenderGl, GrazingReliefHasNoNaNAndMatchesTheCpu) {

@@ -1,0 +1,184 @@
+// render_frames_cli_test.cpp — `sylva render --frames` (docs/animation.md): a scene's
+// animation key moving its plants frame by frame, a grammar growing over its derivation
+// steps, the per-frame outputs, the video through ffmpeg, and the usage errors.
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "tests/app/process.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kCactus = std::string(SYLVA_SOURCE_DIR) + "/presets/cactus.lsys";
+const std::string kElm = std::string(SYLVA_SOURCE_DIR) + "/presets/elm.lsys";
+
+// Two cacti, seen closely so that their sway moves many pixels; `animation`: the key's
+// value, empty for none.
+std::string write_scene(TempDir& dir, const std::string& animation) {
+  fs::copy_file(kCactus, dir.file("cactus.lsys"), fs::copy_options::overwrite_existing);
+  dir.write("c.scene.json", R"({"image": {"width": 64, "height": 48},
+  "camera": {"eye": [2.5, 1.2, 3.5], "target": [0, 0.8, 0]},
+  )" + (animation.empty() ? std::string() : "\"animation\": " + animation + ",") + R"(
+  "plants": [{"grammar": "cactus.lsys", "seed": 3}, {"grammar": "cactus.lsys", "seed": 4, "position": [0.8, 0, -0.5]}]})");
+  return dir.file("c.scene.json");
+}
+
+const char* const kDance = R"({"motion": "dance", "fps": 10, "duration_s": 0.4})";
+
+std::vector<float> pixels(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) return {};
+  const OIIO::ImageSpec& spec = in->spec();
+  std::vector<float> p(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, p.data())) return {};
+  return p;
+}
+
+double mean_abs_difference(const std::vector<float>& a, const std::vector<float>& b) {
+  if (a.size() != b.size() || a.empty()) return INFINITY;
+  double sum = 0;
+  for (size_t i = 0; i < a.size(); ++i) sum += std::abs(a[i] - b[i]);
+  return sum / static_cast<double>(a.size());
+}
+
+bool gl_missing(const ProcessResult& r) {
+  return r.exit_code == 1 && r.err.find("--backend gl") != std::string::npos;
+}
+
+TEST(RenderFrames, ASceneWritesOneImagePerFrameAndItsPlantsMove) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, kDance);
+  ProcessResult r = run_sylva({"render", scene, "--frames", "all", "-o", dir.file("out/f_{frame}.png"), "--backend", "cpu"});
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  // all: ceil(0.4 s × 10 fps) = 4 frames, numbered with four digits, in a folder made for them.
+  for (const char* f : {"f_0000.png", "f_0001.png", "f_0002.png", "f_0003.png"})
+    EXPECT_TRUE(fs::exists(dir.file(std::string("out/") + f))) << f << "\n" << describe(r);
+  EXPECT_FALSE(fs::exists(dir.file("out/f_0004.png")));
+  EXPECT_NE(r.err.find("[4/4] frame 3"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("4 frames in"), std::string::npos) << describe(r);
+  // Frame 0 is the rest pose (t = 0): the still scene's picture, pixel for pixel; later
+  // frames are not.
+  const std::string still = write_scene(dir, "");
+  ProcessResult plain = run_sylva({"render", still, "-o", dir.file("still.png"), "--backend", "cpu"});
+  ASSERT_EQ(plain.exit_code, 0) << describe(plain);
+  const std::vector<float> rest = pixels(dir.file("still.png"));
+  EXPECT_EQ(mean_abs_difference(pixels(dir.file("out/f_0000.png")), rest), 0.0);
+  EXPECT_GT(mean_abs_difference(pixels(dir.file("out/f_0002.png")), rest), 1e-3);
+}
+
+TEST(RenderFrames, OnOpenGlTheRendererReuploadsEachPoseAndMatchesTheCpu) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, kDance);
+  ProcessResult gl = run_sylva({"render", scene, "--frames", "0..3", "-o", dir.file("gl_{frame}.png"), "--backend", "gl"});
+  if (gl_missing(gl)) GTEST_SKIP() << "no OpenGL: " << gl.err;
+  ASSERT_EQ(gl.exit_code, 0) << describe(gl);
+  EXPECT_NE(gl.err.find("re-skin + upload"), std::string::npos) << describe(gl);  // 3 updates, one renderer
+  ProcessResult cpu = run_sylva({"render", scene, "--frames", "0..3", "-o", dir.file("cpu_{frame}.png"), "--backend", "cpu"});
+  ASSERT_EQ(cpu.exit_code, 0) << describe(cpu);
+  // Frame 3 drawn by GL is the CPU's frame 3 (the backends' usual 1–2/255), much closer to
+  // it than to the rest pose: the moved segment records reached the GPU.
+  const std::vector<float> gl3 = pixels(dir.file("gl_0003.png"));
+  const double same_pose = mean_abs_difference(gl3, pixels(dir.file("cpu_0003.png")));
+  const double rest_pose = mean_abs_difference(gl3, pixels(dir.file("cpu_0000.png")));
+  std::printf("[ frames ] GL frame 3 against the CPU's frame 3: %.5f, against its frame 0: %.5f\n", same_pose, rest_pose);
+  EXPECT_LT(same_pose, 3.0 / 255);
+  EXPECT_LT(same_pose * 3, rest_pose);
+}
+
+TEST(RenderFrames, AGrammarGrowsOneDerivationStepPerFrameSeenByTheLastFramesCamera) {
+  TempDir dir;
+  ProcessResult r = run_sylva({"render", kElm, "--frames", "4..6", "-o", dir.file("g_{frame}.png"), "--width", "48",
+                               "--height", "36", "--backend", "cpu"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  for (const char* f : {"g_0004.png", "g_0005.png", "g_0006.png"}) EXPECT_TRUE(fs::exists(dir.file(f))) << f;
+  // The last frame is the grammar grown 6 steps in its own default view.
+  ProcessResult six = run_sylva({"render", kElm, "-n", "6", "-o", dir.file("six.png"), "--width", "48", "--height", "36",
+                                 "--backend", "cpu"});
+  ASSERT_EQ(six.exit_code, 0) << describe(six);
+  EXPECT_EQ(mean_abs_difference(pixels(dir.file("g_0006.png")), pixels(dir.file("six.png"))), 0.0);
+  EXPECT_GT(mean_abs_difference(pixels(dir.file("g_0004.png")), pixels(dir.file("six.png"))), 1e-4);
+  // Frame 0 is the axiom: no segment yet, sky and ground only — still a picture.
+  ProcessResult axiom = run_sylva({"render", kElm, "--frames", "0", "-o", dir.file("a_{frame}.png"), "--width", "16",
+                                   "--height", "12"});
+  EXPECT_EQ(axiom.exit_code, 0) << describe(axiom);
+  EXPECT_TRUE(fs::exists(dir.file("a_0000.png")));
+}
+
+TEST(RenderFrames, TheVideoIsEncodedWithFfmpegOrRefusedBeforeAnyFrame) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, kDance);
+  // Without ffmpeg on PATH: exit 1 saying so, and nothing rendered.
+  ProcessResult none = run_process({"/usr/bin/env", "PATH=" + dir.path().string() + "/no-such-folder", SYLVA_BINARY, "render",
+                                    scene, "--frames", "0..1", "-o", dir.file("n_{frame}.png"), "--video",
+                                    dir.file("n.mp4"), "--backend", "cpu"});
+  EXPECT_EQ(none.exit_code, 1) << describe(none);
+  EXPECT_NE(none.err.find("--video needs ffmpeg"), std::string::npos) << describe(none);
+  EXPECT_FALSE(fs::exists(dir.file("n_0000.png")));
+  EXPECT_FALSE(fs::exists(dir.file("n.mp4")));
+  if (run_process({"/bin/sh", "-c", "command -v ffmpeg"}).exit_code != 0) GTEST_SKIP() << "ffmpeg is not installed";
+  ProcessResult r = run_sylva({"render", scene, "--frames", "0..3", "-o", dir.file("v_{frame}.png"), "--video",
+                               dir.file("dance.mp4"), "--fps", "12", "--backend", "cpu"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.err.find("4 frames at 12 fps"), std::string::npos) << describe(r);
+  std::ifstream video(dir.file("dance.mp4"), std::ios::binary);
+  std::string head(12, '\0');
+  video.read(head.data(), 12);
+  EXPECT_EQ(head.substr(4, 4), "ftyp") << "not an MP4 file";
+  // ffprobe, installed with ffmpeg, counts the frames and the rate.
+  ProcessResult probe = run_process({"ffprobe", "-v", "error", "-select_streams", "v:0", "-count_frames", "-show_entries",
+                                     "stream=nb_read_frames,r_frame_rate,width,height", "-of", "csv=p=0",
+                                     dir.file("dance.mp4")});
+  EXPECT_EQ(probe.exit_code, 0) << describe(probe);
+  EXPECT_EQ(probe.out, "64,48,12/1,4\n") << describe(probe);
+  // No temporary is left beside the video.
+  for (const auto& entry : fs::directory_iterator(dir.path()))
+    EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
+}
+
+TEST(RenderFrames, BadFrameRequestsAreUsageErrors) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, kDance);
+  const std::string still = dir.file("still.scene.json");
+  fs::copy_file(write_scene(dir, ""), still);
+  write_scene(dir, kDance);
+  fs::copy_file(kElm, dir.file("elm.lsys"));
+  ASSERT_EQ(run_sylva({"grow", kElm, "-o", dir.file("elm.skel.json")}).exit_code, 0);
+  struct Case {
+    std::vector<std::string> args;
+    const char* message;
+  };
+  const std::string f = dir.file("f_{frame}.png");
+  for (const Case& c : std::vector<Case>{
+           {{scene, "--frames", "0..3", "-o", dir.file("f.png")}, "must hold {frame}"},
+           {{scene, "-o", f}, "holds {frame}: give --frames"},
+           {{scene, "--frames", "5..2", "-o", f}, "the range is empty"},
+           {{scene, "--frames", "0..100000", "-o", f}, "at most 100000 frames"},
+           {{scene, "--frames", "x", "-o", f}, "expected all, a frame N or a range A..B"},
+           {{scene, "--frames", "-1..2", "-o", f}, "expected all, a frame N or a range A..B"},
+           {{still, "--frames", "0..1", "-o", f}, "has no animation key"},
+           {{dir.file("elm.skel.json"), "--frames", "0..1", "-o", f}, "--frames applies to a .scene.json scene"},
+           {{dir.file("elm.lsys"), "--frames", "0..1", "-n", "3", "-o", f}, "leave out -n"},
+           {{scene, "--frames", "0..1", "-o", f, "--video", dir.file("v.avi")}, "expected a .mp4"},
+           {{scene, "--frames", "0..1", "-o", dir.file("f_{frame}.exr"), "--video", dir.file("v.mp4")}, "PNG frames"},
+           {{scene, "--frames", "0..1", "-o", f, "--fps", "0"}, "--fps 0: expected"},
+           {{scene, "-o", dir.file("g.png"), "--video", dir.file("v.mp4")}, "apply with --frames only"},
+       }) {
+    std::vector<std::string> args = {"render"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    ProcessResult r = run_sylva(args);
+    EXPECT_FALSE(crashed(r)) << describe(r);
+    EXPECT_EQ(r.exit_code, 2) << describe(r);
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << describe(r);
+  }
+  EXPECT_FALSE(fs::exists(dir.file("f_0000.png")));
+}
+
+}  // namespace
