@@ -1,6 +1,8 @@
 // scene.cpp — reading scene.md's `.scene.json`, and the default scene around a skeleton.
 #include "core/scene.h"
 
+#include "core/scatter.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -8,7 +10,12 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <limits>
+#include <atomic>
+#include <map>
+#include <mutex>
 #include <numbers>
+#include <thread>
+#include <tuple>
 
 #include "core/fog.h"
 #include "core/materials.h"
@@ -224,34 +231,157 @@ std::map<uint32_t, SceneMaterial> read_materials(const JsonValue& v) {
   return table;
 }
 
+// What a plant and a scatter entry share: the grammar (required; its place kept for
+// grow_scene_plants' note), the derivation steps and the #define overrides.
+void read_recipe(const JsonValue& v, const std::string& base_dir, const std::string& what, std::string* grammar,
+                 SourceLoc* grammar_loc, std::optional<int64_t>* steps, std::map<std::string, double>* defines) {
+  const JsonValue* g = v.find("grammar");
+  if (!g) fail(v, what + " needs a \"grammar\"");
+  *grammar = path_relative_to(base_dir, *g, what + ".grammar");
+  *grammar_loc = {g->line, g->column};
+  if (auto* x = v.find("steps")) {
+    auto n = x->as_uint64();
+    if (!n || *n > 1000000) fail(*x, what + ".steps must be an integer from 0 to 1000000");
+    *steps = static_cast<int64_t>(*n);
+  }
+  if (auto* x = v.find("defines")) {
+    expect_object(*x, what + ".defines");
+    for (const JsonMember& m : x->members) (*defines)[m.key.name] = number(m.value, what + ".defines." + m.key.name);
+  }
+}
+
 ScenePlant read_plant(const JsonValue& v, const std::string& base_dir, size_t index) {
   const std::string what = "plants[" + std::to_string(index) + "]";
   expect_object(v, what);
   check_keys(v, what, {"grammar", "seed", "steps", "defines", "position", "rotate_y_deg", "scale", "bark"});
   ScenePlant p;
-  const JsonValue* g = v.find("grammar");
-  if (!g) fail(v, what + " needs a \"grammar\"");
-  p.grammar = path_relative_to(base_dir, *g, what + ".grammar");
-  p.grammar_loc = {g->line, g->column};
+  read_recipe(v, base_dir, what, &p.grammar, &p.grammar_loc, &p.steps, &p.defines);
   if (auto* x = v.find("seed")) {
     auto s = x->as_uint64();
     if (!s) fail(*x, what + ".seed must be an integer from 0 to 18446744073709551615");
     p.seed = *s;
-  }
-  if (auto* x = v.find("steps")) {
-    auto s = x->as_uint64();
-    if (!s || *s > 1000000) fail(*x, what + ".steps must be an integer from 0 to 1000000");
-    p.steps = static_cast<int64_t>(*s);
-  }
-  if (auto* x = v.find("defines")) {
-    expect_object(*x, what + ".defines");
-    for (const JsonMember& m : x->members) p.defines[m.key.name] = number(m.value, what + ".defines." + m.key.name);
   }
   if (auto* x = v.find("position")) p.position = point(*x, what + ".position");
   if (auto* x = v.find("rotate_y_deg")) p.rotate_y_deg = number(*x, what + ".rotate_y_deg");
   if (auto* x = v.find("scale")) p.scale = number_in(*x, what + ".scale", 0, 1e9, true, false);
   if (auto* x = v.find("bark")) p.bark = read_bark(*x, base_dir, what + ".bark");
   return p;
+}
+
+// A number or a [lo, hi] pair (lo <= hi), each in [min, max] (open at min when open_lo).
+std::pair<double, double> number_or_range(const JsonValue& v, const std::string& what, double min, double max,
+                                          bool open_lo) {
+  if (v.is_array()) {
+    if (v.elements.size() != 2) fail(v, what + " must be a number or [low, high]");
+    const double a = number_in(v.elements[0], what, min, max, open_lo, false);
+    const double b = number_in(v.elements[1], what, min, max, open_lo, false);
+    if (a > b) fail(v, what + " [low, high] must have low <= high");
+    return {a, b};
+  }
+  const double x = number_in(v, what, min, max, open_lo, false);
+  return {x, x};
+}
+
+// A `scatter` entry (docs/scatter.md); its plants are placed by place_scatter.
+SceneScatter read_scatter(const JsonValue& v, const std::string& base_dir, size_t index) {
+  const std::string what = "scatter[" + std::to_string(index) + "]";
+  expect_object(v, what);
+  check_keys(v, what,
+             {"grammar", "steps", "defines", "bark", "count", "density", "disc", "polygon", "seed", "plant_seeds",
+              "rotate_y_deg", "scale", "min_spacing"});
+  SceneScatter sc;
+  read_recipe(v, base_dir, what, &sc.grammar, &sc.grammar_loc, &sc.steps, &sc.defines);
+  if (auto* x = v.find("bark")) sc.bark = read_bark(*x, base_dir, what + ".bark");
+  const JsonValue* disc = v.find("disc");
+  const JsonValue* polygon = v.find("polygon");
+  if ((disc != nullptr) == (polygon != nullptr)) fail(v, what + " needs exactly one area: \"disc\" or \"polygon\"");
+  if (disc) {
+    expect_object(*disc, what + ".disc");
+    check_keys(*disc, what + ".disc", {"centre", "radius"});
+    glm::dvec2 c(0, 0);
+    if (auto* x = disc->find("centre")) {
+      if (!x->is_array() || x->elements.size() != 2) fail(*x, what + ".disc.centre must be [x, z]");
+      c = {number_in(x->elements[0], what + ".disc.centre", -kMaxCoordinateM, kMaxCoordinateM, false, false),
+           number_in(x->elements[1], what + ".disc.centre", -kMaxCoordinateM, kMaxCoordinateM, false, false)};
+    }
+    sc.disc_centre = c;
+    const JsonValue* r = disc->find("radius");
+    if (!r) fail(*disc, what + ".disc needs a \"radius\"");
+    sc.disc_radius = number_in(*r, what + ".disc.radius", 0, 1e9, true, false);
+  } else {
+    if (!polygon->is_array() || polygon->elements.size() < 3)
+      fail(*polygon, what + ".polygon must be an array of at least 3 corners [x, z]");
+    for (const JsonValue& corner : polygon->elements) {
+      if (!corner.is_array() || corner.elements.size() != 2) fail(corner, what + ".polygon corners must be [x, z]");
+      sc.polygon.push_back(
+          {number_in(corner.elements[0], what + ".polygon", -kMaxCoordinateM, kMaxCoordinateM, false, false),
+           number_in(corner.elements[1], what + ".polygon", -kMaxCoordinateM, kMaxCoordinateM, false, false)});
+    }
+    if (!(scatter_area_m2(sc) > 0)) fail(*polygon, what + ".polygon encloses no area");
+  }
+  const JsonValue* count = v.find("count");
+  const JsonValue* density = v.find("density");
+  if ((count != nullptr) == (density != nullptr)) fail(v, what + " needs exactly one of \"count\" and \"density\"");
+  const std::string limit = std::to_string(kMaxScatterPlants);
+  if (count) {
+    auto n = count->as_uint64();
+    if (!n || *n == 0 || *n > kMaxScatterPlants) fail(*count, what + ".count must be an integer from 1 to " + limit);
+    sc.count = *n;
+  } else {
+    sc.density = number_in(*density, what + ".density", 0, 1e6, true, false);
+    const double n = std::round(*sc.density * scatter_area_m2(sc));
+    if (!(n >= 1 && n <= static_cast<double>(kMaxScatterPlants)))
+      fail(*density, what + ".density × the area's " + std::to_string(scatter_area_m2(sc)) + " m^2 must give 1 to " +
+                         limit + " plants");
+    sc.count = static_cast<uint64_t>(n);
+  }
+  if (auto* x = v.find("seed")) {
+    auto n = x->as_uint64();
+    if (!n) fail(*x, what + ".seed must be an integer from 0 to 18446744073709551615");
+    sc.seed = *n;
+  }
+  if (auto* x = v.find("plant_seeds")) {
+    const std::string expected = what + ".plant_seeds must be a seed or [first, last], integers from 0 to "
+                                        "18446744073709551615 with first <= last";
+    if (x->is_array()) {
+      if (x->elements.size() != 2) fail(*x, expected);
+      auto a = x->elements[0].as_uint64(), b = x->elements[1].as_uint64();
+      if (!a || !b || *a > *b) fail(*x, expected);
+      sc.plant_seeds = std::pair<uint64_t, uint64_t>{*a, *b};
+    } else {
+      auto a = x->as_uint64();
+      if (!a) fail(*x, expected);
+      sc.plant_seeds = std::pair<uint64_t, uint64_t>{*a, *a};
+    }
+  }
+  if (auto* x = v.find("rotate_y_deg"))
+    std::tie(sc.rotate_min_deg, sc.rotate_max_deg) = number_or_range(*x, what + ".rotate_y_deg", -1e6, 1e6, false);
+  if (auto* x = v.find("scale")) std::tie(sc.scale_min, sc.scale_max) = number_or_range(*x, what + ".scale", 0, 1e9, true);
+  if (auto* x = v.find("min_spacing")) sc.min_spacing = number_in(*x, what + ".min_spacing", 0, 1e9, false, false);
+  return sc;
+}
+
+// The plants `scatter` (scene.scatter[index]) places on a ground at `ground_height`.
+std::vector<ScenePlant> scatter_plants(const SceneScatter& sc, size_t index, double ground_height,
+                                       const JsonValue& at) {
+  auto placed = place_scatter(sc);
+  if (auto* why = std::get_if<std::string>(&placed)) fail(at, "scatter[" + std::to_string(index) + "]: " + *why);
+  std::vector<ScenePlant> plants;
+  for (const ScatterPlacement& pl : std::get<std::vector<ScatterPlacement>>(placed)) {
+    ScenePlant p;
+    p.grammar = sc.grammar;
+    p.seed = pl.plant_seed;
+    p.steps = sc.steps;
+    p.defines = sc.defines;
+    p.position = {pl.xz.x, ground_height, pl.xz.y};
+    p.rotate_y_deg = pl.rotate_y_deg;
+    p.scale = pl.scale;
+    p.bark = sc.bark;
+    p.grammar_loc = sc.grammar_loc;
+    p.scatter = static_cast<uint32_t>(index + 1);
+    plants.push_back(std::move(p));
+  }
+  return plants;
 }
 
 // The `fog` object (spec/fog.md). Every key out of range is reported at the key (its line
@@ -364,7 +494,7 @@ Scene read_scene(const JsonValue& root, const std::string& base_dir) {
   expect_object(root, "a scene");
   check_keys(root, "the scene",
              {"format", "version", "camera", "image", "sun", "sky", "ground", "fog", "animation", "materials",
-              "plants"});
+              "plants", "scatter"});
   Scene s;
   if (auto* x = root.find("format"); x && !(x->is_string() && x->text == "sylva-scene"))
     fail(*x, "format must be \"sylva-scene\"");
@@ -395,6 +525,16 @@ Scene read_scene(const JsonValue& root, const std::string& base_dir) {
   if (!plants->is_array()) fail(*plants, std::string("plants must be an array, not ") + plants->kind_name());
   for (size_t i = 0; i < plants->elements.size(); ++i)
     s.plants.push_back(read_plant(plants->elements[i], base_dir, i));
+  if (auto* x = root.find("scatter")) {
+    if (!x->is_array()) fail(*x, std::string("scatter must be an array, not ") + x->kind_name());
+    for (size_t k = 0; k < x->elements.size(); ++k) {
+      s.scatter.push_back(read_scatter(x->elements[k], base_dir, k));
+      std::vector<ScenePlant> placed = scatter_plants(s.scatter.back(), k, s.ground.height, x->elements[k]);
+      if (s.plants.size() + placed.size() > kMaxScatterPlants)
+        fail(x->elements[k], "the scene has more than " + std::to_string(kMaxScatterPlants) + " plants");
+      s.plants.insert(s.plants.end(), std::make_move_iterator(placed.begin()), std::make_move_iterator(placed.end()));
+    }
+  }
   return s;
 }
 
@@ -498,39 +638,92 @@ std::optional<std::string> plant_extent_problem(const Skeleton& skeleton, const 
 }
 
 Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& progress) {
-  size_t to_grow = 0, grown_so_far = 0;
-  for (const ScenePlant& plant : scene.plants) to_grow += plant.skeleton ? 0 : 1;
+  // Where the scene names plant i's grammar: its own entry or its scatter entry.
+  auto named_by = [&](size_t i) {
+    const ScenePlant& p = scene.plants[i];
+    return p.scatter ? "scatter[" + std::to_string(p.scatter - 1) + "]" : "plants[" + std::to_string(i) + "]";
+  };
+  // The distinct recipes (grammar, defines, seed, steps) among the plants to grow, each
+  // derived once — a scatter entry's instances share a few — in plant order, so the first
+  // failing plant is the one reported whatever the threads do.
+  using Recipe = std::tuple<std::string, std::map<std::string, double>, std::optional<uint64_t>, std::optional<int64_t>>;
+  std::map<Recipe, size_t> recipe_of;
+  std::vector<size_t> first_plant;    // per recipe: the first plant that asks for it
+  std::vector<size_t> plant_recipe(scene.plants.size(), SIZE_MAX);
   for (size_t i = 0; i < scene.plants.size(); ++i) {
-    ScenePlant& plant = scene.plants[i];
-    if (plant.skeleton) continue;
+    const ScenePlant& p = scene.plants[i];
+    if (p.skeleton) continue;
+    auto [it, added] = recipe_of.try_emplace(Recipe{p.grammar, p.defines, p.seed, p.steps}, first_plant.size());
+    if (added) first_plant.push_back(i);
+    plant_recipe[i] = it->second;
+  }
+  // Each (grammar, defines) is parsed once; a parsed grammar is only read by derive.
+  using Source = std::pair<std::string, std::map<std::string, double>>;
+  std::map<Source, Expected<lsys::Grammar>> grammars;
+  for (size_t r = 0; r < first_plant.size(); ++r) {
+    const ScenePlant& p = scene.plants[first_plant[r]];
+    Source key{p.grammar, p.defines};
+    if (grammars.count(key)) continue;
     if (progress.cancelled()) return cancelled_diagnostic();
+    lsys::ParseOptions parse;
+    parse.define_overrides = p.defines;
+    grammars.emplace(std::move(key), lsys::load_grammar(p.grammar, parse));
+  }
+  std::vector<std::optional<Expected<GrowResult>>> grown(first_plant.size());
+  std::atomic<size_t> next{0}, done{0};
+  std::mutex report;
+  const double total = static_cast<double>(std::max<size_t>(1, first_plant.size()));
+  auto work = [&] {
+    for (size_t r; (r = next.fetch_add(1)) < first_plant.size();) {
+      if (progress.cancelled()) return;
+      const ScenePlant& p = scene.plants[first_plant[r]];
+      const Expected<lsys::Grammar>& g = grammars.at(Source{p.grammar, p.defines});
+      if (!g) continue;  // reported below, at its first plant
+      lsys::DeriveOptions derive;
+      derive.steps = p.steps;
+      derive.seed = p.seed;
+      derive.max_modules = max_modules;
+      // One plant: its derivation's own progress; many: each polls the flag, reports once done.
+      derive.progress = first_plant.size() == 1 ? progress : Progress(progress.cancel_flag());
+      grown[r] = grow(*g, derive, p.grammar, p.defines);
+      const size_t finished = done.fetch_add(1) + 1;
+      if (first_plant.size() > 1) {
+        std::lock_guard<std::mutex> lock(report);
+        progress.report(static_cast<double>(finished) / total, "grow");
+      }
+    }
+  };
+  const unsigned threads = static_cast<unsigned>(
+      std::min<size_t>(first_plant.size(), std::max(1u, std::thread::hardware_concurrency())));
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
+  if (threads > 0) work();
+  for (std::thread& t : pool) t.join();
+  // Every plant whose recipe grew keeps its skeleton, also when another failed or the
+  // work was cancelled.
+  for (size_t i = 0; i < scene.plants.size(); ++i) {
+    const size_t r = plant_recipe[i];
+    if (r != SIZE_MAX && grown[r] && *grown[r]) scene.plants[i].skeleton = (*grown[r])->skeleton;
+  }
+  if (progress.cancelled()) return cancelled_diagnostic();
+  for (size_t r = 0; r < first_plant.size(); ++r) {
+    const size_t i = first_plant[r];
+    const ScenePlant& p = scene.plants[i];
     // The grammar's own diagnostic, and where the scene named the grammar.
     auto located = [&](Diagnostic d) {
       if (d.cancelled) return d;
-      Diagnostic note =
-          diagnostic_at(scene.file, plant.grammar_loc, "plants[" + std::to_string(i) + "].grammar names this grammar");
+      Diagnostic note = diagnostic_at(scene.file, p.grammar_loc, named_by(i) + ".grammar names this grammar");
       return std::move(d).with_note(std::move(note));
     };
-    lsys::ParseOptions parse;
-    parse.define_overrides = plant.defines;
-    auto grammar = lsys::load_grammar(plant.grammar, parse);
-    if (!grammar) return located(std::move(grammar.error()));
-    lsys::DeriveOptions derive;
-    derive.steps = plant.steps;
-    derive.seed = plant.seed;
-    derive.max_modules = max_modules;
-    const double share = 1.0 / static_cast<double>(to_grow);
-    derive.progress = progress.part(static_cast<double>(grown_so_far) * share,
-                                    static_cast<double>(grown_so_far + 1) * share);
-    auto grown = grow(*grammar, derive, plant.grammar, plant.defines);
-    if (!grown) return located(std::move(grown.error()));
-    plant.skeleton = std::move(grown->skeleton);
-    ++grown_so_far;
+    const Expected<lsys::Grammar>& g = grammars.at(Source{p.grammar, p.defines});
+    if (!g) return located(g.error());
+    if (!grown[r]) return cancelled_diagnostic();
+    if (!*grown[r]) return located(grown[r]->error());
   }
   for (size_t i = 0; i < scene.plants.size(); ++i) {
     const ScenePlant& plant = scene.plants[i];
     if (auto problem = plant_extent_problem(*plant.skeleton, plant.position, plant.scale))
-      return diagnostic_at(scene.file, plant.grammar_loc, "plants[" + std::to_string(i) + "]: " + *problem);
+      return diagnostic_at(scene.file, plant.grammar_loc, named_by(i) + ": " + *problem);
   }
   progress.report(1, "grow");
   return {};
@@ -660,14 +853,54 @@ void write_materials(JsonWriter& w, const std::map<uint32_t, SceneMaterial>& tab
   w.end_array();
 }
 
+// The keys read_recipe reads (and a plant's seed), in the order plants have always had them.
+void write_recipe(JsonWriter& w, const std::string& grammar, std::optional<uint64_t> seed,
+                  std::optional<int64_t> steps, const std::map<std::string, double>& defines,
+                  const std::string& base_dir) {
+  w.key("grammar").string(path_for_file(grammar, base_dir));
+  if (seed) w.key("seed").integer(*seed);
+  if (steps) w.key("steps").integer(*steps);
+  w.key("defines").begin_object(Layout::spaced);
+  for (const auto& [name, value] : defines) w.key(name).number(value);
+  w.end_object();
+}
+
+void write_scatter(JsonWriter& w, const SceneScatter& sc, const std::string& base_dir) {
+  w.begin_object(Layout::spaced);
+  write_recipe(w, sc.grammar, std::nullopt, sc.steps, sc.defines, base_dir);
+  if (sc.density) w.key("density").number(*sc.density);
+  else w.key("count").integer(sc.count);
+  if (sc.disc_centre) {
+    w.key("disc").begin_object(Layout::spaced);
+    const double c[2] = {sc.disc_centre->x, sc.disc_centre->y};
+    w.key("centre").numbers(c, 2);
+    w.key("radius").number(sc.disc_radius);
+    w.end_object();
+  } else {
+    w.key("polygon").begin_array(Layout::spaced);
+    for (const glm::dvec2& corner : sc.polygon) {
+      const double c[2] = {corner.x, corner.y};
+      w.numbers(c, 2);
+    }
+    w.end_array();
+  }
+  w.key("seed").integer(sc.seed);
+  if (sc.plant_seeds) {
+    w.key("plant_seeds").begin_array(Layout::spaced);
+    w.integer(sc.plant_seeds->first).integer(sc.plant_seeds->second);
+    w.end_array();
+  }
+  const double rotate[2] = {sc.rotate_min_deg, sc.rotate_max_deg}, scale[2] = {sc.scale_min, sc.scale_max};
+  w.key("rotate_y_deg").numbers(rotate, 2);
+  w.key("scale").numbers(scale, 2);
+  w.key("min_spacing").number(sc.min_spacing);
+  write_bark(w, sc.bark, base_dir);
+  w.end_object();
+}
+
 void write_plant(JsonWriter& w, const ScenePlant& p, const std::string& base_dir) {
   w.begin_object(Layout::spaced);
-  w.key("grammar").string(path_for_file(p.grammar, base_dir));
-  if (p.seed) w.key("seed").integer(*p.seed);
-  if (p.steps) w.key("steps").integer(*p.steps);
-  w.key("defines").begin_object(Layout::spaced);
-  for (const auto& [name, value] : p.defines) w.key(name).number(value);
-  w.end_object();
+  write_recipe(w, p.grammar, p.seed, p.steps, p.defines, base_dir);
   write_vec3(w.key("position"), p.position);
   w.key("rotate_y_deg").number(p.rotate_y_deg);
   w.key("scale").number(p.scale);
@@ -723,8 +956,14 @@ Expected<std::string> write_scene_json(const Scene& scene, const std::string& ba
   if (scene.animation) write_animation(w, *scene.animation);
   if (!scene.materials.empty()) write_materials(w, scene.materials);
   w.key("plants").begin_array(Layout::lines);
-  for (const ScenePlant& plant : scene.plants) write_plant(w, plant, base_dir);
+  for (const ScenePlant& plant : scene.plants)
+    if (plant.scatter == 0) write_plant(w, plant, base_dir);  // scattered ones: their entry
   w.end_array();
+  if (!scene.scatter.empty()) {
+    w.key("scatter").begin_array(Layout::lines);
+    for (const SceneScatter& sc : scene.scatter) write_scatter(w, sc, base_dir);
+    w.end_array();
+  }
   w.end_object();
   return w.take() + "\n";
 }

@@ -13,8 +13,10 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/skeleton.h"
@@ -163,8 +165,39 @@ struct ScenePlant {
   Bark bark;
   SourceLoc grammar_loc = {};              // where the scene file names the grammar ({0,0}:
                                            //   not read from a file); grow_scene_plants' note
+  uint32_t scatter = 0;                    // k + 1: placed by scatter[k] (written as that
+                                           //   entry, not as a plant); 0: one of `plants`
   bool operator==(const ScenePlant&) const = default;
 };
+
+// A `scatter` entry (docs/scatter.md): many plants of one grammar placed at once over an
+// area of the ground — `count` of them (or `density` per m²), at least `min_spacing` apart
+// (Poisson-disc dart throwing), each turned and scaled at random within its ranges and
+// grown with its own grammar seed. The reader places them (core/scatter.h) and appends
+// them to Scene::plants after the scene's own, so everything downstream sees plants;
+// instances with equal grammar, seed, steps and defines are derived once
+// (grow_scene_plants). Deterministic: the same entry places the same plants everywhere.
+struct SceneScatter {
+  std::string grammar;                     // resolved path
+  std::optional<int64_t> steps;
+  std::map<std::string, double> defines;
+  Bark bark;
+  uint64_t count = 0;                      // plants placed (from `density` when that is given)
+  std::optional<double> density;           // plants per m², as the file says
+  std::optional<glm::dvec2> disc_centre;   // the area: a disc (x, z) with disc_radius ...
+  double disc_radius = 0;
+  std::vector<glm::dvec2> polygon;         // ... or a simple polygon (x, z), >= 3 corners
+  uint64_t seed = 0;                       // the placement's random stream
+  std::optional<std::pair<uint64_t, uint64_t>> plant_seeds;  // each instance's grammar seed
+                                           //   drawn from [first, last]; none: its own
+  double rotate_min_deg = 0, rotate_max_deg = 360;
+  double scale_min = 1, scale_max = 1;
+  double min_spacing = 0;                  // metres between any two plants' positions
+  SourceLoc grammar_loc = {};
+  bool operator==(const SceneScatter&) const = default;
+};
+// The most plants one scatter entry places (docs/limits.md).
+inline constexpr uint64_t kMaxScatterPlants = 1'000'000;
 
 struct Scene {
   Camera camera;
@@ -176,7 +209,8 @@ struct Scene {
   std::optional<Fog> fog;          // none: no fog pass
   std::optional<SceneAnimation> animation;  // none: the plants stand still
   std::map<uint32_t, SceneMaterial> materials;  // by material index (< kMaterialSlots)
-  std::vector<ScenePlant> plants;
+  std::vector<ScenePlant> plants;  // the scene's own, then every scatter entry's, in order
+  std::vector<SceneScatter> scatter;
   std::string file = {};           // the file it was read from, for messages ("" if made
                                    //   in code); like ScenePlant::grammar_loc, a place, not
                                    //   part of what the scene describes (not written)

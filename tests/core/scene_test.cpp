@@ -12,6 +12,7 @@
 #include <fstream>
 #include <glm/geometric.hpp>
 #include <random>
+#include <set>
 
 #include "tests/core/test_textures.h"
 
@@ -417,6 +418,7 @@ TEST(SceneGrow, ReportsProgressPerPlantAndStopsWhenCancelled) {
 Scene without_places(Scene s) {
   s.file.clear();
   for (ScenePlant& p : s.plants) p.grammar_loc = {};
+  for (SceneScatter& sc : s.scatter) sc.grammar_loc = {};
   return s;
 }
 
@@ -654,6 +656,164 @@ TEST(SceneAnimationKey, EveryBadValueIsALocatedError) {
     EXPECT_EQ(r.error().loc.line, 1u) << c.animation;
     EXPECT_GT(r.error().loc.column, 14u) << c.animation;  // at the value, inside the animation object
   }
+}
+
+}  // namespace sylva
+
+// ---- Scatter entries (docs/scatter.md) ------------------------------------------------------
+
+namespace sylva {
+namespace {
+
+const std::string kCactusGrammar = std::string(SYLVA_SOURCE_DIR) + "/presets/cactus.lsys";
+
+Expected<Scene> scene_with_scatter(const std::string& entry) {
+  return parse_scene_json(R"({"ground": {"height": -0.5}, "plants": [], "scatter": [)" + entry + "]}", "s.scene.json",
+                          "");
+}
+
+std::string cactus_entry(const std::string& rest) {
+  return R"({"grammar": ")" + kCactusGrammar + R"(", )" + rest + "}";
+}
+
+}  // namespace
+
+TEST(SceneScatterKey, PlacesCountPlantsInsideTheDiscApartAndWithinTheirRanges) {
+  auto s = scene_with_scatter(cactus_entry(
+      R"("count": 300, "disc": {"centre": [10, -4], "radius": 15}, "seed": 9, "plant_seeds": [3, 7],
+         "rotate_y_deg": [-30, 30], "scale": [0.5, 2], "min_spacing": 1.1)"));
+  ASSERT_TRUE(s) << s.error().format();
+  ASSERT_EQ(s->plants.size(), 300u);
+  ASSERT_EQ(s->scatter.size(), 1u);
+  std::set<uint64_t> seeds;
+  for (size_t i = 0; i < s->plants.size(); ++i) {
+    const ScenePlant& p = s->plants[i];
+    EXPECT_EQ(p.scatter, 1u);
+    EXPECT_EQ(p.grammar, kCactusGrammar);
+    EXPECT_EQ(p.position.y, -0.5);  // on the ground
+    EXPECT_LE(std::hypot(p.position.x - 10, p.position.z + 4), 15.0);
+    EXPECT_GE(p.rotate_y_deg, -30);
+    EXPECT_LE(p.rotate_y_deg, 30);
+    EXPECT_GE(p.scale, 0.5);
+    EXPECT_LE(p.scale, 2);
+    ASSERT_TRUE(p.seed);
+    seeds.insert(*p.seed);
+    for (size_t j = 0; j < i; ++j)  // every pair, against the grid's shortcut
+      EXPECT_GE(std::hypot(p.position.x - s->plants[j].position.x, p.position.z - s->plants[j].position.z), 1.1)
+          << i << ", " << j;
+  }
+  EXPECT_EQ(seeds, (std::set<uint64_t>{3, 4, 5, 6, 7}));
+  // Deterministic: the same entry places the same plants.
+  auto again = scene_with_scatter(cactus_entry(
+      R"("count": 300, "disc": {"centre": [10, -4], "radius": 15}, "seed": 9, "plant_seeds": [3, 7],
+         "rotate_y_deg": [-30, 30], "scale": [0.5, 2], "min_spacing": 1.1)"));
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->plants, s->plants);
+  // Another seed, other places.
+  auto other = scene_with_scatter(cactus_entry(R"("count": 400, "disc": {"centre": [10, -4], "radius": 15}, "seed": 10)"));
+  ASSERT_TRUE(other);
+  EXPECT_NE(other->plants.front().position, s->plants.front().position);
+}
+
+TEST(SceneScatterKey, APolygonKeepsItsPlantsInsideEvenWhereItIsConcaveAndDensitySetsTheCount) {
+  // An L: the square [0, 10]² without its quadrant [5, 10]²: 75 m².
+  auto s = scene_with_scatter(
+      cactus_entry(R"("density": 2, "polygon": [[0, 0], [10, 0], [10, 5], [5, 5], [5, 10], [0, 10]], "seed": 1)"));
+  ASSERT_TRUE(s) << s.error().format();
+  EXPECT_EQ(s->plants.size(), 150u);
+  size_t in_each_arm[2] = {0, 0};
+  for (const ScenePlant& p : s->plants) {
+    EXPECT_TRUE(p.position.x >= 0 && p.position.x <= 10 && p.position.z >= 0 && p.position.z <= 10);
+    EXPECT_FALSE(p.position.x > 5 && p.position.z > 5) << p.position.x << ", " << p.position.z;
+    in_each_arm[p.position.x > 5 ? 0 : p.position.z > 5 ? 1 : 0] += p.position.x > 5 || p.position.z > 5;
+  }
+  EXPECT_GT(in_each_arm[0], 20u);  // both arms are used
+  EXPECT_GT(in_each_arm[1], 20u);
+}
+
+TEST(SceneScatterKey, EntriesThatCannotFitOrSayTooLittleOrTooMuchAreLocatedErrors) {
+  struct Case {
+    std::string entry;
+    const char* message;
+  };
+  const std::string disc = R"("disc": {"radius": 2})";
+  for (const Case& c : std::vector<Case>{
+           {cactus_entry(R"("count": 200, "min_spacing": 1, )" + disc), "plants fit 1 m apart in the area of"},
+           {cactus_entry(R"("count": 5)"), "needs exactly one area"},
+           {cactus_entry(R"("count": 5, "polygon": [[0, 0], [1, 1], [2, 2]])"), "encloses no area"},
+           {cactus_entry(R"("count": 5, "polygon": [[0, 0], [1, 1]])"), "at least 3 corners"},
+           {cactus_entry(R"("count": 5, "density": 1, )" + disc), "exactly one of \"count\" and \"density\""},
+           {cactus_entry(R"("count": 0, )" + disc), "count must be an integer from 1 to 1000000"},
+           {cactus_entry(R"("count": 1000001, )" + disc), "count must be an integer from 1 to 1000000"},
+           {cactus_entry(R"("density": 1e6, )" + disc), "must give 1 to 1000000 plants"},
+           {cactus_entry(R"("count": 5, "plant_seeds": [9, 2], )" + disc), "first <= last"},
+           {cactus_entry(R"("count": 5, "scale": [2, 1], )" + disc), "low <= high"},
+           {cactus_entry(R"("count": 5, "scale": 0, )" + disc), "scale must be in (0, 1e+09]"},
+           {cactus_entry(R"("count": 5, "disc": {"radius": -1})"), "disc.radius must be in (0, 1e+09]"},
+           {cactus_entry(R"("count": 5, "spread": 1, )" + disc), "unknown key \"spread\" in scatter[0]"},
+           {R"({"count": 5, "disc": {"radius": 2}})", "scatter[0] needs a \"grammar\""},
+       }) {
+    auto r = scene_with_scatter(c.entry);
+    ASSERT_FALSE(r) << c.entry;
+    EXPECT_NE(r.error().message.find(c.message), std::string::npos) << c.entry << " -> " << r.error().format();
+    EXPECT_EQ(r.error().loc.line, 1u) << c.entry;
+  }
+}
+
+TEST(SceneScatterKey, WritesBackAsItsEntryAndReadsBackEqual) {
+  auto s = parse_scene_json(R"({"plants": [{"grammar": ")" + kCactusGrammar + R"(", "seed": 2}], "scatter": [)" +
+                                cactus_entry(R"("count": 30, "disc": {"centre": [1, 2], "radius": 6}, "seed": 4,
+                                   "plant_seeds": 8, "rotate_y_deg": 45, "scale": [1, 1.5], "min_spacing": 0.5,
+                                   "steps": 3, "defines": {"HEIGHT": 1.1})") +
+                                "," + cactus_entry(R"("density": 0.5, "polygon": [[0, 0], [4, 0], [0, 4]])") + "]}",
+                            "w.scene.json", "");
+  ASSERT_TRUE(s) << s.error().format();
+  ASSERT_EQ(s->plants.size(), 1u + 30u + 4u);
+  Expected<std::string> text = write_scene_json(*s);
+  ASSERT_TRUE(text) << text.error().format();
+  EXPECT_EQ(text->find("\"seed\": 2"), text->rfind("\"seed\": 2"));  // the scene's own plant, written once
+  auto back = parse_scene_json(*text, "w.scene.json", "");
+  ASSERT_TRUE(back) << back.error().format() << *text;
+  back->file = s->file;
+  for (size_t i = 0; i < back->plants.size(); ++i) back->plants[i].grammar_loc = s->plants[i].grammar_loc;
+  for (size_t k = 0; k < back->scatter.size(); ++k) back->scatter[k].grammar_loc = s->scatter[k].grammar_loc;
+  EXPECT_EQ(back->scatter, s->scatter);
+  EXPECT_EQ(back->plants, s->plants);
+}
+
+TEST(SceneScatterKey, InstancesOfOneRecipeGrowOnceAndAGrammarErrorNamesTheEntry) {
+  auto s = scene_with_scatter(cactus_entry(R"("count": 50, "disc": {"radius": 20}, "plant_seeds": [5, 6])"));
+  ASSERT_TRUE(s) << s.error().format();
+  ASSERT_TRUE(grow_scene_plants(*s));
+  Scene single;
+  ScenePlant five;
+  five.grammar = kCactusGrammar;
+  five.seed = 5;
+  single.plants = {five};
+  ASSERT_TRUE(grow_scene_plants(single));
+  size_t fives = 0;
+  for (const ScenePlant& p : s->plants) {
+    ASSERT_TRUE(p.skeleton);
+    if (*p.seed == 5) {
+      ++fives;
+      EXPECT_EQ(*p.skeleton, *single.plants.front().skeleton);  // the same plant as grown alone
+    }
+  }
+  EXPECT_GT(fives, 10u);
+  // A broken grammar: its own error, with a note at the entry that names it.
+  test::TempFolder dir;
+  {
+    std::ofstream(dir.file("bad.lsys")) << "axiom: F\np1: F -> F[\n";
+  }
+  auto bad = parse_scene_json(R"({"plants": [], "scatter": [{"grammar": ")" + dir.file("bad.lsys") +
+                                  R"(", "count": 3, "disc": {"radius": 5}}]})",
+                              "b.scene.json", "");
+  ASSERT_TRUE(bad) << bad.error().format();
+  Status grown = grow_scene_plants(*bad);
+  ASSERT_FALSE(grown);
+  ASSERT_EQ(grown.error().notes.size(), 1u) << grown.error().format();
+  EXPECT_NE(grown.error().notes[0].message.find("scatter[0].grammar names this grammar"), std::string::npos);
+  EXPECT_EQ(grown.error().notes[0].file, "b.scene.json");
 }
 
 }  // namespace sylva
