@@ -19,6 +19,8 @@ packages=(
   libgl-dev libegl-dev libgl1-mesa-dri libegl-mesa0 glslang-tools
   # The studio's window tests: a virtual X server (xvfb-run) and simulated input.
   xvfb xauth xdotool
+  # The fuzz targets (tests/fuzz, scripts/fuzz.sh): clang with libFuzzer and its sanitizers.
+  clang
 )
 # Node.js runs the Khronos glTF validator; any npm already on the machine will do.
 command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
