@@ -628,7 +628,13 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
   JsonWriter json;
   json.begin_object();
   json.key("asset").begin_object().key("version").string("2.0").key("generator").string("sylva").end_object();
-  if (any_instancing) json.key("extensionsUsed").begin_array().string("EXT_mesh_gpu_instancing").end_array();
+  // The instances' placements exist only in the extension (the node has no fallback
+  // transform per instance): a viewer without it would show one plant at the origin, so
+  // the extension is required, not merely used (glTF 2.0 sec. 3.12).
+  if (any_instancing) {
+    json.key("extensionsUsed").begin_array().string("EXT_mesh_gpu_instancing").end_array();
+    json.key("extensionsRequired").begin_array().string("EXT_mesh_gpu_instancing").end_array();
+  }
   json.key("scene").integer(0);
   json.key("scenes").begin_array().begin_object().key("nodes").begin_array();
   for (size_t i = 0; i < nodes.size(); ++i) json.integer(i);
@@ -867,7 +873,11 @@ Status read_sylva_extras(const std::string& path, const JsonValue& node, size_t 
 Expected<std::vector<GltfPlant>> import_gltf_skeletons(const std::string& path) {
   Expected<std::string> file = read_text_file(path);
   if (!file) return std::move(file.error());
-  Expected<std::string_view> json = json_text_of(path, *file);
+  return parse_gltf_skeletons(*file, path);
+}
+
+Expected<std::vector<GltfPlant>> parse_gltf_skeletons(const std::string& bytes, const std::string& path) {
+  Expected<std::string_view> json = json_text_of(path, bytes);
   if (!json) return std::move(json.error());
   Expected<JsonValue> parsed = parse_json(*json, path);
   if (!parsed) return std::move(parsed.error());

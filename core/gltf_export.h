@@ -112,4 +112,8 @@ double bark_reference_radius_m(const Skeleton& skeleton);
 // extras is an error naming the file, not a crash; a bad value is located in the JSON.
 Expected<std::vector<GltfPlant>> import_gltf_skeletons(const std::string& path);
 
+// The same from the file's bytes already in memory (`path` names it in messages): the
+// reader import_gltf_skeletons calls, and the one tests/fuzz/gltf_fuzz.cpp feeds.
+Expected<std::vector<GltfPlant>> parse_gltf_skeletons(const std::string& bytes, const std::string& path);
+
 }  // namespace sylva

@@ -1,6 +1,7 @@
 // turtle.cpp — the 3D turtle (ABOP ch. 1.5, 2.2) building skeleton chains (skeleton.md).
 #include "core/turtle.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <glm/geometric.hpp>
@@ -82,6 +83,28 @@ void rotate_pair(dvec3& a, dvec3& b, Turn t) {
 dvec3 rotate_about(const dvec3& v, const dvec3& k, double angle_rad) {
   const double c = std::cos(angle_rad), s = std::sin(angle_rad);
   return v * c + glm::cross(k, v) * s + k * glm::dot(k, v) * (1 - c);
+}
+
+// The places of the grammar that write a module with `symbol`: the axiom, then every
+// production and interpretation production whose successor holds it, in file order.
+// Modules carry no source place (derive.h), so this is where a turtle error can point.
+std::vector<SourceLoc> places_writing(const lsys::Grammar& g, lsys::SymbolId symbol) {
+  std::vector<SourceLoc> places;
+  for (const lsys::Module& m : g.axiom.modules)
+    if (m.symbol == symbol) {
+      places.push_back(g.axiom_loc);
+      break;
+    }
+  for (const auto* list : {&g.productions, &g.homomorphism})
+    for (const lsys::Production& p : *list)
+      for (const lsys::SuccessorModule& m : p.successor.modules)
+        if (m.symbol == symbol) {
+          places.push_back(p.loc);
+          break;
+        }
+  std::sort(places.begin(), places.end(),
+            [](SourceLoc a, SourceLoc b) { return a.line != b.line ? a.line < b.line : a.column < b.column; });
+  return places;
 }
 
 }  // namespace
@@ -287,8 +310,21 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
     const Module& m = word.modules[i];
     one.modules.push_back(Module{m.symbol, m.param_count, 0});
     one.params.assign(word.params_of(m), word.params_of(m) + m.param_count);
-    return g.error_at({}, "turtle: " + f.message + " at module " + std::to_string(i) + " (" +
-                              print_word(one, g.symbols) + ") of the interpreted word");
+    const std::string module = print_word(one, g.symbols);
+    const std::string message =
+        "turtle: " + f.message + " at module " + std::to_string(i) + " (" + module + ") of the interpreted word";
+    // The error at the one place that writes the module; where several could have, at the
+    // file, with a note at each of them.
+    const std::vector<SourceLoc> places = places_writing(g, m.symbol);
+    if (places.size() == 1) return g.error_at(places[0], message + ", written here");
+    Diagnostic d = g.error_at({}, message);
+    constexpr size_t kMaxNotes = 4;
+    for (size_t k = 0; k < places.size() && k < kMaxNotes; ++k)
+      d = std::move(d).with_note(g.error_at(places[k], "a module '" + g.symbols.name(m.symbol) + "' is written here"));
+    if (places.size() > kMaxNotes)
+      d = std::move(d).with_note(g.error_at({}, "and by " + std::to_string(places.size() - kMaxNotes) +
+                                                    " more productions"));
+    return d;
   }
 
   // Flatten: chains' joints were interleaved in creation order; a counting sort by chain

@@ -82,7 +82,17 @@ void validate_text(std::string_view text) {
                       (len == 4 && cp < 0x10000);
       if (overlong || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
         fail({line, col}, "invalid UTF-8 (is this a binary file?)");
+      // A BOM is read (and skipped) only as the text's first bytes; anywhere else it is
+      // an invisible character that would become a module of its own.
+      if (cp == 0xFEFF && i != 0)
+        fail({line, col}, "a byte order mark (U+FEFF) inside the text: only a file's first bytes may hold one "
+                          "(were two files joined?)");
     }
+    // CR is read as part of CRLF only: in a file with CR-only (classic Mac) line endings
+    // every line would run into the next, giving a misleading error far from the cause.
+    if (c == '\r' && (i + 1 == text.size() || text[i + 1] != '\n'))
+      fail({line, col}, "a carriage return without a line feed after it: CR-only (classic Mac) line endings "
+                        "are not read; save the file with LF or CRLF line endings");
     if (c == '\n') {
       ++line;
       col = 1;
@@ -1151,7 +1161,8 @@ std::string Grammar::source_line(uint32_t line) const {
   }
   size_t end = text->find('\n', pos);
   std::string s = text->substr(pos, end == std::string::npos ? std::string::npos : end - pos);
-  if (!s.empty() && s.back() == '\r') s.pop_back();
+  // The line ends at its CR too (CRLF, or the lone CR an error points at).
+  if (size_t cr = s.find('\r'); cr != std::string::npos) s.resize(cr);
   return s;
 }
 

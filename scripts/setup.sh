@@ -20,6 +20,8 @@ packages=(
   # The studio's window tests: a virtual X server (xvfb-run) and simulated input.
   xvfb xauth xdotool
   ffmpeg  # `sylva render --frames ... --video` encodes with it; its ffprobe checks the tests' videos
+  # The fuzz targets (tests/fuzz, scripts/fuzz.sh): clang with libFuzzer and its sanitizers.
+  clang
 )
 # Node.js runs the Khronos glTF validator; any npm already on the machine will do.
 command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)

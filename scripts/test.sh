@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The README's second command: build and run the whole test suite twice — an optimised
-# build, and an AddressSanitizer + UndefinedBehaviorSanitizer build — with CTest.
+# build, and an AddressSanitizer + UndefinedBehaviorSanitizer build — with CTest — then a
+# short fuzzing smoke run (20 s per target, scripts/fuzz.sh) where clang is installed.
 # Installs missing dependencies first (idempotent).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,3 +13,10 @@ for preset in release asan; do
   cmake --build --preset "$preset"
   ctest --preset "$preset"
 done
+
+if command -v clang++ >/dev/null 2>&1; then
+  echo "== fuzz: 20 s per target (docs/fuzzing.md)"
+  bash scripts/fuzz.sh 20
+else
+  echo "== fuzz: skipped (no clang++; scripts/setup.sh installs it)"
+fi

@@ -7,6 +7,8 @@
 // as a fraction of what the memory system can move. Throughput counts every module
 // produced by every step (the work done), not only the final word.
 #include <benchmark/benchmark.h>
+#include <unistd.h>
+
 
 #include <cinttypes>
 #include <cstdio>
@@ -60,8 +62,12 @@ int64_t steps_to_reach(const lsys::Grammar& g, uint64_t target, int64_t max_step
   return max_steps;
 }
 
+// Colour codes only on a terminal: a benchmark's output piped to a file or a CI log must
+// be plain text (Google Benchmark's own --benchmark_color does not reach a reporter made
+// here, whose default is colour always).
 class CapturingReporter : public benchmark::ConsoleReporter {
  public:
+  CapturingReporter() : ConsoleReporter(isatty(STDOUT_FILENO) ? OO_ColorTabular : OO_Tabular) {}
   void ReportRuns(const std::vector<Run>& runs) override {
     for (const Run& r : runs) {
       if (r.run_type == Run::RT_Iteration || r.aggregate_name == "median")
@@ -114,6 +120,15 @@ int run_bench(const std::vector<std::string>& args) {
   std::string presets = SYLVA_PRESETS_DIR;
   std::vector<std::string> gb_args = {"sylva-bench"};
   for (size_t i = 1; i < args.size(); ++i) {
+    if (args[i] == "-h" || args[i] == "--help") {
+      std::cout << "usage: sylva bench lsystem [--quick] [--presets DIR] [Google Benchmark flags]\n\n"
+                   "Derivation throughput (modules produced per second, one thread) for ABOP 1.24a,\n"
+                   "Honda's tree (ABOP 2.6) and ABOP 1.31a from DIR (default: the presets); turtle\n"
+                   "segments per second; peak bytes per module; memcpy bandwidth in the same run.\n"
+                   "--quick uses small sizes (a smoke test, not a measurement). --benchmark_* flags\n"
+                   "(e.g. --benchmark_filter=REGEX) go to Google Benchmark.\n";
+      return kOk;
+    }
     if (args[i] == "--quick") quick = true;
     else if (args[i] == "--presets" && i + 1 < args.size()) presets = args[++i];
     else if (args[i].rfind("--benchmark_", 0) == 0) gb_args.push_back(args[i]);

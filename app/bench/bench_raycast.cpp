@@ -169,6 +169,15 @@ int run_bench_raycast(const std::vector<std::string>& args) {
       if (i + 1 >= args.size()) throw UsageError{args[i] + " needs a value"};
       return args[++i];
     };
+    if (args[i] == "-h" || args[i] == "--help") {
+      std::cout << "usage: sylva bench raycast [PRESET] [--width W --height H] [--csv FILE] [--quick]\n\n"
+                   "Primary rays per second on a preset (default pine, 1024x768): sylva's BVH and\n"
+                   "analytic frusta against Embree user geometry, round curves and tessellated\n"
+                   "meshes, on one thread and all threads, with depth error and bytes per segment.\n"
+                   "--csv FILE writes the rows; --quick uses 256x192 and one repeat (a smoke test,\n"
+                   "not a measurement).\n";
+      return kOk;
+    }
     if (args[i] == "--quick") width = 256, height = 192, max_level = 1, repeats = 1;
     else if (const std::string flag = args[i]; flag == "--width") width = parse_count(flag, value(), 16384);
     else if (flag == "--height") height = parse_count(flag, value(), 16384);

@@ -4,6 +4,8 @@
 // batch in parallel (app/batch.h). The mesh's bark comes from each plant of a scene, or
 // for a grammar or skeleton from the --bark-* flags (scene.md's bark keys as flags).
 #include <charconv>
+#include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -30,7 +32,9 @@ void print_export_help() {
                "Writes glTF 2.0 (Y up, metres; .glb binary or .gltf with embedded data), atomically.\n"
                "Each plant is a node named after its grammar with the skeleton as a LINES mesh\n"
                "(POSITION, _RADIUS) and the exact skeleton, seed and skinning data in the node's\n"
-               "extras.sylva. INPUT is a .lsys grammar, a .skel.json skeleton or a .scene.json scene.\n\n"
+               "extras.sylva. INPUT is a .lsys grammar, a .skel.json skeleton or a .scene.json scene.\n"
+               "Prints one summary line per file written: INPUT -> FILE, plants, chains, segments,\n"
+               "bytes, time.\n\n"
                "  -o, --output FILE        the .gltf or .glb file to write\n"
                "      --mesh               also write the skinned frusta as a triangle mesh: normals,\n"
                "                           TEXCOORD_0 = (turns around * u_repeat, metres along *\n"
@@ -98,6 +102,22 @@ double number_flag(const std::string& name, const std::string& text, double lo, 
 
 bool is_flag(const std::string& a, const std::string& name) { return a == name || a.rfind(name + "=", 0) == 0; }
 
+// The one summary line export prints on stdout, like grow's: what was read, what was
+// written, its plants, chains and segments, the file's size and the time taken.
+std::string export_summary(const std::string& input, const std::string& output, const std::vector<GltfPlant>& plants,
+                           std::chrono::steady_clock::time_point start) {
+  size_t chains = 0, segments = 0;
+  for (const GltfPlant& p : plants) chains += p.skeleton.chains.size(), segments += p.skeleton.segment_count();
+  std::error_code ec;
+  const uintmax_t bytes = std::filesystem::file_size(output, ec);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  char time[32];
+  std::snprintf(time, sizeof time, "%.4g", ms);
+  return input + " -> " + output + ": " + std::to_string(plants.size()) + (plants.size() == 1 ? " plant, " : " plants, ") +
+         std::to_string(chains) + " chains, " + std::to_string(segments) + " segments, " +
+         (ec ? std::string("? bytes") : std::to_string(bytes) + " bytes") + ", " + time + " ms";
+}
+
 }  // namespace
 
 int run_export(const std::vector<std::string>& raw_args) {
@@ -159,6 +179,7 @@ int run_export(const std::vector<std::string>& raw_args) {
     print_export_help();
     return kOk;
   }
+  const auto start = std::chrono::steady_clock::now();
   const std::string& input = a.grammar;
   InputKind kind;
   if (ends_with(input, ".skel.json")) kind = InputKind::skeleton;
@@ -199,6 +220,7 @@ int run_export(const std::vector<std::string>& raw_args) {
       std::cerr << exported.error().format();
       return kInputError;
     }
+    std::cout << export_summary(input, a.output, {plant}, start) << "\n";
     return kOk;
   }
   if (kind == InputKind::scene) {
@@ -229,6 +251,7 @@ int run_export(const std::vector<std::string>& raw_args) {
       std::cerr << exported.error().format();
       return kInputError;
     }
+    std::cout << export_summary(input, a.output, plants, start) << "\n";
     return kOk;
   }
 
@@ -236,14 +259,17 @@ int run_export(const std::vector<std::string>& raw_args) {
   auto g = load_grammar_for(a, &code);
   if (!g) return code;
   // Grows with `one`'s seed and exports to `output`.
-  auto export_one = [&](const GrammarArgs& one, const std::string& output) -> Status {
+  // Grows with `one`'s seed and exports to `output`; the summary line on success.
+  auto export_one = [&](const GrammarArgs& one, const std::string& output) -> Expected<std::string> {
+    const auto one_start = std::chrono::steady_clock::now();
     auto grown = grow(*g, derive_options_for(one), one.grammar, one.defines);
     if (!grown) return std::move(grown.error());
     GltfPlant plant;
     plant.name = plant_name(input);
     plant.skeleton = std::move(grown->skeleton);
     plant.bark = bark;
-    return export_gltf({plant}, output, options);
+    if (Status exported = export_gltf({plant}, output, options); !exported) return std::move(exported.error());
+    return export_summary(input, output, {plant}, one_start);
   };
   if (range) {
     if (Status folder = create_parent_folder(expand_seed_pattern(a.output, range->first)); !folder) {
@@ -257,8 +283,10 @@ int run_export(const std::vector<std::string>& raw_args) {
       Expected<std::string> output = seed_output_path(a.output, seed);
       if (!output)
         r.error = std::move(output.error());
-      else if (Status exported = export_one(one, *output); !exported)
+      else if (Expected<std::string> exported = export_one(one, *output); !exported)
         r.error = std::move(exported.error());
+      else
+        r.summary = std::move(*exported);
       return r;
     });
   }
@@ -268,10 +296,12 @@ int run_export(const std::vector<std::string>& raw_args) {
     std::cerr << output.error().format();
     return kInputError;
   }
-  if (Status exported = export_one(a, *output); !exported) {
+  Expected<std::string> exported = export_one(a, *output);
+  if (!exported) {
     std::cerr << exported.error().format();
     return kInputError;
   }
+  std::cout << *exported << "\n";
   return kOk;
 }
 

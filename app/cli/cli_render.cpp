@@ -6,6 +6,7 @@
 
 #include <array>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -32,6 +33,17 @@ namespace {
 
 constexpr int kInterrupted = 130;  // 128 + SIGINT, the shell's convention
 constexpr uint32_t kMaxConeParam = 100000;  // --cone-params: any larger is a typo
+
+// Mesa's software rasterisers, by the GL_RENDERER string they report ("llvmpipe (LLVM
+// 15.0.6, 256 bits)", "softpipe", "swrast"): auto still renders with them (cli.md), and
+// says so, since the CPU ray caster may be the faster choice on such a machine.
+bool is_software_renderer(const std::string& renderer) {
+  std::string lower = renderer;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (const char* name : {"llvmpipe", "softpipe", "swrast"})
+    if (lower.find(name) != std::string::npos) return true;
+  return false;
+}
 
 std::atomic<bool> g_interrupted{false};
 extern "C" void on_sigint(int) { g_interrupted.store(true); }
@@ -574,6 +586,12 @@ int run_render(const std::vector<std::string>& args) {
           const std::string& renderer = context.context->info().renderer;
           backend_name = options.geometry.kind == GeometryKind::mesh ? "OpenGL rasteriser (meshes, " + renderer + ")"
                                                                      : "OpenGL ray caster (" + renderer + ")";
+          // auto names what it chose (the fallback below names the CPU and why).
+          if (a.backend == "auto")
+            std::cerr << "sylva render: --backend auto: " << backend_name
+                      << (is_software_renderer(renderer) ? ", a software renderer (--backend cpu: the CPU ray caster)"
+                                                         : "")
+                      << "\n";
         } catch (const GlError& e) {
           why_not = e.what();
         }

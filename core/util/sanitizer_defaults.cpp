@@ -2,7 +2,15 @@
 // findings inside OpenImageIO 2.4 and one bug of GCC 12's sanitizer runtime, not in sylva. Linked into every executable of such a
 // build (an object library: a static archive would never pull these unreferenced hooks
 // in), so every test binary that reads an image gets them, whatever stage it tests.
+// GCC says ASan with __SANITIZE_ADDRESS__, clang 14 (the fuzz preset) with __has_feature.
 #if defined(__SANITIZE_ADDRESS__)
+#define SYLVA_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SYLVA_ASAN 1
+#endif
+#endif
+#if defined(SYLVA_ASAN)
 // OpenImageIO 2.4's TextureSystem::destroy deletes its implementation through the base
 // class pointer with the base class's size (a sized-delete mismatch inside the library,
 // not in sylva: ASan reports it from libOpenImageIO's own frame). Sanitizer builds turn

@@ -17,6 +17,31 @@ TEST(BenchLsystem, QuickRunPrintsEveryCaseAndTheMemcpyBandwidth) {
     EXPECT_NE(r.out.find(expected), std::string::npos) << expected << "\n" << r.out;
 }
 
+// Output piped to a file or a log is plain text: colour codes only on a terminal (the
+// test's stdout is a pipe).
+TEST(BenchLsystem, PipedOutputHasNoColourCodes) {
+  auto r = run_process({SYLVA_BINARY, "bench", "lsystem", "--quick", "--benchmark_min_time=0.001",
+                        "--benchmark_filter=memcpy"},
+                       SYLVA_SOURCE_DIR, 240);
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("memcpy"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find('\x1b'), std::string::npos) << r.out;
+  EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
+}
+
+// Every benchmark answers --help with its own usage on stdout and exit 0, doing no work.
+TEST(BenchHelp, EveryBenchmarkPrintsItsUsage) {
+  for (const char* name : {"lsystem", "raycast", "geometry", "gpu", "fog", "studio"}) {
+    for (const char* flag : {"--help", "-h"}) {
+      auto r = run_process({SYLVA_BINARY, "bench", name, flag}, SYLVA_SOURCE_DIR, 60);
+      ASSERT_FALSE(crashed(r)) << name << " " << flag << "\n" << describe(r);
+      EXPECT_EQ(r.exit_code, 0) << name << " " << flag << "\n" << describe(r);
+      EXPECT_EQ(r.out.rfind(std::string("usage: sylva bench ") + name, 0), 0u) << name << " " << flag << "\n" << r.out;
+    }
+  }
+}
+
 TEST(BenchLsystem, AnUnknownBenchmarkIsAUsageError) {
   auto r = run_process({SYLVA_BINARY, "bench", "nope"}, SYLVA_SOURCE_DIR);
   EXPECT_EQ(r.exit_code, 2);

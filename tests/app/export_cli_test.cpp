@@ -111,6 +111,46 @@ TEST(ExportCli, EveryVariantPassesTheKhronosValidator) {
   EXPECT_EQ((*forest)[3].name, "abop_1_27_stochastic");
 }
 
+// Like grow, export prints one summary line on stdout for each file it writes: what it
+// read, the file, its plants, chains and segments, the file's size in bytes and the time.
+TEST(ExportCli, PrintsOneSummaryLinePerFileLikeGrow) {
+  TempDir dir;
+  const std::string scene = dir.write("pair.scene.json", R"({"format":"sylva-scene","version":1,"plants":[
+    {"grammar":")" + kPlant + R"(","seed":1,"position":[0,0,0]},
+    {"grammar":")" + kOtherPlant + R"(","seed":2,"position":[-3,0,0]}]})");
+  expect_ok(run_sylva({"grow", kPlant, "-o", dir.file("plant.skel.json")}));
+  const auto grown = sylva::read_skeleton_file(dir.file("plant.skel.json"));
+  ASSERT_TRUE(grown) << grown.error().format();
+  struct Case {
+    std::string input, plants;
+  };
+  for (const Case& c : {Case{kPlant, "1 plant, "}, Case{dir.file("plant.skel.json"), "1 plant, "},
+                        Case{scene, "2 plants, "}}) {
+    const std::string out = dir.file("out.glb");
+    ProcessResult r = run_sylva({"export", c.input, "-o", out});
+    expect_ok(r);
+    const std::string bytes = std::to_string(fs::file_size(out)) + " bytes, ";
+    EXPECT_EQ(r.out.rfind(c.input + " -> " + out + ": " + c.plants, 0), 0u) << r.out;
+    EXPECT_NE(r.out.find(bytes), std::string::npos) << bytes << "\n" << r.out;
+    EXPECT_NE(r.out.find(" chains, "), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find('\n'), r.out.size() - 1) << "one line:\n" << r.out;
+    EXPECT_EQ(r.out.substr(r.out.size() - 4), " ms\n") << r.out;
+    if (c.plants == "1 plant, ") {
+      EXPECT_NE(r.out.find(std::to_string(grown->chains.size()) + " chains, " +
+                           std::to_string(grown->segment_count()) + " segments, "),
+                std::string::npos)
+          << r.out;
+    }
+  }
+  // A batch: one line per seed.
+  ProcessResult r = run_sylva({"export", kPlant, "--seed", "1..3", "-o", dir.file("b/p_{seed}.glb")});
+  expect_ok(r);
+  for (int seed = 1; seed <= 3; ++seed)
+    EXPECT_NE(r.out.find(kPlant + " -> " + dir.file("b/p_" + std::to_string(seed) + ".glb") + ": 1 plant, "),
+              std::string::npos)
+        << r.out;
+}
+
 TEST(ExportCli, TheValidatorHarnessRejectsErrorsAndWarnings) {
   TempDir dir;
   // An error: mode -1 (what tinygltf writes when Primitive::mode is unset).

@@ -68,6 +68,29 @@ TEST(RenderCli, AutoBackendUsesOpenGlOrFallsBackToTheCpuSayingWhy) {
   EXPECT_TRUE(std::filesystem::exists(dir.file("s.png")));
 }
 
+// Without --verbose, auto still names the backend it chose on stderr, and says when
+// OpenGL is one of Mesa's software renderers (llvmpipe in CI), for which --backend cpu
+// may be the faster choice. gl and cpu, chosen by the user, say nothing.
+TEST(RenderCli, AutoBackendNamesTheBackendItChose) {
+  TempDir dir;
+  ProcessResult r = run_sylva({"render", kSaguaro, "-o", dir.file("s.png"), "--width", "32", "--height", "24"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  if (r.err.find("using the CPU ray caster") != std::string::npos) {
+    EXPECT_EQ(r.err.find("--backend auto: OpenGL"), std::string::npos) << describe(r);
+  } else {
+    const size_t at = r.err.find("sylva render: --backend auto: OpenGL ray caster (");
+    ASSERT_NE(at, std::string::npos) << describe(r);
+    const std::string line = r.err.substr(at, r.err.find('\n', at) - at);
+    const bool software = line.find("llvmpipe") != std::string::npos || line.find("softpipe") != std::string::npos;
+    EXPECT_EQ(line.find(", a software renderer (--backend cpu: the CPU ray caster)") != std::string::npos, software)
+        << line;
+  }
+  ProcessResult cpu = run_sylva({"render", kSaguaro, "-o", dir.file("c.png"), "--width", "32", "--height", "24",
+                                 "--backend", "cpu"});
+  ASSERT_EQ(cpu.exit_code, 0) << describe(cpu);
+  EXPECT_EQ(cpu.err.find("--backend auto"), std::string::npos) << describe(cpu);
+}
+
 TEST(RenderCli, AutoBackendWithoutEglFallsBackToTheCpuSayingWhy) {
   TempDir dir;
   ProcessResult r = run_sylva_without_egl({"render", kSaguaro, "-o", dir.file("s.png"), "--width", "32", "--height", "24"});

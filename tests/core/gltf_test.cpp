@@ -377,6 +377,10 @@ TEST(GltfExport, InstancingPutsIdenticalPlantsOnOneNodeWithExactPlacementsInExtr
   const JsonValue& used = at(glb.json, "extensionsUsed");
   ASSERT_EQ(used.elements.size(), 1u);
   EXPECT_EQ(used.elements[0].text, "EXT_mesh_gpu_instancing");
+  // Required: the instances have no fallback placement outside the extension.
+  const JsonValue& required = at(glb.json, "extensionsRequired");
+  ASSERT_EQ(required.elements.size(), 1u);
+  EXPECT_EQ(required.elements[0].text, "EXT_mesh_gpu_instancing");
   const JsonValue& nodes = at(glb.json, "nodes");
   ASSERT_EQ(nodes.elements.size(), 2u);  // a0/a1/a2 share one node, b0 has its own
   EXPECT_EQ(at(nodes.elements[0], "name").text, "a0");

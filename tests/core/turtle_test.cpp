@@ -616,6 +616,35 @@ TEST(TurtleErrors, PositionsAndRadiiBeyondTheLimitAreErrorsNamingTheModule) {
   EXPECT_TRUE(grow_text("axiom: F(1e11)!(1e11)F\n").ok());
 }
 
+// A turtle error points into the grammar: at the one production (or the axiom) that
+// writes the module, or, where several could have, a note at each of them.
+TEST(TurtleErrors, AreLocatedAtTheProductionThatWritesTheModule) {
+  sylva::Expected<GrowResult> result = grow_text("derivation length: 1\naxiom: A\nA -> F!(-1)F\n");
+  ASSERT_FALSE(result.ok());
+  const Diagnostic& d = result.error();
+  EXPECT_EQ(d.loc, (SourceLoc{3, 1})) << d.format();
+  EXPECT_EQ(d.source_line, "A -> F!(-1)F") << d.format();
+  EXPECT_NE(d.message.find("the radius must be finite and not negative at module 1 (!(-1))"), std::string::npos)
+      << d.format();
+  EXPECT_EQ(d.format().rfind("test.lsys:3:1: error: turtle: ", 0), 0u) << d.format();
+
+  result = grow_text("axiom: F!(1e13)\n");
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.error().loc, (SourceLoc{1, 1})) << result.error().format();
+
+  // F is written by the axiom and by two productions: the file, and a note at each.
+  result = grow_text("derivation length: 1\naxiom: F(1e300)B\nB -> F\nC -> FF\n");
+  ASSERT_FALSE(result.ok());
+  const Diagnostic& many = result.error();
+  EXPECT_EQ(many.loc, (SourceLoc{0, 0})) << many.format();
+  EXPECT_NE(many.message.find("exceeds the limit of 1e12 m"), std::string::npos) << many.format();
+  ASSERT_EQ(many.notes.size(), 3u) << many.format();
+  EXPECT_EQ(many.notes[0].loc, (SourceLoc{2, 1})) << many.format();
+  EXPECT_EQ(many.notes[1].loc, (SourceLoc{3, 1})) << many.format();
+  EXPECT_EQ(many.notes[2].loc, (SourceLoc{4, 1})) << many.format();
+  EXPECT_EQ(many.notes[1].message, "a module 'F' is written here") << many.format();
+}
+
 TEST(TurtleErrors, FractionalMaterialIsAnErrorNamingTheModule) {
   const std::string message = grow_error("axiom: F'(1.5)F\n");
   EXPECT_NE(message.find("material"), std::string::npos) << message;

@@ -186,6 +186,11 @@ TEST(SyntaxErrors, AreLocatedWithLineAndColumn) {
       {"axiom: F\nA > ]B -> C\nB -> ]\n", 3, 6, "without matching"},
       {"axiom: F\n[ -> F\n", 2, 1, "cannot be rewritten"},
       {"axiom: F\nA x -> B\n", 2, 1, "one module"},
+      // A BOM anywhere but first, and CR-only line endings: errors at the character.
+      {"axiom: F\nF -> F\xEF\xBB\xBF[+F]F\n", 2, 7, "byte order mark (U+FEFF) inside the text"},
+      {"\xEF\xBB\xBF\xEF\xBB\xBF" "axiom: F\n", 1, 4, "byte order mark"},
+      {"derivation length: 2\raxiom: F\rF -> FF\r", 1, 21, "CR-only (classic Mac) line endings"},
+      {"axiom: F\r\nF -> F\rF\r\n", 2, 7, "carriage return without a line feed"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.text);
@@ -199,6 +204,21 @@ TEST(SyntaxErrors, AreLocatedWithLineAndColumn) {
 TEST(SyntaxErrors, TheFormattedMessageShowsTheSourceLineAndACaret) {
   Diagnostic d = parse_error("axiom: F\nA -> F(foo(2))\n");
   EXPECT_EQ(d.format(), "test.lsys:2:8: error: unknown function 'foo'\nA -> F(foo(2))\n       ^\n");
+}
+
+// The caret line of a CR-only file is its first line, not the whole file.
+TEST(SyntaxErrors, ACrOnlyFileShowsItsFirstLineWithTheCaretAtTheCarriageReturn) {
+  Diagnostic d = parse_error("axiom: F\rF -> FF\r");
+  EXPECT_EQ(d.format(),
+            "test.lsys:1:9: error: a carriage return without a line feed after it: CR-only (classic Mac) line "
+            "endings are not read; save the file with LF or CRLF line endings\naxiom: F\n        ^\n");
+}
+
+// A BOM as the first bytes is skipped, as before; CRLF line endings are read.
+TEST(SyntaxErrors, ALeadingBomAndCrlfLineEndingsAreRead) {
+  Grammar g = parse_ok("\xEF\xBB\xBF" "axiom: F\r\nF -> FF\r\n");
+  EXPECT_EQ(g.axiom.size(), 1u);
+  EXPECT_EQ(g.productions.size(), 1u);
 }
 
 TEST(SyntaxErrors, AMillionNestedBracketsParseWithoutRecursion) {
