@@ -108,6 +108,7 @@ void append_leaves(LeafMesh& mesh, const Skeleton& placed, uint32_t plant) {
     for (const auto& v : leaf.vertices_m) mesh.positions.emplace_back(v[0], v[1], v[2]);
     for (uint32_t i : triangles) mesh.indices.push_back(first + i);
     mesh.triangle_leaf.insert(mesh.triangle_leaf.end(), triangles.size() / 3, index);
+    mesh.vertex_leaf.insert(mesh.vertex_leaf.end(), leaf.vertices_m.size(), index);
     mesh.leaves.push_back({plant, l, leaf.material, newell / glm::length(newell)});
   }
 }

@@ -43,6 +43,8 @@ struct LeafMesh {
   std::vector<glm::dvec3> positions;    // metres; each leaf's own vertices, unshared
   std::vector<uint32_t> indices;        // 3 per triangle into positions
   std::vector<uint32_t> triangle_leaf;  // per triangle: index into `leaves`
+  std::vector<uint32_t> vertex_leaf;    // per position: index into `leaves` (a vertex the
+                                        //   triangulation dropped included)
   std::vector<LeafRef> leaves;          // per leaf with at least one triangle
 
   size_t triangle_count() const { return indices.size() / 3; }

@@ -424,7 +424,11 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, 
   }
   // Leaves (leaf_tracer.h): their own triangles beside the frusta or mesh; a scene
   // without leaves keeps its tracer as it is.
-  if (!leaves.empty()) g.tracer = std::make_unique<LeafTracer>(std::move(leaves), std::move(g.tracer));
+  if (!leaves.empty()) {
+    auto with_leaves = std::make_unique<LeafTracer>(std::move(leaves), std::move(g.tracer));
+    g.leaves = with_leaves.get();
+    g.tracer = std::move(with_leaves);
+  }
   if (passes)
     passes->push_back({"accel build", seconds_since(start),
                        g.tracer->describe() + ", " + std::to_string(g.tracer->memory_bytes() / 1024) + " KiB"});

@@ -67,6 +67,7 @@
 namespace sylva {
 
 class SceneTextures;  // texture.h
+class LeafTracer;     // leaf_tracer.h
 
 // World-space geometry of a scene: every plant's skeleton transformed (position,
 // rotate_y_deg, scale) and skinned, and what the renderer traces: the frusta themselves
@@ -76,7 +77,8 @@ struct SceneGeometry {
   std::vector<uint32_t> plant_of_frustum;  // plant index of each frustum
   std::shared_ptr<const SceneTextures> own_textures;  // opened here when the caller gave
                                                       // none and the relief needs them
-  std::unique_ptr<SceneTracer> tracer;     // over `frusta` (or a mesh made from them)
+  std::unique_ptr<SceneTracer> tracer;     // over `frusta` (or a mesh made from them) and the leaves
+  const LeafTracer* leaves = nullptr;      // `tracer` when the scene has leaves (leaf_tracer.h), else null
   bool cancelled = false;                  // stopped by `progress` between plants: no tracer
 };
 

@@ -70,6 +70,7 @@ TEST(LeafMesh, APlacedPlantsLeavesMoveRotateAndScaleWithIt) {
   EXPECT_EQ(mesh.leaves[0].plant, 7u);
   EXPECT_EQ(mesh.leaves[0].material, 1u);
   EXPECT_EQ(mesh.triangle_count(), 1u);
+  EXPECT_EQ(mesh.vertex_leaf, (std::vector<uint32_t>{0, 0, 0}));
   EXPECT_NEAR(glm::length(mesh.leaves[0].normal), 1, 1e-12);
   EXPECT_NEAR(mesh.leaves[0].normal.x, 1, 1e-12);  // +z turned by 90° about y
 }

@@ -100,6 +100,10 @@ inline Scene one_leaf_scene(glm::dvec3 eye, glm::dvec3 sun, uint32_t width = 96,
   return s;
 }
 
+// one_leaf_scene with the sun along (0, 1, 1), seen from (−0.5, 3, 4): the square (z = 0,
+// 1 <= y <= 2) throws its shadow onto the ground at −2 <= z <= −1, −1 <= x <= 0, in view.
+inline Scene leaf_shadow_scene() { return one_leaf_scene({-0.5, 3, 4}, {0, 1, 1}); }
+
 // Where world point p appears in `scene`'s image: continuous pixel coordinates (x right,
 // y down), the inverse of camera_ray.
 inline glm::dvec2 pixel_of(const Scene& scene, const glm::dvec3& p) {
