@@ -9,6 +9,7 @@
 #include <limits>
 #include <numbers>
 
+#include "core/leaf_mesh.h"
 #include "core/render_common.h"
 #include "core/util/math.h"
 
@@ -52,7 +53,7 @@ ViewFrustum view_frustum(const Scene& scene) {
 Aabb plant_box(const Skeleton& placed, const SkinOptions& skin, double relief_m) {
   const double inf = std::numeric_limits<double>::infinity();
   Aabb box{glm::dvec3(inf), glm::dvec3(-inf)};
-  if (placed.joints.empty()) return Aabb{};
+  if (placed.joints.empty() && placed.leaves.empty()) return Aabb{};
   const double tilt = skin.max_tilt_deg * kRadPerDeg;
   const double knuckle = 1 / std::cos(std::numbers::pi / (2.0 * std::max(2, skin.knuckle_frusta)));
   // Per joint: the largest reach of a cut through it, in joint radii.
@@ -80,6 +81,7 @@ Aabb plant_box(const Skeleton& placed, const SkinOptions& skin, double relief_m)
     box.lo = glm::min(box.lo, p - glm::dvec3(pad));
     box.hi = glm::max(box.hi, p + glm::dvec3(pad));
   }
+  grow(box, leaf_bounds(placed));  // leaves are drawn too (empty without leaves)
   // The relief, and a little more than the rounding of the arithmetic above.
   const double margin = relief_m + 1e-9 * std::max({1.0, glm::length(box.lo), glm::length(box.hi)});
   box.lo -= glm::dvec3(margin);

@@ -45,7 +45,7 @@ struct ViewFrustum {
 ViewFrustum view_frustum(const Scene& scene);
 
 // A conservative world box of the skinned surface of `placed` (a placed skeleton:
-// place_plant), grown by `relief_m` (relief or displacement depth, metres).
+// place_plant) and its leaves, grown by `relief_m` (relief or displacement depth, metres).
 Aabb plant_box(const Skeleton& placed, const SkinOptions& skin, double relief_m = 0);
 
 // The box containing every point the plant in `box` can shadow under `scene`'s sun and

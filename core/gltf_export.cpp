@@ -33,6 +33,7 @@
 
 #include "core/util/file_io.h"
 #include "core/util/json.h"
+#include "core/leaf_mesh.h"
 #include "core/materials.h"
 #include "core/normal_map.h"
 #include "core/skin.h"
@@ -311,6 +312,29 @@ std::string material_json(uint32_t material, const Bark& bark, const std::map<ui
   return w.take();
 }
 
+// The material of the leaves of index `material` (gltf_export.h): the table's look, never
+// the bark's (docs/leaves.md), double-sided.
+std::string leaf_material_json(uint32_t material, const std::map<uint32_t, SceneMaterial>& materials) {
+  const MaterialLook look = material_look(materials, nullptr, material);
+  JsonWriter w;
+  w.begin_object();
+  w.key("name").string("sylva_leaf_material_" + std::to_string(material));
+  w.key("pbrMetallicRoughness").begin_object();
+  const double factor[4] = {look.albedo.x, look.albedo.y, look.albedo.z, 1};
+  w.key("baseColorFactor").numbers(factor, 4);
+  w.key("metallicFactor").number(0);
+  w.key("roughnessFactor").number(0.9);
+  w.end_object();
+  w.key("doubleSided").boolean(true);
+  w.key("extras").begin_object().key("sylva").begin_object();
+  w.key("material_index").integer(material);
+  w.key("leaf").boolean(true);
+  if (materials.count(material)) w.key("specular").number(look.specular);
+  w.end_object().end_object();
+  w.end_object();
+  return w.take();
+}
+
 double median_segment_radius(const SkinnedSkeleton& skinned) {
   std::vector<double> radii;
   for (const Frustum& f : skinned.frusta)
@@ -563,6 +587,44 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
           primitives.key("attributes").raw(attributes.text());
           primitives.key("indices").integer(buffer.add_indices(indices));
           primitives.key("material").integer(m);
+          primitives.key("mode").integer(kModeTriangles);
+          primitives.end_object();
+          ++primitive_count;
+        }
+      }
+    }
+    if (options.mesh && !sk.leaves.empty()) {
+      // The leaves (leaf_mesh.h): flat triangles with their leaf's normal at each vertex,
+      // one primitive per material index in increasing order, double-sided materials.
+      LeafMesh leaves;
+      append_leaves(leaves, sk, 0);
+      std::map<uint32_t, std::vector<uint32_t>> triangles_of;
+      std::vector<float> positions, normals;
+      for (const glm::dvec3& q : leaves.positions)
+        positions.insert(positions.end(), {static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z)});
+      for (uint32_t l : leaves.vertex_leaf) {
+        // Renormalised in float so the validator's unit-length check holds exactly.
+        const glm::dvec3& n = leaves.leaves[l].normal;
+        const float f[3] = {static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z)};
+        const float len = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+        normals.insert(normals.end(), {f[0] / len, f[1] / len, f[2] / len});
+      }
+      for (size_t t = 0; t < leaves.triangle_count(); ++t) {
+        std::vector<uint32_t>& list = triangles_of[leaves.leaves[leaves.triangle_leaf[t]].material];
+        list.insert(list.end(), leaves.indices.begin() + static_cast<std::ptrdiff_t>(3 * t),
+                    leaves.indices.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
+      }
+      if (!triangles_of.empty()) {
+        JsonWriter attributes;
+        attributes.begin_object();
+        attributes.key("POSITION").integer(buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer));
+        attributes.key("NORMAL").integer(buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer));
+        attributes.end_object();
+        for (const auto& [material, indices] : triangles_of) {
+          primitives.begin_object();
+          primitives.key("attributes").raw(attributes.text());
+          primitives.key("indices").integer(buffer.add_indices(indices));
+          primitives.key("material").integer(table.material(leaf_material_json(material, options.materials)));
           primitives.key("mode").integer(kModeTriangles);
           primitives.end_object();
           ++primitive_count;

@@ -13,6 +13,13 @@
 //     index that occurs in the plant (triangles grouped by their frustum's material),
 //     all sharing one set of vertex attributes — POSITION, NORMAL, TEXCOORD_0 and, when
 //     the bark has a height map, TANGENT — and one material each (below).
+//   - with `mesh`, the plant's leaves (skeleton.md "Leaves"; leaf_mesh.h's triangulation)
+//     as further TRIANGLES primitives, one per material index the leaves use, in
+//     increasing order, sharing one POSITION and NORMAL set (each leaf's own vertices, its
+//     unit Newell normal at each); their material "sylva_leaf_material_<k>" is
+//     double-sided, its baseColorFactor material_look(options.materials, no bark, k) (a
+//     leaf is never bark), extras.sylva {"material_index", "leaf": true, and "specular"
+//     where the table describes k}.
 //
 // Bark and materials (with `mesh`; without it the bark is ignored and no texture read).
 // A plant's `bark` (scene.h, scene.md) covers its wood only, the segments of material 0

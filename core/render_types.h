@@ -28,6 +28,11 @@ enum AovFlags : uint32_t {
   kAovFog = 1u << 4,     // fog.R fog.G fog.B fog.T (spec/fog.md, "Outputs")
 };
 
+// The id AOV of a leaf (both renderers): id.plant its plant, id.chain kAovLeafChain (no
+// chain is negative; −1 is a miss), id.segment the leaf's index in its plant's
+// Skeleton::leaves (the order the grammar closes them).
+inline constexpr float kAovLeafChain = -2.0f;
+
 // Which geometry stands for the plants (paper 000 sec. 4: the analytic frusta are the reference,
 // the tessellated meshes the polygon baseline).
 enum class GeometryKind : uint8_t {

@@ -18,6 +18,7 @@
 #include <tuple>
 
 #include "core/fog.h"
+#include "core/leaf_mesh.h"
 #include "core/materials.h"
 #include "core/util/diagnostic.h"
 #include "core/util/file_io.h"
@@ -560,7 +561,7 @@ Expected<Scene> read_scene_file(const std::string& path) {
 
 SkeletonBounds skeleton_bounds(const Skeleton& skeleton) {
   SkeletonBounds b;
-  if (skeleton.joints.empty()) return b;
+  if (skeleton.joints.empty() && skeleton.leaves.empty()) return b;
   const double inf = std::numeric_limits<double>::infinity();
   b.lo = glm::dvec3(inf);
   b.hi = glm::dvec3(-inf);
@@ -569,6 +570,7 @@ SkeletonBounds skeleton_bounds(const Skeleton& skeleton) {
     b.lo = glm::min(b.lo, p - glm::dvec3(j.radius_m));
     b.hi = glm::max(b.hi, p + glm::dvec3(j.radius_m));
   }
+  grow(b, leaf_bounds(skeleton));  // empty without leaves
   return b;
 }
 
@@ -991,6 +993,11 @@ Skeleton place_plant(const ScenePlant& plant) {
     j.position_m[2] = plant.position.z - s * x + c * z;
     j.radius_m *= plant.scale;
   }
+  for (Leaf& leaf : sk.leaves)
+    for (auto& v : leaf.vertices_m) {
+      const double x = plant.scale * v[0], y = plant.scale * v[1], z = plant.scale * v[2];
+      v = {plant.position.x + c * x + s * z, plant.position.y + y, plant.position.z - s * x + c * z};
+    }
   return sk;
 }
 

@@ -246,7 +246,7 @@ glm::dvec3 unit_sun_direction(const glm::dvec3& toward_sun);
 // radii scaled. Precondition: plant.skeleton is set.
 Skeleton place_plant(const ScenePlant& plant);
 
-// Axis-aligned bounds of a skeleton's joints grown by their radii (metres).
+// Axis-aligned bounds of a skeleton's joints grown by their radii, and of its leaves' vertices (metres).
 using SkeletonBounds = Aabb;
 SkeletonBounds skeleton_bounds(const Skeleton& skeleton);
 

@@ -15,6 +15,9 @@
 #include <limits>
 #include <utility>
 
+#include <glm/geometric.hpp>
+
+#include "core/leaf_mesh.h"
 #include "core/util/file_io.h"
 #include "core/util/json.h"
 
@@ -491,15 +494,9 @@ std::optional<std::string> leaf_polygon_problem(std::span<const std::array<doubl
     return "a leaf needs at least 3 distinct vertices, this polygon has " + std::to_string(distinct) + " (" +
            count_of(vertices.size(), "vertex", "vertices") + ")";
   // Newell's normal: twice the vector area of the polygon, whatever its shape.
-  double n[3] = {0, 0, 0};
-  for (size_t v = 0; v < vertices.size(); ++v) {
-    const auto& a = vertices[v];
-    const auto& b = vertices[(v + 1) % vertices.size()];
-    n[0] += (a[1] - b[1]) * (a[2] + b[2]);
-    n[1] += (a[2] - b[2]) * (a[0] + b[0]);
-    n[2] += (a[0] - b[0]) * (a[1] + b[1]);
-  }
-  const double length = std::hypot(n[0], n[1], n[2]);
+  const glm::dvec3 newell = polygon_newell_normal(vertices);
+  const double n[3] = {newell.x, newell.y, newell.z};
+  const double length = glm::length(newell);
   if (!(length > 1e-12 * diagonal * diagonal)) return "the polygon has no area (its vertices lie on one line)";
   double off = 0;
   size_t worst = 0;

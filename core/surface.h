@@ -33,7 +33,11 @@ struct SurfaceHit {
   uint32_t chain = 0;                    // chain of the plant's skeleton
   uint32_t segment = 0;                  // segment (knuckle: joint) index in the chain
   uint32_t material = 0;                 // material index of the segment
-  uint32_t frustum = 0;                  // index into SceneGeometry::frusta
+  uint32_t frustum = 0;                  // index into SceneGeometry::frusta (a leaf: none, 0)
+  uint32_t leaf = kNoLeaf;               // a leaf hit: index into the plant's Skeleton::leaves
+
+  static constexpr uint32_t kNoLeaf = 0xFFFFFFFFu;
+  bool is_leaf() const { return leaf != kNoLeaf; }
 
   bool hit() const { return t < std::numeric_limits<double>::infinity(); }
 };

@@ -35,6 +35,7 @@
 #define MAX_MATERIALS 16          // shade.frag.glsl's material table (materials.h fills it)
 #define PLANT_INDEX_BITS 24       // G-buffer ids.x: plant | material << PLANT_INDEX_BITS
 #define PLANT_INDEX_MASK 0xFFFFFFu
+#define LEAF_CHAIN 0xFFFFFFFEu    // G-buffer ids.y of a leaf (gl_mesh.h), ids.z its index
 #define PYRAMID_VERTICES 36       // a frustum's bounding pyramid: 12 triangles (skin.glsl)
 #define FOG_LIST_END 0xFFFFFFFFu  // the end of a pixel's interval list (fog_lists.glsl)
 #define FOG_MAX_INTERVALS 16      // merged intervals the fog resolve holds per pixel (fog.frag.glsl)

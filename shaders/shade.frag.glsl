@@ -151,17 +151,18 @@ void main() {
     uvec4 ids = texelFetch(g_ids, texel, 0);
     uint plant = ids.x & PLANT_INDEX_MASK;
     uint material = ids.x >> PLANT_INDEX_BITS;
+    bool wood = material == 0u && ids.y != LEAF_CHAIN;  // a leaf is never bark (materials.md)
     vec4 decided = texelFetch(g_albedo, texel, 0);
     int slot = min(int(material), u_material_count - 1);
-    albedo = decided.a > 0.0                               ? decided.rgb
-             : material == 0u && plant_bark[plant].w > 0.0 ? plant_bark[plant].rgb
-                                                           : u_material_albedo[slot];
+    albedo = decided.a > 0.0                     ? decided.rgb
+             : wood && plant_bark[plant].w > 0.0 ? plant_bark[plant].rgb
+                                                 : u_material_albedo[slot];
     n = normal_distance.xyz;
     n_geometric = geometric_u.xyz;
     t = plant_t;
     specular = u_material_specular[slot];
 #ifdef SUN
-    if (material == 0u && plant_maps[plant].relief_depth_m > 0.0) shadow_offset_m = t * u_pixel_step_rad;
+    if (wood && plant_maps[plant].relief_depth_m > 0.0) shadow_offset_m = t * u_pixel_step_rad;
 #endif
   }
 #ifdef FOG

@@ -4,6 +4,7 @@
 #include "core/cpu/mesh_accel.h"
 
 #include "core/cpu/embree_scene.h"
+#include "core/cpu/embree_triangles.h"
 
 
 #include <algorithm>
@@ -20,52 +21,6 @@ namespace {
 
 constexpr float kInfF = std::numeric_limits<float>::infinity();
 
-// A ray against one triangle in double, without an inside test: t where the ray crosses
-// the triangle's plane, and the barycentrics (b1, b2) of that point (b0 = 1 − b1 − b2).
-// det == 0: the ray is parallel to the plane (t is then meaningless).
-struct TriangleCrossing {
-  double t = 0, b1 = 0, b2 = 0, det = 0;
-};
-
-TriangleCrossing cross_triangle(const Ray& ray, const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2) {
-  // Edges from p0 and the origin relative to p0: differences of nearby doubles, exact
-  // enough however far the scene is from the world's origin.
-  const glm::dvec3 e1 = p1 - p0, e2 = p2 - p0, s = ray.origin - p0;
-  const glm::dvec3 pvec = glm::cross(ray.direction, e2);
-  TriangleCrossing c;
-  c.det = glm::dot(e1, pvec);
-  if (c.det == 0) return c;
-  const double inv = 1 / c.det;
-  const glm::dvec3 qvec = glm::cross(s, e1);
-  c.b1 = glm::dot(s, pvec) * inv;
-  c.b2 = glm::dot(ray.direction, qvec) * inv;
-  c.t = glm::dot(e2, qvec) * inv;
-  return c;
-}
-
-// The intersect context Embree passes to the filter, extended with the double query
-// (Embree 3 allows a context to be embedded first).
-struct MeshQuery {
-  RTCIntersectContext embree;
-  const TriangleMesh* mesh;
-  Ray ray;
-  double t_min;
-  double t_max;
-};
-
-// Keeps a float candidate only if its double t lies in the query's (t_min, t_max).
-void range_filter(const RTCFilterFunctionNArguments* args) {
-  const auto* q = reinterpret_cast<const MeshQuery*>(args->context);
-  const TriangleMesh& m = *q->mesh;
-  for (unsigned i = 0; i < args->N; ++i) {
-    if (!args->valid[i]) continue;
-    const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
-    const uint32_t* tri = &m.indices[3 * static_cast<size_t>(prim)];
-    const TriangleCrossing c = cross_triangle(q->ray, m.positions[tri[0]], m.positions[tri[1]], m.positions[tri[2]]);
-    if (c.det == 0 || !(c.t > q->t_min && c.t < q->t_max)) args->valid[i] = 0;
-  }
-}
-
 }  // namespace
 
 struct MeshTracer::Impl {
@@ -78,14 +33,8 @@ struct MeshTracer::Impl {
   Aabb bounds = empty_box();
   EmbreeScene embree{/*need_filter_functions=*/true};
 
-  MeshQuery start_query(const Ray& ray, double t_min, double t_max) const {
-    MeshQuery q{};
-    rtcInitIntersectContext(&q.embree);
-    q.mesh = &mesh;
-    q.ray = ray;
-    q.t_min = t_min;
-    q.t_max = t_max;
-    return q;
+  TriangleQuery start_query(const Ray& ray, double t_min, double t_max) const {
+    return start_triangle_query(mesh.positions.data(), mesh.indices.data(), ray, t_min, t_max);
   }
 
   RTCRay embree_ray(const Ray& ray, double t_min, double t_max) const {
@@ -115,18 +64,9 @@ MeshTracer::MeshTracer(TriangleMesh mesh, std::span<const Frustum> frusta, std::
   m.centre = tm.positions.empty() ? glm::dvec3(0) : 0.5 * (lo + hi);
   if (!tm.positions.empty()) m.bounds = {lo, hi};
   if (tm.triangle_count() > 0) {
-    RTCGeometry geom = rtcNewGeometry(m.embree.device(), RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                          3 * sizeof(float), tm.positions.size()));
-    for (size_t i = 0; i < tm.positions.size(); ++i) {
-      const glm::dvec3 p = tm.positions[i] - m.centre;
-      v[3 * i] = static_cast<float>(p.x), v[3 * i + 1] = static_cast<float>(p.y), v[3 * i + 2] = static_cast<float>(p.z);
-    }
     // The mesh's own index array, shared (not copied): it lives as long as the tracer.
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, tm.indices.data(), 0,
-                               3 * sizeof(uint32_t), tm.triangle_count());
-    rtcSetGeometryIntersectFilterFunction(geom, range_filter);
-    rtcSetGeometryOccludedFilterFunction(geom, range_filter);
+    RTCGeometry geom = new_filtered_triangles(m.embree.device(), tm.positions.data(), tm.positions.size(),
+                                              tm.indices.data(), tm.triangle_count(), m.centre);
     m.embree.attach(geom);
   }
   m.embree.commit();
@@ -138,7 +78,7 @@ const TriangleMesh& MeshTracer::mesh() const { return impl_->mesh; }
 
 SurfaceHit MeshTracer::nearest(const Ray& ray, double t_min, double t_max) const {
   const Impl& m = *impl_;
-  MeshQuery q = m.start_query(ray, t_min, t_max);
+  TriangleQuery q = m.start_query(ray, t_min, t_max);
   RTCRayHit rh{};
   rh.ray = m.embree_ray(ray, t_min, t_max);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -192,7 +132,7 @@ SurfaceHit MeshTracer::nearest(const Ray& ray, double t_min, double t_max) const
 
 bool MeshTracer::any(const Ray& ray, double t_min, double t_max) const {
   const Impl& m = *impl_;
-  MeshQuery q = m.start_query(ray, t_min, t_max);
+  TriangleQuery q = m.start_query(ray, t_min, t_max);
   RTCRay r = m.embree_ray(ray, t_min, t_max);
   rtcOccluded1(m.embree.scene(), &q.embree, &r);
   return r.tfar == -kInfF;

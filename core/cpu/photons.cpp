@@ -15,6 +15,7 @@
 
 #include "core/cpu/bvh.h"  // frustum_bounds
 #include "core/cpu/frustum_accel.h"
+#include "core/cpu/leaf_tracer.h"
 #include "core/cpu/render_cpu.h"
 #include "core/render_common.h"
 #include "core/relief.h"
@@ -117,7 +118,10 @@ bool parallel_chunks(uint64_t chunks, unsigned threads, const std::atomic<bool>*
 // The tests check that the mask changes no shadow vector.
 class SunMask {
  public:
-  SunMask(std::span<const Frustum> frusta, const SunEmitter& e, unsigned threads) : frame_(axis_frame(e.to_sun)), e_(e) {
+  // Over the frusta and, when given, the leaves' triangles (each in the capsule around its
+  // first edge as wide as its third vertex is far: the triangle lies within it).
+  SunMask(std::span<const Frustum> frusta, const LeafMesh* leaves, const SunEmitter& e, unsigned threads)
+      : frame_(axis_frame(e.to_sun)), e_(e) {
     struct Capsule {
       glm::dvec2 a, b;
       double radius, z0, z1;
@@ -139,6 +143,21 @@ class SunMask {
         c.z1 = std::max(c.z1, depth(v));
       }
       c.radius = c.radius * (1 + 1e-9) + 1e-9;
+      lo = glm::min(lo, glm::min(c.a, c.b) - c.radius);
+      hi = glm::max(hi, glm::max(c.a, c.b) + c.radius);
+      z_lo = std::min(z_lo, c.z0);
+      z_hi = std::max(z_hi, c.z1);
+      capsules.push_back(c);
+    }
+    for (size_t t = 0; leaves && t < leaves->triangle_count(); ++t) {
+      const glm::dvec3* v[3];
+      for (int k = 0; k < 3; ++k) v[k] = &leaves->positions[leaves->indices[3 * t + static_cast<size_t>(k)]];
+      Capsule c;
+      c.a = lateral(*v[0]);
+      c.b = lateral(*v[1]);
+      c.radius = segment_distance(lateral(*v[2]), c.a, c.b) * (1 + 1e-9) + 1e-9;
+      c.z0 = std::min({depth(*v[0]), depth(*v[1]), depth(*v[2])});
+      c.z1 = std::max({depth(*v[0]), depth(*v[1]), depth(*v[2])});
       lo = glm::min(lo, glm::min(c.a, c.b) - c.radius);
       hi = glm::max(hi, glm::max(c.a, c.b) + c.radius);
       z_lo = std::min(z_lo, c.z0);
@@ -264,7 +283,7 @@ class SunMask {
 
 }  // namespace
 
-SunEmitter sun_emitter(std::span<const Frustum> frusta, const Sun& sun) {
+SunEmitter sun_emitter(std::span<const Frustum> frusta, const Sun& sun, const Aabb& leaves) {
   SunEmitter e;
   glm::dvec3 lo(kInf), hi(-kInf);
   for (const Frustum& f : frusta) {
@@ -272,6 +291,7 @@ SunEmitter sun_emitter(std::span<const Frustum> frusta, const Sun& sun) {
     lo = glm::min(lo, b.lo);
     hi = glm::max(hi, b.hi);
   }
+  if (!frusta.empty() && leaves.lo.x <= leaves.hi.x) lo = glm::min(lo, leaves.lo), hi = glm::max(hi, leaves.hi);
   if (!frusta.empty()) {
     e.centre = 0.5 * (lo + hi);
     e.sphere_radius_m = 0.5 * glm::length(hi - lo);
@@ -290,9 +310,18 @@ SunEmitter sun_emitter(std::span<const Frustum> frusta, const Sun& sun) {
 
 namespace {
 
-// The photons of `e` through `accel` (built over `frusta`), those `mask` clears skipped.
+// The leaves as the photons see them: the triangles, and per plant the frustum its leaves'
+// shadow vectors name (its first: the clustering keeps plants apart by it).
+constexpr uint32_t kNoFrustum = 0xFFFFFFFFu;
+struct PhotonLeaves {
+  const LeafTracer* tracer = nullptr;  // null: no leaves
+  std::vector<uint32_t> first_frustum_of_plant;
+};
+
+// The photons of `e` through `accel` (built over `frusta`) and the leaves, those `mask`
+// clears skipped.
 SunPhotons trace_photons(const FrustumAccel& accel, const SunMask& mask, std::span<const Frustum> frusta,
-                         const SunEmitter& e, const SunPhotonOptions& options) {
+                         const PhotonLeaves& leaves, const SunEmitter& e, const SunPhotonOptions& options) {
   SunPhotons out;
   out.emitter = e;
   out.vectors.origin = e.centre;
@@ -318,6 +347,19 @@ SunPhotons trace_photons(const FrustumAccel& accel, const SunMask& mask, std::sp
       ray.direction = photon_direction(e.to_sun, frame, one_minus_cos, rng);
       if (options.occupancy_mask && !mask.may_hit(ray.origin, ray.direction)) continue;
       const BvhHit hit = accel.nearest(ray, 0, kInf);
+      // A leaf before the first frustum (or instead of one) stops the photon: a leaf is
+      // thin, so its far side is its hit point (docs/leaves.md), and the vector names the
+      // first frustum of the leaf's plant.
+      if (leaves.tracer) {
+        const SurfaceHit leaf = leaves.tracer->nearest_leaf(ray, 0, hit.hit_any() ? hit.hit.t : kInf);
+        if (leaf.hit()) {
+          const uint32_t frustum =
+              leaf.plant < leaves.first_frustum_of_plant.size() ? leaves.first_frustum_of_plant[leaf.plant] : kNoFrustum;
+          if (frustum != kNoFrustum)
+            local.push_back({glm::vec3(leaf.position - e.centre), glm::vec3(ray.direction), frustum});
+          continue;
+        }
+      }
       if (!hit.hit_any()) continue;
       // Fig. 2b: where the photon leaves the frustum it hit (its convex solid).
       const SolidInterval solid = frustum_solid_interval(ray, frusta[hit.frustum].shape, 0, kInf);
@@ -344,20 +386,32 @@ SunPhotons trace_photons(const FrustumAccel& accel, const SunMask& mask, std::sp
 
 struct SunPhotonTracer::Impl {
   std::span<const Frustum> frusta;
+  PhotonLeaves leaves;
   SunEmitter emitter;
   std::optional<FrustumAccel> accel;  // none without frusta
   std::optional<SunMask> mask;
   double build_seconds = 0;
 };
 
-SunPhotonTracer::SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun, unsigned threads)
+SunPhotonTracer::SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun, unsigned threads,
+                                 const LeafTracer* leaves, std::span<const uint32_t> plant_of_frustum)
     : impl_(std::make_unique<Impl>()) {
   const Clock::time_point start = Clock::now();
   impl_->frusta = frusta;
-  impl_->emitter = sun_emitter(frusta, sun);
+  const LeafMesh* leaf_mesh = leaves && !leaves->leaves().empty() ? &leaves->leaves() : nullptr;
+  if (leaf_mesh) {
+    impl_->leaves.tracer = leaves;
+    std::vector<uint32_t>& first = impl_->leaves.first_frustum_of_plant;
+    for (uint32_t f = 0; f < plant_of_frustum.size(); ++f) {
+      const uint32_t p = plant_of_frustum[f];
+      if (p >= first.size()) first.resize(p + 1, kNoFrustum);
+      if (first[p] == kNoFrustum) first[p] = f;
+    }
+  }
+  impl_->emitter = sun_emitter(frusta, sun, leaf_mesh ? leaf_mesh->bounds() : empty_box());
   if (!frusta.empty()) {
     impl_->accel.emplace(frusta);
-    impl_->mask.emplace(frusta, impl_->emitter, thread_count(threads));
+    impl_->mask.emplace(frusta, leaf_mesh, impl_->emitter, thread_count(threads));
   }
   impl_->build_seconds = seconds_since(start);
 }
@@ -375,11 +429,13 @@ SunPhotons SunPhotonTracer::trace(const SunPhotonOptions& options) const {
     out.vectors.origin = impl_->emitter.centre;
     return out;
   }
-  return trace_photons(*impl_->accel, *impl_->mask, impl_->frusta, impl_->emitter, options);
+  return trace_photons(*impl_->accel, *impl_->mask, impl_->frusta, impl_->leaves, impl_->emitter, options);
 }
 
 bool SunPhotonTracer::toward_sun_blocked(const glm::dvec3& point) const {
-  return impl_->accel && impl_->accel->any({point, impl_->emitter.to_sun}, 0, kInf);
+  const Ray ray{point, impl_->emitter.to_sun};
+  return impl_->accel && (impl_->accel->any(ray, 0, kInf) ||
+                          (impl_->leaves.tracer && impl_->leaves.tracer->nearest_leaf(ray, 0, kInf).hit()));
 }
 
 SunPhotons trace_sun_photons(std::span<const Frustum> frusta, const Sun& sun, const SunPhotonOptions& options) {
@@ -598,14 +654,15 @@ std::string AutoConeReport::describe() const {
 std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, const Scene& scene,
                                                 const SunConeOptions& options, const SunPhotonTracer* tracer) {
   auto out = std::make_unique<SunCones>();
-  out->emitter = sun_emitter(geometry.frusta, scene.sun);
+  out->emitter = sun_emitter(geometry.frusta, scene.sun, geometry.leaves ? geometry.leaves->leaves().bounds() : empty_box());
   const SunEmitter& e = out->emitter;
   out->params = options.params.value_or(ConeParams{});
   if (!(e.to_sun.y > 0) || geometry.frusta.empty() || options.photons.photons == 0) return out;
 
   const Clock::time_point start = Clock::now();
   std::optional<SunPhotonTracer> own;
-  if (!tracer) tracer = &own.emplace(geometry.frusta, scene.sun, options.photons.threads);
+  if (!tracer)
+    tracer = &own.emplace(geometry.frusta, scene.sun, options.photons.threads, geometry.leaves, geometry.plant_of_frustum);
   SunPhotons photons = tracer->trace(options.photons);
   out->photon_seconds = seconds_since(start);
   out->photons = photons.traced;

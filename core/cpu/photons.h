@@ -19,6 +19,9 @@
 // At the first frustum it hits it leaves a shadow vector where it exits that frustum's
 // solid (frustum_solid_interval; Fig. 2b: on the occluder's far side), with its
 // direction and the frustum's index. Photons that hit nothing leave nothing.
+// Leaves (docs/leaves.md) stop photons too: a photon whose first hit is a leaf leaves its
+// vector at the hit point (a leaf has no thickness, so its far side is where the photon
+// meets it), naming the first frustum of the leaf's plant.
 //
 // Units and frames: world space, metres, Y up; the vectors' float positions are
 // relative to the bounding sphere's centre (ShadowVectors::origin).
@@ -43,6 +46,8 @@
 
 namespace sylva {
 
+class LeafTracer;  // leaf_tracer.h
+
 struct SunPhotonOptions {
   uint64_t photons = 1'000'000;             // photons emitted, >= 0
   uint64_t seed = 0;                        // the sequence's rotation and the directions' stream
@@ -62,8 +67,9 @@ struct SunEmitter {
   double disc_radius_m = 0;
 };
 
-// The emitter for `frusta` (empty: a zero sphere) under `sun`.
-SunEmitter sun_emitter(std::span<const Frustum> frusta, const Sun& sun);
+// The emitter for `frusta` (empty: a zero sphere) and, with frusta, the box `leaves` of
+// their plants' leaves (empty_box(): none) under `sun`.
+SunEmitter sun_emitter(std::span<const Frustum> frusta, const Sun& sun, const Aabb& leaves = empty_box());
 
 struct SunPhotons {
   ShadowVectors vectors;  // in photon order; origin = the emitter's sphere centre
@@ -83,7 +89,11 @@ struct SunPhotons {
 // core). `frusta` must outlive it, unchanged. Thread-safe (const).
 class SunPhotonTracer {
  public:
-  SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun, unsigned threads = 0);
+  // `leaves` (optional, outliving the tracer): the scene's leaves, which stop photons too
+  // (see the header comment); `plant_of_frustum` names each frustum's plant (a leaf's
+  // vectors carry the first frustum of its plant; a plant without frusta leaves none).
+  SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun, unsigned threads = 0,
+                  const LeafTracer* leaves = nullptr, std::span<const uint32_t> plant_of_frustum = {});
   ~SunPhotonTracer();
   SunPhotonTracer(const SunPhotonTracer&) = delete;
   SunPhotonTracer& operator=(const SunPhotonTracer&) = delete;

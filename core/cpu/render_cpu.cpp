@@ -6,6 +6,7 @@
 #include "core/fog.h"
 #include "core/fog_integrator.h"
 #include "core/cpu/frustum_tracer.h"
+#include "core/cpu/leaf_tracer.h"
 #include "core/cpu/mesh_accel.h"
 #include "core/cpu/photons.h"
 #include "core/render_common.h"
@@ -216,8 +217,10 @@ class Renderer {
     if (glm::dot(ng, view) < 0) ng = -ng;   // seen from inside: light the side we see
     if (glm::dot(n, view) < 0) n = -n;
     const ScenePlant& plant = scene_.plants[s.plant];
-    const MaterialLook look = material_look(scene_.materials, &plant.bark, s.material);
+    // A leaf is never bark (docs/materials.md): the table's look of its material, untextured.
+    const MaterialLook look = material_look(scene_.materials, s.is_leaf() ? nullptr : &plant.bark, s.material);
     glm::dvec3 albedo = look.albedo;
+    if (s.is_leaf()) return lit(albedo, n, ng, s.position, view, look.specular, rng, shadow_rays);
     if (s.material == 0 && textures_ && textures_->has_albedo(s.plant)) {  // bark: wood only
       const UvFootprint footprint = uv_footprint(s, {h.ray.origin, h.ray.direction + direction_dx_},
                                                  {h.ray.origin, h.ray.direction + direction_dy_});
@@ -260,8 +263,9 @@ class Renderer {
     }
     if (!image.id.empty()) {
       image.id[pixel * 3 + 0] = hit ? static_cast<float>(s.plant) : -1.0f;
-      image.id[pixel * 3 + 1] = hit ? static_cast<float>(s.chain) : -1.0f;
-      image.id[pixel * 3 + 2] = hit ? static_cast<float>(s.segment) : -1.0f;
+      // A leaf: chain kAovLeafChain, segment its index in the plant's leaves (render_cpu.h).
+      image.id[pixel * 3 + 1] = !hit ? -1.0f : s.is_leaf() ? kAovLeafChain : static_cast<float>(s.chain);
+      image.id[pixel * 3 + 2] = !hit ? -1.0f : static_cast<float>(s.is_leaf() ? s.leaf : s.segment);
     }
     if (!image.fog.empty()) {
       const FogRayResult f = centre_fog ? *centre_fog : integrate_fog(*centre_hit, cost);
@@ -343,6 +347,7 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, 
   double cull_s = 0, skin_s = 0, tessellate_s = 0, displace_s = 0;
   uint32_t culled = 0, displaced = 0;
   TriangleMesh triangles;
+  LeafMesh leaves;
   for (uint32_t p = 0; p < scene.plants.size(); ++p) {
     if (progress.cancelled()) {  // between plants
       g.cancelled = true;
@@ -373,6 +378,7 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, 
       return g;
     }
     const SkinnedSkeleton& skinned = *skinned_or;
+    append_leaves(leaves, placed, p);
     const uint32_t first_frustum = static_cast<uint32_t>(g.frusta.size());
     g.frusta.insert(g.frusta.end(), skinned.frusta.begin(), skinned.frusta.end());
     g.plant_of_frustum.insert(g.plant_of_frustum.end(), skinned.frusta.size(), p);
@@ -415,6 +421,13 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, 
       g.tracer = std::make_unique<MeshTracer>(std::move(triangles), g.frusta, g.plant_of_frustum, options.mesh_level,
                                               displaced > 0);
       break;
+  }
+  // Leaves (leaf_tracer.h): their own triangles beside the frusta or mesh; a scene
+  // without leaves keeps its tracer as it is.
+  if (!leaves.empty()) {
+    auto with_leaves = std::make_unique<LeafTracer>(std::move(leaves), std::move(g.tracer));
+    g.leaves = with_leaves.get();
+    g.tracer = std::move(with_leaves);
   }
   if (passes)
     passes->push_back({"accel build", seconds_since(start),

@@ -35,7 +35,8 @@
 // distance from the eye, +inf where no plant is hit — the ground and the sky are not
 // plants), world-space shading normal (0 on a miss), uv (u turns, v_m metres of arc
 // length; 0 on a miss), id (plant, chain, segment as floats, exact below 2^24; −1 on a
-// miss). For a knuckle frustum id.segment is the joint's index. fog (kAovFog, a scene with
+// miss). For a knuckle frustum id.segment is the joint's index; a leaf writes (plant, kAovLeafChain = −2, its
+// index in the plant's leaves), docs/leaves.md. fog (kAovFog, a scene with
 // fog only): the fog's in-scatter RGB and T(0, t_end) through the pixel's centre, so that
 // beauty = fog.T·L_end + fog.RGB at spp 1 (at spp > 1 the centre ray is integrated again,
 // with its own random stream).
@@ -66,6 +67,7 @@
 namespace sylva {
 
 class SceneTextures;  // texture.h
+class LeafTracer;     // leaf_tracer.h
 
 // World-space geometry of a scene: every plant's skeleton transformed (position,
 // rotate_y_deg, scale) and skinned, and what the renderer traces: the frusta themselves
@@ -75,7 +77,8 @@ struct SceneGeometry {
   std::vector<uint32_t> plant_of_frustum;  // plant index of each frustum
   std::shared_ptr<const SceneTextures> own_textures;  // opened here when the caller gave
                                                       // none and the relief needs them
-  std::unique_ptr<SceneTracer> tracer;     // over `frusta` (or a mesh made from them)
+  std::unique_ptr<SceneTracer> tracer;     // over `frusta` (or a mesh made from them) and the leaves
+  const LeafTracer* leaves = nullptr;      // `tracer` when the scene has leaves (leaf_tracer.h), else null
   bool cancelled = false;                  // stopped by `progress` between plants: no tracer
 };
 

@@ -44,6 +44,7 @@ inline constexpr uint32_t kMaxMaterials = 16;   // shade.frag.glsl's u_material_
 inline constexpr uint32_t kPlantIndexBits = 24;  // G-buffer ids.x = plant | material << 24
 inline constexpr uint32_t kPlantIndexMask = (1u << kPlantIndexBits) - 1;
 inline constexpr uint32_t kMaxPlants = 1u << kPlantIndexBits;
+inline constexpr uint32_t kLeafChain = 0xFFFFFFFEu;  // G-buffer ids.y of a leaf (ids.z: its index)
 inline constexpr uint32_t kPyramidVertices = 36;  // vertex pulling: 36 vertices a frustum
 inline constexpr uint32_t kFogListEnd = 0xFFFFFFFFu;  // the end of a pixel's interval list
 inline constexpr uint32_t kFogMaxIntervals = 16;      // merged intervals the resolve holds per pixel
@@ -78,6 +79,7 @@ inline constexpr GlslConstant kGlslConstants[] = {
     {"MAX_MATERIALS", kMaxMaterials},
     {"PLANT_INDEX_BITS", kPlantIndexBits},
     {"PLANT_INDEX_MASK", kPlantIndexMask},
+    {"LEAF_CHAIN", kLeafChain},
     {"PYRAMID_VERTICES", kPyramidVertices},
     {"FOG_CONES_BINDING", kFogConesBinding},
     {"FOG_NODES_BINDING", kFogNodesBinding},

@@ -17,6 +17,7 @@
 #include "core/gl/gl_views.h"
 #include "core/render_common.h"
 #include "core/cpu/texture.h"
+#include "core/leaf_mesh.h"
 #include "core/plant_mesh.h"
 
 namespace sylva {
@@ -103,6 +104,36 @@ void append_plant(MeshArrays& out, const TriangleMesh& part, const SkinnedSkelet
   }
 }
 
+// Appends plant `plant`'s leaves `part` (leaf_mesh.h: one plant's) to `out`: a record
+// per leaf (ids plant | material << 24, kLeafChain, the leaf's index), its flat normal at
+// every vertex, uv 0, and a sphere per leaf.
+void append_leaves(MeshArrays& out, const LeafMesh& part) {
+  if (part.empty()) return;
+  if (out.vertices.size() + part.positions.size() > std::numeric_limits<uint32_t>::max())
+    throw GlError("the GL leaves hold at most 2^32 vertices");
+  const Aabb box = part.bounds();
+  const glm::vec3 origin_hi(0.5 * (box.lo + box.hi));
+  const glm::dvec3 origin(origin_hi);
+  const uint32_t first_record = static_cast<uint32_t>(out.frusta.size());
+  for (const LeafRef& leaf : part.leaves)
+    out.frusta.push_back({{origin_hi.x, origin_hi.y, origin_hi.z, 0.0f},
+                          {leaf.plant | (std::min(leaf.material, 255u) << gl::kPlantIndexBits), gl::kLeafChain,
+                           leaf.leaf, 0u}});
+  const std::vector<uint32_t>& vertex_leaf = part.vertex_leaf;
+  const uint32_t first_vertex = static_cast<uint32_t>(out.vertices.size());
+  for (size_t v = 0; v < part.positions.size(); ++v) {
+    const glm::vec3 q(part.positions[v] - origin), n(part.leaves[vertex_leaf[v]].normal);
+    out.vertices.push_back({{q.x, q.y, q.z}, {n.x, n.y, n.z}, {0.0f, 0.0f}, first_record + vertex_leaf[v]});
+  }
+  for (uint32_t i : part.indices) out.indices.push_back(first_vertex + i);
+  std::vector<Aabb> boxes(part.leaves.size(), empty_box());
+  for (size_t v = 0; v < part.positions.size(); ++v) grow(boxes[vertex_leaf[v]], part.positions[v]);
+  for (const Aabb& b : boxes) {
+    const double radius = 0.5 * glm::length(b.hi - b.lo);
+    out.spheres.push_back({0.5 * (b.lo + b.hi), radius * 1.001 + 1e-6 * (glm::length(box.hi - box.lo) + radius)});
+  }
+}
+
 bool sun_shines(const Scene& scene) {
   return scene.sun.radiance.x > 0 || scene.sun.radiance.y > 0 || scene.sun.radiance.z > 0;
 }
@@ -111,6 +142,7 @@ bool sun_shines(const Scene& scene) {
 
 struct GlMesh::State {
   RenderOptions options;
+  bool leaves = false;  // leaves_of: the scene's leaves instead of its tessellated frusta
   std::vector<RenderPass> setup_passes;
   std::vector<GlMeshSphere> spheres;
   uint64_t triangles = 0, frusta = 0, gpu_bytes = 0;
@@ -143,6 +175,7 @@ struct GlMesh::State {
     }
 
     MeshArrays arrays;
+    if (leaves) return build_leaves(scene, arrays);
     double skin_s = 0, tessellate_s = 0, displace_s = 0;
     uint64_t skinned_frusta = 0;
     for (uint32_t p = 0; p < scene.plants.size(); ++p) {
@@ -167,9 +200,6 @@ struct GlMesh::State {
     frusta = skinned_frusta;
     displaced = arrays.displaced_plants > 0;
     spheres = std::move(arrays.spheres);
-    const size_t vertex_bytes = arrays.vertices.size() * sizeof(MeshVertex);
-    const size_t index_bytes = arrays.indices.size() * sizeof(uint32_t);
-    const size_t frustum_bytes = arrays.frusta.size() * sizeof(MeshFrustumRecord);
     setup_passes.push_back({"skin", skin_s,
                             std::to_string(scene.plants.size()) + " plants, " + std::to_string(frusta) + " frusta"});
     setup_passes.push_back({"tessellate", tessellate_s,
@@ -178,7 +208,36 @@ struct GlMesh::State {
     if (displaced)
       setup_passes.push_back({"displace", displace_s,
                               std::to_string(arrays.displaced_plants) + " plants by their height maps"});
+    return upload(arrays);
+  }
 
+  // The leaves of every plant (placed as the frusta are), then uploaded.
+  uint64_t build_leaves(const Scene& scene, MeshArrays& arrays) {
+    const Clock::time_point start = Clock::now();
+    uint64_t count = 0;
+    for (uint32_t p = 0; p < scene.plants.size(); ++p) {
+      const ScenePlant& plant = scene.plants[p];
+      if (!plant.skeleton) throw std::logic_error("GlMesh: a plant has no skeleton (call grow_scene_plants)");
+      if (plant.skeleton->leaves.empty()) continue;
+      LeafMesh part;
+      sylva::append_leaves(part, place_plant(plant), p);
+      count += part.leaves.size();
+      append_leaves(arrays, part);
+    }
+    triangles = arrays.indices.size() / 3;
+    frusta = 0;
+    displaced = false;
+    spheres = std::move(arrays.spheres);
+    setup_passes.push_back({"triangulate", seconds_since(start),
+                            std::to_string(count) + " leaves, " + std::to_string(triangles) + " triangles"});
+    return upload(arrays);
+  }
+
+  // Uploads `arrays` (replacing what was there) and records the "upload" pass.
+  uint64_t upload(const MeshArrays& arrays) {
+    const size_t vertex_bytes = arrays.vertices.size() * sizeof(MeshVertex);
+    const size_t index_bytes = arrays.indices.size() * sizeof(uint32_t);
+    const size_t frustum_bytes = arrays.frusta.size() * sizeof(MeshFrustumRecord);
     const Clock::time_point start = Clock::now();
     vertex_buffer.reset();
     index_buffer.reset();
@@ -202,7 +261,8 @@ struct GlMesh::State {
     setup_passes.push_back({"upload", seconds_since(start),
                             std::to_string(gpu_bytes / 1024) + " KiB: " + std::to_string(arrays.vertices.size()) +
                                 " vertices (36 B) + " + std::to_string(triangles) + " triangles (12 B) + " +
-                                std::to_string(arrays.frusta.size()) + " frustum records (32 B)"});
+                                std::to_string(arrays.frusta.size()) + (leaves ? " leaf" : " frustum") +
+                                " records (32 B)"});
     return gpu_bytes;
   }
 
@@ -247,6 +307,24 @@ GlMesh::GlMesh(const Scene& scene, const RenderOptions& options, int bark_textur
   }
   st.setup_passes.push_back({"programs", compile_s, names});
   check_gl("GL mesh programs");
+}
+
+GlMesh::GlMesh(const Scene& scene, const RenderOptions& options, LeavesTag) : state_(std::make_unique<State>()) {
+  State& st = *state_;
+  st.options = options;
+  st.leaves = true;
+  st.build(scene, nullptr);
+  double compile_s = 0;
+  st.program(MeshPass::gbuffer, &compile_s);
+  if (sun_shines(scene)) st.program(MeshPass::shadow, &compile_s);
+  check_gl("GL leaves programs");
+}
+
+std::unique_ptr<GlMesh> GlMesh::leaves_of(const Scene& scene, const RenderOptions& options) {
+  const bool any = std::any_of(scene.plants.begin(), scene.plants.end(),
+                               [](const ScenePlant& p) { return p.skeleton && !p.skeleton->leaves.empty(); });
+  if (!any) return nullptr;
+  return std::unique_ptr<GlMesh>(new GlMesh(scene, options, LeavesTag{}));
 }
 
 GlMesh::~GlMesh() = default;

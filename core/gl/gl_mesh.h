@@ -81,6 +81,13 @@ class GlMesh {
   // supplies the height maps; null: opened here when a displaced mesh needs them.
   GlMesh(const Scene& scene, const RenderOptions& options, int bark_texture_units = 0,
          const SceneTextures* textures = nullptr);
+  // The leaves of `scene` (leaf_mesh.h; skeleton.md "Leaves") drawn the same way, with the
+  // same programs (without bark: a leaf is never bark, materials.md): one record per leaf
+  // with ids plant | material << 24, gl::kLeafChain, the leaf's index in its plant's
+  // leaves; its flat Newell normal as every vertex's shading normal (mesh.frag.glsl turns
+  // it toward the eye: two-sided), uv 0; a sphere per leaf. Null when no plant has leaves.
+  // The frusta's renderer draws it after the frusta into the same G-buffer and shadow map.
+  static std::unique_ptr<GlMesh> leaves_of(const Scene& scene, const RenderOptions& options);
   ~GlMesh();
   GlMesh(const GlMesh&) = delete;
   GlMesh& operator=(const GlMesh&) = delete;
@@ -111,6 +118,8 @@ class GlMesh {
   const std::vector<RenderPass>& setup_passes() const;
 
  private:
+  struct LeavesTag {};
+  GlMesh(const Scene& scene, const RenderOptions& options, LeavesTag);
   struct State;
   std::unique_ptr<State> state_;
 };

@@ -192,6 +192,7 @@ struct GlRenderer::State {
   uint32_t fog_nodes_wanted = 0;        // the most list nodes a cone pass asked for so far
   std::unique_ptr<GlBarkMaps> bark_maps;
   std::unique_ptr<GlMesh> mesh;      // GeometryKind::mesh: the polygon baseline, drawn instead of the frusta
+  std::unique_ptr<GlMesh> leaves;    // the plants' leaves (GlMesh::leaves_of), drawn after either; null: none
 
   GlVertexArray vao;  // empty: the frusta pull their vertices from the records
   GlBuffer segment_buffer, id_buffer, list_buffer;
@@ -276,7 +277,8 @@ struct GlRenderer::State {
     f.camera_view = camera_view(f.camera, f.near, f.width, f.height);
     // Frusta whose pyramid may reach within the near plane of the eye: drawn again from
     // their back faces (EYE_INSIDE), since their front faces are clipped or behind the eye.
-    for (uint32_t i = 0; !mesh && i < spheres.size(); ++i)
+    // (The leaves' spheres follow the frusta's: they are never inside.)
+    for (uint32_t i = 0; !mesh && i < std::min<uint64_t>(spheres.size(), frusta); ++i)
       if (glm::length(spheres[i].centre - f.camera.eye) < spheres[i].radius + 4 * f.near) f.eye_inside.push_back(i);
     if (!f.eye_inside.empty()) {
       const size_t bytes = f.eye_inside.size() * sizeof(uint32_t);
@@ -401,6 +403,13 @@ struct GlRenderer::State {
     spheres.clear();
     for (const GlMeshSphere& s : mesh->bounding_spheres()) spheres.push_back({s.centre, s.radius});
   }
+
+  // The leaves' spheres after the frusta's (or the mesh's): the near plane and the shadow
+  // map's frame hold them too.
+  void add_leaf_spheres() {
+    if (leaves)
+      for (const GlMeshSphere& s : leaves->bounding_spheres()) spheres.push_back({s.centre, s.radius});
+  }
 };
 
 // ---- Construction: what is uploaded once -------------------------------------------------
@@ -460,6 +469,16 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options, std::sh
                                std::to_string(st.uploaded_bytes / 1024) + " KiB: " + std::to_string(st.frusta) +
                                    " GpuSegment records (64 B) + ids (16 B)"});
   }
+  // The leaves (gl_mesh.h leaves_of): their own upload and programs.
+  st.leaves = GlMesh::leaves_of(scene, options);
+  if (st.leaves) {
+    st.add_leaf_spheres();
+    st.uploaded_bytes += st.leaves->gpu_bytes();
+    for (RenderPass pass : st.leaves->setup_passes()) {
+      pass.name = "leaves " + pass.name;
+      st.setup_passes.push_back(std::move(pass));
+    }
+  }
   st.pending_plant_bytes += st.uploaded_bytes;
 
   // What every frame needs; EYE_INSIDE is built when a frame needs it.
@@ -506,19 +525,23 @@ uint64_t GlRenderer::update_plants(const Scene& scene) {
   if (scene.plants.size() != st.plant_count)
     throw std::invalid_argument("GlRenderer::update_plants: the scene has " + std::to_string(scene.plants.size()) +
                                 " plants, the renderer " + std::to_string(st.plant_count));
+  // The leaves are uploaded again whole (they move with their joints: animate.h).
+  const uint64_t leaf_bytes = st.leaves ? st.leaves->update(scene) : 0;
   if (st.mesh) {  // the polygon baseline is re-tessellated and uploaded whole
-    const uint64_t uploaded = st.mesh->update(scene);
+    const uint64_t uploaded = st.mesh->update(scene) + leaf_bytes;
     st.take_mesh_spheres();
+    st.add_leaf_spheres();
     st.frusta = st.mesh->frusta();
-    st.uploaded_bytes = st.mesh->gpu_bytes();
+    st.uploaded_bytes = st.mesh->gpu_bytes() + (st.leaves ? st.leaves->gpu_bytes() : 0);
     st.pending_plant_bytes += uploaded;
     return uploaded;
   }
   std::vector<GpuSegment> records;
   std::vector<uint32_t> ids;
   st.skin_plants(scene, &records, &ids);
+  st.add_leaf_spheres();
   const size_t record_bytes = records.size() * sizeof(GpuSegment);
-  uint64_t uploaded = record_bytes;
+  uint64_t uploaded = record_bytes + leaf_bytes;
   if (records.size() == st.frusta) {
     update_gl_buffer(st.segment_buffer, records.data(), record_bytes);
   } else {
@@ -527,7 +550,7 @@ uint64_t GlRenderer::update_plants(const Scene& scene) {
     st.id_buffer = make_gl_buffer(ids.data(), ids.size() * sizeof(uint32_t));
     uploaded += ids.size() * sizeof(uint32_t);
     st.frusta = records.size();
-    st.uploaded_bytes = record_bytes + ids.size() * sizeof(uint32_t);
+    st.uploaded_bytes = record_bytes + ids.size() * sizeof(uint32_t) + (st.leaves ? st.leaves->gpu_bytes() : 0);
   }
   check_gl("update_plants");
   st.pending_plant_bytes += uploaded;
@@ -678,6 +701,7 @@ void GlRenderer::shadow_pass(Frame& f, const glm::dvec3& l) {
     glUseProgram(f.shadow_program);
     if (st.frusta > 0) glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(st.frusta * gl::kPyramidVertices));
   }
+  if (st.leaves) st.leaves->draw_shadow(view);
   st.timers.end();
 }
 
@@ -715,6 +739,7 @@ void GlRenderer::geometry_pass(Frame& f, double jitter_x, double jitter_y) {
       glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(f.eye_inside.size() * gl::kPyramidVertices));
     }
   }
+  if (st.leaves) st.leaves->draw_gbuffer(f.camera_view, f.differential_step);
   st.timers.end();
 }
 
@@ -935,7 +960,9 @@ RenderImage GlRenderer::read_back() {
         }
         if (!image.id.empty()) {
           image.id[dst * 3 + 0] = hit ? static_cast<float>(g2[src * 4 + 0] & gl::kPlantIndexMask) : -1.0f;
-          image.id[dst * 3 + 1] = hit ? static_cast<float>(g2[src * 4 + 1]) : -1.0f;
+          // A leaf: kAovLeafChain (render_types.h), segment its index in the plant's leaves.
+          const uint32_t chain = g2[src * 4 + 1];
+          image.id[dst * 3 + 1] = !hit ? -1.0f : chain == gl::kLeafChain ? kAovLeafChain : static_cast<float>(chain);
           image.id[dst * 3 + 2] = hit ? static_cast<float>(g2[src * 4 + 2]) : -1.0f;
         }
       }

@@ -151,6 +151,18 @@ TEST(ExportCli, PrintsOneSummaryLinePerFileLikeGrow) {
         << r.out;
 }
 
+TEST(ExportCli, ALeafyPlantsMeshPassesTheKhronosValidator) {
+  // The leaves' double-sided primitives (gltf_export.h) beside the frusta's.
+  TempDir dir;
+  const std::string leafy = kSource + "/presets/abop_1_25_bush_leaves.lsys";
+  std::vector<std::string> files;
+  for (const char* ext : {".glb", ".gltf"}) {
+    files.push_back(dir.file(std::string("leafy") + ext));
+    expect_ok(run_sylva({"export", leafy, "-o", files.back(), "--mesh", "--segments-around", "4", "-D", "N=4"}));
+  }
+  expect_valid(files);
+}
+
 TEST(ExportCli, TheValidatorHarnessRejectsErrorsAndWarnings) {
   TempDir dir;
   // An error: mode -1 (what tinygltf writes when Primitive::mode is unset).

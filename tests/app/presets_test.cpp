@@ -43,6 +43,7 @@ const Preset kPresets[] = {
     {"abop_1_24e", 4118, std::nullopt},
     {"abop_1_24f", 992, std::nullopt},
     {"abop_1_25_bush", 7743, std::nullopt},
+    {"abop_1_25_bush_leaves", 3891, std::nullopt},
     {"abop_1_27_stochastic", 885, std::nullopt},
     {"abop_1_31a_context", 2501, std::nullopt},
     {"abop_2_6_honda", 1023, std::nullopt},

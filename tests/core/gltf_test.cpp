@@ -352,6 +352,39 @@ TEST(GltfImport, LeavesRoundTripThroughTheNodeExtras) {
   }
 }
 
+TEST(GltfExport, LeavesGetOneDoubleSidedPrimitivePerMaterialWithUnitNormals) {
+  // Two leaves of materials 0 and 1 on wood of material 0 (the '(1) comes after the last
+  // F): the LINES skeleton, the frusta's primitive and a leaf primitive per leaf material.
+  TempFolder dir;
+  const Skeleton sk = grow_text("angle: 60\naxiom: F(2)[&F{.+f.-f.-f.+|+f.-f.}]F'(1){.+f.-f.-f.}\n");
+  ASSERT_EQ(sk.leaves.size(), 2u);
+  GltfExportOptions o;
+  o.mesh = true;
+  ASSERT_TRUE(export_gltf({{"leafy", sk}}, dir.file("p.glb"), o).ok());
+  const Glb glb = read_glb(dir.file("p.glb"));
+  const JsonValue& primitives = at(at(glb.json, "meshes").elements[0], "primitives");
+  ASSERT_EQ(primitives.elements.size(), 4u);
+  const JsonValue& materials = at(glb.json, "materials");
+  std::vector<std::string> leaf_materials;
+  size_t leaf_triangles = 0;
+  for (const JsonValue& p : primitives.elements) {
+    const JsonValue* m = p.find("material");
+    if (!m) continue;
+    const JsonValue& material = materials.elements[static_cast<size_t>(m->number)];
+    const JsonValue* sides = material.find("doubleSided");
+    if (!sides) continue;  // the frusta's
+    EXPECT_TRUE(sides->boolean);
+    leaf_materials.push_back(at(material, "name").text);
+    leaf_triangles += static_cast<size_t>(at(at(glb.json, "accessors").elements[static_cast<size_t>(at(p, "indices").number)], "count").number) / 3;
+    const std::vector<double> normals = accessor_values(glb, static_cast<size_t>(at(at(p, "attributes"), "NORMAL").number));
+    ASSERT_FALSE(normals.empty());
+    for (size_t v = 0; v + 2 < normals.size(); v += 3)
+      EXPECT_NEAR(std::hypot(normals[v], normals[v + 1], normals[v + 2]), 1, 1e-6);
+  }
+  EXPECT_EQ(leaf_materials, (std::vector<std::string>{"sylva_leaf_material_0", "sylva_leaf_material_1"}));
+  EXPECT_EQ(leaf_triangles, 4u + 2u);  // a hexagon and a quadrilateral
+}
+
 TEST(GltfExport, SameInputGivesByteIdenticalFiles) {
   TempFolder dir;
   const Skeleton sk = grow_text(kGrammar);

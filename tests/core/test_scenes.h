@@ -3,10 +3,15 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include "core/render_common.h"
 #include "core/scene.h"
+#include "core/shading.h"
+#include "core/turtle.h"
+#include "lsystem/grammar.h"
 
 namespace sylva::test {
 
@@ -64,6 +69,74 @@ inline Scene foggy_cylinder(FogMode mode, uint32_t steps, uint32_t width = 48, u
   f.steps = steps;
   s.fog = f;
   return s;
+}
+
+// The leaf tests' grammar (tests/cpu/render_leaves_test.cpp, tests/gl/render_gl_leaves_test.cpp):
+// a thin stem (radius 0.02 m) from the origin to (0, 1, 0), then, of material 2, one
+// square leaf 1 m wide in the plane z = 0 with corners (0, 1), (−1, 1), (−1, 2), (0, 2)
+// (x, y), hanging from the stem's top joint.
+inline constexpr const char* kOneLeafGrammar = "angle: 90\naxiom: !(0.02)F(1)'(2){.+f(1).-f(1).-f(1).}\n";
+inline constexpr uint32_t kOneLeafMaterial = 2;
+inline const glm::dvec3 kOneLeafAlbedo{0.7, 0.15, 0.1};  // the scene's table entry for it
+
+// The skeleton a grammar text grows into (default seed and steps); empty when it fails.
+inline Skeleton grown(const char* text) {
+  Expected<lsys::Grammar> grammar = lsys::parse_grammar(text, "test.lsys", {});
+  if (!grammar.ok()) return {};
+  Expected<GrowResult> result = grow(*grammar, {}, "test.lsys", {});
+  return result.ok() ? std::move(result->skeleton) : Skeleton{};
+}
+
+// kOneLeafGrammar's plant seen from `eye` (looking at (−0.5, 1, −0.5)), the ground at
+// y = 0, a point sun toward `sun`, material 2 described by the table (kOneLeafAlbedo,
+// specular 0.5); 96 × 72 pixels.
+inline Scene one_leaf_scene(glm::dvec3 eye, glm::dvec3 sun, uint32_t width = 96, uint32_t height = 72) {
+  Scene s = scene_around(grown(kOneLeafGrammar), eye, {-0.5, 1, -0.5}, width, height, 0);
+  s.sun.direction = glm::normalize(sun);
+  SceneMaterial m;
+  m.albedo_rgb = kOneLeafAlbedo;
+  m.specular = 0.5;
+  s.materials[kOneLeafMaterial] = m;
+  return s;
+}
+
+// one_leaf_scene with the sun along (0, 1, 1), seen from (−0.5, 3, 4): the square (z = 0,
+// 1 <= y <= 2) throws its shadow onto the ground at −2 <= z <= −1, −1 <= x <= 0, in view.
+inline Scene leaf_shadow_scene() { return one_leaf_scene({-0.5, 3, 4}, {0, 1, 1}); }
+
+// Where world point p appears in `scene`'s image: continuous pixel coordinates (x right,
+// y down), the inverse of camera_ray.
+inline glm::dvec2 pixel_of(const Scene& scene, const glm::dvec3& p) {
+  const render_common::CameraFrame f = render_common::camera_frame(scene);
+  const glm::dvec3 d = p - f.eye;
+  const double z = glm::dot(d, f.forward);
+  const double sx = glm::dot(d, f.right) / z, sy = glm::dot(d, f.up) / z;
+  return {(sx / f.half_width + 1) * 0.5 * f.width, (1 - sy / f.half_height) * 0.5 * f.height};
+}
+
+// What pixel (x, y)'s centre ray sees of one_leaf_scene's leaf, computed here from the
+// square itself: the hit's distance from the eye and its radiance under the sun
+// (shading.h with the leaf's normal turned toward the eye, the sun unoccluded); none when
+// the ray misses the square or passes within `margin_m` of its edges or of the stem.
+struct LeafPixel {
+  double distance = 0;
+  glm::dvec3 radiance{0};
+};
+inline std::optional<LeafPixel> one_leaf_pixel(const Scene& s, uint32_t x, uint32_t y, double margin_m = 0.05) {
+  const Ray ray = camera_ray(s, x + 0.5, y + 0.5);
+  if (ray.direction.z == 0) return std::nullopt;
+  const double t = -ray.origin.z / ray.direction.z;
+  const glm::dvec3 p = ray.origin + t * ray.direction;
+  if (!(t > 0) || p.x < -1 + margin_m || p.x > -margin_m || p.y < 1 + margin_m || p.y > 2 - margin_m)
+    return std::nullopt;
+  const glm::dvec3 view = -glm::normalize(ray.direction);
+  const glm::dvec3 n(0, 0, view.z > 0 ? 1 : -1);
+  const glm::dvec3 l = glm::normalize(s.sun.direction);
+  const double cos_sun = shading::sun_cosine(n, n, l);
+  LeafPixel out;
+  out.distance = t * glm::length(ray.direction);
+  out.radiance = shading::surface_radiance(kOneLeafAlbedo, n, l, view, 0.5, s.sky, s.sun.radiance, cos_sun, 1);
+  return out;
 }
 
 }  // namespace sylva::test

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
 
@@ -62,6 +63,19 @@ TEST(Culling, APlantInViewIsKept) {
   const Scene s = scene_with({{0, 0, 0}, {4, 0, -30}}, {0.4, 1, 0.2});
   EXPECT_FALSE(culled(s, 0));
   EXPECT_FALSE(culled(s, 1));
+}
+
+TEST(Culling, APlantOutsideTheViewWhoseLeafReachesIntoItIsKept) {
+  // 8 m to the right, the view ±4.9 m wide there, a sun overhead: the pole and its shadow
+  // stay outside; a leaf from its top reaching 5 m to the left does not.
+  Scene s = scene_with({{8, 0, 0}}, {0, 1, 0});
+  ASSERT_TRUE(culled(s, 0));
+  s.plants[0].skeleton->leaves = {Leaf{ChainParent{0, 2}, 1, {{0, 2.5, 0}, {-5, 2.5, 0}, {-5, 3, 0}}}};
+  EXPECT_FALSE(culled(s, 0));
+  RenderOptions o;
+  o.aovs = kAovId;
+  const RenderResult r = render_cpu(s, o);
+  EXPECT_NE(std::count(r.image.id.begin(), r.image.id.end(), kAovLeafChain), 0);
 }
 
 TEST(Culling, APlantOutsideTheViewWhoseShadowFallsIntoItIsKept) {

@@ -287,3 +287,38 @@ TEST(SunCones, GivenParametersAreUsedAndTheResultIsReproducible) {
 
 }  // namespace
 }  // namespace sylva
+
+namespace sylva {
+namespace {
+
+// The one square leaf of test_scenes.h (z = 0, −1 <= x <= 0, 1 <= y <= 2) on its thin
+// stem, the sun along (0, 1, 1): photons that meet the leaf stop there.
+TEST(SunPhotonsLeaves, ALeafStopsPhotonsAtItsHitPoint) {
+  const Scene s = test::leaf_shadow_scene();
+  const SceneGeometry g = exact_geometry(s);
+  ASSERT_NE(g.leaves, nullptr);
+  SunPhotonOptions o;
+  o.photons = 20000;
+  const SunPhotons with = SunPhotonTracer(g.frusta, s.sun, 0, g.leaves, g.plant_of_frustum).trace(o);
+  const SunPhotons without = SunPhotonTracer(g.frusta, s.sun, 0).trace(o);
+  size_t on_leaf = 0;
+  for (const ShadowVector& v : with.vectors.vectors) {
+    const glm::dvec3 p = with.vectors.origin + glm::dvec3(v.position);
+    if (std::abs(p.z) > 1e-5 || p.x > -0.03) continue;  // on the stem
+    ++on_leaf;
+    EXPECT_GE(p.x, -1 - 1e-5);
+    EXPECT_LE(p.y, 2 + 1e-5);
+    EXPECT_GE(p.y, 1 - 1e-5);
+    EXPECT_EQ(v.frustum, 0u);  // the plant's first frustum
+  }
+  // The leaf is 1 m² seen at 45°; the stem a few cm wide: most vectors are the leaf's.
+  EXPECT_GT(on_leaf, with.vectors.vectors.size() / 2);
+  EXPECT_GT(with.vectors.vectors.size(), 4 * without.vectors.vectors.size());
+  // Under the leaf's shadow the sun is blocked; the tracer without leaves sees through.
+  const SunPhotonTracer tracer(g.frusta, s.sun, 0, g.leaves, g.plant_of_frustum);
+  EXPECT_TRUE(tracer.toward_sun_blocked({-0.5, 0, -1.5}));
+  EXPECT_FALSE(SunPhotonTracer(g.frusta, s.sun, 0).toward_sun_blocked({-0.5, 0, -1.5}));
+}
+
+}  // namespace
+}  // namespace sylva

@@ -1,0 +1,55 @@
+// leaf_tracer.h — a scene's leaves (leaf_mesh.h) in the CPU ray caster: Embree 3 triangles
+// (embree_triangles.h: float traversal, every hit decided again in double) beside the
+// scene's other geometry (the frusta, or their mesh), one SceneTracer (surface.h) over
+// both, so that primary rays, shadow rays, the fog's shadow rays and the sun's photons see
+// leaves wherever they see wood.
+//
+// The leaves have an Embree scene of their own rather than sharing the frusta's: the
+// frusta's user geometry keeps its nearest double t in the query context (frustum_accel.cpp)
+// and a triangle found by Embree's float test would not lower it. A nearest query asks
+// the other geometry first and the leaves only up to its hit (so a leaf behind wood costs
+// one short traversal); `any` asks the leaves first (they are few and thin).
+//
+// What a leaf hit reports (SurfaceHit): t and position in double; geometric_normal =
+// shading_normal = the leaf's unit Newell normal, whichever side was hit (a leaf is
+// two-sided: the renderer turns it toward the viewer and the light, render_cpu.cpp);
+// u = v_m = 0 and no tangents (a leaf has no texture); plant, material, `leaf` (its index
+// in the plant's Skeleton::leaves); chain, segment and frustum 0.
+//
+// Thread-safe for concurrent queries.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "core/leaf_mesh.h"
+#include "core/surface.h"
+
+namespace sylva {
+
+class LeafTracer final : public SceneTracer {
+ public:
+  // `other`: the rest of the scene (may be null: leaves alone).
+  LeafTracer(LeafMesh leaves, std::unique_ptr<SceneTracer> other);
+  ~LeafTracer() override;
+  LeafTracer(const LeafTracer&) = delete;
+  LeafTracer& operator=(const LeafTracer&) = delete;
+
+  SurfaceHit nearest(const Ray& ray, double t_min, double t_max) const override;
+  bool any(const Ray& ray, double t_min, double t_max) const override;
+  Aabb bounds() const override;
+  size_t memory_bytes() const override;
+  // The other geometry's line, then ", N leaves (M Embree triangles)".
+  std::string describe() const override;
+
+  // The nearest leaf alone (the other geometry not asked).
+  SurfaceHit nearest_leaf(const Ray& ray, double t_min, double t_max) const;
+  const LeafMesh& leaves() const;
+  const SceneTracer* other() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sylva

@@ -1,0 +1,79 @@
+// leaf_mesh_test.cpp — leaves as triangles: ear clipping keeps a concave outline, every
+// triangle turns as the polygon does, a placed plant's leaves move with it.
+#include "core/leaf_mesh.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <glm/geometric.hpp>
+#include <vector>
+
+#include "core/scene.h"
+
+namespace sylva {
+namespace {
+
+using Polygon = std::vector<std::array<double, 3>>;
+
+glm::dvec3 at(const Polygon& p, uint32_t i) { return {p[i][0], p[i][1], p[i][2]}; }
+
+// Sum of the triangles' vector areas (twice), and whether each turns along `normal`.
+glm::dvec3 doubled_area(const Polygon& p, const std::vector<uint32_t>& t, const glm::dvec3& normal) {
+  glm::dvec3 sum(0);
+  for (size_t k = 0; k < t.size(); k += 3) {
+    const glm::dvec3 a = glm::cross(at(p, t[k + 1]) - at(p, t[k]), at(p, t[k + 2]) - at(p, t[k]));
+    EXPECT_GT(glm::dot(a, normal), 0) << "triangle " << k / 3 << " turns the other way";
+    sum += a;
+  }
+  return sum;
+}
+
+TEST(LeafMesh, EarClippingCoversAConcaveLeafExactly) {
+  // An L of area 3 in the plane y = 1, counter-clockwise seen from +y (x, then −z).
+  const Polygon l = {{0, 1, 0}, {2, 1, 0}, {2, 1, -1}, {1, 1, -1}, {1, 1, -2}, {0, 1, -2}};
+  const std::vector<uint32_t> t = triangulate_polygon(l);
+  ASSERT_EQ(t.size(), 3u * 4u);  // n − 2 triangles
+  const glm::dvec3 n = polygon_newell_normal(l);
+  EXPECT_NEAR(n.y, 6, 1e-12);  // twice the area, along +y
+  const glm::dvec3 sum = doubled_area(l, t, n);
+  EXPECT_NEAR(sum.y, 6, 1e-12);  // no overlap, no gap: the concave corner is not bridged
+}
+
+TEST(LeafMesh, RepeatedAndCollinearVerticesAddNoTriangleWithoutArea) {
+  // A unit square with a repeated corner and a vertex in the middle of its top edge.
+  const Polygon square = {{0, 0, 0}, {1, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0.5, 1, 0}, {0, 1, 0}};
+  const std::vector<uint32_t> t = triangulate_polygon(square);
+  EXPECT_LE(t.size(), 3u * 3u);  // doubled_area fails any triangle without area
+  EXPECT_NEAR(doubled_area(square, t, {0, 0, 1}).z, 2, 1e-12);
+  EXPECT_TRUE(triangulate_polygon(Polygon{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}}).empty());
+}
+
+TEST(LeafMesh, APlacedPlantsLeavesMoveRotateAndScaleWithIt) {
+  Skeleton sk;
+  sk.joints = {{{0, 0, 0}, 0.1, 0}, {{0, 1, 0}, 0.1, 0}};
+  sk.chains = {{0, 2, std::nullopt}};
+  sk.leaves = {Leaf{ChainParent{0, 1}, 1, {{0, 1, 0}, {1, 1, 0}, {1, 2, 0}}}};
+  ScenePlant plant;
+  plant.skeleton = sk;
+  plant.position = {10, 0, 0};
+  plant.rotate_y_deg = 90;  // x -> −z
+  plant.scale = 2;
+  const Skeleton placed = place_plant(plant);
+  ASSERT_EQ(placed.leaves.size(), 1u);
+  const auto& v = placed.leaves[0].vertices_m[1];  // (1, 1, 0) scaled to (2, 2, 0), turned, moved
+  EXPECT_NEAR(v[0], 10, 1e-12);
+  EXPECT_NEAR(v[1], 2, 1e-12);
+  EXPECT_NEAR(v[2], -2, 1e-12);
+  LeafMesh mesh;
+  append_leaves(mesh, placed, 7);
+  ASSERT_EQ(mesh.leaves.size(), 1u);
+  EXPECT_EQ(mesh.leaves[0].plant, 7u);
+  EXPECT_EQ(mesh.leaves[0].material, 1u);
+  EXPECT_EQ(mesh.triangle_count(), 1u);
+  EXPECT_EQ(mesh.vertex_leaf, (std::vector<uint32_t>{0, 0, 0}));
+  EXPECT_NEAR(glm::length(mesh.leaves[0].normal), 1, 1e-12);
+  EXPECT_NEAR(mesh.leaves[0].normal.x, 1, 1e-12);  // +z turned by 90° about y
+}
+
+}  // namespace
+}  // namespace sylva

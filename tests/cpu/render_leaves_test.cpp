@@ -1,0 +1,58 @@
+// render_leaves_test.cpp — leaves (skeleton.md "Leaves", docs/leaves.md) in the CPU ray
+// caster: a grammar's one known square leaf lands on the pixels its projection covers,
+// with its material's colour, its id and its distance; it is two-sided, opaque, and it
+// shadows the ground.
+#include <gtest/gtest.h>
+
+#include "core/cpu/render_cpu.h"
+#include "core/shading.h"
+#include "tests/core/leaf_checks.h"
+#include "tests/core/test_scenes.h"
+
+namespace sylva {
+namespace {
+
+RenderResult render_with_aovs(const Scene& s) {
+  RenderOptions o;
+  o.aovs = kAovDepth | kAovId | kAovNormal;
+  return render_cpu(s, o);
+}
+
+TEST(RenderCpuLeaves, AGrammarsLeafCoversItsProjectionWithItsMaterialAndId) {
+  // Seen from the front (+z), the sun behind the eye and above: the lit face.
+  const Scene s = test::one_leaf_scene({-0.5, 1.5, 5}, {0.2, 0.5, 1});
+  test::expect_the_leaf_where_projected(s, render_with_aovs(s), 1e-5, 1e-5);
+}
+
+TEST(RenderCpuLeaves, ALeafIsTwoSided) {
+  // From behind (−z), with the sun behind the eye too: the back is lit the same way.
+  const Scene s = test::one_leaf_scene({-0.5, 1.5, -5}, {0.2, 0.5, -1});
+  test::expect_the_leaf_where_projected(s, render_with_aovs(s), 1e-5, 1e-5);
+}
+
+TEST(RenderCpuLeaves, ALeafSeenAgainstTheSunShowsTheSkyAmbientOnly) {
+  // The sun behind the leaf: its near side gets no sunlight (a leaf is opaque).
+  const Scene s = test::one_leaf_scene({-0.5, 1.5, 5}, {0.2, 0.5, -1});
+  const RenderResult r = render_cpu(s, {});
+  const glm::dvec2 c = test::pixel_of(s, {-0.5, 1.5, 0});
+  const glm::dvec3 ambient = shading::sky_ambient(test::kOneLeafAlbedo, {0, 0, 1}, s.sky);
+  const glm::dvec3 got = test::beauty_at(r.image, static_cast<uint32_t>(c.x), static_cast<uint32_t>(c.y));
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], ambient[k], 1e-6);
+}
+
+TEST(RenderCpuLeaves, ALeafShadowsTheGroundWhereTheSunProjectsIt) {
+  const Scene s = test::leaf_shadow_scene();
+  Scene bare = s;
+  bare.plants[0].skeleton->leaves.clear();
+  test::expect_the_leaf_shadow(s, render_cpu(s, {}).image, render_cpu(bare, {}).image, 1e-6);
+}
+
+TEST(RenderCpuLeaves, TheDefaultCameraFramesTheLeaves) {
+  // skeleton_bounds holds the leaf (x down to −1, y up to 2), not only the stem.
+  const SkeletonBounds b = skeleton_bounds(test::grown(test::kOneLeafGrammar));
+  EXPECT_NEAR(b.lo.x, -1, 1e-12);
+  EXPECT_NEAR(b.hi.y, 2, 1e-12);
+}
+
+}  // namespace
+}  // namespace sylva
