@@ -39,6 +39,7 @@
 #define PYRAMID_VERTICES 36       // a frustum's bounding pyramid: 12 triangles (skin.glsl)
 #define FOG_LIST_END 0xFFFFFFFFu  // the end of a pixel's interval list (fog_lists.glsl)
 #define FOG_MAX_INTERVALS 16      // merged intervals the fog resolve holds per pixel (fog.frag.glsl)
+#define FOG_MAX_LIST_NODES 1024u  // list nodes the fog resolve walks per pixel (more: marched whole)
 
 // Uniform blocks (std140): none. The views (views.glsl's camera and sun uniforms) and the
 // shading parameters are default-block uniforms set by name (core/gl/gl_views.h,

@@ -159,7 +159,17 @@ void main() {
     for (int i = 0; i < FOG_MAX_INTERVALS; ++i) starts[i] = ends[i] = 0.0;  // (inout below)
     int count = 0;
     bool whole = !u_cones || fog_overflowed[pixel_index] != 0u;
-    for (uint node = fog_heads[pixel_index]; !whole && node != FOG_LIST_END;) {
+    // The list's walk has a bound: on llvmpipe (Mesa 22.3) a loop whose trip count only the
+    // data ends (while node != FOG_LIST_END) left every later loop of the shader after
+    // one iteration — medium's march took 1 of u_steps samples (docs/gl-fog.md, "medium").
+    // A list longer than the bound is marched whole, as an overflowed one.
+    uint node = fog_heads[pixel_index];
+    for (uint walked = 0u; walked <= FOG_MAX_LIST_NODES && !whole; ++walked) {
+      if (node == FOG_LIST_END) break;
+      if (walked == FOG_MAX_LIST_NODES) {
+        whole = true;
+        break;
+      }
       FogNode n = fog_nodes[node];
       node = n.next;
       float t0 = max(n.t_in, a), t1 = min(n.t_out, b);

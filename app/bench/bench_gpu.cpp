@@ -48,6 +48,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/bench/bench_gpu_fog.h"
 #include "app/bench/bench_metrics.h"
 #include "app/cli/cli.h"
 #include "app/cli/render_input.h"
@@ -71,7 +72,8 @@ void print_help() {
   std::cout
       << "usage: sylva bench gpu [INPUT...] [--width W --height H] [--frames N] [--warmup K]\n"
          "                       [--methods LIST] [--csv FILE] [--plot FILE.png] [--quick]\n"
-         "                       [--reference-steps N] [--reference-bisection N]\n\n"
+         "                       [--reference-steps N] [--reference-bisection N]\n"
+         "       sylva bench gpu --fog [SCENE...] [--width W --height H] [--frames N] [--quick] ...\n\n"
          "Error against GPU time per frame of the GL backend's ways to draw INPUT (scenes,\n"
          "grammars, skeletons or glTF exports, as for `sylva render`; a bare name is looked\n"
          "up in presets/scenes/NAME.scene.json, then presets/NAME.lsys; default: the pine and\n"
@@ -88,7 +90,11 @@ void print_help() {
          "  --plot FILE             log-log depth error vs GPU time PNG (default bench_gpu.png)\n"
          "  --quick                 a 160x120 image, 3 frames after 1, fewer settings (tests)\n"
          "  --reference-steps N     uniform relief steps of the reference (default 1024)\n"
-         "  --reference-bisection N bisection steps of the reference (default 24)\n";
+         "  --reference-bisection N bisection steps of the reference (default 24)\n"
+         "  --fog                   the fog pass instead: brute at 16..256 steps, fast and medium on\n"
+         "                          foggy scenes (default elm_grove_low_sun), fog GPU ms and the fog\n"
+         "                          AOV's RMSE against the CPU reference (default bench_gpu_fog.csv,\n"
+         "                          .png; --quick: 96x72, brute 16 and 64, 2 frames after 1)\n";
 }
 
 struct ImageSize {
@@ -101,6 +107,8 @@ struct Args {
   std::vector<std::string> families;  // empty: every family
   bool quick = false;
   bool help = false;
+  bool fog = false;                   // --fog: the fog pass's rows (bench_gpu_fog.h)
+  bool csv_given = false, plot_given = false;
   std::string csv = "bench_gpu.csv", plot = "bench_gpu.png";
   int reference_steps = 1024;
   int reference_bisection = 24;
@@ -142,8 +150,9 @@ Args parse_args(const std::vector<std::string>& args) {
     else if (a == "--frames") out.frames = parse_count(a, value(), 1'000'000);
     else if (a == "--warmup") out.warmup = static_cast<uint32_t>(parse_count(a, value(), 1'000'000));
     else if (a == "--quick") out.quick = true;
-    else if (a == "--csv") out.csv = value();
-    else if (a == "--plot") out.plot = value();
+    else if (a == "--fog") out.fog = true;
+    else if (a == "--csv") out.csv = value(), out.csv_given = true;
+    else if (a == "--plot") out.plot = value(), out.plot_given = true;
     else if (a == "--reference-steps") out.reference_steps = static_cast<int>(parse_count(a, value(), 1 << 20));
     else if (a == "--reference-bisection") out.reference_bisection = static_cast<int>(parse_count(a, value(), 60));
     else if (a == "--methods") {
@@ -157,7 +166,11 @@ Args parse_args(const std::vector<std::string>& args) {
   if (out.help) return out;
   if (out.width.has_value() != out.height.has_value()) throw UsageError{"give --width and --height together"};
   for (std::string& input : out.inputs) input = resolve_input(input);
-  if (out.inputs.empty()) out.inputs = {resolve_input("pine"), resolve_input("saguaro")};
+  if (out.inputs.empty())
+    out.inputs = out.fog ? std::vector<std::string>{resolve_input("elm_grove_low_sun")}
+                         : std::vector<std::string>{resolve_input("pine"), resolve_input("saguaro")};
+  if (out.fog && !out.csv_given) out.csv = "bench_gpu_fog.csv";
+  if (out.fog && !out.plot_given) out.plot = "bench_gpu_fog.png";
   return out;
 }
 
@@ -448,6 +461,18 @@ int run_bench_gpu(const std::vector<std::string>& args) {
   const std::string device = device_label(gl.context->info());
   std::cerr << "sylva bench gpu: " << gl.context->info().describe() << "\n";
   std::printf("device: %s\n", device.c_str());
+  if (a.fog) {
+    GpuFogArgs fog;
+    fog.inputs = a.inputs;
+    for (const ImageSize& s : sizes) fog.sizes.push_back({s.width, s.height});
+    if (a.quick && !a.width) fog.sizes = {{96, 72}};
+    fog.frames = a.frames.value_or(a.quick ? 2 : 10);
+    fog.warmup = a.warmup.value_or(1);
+    fog.quick = a.quick;
+    fog.csv = a.csv;
+    fog.plot = a.plot;
+    return run_gpu_fog_rows(fog, device, gl.context->info());
+  }
   std::printf("%-28s %-18s %9s %9s %9s %9s %9s %10s %10s %10s %9s %11s %9s %11s\n", "input", "method", "gpu_ms", "p10",
               "p90", "fps", "wall_ms", "mem_MiB", "setup_KiB", "KiB/frame", "upd_ms", "depth_rmse", "mismatch",
               "colour_rmse");

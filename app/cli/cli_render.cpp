@@ -68,7 +68,7 @@ void print_render_help() {
          "      --backend B        auto (default): OpenGL on a window-less EGL context (the GPU,\n"
          "                         or Mesa's llvmpipe without one), else the CPU ray caster,\n"
          "                         saying why; gl: OpenGL or exit 1 saying why; cpu: the CPU\n"
-         "                         reference (fog's medium, refined, reference: CPU only)\n"
+         "                         reference (fog's refined and reference: CPU only)\n"
          "      --width W          image width in pixels (default: the scene's, else 1024)\n"
          "      --height H         image height in pixels (default: the scene's, else 768)\n"
          "      --aov LIST         extra outputs, comma-separated: depth (channel Z, distance\n"

@@ -28,7 +28,19 @@ std::vector<double> view_key(const Scene& s) {
   return {c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.up.x, c.up.y, c.up.z, c.fov_y_deg,
           static_cast<double>(s.width), static_cast<double>(s.height), s.sun.direction.x, s.sun.direction.y,
           s.sun.direction.z, s.sun.angular_radius_deg, s.sun.radiance.x, s.sun.radiance.y, s.sun.radiance.z,
-          s.sky.x, s.sky.y, s.sky.z, s.ground.height, s.ground.albedo.x, s.ground.albedo.y, s.ground.albedo.z};
+          s.sky.x, s.sky.y, s.sky.z, s.ground.height, s.ground.albedo.x, s.ground.albedo.y, s.ground.albedo.z,
+          s.fog ? 1.0 : 0.0, s.fog ? s.fog->sigma_s : 0, s.fog ? s.fog->sigma_a : 0, s.fog ? s.fog->g : 0,
+          s.fog ? s.fog->height_falloff : 0, s.fog ? s.fog->top : 0, s.fog ? static_cast<double>(s.fog->mode) : 0,
+          s.fog ? static_cast<double>(s.fog->steps) : 0};
+}
+
+// The scene the renderer draws: a cone mode without cones yet is drawn brute (the same
+// fog, slower) until the cone worker's first cones arrive.
+Scene drawable(const Scene& scene, bool have_cones) {
+  if (!scene.fog || have_cones || scene.fog->mode == FogMode::brute) return scene;
+  Scene s = scene;
+  s.fog->mode = FogMode::brute;
+  return s;
 }
 
 struct Picture {
@@ -101,7 +113,8 @@ struct GlViewport::Shared {
     uint64_t version;
   };
   std::optional<View> view;
-  std::function<void(GlRenderer*, const RenderOptions&)> task;  // an export, run and waited for
+  std::function<void(GlRenderer*, const RenderOptions&, bool)> task;  // an export, run and waited for
+  std::shared_ptr<const ConeSet> cones;  // newer fog cones, not yet taken
   // Results.
   std::optional<Picture> picture;
   uint64_t built_version = 0;  // the plants the render thread's renderer holds
@@ -158,14 +171,21 @@ void GlViewport::run() {
   bool unshown_plants = false;               // the renderer's plants have no full picture yet
   RenderOptions options;
   uint64_t version = 0;
+  std::shared_ptr<const ConeSet> cones;  // the last fog cones given: every renderer draws them
+  bool cones_applied = false;            // uploaded into the current renderer
   for (;;) {
     std::optional<Shared::Plants> plants;
     std::optional<Shared::View> view;
-    std::function<void(GlRenderer*, const RenderOptions&)> task;
+    std::function<void(GlRenderer*, const RenderOptions&, bool)> task;
     {
       std::unique_lock<std::mutex> lock(sh.mutex);
-      sh.wake.wait(lock, [&] { return sh.quit || sh.plants || sh.view || sh.task; });
+      sh.wake.wait(lock, [&] { return sh.quit || sh.plants || sh.view || sh.task || sh.cones; });
       if (sh.quit) break;
+      if (sh.cones) {
+        cones = std::move(sh.cones);
+        sh.cones.reset();
+        cones_applied = false;
+      }
       plants = std::move(sh.plants);
       sh.plants.reset();
       sh.cancel_build = false;
@@ -202,8 +222,13 @@ void GlViewport::run() {
       }
       upload_ms = ms_since(start);
       unshown_plants = renderer != nullptr;
+      cones_applied = false;
     }
-    if (task) task(renderer.get(), options);
+    if (renderer && cones && !cones_applied) {
+      renderer->set_fog_cones(*cones);
+      cones_applied = true;
+    }
+    if (task) task(renderer.get(), options, cones_applied);
     // Hands a picture (or the error) to the UI thread; `last`: the render thread is done.
     auto publish = [&](std::optional<Picture> picture, bool last) {
       const bool any = picture || !error.empty();
@@ -230,7 +255,7 @@ void GlViewport::run() {
         bool newer_waiting = false;
         if (unshown_plants && last_full_ms > sh.preview_above_ms) {
           renderer->set_shadow_map_texels(kPreviewShadowTexels);
-          Picture quick = present(*renderer, preview_of(view->scene), target);
+          Picture quick = present(*renderer, preview_of(drawable(view->scene, cones_applied)), target);
           renderer->set_shadow_map_texels(0);
           quick.plants_version = version;
           quick.preview = true;
@@ -240,7 +265,7 @@ void GlViewport::run() {
           newer_waiting = sh.plants.has_value();
         }
         if (!newer_waiting) {
-          picture = present(*renderer, view->scene, target);
+          picture = present(*renderer, drawable(view->scene, cones_applied), target);
           picture->plants_version = version;
           last_full_ms = picture->render_ms;
           unshown_plants = false;
@@ -266,9 +291,18 @@ void GlViewport::set_plants(const Scene& scene, const RenderOptions& options) {
   shared_->wake.notify_all();
 }
 
+void GlViewport::set_fog_cones(std::shared_ptr<const ConeSet> cones) {
+  {
+    std::lock_guard<std::mutex> lock(shared_->mutex);
+    shared_->cones = std::move(cones);
+  }
+  shared_->wake.notify_all();
+  asked_view_.clear();  // the next image() asks for the picture with them
+}
+
 bool GlViewport::busy() const {
   std::lock_guard<std::mutex> lock(shared_->mutex);
-  return shared_->working || shared_->plants || shared_->view || shared_->picture;
+  return shared_->working || shared_->plants || shared_->view || shared_->picture || shared_->cones;
 }
 
 void GlViewport::take_picture() {
@@ -334,7 +368,7 @@ std::optional<std::string> GlViewport::write_image(const Scene& scene, const Ren
   auto result = done.get_future();
   {
     std::lock_guard<std::mutex> lock(shared_->mutex);
-    shared_->task = [&](GlRenderer* current, const RenderOptions& current_options) {
+    shared_->task = [&](GlRenderer* current, const RenderOptions& current_options, bool current_has_cones) {
       try {
         std::unique_ptr<GlRenderer> own;
         GlRenderer* r = current;
@@ -343,7 +377,7 @@ std::optional<std::string> GlViewport::write_image(const Scene& scene, const Ren
           own = std::make_unique<GlRenderer>(scene, options);
           r = own.get();
         }
-        RenderResult rendered = r->render(scene);
+        RenderResult rendered = r->render(drawable(scene, r == current && current_has_cones));
         Expected<std::vector<std::string>> written = write_render(path, rendered.image);
         std::optional<std::string> error;
         if (!written) {

@@ -45,6 +45,7 @@ class GlViewport : public Viewport {
   void set_plants(const Scene& scene, const RenderOptions& options) override;
   ViewImage image(const Scene& scene) override;
   const ViewStats& stats() const override { return stats_; }
+  void set_fog_cones(std::shared_ptr<const ConeSet> cones) override;
   bool busy() const override;
   std::optional<std::string> write_image(const Scene& scene, const RenderOptions& options,
                                          const std::string& path) override;

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include <glm/geometric.hpp>
 #include <imgui_stdlib.h>
@@ -61,7 +62,10 @@ std::optional<uint64_t> parse_u64_exact(const std::string& s) {
 }  // namespace
 
 StudioApp::StudioApp(StudioOptions options, Viewport* viewport)
-    : options_(std::move(options)), viewport_(viewport), worker_(std::make_unique<GrowWorker>()) {
+    : options_(std::move(options)),
+      viewport_(viewport),
+      worker_(std::make_unique<GrowWorker>()),
+      cones_(std::make_unique<ConeWorker>()) {
   show_presets_ = true;  // until a document is opened
   scene_ = Scene{};
   scene_.plants.assign(1, ScenePlant{});  // an untitled grammar: typing grows it
@@ -82,7 +86,7 @@ std::string StudioApp::title() const {
 bool StudioApp::dirty() const { return text_ != saved_text_; }
 
 bool StudioApp::wants_frames() const {
-  return worker_->busy() || worker_->result_waiting() || edited_at_ || unsnapped_at_ || animating_ ||
+  return worker_->busy() || worker_->result_waiting() || cones_->busy() || edited_at_ || unsnapped_at_ || animating_ ||
          view_half_res_ || latency_start_ || (viewport_ && viewport_->busy());
 }
 
@@ -502,6 +506,7 @@ void StudioApp::frame(double now) {
   now_ = now;
   rects_.clear();
   poll_worker();
+  update_cones();
   handle_shortcuts();
 
   // A pause in typing: grow the new text; a longer one: an undo step.
@@ -539,7 +544,9 @@ void StudioApp::frame(double now) {
     draw_parameters();
     draw_derivation();
     draw_view();
+    draw_fog();
     ImGui::EndChild();
+    keep("panels");
   }
   ImGui::EndChild();
 
@@ -832,11 +839,101 @@ void StudioApp::draw_derivation() {
   }
 }
 
+// The fog's cone modes (medium, fast, auto) need the shadow cones of the plants on screen
+// under the sun: asked of the cone worker when the plants, how they are skinned, the sun,
+// the photons or the cones' kind changed — never for the camera or the medium, which the
+// same cones serve. The viewport draws with the last cones until the new ones arrive.
+void StudioApp::update_cones() {
+  if (std::optional<ConeResult> done = cones_->poll(); done && viewport_)
+    viewport_->set_fog_cones(std::move(done->cones));
+  if (!viewport_ || !plant_ || !scene_.fog || scene_.fog->mode == FogMode::brute) return;
+  const FogMode kind = scene_.fog->mode == FogMode::medium ? FogMode::medium : FogMode::fast;
+  const glm::dvec3 sun = unit_sun_direction(scene_.sun.direction);
+  std::vector<double> key = {static_cast<double>(plants_applied_),
+                             sun.x,
+                             sun.y,
+                             sun.z,
+                             scene_.sun.angular_radius_deg,
+                             scene_.ground.height,
+                             static_cast<double>(scene_.fog->photons),
+                             static_cast<double>(kind),
+                             static_cast<double>(render_options_.skin.knuckle_frusta),
+                             render_options_.geometry.relief ? 1.0 : 0.0};
+  if (key == cone_key_) return;
+  cone_key_ = std::move(key);
+  ++cone_requests_;
+  cones_->submit(ConeRequest{view_scene(), render_options_.skin, kind, scene_.fog->photons});
+}
+
+// spec/fog.md's medium, live: every control changes scene_.fog, which the viewport's next
+// picture draws (a new picture, never a re-skin; new cones only for new photons or mode
+// kind) and save_scene writes.
+void StudioApp::draw_fog() {
+  if (!ImGui::CollapsingHeader("Fog", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (!scene_.fog) {
+    if (ImGui::Button("add fog")) scene_.fog = Fog{};
+    keep("fog:add");
+    return;
+  }
+  Fog& f = *scene_.fog;
+  auto slider = [&](const char* label, double* value, float lo, float hi, const char* format, bool logarithmic) {
+    float v = static_cast<float>(*value);
+    ImGui::SetNextItemWidth(150);
+    if (ImGui::SliderFloat(label, &v, lo, hi, format, logarithmic ? ImGuiSliderFlags_Logarithmic : 0)) *value = v;
+    keep(std::string("fog:") + label);
+  };
+  slider("sigma_s", &f.sigma_s, 0, 0.5f, "%.4f /m", true);
+  ImGui::SameLine();
+  slider("sigma_a", &f.sigma_a, 0, 0.5f, "%.4f /m", true);
+  slider("g", &f.g, -0.9f, 0.9f, "%.2f", false);
+  ImGui::SameLine();
+  slider("height falloff", &f.height_falloff, 0, 1, "%.3f /m", true);
+  bool ceiling = std::isfinite(f.top);
+  if (ImGui::Checkbox("top", &ceiling)) f.top = ceiling ? scene_.ground.height + 30 : std::numeric_limits<double>::infinity();
+  keep("fog:top on");
+  if (ceiling) {
+    ImGui::SameLine();
+    float top = static_cast<float>(f.top - scene_.ground.height);
+    ImGui::SetNextItemWidth(150);
+    if (ImGui::SliderFloat("above ground", &top, 0.5f, 500, "%.1f m", ImGuiSliderFlags_Logarithmic))
+      f.top = scene_.ground.height + top;
+    keep("fog:top");
+  }
+  // The GL backend's modes (docs/gl-fog.md); refined and reference are the CPU's.
+  const FogMode modes[] = {FogMode::automatic, FogMode::brute, FogMode::medium, FogMode::fast};
+  ImGui::SetNextItemWidth(100);
+  if (ImGui::BeginCombo("mode", fog_mode_name(f.mode))) {
+    for (FogMode m : modes)
+      if (ImGui::Selectable(fog_mode_name(m), m == f.mode)) f.mode = m;
+    ImGui::EndCombo();
+  }
+  keep("fog:mode");
+  ImGui::SameLine();
+  int steps = static_cast<int>(f.steps);
+  ImGui::SetNextItemWidth(120);
+  if (ImGui::SliderInt("steps", &steps, 1, 512, "%d", ImGuiSliderFlags_Logarithmic))
+    f.steps = static_cast<uint32_t>(std::clamp(steps, 1, 512));
+  keep("fog:steps");
+  ImGui::SameLine();
+  // Each new count is a new cone build (the latest wins: the one running is cancelled).
+  static_assert(sizeof(unsigned long long) == sizeof(uint64_t));
+  uint64_t photons = f.photons;
+  const uint64_t photons_min = 1000, photons_max = 10'000'000;
+  ImGui::SetNextItemWidth(150);
+  ImGui::SliderScalar("photons", ImGuiDataType_U64, &photons, &photons_min, &photons_max, "%llu",
+                      ImGuiSliderFlags_Logarithmic);
+  if (photons != f.photons) f.photons = std::max<uint64_t>(1, photons);
+  keep("fog:photons");
+  if (ImGui::Button("remove fog")) scene_.fog.reset();
+  keep("fog:remove");
+}
+
 void StudioApp::draw_view() {
   if (!ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) return;
   bool sun = false;
   ImGui::SetNextItemWidth(150);
   sun |= ImGui::SliderFloat("sun azimuth", &sun_azimuth_deg_, -180, 180, "%.0f deg");
+  keep("sun azimuth");
   ImGui::SameLine();
   ImGui::SetNextItemWidth(150);
   sun |= ImGui::SliderFloat("elevation", &sun_elevation_deg_, 1, 90, "%.0f deg");

@@ -8,7 +8,8 @@
 //   editor text ── debounce ──► GrowWorker (parse, derive, interpret, skeleton) ──► poll()
 //   parameters ── continuous or on release ──►    "        (the ladder's top rung)
 //   skin / bark / relief options ──► Viewport::set_plants (re-skin, re-upload)
-//   camera / sun / size ──► Viewport::image (re-render only)
+//   camera / sun / size / fog medium ──► Viewport::image (re-render only)
+//   plants / sun / photons (a fog cone mode) ──► ConeWorker ──► Viewport::set_fog_cones
 // A parse or derivation error leaves the last good plant on screen and marks the text.
 #pragma once
 
@@ -22,6 +23,7 @@
 #include <imgui.h>
 
 #include "app/studio/code_editor.h"
+#include "app/studio/cone_worker.h"
 #include "app/studio/define_controls.h"
 #include "app/studio/document_files.h"
 #include "app/studio/grow_worker.h"
@@ -92,6 +94,8 @@ class StudioApp {
   uint64_t plants_applied() const { return plants_applied_; }        // results put on screen
   bool plant_drawn() const { return drawn_version_ == plants_applied_ && plants_applied_ > 0; }
   GrowWorker& worker() { return *worker_; }
+  const ConeWorker& cone_worker() const { return *cones_; }
+  uint64_t cone_requests() const { return cone_requests_; }  // cone builds asked of the cone worker
   CodeEditor& editor() { return editor_; }
   const UndoHistory& history() const { return history_; }
   const std::map<std::string, double>& overrides() const { return overrides_; }
@@ -142,6 +146,8 @@ class StudioApp {
   void draw_parameters();
   void draw_derivation();
   void draw_view();
+  void draw_fog();
+  void update_cones();  // the fog's cones for the plants and sun on screen (cone_worker.h)
   void draw_presets();
   void draw_modals();
   void draw_file_dialog();
@@ -153,6 +159,9 @@ class StudioApp {
   StudioOptions options_;
   Viewport* viewport_;
   std::unique_ptr<GrowWorker> worker_;
+  std::unique_ptr<ConeWorker> cones_;
+  std::vector<double> cone_key_;  // what the last cone request was built for
+  uint64_t cone_requests_ = 0;
   CodeEditor editor_;
   UndoHistory history_;
 

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,6 +20,10 @@
 
 #include "core/render_types.h"
 #include "core/scene.h"
+
+namespace sylva {
+class ConeSet;
+}
 
 namespace sylva::studio {
 
@@ -51,6 +56,11 @@ class Viewport {
   // plants last set.
   virtual ViewImage image(const Scene& scene) = 0;
   virtual const ViewStats& stats() const = 0;
+  // The shadow cones of the plants last set and the scene's sun, for the fog's cone modes
+  // (medium, fast, auto; cone_worker.h builds them). A new sun or new plants do not drop
+  // the last cones: they keep drawing until newer come; before the first the fog is drawn
+  // brute. A camera move never needs new ones.
+  virtual void set_fog_cones(std::shared_ptr<const ConeSet> cones) = 0;
   // Whether a picture is being made (the UI keeps drawing frames to show it when done).
   virtual bool busy() const { return false; }
   // Renders `scene` at its width × height with `options` through the same renderer as

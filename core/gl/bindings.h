@@ -48,6 +48,7 @@ inline constexpr uint32_t kLeafChain = 0xFFFFFFFEu;  // G-buffer ids.y of a leaf
 inline constexpr uint32_t kPyramidVertices = 36;  // vertex pulling: 36 vertices a frustum
 inline constexpr uint32_t kFogListEnd = 0xFFFFFFFFu;  // the end of a pixel's interval list
 inline constexpr uint32_t kFogMaxIntervals = 16;      // merged intervals the resolve holds per pixel
+inline constexpr uint32_t kFogMaxListNodes = 1024;    // nodes the resolve walks per pixel (more: marched whole)
 
 static_assert(kBarkTexturesUnit + kMaxBarkImages <= kGNormalDistanceUnit,
               "the bark images' units must not reach the G-buffer's");
@@ -88,6 +89,7 @@ inline constexpr GlslConstant kGlslConstants[] = {
     {"FOG_COUNTERS_BINDING", kFogCountersBinding},
     {"FOG_LIST_END", kFogListEnd},
     {"FOG_MAX_INTERVALS", kFogMaxIntervals},
+    {"FOG_MAX_LIST_NODES", kFogMaxListNodes},
 };
 
 // ---- Records (std430 arrays in shader storage) ----------------------------------------

@@ -115,12 +115,12 @@ ShadowFrame shadow_frame(const std::vector<Sphere>& spheres, const glm::dvec3& d
 namespace {
 
 // The fog pass's mode for the mode `options` or the scene ask for (auto: the cone-interval
-// pass, fast; spec/fog.md), or nullopt where the GPU has none: refined, reference, and
-// medium, whose resolve (fog.frag.glsl FOG_MEDIUM) agrees with brute on small scenes but
-// is darker than it on the dense canopy (docs/gl-fog.md, "Not done").
+// pass, fast; spec/fog.md), or nullopt where the GPU has none: refined and reference
+// (their exact shadow transitions need shadow rays, docs/gl-fog.md).
 std::optional<GlFogMode> gl_fog_mode_of(FogMode mode) {
   switch (mode) {
     case FogMode::brute: return GlFogMode::brute;
+    case FogMode::medium: return GlFogMode::medium;
     case FogMode::fast:
     case FogMode::automatic: return GlFogMode::fast;
     default: return std::nullopt;
@@ -137,8 +137,8 @@ std::optional<std::string> gl_fog_unsupported(const Scene& scene, const RenderOp
   if (!scene.fog) return std::nullopt;
   const FogMode mode = requested_fog_mode(scene, options);
   if (gl_fog_mode_of(mode)) return std::nullopt;
-  return std::string("the GL backend's fog pass runs brute and fast (auto) only, for now (the fog asks for ") +
-         fog_mode_name(mode) + "; --fog-mode brute or fast draws it with OpenGL)";
+  return std::string("the GL backend's fog pass runs brute, medium and fast (auto) only (the fog asks for ") +
+         fog_mode_name(mode) + "; --fog-mode brute, medium or fast draws it with OpenGL)";
 }
 
 }  // namespace
@@ -642,8 +642,8 @@ void GlRenderer::begin_frame(const Scene& scene, Frame& f) {
   f.fog_on = scene.fog.has_value();
   if (f.fog_on) {
     f.fog_mode = *gl_fog_mode_of(requested_fog_mode(scene, st.options));
-    if (f.fog_mode == GlFogMode::fast && !st.fog_cones)
-      throw GlError("the GL fog pass's fast mode needs shadow cones (GlRenderer::set_fog_cones; render_gl builds them)");
+    if (f.fog_mode != GlFogMode::brute && !st.fog_cones)
+      throw GlError("the GL fog pass's cone modes (medium, fast) need shadow cones (GlRenderer::set_fog_cones; render_gl builds them)");
     f.fog_cones = f.fog_mode != GlFogMode::brute && st.fog_cones;
     f.fog_steps = std::clamp(st.options.fog.steps.value_or(scene.fog->steps), 1u, kFogMaxSteps);
     s.fog_mode = gl_fog_mode_name(f.fog_mode);
@@ -1029,7 +1029,7 @@ RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrame
   if (scene.fog && requested_fog_mode(scene, options) != FogMode::brute) {
     // The cone modes: sun photons and shadow cones on the CPU (as render_cpu builds them),
     // uploaded once.
-    const FogMode mode = FogMode::fast;
+    const FogMode mode = requested_fog_mode(scene, options) == FogMode::medium ? FogMode::medium : FogMode::fast;
     const SceneGeometry geometry = build_scene_geometry(scene, options.skin, GeometryOptions{}, &cone_passes);
     const std::unique_ptr<const SunCones> cones = build_sun_cones(
         geometry, scene,

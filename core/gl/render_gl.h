@@ -33,7 +33,9 @@
 //                  and writes the fog AOV (fog.R fog.G fog.B fog.T). `fast` (and
 //                  `auto`): first a cone pass draws the shadow cones (set_fog_cones) as
 //                  frusta, their intervals into per-pixel lists; the resolve integrates
-//                  in closed form outside them. Other modes: refused (gl_unsupported).
+//                  in closed form outside them (V = 0 inside). `medium`: the same
+//                  lists, closed form outside, the N samples of the shadow map spent
+//                  inside the intervals. refined, reference: refused (gl_unsupported).
 //   present        only when the caller gives a target (gl_target.h): the accumulated
 //                  beauty ÷ spp into it, linear or sRGB-encoded.
 // --spp N repeats shadow map (if the sun is a disc), frusta and shade N times with the
@@ -183,8 +185,9 @@ class GlRenderer {
   void set_shadow_map_texels(uint32_t texels);
 
   // The shadow cones of this scene's plants and sun (core/cpu/photons.h build_sun_cones),
-  // uploaded once for every frame in a cone mode (fast, auto) until the next call (a new
-  // sun). Returns the bytes uploaded. Without them fast is refused (GlError).
+  // uploaded once for every frame in a cone mode (medium, fast, auto) until the next call
+  // (a new sun). Returns the bytes uploaded. Without them the cone modes are refused
+  // (GlError).
   uint64_t set_fog_cones(const ConeSet& cones);
 
   uint64_t frusta() const;          // frusta uploaded

@@ -260,3 +260,49 @@ TEST(BenchGpu, WithoutOpenGlItExitsOneSayingWhy) {
 }
 
 }  // namespace
+
+namespace {
+
+const std::vector<std::string> kFogColumns = {
+    "device", "gl_renderer", "input", "width", "height", "method", "mode", "steps", "status", "reason", "frames",
+    "fog_ms_median", "cones_ms_median", "frame_gpu_ms_median", "cones", "photons", "overflow_pixels", "fog_rmse",
+    "fog_rmse_relative", "fog_bias_relative", "reference"};
+
+// `bench gpu --fog --quick`: the elm grove at 96x72, brute 16 and 64, fast and medium, each
+// a measured row with the fog pass's GPU time and its RMSE against the CPU reference; the
+// cone modes with their cones and cone pass. Brute's error falls as its steps grow.
+TEST(BenchGpuFog, QuickRunWritesTheFogRowsWithTimesAndErrors) {
+  TempDir dir;
+  const ProcessResult r = run_sylva({"bench", "gpu", "--fog", "--quick", "--csv", dir.file("fog.csv"), "--plot",
+                                     dir.file("fog.png")},
+                                    SYLVA_SOURCE_DIR, 240);
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 context") != std::string::npos) GTEST_SKIP() << "no OpenGL";
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_EQ(read_file(dir.file("fog.png")).substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  const std::vector<CsvRow> rows = read_csv(read_file(dir.file("fog.csv")), kFogColumns);
+  ASSERT_EQ(rows.size(), 4u);
+  const char* const methods[] = {"brute 16", "brute 64", "fast", "medium 64"};
+  const char* const modes[] = {"brute", "brute", "fast", "medium"};
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const CsvRow& row = rows[i];
+    SCOPED_TRACE(row.at("method"));
+    EXPECT_EQ(row.at("method"), methods[i]);
+    EXPECT_EQ(row.at("mode"), modes[i]);
+    EXPECT_EQ(row.at("status"), "ok") << row.at("reason");
+    EXPECT_EQ(row.at("width"), "96");
+    EXPECT_EQ(row.at("height"), "72");
+    EXPECT_EQ(row.at("frames"), "2");
+    EXPECT_NE(row.at("input").find("elm_grove_low_sun"), std::string::npos);
+    EXPECT_GT(number(row, "fog_ms_median"), 0.0);
+    EXPECT_GE(number(row, "frame_gpu_ms_median"), number(row, "fog_ms_median"));
+    EXPECT_GT(number(row, "fog_rmse_relative"), 0.0);
+    EXPECT_LT(std::abs(number(row, "fog_bias_relative")), 1.0);
+    const bool cones = i >= 2;
+    EXPECT_EQ(number(row, "cones") > 0, cones);
+    EXPECT_EQ(number(row, "cones_ms_median") > 0, cones);
+  }
+  EXPECT_LT(number(rows[1], "fog_rmse_relative"), number(rows[0], "fog_rmse_relative")) << "64 steps beat 16";
+}
+
+}  // namespace

@@ -78,6 +78,21 @@ TEST(RenderFogCli, AFoggySceneInBruteRendersWithOpenGlWithTheFogPassAndTheFogAov
   if (!expect_fog_render("gl", "fog (GPU)")) GTEST_SKIP() << "no OpenGL context on this machine";
 }
 
+// medium draws on the GL backend (its cones built as for fast, the map marched inside them).
+TEST(RenderFogCli, MediumRendersWithOpenGlWithItsConesAndTheFogPass) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, R"({"sigma_s": 0.05, "g": 0.6, "top": 20, "steps": 4, "photons": 20000})");
+  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "gl", "--fog-mode", "medium",
+                               "--verbose"});
+  if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 core context") != std::string::npos)
+    GTEST_SKIP() << "no OpenGL context on this machine";
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.err.find("medium, 4 steps"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("fog[FOG_MEDIUM SUN]"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("cone upload"), std::string::npos) << describe(r);
+  EXPECT_TRUE(std::filesystem::exists(dir.file("f.png")));
+}
+
 TEST(RenderFogCli, PngPutsTheFogAovInASideFile) {
   TempDir dir;
   const std::string scene = write_scene(dir, kFog);
@@ -92,14 +107,14 @@ TEST(RenderFogCli, PngPutsTheFogAovInASideFile) {
 TEST(RenderFogCli, TheGlBackendRefusesTheFogModesItLacksWithStatusOneAndAutoFallsBackToTheCpu) {
   TempDir dir;
   const std::string scene = write_scene(dir, kFog);
-  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "gl", "--fog-mode", "medium"});
+  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "gl", "--fog-mode", "refined"});
   EXPECT_EQ(r.exit_code, 1) << describe(r);
-  EXPECT_NE(r.err.find("fog pass runs brute and fast (auto) only, for now (the fog asks for medium"), std::string::npos)
+  EXPECT_NE(r.err.find("fog pass runs brute, medium and fast (auto) only (the fog asks for refined"), std::string::npos)
       << describe(r);
   EXPECT_FALSE(std::filesystem::exists(dir.file("f.png")));
   r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--fog-mode", "reference", "--fog-steps", "2", "--verbose"});
   EXPECT_EQ(r.exit_code, 0) << describe(r);
-  EXPECT_NE(r.err.find("the OpenGL backend cannot draw this (the GL backend's fog pass runs brute and fast (auto) only"),
+  EXPECT_NE(r.err.find("the OpenGL backend cannot draw this (the GL backend's fog pass runs brute, medium and fast (auto) only"),
             std::string::npos)
       << describe(r);
   EXPECT_NE(r.err.find("fog (thread time)"), std::string::npos) << describe(r);

@@ -7,9 +7,11 @@
 #include <chrono>
 #include <thread>
 
+#include "app/studio/cone_worker.h"
 #include "app/studio/gl_viewport.h"
 #include "core/gl/gl_context.h"
 #include "core/scene.h"
+#include "core/shadow_cones.h"
 
 namespace sylva::studio {
 namespace {
@@ -74,6 +76,49 @@ TEST_F(Viewports, AFastRendererShowsNewPlantsInFullAtOnce) {
   const ViewImage full = settle(viewport, scene);
   EXPECT_EQ(viewport.stats().previews, 0u);
   EXPECT_EQ(full.width, 96u);
+}
+
+// The passes' detail of the last picture's pass named `name`, or "" when it did not run.
+std::string pass_detail(const GlViewport& viewport, const std::string& name) {
+  for (const RenderPass& p : viewport.stats().passes)
+    if (p.name == name) return p.detail;
+  return "";
+}
+
+// A scene in a fog cone mode is drawn brute until its cones come (the cone worker builds
+// them off the UI thread), then with them; a new medium is a new picture of the same cones.
+TEST_F(Viewports, FogInAConeModeDrawsBruteUntilTheConesComeThenWithThem) {
+  GlViewport viewport({}, /*preview_above_ms=*/1e9);
+  Scene scene = saguaro(96, 64);
+  Fog fog;
+  fog.sigma_s = 0.05;
+  fog.top = 30;
+  fog.mode = FogMode::fast;
+  fog.steps = 8;
+  fog.photons = 4000;
+  scene.fog = fog;
+  viewport.set_plants(scene, RenderOptions{});
+  settle(viewport, scene);
+  ASSERT_TRUE(viewport.stats().error.empty()) << viewport.stats().error;
+  EXPECT_EQ(pass_detail(viewport, "fog (GPU)").rfind("brute, 8 steps", 0), 0u) << pass_detail(viewport, "fog (GPU)");
+  EXPECT_EQ(pass_detail(viewport, "fog cones (GPU)"), "");
+
+  ConeWorker worker;
+  worker.submit(ConeRequest{scene, SkinOptions{}, FogMode::fast, fog.photons});
+  ASSERT_TRUE(worker.wait_idle(60));
+  std::optional<ConeResult> cones = worker.poll();
+  ASSERT_TRUE(cones);
+  ASSERT_GT(cones->cones->size(), 0u);
+  EXPECT_EQ(worker.builds_finished(), 1u);
+  viewport.set_fog_cones(cones->cones);
+  settle(viewport, scene);
+  EXPECT_EQ(pass_detail(viewport, "fog (GPU)").rfind("fast", 0), 0u) << pass_detail(viewport, "fog (GPU)");
+  EXPECT_NE(pass_detail(viewport, "fog cones (GPU)"), "");
+
+  scene.fog->mode = FogMode::medium;  // the same cones serve the other cone mode
+  settle(viewport, scene);
+  EXPECT_EQ(pass_detail(viewport, "fog (GPU)").rfind("medium, 8 steps", 0), 0u) << pass_detail(viewport, "fog (GPU)");
+  EXPECT_TRUE(viewport.stats().error.empty()) << viewport.stats().error;
 }
 
 }  // namespace

@@ -37,11 +37,16 @@ class FakeViewport : public Viewport {
     last_plants = set_plants_calls;
     return ViewImage{reinterpret_cast<ImTextureID>(static_cast<intptr_t>(1)), false, scene.width, scene.height};
   }
+  void set_fog_cones(std::shared_ptr<const ConeSet> cones) override {
+    ++fog_cones_calls;
+    last_cones = std::move(cones);
+  }
   const ViewStats& stats() const override { return stats_; }
   std::optional<std::string> write_image(const Scene&, const RenderOptions&, const std::string&) override {
     return std::string("no renderer in the headless tests");
   }
-  int set_plants_calls = 0, renders = 0, last_plants = -1;
+  int set_plants_calls = 0, renders = 0, last_plants = -1, fog_cones_calls = 0;
+  std::shared_ptr<const ConeSet> last_cones;
   uint64_t segments = 0;
   std::vector<double> last_key;
   ViewStats stats_;
@@ -134,6 +139,20 @@ class HeadlessUi {
       frame(app);
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
+    return true;
+  }
+  // Drags the viewport 50 pixels to the right with the left button (an orbit); false when
+  // the app drew no viewport.
+  bool orbit(StudioApp& app) {
+    auto view = app.rect("viewport");
+    if (!view) return false;
+    ImGuiIO& io = ImGui::GetIO();
+    io.MousePos = view->centre();
+    frame(app);
+    io.MouseDown[0] = true;
+    for (int i = 0; i < 5; ++i) io.MousePos.x += 10, frame(app);
+    io.MouseDown[0] = false;
+    frames(app, 2);
     return true;
   }
   // Until the worker is idle and its result is on screen.

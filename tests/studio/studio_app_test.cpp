@@ -51,18 +51,7 @@ struct Fixture : ::testing::Test {
     ui.key(app, kKeyEnd);
   }
   // Drags the viewport 50 pixels to the right with the left button (an orbit).
-  bool orbit_by_dragging(StudioApp& app) {
-    auto view = app.rect("viewport");
-    if (!view) return false;
-    ImGuiIO& io = ImGui::GetIO();
-    io.MousePos = view->centre();
-    ui.frame(app);
-    io.MouseDown[0] = true;
-    for (int i = 0; i < 5; ++i) io.MousePos.x += 10, ui.frame(app);
-    io.MouseDown[0] = false;
-    ui.frames(app, 2);
-    return true;
-  }
+  bool orbit_by_dragging(StudioApp& app) { return ui.orbit(app); }
   TempDir dir;
   std::string path;
   HeadlessUi ui;

@@ -1,0 +1,195 @@
+// bench_gpu_fog.cpp — see bench_gpu_fog.h.
+#include "app/bench/bench_gpu_fog.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <thread>
+#include <variant>
+
+#include "app/bench/bench_metrics.h"
+#include "app/bench/plot.h"
+#include "app/cli/cli.h"
+#include "app/cli/render_input.h"
+#include "core/cpu/photons.h"
+#include "core/cpu/render_cpu.h"
+#include "core/gl/render_gl.h"
+
+namespace sylva::cli {
+
+namespace {
+
+struct FogMethod {
+  std::string name;  // "brute 64", "fast", "medium 64"
+  FogMode mode;
+  uint32_t steps;
+};
+
+std::vector<FogMethod> fog_methods(bool quick, uint32_t medium_steps) {
+  std::vector<FogMethod> m;
+  for (uint32_t n : quick ? std::vector<uint32_t>{16, 64} : std::vector<uint32_t>{16, 32, 64, 128, 256})
+    m.push_back({"brute " + std::to_string(n), FogMode::brute, n});
+  m.push_back({"fast", FogMode::fast, medium_steps});
+  m.push_back({"medium " + std::to_string(medium_steps), FogMode::medium, medium_steps});
+  return m;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// The in-scatter's (fog.R fog.G fog.B) RMSE of `test` against `ref`, and `ref`'s mean.
+struct FogError {
+  double rmse = 0, mean_ref = 0, mean_test = 0;
+};
+FogError fog_error(const RenderImage& test, const RenderImage& ref) {
+  FogError e;
+  size_t n = 0;
+  for (size_t i = 0; i < ref.fog.size() && i < test.fog.size(); ++i) {
+    if (i % 4 == 3) continue;
+    const double d = test.fog[i] - ref.fog[i];
+    e.rmse += d * d;
+    e.mean_ref += ref.fog[i];
+    e.mean_test += test.fog[i];
+    ++n;
+  }
+  if (n == 0) return {std::nan(""), std::nan(""), std::nan("")};
+  e.rmse = std::sqrt(e.rmse / n);
+  e.mean_ref /= n;
+  e.mean_test /= n;
+  return e;
+}
+
+std::string number(double v) {
+  if (std::isnan(v)) return "";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+std::string quoted(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string q = "\"";
+  for (char c : text) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+}  // namespace
+
+const char* const kGpuFogCsvColumns =
+    "device,gl_renderer,input,width,height,method,mode,steps,status,reason,frames,fog_ms_median,cones_ms_median,"
+    "frame_gpu_ms_median,cones,photons,overflow_pixels,fog_rmse,fog_rmse_relative,fog_bias_relative,reference\n";
+
+int run_gpu_fog_rows(const GpuFogArgs& a, const std::string& device, const GlContextInfo& gl) {
+  std::ofstream csv(a.csv, std::ios::trunc);
+  if (!csv) {
+    std::cerr << "sylva bench gpu: cannot write " << a.csv << "\n";
+    return kInputError;
+  }
+  csv << "# sylva bench gpu --fog on " << device << " (" << gl.describe() << "), " << a.frames << " frames after "
+      << a.warmup << " warm-up frames, sun as a point\n"
+      << kGpuFogCsvColumns;
+  csv.flush();
+  std::printf("%-34s %-11s %10s %10s %10s %8s %10s %9s\n", "input", "method", "fog_ms", "cones_ms", "frame_ms", "cones",
+              "rmse_rel", "bias_rel");
+  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  std::vector<PlotPanel> panels;
+  int failed = 0;
+  for (const std::string& input : a.inputs) {
+    for (const auto& [width, height] : a.sizes) {
+      std::vector<RenderPass> passes;
+      GrammarArgs grammar;
+      grammar.grammar = input;
+      auto loaded = load_render_input(grammar, width, height, passes);
+      if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
+      Scene scene = std::move(std::get<Scene>(loaded));
+      if (!scene.fog) {
+        std::cerr << "sylva bench gpu --fog: " << input << " has no fog\n";
+        return kInputError;
+      }
+      scene.sun.angular_radius_deg = 0;  // one GL sample sees the disc's centre: a point sun on both
+      const uint64_t photons = a.quick ? std::min<uint64_t>(scene.fog->photons, 200000) : scene.fog->photons;
+      const std::string where = input.substr(input.find_last_of('/') + 1) + " " + std::to_string(width) + "x" +
+                                std::to_string(height);
+      std::cerr << "sylva bench gpu --fog: CPU reference fog of " << where << ", " << threads << " threads\n";
+      RenderOptions ref_options;
+      ref_options.aovs = kAovFog;
+      ref_options.threads = threads;
+      ref_options.fog.mode = FogMode::reference;
+      const RenderImage reference = render_cpu(scene, ref_options).image;
+      const SceneGeometry geometry = build_scene_geometry(scene, SkinOptions{});
+      std::unique_ptr<const SunCones> cones[2];  // fast's, medium's (the automatic choice weighs misses apart)
+      PlotPanel panel{where + ", " + device, "fog GPU time per frame (ms)", "fog RMSE / mean", {}};
+      for (const FogMethod& m : fog_methods(a.quick, scene.fog->steps)) {
+        Scene s = scene;
+        s.fog->mode = m.mode;
+        s.fog->steps = m.steps;
+        RenderOptions options;
+        options.aovs = kAovFog;
+        std::string status = "ok", reason;
+        std::vector<double> fog_ms, cones_ms, frame_ms;
+        size_t cone_count = 0;
+        uint64_t overflow = 0;
+        FogError e{std::nan(""), std::nan(""), std::nan("")};
+        try {
+          GlRenderer renderer(s, options);
+          if (m.mode != FogMode::brute) {
+            std::unique_ptr<const SunCones>& c = cones[m.mode == FogMode::medium ? 1 : 0];
+            if (!c) c = build_sun_cones(geometry, s, sun_cone_options_for(m.mode, photons, std::nullopt, threads, nullptr));
+            renderer.set_fog_cones(c->cones);
+            cone_count = c->cones.size();
+          }
+          RenderImage image;
+          for (uint32_t f = 0; f < a.warmup + a.frames; ++f) {
+            renderer.draw(s);
+            const GlFrameStats stats = renderer.wait_for_frame();
+            image = renderer.read_back();
+            if (f < a.warmup) continue;
+            fog_ms.push_back(stats.pass(GlPass::fog).gpu_s * 1e3);
+            cones_ms.push_back(stats.pass(GlPass::fog_cones).gpu_s * 1e3);
+            frame_ms.push_back(stats.gpu_s() * 1e3);
+            overflow = stats.fog_overflow_pixels;
+          }
+          e = fog_error(image, reference);
+        } catch (const std::exception& ex) {
+          status = "failed";
+          reason = ex.what();
+          ++failed;
+        }
+        const double rel = e.rmse / e.mean_ref, bias = (e.mean_test - e.mean_ref) / e.mean_ref;
+        csv << quoted(device) << ',' << quoted(gl.renderer) << ',' << quoted(input) << ',' << width << ',' << height
+            << ',' << quoted(m.name) << ',' << fog_mode_name(m.mode) << ',' << m.steps << ',' << status << ','
+            << quoted(reason) << ',' << fog_ms.size() << ',' << number(median(fog_ms)) << ','
+            << number(median(cones_ms)) << ',' << number(median(frame_ms)) << ',' << cone_count << ','
+            << (m.mode == FogMode::brute ? 0 : photons) << ',' << overflow << ',' << number(e.rmse) << ','
+            << number(rel) << ',' << number(bias) << ",CPU fog reference\n";
+        csv.flush();  // each row as it finishes: a long run stopped early keeps what it measured
+        if (status != "ok") {
+          std::printf("%-34s %-11s failed: %s\n", where.c_str(), m.name.c_str(), reason.c_str());
+        } else {
+          std::printf("%-34s %-11s %10.3f %10.3f %10.3f %8zu %10.4f %+9.4f\n", where.c_str(), m.name.c_str(),
+                      median(fog_ms), median(cones_ms), median(frame_ms), cone_count, rel, bias);
+          series_named(panel.series, fog_mode_name(m.mode))
+              .points.push_back({median(fog_ms) + median(cones_ms), rel});
+        }
+        std::fflush(stdout);
+      }
+      panels.push_back(std::move(panel));
+    }
+  }
+  if (Status e = write_loglog_plot(panels, a.plot); !e) {
+    std::cerr << e.error().format();
+    return kInputError;
+  }
+  std::cerr << "sylva bench gpu --fog: wrote " << a.csv << " and " << a.plot << "\n";
+  return failed > 0 ? kInputError : kOk;
+}
+
+}  // namespace sylva::cli
