@@ -71,7 +71,7 @@ class Renderer {
  public:
   Renderer(const Scene& scene, const SceneGeometry& geometry, const RenderOptions& options,
            const SceneTextures* textures, const FogIntegrator* fog)
-      : scene_(scene), geometry_(geometry), options_(options), frame_(camera_frame(scene)),
+      : scene_(scene), options_(options), frame_(camera_frame(scene)),
         tracer_(*geometry.tracer), sun_direction_(glm::normalize(scene.sun.direction)),
         sun_frame_(axis_frame(sun_direction_)),
         cos_alpha_(std::cos(scene.sun.angular_radius_deg * kPi / 180)),
@@ -275,7 +275,6 @@ class Renderer {
   }
 
   const Scene& scene_;
-  const SceneGeometry& geometry_;
   const RenderOptions& options_;
   const CameraFrame frame_;
   const SceneTracer& tracer_;
