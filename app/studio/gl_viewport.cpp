@@ -99,7 +99,7 @@ struct GlViewport::Shared {
   // flight stop (GlRenderer checks it every 1024 chains) instead of finishing for nothing.
   std::atomic<bool> cancel_build{false};
   std::function<void()> on_picture;
-  double preview_above_ms = 50;  // see the constructor
+  double preview_above_ms = 1000;  // see the constructor
   uint64_t previews = 0;         // made so far
   // Requests (latest wins).
   struct Plants {

@@ -36,8 +36,11 @@ class GlViewport : public Viewport {
   // wakes itself with it). New plants are first shown as a preview (half the pixels a side,
   // a 512² shadow map; ViewStats::preview) when the last full picture took longer than
   // `preview_above_ms`, then in full. Throws GlError when the render thread gets no GL
-  // context.
-  explicit GlViewport(std::function<void()> on_picture = {}, double preview_above_ms = 50);
+  // context. The default, 1 s, was measured (docs/benchmarks.md, the studio): on llvmpipe
+  // a preview of the pine (a ~0.3 s picture) cost more than the full picture it stood in for
+  // (the half-size targets and the small shadow map are reallocated twice), so previews are
+  // kept for pictures slow enough that a quarter of the pixels pays for that.
+  explicit GlViewport(std::function<void()> on_picture = {}, double preview_above_ms = 1000);
   ~GlViewport() override;
   GlViewport(const GlViewport&) = delete;
   GlViewport& operator=(const GlViewport&) = delete;
