@@ -7,6 +7,7 @@
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <numbers>
+#include <time.h>
 
 #include "core/ray_frustum.h"
 #include "core/scene.h"
@@ -19,6 +20,14 @@ using Clock = std::chrono::steady_clock;
 
 inline double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// CPU time of this process, all threads (core-seconds): what a stage costs, which other
+// jobs on a shared machine disturb far less than its wall time.
+inline double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 // SplitMix64 (lsystem/random.h), counter based: a pixel sample (CPU) or a pass (GL) draws

@@ -29,18 +29,18 @@
 // family needs to reach given RMSEs (interpolated on its fastest settings, log-log) and
 // fast mode's bias floor.
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
-#include <time.h>
 #include <vector>
 
 #include "app/bench/bench_metrics.h"
+#include "app/bench/fog_view.h"
 #include "app/bench/plot.h"
 #include "app/cli/cli.h"
 #include "app/cli/render_input.h"
@@ -62,6 +62,7 @@ void print_help() {
                "                            [--reference-steps N] [--reference-stride S]\n"
                "                            [--fixed-params p1,p2,p3,p4[,t]]\n"
                "                            [--threads N] [--per-core-photons N] [--cones-only]\n"
+               "                            [--clock wall|cpu] [--merge FILE.csv]...\n"
                "                            [--csv FILE] [--plot FILE.png] [--quick]\n\n"
                "Error against run time of the fog modes on SCENE (a scene with a `fog` key): the fog\n"
                "AOV's in-scatter through every pixel centre by brute, medium, fast and refined,\n"
@@ -85,6 +86,12 @@ void print_help() {
                "  --csv FILE            rows (default SCENE-stem.fog.csv; the cones' coverage in\n"
                "                        the same name with -cones.csv)\n"
                "  --plot FILE           log-log RMSE against time (default SCENE-stem.fog.png)\n"
+               "  --clock wall|cpu      times as wall seconds (default), or as the process's CPU\n"
+               "                        seconds divided by the threads: what two idle cores would\n"
+               "                        take, for a machine shared with other jobs\n"
+               "  --merge FILE.csv      rows of an earlier run (the same scene, size, threads, clock\n"
+               "                        and reference) join this run's tables, plot and CSV; a\n"
+               "                        setting this run measures replaces that file's rows of it\n"
                "  --quick               a smoke test: 64x48, brute 8,32, cone steps 16, photons\n"
                "                        10000,100000, 2 seeds, reference steps 8\n";
 }
@@ -105,6 +112,8 @@ struct Args {
   bool cones_only = false;
   std::string csv, cones_csv, plot;
   bool quick = false;
+  bool cpu_clock = false;           // --clock cpu
+  std::vector<std::string> merge;  // --merge FILE, in order
 };
 
 std::vector<std::string> split(const std::string& text, char by) {
@@ -196,6 +205,12 @@ Args parse_args(const std::vector<std::string>& args) {
       out.plot = value();
     } else if (a == "--quick") {
       out.quick = true;
+    } else if (a == "--clock") {
+      const std::string v = value();
+      if (v != "wall" && v != "cpu") throw UsageError{"--clock: '" + v + "' is not wall or cpu"};
+      out.cpu_clock = v == "cpu";
+    } else if (a == "--merge") {
+      out.merge.push_back(value());
     } else {
       rest.push_back(a);
     }
@@ -223,98 +238,16 @@ Args parse_args(const std::vector<std::string>& args) {
   return out;
 }
 
-// CPU time of this process, all threads (seconds): photons and cones in core-seconds,
-// which other jobs on a shared machine disturb less than wall time.
-double process_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
 std::string params_text(const ConeParams& p) {
   char line[96];
   std::snprintf(line, sizeof line, "%u;%u;%u;%u;%.3g", p.p1, p.p2, p.p3, p.p4, p.variance_threshold);
   return line;
 }
 
-// The pixel-centre camera rays of the view and where each ends (the first plant or the
-// ground; +inf: the sky), as render_cpu's fog AOV takes them.
-struct View {
-  uint32_t width = 0, height = 0;
-  std::vector<glm::dvec3> origin, direction;  // direction unit
-  std::vector<double> t_end;
-};
-
-View pixel_rays(const Scene& scene, const SceneTracer& tracer) {
-  View v;
-  v.width = scene.width, v.height = scene.height;
-  const size_t n = size_t(v.width) * v.height;
-  v.origin.resize(n), v.direction.resize(n), v.t_end.resize(n);
-  for (uint32_t y = 0; y < v.height; ++y)
-    for (uint32_t x = 0; x < v.width; ++x) {
-      const size_t i = size_t(y) * v.width + x;
-      const Ray ray = camera_ray(scene, x + 0.5, y + 0.5);
-      const double length = glm::length(ray.direction);
-      const double surface = tracer.nearest(ray, 0, std::numeric_limits<double>::infinity()).t;
-      const double ground = shading::ground_distance(ray.origin.y - scene.ground.height, ray.direction.y);
-      v.origin[i] = ray.origin;
-      v.direction[i] = ray.direction / length;
-      v.t_end[i] = std::min(surface, ground) * length;
-    }
-  return v;
-}
-
-// The fog's in-scatter of every pixel (RGB, row-major) by `integrator`, on `threads`
-// threads; pixel i's random numbers from (seed, i) only.
-std::vector<float> fog_image(const View& v, const FogIntegrator& integrator, uint64_t seed, unsigned threads,
-                             double* seconds) {
-  const size_t n = v.origin.size();
-  std::vector<float> out(n * 3);
-  std::atomic<size_t> next{0};
-  const auto start = render_common::Clock::now();
-  auto worker = [&] {
-    for (;;) {
-      const size_t begin = next.fetch_add(256);
-      if (begin >= n) return;
-      for (size_t i = begin; i < std::min(n, begin + 256); ++i) {
-        render_common::SampleRng rng(lsys::mix_pair(seed, i));
-        const FogRayResult r = integrator.integrate(v.origin[i], v.direction[i], v.t_end[i], rng);
-        for (int c = 0; c < 3; ++c) out[i * 3 + c] = static_cast<float>(r.inscatter[c]);
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
-  *seconds = render_common::seconds_since(start);
-  return out;
-}
-
-// The pixels `view` keeps of a `stride` grid: (x, y) with x, y ≡ stride/2 (mod stride).
-View strided(const View& v, uint32_t stride, std::vector<size_t>* pixels) {
-  View out;
-  pixels->clear();
-  for (uint32_t y = stride / 2; y < v.height; y += stride)
-    for (uint32_t x = stride / 2; x < v.width; x += stride) {
-      const size_t i = size_t(y) * v.width + x;
-      pixels->push_back(i);
-      out.origin.push_back(v.origin[i]), out.direction.push_back(v.direction[i]), out.t_end.push_back(v.t_end[i]);
-    }
-  out.width = static_cast<uint32_t>(pixels->size()), out.height = 1;
-  return out;
-}
-
 // Over `pixels` (of `a`, RGB) against `reference` (RGB, one per pixel in that order).
 template <typename T>
 double rmse(const std::vector<T>& a, const std::vector<double>& reference, const std::vector<size_t>& pixels) {
-  double sum = 0;
-  for (size_t k = 0; k < pixels.size(); ++k)
-    for (int c = 0; c < 3; ++c) {
-      const double d = a[pixels[k] * 3 + c] - reference[k * 3 + c];
-      sum += d * d;
-    }
-  return std::sqrt(sum / std::max<size_t>(1, 3 * pixels.size()));
+  return rmse_at(a, 3, reference, pixels);
 }
 
 // One row of the CSV, and the setting it belongs to.
@@ -325,6 +258,7 @@ struct Row {
   uint32_t seed = 0;
   double photon_s = 0, cone_s = 0, render_s = 0, total_s = 0, rmse = -1, bias = -1;
   size_t cones = 0;
+  bool merged = false;  // from a --merge file: its bias is that run's
   std::string setting() const { return mode + "/" + std::to_string(steps) + "/" + std::to_string(photons); }
 };
 
@@ -351,6 +285,52 @@ double time_to_reach(std::vector<Point> points, double target) {
   return -1;
 }
 
+// The rows of an earlier run's CSV (`path`), which must have been written with `header`
+// (scene, size, threads, clock and reference) as its first line.
+Expected<std::vector<Row>> read_rows(const std::string& path, const std::string& header) {
+  auto text = read_text_file(path);
+  if (!text) return text.error();
+  std::istringstream in(*text);
+  std::string line;
+  std::vector<Row> rows;
+  uint32_t number = 0;
+  auto at = [&](uint32_t column, const std::string& why) { return diagnostic_at(path, {number, column}, why); };
+  while (std::getline(in, line)) {
+    ++number;
+    if (number == 1) {
+      if (line + "\n" != header)
+        return at(1, "was written by another run setting ('" + line + "'; this run's: '" +
+                         header.substr(0, header.size() - 1) + "'): scene, size, threads, clock and reference must agree");
+      continue;
+    }
+    if (number == 2 || line.empty()) continue;  // the column names
+    const std::vector<std::string> f = split(line, ',');
+    if (f.size() < 9 || f.size() > 11) return at(1, "expected 11 columns, found " + std::to_string(f.size()));
+    std::vector<double> v(11, -1);
+    uint32_t column = 1;
+    for (size_t k = 0; k < f.size(); column += static_cast<uint32_t>(f[k].size()) + 1, ++k) {
+      if (k == 0 || f[k].empty()) continue;
+      char* end = nullptr;
+      v[k] = std::strtod(f[k].c_str(), &end);
+      if (end == f[k].c_str() || *end != '\0' || !std::isfinite(v[k]) || v[k] < 0)
+        return at(column, "'" + f[k] + "' is not a number of zero or more");
+    }
+    Row r;
+    r.mode = f[0];
+    r.steps = static_cast<uint32_t>(std::max(0.0, v[1]));
+    r.photons = static_cast<uint64_t>(std::max(0.0, v[2]));
+    r.seed = static_cast<uint32_t>(std::max(0.0, v[3]));
+    r.photon_s = std::max(0.0, v[4]), r.cone_s = std::max(0.0, v[5]), r.render_s = std::max(0.0, v[6]);
+    r.total_s = std::max(0.0, v[7]);
+    r.rmse = v[8], r.bias = v[9];
+    r.cones = static_cast<size_t>(std::max(0.0, v[10]));
+    r.merged = true;
+    rows.push_back(r);
+  }
+  if (number < 2) return diagnostic_at(path, {number, 0}, "has no rows");
+  return rows;
+}
+
 }  // namespace
 
 int run_bench_fog(const std::vector<std::string>& args) {
@@ -369,6 +349,20 @@ int run_bench_fog(const std::vector<std::string>& args) {
     return kInputError;
   }
   const unsigned threads = a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency());
+  const std::string header = "# sylva bench fog " + a.grammar.grammar + ", " + std::to_string(scene.width) + "x" +
+                             std::to_string(scene.height) + ", " + std::to_string(threads) + " threads, reference " +
+                             std::to_string(a.reference_steps) + " steps on every " +
+                             std::to_string(a.reference_stride) + "-th pixel each way" +
+                             (a.cpu_clock ? ", CPU clock" : "") + "\n";
+  std::vector<Row> merged;  // read before the run: a bad file fails in a second, not after an hour
+  for (const std::string& path : a.merge) {
+    auto more = read_rows(path, header);
+    if (!more) {
+      std::cerr << more.error().format();
+      return kInputError;
+    }
+    merged.insert(merged.end(), more->begin(), more->end());
+  }
   GeometryOptions geometry;
   geometry.cull = false;     // a plant outside the view still casts shafts into it
   geometry.relief = false;   // the exact frusta for photons, shadow rays and the reference alike
@@ -426,8 +420,10 @@ int run_bench_fog(const std::vector<std::string>& args) {
     o.mode = mode;
     o.steps = std::max(1u, row.steps);
     const FogIntegrator integrator(*medium, fog_sun_of(scene.sun), scene.sky, *g.tracer, cones, o);
+    double cpu = 0;
     const std::vector<float> image = fog_image(view, integrator, lsys::mix_pair(row.seed, 0x666f67), threads,
-                                               &row.render_s);
+                                               &row.render_s, &cpu);
+    if (a.cpu_clock) row.render_s = cpu / threads;
     row.total_s = row.photon_s + row.cone_s + row.render_s;
     row.rmse = rmse(image, reference, reference_pixels);
     std::vector<double>& sum = sums[row.setting()];
@@ -464,9 +460,9 @@ int run_bench_fog(const std::vector<std::string>& args) {
         o.photons.seed = seed;
         o.photons.threads = threads;
         if (!automatic) o.params = a.fixed_params;
-        const double cpu_start = process_cpu_seconds();
+        const double cpu_start = render_common::process_cpu_seconds();
         const auto c = build_sun_cones(g, scene, o, &tracer);
-        const double cpu_s = process_cpu_seconds() - cpu_start;
+        const double cpu_s = render_common::process_cpu_seconds() - cpu_start;
         double params_s = 0;
         for (const RenderPass& p : c->passes)
           if (p.name == "cone params") params_s = p.seconds;
@@ -494,7 +490,11 @@ int run_bench_fog(const std::vector<std::string>& args) {
                       static_cast<unsigned long long>(cov.shadowed), query_us);
         cones_csv << line;
         Row base;
-        base.photons = photons, base.seed = seed, base.photon_s = c->photon_seconds, base.cone_s = c->cone_seconds;
+        // The final coverage is a report (the cones' CSV), not a cost of rendering.
+        base.photons = photons, base.seed = seed;
+        base.photon_s = a.cpu_clock ? c->photon_cpu_seconds / threads : c->photon_seconds;
+        base.cone_s = a.cpu_clock ? (c->cone_cpu_seconds - c->coverage_cpu_seconds) / threads
+                                  : c->cone_seconds - c->coverage_seconds;
         base.cones = c->cones.size();
         {
           Row row = base;
@@ -532,15 +532,25 @@ int run_bench_fog(const std::vector<std::string>& args) {
     for (size_t i = 0; i < sum.size(); ++i) mean[i] = sum[i] / counts[setting];
     bias[setting] = rmse(mean, reference, reference_pixels);
   }
+  // The merged runs' rows, less the settings this run measured again.
+  {
+    std::set<std::string> measured;
+    for (const Row& r : rows) measured.insert(r.setting());
+    size_t replaced = 0;
+    for (const Row& r : merged)
+      if (measured.count(r.setting())) ++replaced;
+      else rows.push_back(r);
+    if (!merged.empty())
+      std::printf("merged %zu rows of %zu file(s)%s\n", merged.size() - replaced, a.merge.size(),
+                  replaced ? (", " + std::to_string(replaced) + " replaced by this run's").c_str() : "");
+  }
   std::ostringstream csv;
-  csv << "# sylva bench fog " << a.grammar.grammar << ", " << scene.width << "x" << scene.height << ", " << threads
-      << " threads, reference " << a.reference_steps << " steps on every " << a.reference_stride
-      << "-th pixel each way\n";
+  csv << header;
   csv << "mode,steps,photons,seed,photon_s,cone_s,render_s,total_s,rmse,bias,cones\n";
   for (Row& r : rows) {
     char line[512];
     const bool rendered = r.rmse >= 0;
-    if (rendered) r.bias = bias[r.setting()];
+    if (rendered && !r.merged) r.bias = bias[r.setting()];
     char rm[32] = "", bi[32] = "";
     if (rendered) std::snprintf(rm, sizeof rm, "%.6g", r.rmse), std::snprintf(bi, sizeof bi, "%.6g", r.bias);
     std::snprintf(line, sizeof line, "%s,%u,%llu,%u,%.6g,%.6g,%.6g,%.6g,%s,%s,%zu\n", r.mode.c_str(), r.steps,
@@ -570,8 +580,11 @@ int run_bench_fog(const std::vector<std::string>& args) {
       }
     // Targets: brute's mean RMSE at its settings' step counts (1024 the issue's).
     std::vector<std::pair<std::string, double>> targets;
+    std::set<uint32_t> brute_steps;  // this run's and the merged files'
+    for (const Row& r : rows)
+      if (r.mode == "brute" && r.rmse >= 0) brute_steps.insert(r.steps);
     if (curves.count("brute"))
-      for (uint32_t steps : a.brute_steps) {
+      for (uint32_t steps : brute_steps) {
         const std::string key = "brute/" + std::to_string(steps) + "/0";
         if (families["brute"].count(key))
           targets.push_back({"brute " + std::to_string(steps), families["brute"][key].rmse / n["brute"][key]});

@@ -12,6 +12,7 @@
 #include <variant>
 
 #include "app/bench/bench_metrics.h"
+#include "app/bench/fog_view.h"
 #include "app/bench/plot.h"
 #include "app/cli/cli.h"
 #include "app/cli/render_input.h"
@@ -45,25 +46,19 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// The in-scatter's (fog.R fog.G fog.B) RMSE of `test` against `ref`, and `ref`'s mean.
+// The in-scatter's (fog.R fog.G fog.B) RMSE of `test` against the reference (RGB at
+// `pixels`, fog_view.h), and both means over those pixels.
 struct FogError {
   double rmse = 0, mean_ref = 0, mean_test = 0;
 };
-FogError fog_error(const RenderImage& test, const RenderImage& ref) {
+FogError fog_error(const RenderImage& test, const std::vector<double>& reference, const std::vector<size_t>& pixels) {
+  if (pixels.empty() || test.fog.size() < (pixels.back() + 1) * 4) return {std::nan(""), std::nan(""), std::nan("")};
   FogError e;
-  size_t n = 0;
-  for (size_t i = 0; i < ref.fog.size() && i < test.fog.size(); ++i) {
-    if (i % 4 == 3) continue;
-    const double d = test.fog[i] - ref.fog[i];
-    e.rmse += d * d;
-    e.mean_ref += ref.fog[i];
-    e.mean_test += test.fog[i];
-    ++n;
-  }
-  if (n == 0) return {std::nan(""), std::nan(""), std::nan("")};
-  e.rmse = std::sqrt(e.rmse / n);
-  e.mean_ref /= n;
-  e.mean_test /= n;
+  e.rmse = rmse_at(test.fog, 4, reference, pixels);
+  for (size_t k = 0; k < pixels.size(); ++k)
+    for (int c = 0; c < 3; ++c) e.mean_ref += reference[k * 3 + c], e.mean_test += test.fog[pixels[k] * 4 + c];
+  e.mean_ref /= 3.0 * pixels.size();
+  e.mean_test /= 3.0 * pixels.size();
   return e;
 }
 
@@ -118,13 +113,27 @@ int run_gpu_fog_rows(const GpuFogArgs& a, const std::string& device, const GlCon
       const uint64_t photons = a.quick ? std::min<uint64_t>(scene.fog->photons, 200000) : scene.fog->photons;
       const std::string where = input.substr(input.find_last_of('/') + 1) + " " + std::to_string(width) + "x" +
                                 std::to_string(height);
-      std::cerr << "sylva bench gpu --fog: CPU reference fog of " << where << ", " << threads << " threads\n";
-      RenderOptions ref_options;
-      ref_options.aovs = kAovFog;
-      ref_options.threads = threads;
-      ref_options.fog.mode = FogMode::reference;
-      const RenderImage reference = render_cpu(scene, ref_options).image;
-      const SceneGeometry geometry = build_scene_geometry(scene, SkinOptions{});
+      std::cerr << "sylva bench gpu --fog: CPU reference fog of " << where << ", every " << a.reference_stride
+                << "-th pixel each way, " << threads << " threads\n";
+      // The reference: render_cpu's fog AOV (mode reference at the scene's steps) through
+      // the pixel centres of a uniform grid of the image (fog_view.h).
+      GeometryOptions geometry_options;
+      geometry_options.cull = false;  // a plant outside the view still casts shafts into it
+      const SceneGeometry geometry = build_scene_geometry(scene, SkinOptions{}, geometry_options);
+      std::vector<double> reference;
+      std::vector<size_t> pixels;
+      double reference_s = 0;
+      {
+        FogIntegratorOptions ro;
+        ro.mode = FogMode::reference;
+        ro.steps = scene.fog->steps;
+        const FogIntegrator integrator(fog_medium_of(scene), fog_sun_of(scene.sun), scene.sky, *geometry.tracer,
+                                       nullptr, ro);
+        const View sparse = strided(pixel_rays(scene, *geometry.tracer), a.reference_stride, &pixels);
+        const std::vector<float> image = fog_image(sparse, integrator, 0, threads, &reference_s);
+        reference.assign(image.begin(), image.end());
+      }
+      std::cerr << "sylva bench gpu --fog: reference of " << pixels.size() << " pixels in " << reference_s << " s\n";
       std::unique_ptr<const SunCones> cones[2];  // fast's, medium's (the automatic choice weighs misses apart)
       PlotPanel panel{where + ", " + device, "fog GPU time per frame (ms)", "fog RMSE / mean", {}};
       for (const FogMethod& m : fog_methods(a.quick, scene.fog->steps)) {
@@ -157,7 +166,7 @@ int run_gpu_fog_rows(const GpuFogArgs& a, const std::string& device, const GlCon
             frame_ms.push_back(stats.gpu_s() * 1e3);
             overflow = stats.fog_overflow_pixels;
           }
-          e = fog_error(image, reference);
+          e = fog_error(image, reference, pixels);
         } catch (const std::exception& ex) {
           status = "failed";
           reason = ex.what();
@@ -169,7 +178,9 @@ int run_gpu_fog_rows(const GpuFogArgs& a, const std::string& device, const GlCon
             << quoted(reason) << ',' << fog_ms.size() << ',' << number(median(fog_ms)) << ','
             << number(median(cones_ms)) << ',' << number(median(frame_ms)) << ',' << cone_count << ','
             << (m.mode == FogMode::brute ? 0 : photons) << ',' << overflow << ',' << number(e.rmse) << ','
-            << number(rel) << ',' << number(bias) << ",CPU fog reference\n";
+            << number(rel) << ',' << number(bias) << ",CPU fog reference"
+            << (a.reference_stride > 1 ? " on every " + std::to_string(a.reference_stride) + "-th pixel each way" : "")
+            << "\n";
         csv.flush();  // each row as it finishes: a long run stopped early keeps what it measured
         if (status != "ok") {
           std::printf("%-34s %-11s failed: %s\n", where.c_str(), m.name.c_str(), reason.c_str());

@@ -14,11 +14,13 @@ struct GpuFogArgs {
   std::vector<std::string> inputs;  // foggy scenes (resolved); empty: the elm grove at a low sun
   std::vector<std::pair<uint32_t, uint32_t>> sizes;
   uint32_t frames = 10, warmup = 2;
+  uint32_t reference_stride = 1;  // the CPU reference (and the error) on every S-th pixel each way
   bool quick = false;  // brute 16 and 64 only, 200 000 photons at most
   std::string csv, plot;
 };
 
-// Per input and size: the CPU's reference fog (fog mode reference), then brute at
+// Per input and size: the CPU's reference fog (fog mode reference at the scene's steps,
+// through the pixel centres of every reference_stride-th pixel each way), then brute at
 // N ∈ {16, 32, 64, 128, 256} steps, fast and medium (the cones built once per kind, as
 // render_gl builds them), each `warmup` + `frames` frames; a row per method — the fog
 // pass's and the cone pass's GPU ms (GlFrameStats, median), the frame's, and the RMSE of

@@ -27,6 +27,7 @@ namespace {
 
 using render_common::Clock;
 using render_common::seconds_since;
+using render_common::process_cpu_seconds;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr uint64_t kChunk = 1u << 15;  // photons per work item (cancellation granularity)
@@ -35,13 +36,6 @@ constexpr uint64_t kChunk = 1u << 15;  // photons per work item (cancellation gr
 // fixed point so that photon 10⁹ is as exact as photon 1.
 constexpr uint64_t kR2Step0 = 0xC13FA9A902A6328FULL;  // 2^64 / g
 constexpr uint64_t kR2Step1 = 0x91E10DA5C79E7B1CULL;  // 2^64 / g²
-
-// CPU time of this process, all threads (seconds).
-double process_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
 
 double unit_from_fixed(uint64_t x) { return static_cast<double>(x >> 11) * 0x1.0p-53; }
 
@@ -660,11 +654,13 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
   if (!(e.to_sun.y > 0) || geometry.frusta.empty() || options.photons.photons == 0) return out;
 
   const Clock::time_point start = Clock::now();
+  const double cpu_start = process_cpu_seconds();
   std::optional<SunPhotonTracer> own;
   if (!tracer)
     tracer = &own.emplace(geometry.frusta, scene.sun, options.photons.threads, geometry.leaves, geometry.plant_of_frustum);
   SunPhotons photons = tracer->trace(options.photons);
   out->photon_seconds = seconds_since(start);
+  out->photon_cpu_seconds = process_cpu_seconds() - cpu_start;
   out->photons = photons.traced;
   out->cancelled = photons.cancelled;
   out->vectors = std::move(photons.vectors);
@@ -676,6 +672,7 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
   if (out->cancelled) return out;
 
   const Clock::time_point cones_start = Clock::now();
+  const double cones_cpu_start = process_cpu_seconds();
   const double ground = scene.ground.height;
   // Cones end below the ground; the length limit only matters for a sun near the
   // horizon: the sweep from the sphere's top to the ground, and 2R more.
@@ -707,6 +704,7 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
   }
   if (options.coverage_points > 0) {
     const Clock::time_point t = Clock::now();
+    const double cpu_t = process_cpu_seconds();
     const ShadowSamples samples =
         sample_shadow_region(*tracer, Window{}, ground, options.coverage_points, options.coverage_points,
                              options.photons.seed + 1);
@@ -715,9 +713,12 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
                   static_cast<unsigned long long>(out->coverage->points),
                   static_cast<unsigned long long>(out->coverage->shadowed), out->coverage->missed_shadow,
                   out->coverage->covered_lit);
-    out->passes.push_back({"cone coverage", seconds_since(t), detail});
+    out->coverage_seconds = seconds_since(t);
+    out->coverage_cpu_seconds = process_cpu_seconds() - cpu_t;
+    out->passes.push_back({"cone coverage", out->coverage_seconds, detail});
   }
   out->cone_seconds = seconds_since(cones_start);
+  out->cone_cpu_seconds = process_cpu_seconds() - cones_cpu_start;
   return out;
 }
 

@@ -181,8 +181,12 @@ struct SunCones {
   std::optional<ConeCoverage> coverage;     // of the final set (coverage_points > 0)
   SunEmitter emitter;
   uint64_t photons = 0;
-  double photon_seconds = 0;  // tracing (and the accelerator's build)
-  double cone_seconds = 0;    // clustering, the choice, the hierarchy, the coverage
+  double photon_seconds = 0;  // tracing (and the accelerator's build), wall
+  double cone_seconds = 0;    // clustering, the choice, the hierarchy, the coverage, wall
+  double coverage_seconds = 0;  // of cone_seconds: the final coverage measurement (a
+                                // report, which rendering does not need), wall
+  // The same in CPU time of the process (core-seconds, every thread).
+  double photon_cpu_seconds = 0, cone_cpu_seconds = 0, coverage_cpu_seconds = 0;
   bool cancelled = false;
   std::vector<RenderPass> passes;  // "photons", "cone params", "cones", "cone coverage"
 };

@@ -70,11 +70,47 @@ TEST(BenchFog, AStridedReferenceMeasuresOnItsGridAndTimesTheWholeImage) {
   EXPECT_EQ(count_lines_starting(rows, "brute,8,0,"), 2u) << rows;
 }
 
+TEST(BenchFog, AMergedRunJoinsTheTablesAndASettingMeasuredAgainReplacesItsRows) {
+  TempDir dir;
+  const std::string scene = "presets/scenes/elm_grove_low_sun.scene.json";
+  const std::string first = dir.file("first.csv"), second = dir.file("second.csv");
+  auto run = [&](std::vector<std::string> more) {
+    std::vector<std::string> argv = {SYLVA_BINARY, "bench", "fog", scene, "--quick", "--clock", "cpu",
+                                     "--photons", "10000", "--plot", dir.file("p.png")};
+    argv.insert(argv.end(), more.begin(), more.end());
+    return run_process(argv, SYLVA_SOURCE_DIR, 600);
+  };
+  auto a = run({"--modes", "brute", "--csv", first});
+  ASSERT_EQ(a.exit_code, 0) << describe(a);
+  const std::string first_rows = read_file(first);
+  EXPECT_NE(first_rows.find("each way, CPU clock\n"), std::string::npos) << first_rows;
+  auto b = run({"--modes", "brute,fast", "--brute-steps", "32", "--merge", first, "--csv", second});
+  ASSERT_EQ(b.exit_code, 0) << describe(b);
+  const std::string rows = read_file(second);
+  // brute 8 comes from the first run only, brute 32 from the second only (it replaced the
+  // first's), the cones of 1e4 photons from the second, fast from the second.
+  EXPECT_EQ(count_lines_starting(rows, "brute,8,0,"), 2u) << rows;
+  EXPECT_EQ(count_lines_starting(rows, "brute,32,0,"), 2u) << rows;
+  EXPECT_EQ(count_lines_starting(rows, "cones-auto,0,10000,"), 2u) << rows;
+  EXPECT_EQ(count_lines_starting(rows, "fast-fixed,0,10000,"), 2u) << rows;
+  EXPECT_NE(b.out.find("merged 2 rows of 1 file(s), 6 replaced by this run's"), std::string::npos) << b.out;
+  // The time table's targets include brute 8, which only the merged file measured.
+  EXPECT_NE(b.out.find("brute 8"), std::string::npos) << b.out;
+  // A file from another setting (here: the wall clock) is refused before anything runs,
+  // at its first line.
+  auto c = run_process({SYLVA_BINARY, "bench", "fog", scene, "--quick", "--modes", "fast", "--merge", first,
+                        "--csv", dir.file("third.csv")},
+                       SYLVA_SOURCE_DIR, 600);
+  EXPECT_EQ(c.exit_code, 1) << describe(c);
+  EXPECT_NE(c.err.find(first + ":1:1: error: was written by another run setting"), std::string::npos) << c.err;
+}
+
 TEST(BenchFog, BadConeParametersAndPhotonCountsAreUsageErrors) {
   for (const std::vector<std::string>& bad :
        {std::vector<std::string>{"--cone-params", "1,2,3"}, {"--cone-params", "16,8,24,4"},  // p1 < p3 + 1
         {"--cone-params", "96,8,24,4,x"}, {"--photons", "0"}, {"--photons", "1e5"}, {"--seeds", "0"},
-        {"--modes", "brute,slow"}, {"--brute-steps", "0"}, {"--reference-stride", "0"}}) {
+        {"--modes", "brute,slow"}, {"--brute-steps", "0"}, {"--reference-stride", "0"},
+        {"--clock", "sundial"}}) {
     std::vector<std::string> argv = {SYLVA_BINARY, "bench", "fog", "presets/scenes/pine.scene.json"};
     argv.insert(argv.end(), bad.begin(), bad.end());
     auto r = run_process(argv, SYLVA_SOURCE_DIR);

@@ -305,4 +305,25 @@ TEST(BenchGpuFog, QuickRunWritesTheFogRowsWithTimesAndErrors) {
   EXPECT_LT(number(rows[1], "fog_rmse_relative"), number(rows[0], "fog_rmse_relative")) << "64 steps beat 16";
 }
 
+TEST(BenchGpuFog, AStridedReferenceMeasuresTheErrorOnItsGrid) {
+  TempDir dir;
+  const ProcessResult r = run_sylva({"bench", "gpu", "--fog", "--quick", "--reference-stride", "4", "--csv",
+                                     dir.file("fog.csv"), "--plot", dir.file("fog.png")},
+                                    SYLVA_SOURCE_DIR, 240);
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 context") != std::string::npos) GTEST_SKIP() << "no OpenGL";
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  // 96x72 every 4th pixel each way: 24 x 18.
+  EXPECT_NE(r.err.find("reference of 432 pixels"), std::string::npos) << r.err;
+  const std::vector<CsvRow> rows = read_csv(read_file(dir.file("fog.csv")), kFogColumns);
+  ASSERT_EQ(rows.size(), 4u);
+  for (const CsvRow& row : rows) {
+    SCOPED_TRACE(row.at("method"));
+    EXPECT_EQ(row.at("status"), "ok") << row.at("reason");
+    EXPECT_EQ(row.at("reference"), "CPU fog reference on every 4-th pixel each way");
+    EXPECT_GT(number(row, "fog_rmse_relative"), 0.0);
+  }
+  EXPECT_LT(number(rows[1], "fog_rmse_relative"), number(rows[0], "fog_rmse_relative")) << "64 steps beat 16";
+}
+
 }  // namespace

@@ -1,0 +1,74 @@
+// fog_view.cpp — see fog_view.h.
+#include "app/bench/fog_view.h"
+
+#include <algorithm>
+#include <atomic>
+#include <limits>
+#include <thread>
+
+#include "core/render_common.h"
+#include "core/shading.h"
+#include "lsystem/random.h"
+
+namespace sylva::cli {
+
+View pixel_rays(const Scene& scene, const SceneTracer& tracer) {
+  View v;
+  v.width = scene.width, v.height = scene.height;
+  const size_t n = size_t(v.width) * v.height;
+  v.origin.resize(n), v.direction.resize(n), v.t_end.resize(n);
+  for (uint32_t y = 0; y < v.height; ++y)
+    for (uint32_t x = 0; x < v.width; ++x) {
+      const size_t i = size_t(y) * v.width + x;
+      const Ray ray = camera_ray(scene, x + 0.5, y + 0.5);
+      const double length = glm::length(ray.direction);
+      const double surface = tracer.nearest(ray, 0, std::numeric_limits<double>::infinity()).t;
+      const double ground = shading::ground_distance(ray.origin.y - scene.ground.height, ray.direction.y);
+      v.origin[i] = ray.origin;
+      v.direction[i] = ray.direction / length;
+      v.t_end[i] = std::min(surface, ground) * length;
+    }
+  return v;
+}
+
+View strided(const View& v, uint32_t stride, std::vector<size_t>* pixels) {
+  View out;
+  pixels->clear();
+  for (uint32_t y = stride / 2; y < v.height; y += stride)
+    for (uint32_t x = stride / 2; x < v.width; x += stride) {
+      const size_t i = size_t(y) * v.width + x;
+      pixels->push_back(i);
+      out.origin.push_back(v.origin[i]), out.direction.push_back(v.direction[i]), out.t_end.push_back(v.t_end[i]);
+    }
+  out.width = static_cast<uint32_t>(pixels->size()), out.height = 1;
+  return out;
+}
+
+std::vector<float> fog_image(const View& v, const FogIntegrator& integrator, uint64_t seed, unsigned threads,
+                             double* seconds, double* cpu_seconds) {
+  const size_t n = v.origin.size();
+  std::vector<float> out(n * 3);
+  std::atomic<size_t> next{0};
+  const auto start = render_common::Clock::now();
+  const double cpu_start = render_common::process_cpu_seconds();
+  auto worker = [&] {
+    for (;;) {
+      const size_t begin = next.fetch_add(256);
+      if (begin >= n) return;
+      for (size_t i = begin; i < std::min(n, begin + 256); ++i) {
+        render_common::SampleRng rng(lsys::mix_pair(seed, i));
+        const FogRayResult r = integrator.integrate(v.origin[i], v.direction[i], v.t_end[i], rng);
+        for (int c = 0; c < 3; ++c) out[i * 3 + c] = static_cast<float>(r.inscatter[c]);
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  *seconds = render_common::seconds_since(start);
+  if (cpu_seconds) *cpu_seconds = render_common::process_cpu_seconds() - cpu_start;
+  return out;
+}
+
+}  // namespace sylva::cli
