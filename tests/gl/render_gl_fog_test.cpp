@@ -326,35 +326,57 @@ ConeRenders render_with_cones(const Scene& scene, FogMode mode, const ConeSet& c
 // intersector, ~1e-6 relative) against double. Stated: 99 % of the pixels whose end both
 // see alike within 1e-3 relative, the whole image's RMSE within 1e-3 of the mean (rays that
 // graze a cone's boundary may differ by a whole interval).
-TEST(GlFog, FastOnTheGpuMatchesTheCpusFastWithTheSameCones) {
-  SYLVA_REQUIRE_GL();
-  const Scene s = test::foggy_cylinder(FogMode::fast, 16, 96, 72);
-  const auto cones = cones_for(s, FogMode::fast, 20000);
-  ASSERT_GT(cones->cones.size(), 0u);
+struct FastMatch {
+  size_t same = 0, close = 0;  // pixels whose end both see alike; of them, within 1e-3
+  FogError error;
+};
+FastMatch fast_against_the_cpu(const char* what, const Scene& s, uint64_t photons) {
+  const auto cones = cones_for(s, FogMode::fast, photons);
+  EXPECT_GT(cones->cones.size(), 0u);
   const ConeRenders r = render_with_cones(s, FogMode::fast, cones->cones);
   EXPECT_EQ(r.stats.fog_mode, "fast");
   EXPECT_EQ(r.stats.fog_cones, cones->cones.size());
-  EXPECT_EQ(r.stats.pass(GlPass::fog_cones).runs, 1u);
   EXPECT_EQ(r.stats.pass(GlPass::fog).program, "fog[FOG_FAST SUN]");
   EXPECT_TRUE(r.stats.fog_counted);
   EXPECT_GT(r.stats.fog_fragments, 0u);
   EXPECT_EQ(r.stats.fog_overflow_pixels, 0u);
+  FastMatch m;
   const size_t pixels = size_t{s.width} * s.height;
-  size_t same = 0, close = 0;
   for (size_t p = 0; p < pixels; ++p) {
     if (!same_end(r.gl, r.cpu, p)) continue;
-    ++same;
+    ++m.same;
     bool ok = true;
     for (int k = 0; k < 3; ++k)
       ok = ok && std::abs(r.gl.fog[p * 4 + k] - r.cpu.fog[p * 4 + k]) <= 1e-3 * r.cpu.fog[p * 4 + k] + 1e-9;
-    close += ok ? 1 : 0;
+    m.close += ok ? 1 : 0;
   }
-  const FogError e = fog_error(r.gl, r.cpu);
-  std::printf("[ fog ] fast, %zu cones: %zu of %zu pixels within 1e-3, RMSE %.3g of the mean, %llu intervals\n",
-              cones->cones.size(), close, same, e.relative_rmse(),
+  m.error = fog_error(r.gl, r.cpu);
+  std::printf("[ fog ] %s, fast, %zu cones: %zu of %zu pixels within 1e-3, RMSE %.3g of the mean, bias %+.3g, %llu "
+              "intervals\n",
+              what, cones->cones.size(), m.close, m.same, m.error.relative_rmse(), m.error.relative_bias(),
               static_cast<unsigned long long>(r.stats.fog_fragments));
-  EXPECT_GE(close, same * 99 / 100);
-  EXPECT_LE(e.relative_rmse(), 1e-3);
+  return m;
+}
+
+TEST(GlFog, FastOnTheGpuMatchesTheCpusFastWithTheSameCones) {
+  SYLVA_REQUIRE_GL();
+  const FastMatch m = fast_against_the_cpu("cylinder", test::foggy_cylinder(FogMode::fast, 16, 96, 72), 20000);
+  EXPECT_GE(m.close, m.same * 99 / 100);
+  EXPECT_LE(m.error.relative_rmse(), 1e-3);
+}
+
+// The same on the canopy (the grove, 200 000 photons: 155 overlapping cones, eight
+// intervals a ray). Before the list walk was bounded (docs/gl-fog.md, sec. 2c) GL lost
+// intervals here: 2.5 % RMSE of the mean, up to 11 % at sky pixels above the sun. Measured
+// on llvmpipe since: every pixel within 1e-3, RMSE 1.5e-5 of the mean, bias -5e-7. Stated
+// as for the cylinder: 99 % of the pixels within 1e-3, RMSE within 1e-3 of the mean, and
+// |bias| within 1e-4.
+TEST(GlFog, FastOnTheGpuMatchesTheCpusFastOnTheCanopy) {
+  SYLVA_REQUIRE_GL();
+  const FastMatch m = fast_against_the_cpu("elm grove", elm_grove(120, 90, 64), 200000);
+  EXPECT_GE(m.close, m.same * 99 / 100);
+  EXPECT_LE(m.error.relative_rmse(), 1e-3);
+  EXPECT_LE(std::abs(m.error.relative_bias()), 1e-4);
 }
 
 // medium: V = 1 outside the cone intervals (closed form), the shadow map marched inside
