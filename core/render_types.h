@@ -45,6 +45,10 @@ struct GeometryOptions {
   int mesh_level = 2;   // m: 16·4^m triangles per segment
   bool cull = true;     // leave out plants that can affect no pixel (outside the view
                         // frustum and casting no shadow into it; culling.h)
+  bool instance = true; // plants that share a skeleton (instances.h) skinned and uploaded
+                        // once, drawn through each plant's transform (docs/scatter.md,
+                        // "Instancing"); false: every plant skinned where it stands. The
+                        // picture is the same either way, within rounding.
   bool displace = true; // mesh: displace each plant's mesh by its height map where it has
                         // one (the paper's GS+R; tessellate.h displace)
   bool relief = true;   // frusta: relief-map every plant whose bark has a height map and a

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""make_textures.py — synthesises the bundled bark and cactus textures (presets/textures/).
+"""make_textures.py — synthesises the bundled bark, cactus, stone and roof-tile textures (presets/textures/).
 
     /usr/bin/python3 scripts/make_textures.py [OUTPUT_DIR]      (default presets/textures)
 
@@ -23,6 +23,8 @@ import numpy as np
 SIZE = 512
 BARK_SEED = 20240611
 CACTUS_SEED = 20240612
+STONE_SEED = 20261202
+TILES_SEED = 20261203
 
 
 # --- PNG ------------------------------------------------------------------------------
@@ -232,14 +234,79 @@ def make_cactus(n):
     return to_u8(srgb_encode(colour)), to_u16(height)
 
 
+# --- the well's stone and roof tiles (paper 000 fig. 10) --------------------------------
+
+STONE_COURSES = 8        # courses of blocks per repeat along t
+STONE_BLOCKS = 6         # blocks per course across s (alternate courses offset by half)
+TILE_ROWS = 16           # rows of roof tiles per repeat along t
+TILE_COLUMNS = 16        # tiles per row across s
+
+
+def running_bond(n, rows, columns):
+    """Cells in running bond on the n x n grid: `rows` rows per repeat along t, `columns`
+    cells a row across s, odd rows shifted by half a cell. Returns each texel's row and
+    cell index and its fractions (fu across, ft along) within the cell."""
+    s = (np.arange(n)[None, :] + 0.5) / n
+    t = (np.arange(n)[:, None] + 0.5) / n
+    row = np.floor(t * rows)
+    u = s * columns + 0.5 * (row % 2)
+    return row, np.floor(u) % columns, u % 1.0, (t * rows) % 1.0
+
+
+def make_stone(n):
+    """Dressed stone blocks in running bond (the well's wall): STONE_COURSES courses per
+    repeat along t, STONE_BLOCKS blocks per course across s, alternate courses shifted by
+    half a block; mortar joints are the grooves (height 0), each block's face bulges a
+    little and carries its own tint and pitting."""
+    rng = np.random.default_rng(STONE_SEED)
+    course, block, fu, ft = running_bond(n, STONE_COURSES, STONE_BLOCKS)
+    edge = np.minimum(np.minimum(fu, 1 - fu) * 1.6, np.minimum(ft, 1 - ft))  # to the nearest joint
+    face = smoothstep(0.02, 0.09, edge)
+    bulge = np.sin(np.pi * fu) * np.sin(np.pi * ft)
+    pits = spectral_noise(rng, n, (24.0, 160.0), 0.6, 1.0)
+    tint_of = rng.uniform(-1.0, 1.0, (STONE_COURSES, STONE_BLOCKS))
+    tint = tint_of[course.astype(int) % STONE_COURSES, block.astype(int)]
+    height = face * (0.75 + 0.2 * bulge + 0.03 * pits)
+    height = (height - height.min()) / (height.max() - height.min())
+    mortar = np.array([0.30, 0.28, 0.25])
+    stone = np.array([0.42, 0.37, 0.30])
+    colour = stone * (1.0 + 0.12 * tint + 0.05 * pits)[..., None]
+    colour = mix(mortar, colour, face)
+    return to_u8(srgb_encode(colour)), to_u16(height)
+
+
+def make_tiles(n):
+    """Overlapping roof tiles (the well's roof): TILE_ROWS rows per repeat along t, each
+    tile rising from its lower edge (height 0, where the row above overlaps it) to 1,
+    rounded across s; alternate rows offset by half a tile; terracotta with a per-tile tint."""
+    rng = np.random.default_rng(TILES_SEED)
+    row, tile, fu, ft = running_bond(n, TILE_ROWS, TILE_COLUMNS)
+    rise = ft ** 0.7                                  # 0 at the overlapped edge, 1 at the lip
+    round_across = np.sin(np.pi * fu) ** 0.5
+    grain = spectral_noise(rng, n, (30.0, 160.0), 0.5, 1.0)
+    tint_of = rng.uniform(-1.0, 1.0, (TILE_ROWS, TILE_COLUMNS))
+    tint = tint_of[row.astype(int) % TILE_ROWS, tile.astype(int)]
+    height = rise * (0.55 + 0.45 * round_across) + 0.01 * grain
+    height = (height - height.min()) / (height.max() - height.min())
+    clay = np.array([0.38, 0.13, 0.07])
+    shade = np.array([0.16, 0.06, 0.04])
+    colour = clay * (1.0 + 0.15 * tint + 0.04 * grain)[..., None]
+    colour = mix(shade, colour, smoothstep(0.0, 0.35, rise))
+    return to_u8(srgb_encode(colour)), to_u16(height)
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     out_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "..", "presets", "textures")
     os.makedirs(out_dir, exist_ok=True)
     bark_albedo, bark_height = make_bark(SIZE)
     cactus_albedo, cactus_height = make_cactus(SIZE)
+    stone_albedo, stone_height = make_stone(SIZE)
+    tiles_albedo, tiles_height = make_tiles(SIZE)
     for name, pixels in (("bark.png", bark_albedo), ("bark_height.png", bark_height),
-                         ("cactus.png", cactus_albedo), ("cactus_height.png", cactus_height)):
+                         ("cactus.png", cactus_albedo), ("cactus_height.png", cactus_height),
+                         ("stone.png", stone_albedo), ("stone_height.png", stone_height),
+                         ("tiles.png", tiles_albedo), ("tiles_height.png", tiles_height)):
         path = os.path.join(out_dir, name)
         write_png(path, pixels)
         print(f"{os.path.normpath(path)}: {pixels.shape[1]}x{pixels.shape[0]}, {os.path.getsize(path)} bytes")

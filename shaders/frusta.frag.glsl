@@ -21,10 +21,17 @@
 // BARK: the albedo texture is looked up here, where the hit is known (bark.glsl), over
 // the footprint of the ray differentials, into g_albedo (a = 1); a = 0 leaves the albedo
 // to shade.frag.glsl (material table, bark colour).
+// INSTANCED: a plant drawn through its transform (frusta_common.glsl) casts the ray in its
+// skeleton's frame (origin and direction taken back, so t is the world ray's t) and turns
+// the hit's normals, v_m and texture footprint back to the world (instance_tracer.h's
+// world_hit on the CPU).
 
 flat in FrustumShapeF v_shape;
 flat in uvec4 v_segment_info;
 flat in vec3 v_frame_origin;
+#ifdef INSTANCED
+flat in uint v_instance;
+#endif
 
 #ifdef GBUFFER_PASS
 #if !defined(EYE_INSIDE) && !defined(NO_CONSERVATIVE_DEPTH)
@@ -53,7 +60,20 @@ void main() {
   ray.origin = v_frame_origin;
   ray.direction = camera_ray_direction(pixel);
 #endif
+  vec3 world_direction = ray.direction;
   uint plant = segment_ids[v_segment_info.x].x;
+#ifdef INSTANCED
+  GpuInstance inst = instances[v_instance];
+  bool moved = inst.own == 0u;
+  if (moved) {
+#ifdef SHADOW_PASS
+    ray.origin = v_frame_origin +
+                 instance_unrotate(inst, xy.x * u_light_e0 + xy.y * u_light_e1 - u_light_depth.x * u_light_dir) / inst.scale;
+#endif
+    ray.direction = instance_unrotate(inst, ray.direction) / inst.scale;
+    plant = inst.plant;
+  }
+#endif
 #ifdef RELIEF
   ReliefMapF map = ReliefMapF(plant_maps[plant], plant_maps[plant].relief_depth_m);
   bool relief = map.depth_m > 0.0 && !fr.knuckle && fr.material == 0u;  // bark: wood only
@@ -79,13 +99,13 @@ void main() {
 #ifdef SHADOW_PASS
   gl_FragDepth = max(hit.t / u_light_depth.y, gl_FragCoord.z);
 #else
-  float depth = u_near / (hit.t * dot(ray.direction, u_forward));
+  float depth = u_near / (hit.t * dot(world_direction, u_forward));
 #ifdef EYE_INSIDE
   gl_FragDepth = depth;
 #else
   gl_FragDepth = min(depth, gl_FragCoord.z);
 #endif
-  vec3 view = -ray.direction;
+  vec3 view = -world_direction;
   vec3 n_geometric = hit.normal;
   vec3 n_shading = hit.kind == kHitSide ? surface_normal(fr, hit.y, hit.radial) : hit.normal;
   float u = 0.0, v_m = 0.0;
@@ -101,6 +121,13 @@ void main() {
     v_m = relief_hit.v_m;
   }
 #endif
+#ifdef INSTANCED
+  if (moved) {
+    v_m *= inst.scale;
+    n_geometric = instance_rotate(inst, n_geometric);
+    n_shading = instance_rotate(inst, n_shading);
+  }
+#endif
   vec4 albedo = vec4(0.0);
 #ifdef BARK
   // describe_frustum_hit's / describe_relief_hit's tangents (frustum_tracer.cpp): around,
@@ -114,16 +141,29 @@ void main() {
   }
   vec3 dp_du = (2.0 * kPi * max(around_m, 0.0)) * cross(fr.shape.axis, hit.radial);
   vec3 dp_dv = normalize(fr.shape.axis + fr.shape.slope * hit.radial);
-  UvFootprint footprint = uv_footprint(position, hit.normal, dp_du, dp_dv, vec3(0.0), ray.direction + u_ray_dx,
-                                       ray.direction + u_ray_dy);
+  vec3 ray_dx = u_ray_dx, ray_dy = u_ray_dy;
+#ifdef INSTANCED
+  if (moved) {
+    ray_dx = instance_unrotate(inst, ray_dx) / inst.scale;
+    ray_dy = instance_unrotate(inst, ray_dy) / inst.scale;
+  }
+#endif
+  UvFootprint footprint = uv_footprint(position, hit.normal, dp_du, dp_dv, vec3(0.0), ray.direction + ray_dx,
+                                       ray.direction + ray_dy);
+#ifdef INSTANCED
+  if (moved) {  // v_m in world metres: the plant's arc lengths are scale times the skeleton's
+    footprint.dv_dx *= inst.scale;
+    footprint.dv_dy *= inst.scale;
+  }
+#endif
   if (fr.material == 0u) albedo = bark_albedo(plant, u, v_m, footprint);  // bark: wood only
 #endif
   if (dot(n_geometric, view) < 0.0) n_geometric = -n_geometric;  // seen from inside
   if (dot(n_shading, view) < 0.0) n_shading = -n_shading;
   uvec4 ids = segment_ids[v_segment_info.x];
-  g_normal_distance = vec4(n_shading, hit.t * length(ray.direction));
+  g_normal_distance = vec4(n_shading, hit.t * length(world_direction));
   g_geometric_u = vec4(n_geometric, u);
-  g_ids = uvec4(ids.x | (fr.material << PLANT_INDEX_BITS), ids.y, ids.z, floatBitsToUint(v_m));
+  g_ids = uvec4(plant | (fr.material << PLANT_INDEX_BITS), ids.y, ids.z, floatBitsToUint(v_m));
   g_albedo = albedo;
 #endif
 }

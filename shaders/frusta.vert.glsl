@@ -8,10 +8,20 @@
 flat out FrustumShapeF v_shape;   // relative to the record's origin_hi
 flat out uvec4 v_segment_info;    // frustum index, material | knuckle << 8, u_offset bits, v_lower_m bits
 flat out vec3 v_frame_origin;     // the ray's origin frame: eye (light centre) − origin_hi
+#ifdef INSTANCED
+flat out uint v_instance;         // INSTANCED: the plant's transform (frusta_common.glsl)
+#endif
 
 void main() {
-#ifdef EYE_INSIDE
+#if defined(EYE_INSIDE) && defined(INSTANCED)
+  uint item = uint(gl_VertexID / PYRAMID_VERTICES);
+  uint instance = segment_list[2u * item];
+  uint segment = segment_list[2u * item + 1u];
+#elif defined(EYE_INSIDE)
   uint segment = segment_list[gl_VertexID / PYRAMID_VERTICES];
+#elif defined(INSTANCED)
+  uint instance = u_instance_base + uint(gl_InstanceID);
+  uint segment = uint(gl_VertexID / PYRAMID_VERTICES);  // gl_VertexID counts from the draw's first
 #else
   uint segment = uint(gl_VertexID / PYRAMID_VERTICES);
 #endif
@@ -36,10 +46,29 @@ void main() {
                                         1e-4 * radius_max + 1e-6 * size, 1e-4 * size);
 #ifdef SHADOW_PASS
   vec3 frame_origin = (u_light_hi - origin_hi) + u_light_lo;
-  gl_Position = light_clip_position(corner - frame_origin);
 #else
   vec3 frame_origin = (u_eye_hi - origin_hi) + u_eye_lo;
-  gl_Position = camera_clip_position(corner - frame_origin);
+#endif
+  vec3 corner_rel = corner - frame_origin;  // relative to the eye (light centre)
+#ifdef INSTANCED
+  GpuInstance inst = instances[instance];
+  if (inst.own == 0u) {
+    // The eye (light centre) in the plant's frame, relative to the record's origin_hi; the
+    // corner taken to the world, relative to the eye.
+#ifdef SHADOW_PASS
+    vec3 view_rel = (u_light_hi - inst.position_hi) + (u_light_lo - inst.position_lo);
+#else
+    vec3 view_rel = (u_eye_hi - inst.position_hi) + (u_eye_lo - inst.position_lo);
+#endif
+    frame_origin = instance_unrotate(inst, view_rel) / inst.scale - origin_hi;
+    corner_rel = inst.scale * instance_rotate(inst, corner + origin_hi) - view_rel;
+  }
+  v_instance = instance;
+#endif
+#ifdef SHADOW_PASS
+  gl_Position = light_clip_position(corner_rel);
+#else
+  gl_Position = camera_clip_position(corner_rel);
 #endif
   v_shape = fr.shape;
   v_segment_info = uvec4(segment, fr.material | (fr.knuckle ? 0x100u : 0u),

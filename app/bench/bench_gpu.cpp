@@ -16,7 +16,8 @@
 //   RC+R s×b    relief-mapped frusta, s uniform and b bisection steps, v interpolated;
 //   GS m        the frusta tessellated at GS level m (16·4^m triangles a segment);
 //   GS+R m      the same meshes displaced by the height map;
-//   RC-anim     RC with every plant swaying (core/animate.h) at 60 frames a second of
+//   RC-anim     RC with every plant swaying (core/animate.h; a scene's `animation` key's
+//               motion where it has one: the dancing cacti dance) at 60 frames a second of
 //               animation time: per frame the skeletons are swayed, re-skinned and their
 //               segment records uploaded again (GlRenderer::update_plants); the CPU time
 //               of the sway and of re-skin + upload and the bytes uploaded per frame are
@@ -288,7 +289,8 @@ void run_method(const Scene& scene, uint32_t frames, uint32_t warmup, LazyRefere
     std::vector<Skeleton> rest;
     if (m.animated)
       for (const ScenePlant& p : scene.plants) rest.push_back(*p.skeleton);
-    const SwayParameters sway;
+    // The scene's own motion where it has an `animation` key (the dancing cacti dance).
+    const SwayParameters sway = scene.animation ? sway_parameters_of(*scene.animation) : SwayParameters{};
     GlRenderer renderer(scene, options);
     renderer.set_conservative_depth(m.conservative_depth);
     row.frusta = renderer.frusta();

@@ -22,10 +22,24 @@ file system on a real cluster). The grammar's text travels with the tasks, so wo
 need not see the grammar file; its path is recorded in each skeleton as given here, as
 the command line records the path it was given (run both from the same folder for
 identical files).
+
+The frames of an animated scene go the same way (``sylva render SCENE --frames A..B -o
+out/f_{frame}.png``, docs/animation.md): one task per frame, each running the ``sylva``
+command line for its one frame, so every file is the one the local command writes —
+same code, same bytes — whichever worker rendered it:
+
+    with LocalCluster(n_workers=2, threads_per_worker=1) as cluster, Client(cluster) as client:
+        written = sylva_dask.frames(client, "presets/scenes/dancing_cacti.scene.json", range(0, 96),
+                                    "out/cacti/f_{frame}.png", sylva="build/release/app/cli/sylva")
+
+The workers need the ``sylva`` executable (``sylva=`` or ``$SYLVA_BINARY`` or PATH) and
+must see the scene, what it names (grammars, textures) and the output folder.
 """
 import os
+import shutil
+import subprocess
 
-__all__ = ["batch", "output_path", "KINDS"]
+__all__ = ["batch", "frames", "output_path", "frame_path", "KINDS"]
 
 #: What a task writes: "grow" a sylva-skeleton JSON file (``sylva grow``), "export" a glTF
 #: 2.0 file, .gltf or .glb by the pattern's extension (``sylva export``).
@@ -90,3 +104,68 @@ def batch(client, kind, grammar, seeds, output, *, steps=None, defines=None, mes
                          seeds, paths, [steps] * len(seeds), [defines] * len(seeds), [mesh] * len(seeds),
                          [segments_around] * len(seeds), pure=False)
     return client.gather(futures)
+
+
+def frame_path(pattern, frame):
+    """The file of one frame: ``{frame}`` in ``pattern`` replaced by the frame number with at
+    least four digits (``f_0007.png``), as ``sylva render --frames`` names it."""
+    if "{frame}" not in pattern:
+        raise ValueError(f"the output pattern {pattern!r} has no {{frame}}: every frame would write the same file")
+    return pattern.replace("{frame}", f"{frame:04d}")
+
+
+def _sylva_binary(sylva):
+    """The command line the frame tasks run: ``sylva``, else $SYLVA_BINARY, else PATH's."""
+    path = sylva or os.environ.get("SYLVA_BINARY") or shutil.which("sylva")
+    if not path:
+        raise FileNotFoundError("no sylva executable: pass sylva=PATH, set SYLVA_BINARY or put sylva on PATH")
+    return os.path.abspath(path) if os.sep in path else path
+
+
+def _frame_task(binary, scene, frame, pattern, path, arguments):
+    """One frame on a worker: ``sylva render SCENE --frames F -o PATTERN ...``; its path."""
+    done = subprocess.run([binary, "render", scene, "--frames", str(frame), "-o", pattern, *arguments],
+                          capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"sylva render {scene} --frames {frame} failed ({done.returncode}): {done.stderr.strip()}")
+    return path
+
+
+def frames(client, scene, frame_numbers, output, *, backend="cpu", spp=None, width=None, height=None,
+           fps=None, sylva=None):
+    """Renders the frames ``frame_numbers`` of the animated ``scene`` (a .scene.json with an
+    ``animation`` key) on the workers of ``client``, one task per frame, into ``output``
+    with ``{frame}`` replaced (frame_path). Returns the paths written, in the order given.
+
+    ``backend`` (default "cpu", the reference, whose frames depend only on their number),
+    ``spp``, ``width``, ``height`` and ``fps`` are ``sylva render``'s flags. Every frame's
+    file is what ``sylva render SCENE --frames A..B -o OUTPUT`` with the same flags writes
+    for it. A frame that fails raises RuntimeError with the command's message here (the
+    frames that finished stay: each is written atomically).
+
+    Raises ``ValueError`` for a pattern without ``{frame}``, repeated frames (two tasks
+    would race for one file) or a scene file that does not exist, ``TypeError`` for a frame
+    that is not an integer, ``FileNotFoundError`` when there is no ``sylva`` executable.
+    """
+    frame_numbers = list(frame_numbers)
+    for frame in frame_numbers:
+        if isinstance(frame, bool) or not hasattr(frame, "__index__"):
+            raise TypeError(f"a frame is an integer, not {type(frame).__name__}")
+        if int(frame) < 0:
+            raise ValueError(f"frame {int(frame)} is negative")
+    frame_numbers = [int(f) for f in frame_numbers]
+    if len(set(frame_numbers)) != len(frame_numbers):
+        raise ValueError("a frame is repeated: its tasks would write the same file")
+    paths = [frame_path(output, f) for f in frame_numbers]
+    if not os.path.isfile(scene):
+        raise ValueError(f"{scene}: no such scene file")
+    binary = _sylva_binary(sylva)
+    arguments = ["--backend", backend]
+    for flag, value in (("--spp", spp), ("--width", width), ("--height", height), ("--fps", fps)):
+        if value is not None:
+            arguments += [flag, str(value)]
+    futures = client.map(_frame_task, [binary] * len(frame_numbers), [os.path.abspath(scene)] * len(frame_numbers),
+                         frame_numbers, [os.path.abspath(output)] * len(frame_numbers),
+                         [os.path.abspath(p) for p in paths], [arguments] * len(frame_numbers), pure=False)
+    client.gather(futures)  # raises a failed frame's error here
+    return paths

@@ -35,6 +35,35 @@ void EmbreeScene::attach(RTCGeometry geometry) {
   rtcReleaseGeometry(geometry);
 }
 
+void EmbreeScene::attach_user_geometry(unsigned count, void* user_data, RTCBoundsFunction bounds,
+                                       RTCIntersectFunctionN intersect, RTCOccludedFunctionN occluded) {
+  if (count == 0) return;
+  RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(geom, count);
+  rtcSetGeometryUserData(geom, user_data);
+  rtcSetGeometryBoundsFunction(geom, bounds, nullptr);
+  rtcSetGeometryIntersectFunction(geom, intersect);
+  rtcSetGeometryOccludedFunction(geom, occluded);
+  attach(geom);
+}
+
+void EmbreeScene::write_bounds(RTCBounds* o, const Aabb& box, const glm::dvec3& centre, double pad) {
+  const glm::dvec3 lo = box.lo - centre - glm::dvec3(pad);
+  const glm::dvec3 hi = box.hi - centre + glm::dvec3(pad);
+  o->lower_x = round_down(lo.x), o->lower_y = round_down(lo.y), o->lower_z = round_down(lo.z);
+  o->upper_x = round_up(hi.x), o->upper_y = round_up(hi.y), o->upper_z = round_up(hi.z);
+}
+
+void EmbreeScene::record_hit(const RTCIntersectFunctionNArguments* args, double t, const glm::dvec3& n) {
+  auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
+  rh->ray.tfar = round_up(t);
+  rh->hit.Ng_x = static_cast<float>(n.x), rh->hit.Ng_y = static_cast<float>(n.y), rh->hit.Ng_z = static_cast<float>(n.z);
+  rh->hit.u = rh->hit.v = 0;
+  rh->hit.primID = args->primID;
+  rh->hit.geomID = args->geomID;
+  rh->hit.instID[0] = args->context->instID[0];
+}
+
 void EmbreeScene::commit() { rtcCommitScene(scene_); }
 
 size_t EmbreeScene::memory_bytes() const { return static_cast<size_t>(std::max<int64_t>(0, bytes_.load())); }

@@ -15,6 +15,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/ray_frustum.h"
+#include "core/util/bounds.h"
 
 namespace sylva {
 
@@ -31,6 +32,10 @@ class EmbreeScene {
 
   // Commits `geometry`, attaches it to the scene and drops the caller's reference.
   void attach(RTCGeometry geometry);
+  // Attaches a user geometry of `count` primitives (none: nothing) with these callbacks
+  // and user data.
+  void attach_user_geometry(unsigned count, void* user_data, RTCBoundsFunction bounds,
+                            RTCIntersectFunctionN intersect, RTCOccludedFunctionN occluded);
   // Builds the BVH over what is attached (call once, after the last attach).
   void commit();
   // Bytes Embree holds for this device (its memory monitor).
@@ -39,6 +44,13 @@ class EmbreeScene {
   // `ray` on [t_min, t_max] as Embree's float ray relative to `centre` (the scene's
   // vertices are relative to it too): the range widened to the floats around it.
   static RTCRay embree_ray(const Ray& ray, const glm::dvec3& centre, double t_min, double t_max);
+  // `box` relative to `centre`, grown by `pad` on every side, rounded outward to floats
+  // (a user geometry's bounds callback: Embree's float boxes never lose the double box).
+  static void write_bounds(RTCBounds* out, const Aabb& box, const glm::dvec3& centre, double pad);
+  // Records a user geometry's hit at exact distance t with normal n in the intersect
+  // callback's ray: tfar rounded up (Embree culls with it in float, so no nearer box is
+  // skipped), the normal, the primitive and geometry.
+  static void record_hit(const RTCIntersectFunctionNArguments* args, double t, const glm::dvec3& n);
   // The smallest float >= v, the largest float <= v.
   static float round_up(double v);
   static float round_down(double v);

@@ -62,12 +62,7 @@ void bounds_callback(const RTCBoundsFunctionArguments* args) {
     shape.radius0 += data->custom_shell[args->primID];
     shape.radius1 += data->custom_shell[args->primID];
   }
-  const Aabb b = frustum_bounds(shape);
-  const glm::dvec3 lo = b.lo - data->centre - glm::dvec3(data->pad);
-  const glm::dvec3 hi = b.hi - data->centre + glm::dvec3(data->pad);
-  RTCBounds* o = args->bounds_o;
-  o->lower_x = EmbreeScene::round_down(lo.x), o->lower_y = EmbreeScene::round_down(lo.y), o->lower_z = EmbreeScene::round_down(lo.z);
-  o->upper_x = EmbreeScene::round_up(hi.x), o->upper_y = EmbreeScene::round_up(hi.y), o->upper_z = EmbreeScene::round_up(hi.z);
+  EmbreeScene::write_bounds(args->bounds_o, frustum_bounds(shape), data->centre, data->pad);
 }
 
 // Tests one candidate with the exact double ray; records it if nearer.
@@ -86,16 +81,7 @@ void intersect_callback(const RTCIntersectFunctionNArguments* args) {
   if (!args->valid[0]) return;
   auto* q = reinterpret_cast<QueryContext*>(args->context);
   if (!test_candidate(q, args->primID)) return;
-  auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);
-  // Embree culls with a float tfar: round the exact t up so no nearer box is skipped.
-  rh->ray.tfar = EmbreeScene::round_up(q->t_best);
-  rh->hit.Ng_x = static_cast<float>(q->best.hit.normal.x);
-  rh->hit.Ng_y = static_cast<float>(q->best.hit.normal.y);
-  rh->hit.Ng_z = static_cast<float>(q->best.hit.normal.z);
-  rh->hit.u = rh->hit.v = 0;
-  rh->hit.primID = args->primID;
-  rh->hit.geomID = args->geomID;
-  rh->hit.instID[0] = args->context->instID[0];
+  EmbreeScene::record_hit(args, q->t_best, q->best.hit.normal);
 }
 
 void occluded_callback(const RTCOccludedFunctionNArguments* args) {
@@ -132,15 +118,8 @@ FrustumAccel::FrustumAccel(std::span<const Frustum> frusta, CustomFrusta custom)
   m.data.custom = has_custom ? custom.intersector : nullptr;
   m.data.centre = frusta.empty() ? glm::dvec3(0) : 0.5 * (lo + hi);
   m.data.pad = frusta.empty() ? 0 : 1e-6 * glm::length(hi - lo);
-  if (!frusta.empty()) {
-    RTCGeometry geom = rtcNewGeometry(m.embree.device(), RTC_GEOMETRY_TYPE_USER);
-    rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(frusta.size()));
-    rtcSetGeometryUserData(geom, &m.data);
-    rtcSetGeometryBoundsFunction(geom, bounds_callback, nullptr);
-    rtcSetGeometryIntersectFunction(geom, intersect_callback);
-    rtcSetGeometryOccludedFunction(geom, occluded_callback);
-    m.embree.attach(geom);
-  }
+  m.embree.attach_user_geometry(static_cast<unsigned>(frusta.size()), &m.data, bounds_callback, intersect_callback,
+                                occluded_callback);
   m.embree.commit();
 }
 

@@ -6,6 +6,8 @@
 #include "core/fog.h"
 #include "core/fog_integrator.h"
 #include "core/cpu/frustum_tracer.h"
+#include "core/cpu/instance_tracer.h"
+#include "core/instances.h"
 #include "core/cpu/leaf_tracer.h"
 #include "core/cpu/mesh_accel.h"
 #include "core/cpu/photons.h"
@@ -325,9 +327,15 @@ SceneRelief scene_relief(const Scene& scene, const GeometryOptions& options, con
 
 }  // namespace
 
-SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, const GeometryOptions& options,
-                                   std::vector<RenderPass>* passes, const SceneTextures* textures,
-                                   const Progress& progress) {
+namespace {
+
+// The geometry of the plants p with (*only)[p] set, every plant when `only` is null
+// (build_scene_geometry's contract for those plants; the others have no frusta). With
+// `only`, the culling pass is left to the caller: *culled_out counts the plants culled.
+SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin, const GeometryOptions& options,
+                                    std::vector<RenderPass>* passes, const SceneTextures* textures,
+                                    const Progress& progress, const std::vector<char>* only,
+                                    uint32_t* culled_out = nullptr, double* cull_s_out = nullptr) {
   SceneGeometry g;
   const bool mesh = options.kind == GeometryKind::mesh;
   TessellateOptions tessellation;
@@ -353,6 +361,7 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, 
       return g;
     }
     progress.report(static_cast<double>(p) / static_cast<double>(scene.plants.size()), "geometry");
+    if (only && !(*only)[p]) continue;
     const ScenePlant& plant = scene.plants[p];
     Clock::time_point start = Clock::now();
     Skeleton placed = place_plant(plant);
@@ -397,8 +406,10 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, 
     tessellate_s += seconds_since(start);
   }
   const std::string plants = std::to_string(scene.plants.size());
-  if (passes && options.cull)
+  if (passes && options.cull && !only)
     passes->push_back({"culling", cull_s, std::to_string(culled) + " of " + plants + " plants culled"});
+  if (culled_out) *culled_out = culled;
+  if (cull_s_out) *cull_s_out = cull_s;
   if (passes)
     passes->push_back({"skin", skin_s,
                        std::to_string(scene.plants.size() - culled) + " plants, " + std::to_string(g.frusta.size()) +
@@ -435,6 +446,151 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, 
   return g;
 }
 
+// A prototype's geometry as a tracer that owns it (the tracers hold spans of its frusta).
+class OwningTracer final : public SceneTracer {
+ public:
+  explicit OwningTracer(SceneGeometry geometry) : geometry_(std::move(geometry)) {}
+  SurfaceHit nearest(const Ray& ray, double t_min, double t_max) const override {
+    return geometry_.tracer->nearest(ray, t_min, t_max);
+  }
+  bool any(const Ray& ray, double t_min, double t_max) const override { return geometry_.tracer->any(ray, t_min, t_max); }
+  Aabb bounds() const override { return geometry_.tracer->bounds(); }
+  size_t memory_bytes() const override {
+    return geometry_.tracer->memory_bytes() + geometry_.frusta.size() * (sizeof(Frustum) + sizeof(uint32_t));
+  }
+  std::string describe() const override { return geometry_.tracer->describe(); }
+
+ private:
+  SceneGeometry geometry_;
+};
+
+// Whether `plant`'s geometry is the same in its own frame wherever it stands
+// (build_instanced_geometry's exceptions).
+bool instanceable(const ScenePlant& plant, const SkinOptions& skin, const GeometryOptions& options) {
+  if (skin.twist_rad_per_m != 0 && plant.scale != 1) return false;
+  if (!plant.bark.height_texture) return true;
+  return options.kind == GeometryKind::frusta ? !(options.relief && plant.bark.relief_depth_m > 0) : !options.displace;
+}
+
+}  // namespace
+
+SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, const GeometryOptions& options,
+                                   std::vector<RenderPass>* passes, const SceneTextures* textures,
+                                   const Progress& progress) {
+  return build_plants_geometry(scene, skin, options, passes, textures, progress, nullptr);
+}
+
+SceneGeometry build_instanced_geometry(const Scene& scene, const SkinOptions& skin, const GeometryOptions& options,
+                                       std::vector<RenderPass>* passes, const SceneTextures* textures,
+                                       const Progress& progress) {
+  const Clock::time_point start = Clock::now();
+  const PlantInstances groups = plant_instances(scene);
+  // Plants per prototype among those that may be instanced: a skeleton only one of them
+  // has is skinned in the world (an instance of one saves nothing).
+  std::vector<uint32_t> users(groups.distinct(), 0);
+  std::vector<char> eligible(scene.plants.size(), 0);
+  for (uint32_t p = 0; p < scene.plants.size(); ++p)
+    if (instanceable(scene.plants[p], skin, options)) eligible[p] = 1, ++users[groups.prototype_of_plant[p]];
+  std::vector<char> in_world(scene.plants.size(), 1);
+  for (uint32_t p = 0; p < scene.plants.size(); ++p)
+    if (eligible[p] && users[groups.prototype_of_plant[p]] >= 2) in_world[p] = 0;
+  const bool any_in_world = std::find(in_world.begin(), in_world.end(), 1) != in_world.end();
+  const bool any_instanced = std::find(in_world.begin(), in_world.end(), 0) != in_world.end();
+  if (!any_instanced) return build_scene_geometry(scene, skin, options, passes, textures, progress);
+
+  // The plants skinned in the world first (their passes as build_scene_geometry's).
+  constexpr double kWorldShare = 0.5;
+  SceneGeometry g;
+  uint32_t culled = 0;
+  double cull_s = 0;
+  if (any_in_world) {
+    g = build_plants_geometry(scene, skin, options, passes, textures, progress.part(0, kWorldShare), &in_world,
+                              &culled, &cull_s);
+    if (g.cancelled) return g;
+  }
+  const double instance_start = seconds_since(start);
+  // Cull each instance by its prototype's plant box taken to the world (a box around the
+  // placed plant's box: culling stays conservative).
+  const ViewFrustum view = view_frustum(scene);
+  std::vector<int64_t> prototype_index(groups.distinct(), -1);  // into `prototypes`
+  std::vector<std::unique_ptr<SceneTracer>> prototypes;
+  std::vector<TracedInstance> instances;
+  std::vector<Aabb> local_box(groups.distinct());
+  std::vector<char> boxed(groups.distinct(), 0);
+  const uint32_t world_culled = culled;
+  uint64_t prototype_frusta = 0;
+  std::vector<uint64_t> frusta_of_prototype;
+  const Progress instance_progress = progress.part(kWorldShare, 1);
+  for (uint32_t p = 0; p < scene.plants.size(); ++p) {
+    if (in_world[p]) continue;
+    if (progress.cancelled()) {
+      g.cancelled = true;
+      return g;
+    }
+    instance_progress.report(static_cast<double>(p) / static_cast<double>(scene.plants.size()), "geometry");
+    const uint32_t k = groups.prototype_of_plant[p];
+    const ScenePlant& plant = scene.plants[p];
+    const PlantTransform transform = PlantTransform::of(plant);
+    if (options.cull) {
+      const Clock::time_point cull_start = Clock::now();
+      if (!boxed[k]) local_box[k] = plant_box(*scene.plants[groups.prototypes[k]].skeleton, skin), boxed[k] = 1;
+      const bool out = plant_is_culled(scene, view, transform.world_box(local_box[k]));
+      cull_s += seconds_since(cull_start);
+      if (out) {
+        ++culled;
+        continue;
+      }
+    }
+    if (prototype_index[k] < 0) {
+      // The prototype: the skeleton skinned in its own frame, a scene of that one plant.
+      Scene one;
+      one.plants.push_back(scene.plants[groups.prototypes[k]]);
+      one.plants[0].position = {0, 0, 0};
+      one.plants[0].rotate_y_deg = 0;
+      one.plants[0].scale = 1;
+      // Its geometry is every instance's: no relief or displacement of the first plant with
+      // the skeleton (which may be one of those skinned in the world) may reach it.
+      one.plants[0].bark = Bark{};
+      GeometryOptions local = options;
+      local.cull = false;
+      SceneGeometry pg = build_plants_geometry(one, skin, local, nullptr, nullptr, {}, nullptr);
+      prototype_index[k] = static_cast<int64_t>(prototypes.size());
+      frusta_of_prototype.push_back(pg.frusta.size());
+      prototype_frusta += pg.frusta.size();
+      prototypes.push_back(std::make_unique<OwningTracer>(std::move(pg)));
+    }
+    const uint32_t index = static_cast<uint32_t>(prototype_index[k]);
+    instances.push_back({index, p, transform});
+    g.instance_frusta += frusta_of_prototype[index];
+    ++g.instanced_plants;
+  }
+  g.instanced_skeletons = static_cast<uint32_t>(prototypes.size());
+  const double instances_s = seconds_since(start) - instance_start;
+  const Clock::time_point accel_start = Clock::now();
+  // The plants skinned in the world are one more prototype, at the identity.
+  if (any_in_world && g.tracer) {  // an empty one is left out (InstanceTracer)
+    instances.push_back({static_cast<uint32_t>(prototypes.size()), TracedInstance::kOwnPlant, PlantTransform{}});
+    prototypes.push_back(std::move(g.tracer));
+  }
+  g.leaves = nullptr;  // the world plants' leaves are inside the instance tracer now
+  auto tracer = std::make_unique<InstanceTracer>(std::move(prototypes), std::move(instances));
+  if (passes && options.cull)  // the plants skinned in the world and the instances
+    passes->push_back({"culling", cull_s,
+                       std::to_string(culled) + " of " + std::to_string(scene.plants.size()) + " plants culled"});
+  if (passes) {
+    passes->push_back({"instances", instances_s,
+                       std::to_string(g.instanced_plants) + " plants as instances of " +
+                           std::to_string(g.instanced_skeletons) + " skeletons (" + std::to_string(prototype_frusta) +
+                           " frusta skinned for " + std::to_string(g.instance_frusta) + "), " +
+                           std::to_string(culled - world_culled) + " of them culled"});
+    passes->push_back({"instance accel build", seconds_since(accel_start),
+                       tracer->describe() + ", " + std::to_string(tracer->memory_bytes() / 1024) + " KiB"});
+  }
+  g.tracer = std::move(tracer);
+  progress.report(1, "geometry");
+  return g;
+}
+
 RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   RenderResult result;
   for (const ScenePlant& plant : scene.plants)
@@ -458,14 +614,23 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
       std::sqrt(static_cast<double>(std::max(1u, options.spp)));
   // Progress: the geometry a small share, the tiles the rest.
   constexpr double kGeometryShare = 0.05;
-  SceneGeometry geometry = build_scene_geometry(scene, options.skin, geometry_options, &result.passes, textures.get(),
-                                                options.progress.part(0, kGeometryShare));
+  // Instances (build_instanced_geometry) unless the fog's sun photons will need every
+  // plant's frusta in the world.
+  const bool photons_needed = scene.fog && !options.fog.cones &&
+                              fog_mode_needs_cones(options.fog.mode.value_or(scene.fog->mode));
+  const Progress geometry_progress = options.progress.part(0, kGeometryShare);
+  SceneGeometry geometry =
+      options.geometry.instance && !photons_needed
+          ? build_instanced_geometry(scene, options.skin, geometry_options, &result.passes, textures.get(),
+                                     geometry_progress)
+          : build_scene_geometry(scene, options.skin, geometry_options, &result.passes, textures.get(),
+                                 geometry_progress);
   if (geometry.cancelled) {
     result.cancelled = true;
     return result;
   }
   const Progress tile_progress = options.progress.part(kGeometryShare, 1);
-  result.frusta = geometry.frusta.size();
+  result.frusta = geometry.frusta.size() + geometry.instance_frusta;
   result.geometry_bytes = geometry.tracer->memory_bytes();
 
   RenderImage& image = result.image;

@@ -80,6 +80,12 @@ struct SceneGeometry {
   std::unique_ptr<SceneTracer> tracer;     // over `frusta` (or a mesh made from them) and the leaves
   const LeafTracer* leaves = nullptr;      // `tracer` when the scene has leaves (leaf_tracer.h), else null
   bool cancelled = false;                  // stopped by `progress` between plants: no tracer
+  // build_instanced_geometry only: the plants traced as instances of a shared skeleton are
+  // not in `frusta` (their prototypes' frusta live in `tracer`); their frusta counted once
+  // per plant, the plants, and the distinct skeletons skinned for them.
+  uint64_t instance_frusta = 0;
+  uint32_t instanced_plants = 0;
+  uint32_t instanced_skeletons = 0;
 };
 
 // Skins and indexes every plant (each plant's skeleton must be set: grow_scene_plants)
@@ -95,6 +101,21 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin,
                                    const GeometryOptions& geometry = {},
                                    std::vector<RenderPass>* passes = nullptr,
                                    const SceneTextures* textures = nullptr, const Progress& progress = {});
+
+// build_scene_geometry, but the plants that share a skeleton with another (plant_instances,
+// instances.h) are skinned once per skeleton, in its own frame, and traced as instances
+// through their transforms (instance_tracer.h) — unless a plant's geometry depends on where
+// it stands: a relief or displacement (its depth is in world metres) or, with
+// skin.twist_rad_per_m, a scale other than 1 (the twist turns per world metre). Those, and
+// plants whose skeleton no other plant shares, are skinned in the world as
+// build_scene_geometry does and are the only ones in `frusta` (the sun photons need every
+// plant there: render_cpu instances only without cone-reading fog). Passes: those of
+// build_scene_geometry for the plants skinned in the world (when there are any), then
+// "instances" (culling and skinning of the prototypes) and "instance accel build".
+SceneGeometry build_instanced_geometry(const Scene& scene, const SkinOptions& skin,
+                                       const GeometryOptions& geometry = {},
+                                       std::vector<RenderPass>* passes = nullptr,
+                                       const SceneTextures* textures = nullptr, const Progress& progress = {});
 
 // Renders `scene` (every plant's skeleton set). Deterministic for any thread count.
 // options.progress: "geometry" (the first 5%), then "render", the fraction of tiles done,

@@ -28,6 +28,7 @@ inline constexpr uint32_t kFogNodesBinding = 8;      // the cone intervals' list
 inline constexpr uint32_t kFogHeadsBinding = 9;      // uint32 per pixel: its list's first node
 inline constexpr uint32_t kFogOverflowBinding = 10;  // uint32 per pixel: 1 = its list is incomplete
 inline constexpr uint32_t kFogCountersBinding = 11;  // GlFogCounters
+inline constexpr uint32_t kInstancesBinding = 12;    // GpuInstance per plant drawn as an instance (INSTANCED)
 
 // Texture units.
 inline constexpr uint32_t kBarkTexturesUnit = 0;  // bark image i at kBarkTexturesUnit + i
@@ -87,6 +88,7 @@ inline constexpr GlslConstant kGlslConstants[] = {
     {"FOG_HEADS_BINDING", kFogHeadsBinding},
     {"FOG_OVERFLOW_BINDING", kFogOverflowBinding},
     {"FOG_COUNTERS_BINDING", kFogCountersBinding},
+    {"INSTANCES_BINDING", kInstancesBinding},
     {"FOG_LIST_END", kFogListEnd},
     {"FOG_MAX_INTERVALS", kFogMaxIntervals},
     {"FOG_MAX_LIST_NODES", kFogMaxListNodes},

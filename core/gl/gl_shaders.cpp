@@ -98,6 +98,7 @@ ShaderProgramSource frusta_program(FrustaPass pass, const FrustaFeatures& featur
   if (bark) defines.push_back("BARK");
   if (units > 0) defines.push_back("BARK_TEXTURE_UNITS " + std::to_string(units));
   if (!features.conservative_depth) defines.push_back("NO_CONSERVATIVE_DEPTH");
+  if (features.instanced) defines.push_back("INSTANCED");
   p.name = "frusta[";
   for (size_t i = 0; i < defines.size(); ++i) {
     std::string name = defines[i];
@@ -220,6 +221,16 @@ std::vector<ShaderProgramSource> all_shader_programs() {
           features.texture_units = relief && bark ? 2 : 1;  // one image each (albedo, height)
           all.push_back(frusta_program(pass, features));
         }
+  // Instanced (plants sharing a skeleton), with the bark and uv where they apply.
+  for (FrustaPass pass : {FrustaPass::gbuffer, FrustaPass::gbuffer_eye_inside, FrustaPass::shadow}) {
+    FrustaFeatures features;
+    features.instanced = true;
+    all.push_back(frusta_program(pass, features));
+    if (pass == FrustaPass::shadow) continue;
+    features.want_uv = features.bark = true;
+    features.texture_units = 1;
+    all.push_back(frusta_program(pass, features));
+  }
   // Without the conservative depth layouts (early-Z measurements).
   for (FrustaPass pass : {FrustaPass::gbuffer, FrustaPass::shadow}) {
     FrustaFeatures features;

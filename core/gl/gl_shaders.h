@@ -72,6 +72,8 @@ struct FrustaFeatures {
                                    // and height maps); at least 1 with relief or bark
   bool conservative_depth = true;  // false: NO_CONSERVATIVE_DEPTH, no depth layout (early-Z
                                    // measurements)
+  bool instanced = false;          // INSTANCED: plants drawn through their transforms
+                                   // (frusta_common.glsl GpuInstance), every pass
 };
 // The variant of `pass` with `features`; the shadow pass takes only relief and
 // conservative_depth (it writes depth alone). Its name lists the defines, e.g.

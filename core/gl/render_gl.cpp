@@ -26,6 +26,7 @@
 #include "core/gl/gl_pass_timers.h"
 #include "core/gl/gl_program.h"
 #include "core/gl/gl_views.h"
+#include "core/instances.h"
 #include "core/relief.h"
 #include "core/render_common.h"
 #include "core/util/math.h"
@@ -51,6 +52,37 @@ struct ShadowFrame {
   double x_min = 0, y_min = 0, side = 1;  // square map, metres
   double s_near = 0, s_range = 1;         // s = −dot(p − c, direction)
   double texel_m = 0;
+};
+
+// frusta_common.glsl's GpuInstance (std430: vec3 + float packs into 16 bytes).
+struct GpuInstance {
+  float position_hi[3];
+  float scale;
+  float position_lo[3];
+  float cos_y;
+  float sin_y;
+  uint32_t plant;
+  uint32_t own;  // 1: the identity of the plants skinned in the world
+  uint32_t pad;
+};
+static_assert(sizeof(GpuInstance) == 48);
+
+GpuInstance gpu_instance(const PlantTransform& t, uint32_t plant, bool own) {
+  GpuInstance g{};
+  const GlFloatSplit p = split_to_floats(t.position);
+  for (int k = 0; k < 3; ++k) g.position_hi[k] = p.hi[k], g.position_lo[k] = p.lo[k];
+  g.scale = static_cast<float>(t.scale);
+  g.cos_y = static_cast<float>(t.cos_y);
+  g.sin_y = static_cast<float>(t.sin_y);
+  g.plant = plant;
+  g.own = own ? 1 : 0;
+  return g;
+}
+
+// One instanced draw (INSTANCED): a shared skeleton's records, once per plant of it.
+struct InstancedDraw {
+  uint32_t first_record = 0, records = 0;
+  uint32_t first_instance = 0, instances = 0;
 };
 
 GlSunView sun_view(const ShadowFrame& f, uint32_t texels) {
@@ -169,6 +201,8 @@ struct GlRenderer::Frame {
   bool fog_cones = false;  // a cone mode with cones uploaded: the cone pass runs
   uint32_t fog_steps = 0;  // the fog's samples along each ray (brute; medium inside the cones)
   std::vector<uint32_t> eye_inside;  // frusta whose pyramid may reach the eye's near plane
+                                     // (instanced: pairs of instance, record)
+  uint32_t eye_inside_frusta = 0;    // how many
   GLuint gbuffer_program = 0, inside_program = 0, shadow_program = 0, shade_program = 0, fog_program = 0,
          fog_cones_program = 0, present_program = 0;
   GlCameraView camera_view;  // this sample's (its jitter set per geometry pass)
@@ -182,7 +216,13 @@ struct GlRenderer::State {
   uint32_t shadow_texels_override = 0;  // set_shadow_map_texels; 0: shadow_map_texels()
   std::vector<RenderPass> setup_passes;
   size_t plant_count = 0;
-  uint64_t frusta = 0;
+  uint64_t frusta = 0;               // frusta drawn (an instanced skeleton's once per plant)
+  uint64_t record_count = 0;         // GpuSegment records uploaded (a shared skeleton's once)
+  // Instancing (docs/scatter.md "Instancing"): one draw per shared skeleton, the plants
+  // skinned in the world first (the identity instance); empty: one plain draw of every record.
+  std::vector<InstancedDraw> draws;
+  uint32_t instanced_plants = 0;
+  std::vector<uint32_t> sphere_instance, sphere_record;  // instanced: each sphere's instance and record
   uint64_t uploaded_bytes = 0;       // the geometry: segment records + ids, or the mesh
   uint64_t pending_plant_bytes = 0;  // plant data sent since the last frame
   std::vector<Sphere> spheres;       // around each frustum's bounding pyramid (or its triangles)
@@ -195,7 +235,7 @@ struct GlRenderer::State {
   std::unique_ptr<GlMesh> leaves;    // the plants' leaves (GlMesh::leaves_of), drawn after either; null: none
 
   GlVertexArray vao;  // empty: the frusta pull their vertices from the records
-  GlBuffer segment_buffer, id_buffer, list_buffer;
+  GlBuffer segment_buffer, id_buffer, list_buffer, instance_buffer;
   // The context's programs (shared with other renderers on it, or this renderer's own) and
   // this renderer's variants in them by name: the cache assembles a variant's sources to
   // find it, done once per variant here rather than per frame.
@@ -223,37 +263,130 @@ struct GlRenderer::State {
     return id;
   }
 
-  // Skins every plant of `scene` into one record and one id quadruple (plant, chain,
-  // segment, 0) per frustum, and replaces `spheres` with the frusta's bounding spheres.
+  // Skins one skeleton (placed: in the world) into records and id quadruples (plant, chain,
+  // segment, 0), and its frusta's bounding spheres into *out.
+  void skin_one(const Skeleton& skeleton, uint32_t plant, const Progress& progress, std::vector<GpuSegment>* records,
+                std::vector<uint32_t>* ids, std::vector<Sphere>* out) const {
+    Expected<SkinnedSkeleton> skinned_or = skin_skeleton(skeleton, options.skin, progress);
+    if (!skinned_or) throw GlCancelled();  // the only error skin_skeleton returns
+    const SkinnedSkeleton& skinned = *skinned_or;
+    for (const Frustum& f : skinned.frusta) {
+      records->push_back(pack_gpu_segment(f));
+      ids->insert(ids->end(), {plant, f.chain, f.segment, 0u});
+      // A relief-mapped segment is drawn in the pyramid of its shell (frusta.vert.glsl).
+      const float relief_depth_m = bark_maps->plants().empty() ? 0.0f : bark_maps->plants()[plant].relief_depth_m;
+      const BoundingPyramid pyramid =
+          bounding_pyramid(relief_depth_m > 0 && f.kind == FrustumKind::segment
+                               ? relief_shell(f.shape, relief_depth_m, options.geometry.relief_options.max_depth_per_radius)
+                               : f.shape);
+      glm::dvec3 centre(0);
+      for (const glm::dvec3& v : pyramid.vertices) centre += v / 8.0;
+      double radius = 0;
+      for (const glm::dvec3& v : pyramid.vertices) radius = std::max(radius, glm::length(v - centre));
+      // The shader grows the pyramid by ~1e-4 of the frustum's size (frusta.vert.glsl).
+      out->push_back({centre, radius * 1.001 + 1e-3 * (f.shape.length + std::max(f.shape.radius0, f.shape.radius1))});
+    }
+  }
+
+  // Whether plant p may be drawn through its transform: its geometry is the same in its
+  // own frame wherever it stands (no relief, whose depth is in world metres; with a twist,
+  // which turns per world metre, scale 1) — build_instanced_geometry's rule on the CPU.
+  bool instanceable(const ScenePlant& plant, uint32_t p) const {
+    if (options.skin.twist_rad_per_m != 0 && plant.scale != 1) return false;
+    return bark_maps->plants().empty() || !(bark_maps->plants()[p].relief_depth_m > 0);
+  }
+
+  // Skins every plant of `scene` into records and ids, and replaces `spheres` with the
+  // frusta's bounding spheres (one per frustum drawn). With options.geometry.instance, the
+  // plants that share a skeleton with another instanceable plant (plant_instances) are
+  // skinned once per skeleton in its frame and drawn through *instances (draws, sphere_*);
+  // the others are skinned in the world, first, under the identity instance. Nothing
+  // shared: no instances, one plain draw (as without instancing). Sets frusta and records.
   // Cancelled (options.progress): throws GlCancelled with `spheres` as they were.
-  void skin_plants(const Scene& scene, std::vector<GpuSegment>* records, std::vector<uint32_t>* ids) {
+  void skin_plants(const Scene& scene, std::vector<GpuSegment>* records, std::vector<uint32_t>* ids,
+                   std::vector<GpuInstance>* instances) {
+    const uint32_t n = static_cast<uint32_t>(scene.plants.size());
+    for (const ScenePlant& plant : scene.plants)
+      if (!plant.skeleton) throw std::logic_error("GlRenderer: a plant has no skeleton (call grow_scene_plants)");
+    std::vector<char> in_world(n, 1);
+    PlantInstances groups;
+    if (options.geometry.instance) {
+      groups = plant_instances(scene);
+      std::vector<uint32_t> users(groups.distinct(), 0);
+      for (uint32_t p = 0; p < n; ++p)
+        if (instanceable(scene.plants[p], p)) ++users[groups.prototype_of_plant[p]];
+      for (uint32_t p = 0; p < n; ++p)
+        if (instanceable(scene.plants[p], p) && users[groups.prototype_of_plant[p]] >= 2) in_world[p] = 0;
+    }
     std::vector<Sphere> fresh;
-    for (uint32_t p = 0; p < scene.plants.size(); ++p) {
-      if (!scene.plants[p].skeleton) throw std::logic_error("GlRenderer: a plant has no skeleton (call grow_scene_plants)");
+    std::vector<InstancedDraw> fresh_draws;
+    std::vector<uint32_t> fresh_instance, fresh_record;
+    const double share = 1.0 / std::max(1u, n);
+    for (uint32_t p = 0; p < n; ++p) {
+      if (!in_world[p]) continue;
       if (options.progress.cancelled()) throw GlCancelled();  // between plants
-      const double plants = static_cast<double>(scene.plants.size());
-      Expected<SkinnedSkeleton> skinned_or =
-          skin_skeleton(place_plant(scene.plants[p]), options.skin, options.progress.part(p / plants, (p + 1) / plants));
-      if (!skinned_or) throw GlCancelled();  // the only error skin_skeleton returns
-      const SkinnedSkeleton& skinned = *skinned_or;
-      for (const Frustum& f : skinned.frusta) {
-        records->push_back(pack_gpu_segment(f));
-        ids->insert(ids->end(), {p, f.chain, f.segment, 0u});
-        // A relief-mapped segment is drawn in the pyramid of its shell (frusta.vert.glsl).
-        const float relief_depth_m = bark_maps->plants().empty() ? 0.0f : bark_maps->plants()[p].relief_depth_m;
-        const BoundingPyramid pyramid =
-            bounding_pyramid(relief_depth_m > 0 && f.kind == FrustumKind::segment
-                                 ? relief_shell(f.shape, relief_depth_m, options.geometry.relief_options.max_depth_per_radius)
-                                 : f.shape);
-        glm::dvec3 centre(0);
-        for (const glm::dvec3& v : pyramid.vertices) centre += v / 8.0;
-        double radius = 0;
-        for (const glm::dvec3& v : pyramid.vertices) radius = std::max(radius, glm::length(v - centre));
-        // The shader grows the pyramid by ~1e-4 of the frustum's size (frusta.vert.glsl).
-        fresh.push_back({centre, radius * 1.001 + 1e-3 * (f.shape.length + std::max(f.shape.radius0, f.shape.radius1))});
+      skin_one(place_plant(scene.plants[p]), p, options.progress.part(p * share, (p + 1) * share), records, ids, &fresh);
+    }
+    const bool any_instanced = std::find(in_world.begin(), in_world.end(), 0) != in_world.end();
+    if (any_instanced) {
+      // The world plants' records: the identity instance, drawn as they are.
+      const uint32_t world_records = static_cast<uint32_t>(records->size());
+      fresh_instance.assign(world_records, 0);
+      for (uint32_t r = 0; r < world_records; ++r) fresh_record.push_back(r);
+      if (world_records > 0) {
+        fresh_draws.push_back({0, world_records, static_cast<uint32_t>(instances->size()), 1});
+        instances->push_back(gpu_instance(PlantTransform{}, 0, true));
+      }
+      std::vector<std::vector<uint32_t>> plants_of(groups.distinct());
+      for (uint32_t p = 0; p < n; ++p)
+        if (!in_world[p]) plants_of[groups.prototype_of_plant[p]].push_back(p);
+      instanced_plants = 0;
+      for (uint32_t k = 0; k < groups.distinct(); ++k) {
+        if (plants_of[k].empty()) continue;
+        if (options.progress.cancelled()) throw GlCancelled();
+        const uint32_t first = static_cast<uint32_t>(records->size());
+        // The first plant drawn through it stands for the skeleton (the group's first plant
+        // may be one skinned in the world, with a relief none of these has).
+        const uint32_t prototype = plants_of[k].front();
+        std::vector<Sphere> local;
+        skin_one(*scene.plants[prototype].skeleton, prototype, {}, records, ids, &local);
+        InstancedDraw draw{first, static_cast<uint32_t>(records->size()) - first,
+                           static_cast<uint32_t>(instances->size()), static_cast<uint32_t>(plants_of[k].size())};
+        for (uint32_t p : plants_of[k]) {
+          const PlantTransform t = PlantTransform::of(scene.plants[p]);
+          const uint32_t instance = static_cast<uint32_t>(instances->size());
+          instances->push_back(gpu_instance(t, p, false));
+          for (uint32_t j = 0; j < local.size(); ++j) {
+            fresh.push_back({t.to_world(local[j].centre), local[j].radius * t.scale});
+            fresh_instance.push_back(instance);
+            fresh_record.push_back(first + j);
+          }
+        }
+        instanced_plants += draw.instances;
+        fresh_draws.push_back(draw);
       }
     }
     spheres = std::move(fresh);
+    draws = std::move(fresh_draws);
+    sphere_instance = std::move(fresh_instance);
+    sphere_record = std::move(fresh_record);
+    features.instanced = !draws.empty();
+    frusta = spheres.size();
+    record_count = records->size();
+  }
+
+  // Draws the frusta's pyramids with `program` (in use): every record once, or (instanced)
+  // one instanced draw per shared skeleton, u_instance_base its first instance.
+  void draw_frusta(GLuint program) const {
+    if (draws.empty()) {
+      if (record_count > 0) glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(record_count * gl::kPyramidVertices));
+      return;
+    }
+    for (const InstancedDraw& d : draws) {
+      set_uniform_uint(program, "u_instance_base", d.first_instance);
+      glDrawArraysInstanced(GL_TRIANGLES, static_cast<GLint>(d.first_record * gl::kPyramidVertices),
+                            static_cast<GLsizei>(d.records * gl::kPyramidVertices), static_cast<GLsizei>(d.instances));
+    }
   }
 
   // The shadow map's side for a w × h frame: a texel about a pixel where the plants fill
@@ -279,13 +412,21 @@ struct GlRenderer::State {
     // their back faces (EYE_INSIDE), since their front faces are clipped or behind the eye.
     // (The leaves' spheres follow the frusta's: they are never inside.)
     for (uint32_t i = 0; !mesh && i < std::min<uint64_t>(spheres.size(), frusta); ++i)
-      if (glm::length(spheres[i].centre - f.camera.eye) < spheres[i].radius + 4 * f.near) f.eye_inside.push_back(i);
+      if (glm::length(spheres[i].centre - f.camera.eye) < spheres[i].radius + 4 * f.near) {
+        if (draws.empty()) {
+          f.eye_inside.push_back(i);
+        } else {
+          f.eye_inside.push_back(sphere_instance[i]);
+          f.eye_inside.push_back(sphere_record[i]);
+        }
+        ++f.eye_inside_frusta;
+      }
     if (!f.eye_inside.empty()) {
       const size_t bytes = f.eye_inside.size() * sizeof(uint32_t);
       glNamedBufferData(list_buffer.id(), static_cast<GLsizeiptr>(bytes), f.eye_inside.data(), GL_STREAM_DRAW);
       f.stats.frame_bytes_uploaded += bytes;
     }
-    f.stats.eye_inside = static_cast<uint32_t>(f.eye_inside.size());
+    f.stats.eye_inside = f.eye_inside_frusta;
     // Ray differentials (texture.h): the next sample to the right / below, one pixel /
     // sqrt(spp) away, as render_cpu.cpp's direction_dx_, direction_dy_.
     f.differential_step = 1 / std::sqrt(static_cast<double>(f.spp));
@@ -383,6 +524,7 @@ struct GlRenderer::State {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kSegmentsBinding, segment_buffer.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kSegmentIdsBinding, id_buffer.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kSegmentListBinding, list_buffer.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kInstancesBinding, instance_buffer.id());
     bark_maps->bind();
     glBindTextureUnit(gl::kGNormalDistanceUnit, targets.gbuffer[0].id());
     glBindTextureUnit(gl::kGGeometricUUnit, targets.gbuffer[1].id());
@@ -439,6 +581,7 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options, std::sh
   start = Clock::now();
   std::vector<GpuSegment> records;
   std::vector<uint32_t> ids;  // plant, chain, segment, 0 per frustum
+  std::vector<GpuInstance> instances;
   if (options.geometry.kind == GeometryKind::mesh) {
     // The polygon baseline (gl_mesh.h): its own skin, tessellate, displace, upload, programs.
     st.mesh = std::make_unique<GlMesh>(scene, options, st.bark_maps->albedo() ? st.features.texture_units : 0);
@@ -446,10 +589,13 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options, std::sh
     st.frusta = st.mesh->frusta();
     st.setup_passes = st.mesh->setup_passes();
   } else {
-    st.skin_plants(scene, &records, &ids);
-    st.frusta = records.size();
-    st.setup_passes.push_back({"skin", seconds_since(start),
-                               std::to_string(scene.plants.size()) + " plants, " + std::to_string(st.frusta) + " frusta"});
+    st.skin_plants(scene, &records, &ids, &instances);
+    std::string detail = std::to_string(scene.plants.size()) + " plants, " + std::to_string(st.frusta) + " frusta";
+    if (!st.draws.empty())
+      detail += "; " + std::to_string(st.instanced_plants) + " plants as instances of " +
+                std::to_string(st.draws.size() - (instances.front().own ? 1 : 0)) + " skeletons, " +
+                std::to_string(records.size()) + " frusta skinned";
+    st.setup_passes.push_back({"skin", seconds_since(start), detail});
   }
 
   start = Clock::now();
@@ -457,6 +603,7 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options, std::sh
   // The segment records may be rewritten in place (update_plants).
   st.segment_buffer = make_gl_buffer(records.data(), records.size() * sizeof(GpuSegment), GL_DYNAMIC_STORAGE_BIT);
   st.id_buffer = make_gl_buffer(ids.data(), ids.size() * sizeof(uint32_t));
+  st.instance_buffer = make_gl_buffer(instances.data(), instances.size() * sizeof(GpuInstance));
   GLuint list = 0;
   glCreateBuffers(1, &list);  // mutable storage: a new list each frame that needs one
   st.list_buffer.reset(list);
@@ -464,10 +611,13 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options, std::sh
   if (st.mesh) {
     st.uploaded_bytes = st.mesh->gpu_bytes();  // its "upload" pass is in already
   } else {
-    st.uploaded_bytes = records.size() * sizeof(GpuSegment) + ids.size() * sizeof(uint32_t);
+    st.uploaded_bytes = records.size() * sizeof(GpuSegment) + ids.size() * sizeof(uint32_t) +
+                        instances.size() * sizeof(GpuInstance);
     st.setup_passes.push_back({"upload", seconds_since(start),
-                               std::to_string(st.uploaded_bytes / 1024) + " KiB: " + std::to_string(st.frusta) +
-                                   " GpuSegment records (64 B) + ids (16 B)"});
+                               std::to_string(st.uploaded_bytes / 1024) + " KiB: " + std::to_string(records.size()) +
+                                   " GpuSegment records (64 B) + ids (16 B)" +
+                                   (instances.empty() ? std::string()
+                                                      : " + " + std::to_string(instances.size()) + " instances (48 B)")});
   }
   // The leaves (gl_mesh.h leaves_of): their own upload and programs.
   st.leaves = GlMesh::leaves_of(scene, options);
@@ -538,19 +688,25 @@ uint64_t GlRenderer::update_plants(const Scene& scene) {
   }
   std::vector<GpuSegment> records;
   std::vector<uint32_t> ids;
-  st.skin_plants(scene, &records, &ids);
+  std::vector<GpuInstance> instances;
+  const uint64_t old_records = st.record_count;
+  const bool was_instanced = !st.draws.empty();
+  st.skin_plants(scene, &records, &ids, &instances);
   st.add_leaf_spheres();
   const size_t record_bytes = records.size() * sizeof(GpuSegment);
   uint64_t uploaded = record_bytes + leaf_bytes;
-  if (records.size() == st.frusta) {
+  if (!was_instanced && st.draws.empty() && records.size() == old_records) {
     update_gl_buffer(st.segment_buffer, records.data(), record_bytes);
   } else {
-    // The topology changed (a frustum more or less): new buffers, ids included.
+    // The topology changed (a frustum more or less, or which plants share a skeleton):
+    // new buffers, ids and instances included.
+    const size_t instance_bytes = instances.size() * sizeof(GpuInstance);
     st.segment_buffer = make_gl_buffer(records.data(), record_bytes, GL_DYNAMIC_STORAGE_BIT);
     st.id_buffer = make_gl_buffer(ids.data(), ids.size() * sizeof(uint32_t));
-    uploaded += ids.size() * sizeof(uint32_t);
-    st.frusta = records.size();
-    st.uploaded_bytes = record_bytes + ids.size() * sizeof(uint32_t) + (st.leaves ? st.leaves->gpu_bytes() : 0);
+    st.instance_buffer = make_gl_buffer(instances.data(), instance_bytes);
+    uploaded += ids.size() * sizeof(uint32_t) + instance_bytes;
+    st.uploaded_bytes =
+        record_bytes + ids.size() * sizeof(uint32_t) + instance_bytes + (st.leaves ? st.leaves->gpu_bytes() : 0);
   }
   check_gl("update_plants");
   st.pending_plant_bytes += uploaded;
@@ -699,7 +855,7 @@ void GlRenderer::shadow_pass(Frame& f, const glm::dvec3& l) {
   } else {
     set_sun_view_uniforms(f.shadow_program, view);
     glUseProgram(f.shadow_program);
-    if (st.frusta > 0) glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(st.frusta * gl::kPyramidVertices));
+    st.draw_frusta(f.shadow_program);
   }
   if (st.leaves) st.leaves->draw_shadow(view);
   st.timers.end();
@@ -731,12 +887,12 @@ void GlRenderer::geometry_pass(Frame& f, double jitter_x, double jitter_y) {
   } else {
     set_jitter_uniform(f.gbuffer_program, f.camera_view.jitter);
     glUseProgram(f.gbuffer_program);
-    if (st.frusta > 0) glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(st.frusta * gl::kPyramidVertices));
+    st.draw_frusta(f.gbuffer_program);
     if (f.inside_program) {
       glCullFace(GL_FRONT);
       set_jitter_uniform(f.inside_program, f.camera_view.jitter);
       glUseProgram(f.inside_program);
-      glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(f.eye_inside.size() * gl::kPyramidVertices));
+      glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(f.eye_inside_frusta * gl::kPyramidVertices));
     }
   }
   if (st.leaves) st.leaves->draw_gbuffer(f.camera_view, f.differential_step);

@@ -56,6 +56,9 @@ const Preset kPresets[] = {
     {"pine", 17468, 16997},
     // A small cactus for the dancing-cacti scene (paper 000, Figure 8).
     {"cactus", 25, std::nullopt},
+    // The well of paper 000, Figure 10, one part per PART (presets/scenes/well.scene.json
+    // holds all four: 8 segments, tests/core/paper_scenes_test.cpp); PART 0 is the wall.
+    {"well", 1, std::nullopt},
 };
 
 fs::path presets_dir() { return fs::path(SYLVA_SOURCE_DIR) / "presets"; }

@@ -2,12 +2,17 @@
 // known analytically, seen by a camera placed by the test, no ground in view, a hard sun.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <string>
+#include <vector>
 #include <optional>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/render_common.h"
+#include "core/render_types.h"
 #include "core/scene.h"
 #include "core/shading.h"
 #include "core/turtle.h"
@@ -137,6 +142,70 @@ inline std::optional<LeafPixel> one_leaf_pixel(const Scene& s, uint32_t x, uint3
   out.distance = t * glm::length(ray.direction);
   out.radiance = shading::surface_radiance(kOneLeafAlbedo, n, l, view, 0.5, s.sky, s.sun.radiance, cos_sun, 1);
   return out;
+}
+
+
+// The instancing tests' grove (tests/cpu/instance_tracer_test.cpp, tests/gl/...): 13 plants
+// of three skeletons — a forked stem with a leaf (6 plants), the cylinder of radius 0.12 m
+// (6 plants) and one crooked stem no other plant shares — turned and scaled apart on a
+// 3 m grid, seen from above the front so that plants hide and shadow each other, the ground
+// at y = 0 in view, a point sun from (0.5, 1, 0.3).
+inline constexpr const char* kForkGrammar =
+    "angle: 35\naxiom: !(0.08)F(1)[+!(0.05)F(0.8)'(2){.+f(0.4).-f(0.4).-f(0.4).}][-!(0.05)F(0.7)]!(0.06)F(0.6)\n";
+// Pixels where two images of `channels` floats per pixel differ by more than `tolerance`
+// (relative to max(1, |a|)) in any channel.
+inline size_t differing_pixels(const std::vector<float>& a, const std::vector<float>& b, int channels, double tolerance) {
+  size_t n = 0;
+  for (size_t px = 0; px * channels < a.size() && px * channels < b.size(); ++px)
+    for (int c = 0; c < channels; ++c) {
+      const double x = a[px * channels + c], y = b[px * channels + c];
+      if (x == y) continue;
+      if (!(std::abs(x - y) <= tolerance * std::max(1.0, std::abs(x)))) {
+        ++n;
+        break;
+      }
+    }
+  return n + (a.size() == b.size() ? 0 : 1);
+}
+
+// The pass named `name` of a render, or null.
+inline const RenderPass* find_pass(const RenderResult& r, const std::string& name) {
+  for (const RenderPass& p : r.passes)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+// How many pixels of an id AOV name each of `plants` plants.
+inline std::vector<int> pixels_per_plant(const RenderImage& image, size_t plants) {
+  std::vector<int> seen(plants, 0);
+  for (size_t px = 0; px * 3 < image.id.size(); ++px)
+    if (image.id[px * 3] >= 0 && image.id[px * 3] < static_cast<float>(plants)) ++seen[static_cast<size_t>(image.id[px * 3])];
+  return seen;
+}
+
+// The V channel of a uv AOV.
+inline std::vector<float> v_of_uv(const RenderImage& image) {
+  std::vector<float> v;
+  for (size_t px = 0; 2 * px < image.uv.size(); ++px) v.push_back(image.uv[2 * px + 1]);
+  return v;
+}
+
+inline Scene instanced_grove(uint32_t width = 96, uint32_t height = 72) {
+  const Skeleton fork = grown(kForkGrammar);
+  const Skeleton stem = cylinder(0.12, 0, 1.6);
+  const Skeleton crooked = grown("angle: 25\naxiom: !(0.1)F(0.8)+F(0.8)-F(0.5)\n");
+  Scene s = scene_around(fork, {9, 7, 12}, {-0.5, 0.6, 0}, width, height, 0);
+  s.sun.direction = glm::normalize(glm::dvec3(0.5, 1, 0.3));
+  s.plants.clear();
+  for (int k = 0; k < 13; ++k) {
+    ScenePlant p;
+    p.skeleton = k == 6 ? crooked : k % 2 == 0 ? fork : stem;
+    p.position = {3.0 * (k % 4) - 4.5, 0, 3.0 * (k / 4) - 4.5};
+    p.rotate_y_deg = 37.0 * k;
+    p.scale = 0.7 + 0.05 * k;
+    s.plants.push_back(p);
+  }
+  return s;
 }
 
 }  // namespace sylva::test

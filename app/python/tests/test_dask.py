@@ -87,3 +87,66 @@ def test_the_example_runs_a_local_cluster(tmp_path, sylva_binary):
     cli_batch(sylva_binary, "grow", "presets/elm.lsys", "--seed", "7..9", "-o", str(tmp_path / "c_{seed}.skel.json"))
     assert_same_files([str(tmp_path / f"d/elm_{s}.skel.json") for s in (7, 8, 9)],
                       [str(tmp_path / f"c_{s}.skel.json") for s in (7, 8, 9)])
+
+
+def small_dancing_scene(tmp_path, repo):
+    """The dancing cacti at 64x48, one second at 4 frames per second: frames 0..3."""
+    import json
+    scene = json.loads((repo / "presets/scenes/dancing_cacti.scene.json").read_text())
+    scene["image"] = {"width": 64, "height": 48}
+    scene["animation"]["fps"] = 4
+    scene["animation"]["duration_s"] = 1
+    for plant in scene.get("plants", []):
+        plant["grammar"] = str((repo / "presets/scenes" / plant["grammar"]).resolve())
+    for entry in scene.get("scatter", []):
+        entry["grammar"] = str((repo / "presets/scenes" / entry["grammar"]).resolve())
+    path = tmp_path / "dancing.scene.json"
+    path.write_text(json.dumps(scene))
+    return str(path)
+
+
+def test_frames_on_two_workers_write_the_local_commands_files(tmp_path, client, sylva_binary, repo):
+    scene = small_dancing_scene(tmp_path, repo)
+    cli_batch(sylva_binary, "render", scene, "--backend", "cpu", "--frames", "0..3",
+              "-o", str(tmp_path / "cli/f_{frame}.png"))
+    with distributed.get_task_stream(client) as stream:
+        written = sylva_dask.frames(client, scene, [3, 1, 0, 2], str(tmp_path / "dask/f_{frame}.png"),
+                                    sylva=sylva_binary)
+    assert written == [str(tmp_path / f"dask/f_{f:04d}.png") for f in (3, 1, 0, 2)]
+    assert_same_files(written, [str(tmp_path / f"cli/f_{f:04d}.png") for f in (3, 1, 0, 2)])
+    # The cacti move between frames, so equal files are not a coincidence.
+    assert len({pathlib.Path(p).read_bytes() for p in written}) == 4
+    assert len({task["worker"] for task in stream.data}) == 2
+
+
+def test_frames_refuse_bad_batches_before_any_task(tmp_path, client, sylva_binary, repo):
+    scene = small_dancing_scene(tmp_path, repo)
+    with pytest.raises(ValueError, match="no {frame}"):
+        sylva_dask.frames(client, scene, [0], str(tmp_path / "f.png"), sylva=sylva_binary)
+    with pytest.raises(ValueError, match="repeated"):
+        sylva_dask.frames(client, scene, [1, 1], str(tmp_path / "f_{frame}.png"), sylva=sylva_binary)
+    with pytest.raises(TypeError):
+        sylva_dask.frames(client, scene, [1.5], str(tmp_path / "f_{frame}.png"), sylva=sylva_binary)
+    with pytest.raises(ValueError, match="no such scene"):
+        sylva_dask.frames(client, str(tmp_path / "none.scene.json"), [0], str(tmp_path / "f_{frame}.png"),
+                          sylva=sylva_binary)
+    assert not list(tmp_path.glob("f_*.png"))
+
+
+def test_a_failing_frame_raises_the_commands_message(tmp_path, client, sylva_binary, repo):
+    still = repo / "presets/scenes/pine.scene.json"  # no animation key: --frames refuses it
+    with pytest.raises(RuntimeError, match="--frames 0 failed"):
+        sylva_dask.frames(client, str(still), [0], str(tmp_path / "f_{frame}.png"), sylva=sylva_binary)
+
+
+def test_the_frames_example_renders_a_scenes_frames(tmp_path, sylva_binary, repo):
+    scene = small_dancing_scene(tmp_path, repo)
+    example = pathlib.Path(__file__).resolve().parents[1] / "examples" / "dask_batch.py"
+    import os
+    import sys
+    done = subprocess.run([sys.executable, str(example), "--scene", scene, "--frames", "1..2",
+                           "-o", str(tmp_path / "ex/f_{frame}.png"), "--sylva", sylva_binary, "--workers", "2"],
+                          capture_output=True, text=True, env=dict(os.environ), timeout=300)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "2 files from 2 workers" in done.stdout
+    assert (tmp_path / "ex/f_0001.png").is_file() and (tmp_path / "ex/f_0002.png").is_file()
