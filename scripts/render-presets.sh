@@ -13,7 +13,7 @@
 # The CPU ray caster is the default: on the shared 2-core machine without a GPU it is the
 # faster backend (the pine at 320 x 240: 3.4 s on the CPU, 17 s on llvmpipe, load 11);
 # BACKEND=gl uses OpenGL where there is a GPU. The whole sheet took 42 s on the CPU here
-# (24 pictures, load 11 to 13). The sheet is written by scripts/contact_sheet.py (numpy only).
+# (24 pictures, load 11 to 13; 308 s at load 15 to 18). The sheet is written by scripts/contact_sheet.py (numpy only).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -53,7 +53,7 @@ for grammar in presets/*.lsys; do
   sheet+=("$out/$name.png" "$name|$label")
 done
 # The paper's plants dressed by their scenes; rendered at the sheet's size.
-for scene in pine coconut_palm saguaro; do
+for scene in pine_dense coconut_palm saguaro; do
   t0=$(date +%s.%N)
   "$sylva" render "presets/scenes/$scene.scene.json" -o "$out/scene_$scene.png" --width "$width" \
     --height "$height" --spp "$spp" --backend "$backend" 2>/dev/null
