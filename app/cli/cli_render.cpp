@@ -12,6 +12,7 @@
 #include <iostream>
 
 #include "app/cli/batch.h"
+#include "app/cli/camera_flags.h"
 #include "app/cli/cli.h"
 #include "app/cli/progress_bar.h"
 #include "app/cli/render_input.h"
@@ -53,6 +54,7 @@ void print_render_help() {
   std::cout
       << "usage: sylva render INPUT -o IMAGE [--backend auto|gl|cpu] [--width W --height H]\n"
          "                    [--aov depth,normal,uv,id,fog] [--spp N] [--verbose]\n"
+         "                    [--eye X,Y,Z] [--target X,Y,Z] [--fov DEG]\n"
          "                    [--geometry frusta|mesh] [--mesh-level M]\n"
          "                    [--fog-mode MODE] [--fog-steps N] [--photons N] [--cone-params P]\n"
          "                    [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n"
@@ -79,6 +81,11 @@ void print_render_help() {
          "                         pixel's centre sees: beauty = fog.T x surface + fog.RGB)\n"
          "      --spp N            samples per pixel, stratified (default 1: pixel centres)\n"
          "      --verbose          list the passes that ran and what each cost\n"
+         "      --eye X,Y,Z        the camera's eye in metres (Y up), e.g. --eye 6,3,6\n"
+         "      --target X,Y,Z     the point it looks at, in metres\n"
+         "      --fov DEG          its full vertical field of view in degrees, in (0, 180)\n"
+         "                         (each overrides a scene's camera key; for a grammar or\n"
+         "                         skeleton the default camera frames the plant, fov 35)\n"
          "      --geometry G       what stands for the plants: frusta (default: the exact\n"
          "                         conical frusta) or mesh (the polygon baseline: the frusta\n"
          "                         tessellated, displaced by bark height maps where a scene\n"
@@ -129,6 +136,7 @@ struct RenderArgs {
   uint32_t aovs = 0;
   uint32_t spp = 1;
   bool verbose = false;
+  CameraFlags camera;  // --eye, --target, --fov
   GeometryOptions geometry;
   FogRenderOptions fog;        // --fog-mode, --fog-steps, --photons, --cone-params
   bool fog_flags = false;      // any of them given
@@ -247,6 +255,12 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
       out.fps = fps;
     } else if (a == "--video") {
       out.video = value();
+    } else if (a == "--eye") {
+      out.camera.eye = parse_point_flag(a, value());
+    } else if (a == "--target") {
+      out.camera.target = parse_point_flag(a, value());
+    } else if (a == "--fov") {
+      out.camera.fov_y_deg = parse_fov_flag(value());
     } else if (a == "--verbose" || a == "-v") {
       out.verbose = true;
     } else {
@@ -370,7 +384,8 @@ int run_render_frames(const RenderArgs& a) {
   }
   auto loaded = load_render_input(last_args, a.width, a.height, passes);
   if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
-  const Scene base = std::move(std::get<Scene>(loaded));
+  Scene base = std::move(std::get<Scene>(loaded));
+  apply_camera_flags(a.camera, base.camera);
   if (!growth && !base.animation)
     throw UsageError{"--frames: " + input + " has no animation key, so its plants stand still (docs/animation.md)"};
   if (range.all) range = {0, animation_frame_count(*base.animation) - 1, false};
@@ -540,6 +555,7 @@ int run_render(const std::vector<std::string>& args) {
   auto loaded = load_render_input(a.grammar, a.width, a.height, passes);
   if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
   Scene scene = std::move(std::get<Scene>(loaded));
+  apply_camera_flags(a.camera, scene.camera);
   if (auto problem = image_size_problem(scene.width, scene.height, a.spp)) {
     std::cerr << "sylva render: error: " << *problem << "\n";
     return kInputError;

@@ -7,7 +7,8 @@
 // plant, look at it (scripts/view_skeleton.py), then update the pinned number.
 // The paper 000 plants must also stay within 15% of the segment counts of the paper's
 // Table 1, and every preset must open with the comment block that says what it models,
-// where it comes from and which knobs to turn.
+// where it comes from and which knobs to turn. Polygon leaves (grammar.md `{ . }`) are
+// not segments; their number in the skeleton is pinned beside the segments.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -19,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "core/skeleton.h"
 #include "process.h"
 
 namespace {
@@ -29,6 +31,7 @@ struct Preset {
   const char* name;             // file stem under presets/
   uint64_t segments;            // pinned: measured at the preset's default seed and steps
   std::optional<double> paper;  // paper 000 Table 1 segment count, for the paper's plants
+  uint64_t leaves = 0;          // pinned: polygon leaves in the skeleton
 };
 
 // Printed by gtest in failure messages and test names.
@@ -43,17 +46,21 @@ const Preset kPresets[] = {
     {"abop_1_24e", 4118, std::nullopt},
     {"abop_1_24f", 992, std::nullopt},
     {"abop_1_25_bush", 7743, std::nullopt},
-    {"abop_1_25_bush_leaves", 3891, std::nullopt},
+    {"abop_1_25_bush_leaves", 3891, std::nullopt, 1284},
     {"abop_1_27_stochastic", 885, std::nullopt},
     {"abop_1_31a_context", 2501, std::nullopt},
     {"abop_2_6_honda", 1023, std::nullopt},
+    // Honda's tree in leaf: the book's branching, polygon leaves on its lateral axes.
+    {"abop_2_6_honda_leaves", 1023, std::nullopt, 5098},
     {"abop_2_8_ternary", 1457, std::nullopt},
     // The plants of paper 000, modelled for sylva; Table 1 gives their segment counts.
     {"saguaro", 30, 30},
-    {"aloe_vera", 229, 229},
-    {"elm", 1769, 1833},
-    {"coconut_palm", 3626, 3713},
-    {"pine", 17468, 16997},
+    {"aloe_vera", 229, 229, 456},  // a keel of frusta under two blade halves a segment
+    {"elm", 1769, 1833},           // leaves of frusta (the grove scenes' elm)
+    {"elm_in_leaf", 1872, 1833, 10627},  // the wood is the segments; leaves are polygons
+    {"coconut_palm", 3626, 3713, 3024},  // three blades over each leaflet's frusta
+    {"pine", 17468, 16997},        // needles of true size (the benchmarks' pine)
+    {"pine_dense", 17509, 16997},  // needles drawn as tufts, twice the fascicles
     // A small cactus for the dancing-cacti scene (paper 000, Figure 8).
     {"cactus", 25, std::nullopt},
     // The well of paper 000, Figure 10, one part per PART (presets/scenes/well.scene.json
@@ -100,6 +107,10 @@ TEST_P(PresetTest, GrowsWithThePinnedSegmentCount) {
   ASSERT_TRUE(segments.has_value()) << "no segment count in grow's summary:\n" << r.out;
   EXPECT_EQ(*segments, p.segments)
       << relative << " changed: look at the plant, then update the pinned count.\n" << r.out;
+
+  sylva::Expected<sylva::Skeleton> skeleton = sylva::read_skeleton_file(output);
+  ASSERT_TRUE(skeleton.ok()) << skeleton.error().format();
+  EXPECT_EQ(skeleton->leaves.size(), p.leaves) << relative << " changed its leaves: look at the plant, then update.";
 
   if (p.paper) {
     const double low = 0.85 * *p.paper, high = 1.15 * *p.paper;
