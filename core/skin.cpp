@@ -378,6 +378,27 @@ ChainPath chain_path(const Skeleton& sk, const Chain& chain, uint64_t& skipped) 
   return path;
 }
 
+// One frustum of a ball or dome around a joint: perpendicular cuts, exact normals.
+Frustum knuckle_piece(const dvec3& base, const dvec3& axis, double length, double r0, double r1,
+                      uint32_t chain, uint32_t joint, uint32_t material, int64_t parent) {
+  Frustum f;
+  f.kind = FrustumKind::knuckle;
+  f.chain = chain;
+  f.segment = joint;
+  f.material = material;
+  f.parent = parent;
+  f.shape.base = base;
+  f.shape.axis = axis;
+  f.shape.length = length;
+  f.shape.radius0 = r0;
+  f.shape.radius1 = r1;
+  f.shape.lower = plane_through(base, axis);
+  f.shape.upper = plane_through(base + length * axis, axis);
+  f.v_lower_m = 0;
+  f.v_upper_m = length;
+  return f;
+}
+
 // Appends the knuckle ball of radius `radius` around `center`, axis `axis` (skin.h).
 void add_knuckle(SkinnedSkeleton& out, const dvec3& center, const dvec3& axis, double radius,
                  int count, uint32_t chain, uint32_t joint, uint32_t material, int64_t parent) {
@@ -385,23 +406,166 @@ void add_knuckle(SkinnedSkeleton& out, const dvec3& center, const dvec3& axis, d
   for (int i = 0; i < count; ++i) {
     double a0 = kPi * i / count, a1 = kPi * (i + 1) / count;
     double y0 = -circum * std::cos(a0), y1 = -circum * std::cos(a1);
-    Frustum f;
-    f.kind = FrustumKind::knuckle;
-    f.chain = chain;
-    f.segment = joint;
-    f.material = material;
-    f.parent = parent;
-    f.shape.base = center + y0 * axis;
-    f.shape.axis = axis;
-    f.shape.length = y1 - y0;
-    f.shape.radius0 = i == 0 ? 0.0 : circum * std::sin(a0);
-    f.shape.radius1 = i + 1 == count ? 0.0 : circum * std::sin(a1);
-    f.shape.lower = plane_through(f.shape.base, axis);
-    f.shape.upper = plane_through(f.shape.base + f.shape.length * axis, axis);
-    f.v_lower_m = 0;
-    f.v_upper_m = f.shape.length;
-    out.frusta.push_back(f);
+    out.frusta.push_back(knuckle_piece(center + y0 * axis, axis, y1 - y0,
+                                       i == 0 ? 0.0 : circum * std::sin(a0),
+                                       i + 1 == count ? 0.0 : circum * std::sin(a1), chain, joint,
+                                       material, parent));
   }
+}
+
+// Appends the dome closing a chain end that carries children (docs/joints.md): frusta
+// stacked along `axis` from the end joint, their profile inscribed in the ball of the end
+// radius (vertices on it), so the first starts at exactly the chain's end radius (no step)
+// and the last ends in a tip on the axis. The chain's flat cap lies under it.
+void add_dome(SkinnedSkeleton& out, const dvec3& centre, const dvec3& axis, double radius,
+              int count, uint32_t chain, uint32_t joint, uint32_t material, int64_t parent) {
+  for (int i = 0; i < count; ++i) {
+    double b0 = 0.5 * kPi * i / count, b1 = 0.5 * kPi * (i + 1) / count;
+    out.frusta.push_back(knuckle_piece(centre + radius * std::sin(b0) * axis, axis,
+                                       radius * (std::sin(b1) - std::sin(b0)), radius * std::cos(b0),
+                                       i + 1 == count ? 0.0 : radius * std::cos(b1), chain, joint,
+                                       material, parent));
+  }
+}
+
+// Sec. "Elbows" of docs/joints.md: every interior corner of the path that bends more
+// than `over_rad` becomes a circular arc tangent to both legs, 0.45 of the shorter leg
+// from the joint, of k >= 2 chords that each turn at most `piece_rad` (the chords turn
+// alpha/k at their shared vertices and alpha/2k at the tangent points). An arc whose radius
+// would be below the tube's radius (its inner side would fold) is not made: that bend
+// stays a mitre, or a split joint with its knuckle. Radii follow the legs' taper; each
+// piece keeps its original segment's lower joint and material, split at the arc's middle.
+ChainPath round_bends(const ChainPath& path, double over_rad, double piece_rad) {
+  const size_t m = path.points.size();
+  if (m < 3) return path;
+  ChainPath out;
+  auto push = [&](const dvec3& p, double r, uint32_t material, uint32_t joint) {
+    out.points.push_back(p);
+    out.radii.push_back(r);
+    out.materials.push_back(material);
+    out.joint_index.push_back(joint);
+  };
+  push(path.points[0], path.radii[0], path.materials[0], path.joint_index[0]);
+  for (size_t i = 1; i + 1 < m; ++i) {
+    const dvec3& j = path.points[i];
+    double len1 = glm::length(j - path.points[i - 1]);
+    double len2 = glm::length(path.points[i + 1] - j);
+    dvec3 m1 = (j - path.points[i - 1]) / len1;
+    dvec3 m2 = (path.points[i + 1] - j) / len2;
+    double alpha = std::atan2(glm::length(glm::cross(m1, m2)), glm::dot(m1, m2));
+    double d = 0.45 * std::min(len1, len2);
+    double rho = alpha > 0 ? d / std::tan(alpha / 2) : 0;
+    if (!(alpha > over_rad) || alpha > kPi * 179.0 / 180.0 || !(rho >= path.radii[i])) {
+      push(j, path.radii[i], path.materials[i], path.joint_index[i]);
+      continue;
+    }
+    int k = std::max(2, int(std::ceil(alpha / piece_rad)));
+    dvec3 toward = glm::normalize(m2 - glm::dot(m2, m1) * m1);  // in the bend plane, ⊥ m1
+    dvec3 t1 = j - d * m1;
+    dvec3 centre = t1 + rho * toward;
+    double r_t1 = path.radii[i] + (path.radii[i - 1] - path.radii[i]) * d / len1;
+    double r_t2 = path.radii[i] + (path.radii[i + 1] - path.radii[i]) * d / len2;
+    auto first_half = [&](int piece) { return 2 * piece + 1 < k; };
+    for (int q = 0; q <= k; ++q) {
+      double phi = alpha * q / k;
+      dvec3 p = q == 0 ? t1 : q == k ? j + d * m2
+                                     : centre - rho * std::cos(phi) * toward + rho * std::sin(phi) * m1;
+      uint32_t material = q == 0 || first_half(q - 1) ? path.materials[i] : path.materials[i + 1];
+      uint32_t joint = q < k && first_half(q) ? path.joint_index[i - 1] : path.joint_index[i];
+      push(p, r_t1 + (r_t2 - r_t1) * q / k, material, joint);
+    }
+  }
+  push(path.points[m - 1], path.radii[m - 1], path.materials[m - 1], path.joint_index[m - 1]);
+  return out;
+}
+
+// What a chain's attachment looks like from its parent (docs/joints.md).
+struct Attachment {
+  bool ends_with_children = false;  // a child chain attaches at this chain's last joint
+  int64_t continuation = -1;        // the child there most in line with it (within 45°)
+  double continuation_cos = 0;      // cos of that child's angle to this chain's end
+};
+
+// Unit direction of a chain at joint `k`: the mean of the directions into and out of it
+// (coincident joints skipped); nullopt for a chain of one point.
+std::optional<dvec3> chain_direction_at(const Skeleton& sk, const Chain& ch, uint32_t k) {
+  dvec3 p = joint_position(sk.joints[ch.first_joint + k]);
+  dvec3 sum(0);
+  for (uint32_t i = k; i-- > 0;) {
+    dvec3 d = p - joint_position(sk.joints[ch.first_joint + i]);
+    if (glm::length(d) > 0) { sum += glm::normalize(d); break; }
+  }
+  for (uint32_t i = k + 1; i < ch.joint_count; ++i) {
+    dvec3 d = joint_position(sk.joints[ch.first_joint + i]) - p;
+    if (glm::length(d) > 0) { sum += glm::normalize(d); break; }
+  }
+  if (!(glm::length(sum) > 1e-12)) return std::nullopt;
+  return glm::normalize(sum);
+}
+
+std::vector<Attachment> attachments(const Skeleton& sk) {
+  std::vector<Attachment> at(sk.chains.size());
+  const double cos_limit = std::cos(kPi / 4);
+  for (uint32_t c = 0; c < sk.chains.size(); ++c) {
+    const Chain& ch = sk.chains[c];
+    if (!ch.parent) continue;
+    const Chain& parent = sk.chains[ch.parent->chain];
+    if (ch.parent->joint + 1 != parent.joint_count) continue;
+    if (!(sk.joints[parent.first_joint + ch.parent->joint].radius_m > 0)) continue;
+    Attachment& a = at[ch.parent->chain];
+    a.ends_with_children = true;
+    std::optional<dvec3> end = chain_direction_at(sk, parent, ch.parent->joint);
+    std::optional<dvec3> start = chain_direction_at(sk, ch, 0);
+    if (!end || !start) continue;
+    double cos_angle = glm::dot(*end, *start);
+    if (cos_angle > cos_limit && cos_angle > a.continuation_cos) {
+      a.continuation = c;
+      a.continuation_cos = cos_angle;
+    }
+  }
+  return at;
+}
+
+// The collar of a lateral, or the continuation of its parent's axis (docs/joints.md):
+// adjusts the radius at the chain's first point and may insert one point on its first
+// segment. Only for a chain that starts at its parent's joint.
+void shape_attachment(ChainPath& path, const Skeleton& sk, uint32_t c,
+                      const std::vector<Attachment>& at, double flare) {
+  const Chain& ch = sk.chains[c];
+  if (!ch.parent || path.points.size() < 2) return;
+  const Chain& parent = sk.chains[ch.parent->chain];
+  const Joint& pj = sk.joints[parent.first_joint + ch.parent->joint];
+  const double big_r = pj.radius_m;
+  if (!(big_r > 0)) return;
+  dvec3 start = path.points[0];
+  if (!(glm::length(start - joint_position(pj)) <= 1e-9 * (1 + glm::length(start)))) return;
+  const bool at_end = ch.parent->joint + 1 == parent.joint_count;
+  if (at_end && at[ch.parent->chain].continuation == int64_t(c)) {
+    path.radii[0] = big_r;  // the axis goes on: no radius step
+    return;
+  }
+  std::optional<dvec3> parent_dir = chain_direction_at(sk, parent, ch.parent->joint);
+  if (!parent_dir) return;
+  double len0 = glm::length(path.points[1] - start);
+  dvec3 a = (path.points[1] - start) / len0;
+  double sin_t = glm::length(glm::cross(a, *parent_dir));
+  // Where the lateral's axis leaves the parent: its tube of radius R, or the end's dome.
+  double t_exit = at_end ? big_r : big_r / std::max(sin_t, 1e-6);
+  double r_l = path.radii[0];
+  // A lateral under a quarter of its parent's radius (a needle, a twig on a limb) makes a
+  // crotch too small to see; its collar would double a needled plant's frusta.
+  if (!(r_l >= 0.25 * big_r)) return;
+  double t_q = std::min(t_exit + r_l, 0.5 * len0);
+  if (!(t_q > t_exit + 0.25 * r_l)) return;  // the collar would stay inside the parent
+  double r_q = r_l + (path.radii[1] - r_l) * t_q / len0;
+  double r_max = (at_end ? 0.98 : 0.9) * big_r;  // the collar's cap stays inside the parent
+  double r0 = std::min(r_q + (flare - 1) * r_l * t_q / (t_q - t_exit), r_max);
+  if (!(r0 > r_q * 1.001)) return;
+  path.points.insert(path.points.begin() + 1, start + t_q * a);
+  path.radii.insert(path.radii.begin() + 1, r_q);
+  path.materials.insert(path.materials.begin() + 1, path.materials[1]);
+  path.joint_index.insert(path.joint_index.begin() + 1, path.joint_index[0]);
+  path.radii[0] = r0;
 }
 
 // Index of the frustum, among those already emitted, that touches joint `joint` of
@@ -431,10 +595,13 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
   assert(validate_skeleton(sk).ok() && "skin_skeleton: skeleton violates its invariants");
   assert(options.max_tilt_deg > 0 && options.max_tilt_deg <= 80);
   assert(options.knuckle_frusta >= 2);
+  assert(options.collar_flare >= 1);
+  assert(options.round_piece_deg > 0 && options.round_piece_deg <= options.round_bends_over_deg);
   const double max_tilt_rad = deg_to_rad(options.max_tilt_deg);
   SkinnedSkeleton out;
   std::vector<int64_t> first_frustum_of_chain(sk.chains.size(), -1);
   std::vector<std::vector<uint32_t>> segment_lower_joint(sk.chains.size());
+  const std::vector<Attachment> joins = options.collars ? attachments(sk) : std::vector<Attachment>(sk.chains.size());
 
   for (uint32_t c = 0; c < sk.chains.size(); ++c) {
     if ((c & kProgressChunkMask) == 0 && c != 0) {  // between chunks of chains
@@ -443,6 +610,11 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
     }
     const Chain& chain = sk.chains[c];
     ChainPath path = chain_path(sk, chain, out.zero_length_skipped);
+    if (options.round_bends_over_deg < 180) {
+      path = round_bends(path, deg_to_rad(options.round_bends_over_deg),
+                         deg_to_rad(options.round_piece_deg));
+    }
+    if (options.collars) shape_attachment(path, sk, c, joins, options.collar_flare);
     const size_t n = path.points.size() < 2 ? 0 : path.points.size() - 1;  // segments
     if (n == 0) continue;
     std::vector<dvec3> axis(n);
@@ -594,6 +766,10 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
           } else if (clamped[i]) {
             ++out.clamped_joints;
           }
+        }
+        if (joins[c].ends_with_children && path.radii[n] > 0) {
+          add_dome(out, path.points[n], axis[n - 1], path.radii[n], std::max(2, options.knuckle_frusta / 2), c,
+                   path.joint_index[n], path.materials[n], int64_t(segment_frustum[n - 1]));
         }
         break;
       }

@@ -43,6 +43,12 @@
 // least 2r wide, i.e. legs of length >= r/tan(0.5°) ≈ 115 r, which plants do not have.
 // Splitting is sufficient, not minimal: an S-bend may be split where a tighter test
 // (per generator instead of slab) would have let it be mitred.
+//
+// Joints between chains and rounded bends (docs/joints.md) change the frusta, never the
+// skeleton: a rounded bend replaces the corner at a joint by an arc of short frusta (each
+// still a segment of its original segment: `segment` names that segment's lower joint),
+// a collar splits a lateral's first segment in two, and a chain end that carries children
+// gets a knuckle ball. The guarantees G1–G4 hold for all of them (the same construction).
 #pragma once
 
 #include <array>
@@ -82,6 +88,27 @@ struct SkinOptions {
   double max_tilt_deg = 60;       // (0, 80]: largest angle between a plane normal and axis
   double twist_rad_per_m = 0;     // u turns by this many radians per metre of arc length
   int knuckle_frusta = 8;         // >= 2: frusta per knuckle ball at a split joint
+  // Joints (docs/joints.md). A lateral's first segment gets a collar: it starts on its
+  // parent's axis flared to collar_flare × its radius where its axis leaves the parent
+  // (at most 0.9 of the parent's radius there, so the flare stays inside the parent;
+  // none for a lateral under a quarter of its parent's radius); a chain whose last joint
+  // carries children ends in a dome of knuckle_frusta / 2 frusta inscribed in the ball of
+  // its end radius instead of a flat cap, and the child most in line with it (within 45°)
+  // starts at that radius.
+  bool collars = true;
+  double collar_flare = 1.3;        // >= 1: collar radius / branch radius at the surface
+  double round_bends_over_deg = 20; // bends sharper than this are rounded by an arc ...
+  double round_piece_deg = 10;      // ... of pieces that each turn at most this much
+
+  // Sec. 2 as published: laterals start with a plain capped cylinder, chain ends are flat
+  // caps and every bend is a mitre (or a split joint): what the paper's figures show.
+  static SkinOptions paper() {
+    SkinOptions o;
+    o.collars = false;
+    o.round_bends_over_deg = 180;
+    o.round_piece_deg = 180;
+    return o;
+  }
 };
 
 // One skinned frustum: the shared shape plus what renderers and texturing need.

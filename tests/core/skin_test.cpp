@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -96,7 +97,7 @@ TEST(SkinStraightChain, ThreeCylindersHavePerpendicularCutsCapsAtBothEndsAndZero
 }
 
 TEST(SkinMiter, NinetyDegreeBendWithEqualRadiiCutsAlongThe45DegreeMiterThroughTheJoint) {
-  SkinnedSkeleton skin = skin_skeleton(bent_chain(90, 0.1, 0.1, 0.1));
+  SkinnedSkeleton skin = skin_skeleton(bent_chain(90, 0.1, 0.1, 0.1), SkinOptions::paper());
   ASSERT_EQ(skin.frusta.size(), 2u);
   EXPECT_EQ(skin.split_joints, 0u);
   const Plane& a = skin.frusta[0].shape.upper;
@@ -132,7 +133,7 @@ TEST(SkinBranch, BranchStartsWithPerpendicularCappedCutAndRecordsItsParent) {
   sk.joints = {joint({0, 0, 0}, 0.3), joint({0, 1, 0}, 0.28), joint({0, 2, 0}, 0.25),
                joint({0, 1, 0}, 0.1), joint({0.7, 1.7, 0}, 0.08)};
   sk.chains = {Chain{0, 3, std::nullopt}, Chain{3, 2, ChainParent{0, 1}}};
-  SkinnedSkeleton skin = skin_skeleton(sk);
+  SkinnedSkeleton skin = skin_skeleton(sk, SkinOptions::paper());  // no collar
   ASSERT_EQ(skin.frusta.size(), 3u);
   const Frustum& branch = skin.frusta[2];
   EXPECT_EQ(branch.chain, 1u);
@@ -144,6 +145,75 @@ TEST(SkinBranch, BranchStartsWithPerpendicularCappedCutAndRecordsItsParent) {
   EXPECT_EQ(branch.v_lower_m, 0.0);
   // Its base (the parent's joint) is inside the parent: buried.
   EXPECT_EQ(branch.shape.base, dvec3(0, 1, 0));
+}
+
+// ---- joints between chains and rounded bends (docs/joints.md) ------------------------
+
+TEST(SkinJoints, ALateralStartsWithAFlaredCollarWhoseCapStaysInsideItsParent) {
+  Skeleton sk;
+  sk.joints = {joint({0, 0, 0}, 0.3), joint({0, 1, 0}, 0.28), joint({0, 2, 0}, 0.25),
+               joint({0, 1, 0}, 0.15), joint({0.85, 1.85, 0}, 0.12)};
+  sk.chains = {Chain{0, 3, std::nullopt}, Chain{3, 2, ChainParent{0, 1}}};
+  SkinnedSkeleton skin = skin_skeleton(sk);
+  ASSERT_EQ(skin.frusta.size(), 4u);  // the lateral's one segment is collar + rest
+  const Frustum& collar = skin.frusta[2];
+  const Frustum& rest = skin.frusta[3];
+  EXPECT_EQ(collar.chain, 1u);
+  EXPECT_EQ(collar.segment, 0u);
+  EXPECT_EQ(rest.segment, 0u);
+  EXPECT_GT(collar.shape.radius0, 0.15 * 1.3);   // flared
+  EXPECT_LE(collar.shape.radius0, 0.9 * 0.28);   // its cap inside the parent
+  EXPECT_EQ(collar.shape.radius1, rest.shape.radius0);  // no step at its end
+  EXPECT_EQ(rest.shape.radius1, 0.12);
+  EXPECT_NEAR(collar.v_upper_m + (rest.v_upper_m - rest.v_lower_m), glm::length(dvec3(0.85, 0.85, 0)), 1e-12);
+  for (const Frustum& f : skin.frusta) EXPECT_TRUE(cuts_are_proper(f.shape, 60));
+}
+
+TEST(SkinJoints, AnEndWithChildrenIsADomeAndTheChildInLineGoesOnAtItsRadius) {
+  Skeleton sk;
+  sk.joints = {joint({0, 0, 0}, 0.3), joint({0, 1.5, 0}, 0.3),        // ends at joint 1
+               joint({0, 1.5, 0}, 0.2), joint({0.1, 3, 0}, 0.18),     // in line: goes on
+               joint({0, 1.5, 0}, 0.15), joint({1.0, 2.1, 0}, 0.12)}; // a lateral
+  sk.chains = {Chain{0, 2, std::nullopt}, Chain{2, 2, ChainParent{0, 1}}, Chain{4, 2, ChainParent{0, 1}}};
+  SkinnedSkeleton skin = skin_skeleton(sk);
+  const size_t dome = size_t(SkinOptions{}.knuckle_frusta / 2);
+  ASSERT_EQ(skin.frusta.size(), 1 + dome + 1 + 2);
+  EXPECT_EQ(skin.frusta[0].shape.radius1, 0.3);
+  const Frustum& dome_base = skin.frusta[1];
+  EXPECT_EQ(dome_base.kind, FrustumKind::knuckle);
+  EXPECT_NEAR(dome_base.shape.radius0, 0.3, 1e-15);  // no rim
+  EXPECT_EQ(skin.frusta[dome].shape.radius1, 0.0);  // a tip
+  const Frustum& goes_on = skin.frusta[1 + dome];
+  EXPECT_EQ(goes_on.chain, 1u);
+  EXPECT_EQ(goes_on.shape.radius0, 0.3);  // no radius step
+  EXPECT_EQ(goes_on.shape.radius1, 0.18);
+  for (const Frustum& f : skin.frusta) EXPECT_TRUE(cuts_are_proper(f.shape, 60));
+}
+
+TEST(SkinJoints, ABendSharperThan20DegreesIsAnArcOfPiecesTurningAtMost10Degrees) {
+  for (double angle : {25.0, 60.0, 100.0}) {
+    SkinnedSkeleton skin = skin_skeleton(bent_chain(angle, 0.2, 0.2, 0.2));
+    SkinnedSkeleton plain = skin_skeleton(bent_chain(angle, 0.2, 0.2, 0.2), SkinOptions::paper());
+    ASSERT_EQ(plain.frusta.size(), 2u);
+    ASSERT_GT(skin.frusta.size(), 3u) << angle;
+    EXPECT_EQ(skin.split_joints, 0u);
+    double arc = 0;
+    for (size_t i = 0; i < skin.frusta.size(); ++i) {
+      const Frustum& f = skin.frusta[i];
+      EXPECT_EQ(f.kind, FrustumKind::segment);
+      EXPECT_TRUE(cuts_are_proper(f.shape, 60)) << angle;
+      EXPECT_NEAR(f.v_lower_m, arc, 1e-12);
+      arc = f.v_upper_m;
+      if (i == 0) continue;
+      const Frustum& below = skin.frusta[i - 1];
+      double turn = std::acos(std::clamp(glm::dot(below.shape.axis, f.shape.axis), -1.0, 1.0)) * 180 / kPi;
+      EXPECT_LE(turn, 10 + 1e-9) << angle;
+      EXPECT_LE(below.segment, f.segment);  // pieces keep their segment, in order
+      EXPECT_EQ(below.shape.upper.normal, f.shape.lower.normal);  // mitred, shared plane
+    }
+    EXPECT_EQ(skin.frusta.front().segment, 0u);
+    EXPECT_EQ(skin.frusta.back().segment, 1u);
+  }
 }
 
 TEST(SkinZeroLength, CoincidentJointsAreSkippedAndCountedWithoutNaN) {
@@ -255,8 +325,8 @@ TEST(SkinSeam, MinorAxisFitMakesTheTwoEllipticalCutsCoincide) {
   // leaves the minor axes apart.
   for (double angle : {20.0, 45.0, 90.0}) {
     Skeleton sk = bent_chain(angle, 0.2, 0.2, 0.05);
-    SkinnedSkeleton plain = skin_skeleton(sk);
-    SkinOptions fit_options;
+    SkinnedSkeleton plain = skin_skeleton(sk, SkinOptions::paper());  // the mitre, unrounded
+    SkinOptions fit_options = SkinOptions::paper();
     fit_options.fit_minor_axis = true;
     SkinnedSkeleton fit = skin_skeleton(sk, fit_options);
     ASSERT_EQ(plain.frusta.size(), 2u);
@@ -304,7 +374,7 @@ TEST(SkinUV, UOnTheSharedCutAgreesFromBothFrustaAcrossBentJoints) {
 }
 
 TEST(SkinUV, VRunsFromLowerToUpperCutScaledByArcLengthAndSafeForCylinders) {
-  SkinnedSkeleton skin = skin_skeleton(bent_chain(40, 0.2, 0.2, 0.1, dvec3(0), 2.0));
+  SkinnedSkeleton skin = skin_skeleton(bent_chain(40, 0.2, 0.2, 0.1, dvec3(0), 2.0), SkinOptions::paper());
   const Frustum& f = skin.frusta[1];  // tilted lower cut, perpendicular upper cut
   EXPECT_DOUBLE_EQ(f.v_lower_m, 2.0);
   EXPECT_DOUBLE_EQ(f.v_upper_m, 4.0);
@@ -470,7 +540,7 @@ TEST(SkinGpu, UnpackingTheRecordReproducesTheShapeWithinFloatPrecision) {
 }
 
 TEST(SkinPrecision, ChainAtAMillionMetresMatchesTheChainAtTheOriginTo1e9Relative) {
-  SkinOptions fit;
+  SkinOptions fit = SkinOptions::paper();
   fit.fit_minor_axis = true;
   dvec3 offset(1e6, -1e6, 1e6);
   SkinnedSkeleton near = skin_skeleton(bent_chain(70, 0.3, 0.2, 0.1), fit);

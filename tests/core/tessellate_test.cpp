@@ -62,9 +62,11 @@ TEST(Tessellate, EveryVertexLiesOnTheAnalyticSurfaceBetweenTheCuts) {
 }
 
 TEST(Tessellate, NeighbouringFrustaShareTheirCutVerticesSoTheMeshHasNoCracks) {
+  // Its 45° and 49° bends are rounded (skin.h): the arcs' pieces are neighbours too.
   SkinnedSkeleton sk = skin_skeleton(chain_of({{0, 0, 0, 0.2}, {0, 1, 0, 0.2}, {0.7, 1.7, 0, 0.15}, {0.7, 2.7, 0.4, 0.1}}));
-  ASSERT_EQ(sk.frusta.size(), 3u);
+  ASSERT_GT(sk.frusta.size(), 3u);
   ASSERT_EQ(sk.split_joints, 0u);
+  for (const Frustum& f : sk.frusta) ASSERT_EQ(f.kind, FrustumKind::segment);
   TessellateOptions o;
   o.level = 1;
   o.caps = false;

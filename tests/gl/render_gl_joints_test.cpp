@@ -1,0 +1,39 @@
+// render_gl_joints_test.cpp — branch joints and elbows (docs/joints.md) in the GL renderer:
+// it draws the same skin as the CPU reference, so the close-ups of tests/core/
+// joint_scenes.h agree with the CPU's (render_gl_test.cpp's hit/miss and depth
+// tolerances) and show no convex crease either (render_joints_test.cpp's limit).
+#include "core/gl/render_gl.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "core/cpu/render_cpu.h"
+#include "tests/core/joint_scenes.h"
+#include "tests/gl/gl_test_util.h"
+
+namespace sylva {
+namespace {
+
+constexpr double kLargestSmoothTurnDeg = 50;  // as tests/cpu/render_joints_test.cpp
+
+TEST(RenderGlJoints, CloseUpsOfJointsAndElbowsMatchTheCpuAndShowNoConvexCrease) {
+  SYLVA_REQUIRE_GL();
+  RenderOptions o;
+  o.aovs = kAovDepth | kAovNormal;
+  for (const test::JointCloseUp& c : test::joint_close_ups()) {
+    const RenderResult gl = render_gl(c.scene, o), cpu = render_cpu(c.scene, o);
+    const gl_test::Agreement a = gl_test::compare(gl.image, cpu.image);
+    const test::SurfaceDefects d = test::surface_defects(c.scene, gl.image);
+    std::printf("[ joints ] %-12s GL vs CPU %s; GL %s\n", c.name.c_str(), a.describe().c_str(),
+                d.describe().c_str());
+    EXPECT_GE(a.hit_miss, 0.995) << c.name << ": " << a.describe();
+    EXPECT_LE(a.depth_median_rel, 1e-4) << c.name << ": " << a.describe();
+    EXPECT_GT(d.pairs, 1000u) << c.name;
+    EXPECT_LT(d.convex_crease_deg, kLargestSmoothTurnDeg) << c.name << ": " << d.describe();
+    EXPECT_LT(d.convex_normal_jump_deg, kLargestSmoothTurnDeg) << c.name << ": " << d.describe();
+  }
+}
+
+}  // namespace
+}  // namespace sylva
