@@ -977,6 +977,19 @@ TEST(GltfImport, BrokenFilesGiveLocatedErrorsNotCrashes) {
                       head + doc + good_source + "," + chains +
                           R"(,"instances":[{"name":"a","position_m":[0,0,0],"rotate_y_deg":0,"scale":-1}]}}}]})",
                       "scale");
+  {
+    // An instance bomb: 50,001 instance records (~3 MB) of a 1,000-joint skeleton would be
+    // 50 million joints (2 GiB) in memory: refused at the instances array, naming the limit.
+    std::string joints;
+    for (int j = 0; j < 1000; ++j) joints += (j ? ",[0," : "[0,") + std::to_string(j) + ",0,0.1,0]";
+    std::string instances;
+    for (int k = 0; k < 50001; ++k)
+      instances += (k ? "," : "") + std::string(R"({"name":"a","position_m":[0,0,0],"rotate_y_deg":0,"scale":1})");
+    expect_import_error(dir, "instance_bomb.gltf",
+                        head + doc + good_source + R"(,"chains":[{"parent":null,"joints":[)" + joints + "]}]" +
+                            R"(,"instances":[)" + instances + "]}}}]}",
+                        "joints, more than the limit of 50000000 for one glTF file");
+  }
   expect_import_error(dir, "deep.gltf", std::string(100000, '['), "");
   expect_import_error(dir, "deep_object.gltf", "{\"a\":" + std::string(100000, '['), "");
 
