@@ -199,6 +199,22 @@ TEST(GltfExport, EveryAccessorHasExactMinAndMax) {
   }
 }
 
+TEST(GltfExport, ValuesBeyondFloat32AreRefusedNotWrittenAsNull) {
+  // A skeleton file may hold 1e39 (beyond float32's 3.4e38): the accessors would hold
+  // infinities, which JSON writes as null (an invalid file). Refused, nothing written.
+  TempFolder dir;
+  for (const double far : {1e39, 2e12}) {
+    Skeleton sk;
+    sk.joints.push_back({{0, 0, 0}, 0.1, 0});
+    sk.joints.push_back({{far, 1, 0}, 0.1, 0});
+    sk.chains.push_back({0, 2, std::nullopt});
+    const Status written = export_gltf({{"far", sk}}, dir.file("far.gltf"));
+    ASSERT_FALSE(written.ok()) << far;
+    EXPECT_NE(written.error().message.find("1e12"), std::string::npos) << written.error().message;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("far.gltf")));
+  }
+}
+
 TEST(GltfExport, NoNullEntriesEvenForAPlantWithoutSegments) {
   // Trap: tinygltf writes an empty node as `null`.
   TempFolder dir;
