@@ -32,6 +32,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/util/file_io.h"
+#include "core/util/image_io.h"
 #include "core/util/json.h"
 #include "core/leaf_mesh.h"
 #include "core/materials.h"
@@ -243,12 +244,9 @@ Expected<EmbeddedImage> read_albedo_image(const std::string& path) {
   if (bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) image.mime = "image/png";
   else if (bytes.compare(0, 3, "\xFF\xD8\xFF") == 0) image.mime = "image/jpeg";
   else return file_diagnostic(path, "the bark albedo texture must be a PNG or JPEG file to be embedded in glTF");
-  // The header must decode too (a viewer, and the validator, read it).
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) {
-    const std::string why = OIIO::geterror();
-    return file_diagnostic(path, "the bark albedo texture is not a readable image" + (why.empty() ? "" : ": " + why));
-  }
+  // It must decode too, to its last row (a viewer, and the validator, read it).
+  if (Status decodes = check_image_opens(path); !decodes)
+    return file_diagnostic(path, "the bark albedo texture is not a readable image: " + decodes.error().message);
   image.bytes = std::move(*file);
   return image;
 }
@@ -901,6 +899,17 @@ Status read_sylva_extras(const std::string& path, const JsonValue& node, size_t 
   }
   if (!instances->is_array() || instances->elements.empty())
     return error_at(path, *instances, where + ".instances must be a non-empty array");
+  // Each instance is a copy of the skeleton: a few bytes of instance record must not
+  // become gigabytes of joints (docs/limits.md "Inputs").
+  uint64_t joints = 0;
+  for (const GltfPlant& p : *plants) joints += p.skeleton.joints.size();
+  const uint64_t more = uint64_t{read->joints.size()} * instances->elements.size();
+  if (joints + more > kMaxImportedJoints)
+    return error_at(path, *instances, where + ".instances: " + std::to_string(instances->elements.size()) +
+                                          " copies of a skeleton of " + std::to_string(read->joints.size()) +
+                                          " joints would make the file's plants hold " + std::to_string(joints + more) +
+                                          " joints, more than the limit of " + std::to_string(kMaxImportedJoints) +
+                                          " for one glTF file");
   for (size_t k = 0; k < instances->elements.size(); ++k) {
     const JsonValue& inst = instances->elements[k];
     const std::string iwhere = where + ".instances[" + std::to_string(k) + "]";

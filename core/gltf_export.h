@@ -81,6 +81,10 @@
 namespace sylva {
 
 // One plant placed in the file.
+// The most joints the plants read back from one glTF file may hold, instances counted
+// (each instance is a copy of its skeleton; docs/limits.md "Inputs"): about 2 GiB.
+inline constexpr uint64_t kMaxImportedJoints = 50'000'000;
+
 struct GltfPlant {
   std::string name;             // node name, e.g. "elm" (from the grammar file's stem)
   Skeleton skeleton;            // in the plant's own frame, metres

@@ -5,7 +5,9 @@
 #include <cassert>
 #include <cmath>
 #include <glm/geometric.hpp>
+#include <cstdio>
 #include <numeric>
+#include <string>
 
 namespace sylva {
 
@@ -47,7 +49,32 @@ int tessellation_columns(const TessellateOptions& o) {
 
 int tessellation_rows(const TessellateOptions& o) { return 1 << std::max(0, o.level); }
 
+MeshSize tessellation_size(uint64_t frusta, const TessellateOptions& o) {
+  // In long double: 6 levels x 4096 columns x a million frusta must not wrap.
+  const long double n = tessellation_columns(o), k = std::min(tessellation_rows(o), 1 << 20);
+  const long double vertices = static_cast<long double>(frusta) * ((n + 1) * (k + 1) + 2 * (n + 2));
+  const long double triangles = static_cast<long double>(frusta) * n * (2 * k + 2);
+  const long double bytes = vertices * (sizeof(glm::dvec3) * 2 + sizeof(glm::dvec2)) +
+                            triangles * (3 * sizeof(uint32_t) + sizeof(uint32_t));
+  const auto clamp = [](long double x) { return x >= 1.8e19L ? UINT64_MAX : static_cast<uint64_t>(x); };
+  return {clamp(vertices), clamp(triangles), clamp(bytes)};
+}
+
+void check_mesh_fits(const MeshSize& size, uint64_t already_bytes) {
+  const auto gib = [](long double b) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3Lg GiB", b / (1u << 30));
+    return std::string(text);
+  };
+  const long double total = static_cast<long double>(size.bytes) + already_bytes;
+  if (total > kMaxMeshBytes)
+    throw MeshTooLarge("the mesh would take " + gib(total) + ", more than the limit of " + gib(kMaxMeshBytes) +
+                       " for a mesh (" + std::to_string(size.triangles) +
+                       " triangles in this plant alone); lower --mesh-level or --segments-around");
+}
+
 TriangleMesh tessellate(const SkinnedSkeleton& skinned, const TessellateOptions& o) {
+  check_mesh_fits(tessellation_size(skinned.frusta.size(), o));
   const int n = tessellation_columns(o), k = tessellation_rows(o);
   TriangleMesh mesh;
   const size_t per_frustum_vertices = static_cast<size_t>(n + 1) * (k + 1) + 2 * (n + 2);
@@ -55,6 +82,7 @@ TriangleMesh tessellate(const SkinnedSkeleton& skinned, const TessellateOptions&
   mesh.normals.reserve(mesh.positions.capacity());
   mesh.uvs.reserve(mesh.positions.capacity());
   mesh.indices.reserve(skinned.frusta.size() * static_cast<size_t>(n) * (2 * k + 2) * 3);
+  mesh.triangle_frustum.reserve(mesh.indices.capacity() / 3);
 
   // Top-row points of each frustum, reused as the bottom row of the frustum above it
   // when the two share their cut plane: the mesh is watertight by construction.

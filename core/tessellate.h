@@ -24,6 +24,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <span>
+#include <stdexcept>
 #include <vector>
 
 #include "core/skin.h"
@@ -53,7 +54,29 @@ struct TriangleMesh {
 int tessellation_columns(const TessellateOptions& options);
 int tessellation_rows(const TessellateOptions& options);
 
-// Tessellates every frustum of `skinned`. Deterministic.
+// The most a mesh may take (docs/limits.md "Numbers"): its arrays at most kMaxMeshBytes
+// (64 bytes a vertex, so its vertices stay far below what 32-bit indices address). A
+// mesh past it is refused before anything is allocated for it (MeshTooLarge), naming the
+// limit and what to lower.
+constexpr uint64_t kMaxMeshBytes = uint64_t{8} << 30;  // 8 GiB
+struct MeshTooLarge : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Bytes and vertices tessellate() reserves for `frusta` frusta with `options` (an upper
+// bound of what it uses), computed from the counts alone, without overflow.
+struct MeshSize {
+  uint64_t vertices = 0;
+  uint64_t triangles = 0;
+  uint64_t bytes = 0;
+};
+MeshSize tessellation_size(uint64_t frusta, const TessellateOptions& options);
+// Throws MeshTooLarge when a mesh of `size`, added to `already_bytes` of meshes already
+// built for the same picture, passes the limits.
+void check_mesh_fits(const MeshSize& size, uint64_t already_bytes = 0);
+
+// Tessellates every frustum of `skinned`. Deterministic. Throws MeshTooLarge (before
+// allocating) when the mesh cannot fit.
 TriangleMesh tessellate(const SkinnedSkeleton& skinned, const TessellateOptions& options = {});
 
 // Appends `part` to `into`: its indices shifted past into's vertices, its triangle_frustum

@@ -20,6 +20,9 @@ constexpr uint64_t kAxiomKeyBase = 0xA7104D5EEDULL;
 constexpr uint64_t kHomomorphismStreamBase = 0x40000000ULL;
 constexpr uint32_t kNoMatch = 0xFFFFFFFFu;
 constexpr size_t kMaxParams = 0xFFFFFFF0u;
+// Interpretation writes at most this many times --max-modules modules over all its passes
+// (docs/limits.md "Work"): the default depth's worth of whole words.
+constexpr uint64_t kInterpretBudgetFactor = 16;
 
 struct DeriveFailure {
   SourceLoc loc;
@@ -59,7 +62,11 @@ class Rewriter {
           p.probability.kind == Expr::Kind::kNone && p.successor.all_constant)
         direct_[s] = &p;
     }
-    for (const Production& p : productions_) uses_context_ |= p.has_context();
+    for (const Production& p : productions_) {
+      uses_context_ |= p.has_context();
+      uses_left_context_ |= !p.left_context.empty();
+      uses_right_context_ |= !p.right_context.empty();
+    }
   }
 
   // Rewrites `in` into `out` (cleared first). `stream` distinguishes steps/passes in the
@@ -100,13 +107,102 @@ class Rewriter {
     }
   }
 
+  // Interpretation without context (grammar.md "Interpretation rules"), depth first: each
+  // module of `in` is expanded completely, its successors in turn up to `max_depth`, before
+  // the next one, so a module without a production is copied once rather than once per
+  // pass. The result, random streams and lineage keys are those of the passes (pass d
+  // rewrites the modules produced by pass d - 1 with stream `stream_base + d`); a pending
+  // stack holds at most max_depth successors. Every module written to the stack or `out`
+  // counts against `work_budget`.
+  void expand(const Word& in, Word& out, uint64_t stream_base, int max_depth, uint64_t work_budget,
+              const Progress& progress, int* deepest_applied, uint64_t* left_expandable) {
+    out_ = &out;
+    const bool keyed = !in.lineage.empty();
+    const size_t n = in.size();
+    *deepest_applied = 0;
+    *left_expandable = 0;
+    work_budget_ = work_budget;
+    for (size_t i = 0; i < n; ++i) {
+      if ((i & kProgressChunkMask) == 0 && i != 0) {
+        if (progress.cancelled()) throw DeriveCancelled{};
+        progress.report(static_cast<double>(i) / static_cast<double>(n), "interpret");
+      }
+      if (by_symbol_[in.modules[i].symbol].empty()) {
+        copy_module(in, i, out);  // the common case: nothing to expand, no stack
+        continue;
+      }
+      stack_.clear();
+      stack_depth_.clear();
+      copy_module(in, i, stack_);
+      stack_depth_.push_back(1);
+      while (!stack_.modules.empty()) {
+        const size_t t = stack_.size() - 1;
+        const Module m = stack_.modules[t];
+        const int d = stack_depth_[t];
+        current_depth = d;
+        const Production* chosen = nullptr;
+        Rng rng;
+        const bool has_rules = !by_symbol_[m.symbol].empty();
+        if (has_rules && d <= max_depth) {
+          in_ = &stack_;
+          const Production* direct = direct_[m.symbol];
+          if (direct && direct->predecessor.arity == m.param_count) {
+            chosen = direct;
+          } else {
+            if (keyed) rng = Rng(mix_pair(mix_pair(seed_, stack_.lineage[t]), stream_base + static_cast<uint64_t>(d)));
+            chosen = choose(t, m, rng);
+          }
+        }
+        if (!chosen) {
+          if (has_rules && d > max_depth) ++*left_expandable;
+          copy_module(stack_, t, out);
+          pop(t);
+          continue;
+        }
+        *deepest_applied = std::max(*deepest_applied, d);
+        successor_.clear();
+        out_ = &successor_;
+        apply(*chosen, t, rng, keyed);
+        out_ = &out;
+        pop(t);
+        // A failure while pushing names the production, not a module (t is gone).
+        current_production = chosen;
+        current = SIZE_MAX;
+        // Pushed last to first, so the first successor module is expanded next.
+        for (size_t k = successor_.size(); k-- > 0;) {
+          copy_module(successor_, k, stack_);
+          stack_depth_.push_back(d + 1);
+        }
+      }
+    }
+  }
+
+  // Pattern modules compared with the word so far (each costs one step of the context
+  // walk, however much the walk passes over): the work counter of derive.h's stats.
+  uint64_t context_steps() const { return context_steps_; }
+  // Modules written (to the result, and by expand() to its stack): interpretation's work.
+  uint64_t work() const { return work_; }
+  void set_work_budget(uint64_t budget) { work_budget_ = budget; }
+
   // Index of the module whose production failed, for messages.
   size_t current = 0;
   const Production* current_production = nullptr;
+  int current_depth = 0;  // expand(): the pass the failing module belongs to
+  // The word `current` indexes (the word being rewritten, or expand()'s pending stack).
+  const Word* current_word() const { return in_; }
 
  private:
+  // Removes the last module of expand()'s stack (index t), with its parameters and key.
+  void pop(size_t t) {
+    stack_.params.resize(stack_.modules[t].param_begin);
+    stack_.modules.pop_back();
+    if (!stack_.lineage.empty()) stack_.lineage.pop_back();
+    stack_depth_.pop_back();
+  }
+
   void copy_module(const Word& in, size_t i, Word& out) {
     const Module& m = in.modules[i];
+    if (++work_ > work_budget_) over_budget();
     if (out.modules.size() + out.params.size() + 1 + m.param_count > max_modules_) too_many();
     if (out.params.size() > kMaxParams) too_many_params();
     out.modules.push_back(Module{m.symbol, m.param_count, static_cast<uint32_t>(out.params.size())});
@@ -120,6 +216,10 @@ class Rewriter {
                                 " modules), each parameter counting as a module; raise --max-modules or lower "
                                 "the derivation length"};
   }
+  [[noreturn]] void over_budget() {
+    throw DeriveFailure{{}, "the interpretation exceeds its budget of " + std::to_string(work_budget_) +
+                                " modules written (16 x --max-modules); lower `maximum depth:` or raise --max-modules"};
+  }
   [[noreturn]] void too_many_params() {
     throw DeriveFailure{{}, "the word holds more than 4 billion parameters"};
   }
@@ -129,6 +229,10 @@ class Rewriter {
     for (uint16_t k = 0; k < pm.arity; ++k) slots_[pm.first_slot + k] = p[k];
   }
 
+  // One pass over the word before a step: bracket partners and the jump tables that let
+  // context matching pass over ignored modules, completed branches and the rest of a
+  // branch in one step each (ABOP 1.8's walk, without rescanning what it skips). So the
+  // context of a module costs its pattern's length, not the length of what lies between.
   void compute_brackets(const Word& w) {
     const size_t n = w.size();
     match_.assign(n, kNoMatch);
@@ -143,6 +247,53 @@ class Rewriter {
         open_.pop_back();
       }
     }
+    // Going right (from the end): the first module at or after j that is not ignored;
+    // the same passing over completed branches too (an unclosed '[' stops it); the
+    // ']' that ends the branch j is in (n: the word's end; kNoMatch: an unclosed '['
+    // lies in the way).
+    if (uses_right_context_) compute_right_tables(w);
+    if (uses_left_context_) compute_left_table(w);
+  }
+
+  void compute_right_tables(const Word& w) {
+    const size_t n = w.size();
+    skip_ignored_.assign(n + 1, static_cast<uint32_t>(n));
+    skip_right_.assign(n + 1, static_cast<uint32_t>(n));
+    branch_end_.assign(n + 1, static_cast<uint32_t>(n));
+    for (size_t j = n; j-- > 0;) {
+      const SymbolId s = w.modules[j].symbol;
+      const uint32_t after = static_cast<uint32_t>(j + 1);
+      skip_ignored_[j] = ignored(s) ? skip_ignored_[after] : static_cast<uint32_t>(j);
+      if (ignored(s)) {
+        skip_right_[j] = skip_right_[after];
+        branch_end_[j] = branch_end_[after];
+      } else if (s == kSymPush && match_[j] != kNoMatch) {
+        skip_right_[j] = skip_right_[match_[j] + 1];
+        branch_end_[j] = branch_end_[match_[j] + 1];
+      } else if (s == kSymPush) {
+        skip_right_[j] = static_cast<uint32_t>(j);
+        branch_end_[j] = kNoMatch;
+      } else if (s == kSymPop) {
+        skip_right_[j] = static_cast<uint32_t>(j);
+        branch_end_[j] = static_cast<uint32_t>(j);
+      } else {
+        skip_right_[j] = static_cast<uint32_t>(j);
+        branch_end_[j] = branch_end_[after];
+      }
+    }
+  }
+
+  // Going left: the last module at or before j that is not ignored, not a '[' (climbed
+  // out of) and not a completed branch; an unmatched ']' stops it; kNoMatch past the start.
+  void compute_left_table(const Word& w) {
+    const size_t n = w.size();
+    skip_left_.assign(n, kNoMatch);
+    for (size_t j = 0; j < n; ++j) {
+      const SymbolId s = w.modules[j].symbol;
+      if (s == kSymPush || ignored(s)) skip_left_[j] = j ? skip_left_[j - 1] : kNoMatch;
+      else if (s == kSymPop && match_[j] != kNoMatch) skip_left_[j] = match_[j] ? skip_left_[match_[j] - 1] : kNoMatch;
+      else skip_left_[j] = static_cast<uint32_t>(j);
+    }
   }
 
   bool ignored(SymbolId s) const { return g_.ignored[s] != 0; }
@@ -151,24 +302,17 @@ class Rewriter {
   // the branch we are in (its "["), so the context is the module below on the path.
   bool match_left(const Production& p, size_t i) {
     const Word& w = *in_;
-    int64_t j = static_cast<int64_t>(i) - 1;
-    for (int64_t k = static_cast<int64_t>(p.left_context.size()) - 1; k >= 0;) {
-      if (j < 0) return false;
+    uint32_t j = i ? static_cast<uint32_t>(i - 1) : kNoMatch;
+    for (size_t k = p.left_context.size(); k-- > 0;) {
+      ++context_steps_;
+      if (j != kNoMatch) j = skip_left_[j];
+      if (j == kNoMatch) return false;
       const Module& m = w.modules[j];
-      if (m.symbol == kSymPop) {
-        if (match_[j] == kNoMatch) return false;
-        j = static_cast<int64_t>(match_[j]) - 1;
-        continue;
-      }
-      if (m.symbol == kSymPush || ignored(m.symbol)) {
-        --j;
-        continue;
-      }
+      if (m.symbol == kSymPop) return false;  // an unmatched ']'
       const PatternModule& pm = p.left_context[k];
       if (m.symbol != pm.symbol || m.param_count != pm.arity) return false;
       bind(pm, m);
-      --k;
-      --j;
+      j = j ? j - 1 : kNoMatch;
     }
     return true;
   }
@@ -181,48 +325,37 @@ class Rewriter {
     const size_t n = w.size();
     size_t j = i + 1;
     entered_.clear();
-    for (size_t k = 0; k < p.right_context.size();) {
+    for (size_t k = 0; k < p.right_context.size(); ++k) {
+      ++context_steps_;
       const PatternModule& pm = p.right_context[k];
-      while (j < n && ignored(w.modules[j].symbol)) ++j;
       if (j >= n) return false;
-      const Module& m = w.modules[j];
       if (pm.symbol == kSymPush) {
-        if (m.symbol != kSymPush) return false;
+        j = skip_ignored_[j];
+        if (j >= n || w.modules[j].symbol != kSymPush) return false;
         entered_.push_back(static_cast<uint32_t>(j));
         ++j;
-        ++k;
         continue;
       }
       if (pm.symbol == kSymPop) {
+        if (skip_ignored_[j] >= n) return false;
         size_t close;
         if (!entered_.empty()) {
           close = match_[entered_.back()];
           entered_.pop_back();
         } else {
-          close = j;
-          while (close < n && w.modules[close].symbol != kSymPop) {
-            if (w.modules[close].symbol == kSymPush) {
-              if (match_[close] == kNoMatch) return false;
-              close = match_[close];
-            }
-            ++close;
-          }
+          close = branch_end_[j];
         }
         if (close >= n) return false;
         j = close + 1;
-        ++k;
         continue;
       }
-      if (m.symbol == kSymPush) {
-        if (match_[j] == kNoMatch) return false;
-        j = match_[j] + 1;
-        continue;
-      }
-      if (m.symbol == kSymPop) return false;
+      j = skip_right_[j];
+      if (j >= n) return false;
+      const Module& m = w.modules[j];
+      if (m.symbol == kSymPush || m.symbol == kSymPop) return false;  // an unclosed '[', the branch's end
       if (m.symbol != pm.symbol || m.param_count != pm.arity) return false;
       bind(pm, m);
       ++j;
-      ++k;
     }
     return true;
   }
@@ -300,6 +433,7 @@ class Rewriter {
     Word& out = *out_;
     const Successor& s = p.successor;
     if (out.modules.size() + out.params.size() + s.modules.size() + s.args.size() > max_modules_) too_many();
+    if ((work_ += s.modules.size()) > work_budget_) over_budget();
     if (out.params.size() > kMaxParams) too_many_params();
     const size_t first_new = out.modules.size();
     if (s.all_constant) {
@@ -337,6 +471,13 @@ class Rewriter {
   std::vector<uint32_t> match_;
   std::vector<uint32_t> open_;
   std::vector<uint32_t> entered_;
+  std::vector<uint32_t> skip_ignored_, skip_right_, branch_end_;
+  std::vector<uint32_t> skip_left_;
+  bool uses_left_context_ = false, uses_right_context_ = false;
+  uint64_t context_steps_ = 0;
+  uint64_t work_ = 0, work_budget_ = UINT64_MAX;
+  Word stack_, successor_;
+  std::vector<int> stack_depth_;
   std::vector<std::pair<const Production*, double>> candidates_;
 };
 
@@ -371,14 +512,15 @@ void apply_cut(Word& w) {
   if (keyed) w.lineage.resize(out);
 }
 
-Diagnostic failure_diagnostic(const Grammar& g, const Word& in, const Rewriter& r, const std::string& message,
-                              SourceLoc loc, const char* what, int64_t step) {
+Diagnostic failure_diagnostic(const Grammar& g, const Rewriter& r, const std::string& message, SourceLoc loc,
+                              const char* what, int64_t step) {
   std::string text = message;
+  const Word* in = r.current_word();
   if (r.current_production) {
     const Production& p = *r.current_production;
     text += ", in production '" + p.text + "' at " + std::to_string(p.loc.line) + ":" +
             std::to_string(p.loc.column);
-    if (r.current < in.size()) text += " rewriting module " + module_text(in, r.current, g.symbols);
+    if (in && r.current < in->size()) text += " rewriting module " + module_text(*in, r.current, g.symbols);
     if (loc.line == 0) loc = p.loc;
   }
   text += std::string(" at ") + what + " " + std::to_string(step);
@@ -452,9 +594,9 @@ Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStat
   } catch (const DeriveCancelled&) {
     return cancelled_diagnostic();
   } catch (const DeriveFailure& f) {
-    return failure_diagnostic(g, cur, rewriter, f.message, f.loc, "step", step);
+    return failure_diagnostic(g, rewriter, f.message, f.loc, "step", step);
   } catch (const EvalError& e) {
-    return failure_diagnostic(g, cur, rewriter, e.message, e.loc, "step", step);
+    return failure_diagnostic(g, rewriter, e.message, e.loc, "step", step);
   } catch (const std::bad_alloc&) {
     return g.error_at({}, "out of memory at step " + std::to_string(step) + "; lower --max-modules or the derivation length");
   }
@@ -462,6 +604,7 @@ Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStat
     stats->steps = steps;
     stats->modules = cur.size();
     stats->peak_bytes = peak;
+    stats->context_steps = rewriter.context_steps();
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   options.progress.report(1, "derive");
@@ -477,40 +620,60 @@ Expected<Word> interpret(const Grammar& g, const Word& word, const DeriveOptions
     for (size_t i = 0; i < cur.size(); ++i) cur.lineage[i] = mix_pair(kAxiomKeyBase, i);
   }
   Word next;
-  std::vector<uint8_t> active(cur.size(), 1), next_active;
   Rewriter rewriter(g, g.homomorphism, g.homomorphism_by_symbol, seed, options.max_modules);
-  int depth = 0;
+  const uint64_t budget = options.max_modules > UINT64_MAX / kInterpretBudgetFactor
+                              ? UINT64_MAX
+                              : options.max_modules * kInterpretBudgetFactor;
+  rewriter.set_work_budget(budget);
+  const bool context = std::any_of(g.homomorphism.begin(), g.homomorphism.end(),
+                                   [](const Production& p) { return p.has_context(); });
+  int depth = 0;  // passes performed, as stats report them
+  uint64_t left = 0;
   try {
-    for (depth = 1; depth <= g.max_depth; ++depth) {
-      if (options.progress.cancelled()) return cancelled_diagnostic();
-      next.clear();
-      next_active.clear();
-      rewriter.current_production = nullptr;
-      // Passes until nothing expands: each reports within the pass only (how many
-      // passes there will be is not known), monotone across passes by the share scheme
-      // 1 - 2^-depth.
-      const double first = 1 - std::ldexp(1.0, -(depth - 1)), last = 1 - std::ldexp(1.0, -depth);
-      rewriter.rewrite(cur, next, kHomomorphismStreamBase + static_cast<uint64_t>(depth), &active, &next_active,
-                       options.progress.part(first, last), "interpret");
-      bool changed = std::find(next_active.begin(), next_active.end(), 1) != next_active.end();
+    if (!context) {
+      // Without context, pass d reads nothing but the modules pass d - 1 produced: expand
+      // each module depth first, so unexpandable modules are not copied once per pass.
+      int deepest = 0;
+      rewriter.expand(cur, next, kHomomorphismStreamBase, g.max_depth, budget, options.progress, &deepest, &left);
+      depth = std::min(deepest + 1, g.max_depth);
       std::swap(cur, next);
-      std::swap(active, next_active);
-      if (!changed) break;
+    } else {
+      // Context reads the whole word of the pass before: pass by pass, each over the word.
+      std::vector<uint8_t> active(cur.size(), 1), next_active;
+      for (depth = 1; depth <= g.max_depth; ++depth) {
+        if (options.progress.cancelled()) return cancelled_diagnostic();
+        next.clear();
+        next_active.clear();
+        rewriter.current_production = nullptr;
+        rewriter.current_depth = depth;
+        // Passes until nothing expands: each reports within the pass only (how many
+        // passes there will be is not known), monotone across passes by the share scheme
+        // 1 - 2^-depth.
+        const double first = 1 - std::ldexp(1.0, -(depth - 1)), last = 1 - std::ldexp(1.0, -depth);
+        rewriter.rewrite(cur, next, kHomomorphismStreamBase + static_cast<uint64_t>(depth), &active, &next_active,
+                         options.progress.part(first, last), "interpret");
+        bool changed = std::find(next_active.begin(), next_active.end(), 1) != next_active.end();
+        std::swap(cur, next);
+        std::swap(active, next_active);
+        if (!changed) break;
+      }
+      // Modules produced by the last pass that still have a production: left unexpanded.
+      if (depth > g.max_depth)
+        for (size_t i = 0; i < cur.size(); ++i)
+          if (active[i] && !g.homomorphism_by_symbol[cur.modules[i].symbol].empty()) ++left;
+      depth = std::min(depth, g.max_depth);
     }
   } catch (const DeriveCancelled&) {
     return cancelled_diagnostic();
   } catch (const DeriveFailure& f) {
-    return failure_diagnostic(g, cur, rewriter, f.message, f.loc, "interpretation depth", depth);
+    return failure_diagnostic(g, rewriter, f.message, f.loc, "interpretation depth", rewriter.current_depth);
   } catch (const EvalError& e) {
-    return failure_diagnostic(g, cur, rewriter, e.message, e.loc, "interpretation depth", depth);
+    return failure_diagnostic(g, rewriter, e.message, e.loc, "interpretation depth", rewriter.current_depth);
   }
   if (stats) {
-    stats->depth = std::min(depth, g.max_depth);
-    // Modules produced by the last pass that still have a production: left unexpanded.
-    uint64_t left = 0;
-    for (size_t i = 0; i < cur.size(); ++i)
-      if (active[i] && !g.homomorphism_by_symbol[cur.modules[i].symbol].empty()) ++left;
-    stats->still_expandable = depth > g.max_depth ? left : 0;
+    stats->depth = depth;
+    stats->still_expandable = left;
+    stats->work = rewriter.work();
   }
   cur.lineage.clear();
   cur.lineage.shrink_to_fit();

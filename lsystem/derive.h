@@ -45,6 +45,10 @@ struct DeriveStats {
   int64_t steps = 0;           // steps performed
   uint64_t modules = 0;        // modules in the result
   uint64_t peak_bytes = 0;     // most bytes held by word buffers at any one time
+  // Context pattern modules compared over all steps: the context walk passes over ignored
+  // modules and whole branches in one step each, so this is at most the modules tried
+  // times their patterns' length (a work counter for tests; docs/limits.md "Work").
+  uint64_t context_steps = 0;
   double seconds = 0;
 };
 
@@ -55,10 +59,16 @@ Expected<Word> derive(const Grammar& grammar, const DeriveOptions& options = {},
 struct InterpretStats {
   int depth = 0;                 // homomorphism passes performed
   uint64_t still_expandable = 0; // modules left unexpanded at the depth limit
+  // Modules written: to the result and, without context, to the pending stack of the
+  // depth-first expansion (a work counter for tests; docs/limits.md "Work"). At most
+  // 16 x max_modules: beyond that interpretation fails naming its budget.
+  uint64_t work = 0;
 };
 
 // Applies the homomorphism (interpretation) productions recursively, up to the grammar's
-// maximum depth, giving the word the turtle reads. Returns a copy of `word` when the
+// maximum depth, giving the word the turtle reads. Without context its work is the size of
+// the expansion (a module without a production costs once, not once per pass); with
+// context each pass reads the whole word of the pass before. Returns a copy of `word` when the
 // grammar has no homomorphism.
 Expected<Word> interpret(const Grammar& grammar, const Word& word, const DeriveOptions& options = {},
                          InterpretStats* stats = nullptr);

@@ -58,25 +58,72 @@ bool SymbolTable::find(std::string_view name, SymbolId* id) const {
   return true;
 }
 
+SymbolWork& symbol_work() {
+  thread_local SymbolWork work;
+  return work;
+}
+
+namespace {
+constexpr uint32_t kNoNode = 0xFFFFFFFFu;
+uint64_t edge_key(uint32_t node, unsigned char byte) { return (uint64_t{node} << 8) | byte; }
+}  // namespace
+
+uint32_t SymbolTable::trie_child(uint32_t node, unsigned char byte) const {
+  ++symbol_work().trie_steps;
+  auto it = trie_edges_.find(edge_key(node, byte));
+  return it == trie_edges_.end() ? kNoNode : it->second;
+}
+
 void SymbolTable::declare_multichar(std::string_view name) {
-  if (std::find(multichar_.begin(), multichar_.end(), name) != multichar_.end()) return;
-  multichar_.emplace_back(name);
-  if (!name.empty()) multichar_first_byte_[static_cast<unsigned char>(name[0])] = true;
-  std::stable_sort(multichar_.begin(), multichar_.end(),
-                   [](const std::string& a, const std::string& b) { return a.size() > b.size(); });
+  if (name.empty()) return;
+  multichar_first_byte_[static_cast<unsigned char>(name[0])] = true;
+  uint32_t node = 0;
+  for (char ch : name) {
+    const unsigned char byte = static_cast<unsigned char>(ch);
+    uint32_t child = trie_child(node, byte);
+    if (child == kNoNode) {
+      child = static_cast<uint32_t>(trie_terminal_.size());
+      trie_terminal_.push_back(0);
+      trie_has_child_.push_back(0);
+      trie_edges_.emplace(edge_key(node, byte), child);
+      trie_has_child_[node] = 1;
+    }
+    node = child;
+  }
+  trie_terminal_[node] = 1;
 }
 
 size_t SymbolTable::match_multichar(std::string_view text) const {
   if (text.empty() || !multichar_first_byte_[static_cast<unsigned char>(text[0])]) return 0;
-  for (const std::string& name : multichar_)
-    if (text.substr(0, name.size()) == name) return name.size();
-  return 0;
+  // The deepest terminal node on text's path is the longest declared name it starts with.
+  size_t longest = 0;
+  uint32_t node = 0;
+  for (size_t i = 0; i < text.size() && trie_has_child_[node]; ++i) {
+    node = trie_child(node, static_cast<unsigned char>(text[i]));
+    if (node == kNoNode) break;
+    if (trie_terminal_[node]) longest = i + 1;
+  }
+  return longest;
+}
+
+bool SymbolTable::walk_multichar(uint32_t* node, size_t* depth, size_t* longest, std::string_view piece) const {
+  for (char ch : piece) {
+    if (!trie_has_child_[*node]) return false;
+    *node = trie_child(*node, static_cast<unsigned char>(ch));
+    if (*node == kNoNode) return false;
+    ++*depth;
+    if (trie_terminal_[*node]) *longest = *depth;
+  }
+  return trie_has_child_[*node] != 0;
 }
 
 bool SymbolTable::has_longer_multichar(std::string_view name) const {
-  for (const std::string& m : multichar_)
-    if (m.size() > name.size() && std::string_view(m).substr(0, name.size()) == name) return true;
-  return false;
+  uint32_t node = 0;
+  for (char ch : name) {
+    node = trie_child(node, static_cast<unsigned char>(ch));
+    if (node == kNoNode) return false;
+  }
+  return trie_has_child_[node] != 0;
 }
 
 size_t SymbolTable::module_name_length(std::string_view text) const {
@@ -127,13 +174,16 @@ std::string print_word(const Word& word, const SymbolTable& symbols) {
       }
       out += ')';
     } else if (i + 1 < n && may_merge[m.symbol]) {
-      // Would the reader take a longer name here? Look ahead over the next names.
-      std::string ahead = name;
-      for (size_t j = i + 1; j < n && ahead.size() < name.size() + 64; ++j) {
-        ahead += symbols.name(word.modules[j].symbol);
+      // Would the reader take a longer name here? Walk the name trie over the next names
+      // for as long as some declared name continues them.
+      uint32_t node = 0;
+      size_t depth = 0, longest = 0;
+      bool more = symbols.walk_multichar(&node, &depth, &longest, name);
+      for (size_t j = i + 1; more && j < n; ++j) {
+        more = symbols.walk_multichar(&node, &depth, &longest, symbols.name(word.modules[j].symbol));
         if (word.modules[j].param_count) break;
       }
-      if (symbols.module_name_length(ahead) != name.size()) out += ' ';
+      if (longest > name.size()) out += ' ';
     }
   }
   return out;

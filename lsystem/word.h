@@ -38,8 +38,19 @@ enum BuiltinSymbol : SymbolId {
   kBuiltinSymbolCount
 };
 
+// Work done by the symbol table's multi-character name lookups on this thread: one unit
+// per byte walked in the name trie. Exposed so tests can assert that declaring, tokenising
+// and printing stay linear (docs/limits.md "Work"); reset it before the work to measure.
+struct SymbolWork {
+  uint64_t trie_steps = 0;
+};
+SymbolWork& symbol_work();
+
 // Module names <-> ids. Names are one UTF-8 character unless declared with `module:`
 // (or the built-in @T); tokenisation takes the longest declared name at each place.
+// Declared names live in a byte trie, so declaring a name, matching the longest name at a
+// place and asking whether a longer name extends one each cost the name's length, however
+// many names are declared.
 class SymbolTable {
  public:
   SymbolTable();
@@ -56,6 +67,11 @@ class SymbolTable {
   size_t match_multichar(std::string_view text) const;
   // True if some declared multi-character name is longer than `name` and starts with it.
   bool has_longer_multichar(std::string_view name) const;
+  // Continues a walk down the name trie by `piece`, for a text given in pieces (the names
+  // of following modules). Start with *node = 0 and *depth = 0; *longest becomes the
+  // length of the longest declared name the whole text so far starts with (unchanged when
+  // none is longer). Returns false once no declared name continues the text.
+  bool walk_multichar(uint32_t* node, size_t* depth, size_t* longest, std::string_view piece) const;
   // Length in bytes of the module name that `text` starts with: the longest declared
   // multi-character name, else one UTF-8 character. Precondition: text not empty.
   size_t module_name_length(std::string_view text) const;
@@ -63,7 +79,12 @@ class SymbolTable {
  private:
   std::vector<std::string> names_;
   std::unordered_map<std::string, SymbolId> ids_;
-  std::vector<std::string> multichar_;  // sorted by length, longest first
+  // The trie of declared multi-character names: node 0 is the root; an edge is keyed by
+  // (parent node << 8 | byte).
+  uint32_t trie_child(uint32_t node, unsigned char byte) const;
+  std::unordered_map<uint64_t, uint32_t> trie_edges_;
+  std::vector<uint8_t> trie_terminal_ = {0};   // by node: a declared name ends here
+  std::vector<uint8_t> trie_has_child_ = {0};  // by node: some longer name continues it
   int32_t ascii_ids_[128];               // id of each one-byte name, or -1: the fast path
   bool multichar_first_byte_[256] = {};  // bytes that start some multi-character name
 };
@@ -92,6 +113,8 @@ struct Word {
 // Prints a word as grammar.md "Printing a word" says: modules without separators,
 // arguments in shortest round-trip decimal, a space after a module only where the next
 // module would otherwise merge with it when read back.
+// Its cost is the word's length times at most the longest declared name (the look-ahead
+// after a name that a longer one extends), whatever the number of names.
 std::string print_word(const Word& word, const SymbolTable& symbols);
 
 // Appends the shortest decimal text that reads back as exactly `value`.

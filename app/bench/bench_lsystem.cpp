@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "app/bench/bench_lsystem_scaling.h"
 #include "app/cli/cli.h"
 #include "core/turtle.h"
 #include "lsystem/derive.h"
@@ -124,8 +125,9 @@ int run_bench(const std::vector<std::string>& args) {
       std::cout << "usage: sylva bench lsystem [--quick] [--presets DIR] [Google Benchmark flags]\n\n"
                    "Derivation throughput (modules produced per second, one thread) for ABOP 1.24a,\n"
                    "Honda's tree (ABOP 2.6) and ABOP 1.31a from DIR (default: the presets); turtle\n"
-                   "segments per second; peak bytes per module; memcpy bandwidth in the same run.\n"
-                   "--quick uses small sizes (a smoke test, not a measurement). --benchmark_* flags\n"
+                   "segments per second; peak bytes per module; memcpy bandwidth in the same run;\n"
+                   "scaling/* rows: the work bounds of docs/limits.md at doubling sizes (time per\n"
+                   "item, complexity fit). --quick uses small sizes (a smoke test, not a measurement). --benchmark_* flags\n"
                    "(e.g. --benchmark_filter=REGEX) go to Google Benchmark.\n";
       return kOk;
     }
@@ -232,6 +234,8 @@ int run_bench(const std::vector<std::string>& args) {
                                                         benchmark::Counter::kIsIterationInvariantRate);
     })->Unit(benchmark::kMillisecond)->UseRealTime();
   }
+
+  register_lsystem_scaling_benchmarks(quick);
 
   int gb_argc = static_cast<int>(gb_args.size());
   std::vector<char*> gb_argv;

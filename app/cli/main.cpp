@@ -7,6 +7,7 @@
 
 #include "app/cli/cli.h"
 #include "app/studio/studio.h"
+#include "core/tessellate.h"
 #include "core/util/file_io.h"
 
 namespace {
@@ -68,6 +69,9 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     std::cerr << "sylva " << sub << ": error: " << e.message << " (see 'sylva " << sub << " --help')\n";
     return kUsageError;
+  } catch (const sylva::MeshTooLarge& e) {  // refused before allocating (docs/limits.md)
+    std::cerr << "sylva " << sub << ": error: " << e.what() << "\n";
+    return kInputError;
   } catch (const std::bad_alloc&) {
     std::cerr << "sylva: error: out of memory\n";
     return kInternalError;

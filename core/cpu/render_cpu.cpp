@@ -392,6 +392,7 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     g.plant_of_frustum.insert(g.plant_of_frustum.end(), skinned.frusta.size(), p);
     skin_s += seconds_since(start);
     if (!mesh) continue;
+    check_mesh_fits(tessellation_size(skinned.frusta.size(), tessellation), triangles.memory_bytes());
     const HeightFn height = options.displace && textures ? height_function_for(*textures, p) : HeightFn{};
     TriangleMesh part = plant_mesh(skinned, tessellation, height, plant.bark.relief_depth_m,
                                    options.relief_options.max_depth_per_radius, &tessellate_s, &displace_s);

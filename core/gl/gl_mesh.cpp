@@ -185,7 +185,9 @@ struct GlMesh::State {
       const SkinnedSkeleton skinned = skin_skeleton(place_plant(plant), options.skin);
       skinned_frusta += skinned.frusta.size();
       skin_s += seconds_since(start);
-      // build_scene_geometry's mesh path: the same plant_mesh.
+      // build_scene_geometry's mesh path: the same plant_mesh, within the same limit.
+      check_mesh_fits(tessellation_size(skinned.frusta.size(), tessellation),
+                      arrays.vertices.size() * sizeof(MeshVertex) + arrays.indices.size() * sizeof(uint32_t));
       const HeightFn height = geometry.displace && textures ? height_function_for(*textures, p) : HeightFn{};
       const TriangleMesh part = plant_mesh(skinned, tessellation, height, plant.bark.relief_depth_m,
                                            geometry.relief_options.max_depth_per_radius, &tessellate_s, &displace_s);

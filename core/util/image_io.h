@@ -38,8 +38,9 @@ Expected<PendingFile> write_pending_image(const std::string& path, uint32_t widt
 // The lower-case extension of `path`, with its dot (".png"; "" when there is none).
 std::string lower_extension(const std::string& path);
 
-// Whether OpenImageIO can open `path` as an image; if not, a Diagnostic for `path` whose
-// message is OIIO's reason.
+// Whether OpenImageIO can open `path` as an image of an accepted size whose pixel data
+// decodes to its end (a file cut short is refused, naming the row); if not, a Diagnostic
+// for `path` whose message says why (OIIO's reason where it gives one).
 Status check_image_opens(const std::string& path);
 
 // Whether OpenImageIO has a writer for `path`'s extension (checked before rendering).

@@ -178,6 +178,7 @@ class Parser {
   size_t pos_ = 0;
   uint32_t line_ = 1;
   uint32_t column_ = 1;
+  uint64_t values_ = 0;
   std::optional<Diagnostic> error_;
 };
 
@@ -193,6 +194,11 @@ Expected<JsonValue> Parser::parse() {
       if (at_end()) {
         fail_here(open.empty() ? "empty input; expected a JSON value"
                                : "unexpected end of input; expected a value");
+        break;
+      }
+      if (++values_ > options_.max_values) {
+        fail_here("the document holds more than " + std::to_string(options_.max_values) +
+                  " values, the most sylva reads into memory (each takes about 100 bytes)");
         break;
       }
       const char c = peek();

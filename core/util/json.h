@@ -31,6 +31,10 @@ namespace sylva {
 
 // Nesting deeper than this many arrays/objects is rejected by default.
 inline constexpr uint32_t kJsonDefaultMaxDepth = 256;
+// Values one document may hold (docs/limits.md "Inputs"): a value of the DOM takes about
+// 100 bytes however short its text ("0,": 2 bytes), so a 1 GiB file of small numbers would
+// otherwise take ~50 GiB. 50 million values are about 5 GiB.
+inline constexpr uint64_t kJsonDefaultMaxValues = 50'000'000;
 
 // The key of an object member, with the place of its opening quote.
 struct JsonKey {
@@ -85,6 +89,8 @@ struct JsonParseOptions {
   // Arrays/objects nested deeper than this are an error (located at the opening bracket).
   // Keep it modest: destroying a DOM recurses once per level.
   uint32_t max_depth = kJsonDefaultMaxDepth;
+  // More values than this are an error at the first value past it, before its memory.
+  uint64_t max_values = kJsonDefaultMaxValues;
   // When true, the tokens NaN, Infinity and -Infinity and numbers that overflow a double
   // (1e400) become Number values holding NaN/±infinity (text keeps the source), so a
   // schema checker can reject them with a message that names their place in the schema

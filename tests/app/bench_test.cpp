@@ -13,8 +13,25 @@ TEST(BenchLsystem, QuickRunPrintsEveryCaseAndTheMemcpyBandwidth) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   for (const char* expected : {"memcpy bandwidth:", "derive/a_abop_1_24a", "derive/b_honda_2_6",
                                "derive/c_abop_1_31a", "turtle/a_abop_1_24a", "turtle/b_honda_2_6",
-                               "Mmodules/s", "Msegments/s"})
+                               "Mmodules/s", "Msegments/s", "scaling/declare_names/4000",
+                               "scaling/right_context_past_branch/real_time_BigO", "scaling/interpret_depth16/1000"})
     EXPECT_NE(r.out.find(expected), std::string::npos) << expected << "\n" << r.out;
+}
+
+// Embree user geometry as the renderer traces it hits exactly what sylva's BVH hits: the
+// same double ray reaches the same intersect_frustum, so the row must read 0 % and 0 (a
+// bench that handed intersect_frustum Embree's float ray read 0.0040 % and 0.000685 on
+// the pine at 1024x768).
+TEST(BenchRaycast, EmbreeUserGeometryAgreesWithTheBvhExactly) {
+  auto r = run_process({SYLVA_BINARY, "bench", "raycast", "--quick", "--width", "1024", "--height", "768"},
+                       SYLVA_SOURCE_DIR, 240);
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const size_t at = r.out.find("\nembree-user ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const std::string row = r.out.substr(at + 1, r.out.find('\n', at + 1) - at - 1);
+  EXPECT_NE(row.find(" 0.0000% "), std::string::npos) << row;
+  EXPECT_NE(row.find(" 0 "), std::string::npos) << row;  // depth RMS
 }
 
 // Output piped to a file or a log is plain text: colour codes only on a terminal (the

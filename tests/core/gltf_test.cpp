@@ -199,6 +199,22 @@ TEST(GltfExport, EveryAccessorHasExactMinAndMax) {
   }
 }
 
+TEST(GltfExport, ValuesBeyondFloat32AreRefusedNotWrittenAsNull) {
+  // A skeleton file may hold 1e39 (beyond float32's 3.4e38): the accessors would hold
+  // infinities, which JSON writes as null (an invalid file). Refused, nothing written.
+  TempFolder dir;
+  for (const double far : {1e39, 2e12}) {
+    Skeleton sk;
+    sk.joints.push_back({{0, 0, 0}, 0.1, 0});
+    sk.joints.push_back({{far, 1, 0}, 0.1, 0});
+    sk.chains.push_back({0, 2, std::nullopt});
+    const Status written = export_gltf({{"far", sk}}, dir.file("far.gltf"));
+    ASSERT_FALSE(written.ok()) << far;
+    EXPECT_NE(written.error().message.find("1e12"), std::string::npos) << written.error().message;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("far.gltf")));
+  }
+}
+
 TEST(GltfExport, NoNullEntriesEvenForAPlantWithoutSegments) {
   // Trap: tinygltf writes an empty node as `null`.
   TempFolder dir;
@@ -977,6 +993,19 @@ TEST(GltfImport, BrokenFilesGiveLocatedErrorsNotCrashes) {
                       head + doc + good_source + "," + chains +
                           R"(,"instances":[{"name":"a","position_m":[0,0,0],"rotate_y_deg":0,"scale":-1}]}}}]})",
                       "scale");
+  {
+    // An instance bomb: 50,001 instance records (~3 MB) of a 1,000-joint skeleton would be
+    // 50 million joints (2 GiB) in memory: refused at the instances array, naming the limit.
+    std::string joints;
+    for (int j = 0; j < 1000; ++j) joints += (j ? ",[0," : "[0,") + std::to_string(j) + ",0,0.1,0]";
+    std::string instances;
+    for (int k = 0; k < 50001; ++k)
+      instances += (k ? "," : "") + std::string(R"({"name":"a","position_m":[0,0,0],"rotate_y_deg":0,"scale":1})");
+    expect_import_error(dir, "instance_bomb.gltf",
+                        head + doc + good_source + R"(,"chains":[{"parent":null,"joints":[)" + joints + "]}]" +
+                            R"(,"instances":[)" + instances + "]}}}]}",
+                        "joints, more than the limit of 50000000 for one glTF file");
+  }
   expect_import_error(dir, "deep.gltf", std::string(100000, '['), "");
   expect_import_error(dir, "deep_object.gltf", "{\"a\":" + std::string(100000, '['), "");
 

@@ -234,3 +234,49 @@ TEST(Tessellate, AppendMeshShiftsIndicesAndFrusta) {
 
 }  // namespace
 }  // namespace sylva
+
+namespace sylva {
+namespace {
+
+TEST(TessellateLimits, TheSizeBoundsWhatTessellateTakes) {
+  const SkinnedSkeleton s = skin_skeleton(chain_of({{0, 0, 0, 0.3}, {0, 1, 0, 0.2}, {0.2, 2, 0, 0.1}}));
+  for (int level : {0, 2}) {
+    TessellateOptions o;
+    o.level = level;
+    const MeshSize size = tessellation_size(s.frusta.size(), o);
+    const TriangleMesh m = tessellate(s, o);
+    EXPECT_GE(size.vertices, m.positions.size());
+    EXPECT_GE(size.triangles, m.triangle_count());
+    EXPECT_GE(size.bytes, m.memory_bytes());
+    EXPECT_LE(size.bytes, 2 * m.memory_bytes() + 4096);  // an estimate, not a blanket refusal
+  }
+}
+
+TEST(TessellateLimits, AMeshThatCannotFitIsRefusedBeforeAnythingIsAllocated) {
+  // The pine's 17,468 segments at level 6 (65,536 triangles each) would take ~53 GiB:
+  // refused from the counts, naming the limit; a skinned skeleton of that many frusta
+  // is refused by tessellate() itself before it reserves anything.
+  TessellateOptions o;
+  o.level = 6;
+  EXPECT_GT(tessellation_size(17468, o).bytes, kMaxMeshBytes);
+  try {
+    check_mesh_fits(tessellation_size(17468, o));
+    FAIL() << "no MeshTooLarge";
+  } catch (const MeshTooLarge& e) {
+    EXPECT_NE(std::string(e.what()).find("more than the limit of 8 GiB for a mesh"), std::string::npos) << e.what();
+  }
+  SkinnedSkeleton many;
+  many.frusta.resize(17468);
+  EXPECT_THROW(tessellate(many, o), MeshTooLarge);
+  // What fits alone may not fit beside meshes already built for the same picture.
+  TessellateOptions small;
+  EXPECT_NO_THROW(check_mesh_fits(tessellation_size(17468, small)));
+  EXPECT_THROW(check_mesh_fits(tessellation_size(17468, small), kMaxMeshBytes), MeshTooLarge);
+  // --segments-around 4096 over a million frusta does not wrap the count.
+  o.level = 6;
+  o.segments_around = 4096;
+  EXPECT_GT(tessellation_size(1'000'000, o).bytes, kMaxMeshBytes);
+}
+
+}  // namespace
+}  // namespace sylva

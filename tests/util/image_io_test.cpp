@@ -40,5 +40,29 @@ TEST(ImageIo, AHeaderClaimingTooManyPixelsIsRefusedBeforeReading) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(ImageIo, AnImageWhosePixelDataIsCutShortIsRefused) {
+  // A PNG and an EXR of noise (so their compressed data is long), cut to 60 % of their
+  // bytes: the headers still read, the pixel data does not, and the check names it.
+  std::string dir = ::testing::TempDir() + "sylva-image-io-XXXXXX";
+  ASSERT_NE(::mkdtemp(dir.data()), nullptr);
+  std::vector<float> noise(128 * 128 * 3);
+  uint32_t state = 12345;
+  for (float& v : noise) v = static_cast<float>((state = state * 1664525u + 1013904223u) >> 8) / 16777216.0f;
+  for (const auto& [name, format] : {std::pair{"noise.png", ChannelFormat::uint8}, {"noise.exr", ChannelFormat::half}}) {
+    const std::string path = dir + "/" + name;
+    ASSERT_TRUE(write_image_atomically(path, 128, 128, {"R", "G", "B"}, noise, {format}, true).ok()) << name;
+    EXPECT_TRUE(check_image_opens(path).ok()) << name;
+    const auto size = std::filesystem::file_size(path);
+    std::filesystem::resize_file(path, size * 6 / 10);
+    const Status cut = check_image_opens(path);
+    ASSERT_FALSE(cut.ok()) << name << " cut short was accepted";
+    EXPECT_EQ(cut.error().file, path);
+    EXPECT_NE(cut.error().message.find("the image's pixel data cannot be read (truncated or corrupt) at row"),
+              std::string::npos)
+        << name << ": " << cut.error().message;
+  }
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace sylva

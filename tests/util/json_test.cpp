@@ -324,6 +324,18 @@ TEST(JsonRead, TheDepthLimitIsAnOption) {
   EXPECT_EQ(parse_error("[[1]]", options), "no error");
 }
 
+TEST(JsonRead, TheValueCountIsBoundedBeforeTheValuesTakeMemory) {
+  // A DOM value costs ~100 bytes however short its text: a document of many small values
+  // is refused at the first value past the limit (5 values here: the array and 4 numbers).
+  JsonParseOptions options;
+  options.max_values = 5;
+  EXPECT_EQ(parse_error("[1,2,3,4]", options), "no error");
+  EXPECT_EQ(parse_error("[1,2,3,4,5]", options),
+            "1:10: the document holds more than 5 values, the most sylva reads into memory (each takes about 100 bytes)");
+  EXPECT_EQ(parse_error(R"({"a":{"b":[1,2]}})", options), "no error");
+  EXPECT_EQ(JsonParseOptions{}.max_values, 50'000'000u);
+}
+
 // ---- strings ----------------------------------------------------------------------
 
 TEST(JsonRead, DecodesEveryEscapeIncludingSurrogatePairsToUtf8) {
