@@ -27,6 +27,7 @@
 #include "core/util/file_io.h"
 #include "core/gltf_export.h"
 #include "core/skeleton.h"
+#include "core/tessellate.h"
 #include "core/turtle.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
@@ -555,6 +556,15 @@ void bind_module(py::module_& m) {
       "A ValueError with attributes file, line, column (None where unknown) and message.",
       PyExc_ValueError, nullptr);
   if (!g_grammar_error || !g_skeleton_error) throw py::error_already_set();
+  // A mesh that cannot fit is refused before anything is allocated (docs/limits.md): the
+  // arguments asked too much, a ValueError as the module's README promises.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const MeshTooLarge& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    }
+  });
   for (PyObject* type : {g_grammar_error, g_skeleton_error}) {
     py::object t = py::reinterpret_borrow<py::object>(type);
     t.attr("file") = py::none();

@@ -51,6 +51,14 @@ def test_a_scene_of_several_plants_with_placement(saguaro, tmp_path, validate_gl
     validate_gltf(path)
 
 
+def test_a_mesh_that_cannot_fit_is_a_value_error_before_anything_is_written(tmp_path):
+    pine = sylva.Grammar.from_file("presets/pine.lsys").grow(seed=1)
+    path = tmp_path / "huge.glb"
+    with pytest.raises(ValueError, match="the mesh would take"):
+        sylva.export_gltf(pine, path, mesh=True, segments_around=4096)
+    assert not path.exists()
+
+
 def test_bad_arguments_raise_before_writing(saguaro, tmp_path):
     path = tmp_path / "x.glb"
     with pytest.raises(ValueError):
