@@ -138,7 +138,11 @@ TEST(GlTwin, UnpackAndIntersectMatchTheCppFloatTwin) {
     if (e.kind == 0) continue;
     ++hits;
     EXPECT_NEAR(r[17], e.t, 1e-5 * std::abs(e.t)) << i;
-    EXPECT_NEAR(r[18], e.y, 1e-5 * size) << i;
+    // y is read at origin + t·direction: float's error grows with the distance travelled
+    // (2–10 sizes here), not with the frustum's size alone — the joints' short dome and arc
+    // pieces (docs/joints.md) showed it, 1.7e-6 against 1e-5 of a 0.14 m piece at 0.7 m.
+    const double travelled = std::abs(e.t) * size;  // |direction| = size
+    EXPECT_NEAR(r[18], e.y, 1e-5 * std::max(size, travelled)) << i;
   }
   std::printf("[ twin ] %zu cases, %zu hits, %zu hit-kind mismatches\n", n, hits, kind_mismatches);
   EXPECT_GT(hits, n / 4);
