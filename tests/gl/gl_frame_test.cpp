@@ -158,7 +158,8 @@ TEST(GlFrame, PassTimesArriveAFrameLaterWithoutWaitingAndAreNonNegative) {
   GlRenderer renderer(scene, two_samples_with_depth());
   EXPECT_THROW(renderer.wait_for_frame(), std::logic_error) << "no frame yet";
   const GlFrameStats first = renderer.draw(scene);
-  EXPECT_FALSE(first.gpu_times_ready) << "draw() does not wait for the GPU";
+  // draw() does not wait for the GPU; whether the times happen to be ready when it returns
+  // is a race (llvmpipe can finish a 48x36 frame first), so only polling is asserted below.
   EXPECT_EQ(first.pass(GlPass::shadow).runs, 2u) << "the sun is a disc: a shadow map per sample";
   EXPECT_EQ(first.pass(GlPass::geometry).runs, 3u) << "two samples and the AOVs at pixel centres";
   EXPECT_EQ(first.pass(GlPass::shade).runs, 2u);
