@@ -69,6 +69,13 @@ struct FogRenderOptions {
   const FogConeSource* cones = nullptr;
 };
 
+// The samples per pixel of `sylva render` and of the Python module's render() when none
+// is asked for: the smallest count at which thin needles and twigs stop breaking up at
+// 800x600 on both backends (speckle <= 1 %, `sylva bench spp`; docs/benchmarks.md "Samples
+// per pixel" has the measurement and the cost). RenderOptions itself keeps 1 (the pixel
+// centres), so a caller of the library always says what it pays for.
+inline constexpr uint32_t kDefaultRenderSpp = 8;
+
 struct RenderOptions {
   uint32_t spp = 1;                             // samples per pixel, >= 1
   uint32_t aovs = 0;                            // AovFlags

@@ -8,7 +8,7 @@
 #   scripts/render-presets.sh [SYLVA_BINARY] [OUT_DIR]
 #       SYLVA_BINARY  default build/release/app/sylva
 #       OUT_DIR       where the single pictures go (PNG), default out/presets
-#   environment: BACKEND (default cpu), WIDTH x HEIGHT (320 x 240), SPP (2)
+#   environment: BACKEND (default cpu), WIDTH x HEIGHT (320 x 240), SPP (8, as `sylva render`)
 #
 # The CPU ray caster is the default: on the shared 2-core machine without a GPU it is the
 # faster backend (the pine at 320 x 240: 3.4 s on the CPU, 17 s on llvmpipe, load 11);
@@ -19,7 +19,7 @@ cd "$(dirname "$0")/.."
 
 sylva=${1:-build/release/app/sylva}
 out=${2:-out/presets}
-backend=${BACKEND:-cpu} width=${WIDTH:-320} height=${HEIGHT:-240} spp=${SPP:-2}
+backend=${BACKEND:-cpu} width=${WIDTH:-320} height=${HEIGHT:-240} spp=${SPP:-8}
 mkdir -p "$out" docs/images
 
 # Table 1 of paper 000 (Bhagvat, Jeschke, Cline, Wonka 2009): the segment counts of its plants.

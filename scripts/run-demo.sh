@@ -16,14 +16,14 @@ mkdir -p out
 for plant in saguaro elm; do
   build/release/app/sylva grow "presets/$plant.lsys" -o "out/$plant.skel.json"
 done
-build/release/app/sylva render presets/saguaro.lsys -o out/saguaro.png --width 800 --height 600 --spp 4 \
-  --backend gl
+build/release/app/sylva render presets/saguaro.lsys -o out/saguaro.png --width 800 --height 600 --backend gl
 # The same plant in its scene: bark texture and relief-mapped ribs, marched in the shaders.
 build/release/app/sylva render presets/scenes/saguaro.scene.json -o out/saguaro_ribs.png --width 800 --height 600 \
-  --spp 4 --backend gl
+  --backend gl
 # Crepuscular rays: the fog's shafts between the crowns (paper 002; about half a minute on
-# two cores: one million sun photons, their shadow cones, refined in-scatter).
+# two cores: one million sun photons, their shadow cones, refined in-scatter; one sample per
+# pixel, where the default 8 would march the fog 8 times: docs/benchmarks.md "Samples per pixel").
 build/release/app/sylva render presets/scenes/pine_stand_low_sun.scene.json -o out/pine_stand_fog.png --width 480 \
-  --height 360 --backend cpu
+  --height 360 --backend cpu --spp 1
 echo "skeletons, out/saguaro.png, out/saguaro_ribs.png and out/pine_stand_fog.png written to out/" \
   "(see docs/ for the formats and the other presets)"

@@ -131,16 +131,6 @@ std::string family_named(const std::string& name) {
   throw UsageError{"--methods: unknown method family '" + name + "' (available: RC, RC-nocd, RC+R, GS, GS+R, RC-anim)"};
 }
 
-// INPUT as given when it is a render input, else a preset's scene or grammar by name.
-std::string resolve_input(const std::string& input) {
-  if (is_render_input(input)) return input;
-  const std::string presets = SYLVA_PRESETS_DIR;
-  for (const std::string& candidate : {presets + "/scenes/" + input + ".scene.json", presets + "/" + input + ".lsys"})
-    if (std::filesystem::exists(candidate)) return candidate;
-  throw UsageError{"INPUT '" + input +
-                   "' is neither a .lsys, .skel.json, .scene.json, .glb or .gltf file nor a preset name"};
-}
-
 Args parse_args(const std::vector<std::string>& args) {
   Args out;
   for (size_t i = 1; i < args.size(); ++i) {  // args[0] is "gpu"
@@ -171,10 +161,10 @@ Args parse_args(const std::vector<std::string>& args) {
   }
   if (out.help) return out;
   if (out.width.has_value() != out.height.has_value()) throw UsageError{"give --width and --height together"};
-  for (std::string& input : out.inputs) input = resolve_input(input);
+  for (std::string& input : out.inputs) input = resolve_bench_input(input);
   if (out.inputs.empty())
-    out.inputs = out.fog ? std::vector<std::string>{resolve_input("elm_grove_low_sun")}
-                         : std::vector<std::string>{resolve_input("pine"), resolve_input("saguaro")};
+    out.inputs = out.fog ? std::vector<std::string>{resolve_bench_input("elm_grove_low_sun")}
+                         : std::vector<std::string>{resolve_bench_input("pine"), resolve_bench_input("saguaro")};
   if (out.fog && !out.csv_given) out.csv = "bench_gpu_fog.csv";
   if (out.fog && !out.plot_given) out.plot = "bench_gpu_fog.png";
   return out;

@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "app/cli/cli.h"
+#include "app/cli/render_input.h"
 
 namespace sylva::cli {
 
@@ -12,6 +14,15 @@ bool scene_has_relief(const Scene& scene) {
   for (const ScenePlant& p : scene.plants)
     if (p.bark.height_texture) return true;
   return false;
+}
+
+std::string resolve_bench_input(const std::string& input) {
+  if (is_render_input(input)) return input;
+  const std::string presets = SYLVA_PRESETS_DIR;
+  for (const std::string& candidate : {presets + "/scenes/" + input + ".scene.json", presets + "/" + input + ".lsys"})
+    if (std::filesystem::exists(candidate)) return candidate;
+  throw UsageError{"INPUT '" + input +
+                   "' is neither a .lsys, .skel.json, .scene.json, .glb or .gltf file nor a preset name"};
 }
 
 GeometryOptions frusta_geometry() {

@@ -55,6 +55,11 @@ ImageErrors compare_images(const RenderImage& reference, const RenderImage& imag
 // Parses a count flag's value: an integer from 1 to `max`, else UsageError naming `flag`.
 uint32_t parse_count(const std::string& flag, const std::string& value, uint64_t max);
 
+// INPUT as given when it is a render input (is_render_input), else a preset's scene or
+// grammar by name: presets/scenes/NAME.scene.json, then presets/NAME.lsys. UsageError when
+// it is neither.
+std::string resolve_bench_input(const std::string& input);
+
 // The file name of `path` without its folder and input extension (.scene.json,
 // .skel.json, .lsys, .glb, .gltf): "presets/scenes/pine.scene.json" -> "pine".
 std::string input_stem(const std::string& path);

@@ -49,6 +49,8 @@ int run_bench_geometry(const std::vector<std::string>& args);
 int run_bench_gpu(const std::vector<std::string>& args);
 // `sylva bench fog` (bench_fog.cpp), dispatched by run_bench.
 int run_bench_fog(const std::vector<std::string>& args);
+// `sylva bench spp` (bench_spp.cpp), dispatched by run_bench.
+int run_bench_spp(const std::vector<std::string>& args);
 int run_render(const std::vector<std::string>& args);
 int run_export(const std::vector<std::string>& args);
 

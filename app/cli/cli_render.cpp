@@ -79,7 +79,9 @@ void print_render_help() {
          "                         with fog: fog.R fog.G fog.B, the light the fog scatters\n"
          "                         toward the eye, and fog.T, the transmittance to what the\n"
          "                         pixel's centre sees: beauty = fog.T x surface + fog.RGB)\n"
-         "      --spp N            samples per pixel, stratified (default 1: pixel centres)\n"
+         "      --spp N            samples per pixel, stratified (default 8, where needles and\n"
+         "                         twigs stop breaking up: docs/benchmarks.md; 1: the pixel\n"
+         "                         centres, about 5x faster, aliased)\n"
          "      --verbose          list the passes that ran and what each cost\n"
          "      --eye X,Y,Z        the camera's eye in metres (Y up), e.g. --eye 6,3,6\n"
          "      --target X,Y,Z     the point it looks at, in metres\n"
@@ -134,7 +136,7 @@ struct RenderArgs {
   std::string backend = "auto";
   std::optional<uint32_t> width, height;
   uint32_t aovs = 0;
-  uint32_t spp = 1;
+  uint32_t spp = kDefaultRenderSpp;
   bool verbose = false;
   CameraFlags camera;  // --eye, --target, --fov
   GeometryOptions geometry;

@@ -27,6 +27,7 @@ void print_help(std::ostream& out) {
                "  bench  geometry                     error against run time of frusta, relief, meshes\n"
                "  bench  gpu                          GPU time per frame and error of the GL backend\n"
                "  bench  fog                          sun photons and shadow cones against the photon count\n"
+               "  bench  spp                          sampling error of both backends against samples per pixel\n"
                "  bench  studio [--quick]             the studio's edit-to-picture latency, frame time, memory\n\n"
                "'sylva SUBCOMMAND --help' describes every flag; 'sylva --version' prints the version.\n"
                "Exit status: 0 success, 1 bad input, 2 usage error, 3 internal error.\n";

@@ -51,14 +51,14 @@ py::array_t<float> python_render(const Skeleton& skeleton, uint32_t width, uint3
 
 void bind_render(py::module_& m) {
   m.def("render", &python_render, "skeleton"_a, py::kw_only(), "width"_a = 640u, "height"_a = 480u,
-        "backend"_a = "auto", "spp"_a = 1u, "threads"_a = 0u,
+        "backend"_a = "auto", "spp"_a = kDefaultRenderSpp, "threads"_a = 0u,
         R"doc(Renders a Skeleton with the CPU ray caster and returns an (H, W, 4) float32 array.
 
 The plant stands in its default scene (as `sylva render plant.skel.json`): sun, sky,
 ground at its lowest point and a camera framing it. Pixels are linear RGBA, row 0 at
 the top, alpha 1 (the sky is part of the picture); convert to sRGB for display.
 Keyword-only: width, height (pixels), backend ('auto' or 'cpu'; the GPU renderer is
-not exposed yet), spp (stratified samples per pixel), threads (0: every core). The GIL
+not exposed yet), spp (stratified samples per pixel; default 8, as `sylva render`), threads (0: every core). The GIL
 is released while rendering; the image is the same for every thread count.)doc");
 }
 

@@ -483,7 +483,11 @@ std::optional<std::string> StudioApp::export_png_file(const std::string& path, u
   s.camera = orbit_.camera();
   s.width = width;
   s.height = height;
-  return viewport_->write_image(s, render_options_, path);
+  // The viewport draws one sample a frame to stay interactive; the file gets `sylva
+  // render`'s default, where needles and twigs stop breaking up (docs/benchmarks.md).
+  RenderOptions options = render_options_;
+  options.spp = std::max(options.spp, kDefaultRenderSpp);
+  return viewport_->write_image(s, options, path);
 }
 
 // ---- the frame --------------------------------------------------------------------

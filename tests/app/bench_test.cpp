@@ -49,7 +49,7 @@ TEST(BenchLsystem, PipedOutputHasNoColourCodes) {
 
 // Every benchmark answers --help with its own usage on stdout and exit 0, doing no work.
 TEST(BenchHelp, EveryBenchmarkPrintsItsUsage) {
-  for (const char* name : {"lsystem", "raycast", "geometry", "gpu", "fog", "studio"}) {
+  for (const char* name : {"lsystem", "raycast", "geometry", "gpu", "fog", "spp", "studio"}) {
     for (const char* flag : {"--help", "-h"}) {
       auto r = run_process({SYLVA_BINARY, "bench", name, flag}, SYLVA_SOURCE_DIR, 60);
       ASSERT_FALSE(crashed(r)) << name << " " << flag << "\n" << describe(r);

@@ -53,6 +53,27 @@ ProcessResult run_sylva_without_egl(const std::vector<std::string>& args) {
   return r;
 }
 
+// The default is 8 samples per pixel (kDefaultRenderSpp, chosen by `sylva bench spp`:
+// docs/benchmarks.md): a render without --spp says so and is the --spp 8 picture byte for
+// byte, and --spp 1 (the pixel centres) is a different picture of the thin pine.
+TEST(RenderCli, TheDefaultIsEightSamplesPerPixel) {
+  TempDir dir;
+  const std::string pine = std::string(SYLVA_SOURCE_DIR) + "/presets/pine.lsys";
+  auto render = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> argv = {"render", pine, "-o", dir.file(name), "--width", "96", "--height", "72",
+                                     "--backend", "cpu", "--verbose"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return run_sylva(argv);
+  };
+  ProcessResult d = render("default.png", {});
+  ASSERT_EQ(d.exit_code, 0) << describe(d);
+  EXPECT_NE(d.err.find("96x72, 8 spp, "), std::string::npos) << d.err;
+  ASSERT_EQ(render("eight.png", {"--spp", "8"}).exit_code, 0);
+  ASSERT_EQ(render("one.png", {"--spp", "1"}).exit_code, 0);
+  EXPECT_EQ(read_file(dir.file("default.png")), read_file(dir.file("eight.png")));
+  EXPECT_NE(read_file(dir.file("default.png")), read_file(dir.file("one.png")));
+}
+
 TEST(RenderCli, AutoBackendUsesOpenGlOrFallsBackToTheCpuSayingWhy) {
   TempDir dir;
   ProcessResult r = run_sylva({"render", kSaguaro, "-o", dir.file("s.png"), "--width", "32", "--height", "24",

@@ -1,5 +1,8 @@
 // render_fog_cli_test.cpp — `sylva render` on scenes with fog (cli.md's fog flags,
 // spec/fog.md's `fog` AOV), as a user runs it.
+// Every render here passes --spp 1 (the pixel centres): these tests are about what is
+// drawn, not how it is sampled, and the default of 8 samples would cost 8 times the time
+// (RenderCli.TheDefaultIsEightSamplesPerPixel pins the default).
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
@@ -43,7 +46,7 @@ bool expect_fog_render(const std::string& backend, const char* fog_pass) {
   TempDir dir;
   const std::string scene = write_scene(dir, kFog);
   ProcessResult r =
-      run_sylva({"render", scene, "-o", dir.file("f.exr"), "--aov", "fog,depth", "--verbose", "--backend", backend});
+      run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.exr"), "--aov", "fog,depth", "--verbose", "--backend", backend});
   if (backend == "gl" && r.exit_code == 1 && r.err.find("no OpenGL 4.5 core context") != std::string::npos) return false;
   EXPECT_FALSE(crashed(r)) << describe(r);
   EXPECT_EQ(r.exit_code, 0) << describe(r);
@@ -82,7 +85,7 @@ TEST(RenderFogCli, AFoggySceneInBruteRendersWithOpenGlWithTheFogPassAndTheFogAov
 TEST(RenderFogCli, MediumRendersWithOpenGlWithItsConesAndTheFogPass) {
   TempDir dir;
   const std::string scene = write_scene(dir, R"({"sigma_s": 0.05, "g": 0.6, "top": 20, "steps": 4, "photons": 20000})");
-  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "gl", "--fog-mode", "medium",
+  ProcessResult r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "gl", "--fog-mode", "medium",
                                "--verbose"});
   if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 core context") != std::string::npos)
     GTEST_SKIP() << "no OpenGL context on this machine";
@@ -96,7 +99,7 @@ TEST(RenderFogCli, MediumRendersWithOpenGlWithItsConesAndTheFogPass) {
 TEST(RenderFogCli, PngPutsTheFogAovInASideFile) {
   TempDir dir;
   const std::string scene = write_scene(dir, kFog);
-  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--aov", "fog", "--backend", "cpu",
+  ProcessResult r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--aov", "fog", "--backend", "cpu",
                                "--fog-mode", "reference", "--fog-steps", "2"});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   std::vector<std::string> expected = {"fog.R", "fog.G", "fog.B", "fog.T"};
@@ -107,12 +110,12 @@ TEST(RenderFogCli, PngPutsTheFogAovInASideFile) {
 TEST(RenderFogCli, TheGlBackendRefusesTheFogModesItLacksWithStatusOneAndAutoFallsBackToTheCpu) {
   TempDir dir;
   const std::string scene = write_scene(dir, kFog);
-  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "gl", "--fog-mode", "refined"});
+  ProcessResult r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "gl", "--fog-mode", "refined"});
   EXPECT_EQ(r.exit_code, 1) << describe(r);
   EXPECT_NE(r.err.find("fog pass runs brute, medium and fast (auto) only (the fog asks for refined"), std::string::npos)
       << describe(r);
   EXPECT_FALSE(std::filesystem::exists(dir.file("f.png")));
-  r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--fog-mode", "reference", "--fog-steps", "2", "--verbose"});
+  r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--fog-mode", "reference", "--fog-steps", "2", "--verbose"});
   EXPECT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_NE(r.err.find("the OpenGL backend cannot draw this (the GL backend's fog pass runs brute, medium and fast (auto) only"),
             std::string::npos)
@@ -149,7 +152,7 @@ TEST(RenderFogCli, BadFogFlagsAreUsageErrors) {
       {{"--aov", "fogg"}, "unknown AOV 'fogg'"},
   };
   for (const Bad& b : bad) {
-    std::vector<std::string> args = {"render", scene, "-o", dir.file("f.png"), "--backend", "cpu"};
+    std::vector<std::string> args = {"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "cpu"};
     args.insert(args.end(), b.flags.begin(), b.flags.end());
     ProcessResult r = run_sylva(args);
     EXPECT_EQ(r.exit_code, 2) << b.flags[0] << " " << b.flags[1] << ": " << describe(r);
@@ -162,7 +165,7 @@ TEST(RenderFogCli, GoodConeParamsAndPhotonsAreAccepted) {
   TempDir dir;
   const std::string scene = write_scene(dir, kFog);
   for (const char* params : {"auto", "96,8,24,16", "25,2,24,1"}) {
-    ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--photons", "1000",
+    ProcessResult r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--photons", "1000",
                                  "--cone-params", params, "--fog-steps", "2"});
     EXPECT_EQ(r.exit_code, 0) << params << ": " << describe(r);
   }
@@ -174,14 +177,14 @@ TEST(RenderFogCli, FogFlagsOnASceneWithoutFogAreUsageErrors) {
   for (const std::vector<std::string>& flags : std::vector<std::vector<std::string>>{
            {"--fog-mode", "brute"}, {"--fog-steps", "8"}, {"--photons", "10"}, {"--cone-params", "auto"},
            {"--aov", "fog"}}) {
-    std::vector<std::string> args = {"render", scene, "-o", dir.file("f.png"), "--backend", "cpu"};
+    std::vector<std::string> args = {"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "cpu"};
     args.insert(args.end(), flags.begin(), flags.end());
     ProcessResult r = run_sylva(args);
     EXPECT_EQ(r.exit_code, 2) << flags[0] << ": " << describe(r);
     EXPECT_NE(r.err.find("apply to a scene with fog only"), std::string::npos) << describe(r);
   }
   // Without fog and without the flags: no fog pass at all.
-  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose"});
+  ProcessResult r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose"});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_EQ(r.err.find("fog"), std::string::npos) << describe(r);
 }
@@ -203,7 +206,7 @@ TEST(RenderFogCli, OnlyTheConeModesTraceSunPhotons) {
                         {{"--fog-mode", "brute"}, false, "brute"},
                         {{"--fog-mode", "reference"}, false, "reference"}};
   for (const Case& c : cases) {
-    std::vector<std::string> args = {"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose"};
+    std::vector<std::string> args = {"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose"};
     args.insert(args.end(), c.flags.begin(), c.flags.end());
     ProcessResult r = run_sylva(args);
     ASSERT_EQ(r.exit_code, 0) << c.mode << ": " << describe(r);
@@ -219,12 +222,12 @@ TEST(RenderFogCli, TheConeParametersAreTheFlagsOrTheAutomaticChoiceWithItsReport
   // core/cpu/photons.h AutoConeReport) or the parameters --cone-params gave.
   TempDir dir;
   const std::string scene = write_scene(dir, R"({"mode": "fast", "top": 20, "steps": 2, "photons": 20000})");
-  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose"});
+  ProcessResult r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose"});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_NE(r.err.find("20000 photons"), std::string::npos) << describe(r);
   EXPECT_NE(r.err.find("cone parameters (automatic)"), std::string::npos) << describe(r);
   for (const char* mode : {"medium", "refined", "auto"}) {
-    r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose", "--fog-mode", mode,
+    r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose", "--fog-mode", mode,
                    "--cone-params", "41,8,8,8"});
     ASSERT_EQ(r.exit_code, 0) << mode << ": " << describe(r);
     EXPECT_NE(r.err.find("p1 41, p2 8, p3 8, p4 8"), std::string::npos) << mode << ": " << describe(r);
@@ -241,7 +244,7 @@ TEST(RenderFogCli, EveryBundledFogSceneRendersOnTheCpuWithItsCones) {
     if (!path.ends_with(".scene.json") || read_file(path).find("\"fog\"") == std::string::npos) continue;
     ++scenes;
     TempDir dir;
-    ProcessResult r = run_sylva({"render", path, "-o", dir.file("f.exr"), "--backend", "cpu", "--width", "48",
+    ProcessResult r = run_sylva({"render", "--spp", "1", path, "-o", dir.file("f.exr"), "--backend", "cpu", "--width", "48",
                                  "--height", "36", "--photons", "20000", "--fog-steps", "4", "--aov", "fog",
                                  "--verbose"});
     ASSERT_EQ(r.exit_code, 0) << path << ": " << describe(r);
@@ -256,7 +259,7 @@ TEST(RenderFogCli, EveryBundledFogSceneRendersOnTheCpuWithItsCones) {
 TEST(RenderFogCli, BadFogKeyInASceneIsExitOneAtTheKey) {
   TempDir dir;
   const std::string scene = write_scene(dir, R"({"g": 0.99})");
-  ProcessResult r = run_sylva({"render", scene, "-o", dir.file("f.png"), "--backend", "cpu"});
+  ProcessResult r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "cpu"});
   EXPECT_EQ(r.exit_code, 1) << describe(r);
   EXPECT_NE(r.err.find("f.scene.json:4:11: error: fog.g must be in (-0.938117, 0.938117)"), std::string::npos)
       << describe(r);

@@ -1,6 +1,9 @@
 // render_frames_cli_test.cpp — `sylva render --frames` (docs/animation.md): a scene's
 // animation key moving its plants frame by frame, a grammar growing over its derivation
 // steps, the per-frame outputs, the video through ffmpeg, and the usage errors.
+// Every render here passes --spp 1 (the pixel centres): these tests are about what is
+// drawn, not how it is sampled, and the default of 8 samples would cost 8 times the time
+// (RenderCli.TheDefaultIsEightSamplesPerPixel pins the default).
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
@@ -55,7 +58,7 @@ bool gl_missing(const ProcessResult& r) {
 TEST(RenderFrames, ASceneWritesOneImagePerFrameAndItsPlantsMove) {
   TempDir dir;
   const std::string scene = write_scene(dir, kDance);
-  ProcessResult r = run_sylva({"render", scene, "--frames", "all", "-o", dir.file("out/f_{frame}.png"), "--backend", "cpu"});
+  ProcessResult r = run_sylva({"render", "--spp", "1", scene, "--frames", "all", "-o", dir.file("out/f_{frame}.png"), "--backend", "cpu"});
   ASSERT_FALSE(crashed(r)) << describe(r);
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   // all: ceil(0.4 s × 10 fps) = 4 frames, numbered with four digits, in a folder made for them.
@@ -67,7 +70,7 @@ TEST(RenderFrames, ASceneWritesOneImagePerFrameAndItsPlantsMove) {
   // Frame 0 is the rest pose (t = 0): the still scene's picture, pixel for pixel; later
   // frames are not.
   const std::string still = write_scene(dir, "");
-  ProcessResult plain = run_sylva({"render", still, "-o", dir.file("still.png"), "--backend", "cpu"});
+  ProcessResult plain = run_sylva({"render", "--spp", "1", still, "-o", dir.file("still.png"), "--backend", "cpu"});
   ASSERT_EQ(plain.exit_code, 0) << describe(plain);
   const std::vector<float> rest = pixels(dir.file("still.png"));
   EXPECT_EQ(mean_abs_difference(pixels(dir.file("out/f_0000.png")), rest), 0.0);
@@ -77,11 +80,11 @@ TEST(RenderFrames, ASceneWritesOneImagePerFrameAndItsPlantsMove) {
 TEST(RenderFrames, OnOpenGlTheRendererReuploadsEachPoseAndMatchesTheCpu) {
   TempDir dir;
   const std::string scene = write_scene(dir, kDance);
-  ProcessResult gl = run_sylva({"render", scene, "--frames", "0..3", "-o", dir.file("gl_{frame}.png"), "--backend", "gl"});
+  ProcessResult gl = run_sylva({"render", "--spp", "1", scene, "--frames", "0..3", "-o", dir.file("gl_{frame}.png"), "--backend", "gl"});
   if (gl_missing(gl)) GTEST_SKIP() << "no OpenGL: " << gl.err;
   ASSERT_EQ(gl.exit_code, 0) << describe(gl);
   EXPECT_NE(gl.err.find("re-skin + upload"), std::string::npos) << describe(gl);  // 3 updates, one renderer
-  ProcessResult cpu = run_sylva({"render", scene, "--frames", "0..3", "-o", dir.file("cpu_{frame}.png"), "--backend", "cpu"});
+  ProcessResult cpu = run_sylva({"render", "--spp", "1", scene, "--frames", "0..3", "-o", dir.file("cpu_{frame}.png"), "--backend", "cpu"});
   ASSERT_EQ(cpu.exit_code, 0) << describe(cpu);
   // Frame 3 drawn by GL is the CPU's frame 3 (the backends' usual 1–2/255), much closer to
   // it than to the rest pose: the moved segment records reached the GPU.
@@ -95,18 +98,18 @@ TEST(RenderFrames, OnOpenGlTheRendererReuploadsEachPoseAndMatchesTheCpu) {
 
 TEST(RenderFrames, AGrammarGrowsOneDerivationStepPerFrameSeenByTheLastFramesCamera) {
   TempDir dir;
-  ProcessResult r = run_sylva({"render", kElm, "--frames", "4..6", "-o", dir.file("g_{frame}.png"), "--width", "48",
+  ProcessResult r = run_sylva({"render", "--spp", "1", kElm, "--frames", "4..6", "-o", dir.file("g_{frame}.png"), "--width", "48",
                                "--height", "36", "--backend", "cpu"});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   for (const char* f : {"g_0004.png", "g_0005.png", "g_0006.png"}) EXPECT_TRUE(fs::exists(dir.file(f))) << f;
   // The last frame is the grammar grown 6 steps in its own default view.
-  ProcessResult six = run_sylva({"render", kElm, "-n", "6", "-o", dir.file("six.png"), "--width", "48", "--height", "36",
+  ProcessResult six = run_sylva({"render", "--spp", "1", kElm, "-n", "6", "-o", dir.file("six.png"), "--width", "48", "--height", "36",
                                  "--backend", "cpu"});
   ASSERT_EQ(six.exit_code, 0) << describe(six);
   EXPECT_EQ(mean_abs_difference(pixels(dir.file("g_0006.png")), pixels(dir.file("six.png"))), 0.0);
   EXPECT_GT(mean_abs_difference(pixels(dir.file("g_0004.png")), pixels(dir.file("six.png"))), 1e-4);
   // Frame 0 is the axiom: no segment yet, sky and ground only — still a picture.
-  ProcessResult axiom = run_sylva({"render", kElm, "--frames", "0", "-o", dir.file("a_{frame}.png"), "--width", "16",
+  ProcessResult axiom = run_sylva({"render", "--spp", "1", kElm, "--frames", "0", "-o", dir.file("a_{frame}.png"), "--width", "16",
                                    "--height", "12"});
   EXPECT_EQ(axiom.exit_code, 0) << describe(axiom);
   EXPECT_TRUE(fs::exists(dir.file("a_0000.png")));
@@ -124,7 +127,7 @@ TEST(RenderFrames, TheVideoIsEncodedWithFfmpegOrRefusedBeforeAnyFrame) {
   EXPECT_FALSE(fs::exists(dir.file("n_0000.png")));
   EXPECT_FALSE(fs::exists(dir.file("n.mp4")));
   if (run_process({"/bin/sh", "-c", "command -v ffmpeg"}).exit_code != 0) GTEST_SKIP() << "ffmpeg is not installed";
-  ProcessResult r = run_sylva({"render", scene, "--frames", "0..3", "-o", dir.file("v_{frame}.png"), "--video",
+  ProcessResult r = run_sylva({"render", "--spp", "1", scene, "--frames", "0..3", "-o", dir.file("v_{frame}.png"), "--video",
                                dir.file("dance.mp4"), "--fps", "12", "--backend", "cpu"});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_NE(r.err.find("4 frames at 12 fps"), std::string::npos) << describe(r);

@@ -24,6 +24,12 @@ def test_render_is_the_same_for_any_thread_count(saguaro):
     np.testing.assert_array_equal(a, b)
 
 
+def test_render_takes_sylva_renders_default_of_eight_samples_per_pixel(saguaro):
+    default = sylva.render(saguaro, width=40, height=30)
+    np.testing.assert_array_equal(default, sylva.render(saguaro, width=40, height=30, spp=8))
+    assert not np.array_equal(default, sylva.render(saguaro, width=40, height=30, spp=1))
+
+
 def test_render_rejects_unknown_backends_and_empty_images(saguaro):
     with pytest.raises(ValueError):
         sylva.render(saguaro, backend="vulkan")
