@@ -170,8 +170,8 @@ TEST(ExportCli, ALeafyPlantsMeshPassesTheKhronosValidator) {
 TEST(ExportCli, EveryExtrasModePassesTheValidatorAndCompactReadsBackLikeFull) {
   TempDir dir;
   const std::string leafy = kSource + "/presets/abop_1_25_bush_leaves.lsys";
-  const std::string scatter = dir.write("scatter.scene.json", R"({"format":"sylva-scene","version":1,
-    "scatter":[{"grammar":")" + kPlant + R"(","count":12,"seed":1,"disc":{"centre":[0,0],"radius":10},
+  const std::string scatter = dir.write("scatter.scene.json", R"({"format":"sylva-scene","version":1,"plants":[],
+    "scatter":[{"grammar":")" + kPlant + R"(","count":12,"seed":1,"plant_seeds":[1,3],"disc":{"centre":[0,0],"radius":10},
                 "rotate_y_deg":[0,360],"scale":[0.8,1.2]}]})");
   std::vector<std::string> files;
   struct Case {
