@@ -90,7 +90,7 @@ void print_help() {
          "m = 0..2, RC-anim (22 rows for the pine and saguaro: 4 min 39 s on dev-2c's llvmpipe).\n"
          "--full: the whole sweep, 1024x768 and 1920x1080, 100 frames after 5, RC+R 8x0, 16x4,\n"
          "32x4, 64x8, GS and GS+R m = 0..4 (60 rows; about 5 h on dev-2c's llvmpipe, estimated\n"
-         "in docs/benchmarks.md; minutes on a GPU).\n"
+         "in docs/benchmarks.md).\n"
          "Each row is printed as it finishes and the CSV rewritten (atomically) with the rows done;\n"
          "stderr gets one progress line a row with the time elapsed and an estimate of the time\n"
          "left. A stopped run (Ctrl-C, SIGTERM) leaves a valid CSV of its finished rows whose last\n"
