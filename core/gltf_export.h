@@ -65,6 +65,24 @@
 //     — skin_skeleton's frusta with default SkinOptions, in its order;
 //   "instances": [{"name", "position_m"[3], "rotate_y_deg", "scale"}, ...] — the exact
 //     placement of every plant this node draws (one, or several when instanced).
+// Extras "compact" (GltfExtras::compact, `sylva export`'s default): "format", "version"
+// and "source" as above; "chains", "leaves", "skinning.frusta" and "instances" become
+// objects {"count": n, NAME: bufferView index, ...} whose bufferViews (in buffer 0, no
+// target, no accessor, 8-byte aligned) hold raw little-endian float64 ("f64") or uint32
+// ("u32") values, so every double reads back bit for bit:
+//   "chains"    {"count" C, "joint_count" u32[C], "parent" u32[2C] (chain, joint;
+//                4294967295 twice for a root), "joints" f64[4J] (x, y, z, radius),
+//                "material" u32[J]}, J = the sum of joint_count;
+//   "leaves"    {"count" L, "vertex_count" u32[L], "joint" u32[2L] (as "parent"),
+//                "material" u32[L], "vertices" f64[3V]}, V = the sum of vertex_count;
+//                left out without leaves;
+//   "skinning"  {"max_tilt_deg", "columns", "frusta": {"count" F, "ids" u32[3F] (chain,
+//                segment, knuckle 0/1), "planes" f64[9F] (the other columns in order)}};
+//   "instances" {"count" K, "names" [K strings], "placement" f64[5K] (position_m[3],
+//                rotate_y_deg, scale)}.
+// A bufferView key is left out when its count is 0 (glTF has no empty bufferViews).
+// The reader takes an array-valued "chains" as "full" (files written before "compact"
+// existed), an object-valued one as "compact".
 // Vertex i of the LINES primitive is joint i of the skeleton.
 // Files are written atomically; .glb is binary glTF, .gltf is JSON with the buffer
 // embedded as a data URI. Every file passes the Khronos glTF validator with no errors or
@@ -94,6 +112,13 @@ struct GltfPlant {
   Bark bark = {};               // textures and relief of the mesh (used with `mesh` only)
 };
 
+// How a node's extras.sylva holds the skeleton (docs/gltf.md "Skeleton in extras").
+enum class GltfExtras {
+  full,     // the layout above, every number as JSON text
+  compact,  // the same keys, the large arrays as raw bufferViews (below); bit-exact
+  none,     // no node extras: a plain mesh, which cannot be read back as a skeleton
+};
+
 struct GltfExportOptions {
   bool mesh = false;            // also write the tessellated frusta as a triangle mesh
   int segments_around = 8;      // columns around each frustum for the mesh (>= 3)
@@ -101,6 +126,7 @@ struct GltfExportOptions {
                                 // `mesh`, equal barks) as one node
                                 // with EXT_mesh_gpu_instancing (listed in extensionsUsed)
   std::map<uint32_t, SceneMaterial> materials = {};  // the scene's table (with `mesh`)
+  GltfExtras extras = GltfExtras::full;  // how node extras.sylva holds the skeleton (above)
 };
 
 // Writes `plants` to `path` (.glb or .gltf by extension). An error is a Diagnostic naming
@@ -119,8 +145,12 @@ Status check_bark_textures(const Bark& bark);
 double bark_reference_radius_m(const Skeleton& skeleton);
 
 // Reads the sylva skeletons back from a glTF file's node extras (for `sylva render
-// plant.glb`): one plant per node and instance, in node order. A file without sylva
-// extras is an error naming the file, not a crash; a bad value is located in the JSON.
+// plant.glb`), "full" or "compact": one plant per node and instance, in node order. A
+// file without sylva extras (e.g. written with GltfExtras::none) is an error naming the
+// file, not a crash; a bad value is located in the JSON. For "compact" the binary buffer
+// is read too (the GLB's BIN chunk, or a .gltf's base64 data URI; no other URI is ever
+// resolved), and every bufferView index, offset and length is checked against it and
+// against the counts before anything is allocated.
 Expected<std::vector<GltfPlant>> import_gltf_skeletons(const std::string& path);
 
 // The same from the file's bytes already in memory (`path` names it in messages): the

@@ -617,6 +617,7 @@ void write_skeleton_members(JsonWriter& w, const Skeleton& skeleton, const Skele
   for (const auto& [name, value] : source.defines) w.key(name).number(value);  // std::map: sorted by name
   w.end_object();
   w.end_object();
+  if (style.header_only) return;
   // A chain's parent and a leaf's joint: [chain, joint] or null.
   auto write_joint_ref = [&w](const char* key, const std::optional<ChainParent>& ref) {
     w.key(key);

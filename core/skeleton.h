@@ -102,6 +102,9 @@ struct SkeletonJsonStyle {
   bool compact = false;         // no spaces or line breaks (for embedding, e.g. glTF extras)
   bool seed_as_string = false;  // "seed": "18446744073709551615", for JSON consumers that
                                 //   read every number as a double (glTF extras)
+  bool header_only = false;     // only "format", "version" (2 with leaves) and "source": the
+                                //   chains and leaves go elsewhere (glTF extras "compact",
+                                //   gltf_export.h)
 };
 
 // Writes the members of the sylva-skeleton document — "format", "version", "source"

@@ -49,7 +49,10 @@
 #include <thread>
 #include <vector>
 
+#include <unistd.h>
+
 #include "app/bench/bench_gpu_fog.h"
+#include "app/bench/bench_rows.h"
 #include "app/bench/bench_metrics.h"
 #include "app/cli/cli.h"
 #include "app/cli/render_input.h"
@@ -72,7 +75,7 @@ const char* const kFamilies[] = {"RC", "RC-nocd", "RC+R", "GS", "GS+R", "RC-anim
 void print_help() {
   std::cout
       << "usage: sylva bench gpu [INPUT...] [--width W --height H] [--frames N] [--warmup K]\n"
-         "                       [--methods LIST] [--csv FILE] [--plot FILE.png] [--quick]\n"
+         "                       [--methods LIST] [--csv FILE] [--plot FILE.png] [--full | --quick]\n"
          "                       [--reference-steps N] [--reference-bisection N]\n"
          "       sylva bench gpu --fog [SCENE...] [--width W --height H] [--frames N] [--quick] ...\n\n"
          "Error against GPU time per frame of the GL backend's ways to draw INPUT (scenes,\n"
@@ -83,12 +86,22 @@ void print_help() {
          "(GS+R) and swaying skeletons re-uploaded every frame (RC-anim). GPU time is the\n"
          "sum of the GL_TIME_ELAPSED passes; errors are against the CPU's converged\n"
          "reference. Methods the GL backend cannot draw yet are listed as skipped.\n\n"
-         "  --width W, --height H   one image size (default: 1024x768 and 1920x1080)\n"
-         "  --frames N              measured frames per method (default 100)\n"
-         "  --warmup K              frames rendered before measuring (default 5)\n"
+         "The default run: 1024x768, 10 frames after 2, RC, RC-nocd, RC+R 8x0 and 32x4, GS and GS+R\n"
+         "m = 0..2, RC-anim (22 rows for the pine and saguaro: 4 min 39 s on dev-2c's llvmpipe).\n"
+         "--full: the whole sweep, 1024x768 and 1920x1080, 100 frames after 5, RC+R 8x0, 16x4,\n"
+         "32x4, 64x8, GS and GS+R m = 0..4 (60 rows; about 5 h on dev-2c's llvmpipe, estimated\n"
+         "in docs/benchmarks.md).\n"
+         "Each row is printed as it finishes and the CSV rewritten (atomically) with the rows done;\n"
+         "stderr gets one progress line a row with the time elapsed and an estimate of the time\n"
+         "left. A stopped run (Ctrl-C, SIGTERM) leaves a valid CSV of its finished rows whose last\n"
+         "line is '# partial run: K of N rows ...'; the plot is drawn at the end only.\n\n"
+         "  --width W, --height H   one image size (default 1024x768; --full: and 1920x1080)\n"
+         "  --frames N              measured frames per method (default 10; --full: 100)\n"
+         "  --warmup K              frames rendered before measuring (default 2; --full: 5)\n"
          "  --methods LIST          comma-separated families: RC,RC-nocd,RC+R,GS,GS+R,RC-anim\n"
          "  --csv FILE              the table as CSV (default bench_gpu.csv)\n"
          "  --plot FILE             log-log depth error vs GPU time PNG (default bench_gpu.png)\n"
+         "  --full                  the whole sweep (above)\n"
          "  --quick                 a 160x120 image, 3 frames after 1, fewer settings (tests)\n"
          "  --reference-steps N     uniform relief steps of the reference (default 1024)\n"
          "  --reference-bisection N bisection steps of the reference (default 24)\n"
@@ -110,6 +123,7 @@ struct Args {
   std::optional<uint32_t> width, height, frames, warmup;
   std::vector<std::string> families;  // empty: every family
   bool quick = false;
+  bool full = false;                  // --full: the whole sweep (docs/benchmarks.md)
   bool help = false;
   bool fog = false;                   // --fog: the fog pass's rows (bench_gpu_fog.h)
   bool csv_given = false, plot_given = false;
@@ -145,6 +159,7 @@ Args parse_args(const std::vector<std::string>& args) {
     else if (a == "--frames") out.frames = parse_count(a, value(), 1'000'000);
     else if (a == "--warmup") out.warmup = static_cast<uint32_t>(parse_count(a, value(), 1'000'000));
     else if (a == "--quick") out.quick = true;
+    else if (a == "--full") out.full = true;
     else if (a == "--fog") out.fog = true;
     else if (a == "--csv") out.csv = value(), out.csv_given = true;
     else if (a == "--plot") out.plot = value(), out.plot_given = true;
@@ -161,6 +176,7 @@ Args parse_args(const std::vector<std::string>& args) {
   }
   if (out.help) return out;
   if (out.width.has_value() != out.height.has_value()) throw UsageError{"give --width and --height together"};
+  if (out.full && out.quick) throw UsageError{"--full and --quick exclude each other"};
   for (std::string& input : out.inputs) input = resolve_bench_input(input);
   if (out.inputs.empty())
     out.inputs = out.fog ? std::vector<std::string>{resolve_bench_input("elm_grove_low_sun")}
@@ -179,7 +195,10 @@ struct Method {
   bool animated = false;
 };
 
-std::vector<Method> methods_for(bool relief, bool quick, const std::vector<std::string>& families) {
+// The settings of each family: --quick's (tests), the default run's, or --full's sweep.
+enum class Sweep { quick, standard, full };
+
+std::vector<Method> methods_for(bool relief, Sweep sweep, const std::vector<std::string>& families) {
   auto wanted = [&](const std::string& family) {
     return families.empty() || std::find(families.begin(), families.end(), family) != families.end();
   };
@@ -193,13 +212,14 @@ std::vector<Method> methods_for(bool relief, bool quick, const std::vector<std::
   }
   if (relief && wanted("RC+R")) {
     using Setting = std::pair<int, int>;  // uniform steps, bisection steps
-    const std::vector<Setting> settings =
-        quick ? std::vector<Setting>{{16, 4}} : std::vector<Setting>{{8, 0}, {16, 4}, {32, 4}, {64, 8}};
+    const std::vector<Setting> settings = sweep == Sweep::quick      ? std::vector<Setting>{{16, 4}}
+                                          : sweep == Sweep::standard ? std::vector<Setting>{{8, 0}, {32, 4}}
+                                                                     : std::vector<Setting>{{8, 0}, {16, 4}, {32, 4}, {64, 8}};
     for (const auto& [steps, bisection] : settings)
       m.push_back({"RC+R", "RC+R " + std::to_string(steps) + "x" + std::to_string(bisection),
                    relief_geometry(steps, bisection), steps, bisection});
   }
-  const int max_level = quick ? 1 : 4;
+  const int max_level = sweep == Sweep::full ? 4 : sweep == Sweep::standard ? 2 : 1;
   for (int displaced = 0; displaced <= (relief ? 1 : 0); ++displaced) {
     const std::string family = displaced ? "GS+R" : "GS";
     if (!wanted(family)) continue;
@@ -351,13 +371,20 @@ const char* const kCsvColumns =
     "upload_bytes_per_frame,sway_ms_median,update_ms_median,reference,depth_rmse_m,depth_max_m,hit_mismatch,"
     "colour_rmse,colour_max\n";
 
-std::string csv_text(const std::vector<Row>& rows, const std::string& device, const GlContextInfo& gl,
-                     uint32_t frames, uint32_t warmup) {
+// The CSV's comment and column lines.
+std::string csv_head(const std::string& device, const GlContextInfo& gl, uint32_t frames, uint32_t warmup,
+                     const std::string& run) {
   std::ostringstream out;
   out << "# sylva bench gpu on " << device << " (" << gl.describe() << "), " << frames << " frames after " << warmup
-      << " warm-up frames, sun as a point\n";
+      << " warm-up frames, sun as a point, " << run << "\n";
   out << kCsvColumns;
-  for (const Row& r : rows) {
+  return out.str();
+}
+
+// One row of the CSV, ending in '\n'.
+std::string csv_row(const Row& r, const std::string& device, const GlContextInfo& gl) {
+  std::ostringstream out;
+  {
     const Method& m = r.method;
     const double median_ms = quantile(r.gpu_s, 0.5) * 1e3;
     const ImageErrors e = r.errors.value_or(ImageErrors{});
@@ -443,12 +470,14 @@ int run_bench_gpu(const std::vector<std::string>& args) {
     print_help();
     return kOk;
   }
-  const uint32_t frames = a.frames.value_or(a.quick ? 3 : 100);
-  const uint32_t warmup = a.warmup.value_or(a.quick ? 1 : 5);
+  const Sweep sweep = a.full ? Sweep::full : a.quick ? Sweep::quick : Sweep::standard;
+  const uint32_t frames = a.frames.value_or(a.quick ? 3 : a.full ? 100 : 10);
+  const uint32_t warmup = a.warmup.value_or(a.quick ? 1 : a.full ? 5 : 2);
   std::vector<ImageSize> sizes;
   if (a.width) sizes.push_back({*a.width, *a.height});
   else if (a.quick) sizes.push_back({160, 120});
-  else sizes = {{1024, 768}, {1920, 1080}};
+  else if (a.full) sizes = {{1024, 768}, {1920, 1080}};
+  else sizes = {{1024, 768}};
 
   GlContextResult gl = create_headless_gl_context();
   if (!gl.context) {
@@ -475,7 +504,16 @@ int run_bench_gpu(const std::vector<std::string>& args) {
               "p90", "fps", "wall_ms", "mem_MiB", "setup_KiB", "KiB/frame", "upd_ms", "depth_rmse", "mismatch",
               "colour_rmse");
 
-  std::vector<Row> rows;
+  // Every input at every size first, so that the rows planned are known (the progress
+  // line's estimate, the CSV's partial-run line).
+  struct Job {
+    std::string input;
+    ImageSize size;
+    Scene scene;
+    std::vector<Method> methods;
+  };
+  std::vector<Job> jobs;
+  size_t planned = 0;
   for (const std::string& input : a.inputs) {
     for (const ImageSize& size : sizes) {
       std::vector<RenderPass> passes;
@@ -483,19 +521,35 @@ int run_bench_gpu(const std::vector<std::string>& args) {
       grammar.grammar = input;
       auto loaded = load_render_input(grammar, size.width, size.height, passes);
       if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
-      Scene scene = std::move(std::get<Scene>(loaded));
-      scene.sun.angular_radius_deg = 0;
-      LazyReference reference(scene, a);
-      for (const Method& m : methods_for(scene_has_relief(scene), a.quick, a.families)) {
-        Row row{input, size, m};
-        run_method(scene, frames, warmup, reference, row);
-        print_row(row);
-        rows.push_back(std::move(row));
-      }
+      Job job{input, size, std::move(std::get<Scene>(loaded)), {}};
+      job.scene.sun.angular_radius_deg = 0;
+      job.methods = methods_for(scene_has_relief(job.scene), sweep, a.families);
+      planned += job.methods.size();
+      jobs.push_back(std::move(job));
     }
   }
-
-  if (Status e = write_file_atomically(a.csv, csv_text(rows, device, gl.context->info(), frames, warmup)); !e) {
+  const std::string run = a.full ? "full sweep" : a.quick ? "quick run" : "default run (--full: the whole sweep)";
+  BenchRows csv("sylva bench gpu", a.csv, csv_head(device, gl.context->info(), frames, warmup, run), planned,
+                isatty(STDERR_FILENO) != 0);
+  if (Status e = csv.start(); !e) {
+    std::cerr << e.error().format();
+    return kInputError;
+  }
+  std::vector<Row> rows;
+  for (const Job& job : jobs) {
+    LazyReference reference(job.scene, a);
+    for (const Method& m : job.methods) {
+      Row row{job.input, job.size, m};
+      run_method(job.scene, frames, warmup, reference, row);
+      print_row(row);
+      if (Status e = csv.add(csv_row(row, device, gl.context->info()), where(row) + " " + m.name); !e) {
+        std::cerr << e.error().format();
+        return kInputError;
+      }
+      rows.push_back(std::move(row));
+    }
+  }
+  if (Status e = csv.finish(); !e) {
     std::cerr << e.error().format();
     return kInputError;
   }

@@ -4,14 +4,17 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <thread>
 #include <variant>
 
+#include <unistd.h>
+
 #include "app/bench/bench_metrics.h"
+#include "app/bench/bench_rows.h"
 #include "app/bench/fog_view.h"
 #include "app/bench/plot.h"
 #include "app/cli/cli.h"
@@ -83,15 +86,18 @@ const char* const kGpuFogCsvColumns =
     "frame_gpu_ms_median,cones,photons,overflow_pixels,fog_rmse,fog_rmse_relative,fog_bias_relative,reference\n";
 
 int run_gpu_fog_rows(const GpuFogArgs& a, const std::string& device, const GlContextInfo& gl) {
-  std::ofstream csv(a.csv, std::ios::trunc);
-  if (!csv) {
-    std::cerr << "sylva bench gpu: cannot write " << a.csv << "\n";
+  // Each row as it finishes, with a progress line (bench_rows.h): a long run stopped
+  // early keeps what it measured.
+  const size_t planned = a.inputs.size() * a.sizes.size() * fog_methods(a.quick, 1).size();
+  BenchRows csv("sylva bench gpu --fog", a.csv,
+                "# sylva bench gpu --fog on " + device + " (" + gl.describe() + "), " + std::to_string(a.frames) +
+                    " frames after " + std::to_string(a.warmup) + " warm-up frames, sun as a point\n" +
+                    kGpuFogCsvColumns,
+                planned, isatty(STDERR_FILENO) != 0);
+  if (Status e = csv.start(); !e) {
+    std::cerr << e.error().format();
     return kInputError;
   }
-  csv << "# sylva bench gpu --fog on " << device << " (" << gl.describe() << "), " << a.frames << " frames after "
-      << a.warmup << " warm-up frames, sun as a point\n"
-      << kGpuFogCsvColumns;
-  csv.flush();
   std::printf("%-34s %-11s %10s %10s %10s %8s %10s %9s\n", "input", "method", "fog_ms", "cones_ms", "frame_ms", "cones",
               "rmse_rel", "bias_rel");
   const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
@@ -173,7 +179,8 @@ int run_gpu_fog_rows(const GpuFogArgs& a, const std::string& device, const GlCon
           ++failed;
         }
         const double rel = e.rmse / e.mean_ref, bias = (e.mean_test - e.mean_ref) / e.mean_ref;
-        csv << quoted(device) << ',' << quoted(gl.renderer) << ',' << quoted(input) << ',' << width << ',' << height
+        std::ostringstream line;
+        line << quoted(device) << ',' << quoted(gl.renderer) << ',' << quoted(input) << ',' << width << ',' << height
             << ',' << quoted(m.name) << ',' << fog_mode_name(m.mode) << ',' << m.steps << ',' << status << ','
             << quoted(reason) << ',' << fog_ms.size() << ',' << number(median(fog_ms)) << ','
             << number(median(cones_ms)) << ',' << number(median(frame_ms)) << ',' << cone_count << ','
@@ -181,7 +188,10 @@ int run_gpu_fog_rows(const GpuFogArgs& a, const std::string& device, const GlCon
             << number(rel) << ',' << number(bias) << ",CPU fog reference"
             << (a.reference_stride > 1 ? " on every " + std::to_string(a.reference_stride) + "-th pixel each way" : "")
             << "\n";
-        csv.flush();  // each row as it finishes: a long run stopped early keeps what it measured
+        if (Status written = csv.add(line.str(), where + " " + m.name); !written) {
+          std::cerr << written.error().format();
+          return kInputError;
+        }
         if (status != "ok") {
           std::printf("%-34s %-11s failed: %s\n", where.c_str(), m.name.c_str(), reason.c_str());
         } else {
@@ -194,6 +204,10 @@ int run_gpu_fog_rows(const GpuFogArgs& a, const std::string& device, const GlCon
       }
       panels.push_back(std::move(panel));
     }
+  }
+  if (Status e = csv.finish(); !e) {
+    std::cerr << e.error().format();
+    return kInputError;
   }
   if (Status e = write_loglog_plot(panels, a.plot); !e) {
     std::cerr << e.error().format();

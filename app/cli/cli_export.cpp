@@ -1,6 +1,7 @@
 // cli_export.cpp — `sylva export INPUT -o FILE.gltf|FILE.glb [--mesh] [--segments-around N]`
 // (cli.md): a grammar, skeleton or scene to glTF 2.0 with the skeleton in the
-// node extras (core/gltf_export.h); `--seed A..B` with `-o out/p_{seed}.glb` exports a
+// node extras (core/gltf_export.h; `--extras compact|full|none`, compact by default:
+// docs/gltf.md); `--seed A..B` with `-o out/p_{seed}.glb` exports a
 // batch in parallel (app/batch.h). The mesh's bark comes from each plant of a scene, or
 // for a grammar or skeleton from the --bark-* flags (scene.md's bark keys as flags).
 #include <charconv>
@@ -26,6 +27,7 @@ namespace {
 
 void print_export_help() {
   std::cout << "usage: sylva export INPUT -o FILE.gltf|FILE.glb [--mesh] [--segments-around N] [--instancing]\n"
+               "                    [--extras compact|full|none]\n"
                "                    [--bark-albedo FILE] [--bark-height FILE] [--relief-depth M]\n"
                "                    [--u-repeat N] [--v-per-metre N]\n"
                "                    [-n STEPS] [--seed S|A..B] [-D NAME=VALUE]... [--max-modules N]\n\n"
@@ -42,6 +44,13 @@ void print_export_help() {
                "      --segments-around N  columns around each frustum of the mesh, 3 to 4096 (default 8)\n"
                "      --instancing         repeated identical plants of a scene as one node with\n"
                "                           EXT_mesh_gpu_instancing\n"
+               "      --extras MODE        how each node's extras.sylva holds the skeleton (docs/gltf.md):\n"
+               "                           compact (default) the large arrays (joints, chains, leaves,\n"
+               "                             skinning, instance placements) as raw little-endian float64/\n"
+               "                             uint32 bufferViews referenced by index: bit-exact, small;\n"
+               "                           full  every number as JSON text (as files written before);\n"
+               "                           none  no skeleton: a plain mesh that 'sylva render' cannot read\n"
+               "                           back. 'sylva render FILE' reads compact and full files.\n"
                "Bark of the mesh (a scene gives each plant's own; these are for a .lsys or .skel.json\n"
                "INPUT and need --mesh):\n"
                "      --bark-albedo FILE   albedo texture (PNG or JPEG, sRGB), embedded as baseColorTexture\n"
@@ -123,6 +132,7 @@ std::string export_summary(const std::string& input, const std::string& output, 
 int run_export(const std::vector<std::string>& raw_args) {
   // The export flags first; what is left is the grammar flags' business.
   GltfExportOptions options;
+  options.extras = GltfExtras::compact;  // the CLI's default (the library's is full)
   Bark bark;                 // from the --bark-* flags
   bool bark_flags = false;
   std::vector<std::string> args;
@@ -147,6 +157,12 @@ int run_export(const std::vector<std::string>& raw_args) {
       options.mesh = true;
     } else if (a == "--instancing") {
       options.instancing = true;
+    } else if (is_flag(a, "--extras")) {
+      const std::string mode = flag_value(raw_args, &i, "--extras");
+      if (mode == "compact") options.extras = GltfExtras::compact;
+      else if (mode == "full") options.extras = GltfExtras::full;
+      else if (mode == "none") options.extras = GltfExtras::none;
+      else throw UsageError{"--extras " + mode + ": expected compact, full or none"};
     } else if (a == "--segments-around" || a.rfind("--segments-around=", 0) == 0) {
       std::string v;
       if (a.size() > std::string("--segments-around").size()) {

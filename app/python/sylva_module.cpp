@@ -461,7 +461,8 @@ Bark bark_from_dict(const py::object& value) {
 
 void python_export_gltf(const py::object& plants, const std::filesystem::path& path, bool mesh, int segments_around,
                         bool instancing, const py::object& names, const py::object& positions,
-                        const py::object& rotate_y_deg, const py::object& scales, const py::object& bark) {
+                        const py::object& rotate_y_deg, const py::object& scales, const py::object& bark,
+                        const std::string& extras) {
   const std::vector<const Skeleton*> skeletons = skeleton_list(plants);
   if (skeletons.empty()) throw py::value_error("export_gltf needs at least one plant");
   if (segments_around < 3) throw py::value_error("segments_around must be >= 3");
@@ -499,6 +500,10 @@ void python_export_gltf(const py::object& plants, const std::filesystem::path& p
   options.mesh = mesh;
   options.segments_around = segments_around;
   options.instancing = instancing;
+  if (extras == "full") options.extras = GltfExtras::full;
+  else if (extras == "compact") options.extras = GltfExtras::compact;
+  else if (extras == "none") options.extras = GltfExtras::none;
+  else throw py::value_error("extras must be \"full\", \"compact\" or \"none\", got \"" + extras + "\"");
   Status exported;
   {
     py::gil_scoped_release release;
@@ -723,8 +728,8 @@ released while growing. A RuntimeWarning reports an interpretation cut at max de
   signatures.disable_function_signatures();
   m.def("export_gltf", &python_export_gltf, "plants"_a, "path"_a, py::kw_only(), "mesh"_a = false,
         "segments_around"_a = 8, "instancing"_a = false, "names"_a = py::none(), "positions"_a = py::none(),
-        "rotate_y_deg"_a = py::none(), "scales"_a = py::none(), "bark"_a = py::none(),
-        R"doc(export_gltf(plants: Skeleton | Sequence[Skeleton], path: str | os.PathLike, *, mesh: bool = False, segments_around: int = 8, instancing: bool = False, names: Sequence[str] | None = None, positions: Sequence[tuple[float, float, float]] | None = None, rotate_y_deg: Sequence[float] | None = None, scales: Sequence[float] | None = None, bark: dict | None = None) -> None
+        "rotate_y_deg"_a = py::none(), "scales"_a = py::none(), "bark"_a = py::none(), "extras"_a = "full",
+        R"doc(export_gltf(plants: Skeleton | Sequence[Skeleton], path: str | os.PathLike, *, mesh: bool = False, segments_around: int = 8, instancing: bool = False, names: Sequence[str] | None = None, positions: Sequence[tuple[float, float, float]] | None = None, rotate_y_deg: Sequence[float] | None = None, scales: Sequence[float] | None = None, bark: dict | None = None, extras: str = "full") -> None
 
 Writes plants to a glTF 2.0 file, binary (.glb) or JSON (.gltf) by extension.
 
@@ -747,6 +752,10 @@ Keyword-only:
                    default 1). TEXCOORD_0 becomes (u*u_repeat, v_m*v_per_metre).
                    e.g. bark=dict(albedo="presets/textures/bark.png",
                    height="presets/textures/bark_height.png", u_repeat=2)
+  extras           how extras["sylva"] holds the skeleton (docs/gltf.md): "full" (default
+                   here: every number as JSON, for readers of the JSON), "compact" (the
+                   large arrays as bufferViews of raw float64/uint32, bit-exact and a few
+                   times smaller: `sylva export`'s default) or "none" (a plain mesh)
 The mesh has one material per material index the plants use. The file is written
 atomically; a file that cannot be read or written (a missing texture, a missing folder,
 a FIFO or read-only target) raises OSError, plants beyond the limits (docs/limits.md)

@@ -7,7 +7,9 @@
 #include <cmath>
 #include <map>
 #include <optional>
+#include <fstream>
 #include <sstream>
+#include <thread>
 #include <string>
 #include <vector>
 
@@ -257,6 +259,120 @@ TEST(BenchGpu, WithoutOpenGlItExitsOneSayingWhy) {
   EXPECT_TRUE(list_dir(dir.path()).empty()) << "nothing written";
   EXPECT_EQ(r.exit_code, 1) << describe(r);
   EXPECT_NE(r.err.find("sylva bench gpu: no OpenGL 4.5 context: "), std::string::npos) << describe(r);
+}
+
+// The progress lines on stderr (not a terminal here: plain lines), one per row with the
+// time elapsed and, before the last, an estimate of the time left; the finished CSV has no
+// partial-run line.
+TEST(BenchGpu, EachRowGetsAProgressLineWithElapsedAndTimeLeft) {
+  TempDir dir;
+  const ProcessResult r = run_sylva({"bench", "gpu", kGrammar, "--quick", "--csv", dir.file("gpu.csv"), "--plot",
+                                     dir.file("gpu.png")},
+                                    SYLVA_SOURCE_DIR, 240);
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 context") != std::string::npos) GTEST_SKIP() << "no OpenGL";
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  for (int k = 1; k <= 5; ++k) {
+    const std::string head = "sylva bench gpu: row " + std::to_string(k) + "/5 done in ";
+    const size_t at = r.err.find(head);
+    ASSERT_NE(at, std::string::npos) << head << "\n" << r.err;
+    const std::string line = r.err.substr(at, r.err.find('\n', at) - at);
+    EXPECT_NE(line.find(" elapsed"), std::string::npos) << line;
+    EXPECT_EQ(line.find(" left") != std::string::npos, k < 5) << line;
+    EXPECT_EQ(line.find('\x1b'), std::string::npos) << "no terminal, no decoration: " << line;
+  }
+  EXPECT_NE(r.err.find("(saguaro.lsys 160x120 RC)"), std::string::npos) << r.err;
+  const std::string csv = read_file(dir.file("gpu.csv"));
+  EXPECT_EQ(csv.find("# partial run"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(", quick run\n"), std::string::npos) << csv;
+}
+
+// SIGTERM after the first row: the CSV holds the rows done, each complete, and says it
+// is a partial run; no temporary file is left beside it.
+TEST(BenchGpu, AStoppedRunLeavesAValidCsvOfTheRowsItFinished) {
+  TempDir dir;
+  const std::string csv = dir.file("gpu.csv");
+  std::vector<std::string> argv = {SYLVA_BINARY, "bench", "gpu", "pine", "--quick", "--frames", "20", "--csv", csv,
+                                   "--plot", dir.file("gpu.png")};
+  std::vector<char*> args;
+  for (std::string& a : argv) args.push_back(a.data());
+  args.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, dir.file("out.txt").c_str(), O_WRONLY | O_CREAT, 0644);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, dir.file("err.txt").c_str(), O_WRONLY | O_CREAT, 0644);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, SYLVA_BINARY, &actions, nullptr, args.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  // Wait for the first row (the column line and one data line), at most 200 s.
+  auto rows_in = [](const std::string& text) {
+    size_t lines = 0;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) lines += !line.empty() && line[0] != '#';
+    return lines > 0 ? lines - 1 : 0;  // less the column line
+  };
+  int status = 0;
+  bool exited = false;
+  for (int i = 0; i < 20000; ++i) {
+    if (waitpid(pid, &status, WNOHANG) == pid) {
+      exited = true;
+      break;
+    }
+    std::ifstream in(csv);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (rows_in(text) >= 1) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (exited) {
+    const std::string err = read_file(dir.file("err.txt"));
+    if (err.find("no OpenGL 4.5 context") != std::string::npos) GTEST_SKIP() << "no OpenGL";
+    FAIL() << "the run ended before it could be stopped: " << err;
+  }
+  ASSERT_EQ(kill(pid, SIGTERM), 0);
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "status " << status;
+  EXPECT_EQ(WTERMSIG(status), SIGTERM);
+  const std::string text = read_file(csv);
+  const std::vector<CsvRow> rows = read_csv(text, kColumns);  // checks every row's field count
+  ASSERT_GE(rows.size(), 1u) << text;
+  ASSERT_LT(rows.size(), 8u) << "the pine's quick run has 8 rows; it was stopped before the last";
+  EXPECT_EQ(rows.front().at("method"), "RC");
+  for (const CsvRow& row : rows) {
+    EXPECT_EQ(row.at("status"), "ok") << row.at("method");
+    EXPECT_EQ(row.at("frames"), "20");
+    EXPECT_FALSE(row.at("colour_max").empty()) << "the last column is there: " << row.at("method");
+  }
+  EXPECT_EQ(text.substr(text.rfind("# partial run")),
+            "# partial run: " + std::to_string(rows.size()) + " of 8 rows (the run was stopped, or is still running)\n");
+  EXPECT_EQ(list_dir(dir.path()), (std::vector<std::string>{"err.txt", "gpu.csv", "out.txt"}))
+      << "no temporary and no plot left";
+}
+
+// The default run's settings are what --help says (a small image to keep the test short).
+TEST(BenchGpu, TheDefaultRunMeasuresTheSetTheHelpNames) {
+  const ProcessResult help = run_sylva({"bench", "gpu", "--help"});
+  ASSERT_EQ(help.exit_code, 0) << describe(help);
+  EXPECT_NE(help.out.find("The default run: 1024x768, 10 frames after 2, RC, RC-nocd, RC+R 8x0 and 32x4, GS and GS+R\n"
+                          "m = 0..2, RC-anim"),
+            std::string::npos)
+      << help.out;
+  EXPECT_NE(help.out.find("--full"), std::string::npos) << help.out;
+  const ProcessResult both = run_sylva({"bench", "gpu", "--full", "--quick"});
+  EXPECT_EQ(both.exit_code, 2) << describe(both);
+  const auto rows = run_bench_gpu({kScene, "--width", "64", "--height", "48"});
+  if (!rows) GTEST_SKIP() << "no OpenGL context on this machine";
+  const sylva::Expected<sylva::Scene> read = sylva::read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/" + kScene);
+  ASSERT_TRUE(read.ok()) << read.error().format();
+  std::vector<ExpectedMethod> methods = {{"RC", GeometryKind::frusta, false, 0, false},
+                                         {"RC no cons. depth", GeometryKind::frusta, false, 0, false},
+                                         {"RC+R 8x0", GeometryKind::frusta, true, 0, false},
+                                         {"RC+R 32x4", GeometryKind::frusta, true, 0, false}};
+  for (int displace = 0; displace < 2; ++displace)
+    for (int m = 0; m <= 2; ++m)
+      methods.push_back({std::string(displace ? "GS+R" : "GS") + " m=" + std::to_string(m), GeometryKind::mesh, false, m,
+                         displace != 0});
+  methods.push_back({"RC anim", GeometryKind::frusta, false, 0, false});
+  expect_rows(*rows, kScene, *read, methods, "64", "48", "10");
 }
 
 }  // namespace

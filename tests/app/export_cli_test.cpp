@@ -163,6 +163,79 @@ TEST(ExportCli, ALeafyPlantsMeshPassesTheKhronosValidator) {
   expect_valid(files);
 }
 
+// --extras compact (the default), full and none, for a leafy grammar and a scatter scene
+// with and without instancing: every file passes the validator; compact and full read
+// back to the same plants; none is a plain mesh that render refuses clearly;
+// EXT_mesh_gpu_instancing is required exactly where it is used.
+TEST(ExportCli, EveryExtrasModePassesTheValidatorAndCompactReadsBackLikeFull) {
+  TempDir dir;
+  const std::string leafy = kSource + "/presets/abop_1_25_bush_leaves.lsys";
+  const std::string scatter = dir.write("scatter.scene.json", R"({"format":"sylva-scene","version":1,"plants":[],
+    "scatter":[{"grammar":")" + kPlant + R"(","count":12,"seed":1,"plant_seeds":[1,3],"disc":{"centre":[0,0],"radius":10},
+                "rotate_y_deg":[0,360],"scale":[0.8,1.2]}]})");
+  std::vector<std::string> files;
+  struct Case {
+    std::string input, name;
+    std::vector<std::string> flags;
+    bool instanced;
+  };
+  std::vector<Case> cases;
+  for (const char* mode : {"compact", "full", "none"})
+    for (const char* ext : {".glb", ".gltf"}) {
+      const std::string m = mode;
+      cases.push_back({leafy, "leafy_" + m + ext, {"--extras", m, "--mesh", "--segments-around", "4", "-D", "N=3"}, false});
+      cases.push_back({scatter, "scatter_" + m + ext, {"--extras", m}, false});
+      cases.push_back({scatter, "scatter_inst_" + m + ext, {"--extras", m, "--instancing", "--mesh"}, true});
+    }
+  cases.push_back({scatter, "scatter_default.glb", {"--instancing", "--mesh"}, true});
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {"export", c.input, "-o", dir.file(c.name)};
+    args.insert(args.end(), c.flags.begin(), c.flags.end());
+    expect_ok(run_sylva(args));
+    files.push_back(dir.file(c.name));
+    // extensionsRequired (and extensionsUsed) exactly when the instancing extension is used.
+    const std::string bytes = read_file(dir.file(c.name));
+    EXPECT_EQ(bytes.find("\"extensionsRequired\":[\"EXT_mesh_gpu_instancing\"]") != std::string::npos, c.instanced)
+        << c.name;
+    EXPECT_EQ(bytes.find("EXT_mesh_gpu_instancing") != std::string::npos, c.instanced) << c.name;
+  }
+  expect_valid(files);
+  EXPECT_EQ(read_file(dir.file("scatter_default.glb")), read_file(dir.file("scatter_inst_compact.glb")))
+      << "compact is the default";
+  for (const char* stem : {"leafy_", "scatter_", "scatter_inst_"})
+    for (const char* ext : {".glb", ".gltf"}) {
+      SCOPED_TRACE(std::string(stem) + ext);
+      const auto full = sylva::import_gltf_skeletons(dir.file(std::string(stem) + "full" + ext));
+      const auto compact = sylva::import_gltf_skeletons(dir.file(std::string(stem) + "compact" + ext));
+      ASSERT_TRUE(full.ok()) << full.error().format();
+      ASSERT_TRUE(compact.ok()) << compact.error().format();
+      ASSERT_EQ(full->size(), compact->size());
+      for (size_t i = 0; i < full->size(); ++i) {
+        EXPECT_EQ((*full)[i].skeleton, (*compact)[i].skeleton);
+        EXPECT_EQ((*full)[i].name, (*compact)[i].name);
+        for (int k = 0; k < 3; ++k) EXPECT_EQ((*full)[i].position_m[k], (*compact)[i].position_m[k]);
+        EXPECT_EQ((*full)[i].rotate_y_deg, (*compact)[i].rotate_y_deg);
+        EXPECT_EQ((*full)[i].scale, (*compact)[i].scale);
+      }
+      EXPECT_LT(std::filesystem::file_size(dir.file(std::string(stem) + "compact" + ext)),
+                std::filesystem::file_size(dir.file(std::string(stem) + "full" + ext)));
+    }
+  const auto scattered = sylva::import_gltf_skeletons(dir.file("scatter_inst_compact.glb"));
+  ASSERT_TRUE(scattered.ok());
+  EXPECT_EQ(scattered->size(), 12u);
+  ProcessResult r = run_sylva({"render", dir.file("leafy_none.glb"), "--backend", "cpu", "-o", dir.file("x.png")});
+  EXPECT_FALSE(crashed(r)) << describe(r);
+  EXPECT_EQ(r.exit_code, 1) << describe(r);
+  EXPECT_NE(r.err.find("no sylva skeleton"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--extras none"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir.file("x.png")));
+  ProcessResult bad = run_sylva({"export", kPlant, "-o", dir.file("y.glb"), "--extras", "tiny"});
+  EXPECT_EQ(bad.exit_code, 2) << describe(bad);
+  EXPECT_NE(bad.err.find("--extras tiny: expected compact, full or none"), std::string::npos) << bad.err;
+  ProcessResult help = run_sylva({"export", "--help"});
+  EXPECT_NE(help.out.find("--extras MODE"), std::string::npos) << help.out;
+}
+
 TEST(ExportCli, TheValidatorHarnessRejectsErrorsAndWarnings) {
   TempDir dir;
   // An error: mode -1 (what tinygltf writes when Primitive::mode is unset).

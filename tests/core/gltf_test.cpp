@@ -10,6 +10,7 @@
 
 #include <glm/geometric.hpp>
 
+#include <bit>
 #include <cmath>
 #include <cstdlib>
 #include <numbers>
@@ -19,6 +20,7 @@
 #include <iterator>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <random>
 #include <string>
@@ -1026,17 +1028,15 @@ TEST(GltfImport, BrokenFilesGiveLocatedErrorsNotCrashes) {
                       "no sylva skeleton");
 }
 
-TEST(GltfImport, EveryTruncationAndRandomCorruptionOfARealFileIsHandled) {
-  TempFolder dir;
-  ASSERT_TRUE(export_gltf({{"plant", grow_text("angle: 30\naxiom: F[+F]F\n")}}, dir.file("p.glb")).ok());
-  const std::string bytes = slurp(dir.file("p.glb"));
-  // Every prefix: an error (the header's length no longer matches), never a crash.
-  for (size_t n = 0; n < bytes.size(); ++n) {
+// Every `step`-th prefix of a real file is an error (the header's length no longer
+// matches), and 300 random 3-byte corruptions give an error or valid plants, never a
+// crash (ASan builds check).
+void expect_cuts_and_flips_handled(const TempFolder& dir, const std::string& bytes, size_t step, unsigned seed) {
+  for (size_t n = 0; n < bytes.size(); n += step) {
     Expected<std::vector<GltfPlant>> r = import_gltf_skeletons(dir.write("cut.glb", bytes.substr(0, n)));
     ASSERT_FALSE(r.ok()) << "prefix of " << n << " bytes accepted";
   }
-  // Random byte flips: either an error or plants, never a crash (ASan builds check).
-  std::mt19937 rng(5);
+  std::mt19937 rng(seed);
   for (int trial = 0; trial < 300; ++trial) {
     std::string broken = bytes;
     for (int k = 0; k < 3; ++k)
@@ -1044,8 +1044,316 @@ TEST(GltfImport, EveryTruncationAndRandomCorruptionOfARealFileIsHandled) {
     Expected<std::vector<GltfPlant>> r = import_gltf_skeletons(dir.write("flip.glb", broken));
     if (r) {
       EXPECT_FALSE(r->empty());  // plants, or else a located error
+      for (const GltfPlant& p : *r) EXPECT_TRUE(validate_skeleton(p.skeleton).ok());
     }
   }
+}
+
+TEST(GltfImport, EveryTruncationAndRandomCorruptionOfARealFileIsHandled) {
+  TempFolder dir;
+  ASSERT_TRUE(export_gltf({{"plant", grow_text("angle: 30\naxiom: F[+F]F\n")}}, dir.file("p.glb")).ok());
+  expect_cuts_and_flips_handled(dir, slurp(dir.file("p.glb")), 1, 5);
+}
+
+
+// ---------------------------------------------------------------------------------------
+// Extras "compact" and "none" (gltf_export.h, docs/gltf.md).
+
+// The bits of every double of a skeleton (joints and leaf vertices), to compare exactly
+// (operator== takes -0 for 0).
+std::vector<uint64_t> skeleton_bits(const Skeleton& sk) {
+  std::vector<uint64_t> bits;
+  auto add = [&](double v) { bits.push_back(std::bit_cast<uint64_t>(v)); };
+  for (const Joint& j : sk.joints) {
+    for (double x : j.position_m) add(x);
+    add(j.radius_m);
+    bits.push_back(j.material);
+  }
+  for (const Leaf& l : sk.leaves)
+    for (const auto& v : l.vertices_m)
+      for (double x : v) add(x);
+  return bits;
+}
+
+// A leafy skeleton with doubles that decimal text handles badly: -0, a subnormal, 0.1+0.2.
+Skeleton awkward_leafy_skeleton() {
+  Skeleton sk = grow_text("angle: 60\naxiom: F(2)[&F{.+f.-f.-f.+|+f.-f.}]!(0.3)F'(1){.+f.-f.-f.}\n", 99);
+  EXPECT_EQ(sk.leaves.size(), 2u);
+  sk.joints[0].position_m[0] = -0.0;
+  sk.joints[0].position_m[2] = 5e-324;
+  sk.joints[1].position_m[0] = 0.1 + 0.2;
+  sk.joints[1].radius_m = 1.0 / 3.0;
+  sk.leaves[0].vertices_m[0][2] += 1e-17;
+  sk.source.seed = std::numeric_limits<uint64_t>::max();
+  sk.source.defines = {{"N", 3}, {"X", 0.1 + 0.7}};
+  EXPECT_TRUE(validate_skeleton(sk).ok());
+  return sk;
+}
+
+TEST(GltfExtras, CompactRoundTripIsBitExactForLeavesAndInstancesInGlbAndGltf) {
+  TempFolder dir;
+  const Skeleton leafy = awkward_leafy_skeleton(), other = grow_text(kGrammar, 3);
+  // A scatter-like scene: copies of one skeleton (instanced) and another plant.
+  std::vector<GltfPlant> scene = {{"leafy", leafy, {0.1, -0.0, 1e-300}, 33.3, 0.7},
+                                  {"other", other, {-3, 0, 1}, 10, 1},
+                                  {"leafy_b", leafy, {2.0 / 3.0, 0, 3}, -45.5, 1.0 / 7.0},
+                                  {"leafy_c", leafy, {5, 0.5, -2}, 359.9, 2.5}};
+  for (const char* name : {"s.glb", "s.gltf"})
+    for (bool instancing : {false, true})
+      for (bool mesh : {false, true}) {
+        SCOPED_TRACE(std::string(name) + (instancing ? " instanced" : "") + (mesh ? " mesh" : ""));
+        GltfExportOptions o;
+        o.extras = GltfExtras::compact;
+        o.instancing = instancing;
+        o.mesh = mesh;
+        ASSERT_TRUE(export_gltf(scene, dir.file(name), o).ok());
+        Expected<std::vector<GltfPlant>> r = import_gltf_skeletons(dir.file(name));
+        ASSERT_TRUE(r.ok()) << r.error().format();
+        ASSERT_EQ(r->size(), scene.size());
+        // Instancing groups the copies of `leafy` on the first node: a0, b, c, then other.
+        const std::vector<size_t> order = instancing ? std::vector<size_t>{0, 2, 3, 1} : std::vector<size_t>{0, 1, 2, 3};
+        for (size_t i = 0; i < order.size(); ++i) {
+          const GltfPlant& back = (*r)[i];
+          const GltfPlant& original = scene[order[i]];
+          EXPECT_EQ(back.name, original.name);
+          EXPECT_EQ(back.skeleton, original.skeleton);
+          EXPECT_EQ(skeleton_bits(back.skeleton), skeleton_bits(original.skeleton));
+          EXPECT_EQ(write_skeleton_json(back.skeleton), write_skeleton_json(original.skeleton));
+          for (int k = 0; k < 3; ++k)
+            EXPECT_EQ(std::bit_cast<uint64_t>(back.position_m[k]), std::bit_cast<uint64_t>(original.position_m[k]));
+          EXPECT_EQ(std::bit_cast<uint64_t>(back.rotate_y_deg), std::bit_cast<uint64_t>(original.rotate_y_deg));
+          EXPECT_EQ(std::bit_cast<uint64_t>(back.scale), std::bit_cast<uint64_t>(original.scale));
+        }
+      }
+}
+
+TEST(GltfExtras, CompactKeepsTheKeysWithArraysInUntargetedAlignedBufferViewsAndIsSmallerThanFull) {
+  TempFolder dir;
+  const Skeleton sk = grow_text(kGrammar);
+  GltfExportOptions full, compact;
+  compact.extras = GltfExtras::compact;
+  ASSERT_TRUE(export_gltf({{"plant", sk}}, dir.file("full.glb"), full).ok());
+  ASSERT_TRUE(export_gltf({{"plant", sk}}, dir.file("compact.glb"), compact).ok());
+  EXPECT_LT(fs::file_size(dir.file("compact.glb")), fs::file_size(dir.file("full.glb")));
+  const Glb glb = read_glb(dir.file("compact.glb"));
+  // The JSON is what shrinks: the doubles leave it (their 8 bytes each go to the BIN chunk).
+  EXPECT_LT(3 * u32_at(slurp(dir.file("compact.glb")), 12), u32_at(slurp(dir.file("full.glb")), 12));
+  const JsonValue& sylva = at(at(at(glb.json, "nodes").elements.at(0), "extras"), "sylva");
+  EXPECT_EQ(at(sylva, "format").text, "sylva-skeleton");
+  EXPECT_EQ(at(at(sylva, "source"), "seed").text, "7");
+  const JsonValue& chains = at(sylva, "chains");
+  ASSERT_TRUE(chains.is_object());
+  EXPECT_EQ(at(chains, "count").number, static_cast<double>(sk.chains.size()));
+  const JsonValue& views = at(glb.json, "bufferViews");
+  auto view_of = [&](const JsonValue& index) -> const JsonValue& { return views.elements.at(static_cast<size_t>(index.number)); };
+  struct Expect {
+    const JsonValue* object;
+    const char* key;
+    size_t bytes;
+  };
+  const JsonValue& frusta = at(at(sylva, "skinning"), "frusta");
+  const size_t frustum_count = skin_skeleton(sk).frusta.size();
+  for (const Expect& e : {Expect{&chains, "joint_count", 4 * sk.chains.size()},
+                          Expect{&chains, "parent", 8 * sk.chains.size()},
+                          Expect{&chains, "joints", 32 * sk.joints.size()},
+                          Expect{&chains, "material", 4 * sk.joints.size()},
+                          Expect{&frusta, "ids", 12 * frustum_count},
+                          Expect{&frusta, "planes", 72 * frustum_count},
+                          Expect{&at(sylva, "instances"), "placement", 40}}) {
+    SCOPED_TRACE(e.key);
+    const JsonValue& view = view_of(at(*e.object, e.key));
+    EXPECT_EQ(at(view, "byteLength").number, static_cast<double>(e.bytes));
+    EXPECT_EQ(static_cast<uint64_t>(at(view, "byteOffset").number) % 8, 0u);
+    EXPECT_EQ(view.find("target"), nullptr);
+  }
+  // The joints' view holds the doubles themselves.
+  const JsonValue& joints_view = view_of(at(chains, "joints"));
+  double first[4];
+  std::memcpy(first, glb.bin.data() + static_cast<size_t>(at(joints_view, "byteOffset").number), sizeof first);
+  EXPECT_EQ(first[0], sk.joints[0].position_m[0]);
+  EXPECT_EQ(first[3], sk.joints[0].radius_m);
+  EXPECT_EQ(at(at(sylva, "instances"), "names").elements.at(0).text, "plant");
+  // Still one LINES primitive that any viewer shows, and the same skeleton as "full".
+  EXPECT_EQ(at(glb.json, "meshes").elements.size(), 1u);
+  auto a = import_gltf_skeletons(dir.file("full.glb")), b = import_gltf_skeletons(dir.file("compact.glb"));
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ((*a)[0].skeleton, (*b)[0].skeleton);
+}
+
+TEST(GltfExtras, NoneWritesAPlainMeshThatImportRefusesClearly) {
+  TempFolder dir;
+  GltfExportOptions o;
+  o.extras = GltfExtras::none;
+  o.mesh = true;
+  ASSERT_TRUE(export_gltf({{"plant", grow_text(kGrammar)}}, dir.file("p.glb"), o).ok());
+  const Glb glb = read_glb(dir.file("p.glb"));
+  EXPECT_EQ(at(glb.json, "nodes").elements.at(0).find("extras"), nullptr);
+  const JsonValue& primitives = at(at(glb.json, "meshes").elements.at(0), "primitives");
+  ASSERT_GE(primitives.elements.size(), 2u);  // the LINES skeleton, then the triangles
+  EXPECT_EQ(at(primitives.elements[0], "mode").number, 1);
+  EXPECT_EQ(at(primitives.elements[1], "mode").number, 4);
+  Expected<std::vector<GltfPlant>> r = import_gltf_skeletons(dir.file("p.glb"));
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().format().find("no sylva skeleton"), std::string::npos) << r.error().format();
+  EXPECT_NE(r.error().format().find("--extras none"), std::string::npos) << r.error().format();
+}
+
+TEST(GltfExtras, APlantWithoutSegmentsHasViewsButNoAccessorsAndRoundTrips) {
+  TempFolder dir;
+  Skeleton sk;
+  sk.joints = {{{1, 2, 3}, 0.5, 2}};
+  sk.chains = {{0, 1, std::nullopt}};
+  GltfExportOptions o;
+  o.extras = GltfExtras::compact;
+  for (const char* name : {"p.glb", "p.gltf"}) {
+    ASSERT_TRUE(export_gltf({{"dot", sk}}, dir.file(name), o).ok());
+    Expected<std::vector<GltfPlant>> r = import_gltf_skeletons(dir.file(name));
+    ASSERT_TRUE(r.ok()) << r.error().format();
+    EXPECT_EQ((*r)[0].skeleton, sk);
+  }
+  EXPECT_EQ(read_glb(dir.file("p.glb")).json.find("accessors"), nullptr);
+}
+
+std::string base64_of(std::string_view bytes) {
+  static constexpr char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    uint32_t v = static_cast<uint8_t>(bytes[i]) << 16;
+    if (i + 1 < bytes.size()) v |= static_cast<uint8_t>(bytes[i + 1]) << 8;
+    if (i + 2 < bytes.size()) v |= static_cast<uint8_t>(bytes[i + 2]);
+    out += kDigits[v >> 18];
+    out += kDigits[v >> 12 & 63];
+    out += i + 1 < bytes.size() ? kDigits[v >> 6 & 63] : '=';
+    out += i + 2 < bytes.size() ? kDigits[v & 63] : '=';
+  }
+  return out;
+}
+
+template <class T>
+std::string raw_bytes(std::initializer_list<T> values) {
+  std::string s;
+  for (T v : values) s.append(reinterpret_cast<const char*>(&v), sizeof v);
+  return s;
+}
+
+// A hand-made compact .gltf: one chain of two joints in four bufferViews of buffer 0.
+struct CompactCase {
+  std::string chains = R"({"count":1,"joint_count":0,"parent":1,"joints":2,"material":3})";
+  std::string more;  // further members of extras.sylva, each with a leading comma
+  std::string views = R"([{"buffer":0,"byteOffset":0,"byteLength":4},{"buffer":0,"byteOffset":8,"byteLength":8},)"
+                      R"({"buffer":0,"byteOffset":16,"byteLength":64},{"buffer":0,"byteOffset":80,"byteLength":8}])";
+  std::string bin = raw_bytes<uint32_t>({2, 0}) + raw_bytes<uint32_t>({0xFFFFFFFFu, 0xFFFFFFFFu}) +
+                    raw_bytes<double>({0, 0, 0, 0.1, 0, 1, 0, 0.05}) + raw_bytes<uint32_t>({0, 1});
+  std::string version = "1";
+  std::optional<std::string> uri;  // default: the base64 of bin
+  std::optional<size_t> byte_length;
+
+  std::string text() const {
+    return R"({"asset":{"version":"2.0"},"nodes":[{"name":"p","extras":{"sylva":{"format":"sylva-skeleton","version":)" +
+           version + R"(,"source":{"grammar":"g.lsys","seed":"5","steps":1,"defines":{}},"chains":)" + chains + more +
+           R"(}}}],"bufferViews":)" + views + R"(,"buffers":[{"byteLength":)" +
+           std::to_string(byte_length.value_or(bin.size())) + R"(,"uri":")" +
+           uri.value_or("data:application/octet-stream;base64," + base64_of(bin)) + R"("}]})";
+  }
+};
+
+TEST(GltfExtras, MalformedCompactExtrasGiveLocatedErrorsNeverACrash) {
+  TempFolder dir;
+  const CompactCase good;
+  Expected<std::vector<GltfPlant>> ok = import_gltf_skeletons(dir.write("ok.gltf", good.text()));
+  ASSERT_TRUE(ok.ok()) << ok.error().format();
+  ASSERT_EQ((*ok)[0].skeleton.joints.size(), 2u);
+  EXPECT_EQ((*ok)[0].skeleton.joints[1].material, 1u);
+  EXPECT_EQ((*ok)[0].skeleton.joints[1].radius_m, 0.05);
+
+  struct Bad {
+    const char* name;
+    CompactCase c;
+    const char* expected;
+  };
+  std::vector<Bad> cases;
+  auto add = [&](const char* name, const char* expected, auto&& edit) {
+    CompactCase c;
+    edit(c);
+    cases.push_back({name, c, expected});
+  };
+  add("view_index_out_of_range", "bufferViews", [](CompactCase& c) { c.chains = R"({"count":1,"joint_count":9,"parent":1,"joints":2,"material":3})"; });
+  add("view_index_negative", "bufferViews", [](CompactCase& c) { c.chains = R"({"count":1,"joint_count":-1,"parent":1,"joints":2,"material":3})"; });
+  add("view_index_string", "bufferViews", [](CompactCase& c) { c.chains = R"({"count":1,"joint_count":"0","parent":1,"joints":2,"material":3})"; });
+  add("view_key_missing", "missing key \"joints\"", [](CompactCase& c) { c.chains = R"({"count":1,"joint_count":0,"parent":1,"material":3})"; });
+  add("count_missing", "count must be", [](CompactCase& c) { c.chains = R"({"joint_count":0,"parent":1,"joints":2,"material":3})"; });
+  add("count_huge", "count must be", [](CompactCase& c) { c.chains = R"({"count":1e30,"joint_count":0,"parent":1,"joints":2,"material":3})"; });
+  add("count_mismatch", "expected 4 values", [](CompactCase& c) { c.chains = R"({"count":4,"joint_count":0,"parent":1,"joints":2,"material":3})"; });
+  add("joint_counts_lie", "expected", [](CompactCase& c) { std::memcpy(c.bin.data(), "\xff\xff\xff\x7f", 4); });
+  add("offset_past_end", "runs past the end of buffer 0", [](CompactCase& c) {
+    c.views = R"([{"buffer":0,"byteOffset":4000000000,"byteLength":4},{"buffer":0,"byteOffset":8,"byteLength":8},{"buffer":0,"byteOffset":16,"byteLength":64},{"buffer":0,"byteOffset":80,"byteLength":8}])";
+  });
+  add("length_overflows", "runs past the end of buffer 0", [](CompactCase& c) {
+    c.views = R"([{"buffer":0,"byteOffset":8,"byteLength":18446744073709551615},{"buffer":0,"byteOffset":8,"byteLength":8},{"buffer":0,"byteOffset":16,"byteLength":64},{"buffer":0,"byteOffset":80,"byteLength":8}])";
+  });
+  add("other_buffer", "buffer 0", [](CompactCase& c) {
+    c.views = R"([{"buffer":1,"byteLength":4},{"buffer":0,"byteOffset":8,"byteLength":8},{"buffer":0,"byteOffset":16,"byteLength":64},{"buffer":0,"byteOffset":80,"byteLength":8}])";
+  });
+  add("strided", "byteStride", [](CompactCase& c) {
+    c.views = R"([{"buffer":0,"byteLength":4,"byteStride":8},{"buffer":0,"byteOffset":8,"byteLength":8},{"buffer":0,"byteOffset":16,"byteLength":64},{"buffer":0,"byteOffset":80,"byteLength":8}])";
+  });
+  add("view_not_object", "expected an object", [](CompactCase& c) { c.views = R"([7,{"buffer":0,"byteOffset":8,"byteLength":8},{"buffer":0,"byteOffset":16,"byteLength":64},{"buffer":0,"byteOffset":80,"byteLength":8}])"; });
+  add("no_views", "bufferViews", [](CompactCase& c) { c.views = "{}"; });
+  add("buffer_longer_than_data", "bytes of data", [](CompactCase& c) { c.byte_length = 1u << 30; });
+  add("external_uri", "resolves no other URI", [](CompactCase& c) { c.uri = "/etc/passwd"; });
+  add("bad_base64", "not valid base64", [](CompactCase& c) { c.uri = "data:application/octet-stream;base64,AAA*"; });
+  add("short_base64", "not valid base64", [](CompactCase& c) { c.uri = "data:application/octet-stream;base64,AAA"; });
+  add("nan_joint", "chain 0", [](CompactCase& c) { const double nan = std::nan(""); std::memcpy(c.bin.data() + 16, &nan, 8); });
+  add("negative_radius", "radius", [](CompactCase& c) { const double r = -1; std::memcpy(c.bin.data() + 40, &r, 8); });
+  add("dangling_parent", "parent", [](CompactCase& c) { std::memset(c.bin.data() + 8, 0, 8); });
+  add("half_root_parent", "parent", [](CompactCase& c) { std::memset(c.bin.data() + 8, 0, 4); });
+  add("leaves_in_version_1", "version 2", [](CompactCase& c) { c.more = R"(,"leaves":{"count":0})"; });
+  add("leaves_array", "expected an object", [](CompactCase& c) { c.version = "2"; c.more = R"(,"leaves":[])"; });
+  add("leaf_views_missing", "missing key \"vertex_count\"", [](CompactCase& c) { c.version = "2"; c.more = R"(,"leaves":{"count":1})"; });
+  add("instances_count_zero", "at least 1", [](CompactCase& c) { c.more = R"(,"instances":{"count":0,"names":[]})"; });
+  add("instances_names_short", "names must be an array of 2", [](CompactCase& c) { c.more = R"(,"instances":{"count":2,"names":["a"],"placement":0})"; });
+  add("instances_placement_size", "expected 5 values", [](CompactCase& c) { c.more = R"(,"instances":{"count":1,"names":["a"],"placement":2})"; });
+  add("instance_not_finite", "not finite", [](CompactCase& c) {
+    c.more = R"(,"instances":{"count":1,"names":["a"],"placement":4})";
+    c.views.back() = ',';
+    c.views += R"({"buffer":0,"byteOffset":88,"byteLength":40}])";
+    c.bin += raw_bytes<double>({0, 0, 0, std::numeric_limits<double>::infinity(), 1});
+  });
+  add("instance_bad_scale", "scale must be > 0", [](CompactCase& c) {
+    c.more = R"(,"instances":{"count":1,"names":["a"],"placement":4})";
+    c.views.back() = ',';
+    c.views += R"({"buffer":0,"byteOffset":88,"byteLength":40}])";
+    c.bin += raw_bytes<double>({0, 0, 0, 0, -2});
+  });
+  for (const Bad& b : cases) {
+    SCOPED_TRACE(b.name);
+    expect_import_error(dir, std::string(b.name) + ".gltf", b.c.text(), b.expected);
+  }
+}
+
+TEST(GltfExtras, CompactGlbWithAMissingOrLyingBinChunkIsAClearError) {
+  TempFolder dir;
+  GltfExportOptions o;
+  o.extras = GltfExtras::compact;
+  ASSERT_TRUE(export_gltf({{"plant", grow_text("angle: 30\naxiom: F[+F]F\n")}}, dir.file("p.glb"), o).ok());
+  const std::string bytes = slurp(dir.file("p.glb"));
+  const uint32_t json_length = u32_at(bytes, 12);
+  const size_t bin = 20 + json_length;
+  // Without the BIN chunk (the header's total fixed up).
+  std::string cut = bytes.substr(0, bin);
+  const uint32_t total = static_cast<uint32_t>(cut.size());
+  std::memcpy(cut.data() + 8, &total, 4);
+  expect_import_error(dir, "no_bin.glb", cut, "no BIN chunk");
+  std::string wrong_type = bytes;
+  std::memcpy(wrong_type.data() + bin + 4, "XXXX", 4);
+  expect_import_error(dir, "bin_type.glb", wrong_type, "not BIN");
+  std::string long_chunk = bytes;
+  const uint32_t huge = 0xFFFFFFF0u;
+  std::memcpy(long_chunk.data() + bin, &huge, 4);
+  expect_import_error(dir, "bin_long.glb", long_chunk, "runs past the end of the file");
+  // Every prefix and random flips of the compact file (the flips reach the BIN chunk's
+  // doubles): errors or valid plants, never a crash.
+  expect_cuts_and_flips_handled(dir, bytes, 1, 11);
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 // gltf_fuzz.cpp — libFuzzer target: any bytes as a `.gltf` or `.glb` file read back into
 // sylva skeletons (parse_gltf_skeletons: the `sylva render plant.glb` import path; GLB
-// header and chunks, JSON, node extras). Properties beyond "no crash, no sanitizer
-// finding": an error names the file, and every imported plant's skeleton is valid.
+// header and chunks, JSON, node extras "full" or "compact" — the latter's bufferViews in
+// the BIN chunk or a base64 data URI, seeded by corpus/gltf/*compact*). Properties beyond
+// "no crash, no sanitizer finding": an error names the file, and every imported plant's
+// skeleton is valid.
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>

@@ -137,3 +137,37 @@ def test_bark_colour_and_bark_errors(saguaro, tmp_path):
     with pytest.raises(TypeError):
         sylva.export_gltf(saguaro, out, mesh=True, bark="presets/textures/bark.png")
     assert not out.exists()
+
+
+def glb_chunks(path):
+    data = path.read_bytes()
+    json_length = struct.unpack_from("<I", data, 12)[0]
+    doc = json.loads(data[20:20 + json_length])
+    bin_length = struct.unpack_from("<I", data, 20 + json_length)[0]
+    return doc, data[28 + json_length:28 + json_length + bin_length]
+
+
+def test_compact_extras_hold_the_exact_doubles_in_buffer_views(saguaro, tmp_path, validate_gltf):
+    import numpy as np
+    path = tmp_path / "compact.glb"
+    sylva.export_gltf(saguaro, path, extras="compact")
+    validate_gltf(path)
+    doc, binary = glb_chunks(path)
+    extras = doc["nodes"][0]["extras"]["sylva"]
+    assert extras["source"]["seed"] == "5" and extras["chains"]["count"] == saguaro.chain_count
+    view = doc["bufferViews"][extras["chains"]["joints"]]
+    joints = np.frombuffer(binary, "<f8", view["byteLength"] // 8, view.get("byteOffset", 0)).reshape(-1, 4)
+    assert np.array_equal(joints[:, :3], saguaro.positions) and np.array_equal(joints[:, 3], saguaro.radii)
+    full = tmp_path / "full.glb"
+    sylva.export_gltf(saguaro, full)  # the default here: every number as JSON
+    assert isinstance(glb_json(full)["nodes"][0]["extras"]["sylva"]["chains"], list)
+    assert path.stat().st_size < full.stat().st_size
+
+
+def test_extras_none_writes_no_node_extras_and_a_bad_mode_is_a_value_error(saguaro, tmp_path):
+    path = tmp_path / "plain.glb"
+    sylva.export_gltf(saguaro, path, extras="none")
+    assert "extras" not in glb_json(path)["nodes"][0]
+    with pytest.raises(ValueError, match="extras must be"):
+        sylva.export_gltf(saguaro, tmp_path / "x.glb", extras="tiny")
+    assert not (tmp_path / "x.glb").exists()
