@@ -99,7 +99,8 @@ namespace sylva {
 struct ShadowVector {
   glm::vec3 position;   // world metres relative to ShadowVectors::origin (float, re-centred)
   glm::vec3 direction;  // unit, the photon's direction (away from the sun)
-  uint32_t frustum;     // index into SceneGeometry::frusta (plant/chain/segment from it)
+  uint32_t frustum;     // index into SceneGeometry::frusta (plant/chain/segment from it);
+                        // instanced geometry: the photon tracer's frustum space (photons.h)
 };
 static_assert(sizeof(ShadowVector) <= 32, "a shadow vector is at most 32 bytes (issue: photons)");
 

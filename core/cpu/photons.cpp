@@ -10,11 +10,13 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <stdexcept>
 #include <thread>
 #include <time.h>
 
 #include "core/cpu/bvh.h"  // frustum_bounds
 #include "core/cpu/frustum_accel.h"
+#include "core/cpu/instance_tracer.h"
 #include "core/cpu/leaf_tracer.h"
 #include "core/cpu/render_cpu.h"
 #include "core/render_common.h"
@@ -97,6 +99,45 @@ bool parallel_chunks(uint64_t chunks, unsigned threads, const std::atomic<bool>*
   return done.load() == chunks;
 }
 
+// A prototype's frustum placed by `x` (instances.h): the same solid in the world. A plane
+// n·p = d of the prototype's frame is (R·n)·q = s·d + (R·n)·position in the world.
+FrustumShape placed_shape(const FrustumShape& local, const PlantTransform& x) {
+  FrustumShape w = local;
+  w.base = x.to_world(local.base);
+  w.axis = x.rotate(local.axis);
+  w.length = local.length * x.scale;
+  w.radius0 = local.radius0 * x.scale;
+  w.radius1 = local.radius1 * x.scale;
+  for (Plane* plane : {&w.lower, &w.upper}) {
+    const double offset = plane->offset;
+    plane->normal = x.rotate(plane->normal);
+    plane->offset = x.scale * offset + glm::dot(plane->normal, x.position);
+  }
+  return w;
+}
+
+// The instanced plants of a SceneGeometry (render_cpu.h), for the mask and the emitter.
+struct PlacedPlants {
+  std::span<const SceneGeometry::Prototype> prototypes;
+  std::span<const TracedInstance> instances;
+
+  // f(shape) for every instance's frustum placed in the world, g(a, b, c) for every
+  // instance's leaf triangle.
+  template <class F, class G>
+  void for_each(F&& f, G&& g) const {
+    for (const TracedInstance& inst : instances) {
+      const SceneGeometry::Prototype& proto = prototypes[inst.prototype];
+      for (const Frustum& frustum : proto.frusta) f(placed_shape(frustum.shape, inst.transform));
+      if (!proto.leaves) continue;
+      const LeafMesh& leaves = proto.leaves->leaves();
+      for (size_t t = 0; t < leaves.triangle_count(); ++t)
+        g(inst.transform.to_world(leaves.positions[leaves.indices[3 * t]]),
+          inst.transform.to_world(leaves.positions[leaves.indices[3 * t + 1]]),
+          inst.transform.to_world(leaves.positions[leaves.indices[3 * t + 2]]));
+    }
+  }
+};
+
 // A conservative occupancy mask of the plants in the sun's frame, so that the photons
 // that certainly miss every frustum (most of them: a crown is porous) skip Embree.
 // Depth z runs along the photons from the emitter plane; the frusta's depth range is cut
@@ -113,52 +154,42 @@ bool parallel_chunks(uint64_t chunks, unsigned threads, const std::atomic<bool>*
 class SunMask {
  public:
   // Over the frusta and, when given, the leaves' triangles (each in the capsule around its
-  // first edge as wide as its third vertex is far: the triangle lies within it).
-  SunMask(std::span<const Frustum> frusta, const LeafMesh* leaves, const SunEmitter& e, unsigned threads)
+  // first edge as wide as its third vertex is far: the triangle lies within it), and the
+  // instances of `placed` (their capsules made again from the prototypes for each band of
+  // the rasterisation, never stored: a scatter's placed frusta would not fit).
+  SunMask(std::span<const Frustum> frusta, const LeafMesh* leaves, const SunEmitter& e, unsigned threads,
+          const PlacedPlants* placed = nullptr)
       : frame_(axis_frame(e.to_sun)), e_(e) {
-    struct Capsule {
-      glm::dvec2 a, b;
-      double radius, z0, z1;
-    };
     std::vector<Capsule> capsules;
     capsules.reserve(frusta.size());
     glm::dvec2 lo(kInf), hi(-kInf);
     double z_lo = kInf, z_hi = -kInf;
-    for (const Frustum& f : frusta) {
-      const BoundingPyramid pyramid = bounding_pyramid(f.shape);
-      Capsule c;
-      c.a = lateral(f.shape.base);
-      c.b = lateral(f.shape.base + f.shape.length * f.shape.axis);
-      c.radius = 0;
-      c.z0 = kInf, c.z1 = -kInf;
-      for (const glm::dvec3& v : pyramid.vertices) {
-        c.radius = std::max(c.radius, segment_distance(lateral(v), c.a, c.b));
-        c.z0 = std::min(c.z0, depth(v));
-        c.z1 = std::max(c.z1, depth(v));
-      }
-      c.radius = c.radius * (1 + 1e-9) + 1e-9;
+    auto extend = [&](const Capsule& c) {
       lo = glm::min(lo, glm::min(c.a, c.b) - c.radius);
       hi = glm::max(hi, glm::max(c.a, c.b) + c.radius);
       z_lo = std::min(z_lo, c.z0);
       z_hi = std::max(z_hi, c.z1);
-      capsules.push_back(c);
+    };
+    for (const Frustum& f : frusta) {
+      capsules.push_back(frustum_capsule(f.shape));
+      extend(capsules.back());
     }
     for (size_t t = 0; leaves && t < leaves->triangle_count(); ++t) {
       const glm::dvec3* v[3];
       for (int k = 0; k < 3; ++k) v[k] = &leaves->positions[leaves->indices[3 * t + static_cast<size_t>(k)]];
-      Capsule c;
-      c.a = lateral(*v[0]);
-      c.b = lateral(*v[1]);
-      c.radius = segment_distance(lateral(*v[2]), c.a, c.b) * (1 + 1e-9) + 1e-9;
-      c.z0 = std::min({depth(*v[0]), depth(*v[1]), depth(*v[2])});
-      c.z1 = std::max({depth(*v[0]), depth(*v[1]), depth(*v[2])});
-      lo = glm::min(lo, glm::min(c.a, c.b) - c.radius);
-      hi = glm::max(hi, glm::max(c.a, c.b) + c.radius);
-      z_lo = std::min(z_lo, c.z0);
-      z_hi = std::max(z_hi, c.z1);
-      capsules.push_back(c);
+      capsules.push_back(triangle_capsule(*v[0], *v[1], *v[2]));
+      extend(capsules.back());
     }
-    if (capsules.empty()) return;
+    bool any_placed = false;
+    auto for_each_placed = [&](auto&& visit) {
+      if (placed)
+        placed->for_each([&](const FrustumShape& shape) { visit(frustum_capsule(shape)); },
+                         [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+                           visit(triangle_capsule(a, b, c));
+                         });
+    };
+    for_each_placed([&](const Capsule& c) { extend(c), any_placed = true; });
+    if (capsules.empty() && !any_placed) return;
     // Cells: the larger extent in kCells, at least a hair (a single thin frustum).
     const double extent = std::max({hi.x - lo.x, hi.y - lo.y, 1e-6});
     cell_ = extent / kCells;
@@ -177,20 +208,22 @@ class SunMask {
     // Rows of cells in bands, one band per thread (every band reads every capsule).
     const unsigned bands = std::max(1u, std::min(threads, ny_ / 16 + 1));
     auto rasterise = [&](uint32_t row_begin, uint32_t row_end) {
-      for (const Capsule& c : capsules) {
+      auto draw = [&](const Capsule& c) {
         const uint32_t s0 = slab_of(c.z0), s1 = slab_of(c.z1);
         const uint32_t bits = static_cast<uint32_t>(((uint64_t(1) << (s1 + 1)) - 1) & ~((uint64_t(1) << s0) - 1));
         const double r = c.radius + drift + cell_ * 0.7072;
         const glm::dvec2 box_lo = glm::min(c.a, c.b) - r, box_hi = glm::max(c.a, c.b) + r;
         const uint32_t y0 = std::max(row_begin, cell_y(box_lo.y)), y1 = std::min(row_end - 1, cell_y(box_hi.y));
-        if (y0 > y1 || cell_y(box_lo.y) >= row_end || cell_y(box_hi.y) < row_begin) continue;
+        if (y0 > y1 || cell_y(box_lo.y) >= row_end || cell_y(box_hi.y) < row_begin) return;
         const uint32_t x0 = cell_x(box_lo.x), x1 = cell_x(box_hi.x);
         for (uint32_t y = y0; y <= y1; ++y)
           for (uint32_t x = x0; x <= x1; ++x) {
             const glm::dvec2 centre = lo_ + (glm::dvec2(x, y) + 0.5) * cell_;
             if (segment_distance(centre, c.a, c.b) <= r) cells_[size_t(y) * nx_ + x] |= bits;
           }
-      }
+      };
+      for (const Capsule& c : capsules) draw(c);
+      for_each_placed(draw);
     };
     std::vector<std::thread> pool;
     for (unsigned b = 1; b < bands; ++b)
@@ -247,6 +280,35 @@ class SunMask {
   static constexpr uint32_t kMaxSlabs = 32;
   static constexpr uint32_t kCoarse = 8;
 
+  struct Capsule {
+    glm::dvec2 a, b;
+    double radius, z0, z1;
+  };
+  Capsule frustum_capsule(const FrustumShape& shape) const {
+    const BoundingPyramid pyramid = bounding_pyramid(shape);
+    Capsule c;
+    c.a = lateral(shape.base);
+    c.b = lateral(shape.base + shape.length * shape.axis);
+    c.radius = 0;
+    c.z0 = kInf, c.z1 = -kInf;
+    for (const glm::dvec3& v : pyramid.vertices) {
+      c.radius = std::max(c.radius, segment_distance(lateral(v), c.a, c.b));
+      c.z0 = std::min(c.z0, depth(v));
+      c.z1 = std::max(c.z1, depth(v));
+    }
+    c.radius = c.radius * (1 + 1e-9) + 1e-9;
+    return c;
+  }
+  Capsule triangle_capsule(const glm::dvec3& v0, const glm::dvec3& v1, const glm::dvec3& v2) const {
+    Capsule c;
+    c.a = lateral(v0);
+    c.b = lateral(v1);
+    c.radius = segment_distance(lateral(v2), c.a, c.b) * (1 + 1e-9) + 1e-9;
+    c.z0 = std::min({depth(v0), depth(v1), depth(v2)});
+    c.z1 = std::max({depth(v0), depth(v1), depth(v2)});
+    return c;
+  }
+
   glm::dvec2 lateral(const glm::dvec3& p) const {
     const glm::dvec3 q = p - e_.disc_centre;
     return {glm::dot(q, frame_.e0), glm::dot(q, frame_.e1)};
@@ -277,8 +339,14 @@ class SunMask {
 
 }  // namespace
 
+namespace {
+
+// The emitter around the box [lo, hi] (any: whether there are frusta) under `sun`.
+SunEmitter sun_emitter_of_box(const glm::dvec3& lo, const glm::dvec3& hi, bool any, const Sun& sun);
+
+}  // namespace
+
 SunEmitter sun_emitter(std::span<const Frustum> frusta, const Sun& sun, const Aabb& leaves) {
-  SunEmitter e;
   glm::dvec3 lo(kInf), hi(-kInf);
   for (const Frustum& f : frusta) {
     const Aabb b = frustum_bounds(f.shape);
@@ -286,7 +354,14 @@ SunEmitter sun_emitter(std::span<const Frustum> frusta, const Sun& sun, const Aa
     hi = glm::max(hi, b.hi);
   }
   if (!frusta.empty() && leaves.lo.x <= leaves.hi.x) lo = glm::min(lo, leaves.lo), hi = glm::max(hi, leaves.hi);
-  if (!frusta.empty()) {
+  return sun_emitter_of_box(lo, hi, !frusta.empty(), sun);
+}
+
+namespace {
+
+SunEmitter sun_emitter_of_box(const glm::dvec3& lo, const glm::dvec3& hi, bool any, const Sun& sun) {
+  SunEmitter e;
+  if (any) {
     e.centre = 0.5 * (lo + hi);
     e.sphere_radius_m = 0.5 * glm::length(hi - lo);
   }
@@ -302,8 +377,6 @@ SunEmitter sun_emitter(std::span<const Frustum> frusta, const Sun& sun, const Aa
   return e;
 }
 
-namespace {
-
 // The leaves as the photons see them: the triangles, and per plant the frustum its leaves'
 // shadow vectors name (its first: the clustering keeps plants apart by it).
 constexpr uint32_t kNoFrustum = 0xFFFFFFFFu;
@@ -312,14 +385,15 @@ struct PhotonLeaves {
   std::vector<uint32_t> first_frustum_of_plant;
 };
 
-// The photons of `e` through `accel` (built over `frusta`) and the leaves, those `mask`
-// clears skipped.
-SunPhotons trace_photons(const FrustumAccel& accel, const SunMask& mask, std::span<const Frustum> frusta,
-                         const PhotonLeaves& leaves, const SunEmitter& e, const SunPhotonOptions& options) {
+// The photons of `e`, those `mask` clears skipped, each given to vector_of(ray, &local):
+// it appends the photon's shadow vector, if any, to `local`.
+template <class VectorOf>
+SunPhotons trace_photons(const SunMask& mask, const SunEmitter& e, const SunPhotonOptions& options,
+                         VectorOf&& vector_of) {
   SunPhotons out;
   out.emitter = e;
   out.vectors.origin = e.centre;
-  if (frusta.empty() || options.photons == 0) return out;
+  if (options.photons == 0) return out;
   const Clock::time_point start = Clock::now();
   const double cpu_start = process_cpu_seconds();
   const AxisFrame frame = axis_frame(e.to_sun);
@@ -340,26 +414,7 @@ SunPhotons trace_photons(const FrustumAccel& accel, const SunMask& mask, std::sp
       ray.origin = e.disc_centre + e.disc_radius_m * (q.x * frame.e0 + q.y * frame.e1);
       ray.direction = photon_direction(e.to_sun, frame, one_minus_cos, rng);
       if (options.occupancy_mask && !mask.may_hit(ray.origin, ray.direction)) continue;
-      const BvhHit hit = accel.nearest(ray, 0, kInf);
-      // A leaf before the first frustum (or instead of one) stops the photon: a leaf is
-      // thin, so its far side is its hit point (docs/leaves.md), and the vector names the
-      // first frustum of the leaf's plant.
-      if (leaves.tracer) {
-        const SurfaceHit leaf = leaves.tracer->nearest_leaf(ray, 0, hit.hit_any() ? hit.hit.t : kInf);
-        if (leaf.hit()) {
-          const uint32_t frustum =
-              leaf.plant < leaves.first_frustum_of_plant.size() ? leaves.first_frustum_of_plant[leaf.plant] : kNoFrustum;
-          if (frustum != kNoFrustum)
-            local.push_back({glm::vec3(leaf.position - e.centre), glm::vec3(ray.direction), frustum});
-          continue;
-        }
-      }
-      if (!hit.hit_any()) continue;
-      // Fig. 2b: where the photon leaves the frustum it hit (its convex solid).
-      const SolidInterval solid = frustum_solid_interval(ray, frusta[hit.frustum].shape, 0, kInf);
-      const double t_exit = solid.hit ? std::max(solid.t_exit, hit.hit.t) : hit.hit.t;
-      const glm::dvec3 exit = ray.origin + t_exit * ray.direction;
-      local.push_back({glm::vec3(exit - e.centre), glm::vec3(ray.direction), hit.frustum});
+      vector_of(ray, local);
     }
     ran[c] = 1;
   };
@@ -376,16 +431,98 @@ SunPhotons trace_photons(const FrustumAccel& accel, const SunMask& mask, std::sp
   return out;
 }
 
+// The vector a photon leaves at a leaf hit (a leaf is thin, so its far side is its hit
+// point: docs/leaves.md) naming `frustum`, the first frustum of the leaf's plant.
+void leave_at_leaf(const SurfaceHit& leaf, uint32_t frustum, const Ray& ray, const SunEmitter& e,
+                   std::vector<ShadowVector>& local) {
+  if (frustum != kNoFrustum) local.push_back({glm::vec3(leaf.position - e.centre), glm::vec3(ray.direction), frustum});
+}
+
+// Fig. 2b: the vector where the photon, which hit `shape` at t_hit, leaves its convex solid.
+void leave_at_exit(const FrustumShape& shape, double t_hit, uint32_t frustum, const Ray& ray, const SunEmitter& e,
+                   std::vector<ShadowVector>& local) {
+  const SolidInterval solid = frustum_solid_interval(ray, shape, 0, kInf);
+  const double t_exit = solid.hit ? std::max(solid.t_exit, t_hit) : t_hit;
+  const glm::dvec3 exit = ray.origin + t_exit * ray.direction;
+  local.push_back({glm::vec3(exit - e.centre), glm::vec3(ray.direction), frustum});
+}
+
+// One prototype of the instanced photon tracer: exact frusta (no relief) and leaves in one
+// frame, hit as the non-instanced photons hit them — the nearest frustum, unless a leaf
+// comes first (then the leaf hit, is_leaf()). Its hits' plant: plant_of_frustum's, or 0
+// (an instance's hits take the instance's plant).
+class PhotonPrototype final : public SceneTracer {
+ public:
+  PhotonPrototype(std::span<const Frustum> frusta, const LeafTracer* leaves, std::span<const uint32_t> plant_of_frustum)
+      : frusta_(frusta), leaves_(leaves && !leaves->leaves().empty() ? leaves : nullptr), plants_(plant_of_frustum) {
+    if (!frusta.empty()) accel_.emplace(frusta);
+    for (const Frustum& f : frusta) grow(bounds_, frustum_bounds(f.shape));
+    if (leaves_) grow(bounds_, leaves_->leaves().bounds());
+  }
+  SurfaceHit nearest(const Ray& ray, double t_min, double t_max) const override {
+    const BvhHit hit = accel_ ? accel_->nearest(ray, t_min, t_max) : BvhHit{};
+    if (leaves_) {
+      const SurfaceHit leaf = leaves_->nearest_leaf(ray, t_min, hit.hit_any() ? hit.hit.t : t_max);
+      if (leaf.hit()) return leaf;
+    }
+    SurfaceHit s;
+    if (!hit.hit_any()) return s;
+    s.t = hit.hit.t;
+    s.position = ray.origin + s.t * ray.direction;
+    s.frustum = hit.frustum;
+    s.plant = hit.frustum < plants_.size() ? plants_[hit.frustum] : 0;
+    return s;
+  }
+  bool any(const Ray& ray, double t_min, double t_max) const override {
+    return (accel_ && accel_->any(ray, t_min, t_max)) || (leaves_ && leaves_->nearest_leaf(ray, t_min, t_max).hit());
+  }
+  Aabb bounds() const override { return bounds_; }
+  size_t memory_bytes() const override { return accel_ ? accel_->memory_bytes() : 0; }
+  std::string describe() const override { return std::to_string(frusta_.size()) + " frusta"; }
+
+ private:
+  std::span<const Frustum> frusta_;
+  const LeafTracer* leaves_;
+  std::span<const uint32_t> plants_;
+  std::optional<FrustumAccel> accel_;
+  Aabb bounds_ = empty_box();
+};
+
 }  // namespace
 
 struct SunPhotonTracer::Impl {
   std::span<const Frustum> frusta;
+  std::span<const uint32_t> plant_of_frustum;
   PhotonLeaves leaves;
   SunEmitter emitter;
   std::optional<FrustumAccel> accel;  // none without frusta
   std::optional<SunMask> mask;
   double build_seconds = 0;
+  // With instances (photons.h): the tracer over every plant, the instances, the first
+  // index of each instance's block in the frustum space and the space's plants.
+  std::unique_ptr<InstanceTracer> placed;
+  std::vector<SceneGeometry::Prototype> prototypes;
+  std::vector<TracedInstance> instances;
+  std::vector<uint32_t> instance_of_plant;  // kNoFrustum: skinned in the world
+  std::vector<uint32_t> first_of_instance;
+  std::vector<uint32_t> placed_plant_of_frustum;
+  bool any_frusta = false;
 };
+
+namespace {
+
+// The first frustum of each plant in `plant_of_frustum` (kNoFrustum: none).
+std::vector<uint32_t> first_frustum_of_plants(std::span<const uint32_t> plant_of_frustum) {
+  std::vector<uint32_t> first;
+  for (uint32_t f = 0; f < plant_of_frustum.size(); ++f) {
+    const uint32_t p = plant_of_frustum[f];
+    if (p >= first.size()) first.resize(p + 1, kNoFrustum);
+    if (first[p] == kNoFrustum) first[p] = f;
+  }
+  return first;
+}
+
+}  // namespace
 
 SunPhotonTracer::SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun, unsigned threads,
                                  const LeafTracer* leaves, std::span<const uint32_t> plant_of_frustum)
@@ -393,15 +530,12 @@ SunPhotonTracer::SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun
   const Clock::time_point start = Clock::now();
   impl_->frusta = frusta;
   const LeafMesh* leaf_mesh = leaves && !leaves->leaves().empty() ? &leaves->leaves() : nullptr;
+  impl_->plant_of_frustum = plant_of_frustum;
   if (leaf_mesh) {
     impl_->leaves.tracer = leaves;
-    std::vector<uint32_t>& first = impl_->leaves.first_frustum_of_plant;
-    for (uint32_t f = 0; f < plant_of_frustum.size(); ++f) {
-      const uint32_t p = plant_of_frustum[f];
-      if (p >= first.size()) first.resize(p + 1, kNoFrustum);
-      if (first[p] == kNoFrustum) first[p] = f;
-    }
+    impl_->leaves.first_frustum_of_plant = first_frustum_of_plants(plant_of_frustum);
   }
+  impl_->any_frusta = !frusta.empty();
   impl_->emitter = sun_emitter(frusta, sun, leaf_mesh ? leaf_mesh->bounds() : empty_box());
   if (!frusta.empty()) {
     impl_->accel.emplace(frusta);
@@ -410,24 +544,119 @@ SunPhotonTracer::SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun
   impl_->build_seconds = seconds_since(start);
 }
 
+SunPhotonTracer::SunPhotonTracer(const SceneGeometry& geometry, const Sun& sun, unsigned threads)
+    : SunPhotonTracer(geometry.instances.empty() ? std::span<const Frustum>(geometry.frusta) : std::span<const Frustum>{},
+                      sun, threads, geometry.instances.empty() ? geometry.leaves : nullptr,
+                      geometry.instances.empty() ? std::span<const uint32_t>(geometry.plant_of_frustum)
+                                                 : std::span<const uint32_t>{}) {
+  if (geometry.instances.empty()) return;
+  const Clock::time_point start = Clock::now();
+  Impl& m = *impl_;
+  m.frusta = geometry.frusta;
+  m.prototypes = geometry.prototypes;
+  m.instances = geometry.instances;
+  // The frustum space: the world's frusta, then each instance's block.
+  m.placed_plant_of_frustum.assign(geometry.plant_of_frustum.begin(), geometry.plant_of_frustum.end());
+  m.first_of_instance.reserve(m.instances.size());
+  for (uint32_t i = 0; i < m.instances.size(); ++i) {
+    const TracedInstance& inst = m.instances[i];
+    if (inst.plant >= m.instance_of_plant.size()) m.instance_of_plant.resize(inst.plant + 1, kNoFrustum);
+    m.instance_of_plant[inst.plant] = i;
+    m.first_of_instance.push_back(static_cast<uint32_t>(m.placed_plant_of_frustum.size()));
+    m.placed_plant_of_frustum.insert(m.placed_plant_of_frustum.end(), m.prototypes[inst.prototype].frusta.size(),
+                                     inst.plant);
+  }
+  if (m.placed_plant_of_frustum.size() >= kNoFrustum)
+    throw std::runtime_error("sun photons: more than 2^32 - 1 placed frusta");
+  m.plant_of_frustum = m.placed_plant_of_frustum;
+  m.leaves.tracer = nullptr;
+  m.leaves.first_frustum_of_plant = first_frustum_of_plants(m.plant_of_frustum);
+  // The tracer: a photon prototype per skeleton, the world's plants one more at the identity.
+  std::vector<std::unique_ptr<SceneTracer>> prototypes;
+  for (const SceneGeometry::Prototype& p : m.prototypes)
+    prototypes.push_back(std::make_unique<PhotonPrototype>(p.frusta, p.leaves, std::span<const uint32_t>{}));
+  std::vector<TracedInstance> instances = m.instances;
+  instances.push_back({static_cast<uint32_t>(prototypes.size()), TracedInstance::kOwnPlant, PlantTransform{}});
+  prototypes.push_back(std::make_unique<PhotonPrototype>(geometry.frusta, geometry.world_leaves, geometry.plant_of_frustum));
+  m.placed = std::make_unique<InstanceTracer>(std::move(prototypes), std::move(instances));
+  // The emitter over every placed frustum and leaf, as sun_emitter over the world's.
+  const PlacedPlants placed{m.prototypes, m.instances};
+  glm::dvec3 lo(kInf), hi(-kInf), leaf_lo(kInf), leaf_hi(-kInf);
+  for (const Frustum& f : geometry.frusta) {
+    const Aabb b = frustum_bounds(f.shape);
+    lo = glm::min(lo, b.lo), hi = glm::max(hi, b.hi);
+  }
+  bool any_frusta = !geometry.frusta.empty();
+  placed.for_each(
+      [&](const FrustumShape& shape) {
+        const Aabb b = frustum_bounds(shape);
+        lo = glm::min(lo, b.lo), hi = glm::max(hi, b.hi), any_frusta = true;
+      },
+      [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+        leaf_lo = glm::min(glm::min(leaf_lo, a), glm::min(b, c));
+        leaf_hi = glm::max(glm::max(leaf_hi, a), glm::max(b, c));
+      });
+  const LeafMesh* world_leaves =
+      geometry.world_leaves && !geometry.world_leaves->leaves().empty() ? &geometry.world_leaves->leaves() : nullptr;
+  if (world_leaves) {
+    const Aabb b = world_leaves->bounds();
+    leaf_lo = glm::min(leaf_lo, b.lo), leaf_hi = glm::max(leaf_hi, b.hi);
+  }
+  if (any_frusta && leaf_lo.x <= leaf_hi.x) lo = glm::min(lo, leaf_lo), hi = glm::max(hi, leaf_hi);
+  m.any_frusta = any_frusta;
+  m.emitter = sun_emitter_of_box(lo, hi, any_frusta, sun);
+  if (any_frusta) m.mask.emplace(geometry.frusta, world_leaves, m.emitter, thread_count(threads), &placed);
+  m.build_seconds += seconds_since(start);
+}
+
 SunPhotonTracer::~SunPhotonTracer() = default;
 
 const SunEmitter& SunPhotonTracer::emitter() const { return impl_->emitter; }
 double SunPhotonTracer::build_seconds() const { return impl_->build_seconds; }
 std::span<const Frustum> SunPhotonTracer::frusta() const { return impl_->frusta; }
+std::span<const uint32_t> SunPhotonTracer::plant_of_frustum() const { return impl_->plant_of_frustum; }
 
 SunPhotons SunPhotonTracer::trace(const SunPhotonOptions& options) const {
-  if (!impl_->accel) {
+  const Impl& m = *impl_;
+  const SunEmitter& e = m.emitter;
+  if (!m.any_frusta) {
     SunPhotons out;
-    out.emitter = impl_->emitter;
-    out.vectors.origin = impl_->emitter.centre;
+    out.emitter = e;
+    out.vectors.origin = e.centre;
     return out;
   }
-  return trace_photons(*impl_->accel, *impl_->mask, impl_->frusta, impl_->leaves, impl_->emitter, options);
+  if (m.placed)
+    return trace_photons(*m.mask, e, options, [&](const Ray& ray, std::vector<ShadowVector>& local) {
+      const SurfaceHit hit = m.placed->nearest(ray, 0, kInf);
+      if (!hit.hit()) return;
+      if (hit.is_leaf()) {
+        const auto& first = m.leaves.first_frustum_of_plant;
+        return leave_at_leaf(hit, hit.plant < first.size() ? first[hit.plant] : kNoFrustum, ray, e, local);
+      }
+      const uint32_t i = hit.plant < m.instance_of_plant.size() ? m.instance_of_plant[hit.plant] : kNoFrustum;
+      if (i == kNoFrustum) return leave_at_exit(m.frusta[hit.frustum].shape, hit.t, hit.frustum, ray, e, local);
+      const TracedInstance& inst = m.instances[i];
+      leave_at_exit(placed_shape(m.prototypes[inst.prototype].frusta[hit.frustum].shape, inst.transform), hit.t,
+                    m.first_of_instance[i] + hit.frustum, ray, e, local);
+    });
+  return trace_photons(*m.mask, e, options, [&](const Ray& ray, std::vector<ShadowVector>& local) {
+    const BvhHit hit = m.accel->nearest(ray, 0, kInf);
+    // A leaf before the first frustum (or instead of one) stops the photon, naming the
+    // first frustum of the leaf's plant.
+    if (m.leaves.tracer) {
+      const SurfaceHit leaf = m.leaves.tracer->nearest_leaf(ray, 0, hit.hit_any() ? hit.hit.t : kInf);
+      if (leaf.hit()) {
+        const auto& first = m.leaves.first_frustum_of_plant;
+        return leave_at_leaf(leaf, leaf.plant < first.size() ? first[leaf.plant] : kNoFrustum, ray, e, local);
+      }
+    }
+    if (hit.hit_any()) leave_at_exit(m.frusta[hit.frustum].shape, hit.hit.t, hit.frustum, ray, e, local);
+  });
 }
 
 bool SunPhotonTracer::toward_sun_blocked(const glm::dvec3& point) const {
   const Ray ray{point, impl_->emitter.to_sun};
+  if (impl_->placed) return impl_->placed->any(ray, 0, kInf);
   return impl_->accel && (impl_->accel->any(ray, 0, kInf) ||
                           (impl_->leaves.tracer && impl_->leaves.tracer->nearest_leaf(ray, 0, kInf).hit()));
 }
@@ -648,16 +877,21 @@ std::string AutoConeReport::describe() const {
 std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, const Scene& scene,
                                                 const SunConeOptions& options, const SunPhotonTracer* tracer) {
   auto out = std::make_unique<SunCones>();
+  const bool instanced = !geometry.instances.empty();
   out->emitter = sun_emitter(geometry.frusta, scene.sun, geometry.leaves ? geometry.leaves->leaves().bounds() : empty_box());
-  const SunEmitter& e = out->emitter;
   out->params = options.params.value_or(ConeParams{});
-  if (!(e.to_sun.y > 0) || geometry.frusta.empty() || options.photons.photons == 0) return out;
+  if (!(out->emitter.to_sun.y > 0) || (geometry.frusta.empty() && !instanced) || options.photons.photons == 0)
+    return out;
 
   const Clock::time_point start = Clock::now();
   const double cpu_start = process_cpu_seconds();
   std::optional<SunPhotonTracer> own;
-  if (!tracer)
-    tracer = &own.emplace(geometry.frusta, scene.sun, options.photons.threads, geometry.leaves, geometry.plant_of_frustum);
+  if (!tracer) tracer = &own.emplace(geometry, scene.sun, options.photons.threads);
+  out->emitter = tracer->emitter();  // with instances: over every placed plant
+  const SunEmitter& e = out->emitter;
+  // The plants of the frustum indices the vectors name (with instances: the tracer's space).
+  const std::span<const uint32_t> plant_of_frustum =
+      instanced ? tracer->plant_of_frustum() : std::span<const uint32_t>(geometry.plant_of_frustum);
   SunPhotons photons = tracer->trace(options.photons);
   out->photon_seconds = seconds_since(start);
   out->photon_cpu_seconds = process_cpu_seconds() - cpu_start;
@@ -683,7 +917,7 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
       std::min(1e6, std::max(0.0, top - ground) / std::max(e.to_sun.y, 1e-3) + 2 * e.sphere_radius_m + 1e-3);
   if (!options.params && !out->vectors.vectors.empty()) {
     const Clock::time_point t = Clock::now();
-    out->automatic = choose_cone_params(*tracer, out->vectors, geometry.plant_of_frustum, out->limits,
+    out->automatic = choose_cone_params(*tracer, out->vectors, plant_of_frustum, out->limits,
                                         out->photons, ground, options.photons.seed, options.miss_weight,
                                         options.photons.threads);
     out->params = out->automatic->candidates[out->automatic->chosen].params;
@@ -694,7 +928,7 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
   }
   {
     const Clock::time_point t = Clock::now();
-    out->cones = ConeSet(cluster_shadow_cones(out->vectors, geometry.plant_of_frustum, out->params, out->limits,
+    out->cones = ConeSet(cluster_shadow_cones(out->vectors, plant_of_frustum, out->params, out->limits,
                                               &out->cluster, nullptr, options.photons.threads));
     std::snprintf(detail, sizeof detail, "%llu cones from %llu of %llu vectors (%s)",
                   static_cast<unsigned long long>(out->cluster.cones),

@@ -23,6 +23,19 @@
 // vector at the hit point (a leaf has no thickness, so its far side is where the photon
 // meets it), naming the first frustum of the leaf's plant.
 //
+// Instances (SceneGeometry::instances, build_instanced_geometry): the photons go through
+// the same InstanceTracer construction the renderer uses (instance_tracer.h), over
+// prototypes of exact frusta and leaves in each skeleton's frame (the double ray taken to
+// the frame, the hit back), with the plants skinned in the world one more prototype at the
+// identity. The exit point is found on the frustum placed in the world (its shape through
+// the plant's transform), and the emitter, the mask and the vectors are what the
+// non-instanced path makes of the same plants, up to the rounding of the transforms.
+// A vector's frustum then indexes the tracer's frustum space (plant_of_frustum()): first
+// SceneGeometry::frusta (the plants skinned in the world, same indices), then each
+// instance's block of its prototype's frusta, in SceneGeometry::instances order — instance
+// i's frustum f is first_frustum(i) + f. The clustering keeps plants apart by that index's
+// plant; no frustum is copied per plant (4 bytes of plant index per placed frustum).
+//
 // Units and frames: world space, metres, Y up; the vectors' float positions are
 // relative to the bounding sphere's centre (ShadowVectors::origin).
 #pragma once
@@ -94,6 +107,10 @@ class SunPhotonTracer {
   // vectors carry the first frustum of its plant; a plant without frusta leaves none).
   SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun, unsigned threads = 0,
                   const LeafTracer* leaves = nullptr, std::span<const uint32_t> plant_of_frustum = {});
+  // Over everything `geometry` holds (outliving the tracer, unchanged): its frusta and
+  // leaves, and its instances when build_instanced_geometry made it (see the header
+  // comment). Throws std::runtime_error when Embree fails.
+  SunPhotonTracer(const SceneGeometry& geometry, const Sun& sun, unsigned threads = 0);
   ~SunPhotonTracer();
   SunPhotonTracer(const SunPhotonTracer&) = delete;
   SunPhotonTracer& operator=(const SunPhotonTracer&) = delete;
@@ -104,7 +121,10 @@ class SunPhotonTracer {
   bool toward_sun_blocked(const glm::dvec3& point) const;
   const SunEmitter& emitter() const;
   double build_seconds() const;  // the accelerator's and the mask's
-  std::span<const Frustum> frusta() const;
+  std::span<const Frustum> frusta() const;  // the frusta skinned in the world
+  // The plant of each index a shadow vector may name (the constructor's plant_of_frustum,
+  // or with instances the frustum space of the header comment).
+  std::span<const uint32_t> plant_of_frustum() const;
 
  private:
   struct Impl;
@@ -195,8 +215,10 @@ struct SunCones {
 // shadow vectors into cones ending at scene.ground (the length limit: the bounding
 // sphere's sweep, 2R beyond its far side or to the ground). A sun at or below the
 // horizon (no sunlight reaches the fog) traces nothing and gives no cones. `tracer`, when
-// given, must be built over geometry.frusta and scene.sun (several photon counts or seeds
-// then share its build); null: one is built here (its build counted in photon_seconds).
+// given, must be built over `geometry` (SunPhotonTracer(geometry, sun)) and scene.sun
+// (several photon counts or seeds then share its build); null: one is built here (its
+// build counted in photon_seconds). Instanced geometry's plants cast their photons
+// through their instances (see the header comment).
 std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, const Scene& scene,
                                                 const SunConeOptions& options,
                                                 const SunPhotonTracer* tracer = nullptr);

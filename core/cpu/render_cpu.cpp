@@ -558,10 +558,13 @@ SceneGeometry build_instanced_geometry(const Scene& scene, const SkinOptions& sk
       prototype_index[k] = static_cast<int64_t>(prototypes.size());
       frusta_of_prototype.push_back(pg.frusta.size());
       prototype_frusta += pg.frusta.size();
+      // The vector's buffer and the leaf tracer move with pg into the tracer unchanged.
+      g.prototypes.push_back({std::span<const Frustum>(pg.frusta), pg.leaves});
       prototypes.push_back(std::make_unique<OwningTracer>(std::move(pg)));
     }
     const uint32_t index = static_cast<uint32_t>(prototype_index[k]);
     instances.push_back({index, p, transform});
+    g.instances.push_back(instances.back());
     g.instance_frusta += frusta_of_prototype[index];
     ++g.instanced_plants;
   }
@@ -573,6 +576,7 @@ SceneGeometry build_instanced_geometry(const Scene& scene, const SkinOptions& sk
     instances.push_back({static_cast<uint32_t>(prototypes.size()), TracedInstance::kOwnPlant, PlantTransform{}});
     prototypes.push_back(std::move(g.tracer));
   }
+  g.world_leaves = g.leaves;
   g.leaves = nullptr;  // the world plants' leaves are inside the instance tracer now
   auto tracer = std::make_unique<InstanceTracer>(std::move(prototypes), std::move(instances));
   if (passes && options.cull)  // the plants skinned in the world and the instances
@@ -615,13 +619,10 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
       std::sqrt(static_cast<double>(std::max(1u, options.spp)));
   // Progress: the geometry a small share, the tiles the rest.
   constexpr double kGeometryShare = 0.05;
-  // Instances (build_instanced_geometry) unless the fog's sun photons will need every
-  // plant's frusta in the world.
-  const bool photons_needed = scene.fog && !options.fog.cones &&
-                              fog_mode_needs_cones(options.fog.mode.value_or(scene.fog->mode));
+  // Instances (build_instanced_geometry): the fog's sun photons trace them too (photons.h).
   const Progress geometry_progress = options.progress.part(0, kGeometryShare);
   SceneGeometry geometry =
-      options.geometry.instance && !photons_needed
+      options.geometry.instance
           ? build_instanced_geometry(scene, options.skin, geometry_options, &result.passes, textures.get(),
                                      geometry_progress)
           : build_scene_geometry(scene, options.skin, geometry_options, &result.passes, textures.get(),

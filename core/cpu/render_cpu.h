@@ -53,8 +53,10 @@
 #include <iosfwd>
 #include <string>
 #include <memory>
+#include <span>
 #include <vector>
 
+#include "core/cpu/instance_tracer.h"  // TracedInstance
 #include "core/materials.h"  // kMaterialAlbedo: default albedo by material index
 #include "core/relief.h"
 #include "core/render_common.h"  // camera_ray: the camera convention both renderers follow
@@ -86,6 +88,18 @@ struct SceneGeometry {
   uint64_t instance_frusta = 0;
   uint32_t instanced_plants = 0;
   uint32_t instanced_skeletons = 0;
+  // build_instanced_geometry only, for the sun photons (photons.h): each shared skeleton's
+  // frusta in its own frame and its leaves (null: none), both owned by `tracer`; the
+  // instances traced through them (TracedInstance::prototype indexes `prototypes`, plant the
+  // scene's plant); and the leaves of the plants skinned in the world (`leaves` is null
+  // then: they are inside `tracer`). Empty when nothing is instanced.
+  struct Prototype {
+    std::span<const Frustum> frusta;
+    const LeafTracer* leaves = nullptr;
+  };
+  std::vector<Prototype> prototypes;
+  std::vector<TracedInstance> instances;
+  const LeafTracer* world_leaves = nullptr;
 };
 
 // Skins and indexes every plant (each plant's skeleton must be set: grow_scene_plants)
@@ -108,8 +122,8 @@ SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin,
 // it stands: a relief or displacement (its depth is in world metres) or, with
 // skin.twist_rad_per_m, a scale other than 1 (the twist turns per world metre). Those, and
 // plants whose skeleton no other plant shares, are skinned in the world as
-// build_scene_geometry does and are the only ones in `frusta` (the sun photons need every
-// plant there: render_cpu instances only without cone-reading fog). Passes: those of
+// build_scene_geometry does and are the only ones in `frusta` (the sun photons trace the
+// rest through `prototypes` and `instances`: photons.h). Passes: those of
 // build_scene_geometry for the plants skinned in the world (when there are any), then
 // "instances" (culling and skinning of the prototypes) and "instance accel build".
 SceneGeometry build_instanced_geometry(const Scene& scene, const SkinOptions& skin,

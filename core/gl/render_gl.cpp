@@ -1184,9 +1184,11 @@ RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrame
   std::vector<RenderPass> cone_passes;
   if (scene.fog && requested_fog_mode(scene, options) != FogMode::brute) {
     // The cone modes: sun photons and shadow cones on the CPU (as render_cpu builds them),
-    // uploaded once.
+    // uploaded once; plants that share a skeleton as instances (photons.h).
     const FogMode mode = requested_fog_mode(scene, options) == FogMode::medium ? FogMode::medium : FogMode::fast;
-    const SceneGeometry geometry = build_scene_geometry(scene, options.skin, GeometryOptions{}, &cone_passes);
+    const SceneGeometry geometry =
+        options.geometry.instance ? build_instanced_geometry(scene, options.skin, GeometryOptions{}, &cone_passes)
+                                  : build_scene_geometry(scene, options.skin, GeometryOptions{}, &cone_passes);
     const std::unique_ptr<const SunCones> cones = build_sun_cones(
         geometry, scene,
         sun_cone_options_for(mode, options.fog.photons.value_or(scene.fog->photons), options.fog.cone_params,

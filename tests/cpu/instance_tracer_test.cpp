@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/cpu/photons.h"
 #include "core/cpu/render_cpu.h"
 #include "tests/core/test_scenes.h"
 #include "tests/core/test_textures.h"
@@ -77,6 +78,75 @@ TEST(InstanceTracer, AReliefPlantIsSkinnedInTheWorldAndTheRestStayInstances) {
   const RenderResult flat = render(s, false), instanced = render(s, true);
   EXPECT_EQ(test::differing_pixels(flat.image.id, instanced.image.id, 3, 0), 0u);
   EXPECT_EQ(test::differing_pixels(flat.image.beauty, instanced.image.beauty, 4, 1e-6), 0u);
+}
+
+// ---- Sun photons through instances (photons.h) ----------------------------------------
+
+// The grove (its forks carry a leaf each) in the fog tests' fog (test_scenes.h), `mode`
+// reading shadow cones, 8 steps, 40,000 photons, 48 × 36.
+Scene foggy_grove(FogMode mode) {
+  Scene s = test::instanced_grove(48, 36);
+  s.fog = test::foggy_cylinder(mode, 8).fog;
+  s.fog->photons = 40000;
+  return s;
+}
+
+TEST(InstanceTracer, SunPhotonsThroughInstancesLeaveTheVectorsOfEveryPlantSkinnedInTheWorld) {
+  const Scene s = foggy_grove(FogMode::medium);
+  GeometryOptions no_cull;
+  no_cull.cull = false;
+  const SceneGeometry flat = build_scene_geometry(s, {}, no_cull);
+  const SceneGeometry instanced = build_instanced_geometry(s, {}, no_cull);
+  ASSERT_EQ(instanced.instanced_plants, 12u);
+  ASSERT_FALSE(instanced.instances.empty());
+  SunPhotonOptions o;
+  o.photons = 60000;
+  o.seed = 3;
+  const SunPhotonTracer a(flat, s.sun), b(instanced, s.sun);
+  EXPECT_NEAR(b.emitter().sphere_radius_m, a.emitter().sphere_radius_m, 1e-12);
+  EXPECT_LT(glm::length(b.emitter().centre - a.emitter().centre), 1e-12);
+  const SunPhotons pa = a.trace(o), pb = b.trace(o);
+  ASSERT_EQ(pa.traced, pb.traced);
+  ASSERT_GT(pa.vectors.vectors.size(), 1000u);
+  ASSERT_EQ(pa.vectors.vectors.size(), pb.vectors.vectors.size());
+  // Instance + frustum: the tracer's frustum space names every vector's plant, which is
+  // the flat path's; on this grove the float positions come out bit-identical (in general
+  // they may differ by the rounding of the transforms).
+  ASSERT_EQ(b.plant_of_frustum().size(), flat.frusta.size());
+  for (size_t i = 0; i < pa.vectors.vectors.size(); ++i) {
+    const ShadowVector &va = pa.vectors.vectors[i], &vb = pb.vectors.vectors[i];
+    ASSERT_EQ(flat.plant_of_frustum[va.frustum], b.plant_of_frustum()[vb.frustum]) << i;
+    EXPECT_EQ(va.position, vb.position) << i;
+    EXPECT_EQ(va.direction, vb.direction) << i;
+  }
+  // The exact shadow test agrees too.
+  for (int k = 0; k < 200; ++k) {
+    const glm::dvec3 p(-6 + 0.06 * k, 0.05, -4 + 0.04 * k);
+    EXPECT_EQ(a.toward_sun_blocked(p), b.toward_sun_blocked(p)) << k;
+  }
+}
+
+TEST(InstanceTracer, AFogRenderWithShadowConesIsTheSameThroughInstances) {
+  for (FogMode mode : {FogMode::medium, FogMode::fast}) {
+    const Scene s = foggy_grove(mode);
+    RenderOptions o;
+    o.aovs = kAovId | kAovFog;
+    o.threads = 2;
+    o.fog.cone_params = std::array<uint32_t, 4>{81, 8, 16, 16};
+    o.geometry.instance = false;
+    const RenderResult flat = render_cpu(s, o);
+    o.geometry.instance = true;
+    const RenderResult instanced = render_cpu(s, o);
+    ASSERT_NE(test::find_pass(instanced, "instances"), nullptr) << fog_mode_name(mode);
+    const RenderPass *ca = test::find_pass(flat, "cones"), *cb = test::find_pass(instanced, "cones");
+    ASSERT_NE(ca, nullptr);
+    ASSERT_NE(cb, nullptr);
+    EXPECT_EQ(ca->detail, cb->detail) << fog_mode_name(mode);  // as many cones from as many vectors
+    EXPECT_EQ(test::find_pass(flat, "photons")->detail, test::find_pass(instanced, "photons")->detail);
+    EXPECT_EQ(test::differing_pixels(flat.image.id, instanced.image.id, 3, 0), 0u) << fog_mode_name(mode);
+    EXPECT_EQ(test::differing_pixels(flat.image.fog, instanced.image.fog, 4, 0), 0u) << fog_mode_name(mode);
+    EXPECT_EQ(test::differing_pixels(flat.image.beauty, instanced.image.beauty, 4, 0), 0u) << fog_mode_name(mode);
+  }
 }
 
 }  // namespace
