@@ -44,6 +44,7 @@ __all__ = ["batch", "frames", "output_path", "frame_path", "KINDS"]
 #: What a task writes: "grow" a sylva-skeleton JSON file (``sylva grow``), "export" a glTF
 #: 2.0 file, .gltf or .glb by the pattern's extension (``sylva export``).
 KINDS = ("grow", "export")
+EXTRAS = ("compact", "full", "none")  # sylva export --extras (docs/gltf.md)
 
 
 def output_path(pattern, seed):
@@ -53,7 +54,7 @@ def output_path(pattern, seed):
     return pattern.replace("{seed}", str(seed))
 
 
-def _seed_task(kind, text, grammar_path, seed, path, steps, defines, mesh, segments_around):
+def _seed_task(kind, text, grammar_path, seed, path, steps, defines, mesh, segments_around, extras):
     """One seed on a worker: grow, write atomically (the sylva writers), return the path."""
     import sylva  # on the worker
 
@@ -65,21 +66,23 @@ def _seed_task(kind, text, grammar_path, seed, path, steps, defines, mesh, segme
     if kind == "grow":
         skeleton.save(path)
     else:
-        sylva.export_gltf(skeleton, path, mesh=mesh, segments_around=segments_around)
+        sylva.export_gltf(skeleton, path, mesh=mesh, segments_around=segments_around, extras=extras)
     return path
 
 
-def batch(client, kind, grammar, seeds, output, *, steps=None, defines=None, mesh=False, segments_around=8):
+def batch(client, kind, grammar, seeds, output, *, steps=None, defines=None, mesh=False, segments_around=8,
+          extras="compact"):
     """Grows (``kind="grow"``) or exports (``kind="export"``) every seed of ``grammar`` on the
     workers of ``client`` (a ``dask.distributed.Client``), one task per seed, into
     ``output`` with ``{seed}`` replaced. Returns the paths written, in the order of ``seeds``.
 
-    ``steps`` and ``defines`` are ``sylva grow``'s ``-n`` and ``-D``; ``mesh`` and
-    ``segments_around`` are ``sylva export``'s. The grammar is parsed here first, so a bad
+    ``steps`` and ``defines`` are ``sylva grow``'s ``-n`` and ``-D``; ``mesh``,
+    ``segments_around`` and ``extras`` are ``sylva export``'s, with its defaults (``extras``
+    is ``"compact"`` here, as ``sylva export --extras``, so the files are the CLI batch's). The grammar is parsed here first, so a bad
     grammar raises ``sylva.GrammarError`` before any task is sent; a task that fails raises
     its exception here (the files of the seeds that finished stay: each is complete).
 
-    Raises ``ValueError`` for an unknown kind, a pattern without ``{seed}`` or repeated
+    Raises ``ValueError`` for an unknown kind, an unknown ``extras``, a pattern without ``{seed}`` or repeated
     seeds (two tasks would race for one file), ``TypeError``/``OverflowError`` for a seed
     that is not an integer in [0, 2**64 - 1] (as ``Grammar.grow``).
     """
@@ -87,6 +90,8 @@ def batch(client, kind, grammar, seeds, output, *, steps=None, defines=None, mes
 
     if kind not in KINDS:
         raise ValueError(f"unknown kind {kind!r}: expected one of {', '.join(KINDS)}")
+    if extras not in EXTRAS:
+        raise ValueError(f"unknown extras {extras!r}: expected one of {', '.join(EXTRAS)}")
     seeds = list(seeds)
     if len(set(seeds)) != len(seeds):
         raise ValueError("a seed is repeated: its tasks would write the same file")
@@ -102,7 +107,7 @@ def batch(client, kind, grammar, seeds, output, *, steps=None, defines=None, mes
     paths = [output_path(output, seed) for seed in seeds]
     futures = client.map(_seed_task, [kind] * len(seeds), [parsed.text] * len(seeds), [parsed.file] * len(seeds),
                          seeds, paths, [steps] * len(seeds), [defines] * len(seeds), [mesh] * len(seeds),
-                         [segments_around] * len(seeds), pure=False)
+                         [segments_around] * len(seeds), [extras] * len(seeds), pure=False)
     return client.gather(futures)
 
 

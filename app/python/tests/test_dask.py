@@ -51,6 +51,13 @@ def test_export_with_defines_and_a_seed_folder(tmp_path, client, sylva_binary):
                                defines={"LIMBS": 5}, mesh=True)
     assert written == [str(tmp_path / f"dask/s{s}/elm.glb") for s in (5, 3, 4)]  # the folders made
     assert_same_files(written, [str(tmp_path / f"cli/elm_{s}.glb") for s in (5, 3, 4)])
+    # extras= is --extras: the full JSON extras are the CLI's too, and differ from the compact.
+    cli_batch(sylva_binary, "export", "presets/elm.lsys", "--seed", "3", "--extras", "full",
+              "-o", str(tmp_path / "cli/full_{seed}.gltf"))
+    full = sylva_dask.batch(client, "export", "presets/elm.lsys", [3], str(tmp_path / "dask/full_{seed}.gltf"),
+                            extras="full")
+    assert_same_files(full, [str(tmp_path / "cli/full_3.gltf")])
+    assert b'"chains":[{' in pathlib.Path(full[0]).read_bytes().replace(b" ", b"").replace(b"\n", b"")
 
 
 def test_bad_batches_are_refused_before_any_task(tmp_path, client):
@@ -65,6 +72,8 @@ def test_bad_batches_are_refused_before_any_task(tmp_path, client):
         sylva_dask.batch(client, "grow", "presets/elm.lsys", [1, 1], str(tmp_path / "x_{seed}.skel.json"))
     with pytest.raises(ValueError, match="unknown kind"):
         sylva_dask.batch(client, "render", "presets/elm.lsys", [1], str(tmp_path / "x_{seed}.png"))
+    with pytest.raises(ValueError, match="unknown extras"):
+        sylva_dask.batch(client, "export", "presets/elm.lsys", [1], str(tmp_path / "x_{seed}.glb"), extras="json")
     with pytest.raises(TypeError):
         sylva_dask.batch(client, "grow", "presets/elm.lsys", [1.5], str(tmp_path / "x_{seed}.skel.json"))
     with pytest.raises(OverflowError):
