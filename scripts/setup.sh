@@ -20,6 +20,7 @@ packages=(
   # The studio's window tests: a virtual X server (xvfb-run) and simulated input.
   xvfb xauth xdotool
   ffmpeg  # `sylva render --frames ... --video` encodes with it; its ffprobe checks the tests' videos
+  blender  # tests/app/blender_check_test.cpp: Blender's glTF importer reads what `sylva export` writes
   # The fuzz targets (tests/fuzz, scripts/fuzz.sh): clang with libFuzzer and its sanitizers.
   clang
 )

@@ -1,0 +1,103 @@
+// blender_check_test.cpp — `sylva export` files opened by another program: Blender's glTF
+// importer (Debian's blender 3.4, installed by scripts/setup.sh) reads every triangle of the
+// file, every material with its colour, texture and double-sidedness, and the skeleton in
+// the plant node's extras (scripts/blender_check.py compares Blender's scene with the
+// file's JSON and prints a report). Skipped where blender is not installed.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "process.h"
+
+namespace {
+
+const std::string kSource = SYLVA_SOURCE_DIR;
+
+bool have_blender() { return std::system("command -v blender >/dev/null 2>&1") == 0; }
+
+// Runs scripts/blender_check.py on `file`; returns the run and its report line's JSON.
+ProcessResult blender_check(const std::string& file, std::string* report) {
+  ProcessResult r = run_process({"blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+                                 kSource + "/scripts/blender_check.py", "--", file},
+                                {}, 240);
+  const size_t at = r.out.find("BLENDER_CHECK ");
+  *report = at == std::string::npos ? std::string() : r.out.substr(at + 14, r.out.find('\n', at) - at - 14);
+  return r;
+}
+
+// Every "triangles_file": A, "triangles_blender": B pair of the report.
+std::vector<std::pair<long, long>> triangle_counts(const std::string& report) {
+  std::vector<std::pair<long, long>> counts;
+  const std::regex pair(R"("triangles_file": (\d+), "triangles_blender": (\d+))");
+  for (auto it = std::sregex_iterator(report.begin(), report.end(), pair); it != std::sregex_iterator(); ++it)
+    counts.emplace_back(std::stol((*it)[1]), std::stol((*it)[2]));
+  return counts;
+}
+
+TEST(BlenderCheck, TheElmInLeafImportsWithEveryTriangleItsDoubleSidedLeavesAndItsSkeleton) {
+  if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
+  TempDir dir;
+  const std::string glb = dir.file("elm.glb");
+  ProcessResult exported = run_sylva({"export", kSource + "/presets/elm_in_leaf.lsys", "--mesh", "-o", glb});
+  ASSERT_EQ(exported.exit_code, 0) << describe(exported);
+  std::string report;
+  ProcessResult r = blender_check(glb, &report);
+  ASSERT_EQ(r.exit_code, 0) << describe(r, 20000);
+  EXPECT_NE(report.find(R"("problems": [])"), std::string::npos) << report;
+  const auto counts = triangle_counts(report);
+  ASSERT_EQ(counts.size(), 1u) << report;
+  EXPECT_GT(counts[0].first, 100000) << report;  // the wood's frusta and the leaves
+  EXPECT_EQ(counts[0].first, counts[0].second) << report;
+  EXPECT_NE(report.find(R"("name": "sylva_leaf_material_1", "double_sided": true)"), std::string::npos) << report;
+  EXPECT_NE(report.find(R"("name": "sylva_material_0", "double_sided": false)"), std::string::npos) << report;
+  // Compact extras (the default) are a nested object Blender keeps as a custom property.
+  EXPECT_NE(report.find(R"("format": "sylva-skeleton")"), std::string::npos) << report;
+}
+
+TEST(BlenderCheck, ASceneWithBarkAndATableKeepsItsTextureAndItsColoursInBlender) {
+  if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
+  TempDir dir;
+  const std::string gltf = dir.file("palm.gltf");  // JSON with the textures as data URIs
+  ProcessResult exported = run_sylva(
+      {"export", kSource + "/presets/scenes/coconut_palm.scene.json", "--mesh", "-o", gltf}, {}, 120);
+  ASSERT_EQ(exported.exit_code, 0) << describe(exported);
+  std::string report;
+  ProcessResult r = blender_check(gltf, &report);
+  ASSERT_EQ(r.exit_code, 0) << describe(r, 20000);
+  EXPECT_NE(report.find(R"("problems": [])"), std::string::npos) << report;
+  for (const auto& [in_file, in_blender] : triangle_counts(report)) EXPECT_EQ(in_file, in_blender) << report;
+  // The bark's albedo texture is material 0's (wood) only; the fronds keep the table's colour.
+  EXPECT_NE(report.find(R"("name": "sylva_material_0", "double_sided": false, "blend_method": "OPAQUE", "textured": true)"),
+            std::string::npos)
+      << report;
+  EXPECT_NE(report.find(R"("name": "sylva_material_1", "double_sided": false, "blend_method": "OPAQUE", "textured": false)"),
+            std::string::npos)
+      << report;
+}
+
+// The check is not a formality: a file the validator accepts but Blender reads otherwise
+// is a problem. Two materials of one name are valid glTF; Blender renames the second
+// ("sylva_material_0.001"), so the leaves no longer have the material the file names.
+TEST(BlenderCheck, AFileBlenderReadsOtherwiseThanItSaysIsAProblem) {
+  if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
+  TempDir dir;
+  const std::string gltf = dir.file("elm.gltf");
+  ProcessResult exported = run_sylva({"export", kSource + "/presets/elm_in_leaf.lsys", "--mesh", "-o", gltf});
+  ASSERT_EQ(exported.exit_code, 0) << describe(exported);
+  std::string text = read_file(gltf);
+  const std::string leaf = R"("name":"sylva_leaf_material_1")";
+  const size_t at = text.find(leaf);
+  ASSERT_NE(at, std::string::npos) << text.substr(0, 2000);
+  text.replace(at, leaf.size(), R"("name":"sylva_material_0")");
+  write_file(gltf, text);
+  std::string report;
+  ProcessResult r = blender_check(gltf, &report);
+  EXPECT_EQ(r.exit_code, 1) << describe(r, 20000);
+  EXPECT_NE(report.find("in Blender"), std::string::npos) << report;
+  EXPECT_EQ(report.find(R"("problems": [])"), std::string::npos) << report;
+}
+
+}  // namespace
