@@ -78,13 +78,14 @@ def batch(client, kind, grammar, seeds, output, *, steps=None, defines=None, mes
 
     ``steps`` and ``defines`` are ``sylva grow``'s ``-n`` and ``-D``; ``mesh``,
     ``segments_around`` and ``extras`` are ``sylva export``'s, with its defaults (``extras``
-    is ``"compact"`` here, as ``sylva export --extras``, so the files are the CLI batch's). The grammar is parsed here first, so a bad
-    grammar raises ``sylva.GrammarError`` before any task is sent; a task that fails raises
-    its exception here (the files of the seeds that finished stay: each is complete).
+    is ``"compact"`` here, as ``sylva export --extras``, so the files are the CLI batch's).
+    The grammar is parsed here first, so a bad grammar raises ``sylva.GrammarError`` before
+    any task is sent; a task that fails raises its exception here (the files of the seeds
+    that finished stay: each is complete).
 
-    Raises ``ValueError`` for an unknown kind, an unknown ``extras``, a pattern without ``{seed}`` or repeated
-    seeds (two tasks would race for one file), ``TypeError``/``OverflowError`` for a seed
-    that is not an integer in [0, 2**64 - 1] (as ``Grammar.grow``).
+    Raises ``ValueError`` for an unknown kind, an unknown ``extras``, a pattern without
+    ``{seed}`` or repeated seeds (two tasks would race for one file), ``TypeError`` /
+    ``OverflowError`` for a seed that is not an integer in [0, 2**64 - 1] (as ``Grammar.grow``).
     """
     import sylva
 

@@ -28,6 +28,15 @@ ProcessResult blender_check(const std::string& file, std::string* report) {
   return r;
 }
 
+// `sylva export INPUT --mesh -o OUT` (compact extras, the default); false, with the run
+// described in a test failure, when it does not succeed.
+bool export_mesh(const std::string& input, const std::string& out) {
+  ProcessResult exported = run_sylva({"export", input, "--mesh", "-o", out}, {}, 120);
+  if (exported.exit_code == 0) return true;
+  ADD_FAILURE() << describe(exported);
+  return false;
+}
+
 // Every "triangles_file": A, "triangles_blender": B pair of the report.
 std::vector<std::pair<long, long>> triangle_counts(const std::string& report) {
   std::vector<std::pair<long, long>> counts;
@@ -41,8 +50,7 @@ TEST(BlenderCheck, TheElmInLeafImportsWithEveryTriangleItsDoubleSidedLeavesAndIt
   if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
   TempDir dir;
   const std::string glb = dir.file("elm.glb");
-  ProcessResult exported = run_sylva({"export", kSource + "/presets/elm_in_leaf.lsys", "--mesh", "-o", glb});
-  ASSERT_EQ(exported.exit_code, 0) << describe(exported);
+  ASSERT_TRUE(export_mesh(kSource + "/presets/elm_in_leaf.lsys", glb));
   std::string report;
   ProcessResult r = blender_check(glb, &report);
   ASSERT_EQ(r.exit_code, 0) << describe(r, 20000);
@@ -61,9 +69,7 @@ TEST(BlenderCheck, ASceneWithBarkAndATableKeepsItsTextureAndItsColoursInBlender)
   if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
   TempDir dir;
   const std::string gltf = dir.file("palm.gltf");  // JSON with the textures as data URIs
-  ProcessResult exported = run_sylva(
-      {"export", kSource + "/presets/scenes/coconut_palm.scene.json", "--mesh", "-o", gltf}, {}, 120);
-  ASSERT_EQ(exported.exit_code, 0) << describe(exported);
+  ASSERT_TRUE(export_mesh(kSource + "/presets/scenes/coconut_palm.scene.json", gltf));
   std::string report;
   ProcessResult r = blender_check(gltf, &report);
   ASSERT_EQ(r.exit_code, 0) << describe(r, 20000);
@@ -85,8 +91,7 @@ TEST(BlenderCheck, AFileBlenderReadsOtherwiseThanItSaysIsAProblem) {
   if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
   TempDir dir;
   const std::string gltf = dir.file("elm.gltf");
-  ProcessResult exported = run_sylva({"export", kSource + "/presets/elm_in_leaf.lsys", "--mesh", "-o", gltf});
-  ASSERT_EQ(exported.exit_code, 0) << describe(exported);
+  ASSERT_TRUE(export_mesh(kSource + "/presets/elm_in_leaf.lsys", gltf));
   std::string text = read_file(gltf);
   const std::string leaf = R"("name":"sylva_leaf_material_1")";
   const size_t at = text.find(leaf);
