@@ -667,11 +667,15 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
     }
     if (options.mesh && !sk.leaves.empty()) {
       // The leaves (leaf_mesh.h): flat triangles with their leaf's normal at each vertex,
-      // one primitive per material index in increasing order, double-sided materials.
+      // one primitive per material index in increasing order, double-sided materials;
+      // TEXCOORD_0 = (u, 1 − v) of leaf_uvs (glTF's t runs down the image: an image drawn
+      // upright, petiole at its bottom row, covers the leaf as the renderers map it).
       LeafMesh leaves;
       append_leaves(leaves, sk, 0);
       std::map<uint32_t, std::vector<uint32_t>> triangles_of;
-      std::vector<float> positions, normals;
+      std::vector<float> positions, normals, texcoords;
+      for (const glm::dvec2& t : leaves.uvs)
+        texcoords.insert(texcoords.end(), {static_cast<float>(t.x), static_cast<float>(1 - t.y)});
       for (const glm::dvec3& q : leaves.positions)
         positions.insert(positions.end(), {static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z)});
       for (uint32_t l : leaves.vertex_leaf) {
@@ -691,6 +695,7 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
         attributes.begin_object();
         attributes.key("POSITION").integer(buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer));
         attributes.key("NORMAL").integer(buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer));
+        attributes.key("TEXCOORD_0").integer(buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer));
         attributes.end_object();
         for (const auto& [material, indices] : triangles_of) {
           primitives.begin_object();

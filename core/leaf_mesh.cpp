@@ -2,7 +2,9 @@
 // Clipping" (Geometric Tools, 2002), O(n²) per polygon, ample for a turtle's leaves.
 #include "core/leaf_mesh.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <glm/geometric.hpp>
 
 #include "core/skin.h"  // axis_frame
@@ -91,6 +93,42 @@ std::vector<uint32_t> triangulate_polygon(std::span<const std::array<double, 3>>
   return out;
 }
 
+std::vector<glm::dvec2> leaf_uvs(std::span<const std::array<double, 3>> vertices, const glm::dvec3& normal) {
+  std::vector<glm::dvec2> uv(vertices.size(), glm::dvec2(0));
+  if (vertices.empty()) return uv;
+  const glm::dvec3 base(vertices[0][0], vertices[0][1], vertices[0][2]);
+  // The tip: the vertex farthest from the petiole, the first of those within 1e-9 of the
+  // farthest distance, so that vertices equally far (a symmetric leaf) are told apart by
+  // their order and not by the rounding of a placement (a turned copy keeps its tip).
+  std::vector<glm::dvec3> in_plane(vertices.size());
+  double farthest = 0;
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    const glm::dvec3 d = glm::dvec3(vertices[i][0], vertices[i][1], vertices[i][2]) - base;
+    in_plane[i] = d - glm::dot(d, normal) * normal;
+    farthest = std::max(farthest, glm::length(in_plane[i]));
+  }
+  if (!(farthest > 0)) return uv;
+  glm::dvec3 along(0);
+  for (const glm::dvec3& d : in_plane)
+    if (const double l = glm::length(d); l >= farthest * (1 - 1e-9)) {
+      along = d / l;
+      break;
+    }
+  // Seen from the front (normal toward the viewer, v up), u grows to the right: v × n.
+  const glm::dvec3 across = glm::normalize(glm::cross(along, normal));
+  glm::dvec2 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    const glm::dvec3 d = glm::dvec3(vertices[i][0], vertices[i][1], vertices[i][2]) - base;
+    uv[i] = {glm::dot(d, across), glm::dot(d, along)};
+    lo = glm::min(lo, uv[i]), hi = glm::max(hi, uv[i]);
+  }
+  const glm::dvec2 extent = hi - lo;
+  for (glm::dvec2& t : uv)
+    t = {extent.x > 0 ? std::clamp((t.x - lo.x) / extent.x, 0.0, 1.0) : 0.0,
+         extent.y > 0 ? std::clamp((t.y - lo.y) / extent.y, 0.0, 1.0) : 0.0};
+  return uv;
+}
+
 Aabb LeafMesh::bounds() const {
   Aabb box = empty_box();
   for (const glm::dvec3& q : positions) grow(box, q);
@@ -103,13 +141,16 @@ void append_leaves(LeafMesh& mesh, const Skeleton& placed, uint32_t plant) {
     const std::vector<uint32_t> triangles = triangulate_polygon(leaf.vertices_m);
     if (triangles.empty()) continue;
     const glm::dvec3 newell = polygon_newell_normal(leaf.vertices_m);
+    const glm::dvec3 normal = newell / glm::length(newell);
+    const std::vector<glm::dvec2> uv = leaf_uvs(leaf.vertices_m, normal);
+    mesh.uvs.insert(mesh.uvs.end(), uv.begin(), uv.end());
     const uint32_t first = static_cast<uint32_t>(mesh.positions.size());
     const uint32_t index = static_cast<uint32_t>(mesh.leaves.size());
     for (const auto& v : leaf.vertices_m) mesh.positions.emplace_back(v[0], v[1], v[2]);
     for (uint32_t i : triangles) mesh.indices.push_back(first + i);
     mesh.triangle_leaf.insert(mesh.triangle_leaf.end(), triangles.size() / 3, index);
     mesh.vertex_leaf.insert(mesh.vertex_leaf.end(), leaf.vertices_m.size(), index);
-    mesh.leaves.push_back({plant, l, leaf.material, newell / glm::length(newell)});
+    mesh.leaves.push_back({plant, l, leaf.material, normal});
   }
 }
 

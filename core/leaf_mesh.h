@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <span>
 #include <vector>
@@ -30,6 +31,14 @@ glm::dvec3 polygon_newell_normal(std::span<const std::array<double, 3>> vertices
 // no ear is left) is finished as a fan. Empty for fewer than 3 vertices or no area.
 std::vector<uint32_t> triangulate_polygon(std::span<const std::array<double, 3>> vertices);
 
+// A leaf's texture coordinates (docs/leaves.md "Texture coordinates"), one (u, v) per
+// vertex: v runs from the petiole (vertex 0, where the turtle stood at `{`) toward the tip
+// (the vertex farthest from it), u across, left to right seen from the front (the side
+// `normal` points to); both scaled to [0, 1] over the leaf's bounding rectangle in that
+// frame, so an image drawn upright (petiole at its bottom row) covers the leaf. `normal`:
+// the unit Newell normal. A leaf without extent along an axis gets 0 on it.
+std::vector<glm::dvec2> leaf_uvs(std::span<const std::array<double, 3>> vertices, const glm::dvec3& normal);
+
 // Which leaf a triangle belongs to.
 struct LeafRef {
   uint32_t plant = 0;     // index into Scene::plants
@@ -41,6 +50,7 @@ struct LeafRef {
 // The leaves of a scene (or of one plant) as one triangle soup.
 struct LeafMesh {
   std::vector<glm::dvec3> positions;    // metres; each leaf's own vertices, unshared
+  std::vector<glm::dvec2> uvs;          // per position: leaf_uvs
   std::vector<uint32_t> indices;        // 3 per triangle into positions
   std::vector<uint32_t> triangle_leaf;  // per triangle: index into `leaves`
   std::vector<uint32_t> vertex_leaf;    // per position: index into `leaves` (a vertex the

@@ -6,7 +6,8 @@
 // Units and frames: world space, metres, Y up, doubles. t is in units of the ray's
 // direction (hit point = origin + t·direction). Texture parametrisation as skin.h: u in
 // turns around the axis (u_offset and twist applied), v_m in metres of arc length along
-// the chain. Normals are unit and point out of the solid.
+// the chain; on a leaf (is_leaf) u, v_m are its texture coordinates instead, both in
+// [0, 1] (leaf_mesh.h leaf_uvs). Normals are unit and point out of the solid.
 #pragma once
 
 #include <cstddef>

@@ -48,10 +48,11 @@ void main() {
   if (dot(n_geometric, view) < 0.0) n_geometric = -n_geometric;  // seen from inside
   if (dot(n_shading, view) < 0.0) n_shading = -n_shading;
   // tessellate.h gives the seam column u = 1 on the triangles before it: [0, 1) as skin.h.
-  float u = v_uv.x - floor(v_uv.x);
+  // A leaf's u is its own, in [0, 1] (leaf_mesh.h leaf_uvs), as LeafTracer reports it.
+  float u = v_ids.y == LEAF_CHAIN ? clamp(v_uv.x, 0.0, 1.0) : v_uv.x - floor(v_uv.x);
   g_normal_distance = vec4(n_shading, length(v_rel_eye));
   g_geometric_u = vec4(n_geometric, u);
-  g_ids = uvec4(v_ids.xyz, floatBitsToUint(v_uv.y));
+  g_ids = uvec4(v_ids.xyz, floatBitsToUint(v_ids.y == LEAF_CHAIN ? clamp(v_uv.y, 0.0, 1.0) : v_uv.y));
 #ifdef BARK_TEXTURE_UNITS
   // Derivatives first, in uniform control flow; the image rows run downward (texture.h's y).
   vec2 duv_dx = dFdx(v_uv) * u_footprint_scale, duv_dy = -dFdy(v_uv) * u_footprint_scale;

@@ -58,7 +58,7 @@ SurfaceHit world_hit(const TracedInstance& inst, const Ray& ray, SurfaceHit h) {
   h.shading_normal = x.rotate(h.shading_normal);
   h.dp_du = x.scale * x.rotate(h.dp_du);
   h.dp_dv = x.rotate(h.dp_dv);
-  h.v_m *= x.scale;
+  if (!h.is_leaf()) h.v_m *= x.scale;  // metres of arc; a leaf's v is its own [0, 1]
   if (inst.plant != TracedInstance::kOwnPlant) h.plant = inst.plant;
   return h;
 }

@@ -1,6 +1,7 @@
 // leaf_tracer.cpp — see leaf_tracer.h.
 #include "core/cpu/leaf_tracer.h"
 
+#include <algorithm>
 #include <limits>
 
 #include "core/cpu/embree_scene.h"
@@ -45,7 +46,7 @@ SurfaceHit LeafTracer::nearest_leaf(const Ray& ray, double t_min, double t_max) 
   rtcIntersect1(m.embree.scene(), &q.embree, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return {};
   const uint32_t* tri = &m.leaves.indices[3 * size_t{rh.hit.primID}];
-  // The filter kept it: det != 0 and t in range. A flat leaf needs no barycentrics.
+  // The filter kept it: det != 0 and t in range. The barycentrics give the uv.
   const TriangleCrossing c =
       cross_triangle(ray, m.leaves.positions[tri[0]], m.leaves.positions[tri[1]], m.leaves.positions[tri[2]]);
   const LeafRef& leaf = m.leaves.leaves[m.leaves.triangle_leaf[rh.hit.primID]];
@@ -53,6 +54,10 @@ SurfaceHit LeafTracer::nearest_leaf(const Ray& ray, double t_min, double t_max) 
   s.t = c.t;
   s.position = ray.origin + c.t * ray.direction;
   s.geometric_normal = s.shading_normal = leaf.normal;
+  const glm::dvec2 uv = (1 - c.b1 - c.b2) * m.leaves.uvs[tri[0]] + c.b1 * m.leaves.uvs[tri[1]] +
+                        c.b2 * m.leaves.uvs[tri[2]];
+  s.u = std::clamp(uv.x, 0.0, 1.0);
+  s.v_m = std::clamp(uv.y, 0.0, 1.0);
   s.plant = leaf.plant;
   s.material = leaf.material;
   s.leaf = leaf.leaf;
@@ -86,7 +91,7 @@ Aabb LeafTracer::bounds() const {
 size_t LeafTracer::memory_bytes() const {
   const LeafMesh& l = impl_->leaves;
   return (impl_->other ? impl_->other->memory_bytes() : 0) + impl_->embree.memory_bytes() +
-         l.positions.capacity() * sizeof(glm::dvec3) + l.indices.capacity() * sizeof(uint32_t) +
+         l.positions.capacity() * sizeof(glm::dvec3) + l.uvs.capacity() * sizeof(glm::dvec2) + l.indices.capacity() * sizeof(uint32_t) +
          l.triangle_leaf.capacity() * sizeof(uint32_t) + l.leaves.capacity() * sizeof(LeafRef);
 }
 

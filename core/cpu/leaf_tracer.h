@@ -13,7 +13,8 @@
 // What a leaf hit reports (SurfaceHit): t and position in double; geometric_normal =
 // shading_normal = the leaf's unit Newell normal, whichever side was hit (a leaf is
 // two-sided: the renderer turns it toward the viewer and the light, render_cpu.cpp);
-// u = v_m = 0 and no tangents (a leaf has no texture); plant, material, `leaf` (its index
+// u, v_m = the leaf's texture coordinates (leaf_mesh.h leaf_uvs, both in [0, 1]) at the
+// hit, interpolated over the triangle, and no tangents; plant, material, `leaf` (its index
 // in the plant's Skeleton::leaves); chain, segment and frustum 0.
 //
 // Thread-safe for concurrent queries.

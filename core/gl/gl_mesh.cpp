@@ -106,7 +106,7 @@ void append_plant(MeshArrays& out, const TriangleMesh& part, const SkinnedSkelet
 
 // Appends plant `plant`'s leaves `part` (leaf_mesh.h: one plant's) to `out`: a record
 // per leaf (ids plant | material << 24, kLeafChain, the leaf's index), its flat normal at
-// every vertex, uv 0, and a sphere per leaf.
+// every vertex, its leaf_uvs, and a sphere per leaf.
 void append_leaves(MeshArrays& out, const LeafMesh& part) {
   if (part.empty()) return;
   if (out.vertices.size() + part.positions.size() > std::numeric_limits<uint32_t>::max())
@@ -123,7 +123,8 @@ void append_leaves(MeshArrays& out, const LeafMesh& part) {
   const uint32_t first_vertex = static_cast<uint32_t>(out.vertices.size());
   for (size_t v = 0; v < part.positions.size(); ++v) {
     const glm::vec3 q(part.positions[v] - origin), n(part.leaves[vertex_leaf[v]].normal);
-    out.vertices.push_back({{q.x, q.y, q.z}, {n.x, n.y, n.z}, {0.0f, 0.0f}, first_record + vertex_leaf[v]});
+    const glm::vec2 uv(part.uvs[v]);
+    out.vertices.push_back({{q.x, q.y, q.z}, {n.x, n.y, n.z}, {uv.x, uv.y}, first_record + vertex_leaf[v]});
   }
   for (uint32_t i : part.indices) out.indices.push_back(first_vertex + i);
   std::vector<Aabb> boxes(part.leaves.size(), empty_box());

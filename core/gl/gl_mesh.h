@@ -85,7 +85,7 @@ class GlMesh {
   // same programs (without bark: a leaf is never bark, materials.md): one record per leaf
   // with ids plant | material << 24, gl::kLeafChain, the leaf's index in its plant's
   // leaves; its flat Newell normal as every vertex's shading normal (mesh.frag.glsl turns
-  // it toward the eye: two-sided), uv 0; a sphere per leaf. Null when no plant has leaves.
+  // it toward the eye: two-sided), its leaf_uvs (leaf_mesh.h); a sphere per leaf. Null when no plant has leaves.
   // The frusta's renderer draws it after the frusta into the same G-buffer and shadow map.
   static std::unique_ptr<GlMesh> leaves_of(const Scene& scene, const RenderOptions& options);
   ~GlMesh();

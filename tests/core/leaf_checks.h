@@ -7,6 +7,7 @@
 #include <cmath>
 #include <glm/geometric.hpp>
 
+#include "core/leaf_mesh.h"
 #include "core/render_types.h"
 #include "core/shading.h"
 #include "tests/core/test_scenes.h"
@@ -21,10 +22,21 @@ inline glm::dvec3 beauty_at(const RenderImage& image, uint32_t x, uint32_t y) {
 // Every pixel whose centre ray meets the square (5 cm inside its edges) shows the leaf:
 // id (plant 0, kAovLeafChain, leaf 0), the analytic distance (within depth_rel), the
 // leaf's material shaded under the sun (within radiance_abs), a normal facing the eye;
-// every pixel 5 cm clear of the square and of the stem shows no leaf. `r` rendered with
-// the depth, normal and id AOVs.
+// every pixel 5 cm clear of the square and of the stem shows no leaf; the uv AOV is the
+// leaf's texture coordinates at the hit (within uv_abs): the affine map leaf_uvs gives its
+// corners, carried to the hit through the square's edges. `r` rendered with the depth,
+// normal, id and uv AOVs.
 inline void expect_the_leaf_where_projected(const Scene& s, const RenderResult& r, double depth_rel,
-                                            double radiance_abs) {
+                                            double radiance_abs, double uv_abs) {
+  const Skeleton placed = place_plant(s.plants[0]);
+  const auto& c = placed.leaves.at(0).vertices_m;
+  const std::vector<glm::dvec2> corner_uv =
+      leaf_uvs(c, glm::normalize(polygon_newell_normal(c)));
+  const glm::dvec3 v0(c[0][0], c[0][1], c[0][2]), e1 = glm::dvec3(c[1][0], c[1][1], c[1][2]) - v0,
+      e3 = glm::dvec3(c[3][0], c[3][1], c[3][2]) - v0;  // the square's two edges from vertex 0
+  // Its petiole (vertex 0) is at v = 0 and the opposite corner, the farthest, at v = 1.
+  EXPECT_NEAR(corner_uv[0].y, 0, 1e-12);
+  EXPECT_NEAR(corner_uv[2].y, 1, 1e-12);
   int leaf_pixels = 0, clear_pixels = 0;
   for (uint32_t y = 0; y < s.height; ++y)
     for (uint32_t x = 0; x < s.width; ++x) {
@@ -40,6 +52,11 @@ inline void expect_the_leaf_where_projected(const Scene& s, const RenderResult& 
         for (int k = 0; k < 3; ++k)
           EXPECT_NEAR(c[k], leaf->radiance[k], radiance_abs) << x << "," << y << " channel " << k;
         EXPECT_LT(ray.direction.z * r.image.normal[p * 3 + 2], 0) << x << "," << y;
+        const glm::dvec3 q = ray.origin + (-ray.origin.z / ray.direction.z) * ray.direction - v0;
+        const double a = glm::dot(q, e1) / glm::dot(e1, e1), b = glm::dot(q, e3) / glm::dot(e3, e3);
+        const glm::dvec2 uv = corner_uv[0] + a * (corner_uv[1] - corner_uv[0]) + b * (corner_uv[3] - corner_uv[0]);
+        EXPECT_NEAR(r.image.uv[p * 2 + 0], uv.x, uv_abs) << x << "," << y;
+        EXPECT_NEAR(r.image.uv[p * 2 + 1], uv.y, uv_abs) << x << "," << y;
       } else if (!one_leaf_pixel(s, x, y, -0.05)) {
         const double t = -ray.origin.z / ray.direction.z;
         if (std::abs((ray.origin + t * ray.direction).x) < 0.1) continue;  // the stem's column

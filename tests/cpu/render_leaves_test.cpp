@@ -14,20 +14,20 @@ namespace {
 
 RenderResult render_with_aovs(const Scene& s) {
   RenderOptions o;
-  o.aovs = kAovDepth | kAovId | kAovNormal;
+  o.aovs = kAovDepth | kAovId | kAovNormal | kAovUv;
   return render_cpu(s, o);
 }
 
 TEST(RenderCpuLeaves, AGrammarsLeafCoversItsProjectionWithItsMaterialAndId) {
   // Seen from the front (+z), the sun behind the eye and above: the lit face.
   const Scene s = test::one_leaf_scene({-0.5, 1.5, 5}, {0.2, 0.5, 1});
-  test::expect_the_leaf_where_projected(s, render_with_aovs(s), 1e-5, 1e-5);
+  test::expect_the_leaf_where_projected(s, render_with_aovs(s), 1e-5, 1e-5, 1e-6);
 }
 
 TEST(RenderCpuLeaves, ALeafIsTwoSided) {
   // From behind (−z), with the sun behind the eye too: the back is lit the same way.
   const Scene s = test::one_leaf_scene({-0.5, 1.5, -5}, {0.2, 0.5, -1});
-  test::expect_the_leaf_where_projected(s, render_with_aovs(s), 1e-5, 1e-5);
+  test::expect_the_leaf_where_projected(s, render_with_aovs(s), 1e-5, 1e-5, 1e-6);
 }
 
 TEST(RenderCpuLeaves, ALeafSeenAgainstTheSunShowsTheSkyAmbientOnly) {
