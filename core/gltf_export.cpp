@@ -35,6 +35,7 @@
 #include "core/util/image_io.h"
 #include "core/util/json.h"
 #include "core/leaf_mesh.h"
+#include "core/leaf_images.h"
 #include "core/materials.h"
 #include "core/normal_map.h"
 #include "core/skin.h"
@@ -342,8 +343,10 @@ std::string bark_key(const Bark& b) {
 // The material of index `material` of a plant with bark `bark` (gltf_export.h), as JSON
 // text (identical materials are written once: the text is their key).
 std::string material_json(uint32_t material, const Bark& bark, const std::map<uint32_t, SceneMaterial>& materials,
-                          std::optional<size_t> albedo_texture, std::optional<size_t> normal_texture, double r_ref_m) {
-  const MaterialLook look = material_look(materials, &bark, material);
+                          std::optional<size_t> albedo_texture, std::optional<size_t> normal_texture, double r_ref_m,
+                          const LeafImages* images) {
+  // A segment of a material with a leaf image: the image's mean (leaf_images.h).
+  const MaterialLook look = segment_look(materials, &bark, material, images);
   JsonWriter w;
   w.begin_object();
   w.key("name").string("sylva_material_" + std::to_string(material));
@@ -385,19 +388,30 @@ std::string material_json(uint32_t material, const Bark& bark, const std::map<ui
 }
 
 // The material of the leaves of index `material` (gltf_export.h): the table's look, never
-// the bark's (docs/leaves.md), double-sided.
-std::string leaf_material_json(uint32_t material, const std::map<uint32_t, SceneMaterial>& materials) {
+// the bark's (docs/leaves.md); with the table's leaf image (leaf_images.h) `texture` as
+// baseColorTexture (its RGB white where the entry has only an alpha image: the colour is
+// then the factor), alphaMode MASK at kLeafAlphaCutoff for a cut-out, doubleSided unless
+// the entry is one-sided.
+std::string leaf_material_json(uint32_t material, const std::map<uint32_t, SceneMaterial>& materials,
+                               const LeafImages* images, std::optional<size_t> texture) {
   const MaterialLook look = material_look(materials, nullptr, material);
+  const bool image_albedo = images && images->has_albedo(material);
   JsonWriter w;
   w.begin_object();
   w.key("name").string("sylva_leaf_material_" + std::to_string(material));
   w.key("pbrMetallicRoughness").begin_object();
-  const double factor[4] = {look.albedo.x, look.albedo.y, look.albedo.z, 1};
+  const double factor[4] = {image_albedo ? 1 : look.albedo.x, image_albedo ? 1 : look.albedo.y,
+                            image_albedo ? 1 : look.albedo.z, 1};
   w.key("baseColorFactor").numbers(factor, 4);
+  if (texture) w.key("baseColorTexture").begin_object().key("index").integer(*texture).end_object();
   w.key("metallicFactor").number(0);
   w.key("roughnessFactor").number(0.9);
   w.end_object();
-  w.key("doubleSided").boolean(true);
+  if (texture && images->has_cutout(material)) {
+    w.key("alphaMode").string("MASK");
+    w.key("alphaCutoff").number(kLeafAlphaCutoff);
+  }
+  w.key("doubleSided").boolean(!(images && images->one_sided(material)));
   w.key("extras").begin_object().key("sylva").begin_object();
   w.key("material_index").integer(material);
   w.key("leaf").boolean(true);
@@ -448,8 +462,12 @@ std::vector<float> vertex_tangents(const TriangleMesh& tm, const SkinnedSkeleton
 // Everything the materials of one export refer to, read and baked once.
 class MaterialTable {
  public:
-  // Reads every texture the plants' barks name (before anything is written).
-  Status load(const std::vector<GltfPlant>& plants) {
+  // Reads every texture the plants' barks and the table's leaves name (before anything is
+  // written).
+  Status load(const std::vector<GltfPlant>& plants, const std::map<uint32_t, SceneMaterial>& materials) {
+    Expected<std::shared_ptr<const LeafImages>> leaf = LeafImages::load(materials);
+    if (!leaf) return std::move(leaf.error());
+    leaf_images_ = std::move(*leaf);
     for (const GltfPlant& p : plants) {
       if (p.bark.albedo_texture && !albedo_files_.count(*p.bark.albedo_texture)) {
         Expected<EmbeddedImage> image = read_albedo_image(*p.bark.albedo_texture);
@@ -489,6 +507,20 @@ class MaterialTable {
     return add_image(key, albedo_files_.at(*bark.albedo_texture));
   }
 
+  // The leaf image of material `material` (leaf_images.h: its merged RGBA layer as a PNG),
+  // or nothing when the table names none for it.
+  Expected<std::optional<size_t>> leaf_texture(uint32_t material) {
+    const int k = leaf_images_ ? leaf_images_->layer_of(material) : -1;
+    if (k < 0) return std::optional<size_t>();
+    const std::string key = "leaf:" + std::to_string(material);
+    if (auto it = image_of_.find(key); it != image_of_.end()) return std::optional<size_t>(it->second);
+    std::optional<std::string> png = encode_png_in_memory(leaf_images_->width(), leaf_images_->height(), 4,
+                                                          leaf_images_->layer(static_cast<size_t>(k)));
+    if (!png) return file_diagnostic("", "cannot encode the leaf image of material " + std::to_string(material) + " as PNG");
+    return std::optional<size_t>(add_image(key, {std::move(*png), "image/png"}));
+  }
+  const LeafImages* leaf_images() const { return leaf_images_.get(); }
+
   // The index of a material, written once however many plants use it.
   size_t material(const std::string& json) {
     auto [it, inserted] = material_of_.emplace(json, materials_.size());
@@ -508,6 +540,7 @@ class MaterialTable {
 
   std::map<std::string, EmbeddedImage> albedo_files_;
   std::map<std::string, HeightMap> height_files_;
+  std::shared_ptr<const LeafImages> leaf_images_;
   std::map<std::string, size_t> image_of_;
   std::vector<EmbeddedImage> images_;
   std::map<std::string, size_t> material_of_;
@@ -541,7 +574,7 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
     if (auto problem = plant_problem(plants[i], i)) return file_diagnostic(path, *problem);
   MaterialTable table;
   if (options.mesh)
-    if (Status loaded = table.load(plants); !loaded) return loaded;
+    if (Status loaded = table.load(plants, options.materials); !loaded) return loaded;
 
   // Group identical skeletons when instancing (compared by their exact serialization,
   // and by their barks when those shape the mesh).
@@ -654,7 +687,8 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
           const bool wood = material == 0;  // the bark's textures are the wood's (materials.h)
           const size_t m = table.material(material_json(material, bark, options.materials,
                                                         wood ? albedo_texture : std::nullopt,
-                                                        wood ? normal_texture : std::nullopt, r_ref_m));
+                                                        wood ? normal_texture : std::nullopt, r_ref_m,
+                                                        table.leaf_images()));
           primitives.begin_object();
           primitives.key("attributes").raw(attributes.text());
           primitives.key("indices").integer(buffer.add_indices(indices));
@@ -701,7 +735,10 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
           primitives.begin_object();
           primitives.key("attributes").raw(attributes.text());
           primitives.key("indices").integer(buffer.add_indices(indices));
-          primitives.key("material").integer(table.material(leaf_material_json(material, options.materials)));
+          Expected<std::optional<size_t>> texture = table.leaf_texture(material);
+          if (!texture) return std::move(texture.error());
+          primitives.key("material").integer(
+              table.material(leaf_material_json(material, options.materials, table.leaf_images(), *texture)));
           primitives.key("mode").integer(kModeTriangles);
           primitives.end_object();
           ++primitive_count;

@@ -15,11 +15,15 @@
 //     the bark has a height map, TANGENT — and one material each (below).
 //   - with `mesh`, the plant's leaves (skeleton.md "Leaves"; leaf_mesh.h's triangulation)
 //     as further TRIANGLES primitives, one per material index the leaves use, in
-//     increasing order, sharing one POSITION and NORMAL set (each leaf's own vertices, its
-//     unit Newell normal at each); their material "sylva_leaf_material_<k>" is
-//     double-sided, its baseColorFactor material_look(options.materials, no bark, k) (a
-//     leaf is never bark), extras.sylva {"material_index", "leaf": true, and "specular"
-//     where the table describes k}.
+//     increasing order, sharing one POSITION, NORMAL and TEXCOORD_0 set (each leaf's own
+//     vertices, its unit Newell normal at each, its leaf_uvs as (u, 1 − v)); their
+//     material "sylva_leaf_material_<k>" is double-sided unless the table makes k
+//     one-sided, its baseColorFactor material_look(options.materials, no bark, k) (a
+//     leaf is never bark), or 1 under a leaf image of the table (leaf_images.h:
+//     baseColorTexture = k's merged RGBA layer as an embedded PNG; alphaMode MASK with
+//     alphaCutoff 0.5 for a cut-out), extras.sylva {"material_index", "leaf": true, and
+//     "specular" where the table describes k}. A segment of a material with a leaf image
+//     has the image's mean albedo (segment_look).
 //
 // Bark and materials (with `mesh`; without it the bark is ignored and no texture read).
 // A plant's `bark` (scene.h, scene.md) covers its wood only, the segments of material 0

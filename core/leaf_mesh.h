@@ -2,8 +2,9 @@
 // renderer and the glTF export draws them in: each placed leaf's polygon triangulated
 // (ear clipping in the polygon's plane, so a concave leaf keeps its outline), flat, with
 // one unit normal per leaf (Newell's: the polygon's vector area, counter-clockwise seen
-// from the side it points to). A leaf is two-sided: renderers turn the normal toward the
-// viewer (or the light) and never cull a face.
+// from the side it points to). A leaf is two-sided unless its material says otherwise
+// (leaf_images.h): renderers turn the normal toward the viewer (or the light) and never
+// cull a face. Every vertex has texture coordinates (leaf_uvs).
 //
 // Units and frames: world metres, Y up, double (callers re-centre before going to float).
 #pragma once

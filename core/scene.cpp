@@ -209,14 +209,14 @@ Bark read_bark(const JsonValue& v, const std::string& base_dir, std::string_view
 
 // The `materials` table (docs/materials.md): an array of entries, each naming its index
 // once.
-std::map<uint32_t, SceneMaterial> read_materials(const JsonValue& v) {
+std::map<uint32_t, SceneMaterial> read_materials(const JsonValue& v, const std::string& base_dir) {
   if (!v.is_array()) fail(v, std::string("materials must be an array, not ") + v.kind_name());
   std::map<uint32_t, SceneMaterial> table;
   for (size_t i = 0; i < v.elements.size(); ++i) {
     const JsonValue& e = v.elements[i];
     const std::string what = "materials[" + std::to_string(i) + "]";
     expect_object(e, what);
-    check_keys(e, what, {"index", "albedo", "specular"});
+    check_keys(e, what, {"index", "albedo", "alpha", "specular", "two_sided"});
     const JsonValue* index = e.find("index");
     if (!index) fail(e, what + " needs an \"index\" (the material index it describes)");
     const std::optional<uint64_t> k = index->as_uint64();
@@ -225,8 +225,23 @@ std::map<uint32_t, SceneMaterial> read_materials(const JsonValue& v) {
     if (table.count(static_cast<uint32_t>(*k)))
       fail(*index, what + ".index " + std::to_string(*k) + " is described twice");
     SceneMaterial m;
-    if (auto* x = e.find("albedo")) m.albedo_rgb = colour(*x, what + ".albedo");
+    if (auto* x = e.find("albedo")) {
+      if (x->is_array()) {
+        m.albedo_rgb = colour(*x, what + ".albedo");
+      } else {
+        m.albedo_image = path_relative_to(base_dir, *x, what + ".albedo");
+        check_texture(e, "albedo", *m.albedo_image, what + ".albedo");
+      }
+    }
+    if (auto* x = e.find("alpha")) {
+      m.alpha_image = path_relative_to(base_dir, *x, what + ".alpha");
+      check_texture(e, "alpha", *m.alpha_image, what + ".alpha");
+    }
     if (auto* x = e.find("specular")) m.specular = number_in(*x, what + ".specular", 0, 1, false, false);
+    if (auto* x = e.find("two_sided")) {
+      if (!x->is_bool()) fail(*x, what + ".two_sided must be true or false, not " + x->kind_name());
+      m.two_sided = x->boolean;
+    }
     table.emplace(static_cast<uint32_t>(*k), m);
   }
   return table;
@@ -520,7 +535,7 @@ Scene read_scene(const JsonValue& root, const std::string& base_dir) {
   }
   if (auto* x = root.find("fog")) s.fog = read_fog(*x, s.ground.height);
   if (auto* x = root.find("animation")) s.animation = read_animation(*x);
-  if (auto* x = root.find("materials")) s.materials = read_materials(*x);
+  if (auto* x = root.find("materials")) s.materials = read_materials(*x, base_dir);
   const JsonValue* plants = root.find("plants");
   if (!plants) fail(root, "a scene needs \"plants\" (an array of plants)");
   if (!plants->is_array()) fail(*plants, std::string("plants must be an array, not ") + plants->kind_name());
@@ -843,13 +858,16 @@ void write_bark(JsonWriter& w, const Bark& b, const std::string& base_dir) {
   w.end_object();
 }
 
-void write_materials(JsonWriter& w, const std::map<uint32_t, SceneMaterial>& table) {
+void write_materials(JsonWriter& w, const std::map<uint32_t, SceneMaterial>& table, const std::string& base_dir) {
   w.key("materials").begin_array(Layout::lines);
   for (const auto& [index, m] : table) {
     w.begin_object(Layout::spaced);
     w.key("index").integer(index);
     if (m.albedo_rgb) write_vec3(w.key("albedo"), *m.albedo_rgb);
+    if (m.albedo_image) w.key("albedo").string(path_for_file(*m.albedo_image, base_dir));
+    if (m.alpha_image) w.key("alpha").string(path_for_file(*m.alpha_image, base_dir));
     w.key("specular").number(m.specular);
+    if (!m.two_sided) w.key("two_sided").boolean(false);
     w.end_object();
   }
   w.end_array();
@@ -956,7 +974,7 @@ Expected<std::string> write_scene_json(const Scene& scene, const std::string& ba
   write_ground(w, scene.ground);
   if (scene.fog) write_fog(w, *scene.fog);
   if (scene.animation) write_animation(w, *scene.animation);
-  if (!scene.materials.empty()) write_materials(w, scene.materials);
+  if (!scene.materials.empty()) write_materials(w, scene.materials, base_dir);
   w.key("plants").begin_array(Layout::lines);
   for (const ScenePlant& plant : scene.plants)
     if (plant.scatter == 0) write_plant(w, plant, base_dir);  // scattered ones: their entry

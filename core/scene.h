@@ -133,6 +133,9 @@ struct Bark {
 struct SceneMaterial {
   std::optional<glm::dvec3> albedo_rgb;  // linear albedo; none: default_material_albedo(k)
   double specular = 1;                   // weight of the Blinn–Phong lobe (shading.h), [0, 1]
+  std::optional<std::string> albedo_image{};  // resolved path: the leaves' albedo (leaf_images.h)
+  std::optional<std::string> alpha_image{};   // resolved path: the leaves' cut-out (leaf_images.h)
+  bool two_sided = true;                 // false: a leaf of it exists on its front side only
   bool operator==(const SceneMaterial&) const = default;
 };
 

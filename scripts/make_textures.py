@@ -55,12 +55,16 @@ def _filter_rows(raw, bpp):
 
 
 def write_png(path, pixels):
-    """pixels: (h, w) uint16 (16-bit grey) or (h, w, 3) uint8 (8-bit RGB)."""
+    """pixels: (h, w) uint16 (16-bit grey), (h, w, 3) uint8 (8-bit RGB) or (h, w, 4) uint8
+    (8-bit RGBA, straight alpha)."""
     if pixels.ndim == 2 and pixels.dtype == np.uint16:
         bit_depth, colour_type, bpp = 16, 0, 2
         raw = pixels.astype(">u2").view(np.uint8).reshape(pixels.shape[0], -1)
     elif pixels.ndim == 3 and pixels.shape[2] == 3 and pixels.dtype == np.uint8:
         bit_depth, colour_type, bpp = 8, 2, 3
+        raw = pixels.reshape(pixels.shape[0], -1)
+    elif pixels.ndim == 3 and pixels.shape[2] == 4 and pixels.dtype == np.uint8:
+        bit_depth, colour_type, bpp = 8, 6, 4
         raw = pixels.reshape(pixels.shape[0], -1)
     else:
         raise ValueError("unsupported pixel array")
@@ -71,7 +75,7 @@ def write_png(path, pixels):
 
     png = b"\x89PNG\r\n\x1a\n"
     png += chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, bit_depth, colour_type, 0, 0, 0))
-    if colour_type == 2:
+    if colour_type in (2, 6):
         png += chunk(b"sRGB", b"\x00")  # perceptual; the albedo is sRGB-encoded
     png += chunk(b"IDAT", zlib.compress(_filter_rows(raw, bpp), 9))
     png += chunk(b"IEND", b"")

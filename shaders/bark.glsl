@@ -52,12 +52,6 @@ float height_field(PlantMaps maps, float s, float t) {
   return top + fy * (bottom - top);
 }
 
-// The sRGB transfer function's inverse (IEC 61966-2-1): encoded [0, 1] → linear.
-vec3 srgb_to_linear(vec3 encoded) {
-  vec3 c = clamp(encoded, 0.0, 1.0);
-  return mix(pow((c + 0.055) / 1.055, vec3(2.4)), c / 12.92, lessThanEqual(c, vec3(0.04045)));
-}
-
 // How u and v_m change from a pixel to the next (texture.h's UvFootprint): x to the
 // right, y downward, turns and metres per pixel step. Zero: the finest MIP level.
 struct UvFootprint {

@@ -30,6 +30,7 @@
 #define G_ALBEDO_UNIT 19          // g_albedo (attachment 3)
 #define SHADOW_MAP_UNIT 20        // shade.frag.glsl shadow_map
 #define ACCUMULATION_UNIT 21      // present.frag.glsl u_accumulation
+#define LEAF_IMAGES_UNIT 22       // mesh.frag.glsl u_leaf_images (LEAF_IMAGES: leaf_images.h's layers)
 
 // Constants.
 #define MAX_BARK_IMAGES 16        // distinct bark images a scene may bind (GL 4.5 guarantees 16 units a stage)

@@ -21,6 +21,41 @@ in vec3 v_local;
 in vec3 v_normal;
 in vec2 v_uv;
 flat in uvec4 v_ids;
+#elif defined(LEAF_IMAGES)
+in vec3 v_normal;
+in vec2 v_uv;
+flat in uvec4 v_ids;
+#endif
+
+// LEAF_IMAGES (the leaves, both passes; leaf_images.h): material m's layer u_leaf_layer[m]
+// of the 2D array (RGB sRGB-encoded albedo, A the cut-out; GL_LINEAR, clamped, no MIP
+// levels: LeafImages::sample's filter), its flags u_leaf_flags[m]: 1 albedo image, 2
+// cut-out, 4 one-sided. A fragment is discarded where the leaf is not: alpha below
+// LEAF_ALPHA_CUTOFF, or the back of a one-sided leaf — the side the ray arrives from
+// (the eye's in the G-buffer pass, the sun's in the shadow pass, whose rays run along
+// −u_light_dir) — as LeafTracer's filter lets those rays through.
+#ifdef LEAF_IMAGES
+layout(binding = LEAF_IMAGES_UNIT) uniform sampler2DArray u_leaf_images;
+uniform int u_leaf_layer[MAX_MATERIALS];
+uniform uint u_leaf_flags[MAX_MATERIALS];
+const float LEAF_ALPHA_CUTOFF = 0.5;
+
+// The leaf image's texel at the leaf's (u, v): v = 0 the image's bottom row.
+vec4 leaf_texel(uint material) {
+  int slot = min(int(material), MAX_MATERIALS - 1);
+  return u_leaf_layer[slot] < 0 ? vec4(1.0)
+                                : texture(u_leaf_images, vec3(v_uv.x, 1.0 - v_uv.y, float(u_leaf_layer[slot])));
+}
+
+// Whether the leaf is missing at this fragment for a ray along `ray_direction`.
+bool leaf_missing(uint material, vec4 texel, vec3 ray_direction) {
+  uint flags = u_leaf_flags[min(int(material), MAX_MATERIALS - 1)];
+  if ((flags & 4u) != 0u && dot(ray_direction, v_normal) > 0.0) return true;
+  return (flags & 2u) != 0u && texel.a < LEAF_ALPHA_CUTOFF;
+}
+#endif
+
+#ifdef GBUFFER_PASS
 
 layout(location = 0) out vec4 g_normal_distance;  // shading normal (toward the eye), distance
 layout(location = 1) out vec4 g_geometric_u;      // geometric normal (toward the eye), u
@@ -32,7 +67,16 @@ uniform float u_footprint_scale;  // 1 / sqrt(spp): the ray differentials' step
 #endif
 
 void main() {
+#if defined(SHADOW_PASS) && defined(LEAF_IMAGES)
+  if (leaf_missing(v_ids.x >> PLANT_INDEX_BITS, leaf_texel(v_ids.x >> PLANT_INDEX_BITS), -u_light_dir)) discard;
+#endif
 #ifdef GBUFFER_PASS
+#ifdef LEAF_IMAGES
+  // Sampled in uniform control flow (before any discard), so the helper pixels agree.
+  uint leaf_material = v_ids.x >> PLANT_INDEX_BITS;
+  vec4 leaf = leaf_texel(leaf_material);
+  if (leaf_missing(leaf_material, leaf, v_rel_eye)) discard;
+#endif
   // The triangle's plane: any two differences of interpolated points of it lie in it
   // (perspective-correct interpolation keeps them on the plane, helper pixels extrapolate
   // it). Taken in the plant's frame, whose coordinates are a plant's size, not the eye's
@@ -62,6 +106,10 @@ void main() {
   // The bark covers the wood only (material 0, materials.h).
   g_albedo = (v_ids.x >> PLANT_INDEX_BITS) == 0u ? bark_albedo(v_ids.x & PLANT_INDEX_MASK, u, v_uv.y, footprint)
                                                  : vec4(0.0);
+#elif defined(LEAF_IMAGES)
+  // A leaf image's albedo, decoded after filtering as LeafImages::albedo (and bark.glsl).
+  bool image = (u_leaf_flags[min(int(leaf_material), MAX_MATERIALS - 1)] & 1u) != 0u;
+  g_albedo = image ? vec4(srgb_to_linear(leaf.rgb), 1.0) : vec4(0.0);
 #else
   g_albedo = vec4(0.0);
 #endif

@@ -22,6 +22,11 @@ struct MeshFrustum {
 };
 layout(std430, binding = MESH_FRUSTA_BINDING) readonly buffer MeshFrusta { MeshFrustum mesh_frusta[]; };
 
+#if defined(SHADOW_PASS) && defined(LEAF_IMAGES)
+out vec3 v_normal;          // the leaf's Newell normal (one-sided leaves: which side this is)
+out vec2 v_uv;              // the leaf's uv (cut-outs)
+flat out uvec4 v_ids;
+#endif
 #ifdef GBUFFER_PASS
 out vec3 v_rel_eye;         // position − eye: the distance, and the ray it lies on
 out vec3 v_local;           // position − origin_hi: the triangle's plane (geometric normal)
@@ -36,6 +41,11 @@ void main() {
   // ray-cast frusta for the same point, in the G-buffer and in the shadow map.
 #ifdef SHADOW_PASS
   gl_Position = light_clip_position(a_position - ((u_light_hi - f.origin_hi.xyz) + u_light_lo));
+#ifdef LEAF_IMAGES
+  v_normal = a_normal;
+  v_uv = a_uv;
+  v_ids = f.ids;
+#endif
 #else
   vec3 p = a_position - ((u_eye_hi - f.origin_hi.xyz) + u_eye_lo);  // relative to the eye
   gl_Position = camera_clip_position(p);

@@ -41,12 +41,13 @@ void triangle_range_filter(const RTCFilterFunctionNArguments* args) {
     const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
     const uint32_t* tri = &q->indices[3 * static_cast<size_t>(prim)];
     const TriangleCrossing c = cross_triangle(q->ray, q->positions[tri[0]], q->positions[tri[1]], q->positions[tri[2]]);
-    if (c.det == 0 || !(c.t > q->t_min && c.t < q->t_max)) args->valid[i] = 0;
+    if (!in_query_range(c, *q)) args->valid[i] = 0;
   }
 }
 
 RTCGeometry new_filtered_triangles(RTCDevice device, const glm::dvec3* positions, size_t vertex_count,
-                                   const uint32_t* indices, size_t triangle_count, const glm::dvec3& centre) {
+                                   const uint32_t* indices, size_t triangle_count, const glm::dvec3& centre,
+                                   RTCFilterFunctionN filter) {
   RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* v = static_cast<float*>(
       rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertex_count));
@@ -56,8 +57,8 @@ RTCGeometry new_filtered_triangles(RTCDevice device, const glm::dvec3* positions
   }
   rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, indices, 0, 3 * sizeof(uint32_t),
                              triangle_count);
-  rtcSetGeometryIntersectFilterFunction(geom, triangle_range_filter);
-  rtcSetGeometryOccludedFilterFunction(geom, triangle_range_filter);
+  rtcSetGeometryIntersectFilterFunction(geom, filter);
+  rtcSetGeometryOccludedFilterFunction(geom, filter);
   return geom;
 }
 

@@ -42,9 +42,16 @@ TriangleQuery start_triangle_query(const glm::dvec3* positions, const uint32_t* 
 // t lies in the query's (t_min, t_max).
 void triangle_range_filter(const RTCFilterFunctionNArguments* args);
 
+// Whether a candidate's double crossing `c` lies in the query's range (the range filter's test).
+inline bool in_query_range(const TriangleCrossing& c, const TriangleQuery& q) {
+  return c.det != 0 && c.t > q.t_min && c.t < q.t_max;
+}
+
 // Makes the Embree triangle geometry over `positions` (relative to `centre` in float) and
-// `indices` (shared, not copied: they must outlive the geometry) with the range filter.
+// `indices` (shared, not copied: they must outlive the geometry) with `filter` (intersect
+// and occluded alike; the range filter, or one that applies it and more).
 RTCGeometry new_filtered_triangles(RTCDevice device, const glm::dvec3* positions, size_t vertex_count,
-                                   const uint32_t* indices, size_t triangle_count, const glm::dvec3& centre);
+                                   const uint32_t* indices, size_t triangle_count, const glm::dvec3& centre,
+                                   RTCFilterFunctionN filter = triangle_range_filter);
 
 }  // namespace sylva

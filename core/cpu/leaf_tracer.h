@@ -28,10 +28,17 @@
 
 namespace sylva {
 
+class LeafImages;  // leaf_images.h
+
 class LeafTracer final : public SceneTracer {
  public:
-  // `other`: the rest of the scene (may be null: leaves alone).
-  LeafTracer(LeafMesh leaves, std::unique_ptr<SceneTracer> other);
+  // `other`: the rest of the scene (may be null: leaves alone). `images`: the scene's leaf
+  // materials (leaf_images.h; null: every leaf two-sided and whole) — every query, nearest
+  // and any alike, passes through a cut-out's transparent texels and a one-sided leaf
+  // where the light meets its back: a nearest ray (camera, photon) that arrives at its
+  // back, an `any` ray (a shadow ray, cast from a surface toward the light) that leaves
+  // through its back, so a one-sided leaf casts no shadow with the light behind it.
+  LeafTracer(LeafMesh leaves, std::unique_ptr<SceneTracer> other, std::shared_ptr<const LeafImages> images = nullptr);
   ~LeafTracer() override;
   LeafTracer(const LeafTracer&) = delete;
   LeafTracer& operator=(const LeafTracer&) = delete;
@@ -46,6 +53,7 @@ class LeafTracer final : public SceneTracer {
   // The nearest leaf alone (the other geometry not asked).
   SurfaceHit nearest_leaf(const Ray& ray, double t_min, double t_max) const;
   const LeafMesh& leaves() const;
+  const LeafImages* images() const;  // null when the leaves are plain
   const SceneTracer* other() const;
 
  private:

@@ -8,6 +8,7 @@
 #include "core/cpu/frustum_tracer.h"
 #include "core/cpu/instance_tracer.h"
 #include "core/instances.h"
+#include "core/leaf_images.h"
 #include "core/cpu/leaf_tracer.h"
 #include "core/cpu/mesh_accel.h"
 #include "core/cpu/photons.h"
@@ -78,7 +79,7 @@ class Renderer {
         sun_frame_(axis_frame(sun_direction_)),
         cos_alpha_(std::cos(scene.sun.angular_radius_deg * kPi / 180)),
         sun_on_(scene.sun.radiance.x > 0 || scene.sun.radiance.y > 0 || scene.sun.radiance.z > 0),
-        textures_(textures), fog_(fog) {
+        textures_(textures), leaf_images_(geometry.leaf_images.get()), fog_(fog) {
     // Ray differentials: frame_ray is affine in (x, y), so the neighbouring sample's
     // direction is the direction plus a constant; one pixel / sqrt(spp) (texture.h).
     const double step = 1 / std::sqrt(static_cast<double>(std::max(1u, options.spp)));
@@ -219,10 +220,15 @@ class Renderer {
     if (glm::dot(ng, view) < 0) ng = -ng;   // seen from inside: light the side we see
     if (glm::dot(n, view) < 0) n = -n;
     const ScenePlant& plant = scene_.plants[s.plant];
-    // A leaf is never bark (docs/materials.md): the table's look of its material, untextured.
-    const MaterialLook look = material_look(scene_.materials, s.is_leaf() ? nullptr : &plant.bark, s.material);
+    // A leaf is never bark (docs/materials.md): the table's look of its material, its image
+    // where the table names one (leaf_images.h); a segment of such a material its mean.
+    const MaterialLook look =
+        segment_look(scene_.materials, s.is_leaf() ? nullptr : &plant.bark, s.material, leaf_images_);
     glm::dvec3 albedo = look.albedo;
-    if (s.is_leaf()) return lit(albedo, n, ng, s.position, view, look.specular, rng, shadow_rays);
+    if (s.is_leaf()) {
+      if (leaf_images_ && leaf_images_->has_albedo(s.material)) albedo = leaf_images_->albedo(s.material, s.u, s.v_m);
+      return lit(albedo, n, ng, s.position, view, look.specular, rng, shadow_rays);
+    }
     if (s.material == 0 && textures_ && textures_->has_albedo(s.plant)) {  // bark: wood only
       const UvFootprint footprint = uv_footprint(s, {h.ray.origin, h.ray.direction + direction_dx_},
                                                  {h.ray.origin, h.ray.direction + direction_dy_});
@@ -285,6 +291,7 @@ class Renderer {
   const double cos_alpha_;
   const bool sun_on_;
   const SceneTextures* textures_;  // bark albedo textures; nullptr: none
+  const LeafImages* leaf_images_;  // the table's leaf images (leaf_images.h); nullptr: none
   const FogIntegrator* fog_;       // the scene's fog; nullptr: none
   glm::dvec3 direction_dx_{0}, direction_dy_{0};  // ray differentials' direction offsets
 };
@@ -334,9 +341,11 @@ namespace {
 // `only`, the culling pass is left to the caller: *culled_out counts the plants culled.
 SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin, const GeometryOptions& options,
                                     std::vector<RenderPass>* passes, const SceneTextures* textures,
-                                    const Progress& progress, const std::vector<char>* only,
+                                    std::shared_ptr<const LeafImages> images, const Progress& progress,
+                                    const std::vector<char>* only,
                                     uint32_t* culled_out = nullptr, double* cull_s_out = nullptr) {
   SceneGeometry g;
+  g.leaf_images = images;
   const bool mesh = options.kind == GeometryKind::mesh;
   TessellateOptions tessellation;
   tessellation.level = options.mesh_level;
@@ -436,7 +445,7 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
   // Leaves (leaf_tracer.h): their own triangles beside the frusta or mesh; a scene
   // without leaves keeps its tracer as it is.
   if (!leaves.empty()) {
-    auto with_leaves = std::make_unique<LeafTracer>(std::move(leaves), std::move(g.tracer));
+    auto with_leaves = std::make_unique<LeafTracer>(std::move(leaves), std::move(g.tracer), images);
     g.leaves = with_leaves.get();
     g.tracer = std::move(with_leaves);
   }
@@ -478,7 +487,7 @@ bool instanceable(const ScenePlant& plant, const SkinOptions& skin, const Geomet
 SceneGeometry build_scene_geometry(const Scene& scene, const SkinOptions& skin, const GeometryOptions& options,
                                    std::vector<RenderPass>* passes, const SceneTextures* textures,
                                    const Progress& progress) {
-  return build_plants_geometry(scene, skin, options, passes, textures, progress, nullptr);
+  return build_plants_geometry(scene, skin, options, passes, textures, scene_leaf_images(scene), progress, nullptr);
 }
 
 SceneGeometry build_instanced_geometry(const Scene& scene, const SkinOptions& skin, const GeometryOptions& options,
@@ -498,15 +507,17 @@ SceneGeometry build_instanced_geometry(const Scene& scene, const SkinOptions& sk
   const bool any_in_world = std::find(in_world.begin(), in_world.end(), 1) != in_world.end();
   const bool any_instanced = std::find(in_world.begin(), in_world.end(), 0) != in_world.end();
   if (!any_instanced) return build_scene_geometry(scene, skin, options, passes, textures, progress);
+  const std::shared_ptr<const LeafImages> images = scene_leaf_images(scene);
 
   // The plants skinned in the world first (their passes as build_scene_geometry's).
   constexpr double kWorldShare = 0.5;
   SceneGeometry g;
+  g.leaf_images = images;
   uint32_t culled = 0;
   double cull_s = 0;
   if (any_in_world) {
-    g = build_plants_geometry(scene, skin, options, passes, textures, progress.part(0, kWorldShare), &in_world,
-                              &culled, &cull_s);
+    g = build_plants_geometry(scene, skin, options, passes, textures, images, progress.part(0, kWorldShare),
+                              &in_world, &culled, &cull_s);
     if (g.cancelled) return g;
   }
   const double instance_start = seconds_since(start);
@@ -554,7 +565,7 @@ SceneGeometry build_instanced_geometry(const Scene& scene, const SkinOptions& sk
       one.plants[0].bark = Bark{};
       GeometryOptions local = options;
       local.cull = false;
-      SceneGeometry pg = build_plants_geometry(one, skin, local, nullptr, nullptr, {}, nullptr);
+      SceneGeometry pg = build_plants_geometry(one, skin, local, nullptr, nullptr, images, {}, nullptr);
       prototype_index[k] = static_cast<int64_t>(prototypes.size());
       frusta_of_prototype.push_back(pg.frusta.size());
       prototype_frusta += pg.frusta.size();

@@ -70,6 +70,7 @@ namespace sylva {
 
 class SceneTextures;  // texture.h
 class LeafTracer;     // leaf_tracer.h
+class LeafImages;     // leaf_images.h
 
 // World-space geometry of a scene: every plant's skeleton transformed (position,
 // rotate_y_deg, scale) and skinned, and what the renderer traces: the frusta themselves
@@ -81,6 +82,9 @@ struct SceneGeometry {
                                                       // none and the relief needs them
   std::unique_ptr<SceneTracer> tracer;     // over `frusta` (or a mesh made from them) and the leaves
   const LeafTracer* leaves = nullptr;      // `tracer` when the scene has leaves (leaf_tracer.h), else null
+  // The scene's leaf materials (leaf_images.h: images, cut-outs, one-sidedness) every leaf
+  // tracer of `tracer` applies; null when the table has none.
+  std::shared_ptr<const LeafImages> leaf_images;
   bool cancelled = false;                  // stopped by `progress` between plants: no tracer
   // build_instanced_geometry only: the plants traced as instances of a shared skeleton are
   // not in `frusta` (their prototypes' frusta live in `tracer`); their frusta counted once

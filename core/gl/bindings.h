@@ -38,6 +38,7 @@ inline constexpr uint32_t kGIdsUnit = 18;
 inline constexpr uint32_t kGAlbedoUnit = 19;
 inline constexpr uint32_t kShadowMapUnit = 20;
 inline constexpr uint32_t kAccumulationUnit = 21;
+inline constexpr uint32_t kLeafImagesUnit = 22;  // leaf_images.h's layers, one 2D array texture
 
 // Constants.
 inline constexpr uint32_t kMaxBarkImages = 16;  // GL 4.5 guarantees 16 texture units a stage
@@ -77,6 +78,7 @@ inline constexpr GlslConstant kGlslConstants[] = {
     {"G_ALBEDO_UNIT", kGAlbedoUnit},
     {"SHADOW_MAP_UNIT", kShadowMapUnit},
     {"ACCUMULATION_UNIT", kAccumulationUnit},
+    {"LEAF_IMAGES_UNIT", kLeafImagesUnit},
     {"MAX_BARK_IMAGES", kMaxBarkImages},
     {"MAX_MATERIALS", kMaxMaterials},
     {"PLANT_INDEX_BITS", kPlantIndexBits},

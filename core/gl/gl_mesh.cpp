@@ -17,6 +17,7 @@
 #include "core/gl/gl_views.h"
 #include "core/render_common.h"
 #include "core/cpu/texture.h"
+#include "core/leaf_images.h"
 #include "core/leaf_mesh.h"
 #include "core/plant_mesh.h"
 
@@ -153,6 +154,8 @@ struct GlMesh::State {
   GlVertexArray vao;
   GlBuffer vertex_buffer, index_buffer, frustum_buffer;
   GlProgramObject gbuffer_program, shadow_program;
+  std::shared_ptr<const LeafImages> leaf_images;  // leaves_of only: the table's (null: plain leaves)
+  GlTexture leaf_texture;                         // its layers as one 2D array (LEAF_IMAGES)
 
   // Tessellates, displaces and uploads every plant; replaces the passes' record with what
   // this did. Returns the bytes uploaded.
@@ -236,6 +239,42 @@ struct GlMesh::State {
     return upload(arrays);
   }
 
+  // The leaf images' layers as one RGBA8 2D array texture (leaf_images.h: GL_LINEAR,
+  // clamped, no MIP levels, as LeafImages::sample reads them); returns its bytes.
+  uint64_t upload_leaf_images() {
+    const LeafImages& images = *leaf_images;
+    const GLsizei layers = static_cast<GLsizei>(std::max<size_t>(images.layer_count(), 1));
+    const GLsizei w = static_cast<GLsizei>(std::max(images.width(), 1u)), h = static_cast<GLsizei>(std::max(images.height(), 1u));
+    GLuint id = 0;
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
+    leaf_texture = GlTexture(id);
+    glTextureStorage3D(id, 1, GL_RGBA8, w, h, layers);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    for (size_t k = 0; k < images.layer_count(); ++k)
+      glTextureSubImage3D(id, 0, 0, 0, static_cast<GLint>(k), w, h, 1, GL_RGBA, GL_UNSIGNED_BYTE, images.layer(k).data());
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    check_gl("GL leaf images upload");
+    return uint64_t{static_cast<uint64_t>(w) * static_cast<uint64_t>(h) * 4 * static_cast<uint64_t>(layers)};
+  }
+
+  // mesh.frag.glsl's LEAF_IMAGES uniforms: each material's layer and flags, and the texture.
+  void bind_leaf_images(GLuint program_id) const {
+    GLint layer[gl::kMaxMaterials];
+    GLuint flags[gl::kMaxMaterials];
+    for (uint32_t m = 0; m < gl::kMaxMaterials; ++m) {
+      layer[m] = leaf_images->layer_of(m);
+      flags[m] = (leaf_images->has_albedo(m) ? 1u : 0u) | (leaf_images->has_cutout(m) ? 2u : 0u) |
+                 (leaf_images->one_sided(m) ? 4u : 0u);
+    }
+    glProgramUniform1iv(program_id, glGetUniformLocation(program_id, "u_leaf_layer"), gl::kMaxMaterials, layer);
+    glProgramUniform1uiv(program_id, glGetUniformLocation(program_id, "u_leaf_flags"), gl::kMaxMaterials, flags);
+    glBindTextureUnit(gl::kLeafImagesUnit, leaf_texture.id());
+  }
+
   // Uploads `arrays` (replacing what was there) and records the "upload" pass.
   uint64_t upload(const MeshArrays& arrays) {
     const size_t vertex_bytes = arrays.vertices.size() * sizeof(MeshVertex);
@@ -273,7 +312,7 @@ struct GlMesh::State {
     GlProgramObject& program = pass == MeshPass::shadow ? shadow_program : gbuffer_program;
     if (program) return program.id();
     const Clock::time_point start = Clock::now();
-    program = GlProgramObject(build_gl_program(mesh_program(pass, bark_texture_units)).id);
+    program = GlProgramObject(build_gl_program(mesh_program(pass, bark_texture_units, leaf_images != nullptr)).id);
     if (compile_s) *compile_s += seconds_since(start);
     return program.id();
   }
@@ -288,6 +327,7 @@ struct GlMesh::State {
     glBindVertexArray(vao.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kMeshFrustaBinding, frustum_buffer.id());
     glUseProgram(program_id);
+    if (leaf_images) bind_leaf_images(program_id);
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * triangles), GL_UNSIGNED_INT, nullptr);
     glBindVertexArray(static_cast<GLuint>(previous_vao));
     if (cull) glEnable(GL_CULL_FACE);
@@ -312,22 +352,26 @@ GlMesh::GlMesh(const Scene& scene, const RenderOptions& options, int bark_textur
   check_gl("GL mesh programs");
 }
 
-GlMesh::GlMesh(const Scene& scene, const RenderOptions& options, LeavesTag) : state_(std::make_unique<State>()) {
+GlMesh::GlMesh(const Scene& scene, const RenderOptions& options, std::shared_ptr<const LeafImages> images, LeavesTag)
+    : state_(std::make_unique<State>()) {
   State& st = *state_;
   st.options = options;
   st.leaves = true;
+  st.leaf_images = std::move(images);
   st.build(scene, nullptr);
+  if (st.leaf_images) st.gpu_bytes += st.upload_leaf_images();
   double compile_s = 0;
   st.program(MeshPass::gbuffer, &compile_s);
   if (sun_shines(scene)) st.program(MeshPass::shadow, &compile_s);
   check_gl("GL leaves programs");
 }
 
-std::unique_ptr<GlMesh> GlMesh::leaves_of(const Scene& scene, const RenderOptions& options) {
+std::unique_ptr<GlMesh> GlMesh::leaves_of(const Scene& scene, const RenderOptions& options,
+                                          std::shared_ptr<const LeafImages> images) {
   const bool any = std::any_of(scene.plants.begin(), scene.plants.end(),
                                [](const ScenePlant& p) { return p.skeleton && !p.skeleton->leaves.empty(); });
   if (!any) return nullptr;
-  return std::unique_ptr<GlMesh>(new GlMesh(scene, options, LeavesTag{}));
+  return std::unique_ptr<GlMesh>(new GlMesh(scene, options, std::move(images), LeavesTag{}));
 }
 
 GlMesh::~GlMesh() = default;

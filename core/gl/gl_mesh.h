@@ -65,6 +65,7 @@
 namespace sylva {
 
 class SceneTextures;  // texture.h
+class LeafImages;     // leaf_images.h
 
 // A sphere around one frustum's triangles (displaced ones included), metres.
 struct GlMeshSphere {
@@ -87,7 +88,11 @@ class GlMesh {
   // leaves; its flat Newell normal as every vertex's shading normal (mesh.frag.glsl turns
   // it toward the eye: two-sided), its leaf_uvs (leaf_mesh.h); a sphere per leaf. Null when no plant has leaves.
   // The frusta's renderer draws it after the frusta into the same G-buffer and shadow map.
-  static std::unique_ptr<GlMesh> leaves_of(const Scene& scene, const RenderOptions& options);
+  // `images` (leaf_images.h; null: plain leaves): the table's leaf images, cut-outs and
+  // one-sided materials, uploaded as one 2D array texture (its bytes in gpu_bytes) and
+  // applied in both passes (mesh_program's LEAF_IMAGES).
+  static std::unique_ptr<GlMesh> leaves_of(const Scene& scene, const RenderOptions& options,
+                                           std::shared_ptr<const LeafImages> images = nullptr);
   ~GlMesh();
   GlMesh(const GlMesh&) = delete;
   GlMesh& operator=(const GlMesh&) = delete;
@@ -119,7 +124,7 @@ class GlMesh {
 
  private:
   struct LeavesTag {};
-  GlMesh(const Scene& scene, const RenderOptions& options, LeavesTag);
+  GlMesh(const Scene& scene, const RenderOptions& options, std::shared_ptr<const LeafImages> images, LeavesTag);
   struct State;
   std::unique_ptr<State> state_;
 };

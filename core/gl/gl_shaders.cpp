@@ -107,7 +107,7 @@ ShaderProgramSource frusta_program(FrustaPass pass, const FrustaFeatures& featur
   }
   p.name += "]";
   std::vector<std::string> files = kFrustaCommon;
-  if (features.relief || bark) files.push_back("bark.glsl");
+  if (features.relief || bark) files.insert(files.end(), {"srgb.glsl", "bark.glsl"});
   if (features.relief) files.push_back("relief.glsl");
   p.vertex = {ShaderStage::vertex, with(files, "frusta.vert.glsl"), defines};
   p.fragment = {ShaderStage::fragment, with(files, "frusta.frag.glsl"), defines};
@@ -120,17 +120,24 @@ ShaderProgramSource frusta_program(FrustaPass pass, bool want_uv) {
   return frusta_program(pass, features);
 }
 
-ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units) {
+ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units, bool leaf_images) {
   const bool shadow = pass == MeshPass::shadow;
   std::vector<std::string> defines = {shadow ? "SHADOW_PASS" : "GBUFFER_PASS"};
   ShaderProgramSource p;
   p.name = shadow ? "mesh[SHADOW_PASS" : "mesh[GBUFFER_PASS";
+  if (leaf_images) {
+    defines.push_back("LEAF_IMAGES");
+    p.name += " LEAF_IMAGES";
+  }
   std::vector<std::string> fragment_files = {"mesh.frag.glsl"};
   if (!shadow && bark_texture_units > 0) {
     defines.push_back("BARK_TEXTURE_UNITS " + std::to_string(bark_texture_units));
     p.name += " TEXTURE_UNITS=" + std::to_string(bark_texture_units);
     fragment_files.insert(fragment_files.begin(), "bark.glsl");
   }
+  if (!shadow && (bark_texture_units > 0 || leaf_images)) fragment_files.insert(fragment_files.begin(), "srgb.glsl");
+  // The shadow pass's one-sided leaves need the sun's direction (views.glsl u_light_dir).
+  if (shadow && leaf_images) fragment_files.insert(fragment_files.begin(), "views.glsl");
   p.name += "]";
   p.vertex = {ShaderStage::vertex, {"views.glsl", "mesh.vert.glsl"}, defines};
   p.fragment = {ShaderStage::fragment, fragment_files, defines};
@@ -168,7 +175,7 @@ ShaderProgramSource shade_program(bool sun, bool fog) {
   if (fog) defines.push_back("FOG");
   p.name = std::string("shade[") + (sun ? "SUN" : "") + (sun && fog ? " " : "") + (fog ? "FOG" : "") + "]";
   p.vertex = {ShaderStage::vertex, {"fullscreen.vert.glsl"}, {}};
-  std::vector<std::string> files = {"bark.glsl", "shading.glsl"};
+  std::vector<std::string> files = {"srgb.glsl", "bark.glsl", "shading.glsl"};
   if (fog) files.push_back("fog.glsl");
   p.fragment = {ShaderStage::fragment, with(files, "shade.frag.glsl"), defines};
   return p;
@@ -241,6 +248,7 @@ std::vector<ShaderProgramSource> all_shader_programs() {
   }
   for (MeshPass pass : {MeshPass::gbuffer, MeshPass::shadow}) all.push_back(mesh_program(pass));
   all.push_back(mesh_program(MeshPass::gbuffer, 1));  // with the bark albedo
+  for (MeshPass pass : {MeshPass::gbuffer, MeshPass::shadow}) all.push_back(mesh_program(pass, 0, true));
   for (bool sun : {false, true})
     for (bool fog : {false, true}) all.push_back(shade_program(sun, fog));
   for (bool sun : {false, true})

@@ -22,6 +22,7 @@
 #include "core/gl/gl_fog.h"
 #include "core/gl/gl_frame_targets.h"
 #include "core/gl/gl_mesh.h"
+#include "core/leaf_images.h"
 #include "core/gl/gl_objects.h"
 #include "core/gl/gl_pass_timers.h"
 #include "core/gl/gl_program.h"
@@ -233,6 +234,7 @@ struct GlRenderer::State {
   std::unique_ptr<GlBarkMaps> bark_maps;
   std::unique_ptr<GlMesh> mesh;      // GeometryKind::mesh: the polygon baseline, drawn instead of the frusta
   std::unique_ptr<GlMesh> leaves;    // the plants' leaves (GlMesh::leaves_of), drawn after either; null: none
+  std::shared_ptr<const LeafImages> leaf_images;  // the table's leaf materials (leaf_images.h); null: none
 
   GlVertexArray vao;  // empty: the frusta pull their vertices from the records
   GlBuffer segment_buffer, id_buffer, list_buffer, instance_buffer;
@@ -476,13 +478,14 @@ struct GlRenderer::State {
     set_uniform(shade, "u_eye_above_ground", f.camera.eye.y - scene.ground.height);
     set_uniform(shade, "u_sky", scene.sky);
     set_uniform(shade, "u_ground_albedo", scene.ground.albedo);
-    // Every slot the scene's table may fill (scene.h material_look); higher indices look
-    // like the last slot, as default_material_albedo's past its table.
+    // Every slot the scene's table may fill (scene.h material_look; a material with a leaf
+    // image gives its segments the image's mean, leaf_images.h segment_look); higher
+    // indices look like the last slot, as default_material_albedo's past its table.
     static_assert(gl::kMaxMaterials == kMaterialSlots);
     float albedo[gl::kMaxMaterials * 3], specular[gl::kMaxMaterials];
     const int count = static_cast<int>(kMaterialSlots);
     for (int i = 0; i < count; ++i) {
-      const MaterialLook look = material_look(scene.materials, nullptr, static_cast<uint32_t>(i));
+      const MaterialLook look = segment_look(scene.materials, nullptr, static_cast<uint32_t>(i), leaf_images.get());
       for (int k = 0; k < 3; ++k) albedo[3 * i + k] = static_cast<float>(look.albedo[k]);
       specular[i] = static_cast<float>(look.specular);
     }
@@ -620,7 +623,8 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options, std::sh
                                                       : " + " + std::to_string(instances.size()) + " instances (48 B)")});
   }
   // The leaves (gl_mesh.h leaves_of): their own upload and programs.
-  st.leaves = GlMesh::leaves_of(scene, options);
+  st.leaf_images = scene_leaf_images(scene);
+  st.leaves = GlMesh::leaves_of(scene, options, st.leaf_images);
   if (st.leaves) {
     st.add_leaf_spheres();
     st.uploaded_bytes += st.leaves->gpu_bytes();

@@ -163,6 +163,46 @@ TEST(ExportCli, ALeafyPlantsMeshPassesTheKhronosValidator) {
   expect_valid(files);
 }
 
+TEST(ExportCli, ALeafImageCutOutAndOneSidedLeavesBecomeTheirGltfMaterial) {
+  // One square leaf of material 2 with the bundled elm leaf (its own alpha: a cut-out),
+  // one-sided; material 3's leaf plain. Both files pass the validator.
+  TempDir dir;
+  const std::string grammar = dir.write(
+      "leaf.lsys", "angle: 90\naxiom: !(0.02)F(1)'(2){.+f(1).-f(1).-f(1).}F(1)'(3){.+f(1).-f(1).-f(1).}\n");
+  const std::string scene = dir.write("leaf.scene.json", R"({"format":"sylva-scene","version":1,
+    "materials":[{"index":2,"albedo":")" + kSource + R"(/presets/textures/elm_leaf.png","two_sided":false}],
+    "plants":[{"grammar":"leaf.lsys"}]})");
+  std::vector<std::string> files;
+  for (const char* ext : {".gltf", ".glb"}) {
+    files.push_back(dir.file(std::string("leaf") + ext));
+    expect_ok(run_sylva({"export", scene, "-o", files.back(), "--mesh"}));
+  }
+  expect_valid(files);
+  const std::string text = read_file(files[0]);
+  const size_t m2 = text.find("\"name\":\"sylva_leaf_material_2\"");
+  const size_t m3 = text.find("\"name\":\"sylva_leaf_material_3\"");
+  ASSERT_NE(m2, std::string::npos) << text.substr(0, 4000);
+  ASSERT_NE(m3, std::string::npos);
+  const std::string leaf2 = text.substr(m2, text.find("\"extras\"", m2) - m2);
+  const std::string leaf3 = text.substr(m3, text.find("\"extras\"", m3) - m3);
+  EXPECT_NE(leaf2.find("\"baseColorTexture\""), std::string::npos) << leaf2;
+  EXPECT_NE(leaf2.find("\"alphaMode\":\"MASK\""), std::string::npos) << leaf2;
+  EXPECT_NE(leaf2.find("\"alphaCutoff\":0.5"), std::string::npos) << leaf2;
+  EXPECT_NE(leaf2.find("\"doubleSided\":false"), std::string::npos) << leaf2;
+  EXPECT_EQ(leaf3.find("\"baseColorTexture\""), std::string::npos) << leaf3;
+  EXPECT_EQ(leaf3.find("\"alphaMode\""), std::string::npos) << leaf3;
+  EXPECT_NE(leaf3.find("\"doubleSided\":true"), std::string::npos) << leaf3;
+  EXPECT_NE(text.find("\"TEXCOORD_0\""), std::string::npos);
+  // A leaf image that is not there is refused before anything is written, at its key.
+  const std::string broken = dir.write("broken.scene.json", R"({"format":"sylva-scene","version":1,
+    "materials":[{"index":2,"alpha":"nowhere.png"}],"plants":[{"grammar":"leaf.lsys"}]})");
+  const ProcessResult r = run_sylva({"export", broken, "-o", dir.file("broken.glb"), "--mesh"});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("broken.scene.json:2:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("materials[0].alpha: no such image file"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir.file("broken.glb")));
+}
+
 // --extras compact (the default), full and none, for a leafy grammar and a scatter scene
 // with and without instancing: every file passes the validator; compact and full read
 // back to the same plants; none is a plain mesh that render refuses clearly;

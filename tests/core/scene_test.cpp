@@ -291,7 +291,10 @@ TEST(SceneMaterials, EveryBadEntryIsAnErrorAtItsKey) {
       {R"({"index": 1.5})", "materials[0].index must be an integer", 26},
       {R"({"index": 1, "specular": 1.5})", "materials[0].specular must be in [0, 1]", 41},
       {R"({"index": 1, "albedo": [1, -1, 1]})", "materials[0].albedo components must be >= 0", 43},
-      {R"({"index": 1, "albedo": "leaf.png"})", "materials[0].albedo must be an array of 3 numbers", 39},
+      {R"({"index": 1, "albedo": "leaf.png"})", "materials[0].albedo: no such image file", 29},
+      {R"({"index": 1, "alpha": "mask.png"})", "materials[0].alpha: no such image file", 29},
+      {R"({"index": 1, "albedo": 7})", "materials[0].albedo", 39},
+      {R"({"index": 1, "two_sided": 1})", "materials[0].two_sided must be true or false", 42},
       {R"({"index": 1, "colour": [1, 1, 1]})", "unknown key \"colour\" in materials[0]", 29},
       {R"(7)", "materials[0] must be an object", 16},
   };

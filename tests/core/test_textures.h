@@ -47,6 +47,18 @@ inline void write_rgb_png(const std::string& path, uint32_t width, uint32_t heig
   ASSERT_TRUE(error.ok()) << error.error().message;
 }
 
+// An 8-bit RGBA PNG: RGB sRGB-encoded as write_rgb_png's, A = alpha(x, y) in [0, 1].
+inline void write_rgba_png(const std::string& path, uint32_t width, uint32_t height,
+                           const std::function<std::array<float, 4>(uint32_t, uint32_t)>& texel) {
+  std::vector<float> pixels;
+  for (uint32_t y = 0; y < height; ++y)
+    for (uint32_t x = 0; x < width; ++x)
+      for (float c : texel(x, y)) pixels.push_back(c);
+  const auto error = write_image_atomically(path, width, height, {"R", "G", "B", "A"}, pixels,
+                                            {ChannelFormat::uint8}, true);
+  ASSERT_TRUE(error.ok()) << error.error().message;
+}
+
 // A one-channel float image (EXR, TIFF, ...) with value(x, y) at texel (x, y).
 inline void write_gray_float(const std::string& path, uint32_t width, uint32_t height,
                              const std::function<float(uint32_t, uint32_t)>& value) {

@@ -74,5 +74,39 @@ TEST(RenderGlLeaves, TheLeafyBushMatchesTheCpu) {
   EXPECT_GE(both_leaf, gl_leaf * 95 / 100);
 }
 
+TEST(RenderGlLeaves, ACutOutsTransparentTexelsLetCameraAndShadowRaysThrough) {
+  SYLVA_REQUIRE_GL();
+  test::TempFolder dir;
+  test::write_half_mask(dir.file("mask.png"));
+  const Scene front = test::cut_out_leaf_scene(test::one_leaf_scene({-0.5, 1.5, 5}, {0.2, 0.5, 1}), dir.file("mask.png"));
+  test::expect_the_cut_out(front, render_gl_with_aovs(front));
+  const Scene s = test::cut_out_leaf_scene(test::leaf_shadow_scene(), dir.file("mask.png"));
+  Scene bare = s;
+  bare.plants[0].skeleton->leaves.clear();
+  test::expect_the_cut_out_shadow(s, render_gl(s, {}).image, render_gl(bare, {}).image, kRadianceAbs);
+}
+
+TEST(RenderGlLeaves, AOneSidedLeafIsThereFromItsFrontOnlyForEveryRay) {
+  SYLVA_REQUIRE_GL();
+  // The square's Newell normal is −z (its vertices turn clockwise seen from +z).
+  Scene from_front = test::one_leaf_scene({-0.5, 1.5, -5}, {0.2, 0.5, -1});
+  from_front.materials[test::kOneLeafMaterial].two_sided = false;
+  test::expect_the_leaf_where_projected(from_front, render_gl_with_aovs(from_front), kDepthRel, kRadianceAbs, 2e-3);
+  Scene from_back = test::one_leaf_scene({-0.5, 1.5, 5}, {0.2, 0.5, 1});
+  from_back.materials[test::kOneLeafMaterial].two_sided = false;
+  const RenderResult back = render_gl_with_aovs(from_back);
+  for (size_t p = 0; p < back.image.depth.size(); ++p) ASSERT_NE(back.image.id[p * 3 + 1], kAovLeafChain) << p;
+  // The sun on its back (leaf_shadow_scene's sun from +z): no shadow on the ground.
+  Scene s = test::leaf_shadow_scene();
+  s.materials[test::kOneLeafMaterial].two_sided = false;
+  Scene bare = s;
+  bare.plants[0].skeleton->leaves.clear();
+  const RenderImage with = render_gl(s, {}).image, without = render_gl(bare, {}).image;
+  const glm::dvec2 c = test::pixel_of(s, {-0.5, 0, -1.5});
+  const glm::dvec3 a = test::beauty_at(with, static_cast<uint32_t>(c.x), static_cast<uint32_t>(c.y));
+  const glm::dvec3 b = test::beauty_at(without, static_cast<uint32_t>(c.x), static_cast<uint32_t>(c.y));
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(a[k], b[k], kRadianceAbs);
+}
+
 }  // namespace
 }  // namespace sylva
