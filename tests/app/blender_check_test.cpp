@@ -65,6 +65,23 @@ TEST(BlenderCheck, TheElmInLeafImportsWithEveryTriangleItsDoubleSidedLeavesAndIt
   EXPECT_NE(report.find(R"("format": "sylva-skeleton")"), std::string::npos) << report;
 }
 
+TEST(BlenderCheck, TheElmInLeafScenesLeafImageArrivesAsATexturedCutOutInBlender) {
+  if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
+  TempDir dir;
+  const std::string glb = dir.file("elm_leaf.glb");
+  ASSERT_TRUE(export_mesh(kSource + "/presets/scenes/elm_in_leaf.scene.json", glb));
+  std::string report;
+  ProcessResult r = blender_check(glb, &report);
+  ASSERT_EQ(r.exit_code, 0) << describe(r, 20000);
+  EXPECT_NE(report.find(R"("problems": [])"), std::string::npos) << report;
+  for (const auto& [in_file, in_blender] : triangle_counts(report)) EXPECT_EQ(in_file, in_blender) << report;
+  // The table's leaf image: baseColorTexture with alphaMode MASK, which Blender imports
+  // as an alpha-clipped textured material; the leaves stay double-sided.
+  EXPECT_NE(report.find(R"("name": "sylva_leaf_material_1", "double_sided": true, "blend_method": "CLIP", "textured": true)"),
+            std::string::npos)
+      << report;
+}
+
 TEST(BlenderCheck, ASceneWithBarkAndATableKeepsItsTextureAndItsColoursInBlender) {
   if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
   TempDir dir;
