@@ -46,6 +46,18 @@ std::vector<std::pair<long, long>> triangle_counts(const std::string& report) {
   return counts;
 }
 
+// Exports `input` with --mesh to `out`, checks it in Blender and expects a clean report
+// (exit 0, no problem, every mesh's triangles kept); returns the report ("" on failure).
+std::string clean_blender_report(const std::string& input, const std::string& out) {
+  if (!export_mesh(input, out)) return {};
+  std::string report;
+  ProcessResult r = blender_check(out, &report);
+  EXPECT_EQ(r.exit_code, 0) << describe(r, 20000);
+  EXPECT_NE(report.find(R"("problems": [])"), std::string::npos) << report;
+  for (const auto& [in_file, in_blender] : triangle_counts(report)) EXPECT_EQ(in_file, in_blender) << report;
+  return report;
+}
+
 TEST(BlenderCheck, TheElmInLeafImportsWithEveryTriangleItsDoubleSidedLeavesAndItsSkeleton) {
   if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
   TempDir dir;
@@ -68,13 +80,8 @@ TEST(BlenderCheck, TheElmInLeafImportsWithEveryTriangleItsDoubleSidedLeavesAndIt
 TEST(BlenderCheck, TheElmInLeafScenesLeafImageArrivesAsATexturedCutOutInBlender) {
   if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
   TempDir dir;
-  const std::string glb = dir.file("elm_leaf.glb");
-  ASSERT_TRUE(export_mesh(kSource + "/presets/scenes/elm_in_leaf.scene.json", glb));
-  std::string report;
-  ProcessResult r = blender_check(glb, &report);
-  ASSERT_EQ(r.exit_code, 0) << describe(r, 20000);
-  EXPECT_NE(report.find(R"("problems": [])"), std::string::npos) << report;
-  for (const auto& [in_file, in_blender] : triangle_counts(report)) EXPECT_EQ(in_file, in_blender) << report;
+  const std::string report =
+      clean_blender_report(kSource + "/presets/scenes/elm_in_leaf.scene.json", dir.file("elm_leaf.glb"));
   // The table's leaf image: baseColorTexture with alphaMode MASK, which Blender imports
   // as an alpha-clipped textured material; the leaves stay double-sided.
   EXPECT_NE(report.find(R"("name": "sylva_leaf_material_1", "double_sided": true, "blend_method": "CLIP", "textured": true)"),
@@ -85,13 +92,9 @@ TEST(BlenderCheck, TheElmInLeafScenesLeafImageArrivesAsATexturedCutOutInBlender)
 TEST(BlenderCheck, ASceneWithBarkAndATableKeepsItsTextureAndItsColoursInBlender) {
   if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
   TempDir dir;
-  const std::string gltf = dir.file("palm.gltf");  // JSON with the textures as data URIs
-  ASSERT_TRUE(export_mesh(kSource + "/presets/scenes/coconut_palm.scene.json", gltf));
-  std::string report;
-  ProcessResult r = blender_check(gltf, &report);
-  ASSERT_EQ(r.exit_code, 0) << describe(r, 20000);
-  EXPECT_NE(report.find(R"("problems": [])"), std::string::npos) << report;
-  for (const auto& [in_file, in_blender] : triangle_counts(report)) EXPECT_EQ(in_file, in_blender) << report;
+  // A .gltf: JSON with the textures as data URIs.
+  const std::string report =
+      clean_blender_report(kSource + "/presets/scenes/coconut_palm.scene.json", dir.file("palm.gltf"));
   // The bark's albedo texture is material 0's (wood) only; the fronds keep the table's colour.
   EXPECT_NE(report.find(R"("name": "sylva_material_0", "double_sided": false, "blend_method": "OPAQUE", "textured": true)"),
             std::string::npos)
