@@ -13,29 +13,7 @@ layout(std430, binding = SEGMENT_IDS_BINDING) readonly buffer SegmentIds { uvec4
 // INSTANCED: pairs of instance, record).
 layout(std430, binding = SEGMENT_LIST_BINDING) readonly buffer SegmentList { uint segment_list[]; };
 
-#ifdef INSTANCED
-// Plants that share a skeleton (docs/scatter.md "Instancing"): the skeleton's records once,
-// in its own frame, drawn once per plant through the plant's place_plant transform
-// p_world = position + R_y·(scale·p) (core/instances.h), position as hi + lo floats. own = 1:
-// the identity standing for the plants skinned in the world, whose records keep their
-// frames and plants (drawn exactly as without INSTANCED).
-struct GpuInstance {
-  vec3 position_hi;
-  float scale;
-  vec3 position_lo;
-  float cos_y;
-  float sin_y;
-  uint plant;
-  uint own;
-  uint pad;
-};
-layout(std430, binding = INSTANCES_BINDING) readonly buffer Instances { GpuInstance instances[]; };
-uniform uint u_instance_base;  // the draw's first instance (one draw per shared skeleton)
-
-// R_y·v and R_yᵀ·v, as PlantTransform::rotate / unrotate.
-vec3 instance_rotate(GpuInstance g, vec3 v) { return vec3(g.cos_y * v.x + g.sin_y * v.z, v.y, -g.sin_y * v.x + g.cos_y * v.z); }
-vec3 instance_unrotate(GpuInstance g, vec3 v) { return vec3(g.cos_y * v.x - g.sin_y * v.z, v.y, g.sin_y * v.x + g.cos_y * v.z); }
-#endif
+// INSTANCED: instances.glsl (before this file) holds the per-plant transforms.
 
 uniform float u_twist_rad_per_m;  // SkinOptions::twist_rad_per_m (u of surface_uv, relief's u)
 

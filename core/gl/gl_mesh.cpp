@@ -12,6 +12,7 @@
 
 #include "core/gl/bindings.h"
 #include "core/gl/gl_api.h"
+#include "core/gl/gl_instances.h"
 #include "core/gl/gl_objects.h"
 #include "core/gl/gl_program.h"
 #include "core/gl/gl_views.h"
@@ -48,8 +49,10 @@ struct MeshArrays {
   uint32_t displaced_plants = 0;
 };
 
-// Appends plant `plant`'s mesh `part` (tessellated from `skinned`) to `out`.
-void append_plant(MeshArrays& out, const TriangleMesh& part, const SkinnedSkeleton& skinned, uint32_t plant) {
+// Appends plant `plant`'s mesh `part` (tessellated from `skinned`) to `out`, a sphere per
+// frustum to *spheres.
+void append_plant(MeshArrays& out, const TriangleMesh& part, const SkinnedSkeleton& skinned, uint32_t plant,
+                  std::vector<GlMeshSphere>* spheres) {
   if (part.positions.empty()) return;
   if (out.vertices.size() + part.positions.size() > std::numeric_limits<uint32_t>::max())
     throw GlError("the GL mesh holds at most 2^32 vertices (lower --mesh-level)");
@@ -101,14 +104,14 @@ void append_plant(MeshArrays& out, const TriangleMesh& part, const SkinnedSkelet
     if (!(f_lo[f].x <= f_hi[f].x)) continue;  // no vertex
     // Grown far above float rounding of the uploaded positions (~1e-7 of the plant).
     const double pad = 1e-6 * (glm::length(hi - lo) + radius[f]);
-    out.spheres.push_back({0.5 * (f_lo[f] + f_hi[f]), radius[f] * 1.001 + pad});
+    spheres->push_back({0.5 * (f_lo[f] + f_hi[f]), radius[f] * 1.001 + pad});
   }
 }
 
 // Appends plant `plant`'s leaves `part` (leaf_mesh.h: one plant's) to `out`: a record
 // per leaf (ids plant | material << 24, kLeafChain, the leaf's index), its flat normal at
-// every vertex, its leaf_uvs, and a sphere per leaf.
-void append_leaves(MeshArrays& out, const LeafMesh& part) {
+// every vertex, its leaf_uvs, and a sphere per leaf to *spheres.
+void append_leaves(MeshArrays& out, const LeafMesh& part, std::vector<GlMeshSphere>* spheres) {
   if (part.empty()) return;
   if (out.vertices.size() + part.positions.size() > std::numeric_limits<uint32_t>::max())
     throw GlError("the GL leaves hold at most 2^32 vertices");
@@ -132,9 +135,23 @@ void append_leaves(MeshArrays& out, const LeafMesh& part) {
   for (size_t v = 0; v < part.positions.size(); ++v) grow(boxes[vertex_leaf[v]], part.positions[v]);
   for (const Aabb& b : boxes) {
     const double radius = 0.5 * glm::length(b.hi - b.lo);
-    out.spheres.push_back({0.5 * (b.lo + b.hi), radius * 1.001 + 1e-6 * (glm::length(box.hi - box.lo) + radius)});
+    spheres->push_back({0.5 * (b.lo + b.hi), radius * 1.001 + 1e-6 * (glm::length(box.hi - box.lo) + radius)});
   }
 }
+
+}  // namespace
+
+GlMeshSphere enclosing_sphere(const std::vector<GlMeshSphere>& spheres) {
+  if (spheres.empty()) return {};
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+  for (const GlMeshSphere& s : spheres) lo = glm::min(lo, s.centre - s.radius), hi = glm::max(hi, s.centre + s.radius);
+  const glm::dvec3 centre = 0.5 * (lo + hi);
+  double radius = 0;
+  for (const GlMeshSphere& s : spheres) radius = std::max(radius, glm::length(s.centre - centre) + s.radius);
+  return {centre, radius * (1 + 1e-9)};
+}
+
+namespace {
 
 bool sun_shines(const Scene& scene) {
   return scene.sun.radiance.x > 0 || scene.sun.radiance.y > 0 || scene.sun.radiance.z > 0;
@@ -142,51 +159,115 @@ bool sun_shines(const Scene& scene) {
 
 }  // namespace
 
+// One draw of the instanced mesh (INSTANCED): a skeleton's triangles once per plant of it.
+struct MeshDraw {
+  uint32_t first_index = 0, indices = 0;
+  uint32_t first_instance = 0, instances = 0;
+};
+
 struct GlMesh::State {
   RenderOptions options;
   bool leaves = false;  // leaves_of: the scene's leaves instead of its tessellated frusta
   std::vector<RenderPass> setup_passes;
   std::vector<GlMeshSphere> spheres;
-  uint64_t triangles = 0, frusta = 0, gpu_bytes = 0;
+  uint64_t triangles = 0, drawn_triangles = 0, frusta = 0, gpu_bytes = 0;
   bool displaced = false;
   int bark_texture_units = 0;  // > 0: the G-buffer program writes the bark albedo
   std::unique_ptr<SceneTextures> own_textures;  // height maps opened here, kept for update
   GlVertexArray vao;
-  GlBuffer vertex_buffer, index_buffer, frustum_buffer;
-  GlProgramObject gbuffer_program, shadow_program;
+  GlBuffer vertex_buffer, index_buffer, frustum_buffer, instance_buffer;
+  // Instancing (gl_instances.h): the plants in the world first under the identity, then one
+  // draw per shared skeleton; empty: one plain draw of every triangle.
+  std::vector<MeshDraw> draws;
+  std::vector<GpuInstance> instances;
+  size_t instanced_plants = 0, skeletons = 0;
+  GlProgramObject programs[2][2];  // [shadow][instanced]
   std::shared_ptr<const LeafImages> leaf_images;  // leaves_of only: the table's (null: plain leaves)
   GlTexture leaf_texture;                         // its layers as one 2D array (LEAF_IMAGES)
+
+  // The height maps for GS+R: the caller's, else opened here once (update reuses them);
+  // null when no plant is displaced.
+  const SceneTextures* height_maps(const Scene& scene, const SceneTextures* textures) {
+    const bool any_height = std::any_of(scene.plants.begin(), scene.plants.end(), [](const ScenePlant& p) {
+      return p.bark.height_texture.has_value() && p.bark.relief_depth_m > 0;
+    });
+    if (!options.geometry.displace || !any_height) return nullptr;
+    if (textures) return textures;
+    if (!own_textures) {
+      Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(scene);
+      if (!opened) throw std::runtime_error(opened.error().message);
+      own_textures = std::move(*opened);
+    }
+    return own_textures.get();
+  }
+
+  // Appends the shared skeletons of `split` (after the world's plants, already in `arrays`):
+  // `append(group, spheres)` adds the geometry of the group's first plant in its skeleton's
+  // frame; one draw per group, one instance and one sphere per plant (around the skeleton's
+  // spheres, through the plant's transform).
+  template <typename Append>
+  void append_instanced(const Scene& scene, const GlInstanceGroups& split, MeshArrays& arrays,
+                        std::vector<GlMeshSphere>& world_spheres, const Append& append) {
+    draws.clear();
+    instances.clear();
+    instanced_plants = 0;
+    skeletons = 0;
+    drawn_triangles = arrays.indices.size() / 3;
+    if (!split.instanced()) return;
+    const uint32_t world_indices = static_cast<uint32_t>(arrays.indices.size());
+    if (world_indices > 0) {
+      draws.push_back({0, world_indices, 0, 1});
+      instances.push_back(gpu_instance(PlantTransform{}, 0, true));
+    }
+    for (const std::vector<uint32_t>& group : split.groups) {
+      const uint32_t first = static_cast<uint32_t>(arrays.indices.size());
+      std::vector<GlMeshSphere> local;
+      append(group, &local);
+      const uint32_t count = static_cast<uint32_t>(arrays.indices.size()) - first;
+      if (count == 0) continue;
+      const GlMeshSphere bound = enclosing_sphere(local);
+      draws.push_back({first, count, static_cast<uint32_t>(instances.size()), static_cast<uint32_t>(group.size())});
+      for (uint32_t p : group) {
+        const PlantTransform t = PlantTransform::of(scene.plants[p]);
+        instances.push_back(gpu_instance(t, p, false));
+        world_spheres.push_back({t.to_world(bound.centre), bound.radius * t.scale * (1 + 1e-6)});
+      }
+      instanced_plants += group.size();
+      ++skeletons;
+      drawn_triangles += uint64_t{count / 3} * group.size();
+    }
+    if (draws.size() == 1 && instances.front().own) draws.clear();  // nothing shared after all
+    if (draws.empty()) instances.clear();
+  }
 
   // Tessellates, displaces and uploads every plant; replaces the passes' record with what
   // this did. Returns the bytes uploaded.
   uint64_t build(const Scene& scene, const SceneTextures* textures) {
     setup_passes.clear();
     if (scene.plants.size() >= gl::kMaxPlants) throw GlError("the GL backend draws at most 2^24 plants");
+    for (const ScenePlant& plant : scene.plants)
+      if (!plant.skeleton) throw std::logic_error("GlMesh: a plant has no skeleton (call grow_scene_plants)");
+    MeshArrays arrays;
+    if (leaves) return build_leaves(scene, arrays);
     const GeometryOptions& geometry = options.geometry;
     TessellateOptions tessellation;
     tessellation.level = geometry.mesh_level;
-    // Height maps for GS+R: the caller's, else opened here once (update reuses them).
-    const bool any_height = std::any_of(scene.plants.begin(), scene.plants.end(), [](const ScenePlant& p) {
-      return p.bark.height_texture.has_value() && p.bark.relief_depth_m > 0;
-    });
-    if (geometry.displace && any_height && !textures) {
-      if (!own_textures) {
-        Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(scene);
-        if (!opened) throw std::runtime_error(opened.error().message);
-        own_textures = std::move(*opened);
-      }
-      textures = own_textures.get();
-    }
-
-    MeshArrays arrays;
-    if (leaves) return build_leaves(scene, arrays);
-    double skin_s = 0, tessellate_s = 0, displace_s = 0;
-    uint64_t skinned_frusta = 0;
-    for (uint32_t p = 0; p < scene.plants.size(); ++p) {
+    textures = height_maps(scene, textures);
+    // Drawn through a transform: not displaced (the relief's depth is in world metres) and,
+    // with a skin twist (per world metre), at scale 1 — the frusta's rule (render_gl.cpp).
+    const GlInstanceGroups split = gl_instance_groups(scene, geometry.instance, [&](uint32_t p) {
       const ScenePlant& plant = scene.plants[p];
-      if (!plant.skeleton) throw std::logic_error("GlMesh: a plant has no skeleton (call grow_scene_plants)");
+      if (options.skin.twist_rad_per_m != 0 && plant.scale != 1) return false;
+      return !(textures && plant.bark.height_texture.has_value() && plant.bark.relief_depth_m > 0);
+    });
+    double skin_s = 0, tessellate_s = 0, displace_s = 0;
+    uint64_t skinned_frusta = 0, placed_frusta = 0;
+    std::vector<GlMeshSphere> world_spheres;
+    // Plant p's skeleton (placed in the world, or in its own frame) tessellated into arrays.
+    const auto append = [&](uint32_t p, const Skeleton& skeleton, std::vector<GlMeshSphere>* out) -> size_t {
+      const ScenePlant& plant = scene.plants[p];
       Clock::time_point start = Clock::now();
-      const SkinnedSkeleton skinned = skin_skeleton(place_plant(plant), options.skin);
+      const SkinnedSkeleton skinned = skin_skeleton(skeleton, options.skin);
       skinned_frusta += skinned.frusta.size();
       skin_s += seconds_since(start);
       // build_scene_geometry's mesh path: the same plant_mesh, within the same limit.
@@ -197,45 +278,75 @@ struct GlMesh::State {
                                            geometry.relief_options.max_depth_per_radius, &tessellate_s, &displace_s);
       if (height) ++arrays.displaced_plants;
       start = Clock::now();
-      append_plant(arrays, part, skinned, p);
+      append_plant(arrays, part, skinned, p, out);
       tessellate_s += seconds_since(start);
-    }
+      return skinned.frusta.size();
+    };
+    for (uint32_t p : split.world) placed_frusta += append(p, place_plant(scene.plants[p]), &world_spheres);
+    append_instanced(scene, split, arrays, world_spheres,
+                     [&](const std::vector<uint32_t>& group, std::vector<GlMeshSphere>* local) {
+                       const uint32_t p = group.front();
+                       placed_frusta += append(p, *scene.plants[p].skeleton, local) * group.size();
+                     });
     if (arrays.indices.size() > static_cast<size_t>(INT_MAX))
       throw GlError("the GL mesh draws at most 2^31 indices in one call (lower --mesh-level)");
     triangles = arrays.indices.size() / 3;
-    frusta = skinned_frusta;
+    frusta = placed_frusta;
     displaced = arrays.displaced_plants > 0;
-    spheres = std::move(arrays.spheres);
-    setup_passes.push_back({"skin", skin_s,
-                            std::to_string(scene.plants.size()) + " plants, " + std::to_string(frusta) + " frusta"});
+    spheres = std::move(world_spheres);
+    std::string skin_detail = std::to_string(scene.plants.size()) + " plants, " + std::to_string(frusta) + " frusta";
+    if (!draws.empty())
+      skin_detail += "; " + std::to_string(instanced_plants) + " plants as instances of " + std::to_string(skeletons) +
+                     " skeletons, " + std::to_string(skinned_frusta) + " frusta skinned";
+    setup_passes.push_back({"skin", skin_s, skin_detail});
     setup_passes.push_back({"tessellate", tessellate_s,
                             std::to_string(triangles) + " triangles, GS " + std::to_string(geometry.mesh_level) + ", " +
-                                std::to_string(arrays.vertices.size()) + " vertices"});
+                                std::to_string(arrays.vertices.size()) + " vertices" + drawn_detail()});
     if (displaced)
       setup_passes.push_back({"displace", displace_s,
                               std::to_string(arrays.displaced_plants) + " plants by their height maps"});
     return upload(arrays);
   }
 
-  // The leaves of every plant (placed as the frusta are), then uploaded.
+  // ", N drawn" when instances draw more triangles than were uploaded.
+  std::string drawn_detail() const {
+    return draws.empty() ? std::string() : " (" + std::to_string(drawn_triangles) + " triangles drawn)";
+  }
+
+  // The leaves of every plant (placed as the frusta are, or in their skeleton's frame for
+  // the plants that share one: leaves depend on nothing of where a plant stands), uploaded.
   uint64_t build_leaves(const Scene& scene, MeshArrays& arrays) {
     const Clock::time_point start = Clock::now();
-    uint64_t count = 0;
-    for (uint32_t p = 0; p < scene.plants.size(); ++p) {
-      const ScenePlant& plant = scene.plants[p];
-      if (!plant.skeleton) throw std::logic_error("GlMesh: a plant has no skeleton (call grow_scene_plants)");
-      if (plant.skeleton->leaves.empty()) continue;
+    const GlInstanceGroups split = gl_instance_groups(
+        scene, options.geometry.instance, [&](uint32_t p) { return !scene.plants[p].skeleton->leaves.empty(); });
+    uint64_t uploaded = 0, drawn = 0;
+    std::vector<GlMeshSphere> world_spheres;
+    for (uint32_t p : split.world) {
+      if (scene.plants[p].skeleton->leaves.empty()) continue;
       LeafMesh part;
-      sylva::append_leaves(part, place_plant(plant), p);
-      count += part.leaves.size();
-      append_leaves(arrays, part);
+      sylva::append_leaves(part, place_plant(scene.plants[p]), p);
+      uploaded += part.leaves.size();
+      drawn += part.leaves.size();
+      append_leaves(arrays, part, &world_spheres);
     }
+    append_instanced(scene, split, arrays, world_spheres,
+                     [&](const std::vector<uint32_t>& group, std::vector<GlMeshSphere>* local) {
+                       LeafMesh part;
+                       sylva::append_leaves(part, *scene.plants[group.front()].skeleton, group.front());
+                       uploaded += part.leaves.size();
+                       drawn += part.leaves.size() * group.size();
+                       append_leaves(arrays, part, local);
+                     });
     triangles = arrays.indices.size() / 3;
     frusta = 0;
     displaced = false;
-    spheres = std::move(arrays.spheres);
-    setup_passes.push_back({"triangulate", seconds_since(start),
-                            std::to_string(count) + " leaves, " + std::to_string(triangles) + " triangles"});
+    spheres = std::move(world_spheres);
+    std::string detail = std::to_string(drawn) + " leaves, " + std::to_string(drawn_triangles) + " triangles";
+    if (!draws.empty())
+      detail += "; " + std::to_string(instanced_plants) + " plants as instances of " + std::to_string(skeletons) +
+                " skeletons, " + std::to_string(uploaded) + " leaves and " + std::to_string(triangles) +
+                " triangles uploaded";
+    setup_passes.push_back({"triangulate", seconds_since(start), detail});
     return upload(arrays);
   }
 
@@ -284,7 +395,10 @@ struct GlMesh::State {
     vertex_buffer.reset();
     index_buffer.reset();
     frustum_buffer.reset();
+    instance_buffer.reset();
     vertex_buffer = make_gl_buffer(arrays.vertices.data(), vertex_bytes);
+    const size_t instance_bytes = instances.size() * sizeof(GpuInstance);
+    if (!instances.empty()) instance_buffer = make_gl_buffer(instances.data(), instance_bytes);
     index_buffer = make_gl_buffer(arrays.indices.data(), index_bytes);
     frustum_buffer = make_gl_buffer(arrays.frusta.data(), frustum_bytes);
     if (!vao) vao = make_gl_vertex_array();
@@ -299,28 +413,37 @@ struct GlMesh::State {
       glEnableVertexArrayAttrib(vao.id(), a);
     }
     check_gl("GL mesh upload");
-    gpu_bytes = vertex_bytes + index_bytes + frustum_bytes;
+    gpu_bytes = vertex_bytes + index_bytes + frustum_bytes + instance_bytes;
     setup_passes.push_back({"upload", seconds_since(start),
                             std::to_string(gpu_bytes / 1024) + " KiB: " + std::to_string(arrays.vertices.size()) +
                                 " vertices (36 B) + " + std::to_string(triangles) + " triangles (12 B) + " +
                                 std::to_string(arrays.frusta.size()) + (leaves ? " leaf" : " frustum") +
-                                " records (32 B)"});
+                                " records (32 B)" +
+                                (instances.empty() ? std::string()
+                                                   : " + " + std::to_string(instances.size()) + " instances (48 B)")});
     return gpu_bytes;
   }
 
+  ShaderProgramSource variant(MeshPass pass) const {
+    return mesh_program(pass, pass == MeshPass::shadow ? 0 : bark_texture_units, leaf_images != nullptr, !draws.empty());
+  }
+
+  // The pass's program for the current draws (plain or INSTANCED), built on first use.
   GLuint program(MeshPass pass, double* compile_s) {
-    GlProgramObject& program = pass == MeshPass::shadow ? shadow_program : gbuffer_program;
+    GlProgramObject& program = programs[pass == MeshPass::shadow ? 1 : 0][draws.empty() ? 0 : 1];
     if (program) return program.id();
     const Clock::time_point start = Clock::now();
-    program = GlProgramObject(build_gl_program(mesh_program(pass, bark_texture_units, leaf_images != nullptr)).id);
+    program = GlProgramObject(build_gl_program(variant(pass)).id);
     if (compile_s) *compile_s += seconds_since(start);
     return program.id();
   }
 
-  // Draws every triangle with `program` (its uniforms set), both faces.
+  // Draws every triangle with `program` (its uniforms set), both faces: one draw, or
+  // (instanced) one instanced draw per skeleton, u_instance_base its first instance. The
+  // caller's instance buffer (the frusta's, at the same binding) is bound back after.
   void draw(GLuint program_id) {
     if (triangles == 0) return;
-    GLint previous_vao = 0;
+    GLint previous_vao = 0, previous_instances = 0;
     glGetIntegerv(GL_VERTEX_ARRAY_BINDING, &previous_vao);
     const GLboolean cull = glIsEnabled(GL_CULL_FACE);
     glDisable(GL_CULL_FACE);
@@ -328,7 +451,19 @@ struct GlMesh::State {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kMeshFrustaBinding, frustum_buffer.id());
     glUseProgram(program_id);
     if (leaf_images) bind_leaf_images(program_id);
-    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * triangles), GL_UNSIGNED_INT, nullptr);
+    if (draws.empty()) {
+      glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * triangles), GL_UNSIGNED_INT, nullptr);
+    } else {
+      glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, gl::kInstancesBinding, &previous_instances);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kInstancesBinding, instance_buffer.id());
+      for (const MeshDraw& d : draws) {
+        set_uniform_uint(program_id, "u_instance_base", d.first_instance);
+        glDrawElementsInstanced(GL_TRIANGLES, static_cast<GLsizei>(d.indices), GL_UNSIGNED_INT,
+                                reinterpret_cast<const void*>(uintptr_t{d.first_index} * sizeof(uint32_t)),
+                                static_cast<GLsizei>(d.instances));
+      }
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kInstancesBinding, static_cast<GLuint>(previous_instances));
+    }
     glBindVertexArray(static_cast<GLuint>(previous_vao));
     if (cull) glEnable(GL_CULL_FACE);
   }
@@ -342,11 +477,11 @@ GlMesh::GlMesh(const Scene& scene, const RenderOptions& options, int bark_textur
   st.bark_texture_units = std::max(0, bark_texture_units);
   st.build(scene, textures);
   double compile_s = 0;
-  std::string names = mesh_program(MeshPass::gbuffer, st.bark_texture_units).name;
+  std::string names = st.variant(MeshPass::gbuffer).name;
   st.program(MeshPass::gbuffer, &compile_s);
   if (sun_shines(scene)) {
     st.program(MeshPass::shadow, &compile_s);
-    names += ", " + mesh_program(MeshPass::shadow).name;
+    names += ", " + st.variant(MeshPass::shadow).name;
   }
   st.setup_passes.push_back({"programs", compile_s, names});
   check_gl("GL mesh programs");
@@ -401,7 +536,10 @@ uint64_t GlMesh::gpu_bytes() const { return state_->gpu_bytes; }
 int GlMesh::level() const { return state_->options.geometry.mesh_level; }
 bool GlMesh::displaced() const { return state_->displaced; }
 std::string GlMesh::label() const { return std::string(displaced() ? "GS+R " : "GS ") + std::to_string(level()); }
-std::string GlMesh::gbuffer_variant() const { return mesh_program(MeshPass::gbuffer, state_->bark_texture_units).name; }
+std::string GlMesh::gbuffer_variant() const { return state_->variant(MeshPass::gbuffer).name; }
+std::string GlMesh::shadow_variant() const { return state_->variant(MeshPass::shadow).name; }
+uint64_t GlMesh::drawn_triangles() const { return state_->drawn_triangles; }
+size_t GlMesh::instanced_plants() const { return state_->instanced_plants; }
 const std::vector<GlMeshSphere>& GlMesh::bounding_spheres() const { return state_->spheres; }
 const std::vector<RenderPass>& GlMesh::setup_passes() const { return state_->setup_passes; }
 

@@ -11,6 +11,14 @@
 // height_function_for, through plant_mesh). Plants are not culled (the CPU culls only
 // plants that cannot change a pixel).
 //
+// Instancing (RenderOptions::geometry.instance; docs/scatter.md "Instancing",
+// gl_instances.h): plants that share a skeleton are tessellated once, in the skeleton's
+// frame, and drawn with one glDrawElementsInstanced per skeleton through their transforms
+// (mesh.vert.glsl INSTANCED; ids carry each instance's plant, v_m its world metres). The
+// polygon baseline keeps a displaced plant (GS+R: the relief is in world metres) and, with a
+// skin twist, a plant at a scale other than 1 in the world, as the frusta do; leaves depend
+// on nothing of where a plant stands, so every shared skeleton's leaves are instanced.
+//
 // Upload, once (and again by update):
 //   vertices  36 B each: position in metres relative to its plant's origin_hi (float; the
 //             origin is a float-exact point at the plant's centre, and the shader adds
@@ -20,7 +28,9 @@
 //   indices   uint32, 3 per triangle (tessellate.h's, counter-clockwise from outside);
 //   frusta    32 B each (bindings.h's MeshFrustumRecord): its plant's origin_hi, then
 //             plant | material << 24, chain, segment (knuckle: joint), 0 — shader storage
-//             binding kMeshFrustaBinding.
+//             binding kMeshFrustaBinding;
+//   instances 48 B each (gl_instances.h GpuInstance), when plants share a skeleton: at
+//             kInstancesBinding during the draw (the caller's buffer there is bound back).
 //
 // Drawing: the caller binds the framebuffer, clears it and sets the depth test; the draw
 // sets the view (gl_views.h, as the renderer sets it for the frusta), binds its own program,
@@ -72,6 +82,9 @@ struct GlMeshSphere {
   glm::dvec3 centre{0};
   double radius = 0;
 };
+// One sphere holding every sphere of `spheres` (their box's centre; empty: radius 0 at the
+// origin).
+GlMeshSphere enclosing_sphere(const std::vector<GlMeshSphere>& spheres);
 
 class GlMesh {
  public:
@@ -107,16 +120,20 @@ class GlMesh {
   void draw_gbuffer(const GlCameraView& camera, double footprint_scale);
   void draw_shadow(const GlSunView& view);
 
-  uint64_t triangles() const;   // triangles uploaded
-  uint64_t frusta() const;      // frusta tessellated
+  uint64_t triangles() const;        // triangles uploaded
+  uint64_t drawn_triangles() const;  // triangles drawn (an instanced skeleton's once per plant)
+  uint64_t frusta() const;           // frusta drawn (0 for the leaves)
+  size_t instanced_plants() const;   // plants drawn through their transforms (0: none shared)
   uint64_t gpu_bytes() const;   // bytes in the vertex, index and frustum buffers
   int level() const;            // GeometryOptions::mesh_level
   bool displaced() const;       // whether any plant was displaced (GS+R)
   // "GS 2" or "GS+R 2".
   std::string label() const;
-  // The name of the G-buffer program variant (gl_shaders.h mesh_program).
+  // The names of the passes' program variants (gl_shaders.h mesh_program).
   std::string gbuffer_variant() const;
-  // One per frustum: for the renderer's near plane and shadow-map frame.
+  std::string shadow_variant() const;
+  // Spheres that together hold every triangle drawn, for the renderer's near plane and
+  // shadow-map frame: one per frustum (leaf) of a plant in the world, one per instanced plant.
   const std::vector<GlMeshSphere>& bounding_spheres() const;
   // What the constructor (or the last update) did: "skin", "tessellate", "displace" (when
   // a plant was), "upload", and "programs" (constructor only).

@@ -64,8 +64,9 @@ namespace {
 
 // The frusta program's shared files, in the order of the C++ they mirror: the intersector
 // (ray_frustum.h), skinning and the GPU record (skin.h), the views (shared with the
-// meshes), then the pass's interface.
-const std::vector<std::string> kFrustaCommon = {"ray_frustum.glsl", "skin.glsl", "views.glsl", "frusta_common.glsl"};
+// meshes), the instances' transforms (shared with the meshes), then the pass's interface.
+const std::vector<std::string> kFrustaCommon = {"ray_frustum.glsl", "skin.glsl", "views.glsl", "instances.glsl",
+                                                 "frusta_common.glsl"};
 
 std::vector<std::string> with(std::vector<std::string> files, const std::string& last) {
   files.push_back(last);
@@ -120,7 +121,7 @@ ShaderProgramSource frusta_program(FrustaPass pass, bool want_uv) {
   return frusta_program(pass, features);
 }
 
-ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units, bool leaf_images) {
+ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units, bool leaf_images, bool instanced) {
   const bool shadow = pass == MeshPass::shadow;
   std::vector<std::string> defines = {shadow ? "SHADOW_PASS" : "GBUFFER_PASS"};
   ShaderProgramSource p;
@@ -128,6 +129,10 @@ ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units, bool lea
   if (leaf_images) {
     defines.push_back("LEAF_IMAGES");
     p.name += " LEAF_IMAGES";
+  }
+  if (instanced) {
+    defines.push_back("INSTANCED");
+    p.name += " INSTANCED";
   }
   std::vector<std::string> fragment_files = {"mesh.frag.glsl"};
   if (!shadow && bark_texture_units > 0) {
@@ -139,7 +144,7 @@ ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units, bool lea
   // The shadow pass's one-sided leaves need the sun's direction (views.glsl u_light_dir).
   if (shadow && leaf_images) fragment_files.insert(fragment_files.begin(), "views.glsl");
   p.name += "]";
-  p.vertex = {ShaderStage::vertex, {"views.glsl", "mesh.vert.glsl"}, defines};
+  p.vertex = {ShaderStage::vertex, {"views.glsl", "instances.glsl", "mesh.vert.glsl"}, defines};
   p.fragment = {ShaderStage::fragment, fragment_files, defines};
   return p;
 }
@@ -249,6 +254,10 @@ std::vector<ShaderProgramSource> all_shader_programs() {
   for (MeshPass pass : {MeshPass::gbuffer, MeshPass::shadow}) all.push_back(mesh_program(pass));
   all.push_back(mesh_program(MeshPass::gbuffer, 1));  // with the bark albedo
   for (MeshPass pass : {MeshPass::gbuffer, MeshPass::shadow}) all.push_back(mesh_program(pass, 0, true));
+  for (MeshPass pass : {MeshPass::gbuffer, MeshPass::shadow}) {
+    all.push_back(mesh_program(pass, 0, false, true));  // the instanced polygon baseline
+    all.push_back(mesh_program(pass, 0, true, true));   // instanced leaves with images
+  }
   for (bool sun : {false, true})
     for (bool fog : {false, true}) all.push_back(shade_program(sun, fog));
   for (bool sun : {false, true})

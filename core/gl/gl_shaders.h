@@ -91,8 +91,10 @@ enum class MeshPass {
 // `bark_texture_units` > 0 (gbuffer only): the scene's distinct bark images; the fragment
 // stage then writes the bark albedo through bark.glsl (BARK_TEXTURE_UNITS). `leaf_images`
 // (the leaves, both passes): the table's leaf images, cut-outs and one-sidedness
-// (leaf_images.h) from LEAF_IMAGES_UNIT's 2D array (LEAF_IMAGES).
-ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units = 0, bool leaf_images = false);
+// (leaf_images.h) from LEAF_IMAGES_UNIT's 2D array (LEAF_IMAGES). `instanced`: plants that
+// share a skeleton drawn through instances.glsl's transforms, one draw per skeleton (INSTANCED).
+ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units = 0, bool leaf_images = false,
+                                 bool instanced = false);
 
 // `value` as a GLSL float literal that reads back as it: the shortest decimal of the
 // double, with ".0" added where it has no point or exponent (40 → "40.0", 0.04 → "0.04").

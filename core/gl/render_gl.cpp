@@ -27,6 +27,7 @@
 #include "core/gl/gl_pass_timers.h"
 #include "core/gl/gl_program.h"
 #include "core/gl/gl_views.h"
+#include "core/gl/gl_instances.h"
 #include "core/instances.h"
 #include "core/relief.h"
 #include "core/render_common.h"
@@ -55,31 +56,6 @@ struct ShadowFrame {
   double texel_m = 0;
 };
 
-// frusta_common.glsl's GpuInstance (std430: vec3 + float packs into 16 bytes).
-struct GpuInstance {
-  float position_hi[3];
-  float scale;
-  float position_lo[3];
-  float cos_y;
-  float sin_y;
-  uint32_t plant;
-  uint32_t own;  // 1: the identity of the plants skinned in the world
-  uint32_t pad;
-};
-static_assert(sizeof(GpuInstance) == 48);
-
-GpuInstance gpu_instance(const PlantTransform& t, uint32_t plant, bool own) {
-  GpuInstance g{};
-  const GlFloatSplit p = split_to_floats(t.position);
-  for (int k = 0; k < 3; ++k) g.position_hi[k] = p.hi[k], g.position_lo[k] = p.lo[k];
-  g.scale = static_cast<float>(t.scale);
-  g.cos_y = static_cast<float>(t.cos_y);
-  g.sin_y = static_cast<float>(t.sin_y);
-  g.plant = plant;
-  g.own = own ? 1 : 0;
-  return g;
-}
-
 // One instanced draw (INSTANCED): a shared skeleton's records, once per plant of it.
 struct InstancedDraw {
   uint32_t first_record = 0, records = 0;
@@ -101,10 +77,7 @@ GlSunView sun_view(const ShadowFrame& f, uint32_t texels) {
   return v;
 }
 
-struct Sphere {
-  glm::dvec3 centre;
-  double radius;
-};
+using Sphere = GlMeshSphere;  // gl_mesh.h: centre and radius, metres
 
 bool sun_shines(const Scene& scene) {
   return scene.sun.radiance.x > 0 || scene.sun.radiance.y > 0 || scene.sun.radiance.z > 0;
@@ -223,10 +196,21 @@ struct GlRenderer::State {
   // skinned in the world first (the identity instance); empty: one plain draw of every record.
   std::vector<InstancedDraw> draws;
   uint32_t instanced_plants = 0;
-  std::vector<uint32_t> sphere_instance, sphere_record;  // instanced: each sphere's instance and record
   uint64_t uploaded_bytes = 0;       // the geometry: segment records + ids, or the mesh
   uint64_t pending_plant_bytes = 0;  // plant data sent since the last frame
-  std::vector<Sphere> spheres;       // around each frustum's bounding pyramid (or its triangles)
+  // Spheres that together hold everything drawn (the near plane, the shadow map's frame):
+  // first one around each bounding pyramid of a plant skinned in the world (record i), then
+  // one per instanced plant (instance_spheres[j]), then the mesh's or the leaves' (gl_mesh.h).
+  std::vector<Sphere> spheres;
+  uint32_t world_spheres = 0;
+  struct InstanceSphere {
+    uint32_t draw = 0, instance = 0;
+    PlantTransform transform;
+  };
+  std::vector<InstanceSphere> instance_spheres;
+  // Per draw, its skeleton's pyramids' spheres in the skeleton's frame (the frusta around
+  // the eye are looked for among them only inside an instanced plant's sphere).
+  std::vector<std::vector<Sphere>> draw_spheres;
   FrustaFeatures features;           // the frusta program's switches for this scene (gl_shaders.h)
   std::optional<GlFogCones> fog_cones;  // set_fog_cones: once per (plants, sun)
   GlFogLists fog_lists;                 // the cone intervals per pixel (cone modes)
@@ -299,81 +283,75 @@ struct GlRenderer::State {
   }
 
   // Skins every plant of `scene` into records and ids, and replaces `spheres` with the
-  // frusta's bounding spheres (one per frustum drawn). With options.geometry.instance, the
-  // plants that share a skeleton with another instanceable plant (plant_instances) are
-  // skinned once per skeleton in its frame and drawn through *instances (draws, sphere_*);
-  // the others are skinned in the world, first, under the identity instance. Nothing
-  // shared: no instances, one plain draw (as without instancing). Sets frusta and records.
-  // Cancelled (options.progress): throws GlCancelled with `spheres` as they were.
+  // frusta's (one per frustum of a plant in the world, one per instanced plant). With
+  // options.geometry.instance, the plants that share a skeleton with another instanceable
+  // plant (gl_instances.h) are skinned once per skeleton in its frame and drawn through
+  // *instances (draws); the others are skinned in the world, first, under the identity
+  // instance. Nothing shared: no instances, one plain draw (as without instancing). Sets
+  // frusta and records. Cancelled (options.progress): throws GlCancelled with `spheres` as
+  // they were.
   void skin_plants(const Scene& scene, std::vector<GpuSegment>* records, std::vector<uint32_t>* ids,
                    std::vector<GpuInstance>* instances) {
     const uint32_t n = static_cast<uint32_t>(scene.plants.size());
     for (const ScenePlant& plant : scene.plants)
       if (!plant.skeleton) throw std::logic_error("GlRenderer: a plant has no skeleton (call grow_scene_plants)");
-    std::vector<char> in_world(n, 1);
-    PlantInstances groups;
-    if (options.geometry.instance) {
-      groups = plant_instances(scene);
-      std::vector<uint32_t> users(groups.distinct(), 0);
-      for (uint32_t p = 0; p < n; ++p)
-        if (instanceable(scene.plants[p], p)) ++users[groups.prototype_of_plant[p]];
-      for (uint32_t p = 0; p < n; ++p)
-        if (instanceable(scene.plants[p], p) && users[groups.prototype_of_plant[p]] >= 2) in_world[p] = 0;
-    }
+    const GlInstanceGroups split = gl_instance_groups(scene, options.geometry.instance,
+                                                      [&](uint32_t p) { return instanceable(scene.plants[p], p); });
     std::vector<Sphere> fresh;
     std::vector<InstancedDraw> fresh_draws;
-    std::vector<uint32_t> fresh_instance, fresh_record;
+    std::vector<InstanceSphere> fresh_instance_spheres;
+    std::vector<std::vector<Sphere>> fresh_draw_spheres;
     const double share = 1.0 / std::max(1u, n);
-    for (uint32_t p = 0; p < n; ++p) {
-      if (!in_world[p]) continue;
+    for (uint32_t p : split.world) {
       if (options.progress.cancelled()) throw GlCancelled();  // between plants
       skin_one(place_plant(scene.plants[p]), p, options.progress.part(p * share, (p + 1) * share), records, ids, &fresh);
     }
-    const bool any_instanced = std::find(in_world.begin(), in_world.end(), 0) != in_world.end();
-    if (any_instanced) {
+    const uint32_t world_records = static_cast<uint32_t>(records->size());
+    uint64_t drawn = world_records;
+    instanced_plants = 0;
+    if (split.instanced()) {
       // The world plants' records: the identity instance, drawn as they are.
-      const uint32_t world_records = static_cast<uint32_t>(records->size());
-      fresh_instance.assign(world_records, 0);
-      for (uint32_t r = 0; r < world_records; ++r) fresh_record.push_back(r);
       if (world_records > 0) {
         fresh_draws.push_back({0, world_records, static_cast<uint32_t>(instances->size()), 1});
+        fresh_draw_spheres.emplace_back();
         instances->push_back(gpu_instance(PlantTransform{}, 0, true));
       }
-      std::vector<std::vector<uint32_t>> plants_of(groups.distinct());
-      for (uint32_t p = 0; p < n; ++p)
-        if (!in_world[p]) plants_of[groups.prototype_of_plant[p]].push_back(p);
-      instanced_plants = 0;
-      for (uint32_t k = 0; k < groups.distinct(); ++k) {
-        if (plants_of[k].empty()) continue;
+      std::vector<Sphere> bounds;  // one per instanced plant, after the world's
+      for (const std::vector<uint32_t>& group : split.groups) {
         if (options.progress.cancelled()) throw GlCancelled();
         const uint32_t first = static_cast<uint32_t>(records->size());
-        // The first plant drawn through it stands for the skeleton (the group's first plant
-        // may be one skinned in the world, with a relief none of these has).
-        const uint32_t prototype = plants_of[k].front();
+        // The first plant drawn through it stands for the skeleton (the skeleton's first
+        // plant may be one skinned in the world, with a relief none of these has).
+        const uint32_t prototype = group.front();
         std::vector<Sphere> local;
         skin_one(*scene.plants[prototype].skeleton, prototype, {}, records, ids, &local);
+        const Sphere bound = enclosing_sphere(local);
+        const uint32_t draw_index = static_cast<uint32_t>(fresh_draws.size());
         InstancedDraw draw{first, static_cast<uint32_t>(records->size()) - first,
-                           static_cast<uint32_t>(instances->size()), static_cast<uint32_t>(plants_of[k].size())};
-        for (uint32_t p : plants_of[k]) {
+                           static_cast<uint32_t>(instances->size()), static_cast<uint32_t>(group.size())};
+        for (uint32_t p : group) {
           const PlantTransform t = PlantTransform::of(scene.plants[p]);
           const uint32_t instance = static_cast<uint32_t>(instances->size());
           instances->push_back(gpu_instance(t, p, false));
-          for (uint32_t j = 0; j < local.size(); ++j) {
-            fresh.push_back({t.to_world(local[j].centre), local[j].radius * t.scale});
-            fresh_instance.push_back(instance);
-            fresh_record.push_back(first + j);
-          }
+          bounds.push_back({t.to_world(bound.centre), bound.radius * t.scale * (1 + 1e-6)});
+          fresh_instance_spheres.push_back({draw_index, instance, t});
         }
         instanced_plants += draw.instances;
+        drawn += uint64_t{draw.records} * draw.instances;
         fresh_draws.push_back(draw);
+        fresh_draw_spheres.push_back(std::move(local));
       }
+      world_spheres = static_cast<uint32_t>(fresh.size());
+      fresh.insert(fresh.end(), bounds.begin(), bounds.end());
+    } else {
+      world_spheres = static_cast<uint32_t>(fresh.size());
     }
     spheres = std::move(fresh);
     draws = std::move(fresh_draws);
-    sphere_instance = std::move(fresh_instance);
-    sphere_record = std::move(fresh_record);
+    instance_spheres = std::move(fresh_instance_spheres);
+    draw_spheres = std::move(fresh_draw_spheres);
     features.instanced = !draws.empty();
-    frusta = spheres.size();
+    frusta = drawn;
     record_count = records->size();
   }
 
@@ -412,17 +390,32 @@ struct GlRenderer::State {
     f.camera_view = camera_view(f.camera, f.near, f.width, f.height);
     // Frusta whose pyramid may reach within the near plane of the eye: drawn again from
     // their back faces (EYE_INSIDE), since their front faces are clipped or behind the eye.
+    // An instanced plant's frusta are looked at only where the eye is inside its sphere.
     // (The leaves' spheres follow the frusta's: they are never inside.)
-    for (uint32_t i = 0; !mesh && i < std::min<uint64_t>(spheres.size(), frusta); ++i)
-      if (glm::length(spheres[i].centre - f.camera.eye) < spheres[i].radius + 4 * f.near) {
+    const auto near_eye = [&](const Sphere& sphere) {
+      return glm::length(sphere.centre - f.camera.eye) < sphere.radius + 4 * f.near;
+    };
+    for (uint32_t i = 0; !mesh && i < world_spheres; ++i)
+      if (near_eye(spheres[i])) {
         if (draws.empty()) {
           f.eye_inside.push_back(i);
         } else {
-          f.eye_inside.push_back(sphere_instance[i]);
-          f.eye_inside.push_back(sphere_record[i]);
+          f.eye_inside.push_back(0);  // the identity instance (world records come first)
+          f.eye_inside.push_back(i);
         }
         ++f.eye_inside_frusta;
       }
+    for (uint32_t j = 0; !mesh && j < instance_spheres.size(); ++j) {
+      if (!near_eye(spheres[world_spheres + j])) continue;
+      const InstanceSphere& is = instance_spheres[j];
+      const std::vector<Sphere>& local = draw_spheres[is.draw];
+      for (uint32_t k = 0; k < local.size(); ++k)
+        if (near_eye({is.transform.to_world(local[k].centre), local[k].radius * is.transform.scale})) {
+          f.eye_inside.push_back(is.instance);
+          f.eye_inside.push_back(draws[is.draw].first_record + k);
+          ++f.eye_inside_frusta;
+        }
+    }
     if (!f.eye_inside.empty()) {
       const size_t bytes = f.eye_inside.size() * sizeof(uint32_t);
       glNamedBufferData(list_buffer.id(), static_cast<GLsizeiptr>(bytes), f.eye_inside.data(), GL_STREAM_DRAW);
@@ -452,7 +445,7 @@ struct GlRenderer::State {
     if (f.fog_on) s.pass(GlPass::fog).program = fog_program(f.sun_on, f.fog_mode).name;
     if (f.fog_cones) s.pass(GlPass::fog_cones).program = fog_cones_program().name;
     if (f.sun_on)
-      s.pass(GlPass::shadow).program = (mesh ? mesh_program(MeshPass::shadow) : frusta_variant(FrustaPass::shadow)).name;
+      s.pass(GlPass::shadow).program = mesh ? mesh->shadow_variant() : frusta_variant(FrustaPass::shadow).name;
   }
 
   // The programs' uniforms that stay for the frame: the camera (but its jitter), the ray
@@ -544,16 +537,12 @@ struct GlRenderer::State {
     glFrontFace(GL_CCW);
   }
 
-  void take_mesh_spheres() {
-    spheres.clear();
-    for (const GlMeshSphere& s : mesh->bounding_spheres()) spheres.push_back({s.centre, s.radius});
-  }
+  void take_mesh_spheres() { spheres = mesh->bounding_spheres(); }
 
   // The leaves' spheres after the frusta's (or the mesh's): the near plane and the shadow
   // map's frame hold them too.
   void add_leaf_spheres() {
-    if (leaves)
-      for (const GlMeshSphere& s : leaves->bounding_spheres()) spheres.push_back({s.centre, s.radius});
+    if (leaves) spheres.insert(spheres.end(), leaves->bounding_spheres().begin(), leaves->bounding_spheres().end());
   }
 };
 

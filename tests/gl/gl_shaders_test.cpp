@@ -117,9 +117,9 @@ TEST(GlShaders, SourcesAreAssembledWithVersionDefinesAndFileNumbers) {
   const std::string text = assemble_shader(program.fragment);
   EXPECT_EQ(text.rfind("#version 450 core\n#define SHADOW_PASS\n#line 1 0\n", 0), 0u) << text.substr(0, 80);
   EXPECT_NE(text.find("FrustumHitF intersect_frustum_f("), std::string::npos);
-  // The fragment stage's files: ray_frustum, skin, views, frusta_common, frusta.frag.
-  ASSERT_EQ(program.fragment.files.size(), 5u);
-  EXPECT_EQ(format_shader_log(program.fragment, "0:12(3): error: x\nERROR: 4:4: y\n"),
+  // The fragment stage's files: ray_frustum, skin, views, instances, frusta_common, frusta.frag.
+  ASSERT_EQ(program.fragment.files.size(), 6u);
+  EXPECT_EQ(format_shader_log(program.fragment, "0:12(3): error: x\nERROR: 5:4: y\n"),
             "ray_frustum.glsl:12(3): error: x\nERROR: frusta.frag.glsl:4: y\n");
 }
 

@@ -45,16 +45,15 @@ TEST(RenderGlLeaves, ALeafShadowsTheGroundThroughTheShadowMap) {
   test::expect_the_leaf_shadow(s, render_gl(s, {}).image, render_gl(bare, {}).image, kRadianceAbs);
 }
 
-TEST(RenderGlLeaves, TheLeafyBushMatchesTheCpu) {
-  SYLVA_REQUIRE_GL();
-  const Skeleton bush = gl_test::grow_preset("abop_1_25_bush_leaves");
-  ASSERT_GT(bush.leaves.size(), 1000u);
-  const Scene scene = gl_test::scene_around(bush);
+// The bush `scene` on both backends, within the geometry's and the beauty's tolerances
+// (printed and named `name`); *gl and *cpu get the results.
+void expect_bush_agrees(const Scene& scene, const std::string& name, RenderResult* gl, RenderResult* cpu) {
   RenderOptions options;
   options.aovs = kAovDepth | kAovId;
-  const RenderResult gl = render_gl(scene, options), cpu = render_cpu(scene, options);
-  const gl_test::Agreement a = gl_test::compare(gl.image, cpu.image);
-  std::printf("[ agreement ] bush_leaves 256x192: %s\n", a.describe().c_str());
+  *gl = render_gl(scene, options);
+  *cpu = render_cpu(scene, options);
+  const gl_test::Agreement a = gl_test::compare(gl->image, cpu->image);
+  std::printf("[ agreement ] %s %ux%u: %s\n", name.c_str(), scene.width, scene.height, a.describe().c_str());
   // The geometry as the frusta's tolerances demand.
   EXPECT_GE(a.hit_miss, 0.995) << a.describe();
   EXPECT_LE(a.depth_median_rel, 1e-4) << a.describe();
@@ -62,7 +61,23 @@ TEST(RenderGlLeaves, TheLeafyBushMatchesTheCpu) {
   // 1024² shadow map's texels (about 4 mm here), which the CPU's shadow rays resolve, on
   // the ground and inside the crown (measured on llvmpipe: 1.10/255).
   EXPECT_LE(a.beauty_mad_srgb, 1.5 / 255) << a.describe() << "\n  images: "
-                                          << gl_test::write_diff_images("bush_leaves", gl.image, cpu.image);
+                                          << gl_test::write_diff_images(name, gl->image, cpu->image);
+}
+
+// Pixels whose id names a leaf.
+size_t leaf_pixels(const RenderImage& image) {
+  size_t n = 0;
+  for (size_t p = 0; 3 * p < image.id.size(); ++p) n += image.id[p * 3 + 1] == kAovLeafChain;
+  return n;
+}
+
+TEST(RenderGlLeaves, TheLeafyBushMatchesTheCpu) {
+  SYLVA_REQUIRE_GL();
+  const Skeleton bush = gl_test::grow_preset("abop_1_25_bush_leaves");
+  ASSERT_GT(bush.leaves.size(), 1000u);
+  RenderResult gl, cpu;
+  expect_bush_agrees(gl_test::scene_around(bush), "bush_leaves", &gl, &cpu);
+  const uint64_t hit_pixels = gl_test::compare(gl.image, cpu.image).hit_pixels;
   // Leaves are drawn and named so on both: the same pixels carry a leaf id.
   size_t gl_leaf = 0, both_leaf = 0;
   for (size_t p = 0; p < gl.image.depth.size(); ++p) {
@@ -70,8 +85,33 @@ TEST(RenderGlLeaves, TheLeafyBushMatchesTheCpu) {
     gl_leaf += g;
     both_leaf += g && c;
   }
-  EXPECT_GT(gl_leaf, a.hit_pixels / 8);
+  EXPECT_GT(gl_leaf, hit_pixels / 8);
   EXPECT_GE(both_leaf, gl_leaf * 95 / 100);
+}
+
+TEST(RenderGlLeaves, TheLeafyBushInTheBundledLeafImageMatchesTheCpu) {
+  SYLVA_REQUIRE_GL();
+  // The bush's leaves (material 3: ''' past the wood's 0) in the bundled elm leaf: its
+  // albedo and its alpha cut-out (leaf_images.h), on both backends.
+  const Skeleton bush = gl_test::grow_preset("abop_1_25_bush_leaves");
+  Scene scene = gl_test::scene_around(bush);
+  SceneMaterial leaf;
+  leaf.albedo_image = std::string(SYLVA_SOURCE_DIR) + "/presets/textures/elm_leaf.png";
+  scene.materials[3] = leaf;
+  RenderResult gl, cpu;
+  expect_bush_agrees(scene, "bush_leaves_elm_leaf_image", &gl, &cpu);
+  // The cut-out takes leaf pixels away (the image's leaf fills most of the bush's kite-shaped
+  // leaf, so only a few here), the same on both.
+  Scene plain = scene;
+  plain.materials.erase(3);
+  RenderOptions options;
+  options.aovs = kAovId;
+  const size_t cut = leaf_pixels(gl.image), whole = leaf_pixels(render_gl(plain, options).image);
+  std::printf("[ agreement ] leaf pixels: %zu GL cut out, %zu CPU cut out, %zu GL whole\n", cut, leaf_pixels(cpu.image),
+              whole);
+  EXPECT_GT(cut, 0u);
+  EXPECT_LT(cut, whole);
+  EXPECT_NEAR(static_cast<double>(cut), static_cast<double>(leaf_pixels(cpu.image)), 0.02 * cut);
 }
 
 TEST(RenderGlLeaves, ACutOutsTransparentTexelsLetCameraAndShadowRaysThrough) {
