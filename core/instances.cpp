@@ -45,19 +45,31 @@ Aabb PlantTransform::world_box(const Aabb& local) const {
   return box;
 }
 
+namespace {
+
+// Whether two skeletons have the same shape: joints, chains and leaves (not their source,
+// whose seed may differ where the grammar draws no random number).
+bool same_shape(const Skeleton& a, const Skeleton& b) {
+  return a.joints == b.joints && a.chains == b.chains && a.leaves == b.leaves;
+}
+
+}  // namespace
+
 PlantInstances plant_instances(const Scene& scene) {
-  using Recipe = std::tuple<std::string, std::optional<uint64_t>, std::optional<int64_t>, std::map<std::string, double>>;
-  std::map<Recipe, std::vector<uint32_t>> prototypes_of_recipe;  // prototype indices
+  // Candidates: the same grammar, steps and defines, and as many joints and leaves.
+  using Key = std::tuple<std::string, std::optional<int64_t>, std::map<std::string, double>, size_t, size_t>;
+  std::map<Key, std::vector<uint32_t>> prototypes_of_key;  // prototype indices
   PlantInstances out;
   out.prototype_of_plant.resize(scene.plants.size());
   for (uint32_t p = 0; p < scene.plants.size(); ++p) {
     const ScenePlant& plant = scene.plants[p];
     if (!plant.skeleton) throw std::logic_error("plant_instances: a plant has no skeleton (call grow_scene_plants)");
-    std::vector<uint32_t>& candidates =
-        prototypes_of_recipe[Recipe{plant.grammar, plant.seed, plant.steps, plant.defines}];
+    std::vector<uint32_t>& candidates = prototypes_of_key[Key{plant.grammar, plant.steps, plant.defines,
+                                                              plant.skeleton->joints.size(),
+                                                              plant.skeleton->leaves.size()}];
     uint32_t found = UINT32_MAX;
     for (uint32_t k : candidates)
-      if (*scene.plants[out.prototypes[k]].skeleton == *plant.skeleton) {
+      if (same_shape(*scene.plants[out.prototypes[k]].skeleton, *plant.skeleton)) {
         found = k;
         break;
       }

@@ -39,16 +39,19 @@ struct PlantTransform {
 
 // The plants of a scene grouped by skeleton. prototypes[k] is the first plant with the k-th
 // distinct skeleton; prototype_of_plant[p] is the k of plant p. Two plants share a prototype
-// iff their skeletons are equal (Skeleton::operator==) — a recipe only narrows the search,
-// so plants whose skeletons were changed one by one (an animation's frame) are never merged.
+// iff their skeletons have the same shape — equal joints, chains and leaves; the source may
+// differ in its seed (a grammar without randomness grows one shape from every seed,
+// grow_scene_plants) — and a recipe (grammar, steps, defines) and the joint and leaf
+// counts only narrow the search, so plants whose skeletons were changed one by one (an
+// animation's frame) are never merged.
 struct PlantInstances {
   std::vector<uint32_t> prototypes;
   std::vector<uint32_t> prototype_of_plant;
   size_t distinct() const { return prototypes.size(); }
 };
 
-// Groups `scene`'s plants (every skeleton set: grow_scene_plants). Cost: one skeleton
-// comparison per plant against each prototype of its recipe.
+// Groups `scene`'s plants (every skeleton set: grow_scene_plants). Cost: one shape
+// comparison per plant against each prototype of its recipe and counts.
 PlantInstances plant_instances(const Scene& scene);
 
 }  // namespace sylva

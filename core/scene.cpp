@@ -660,6 +660,26 @@ Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& pro
     const ScenePlant& p = scene.plants[i];
     return p.scatter ? "scatter[" + std::to_string(p.scatter - 1) + "]" : "plants[" + std::to_string(i) + "]";
   };
+  // Each (grammar, defines) is parsed once; a parsed grammar is only read by derive.
+  using Source = std::pair<std::string, std::map<std::string, double>>;
+  std::map<Source, Expected<lsys::Grammar>> grammars;
+  for (size_t i = 0; i < scene.plants.size(); ++i) {
+    const ScenePlant& p = scene.plants[i];
+    if (p.skeleton) continue;
+    Source key{p.grammar, p.defines};
+    if (grammars.count(key)) continue;
+    if (progress.cancelled()) return cancelled_diagnostic();
+    lsys::ParseOptions parse;
+    parse.define_overrides = p.defines;
+    grammars.emplace(std::move(key), lsys::load_grammar(p.grammar, parse));
+  }
+  // A grammar that draws no random number (no stochastic production, no rand, uniform or
+  // gauss, no random axiom) grows the same shape from every seed: its plants' seed is left
+  // out of the recipe, and each plant's copy gets its own seed back in its source.
+  auto seed_matters = [&](const ScenePlant& p) {
+    const Expected<lsys::Grammar>& g = grammars.at(Source{p.grammar, p.defines});
+    return !g || g->uses_random || g->axiom_successor.has_value();
+  };
   // The distinct recipes (grammar, defines, seed, steps) among the plants to grow, each
   // derived once — a scatter entry's instances share a few — in plant order, so the first
   // failing plant is the one reported whatever the threads do.
@@ -670,21 +690,10 @@ Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& pro
   for (size_t i = 0; i < scene.plants.size(); ++i) {
     const ScenePlant& p = scene.plants[i];
     if (p.skeleton) continue;
-    auto [it, added] = recipe_of.try_emplace(Recipe{p.grammar, p.defines, p.seed, p.steps}, first_plant.size());
+    const std::optional<uint64_t> seed = seed_matters(p) ? p.seed : std::nullopt;
+    auto [it, added] = recipe_of.try_emplace(Recipe{p.grammar, p.defines, seed, p.steps}, first_plant.size());
     if (added) first_plant.push_back(i);
     plant_recipe[i] = it->second;
-  }
-  // Each (grammar, defines) is parsed once; a parsed grammar is only read by derive.
-  using Source = std::pair<std::string, std::map<std::string, double>>;
-  std::map<Source, Expected<lsys::Grammar>> grammars;
-  for (size_t r = 0; r < first_plant.size(); ++r) {
-    const ScenePlant& p = scene.plants[first_plant[r]];
-    Source key{p.grammar, p.defines};
-    if (grammars.count(key)) continue;
-    if (progress.cancelled()) return cancelled_diagnostic();
-    lsys::ParseOptions parse;
-    parse.define_overrides = p.defines;
-    grammars.emplace(std::move(key), lsys::load_grammar(p.grammar, parse));
   }
   std::vector<std::optional<Expected<GrowResult>>> grown(first_plant.size());
   std::atomic<size_t> next{0}, done{0};
@@ -720,7 +729,11 @@ Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& pro
   // work was cancelled.
   for (size_t i = 0; i < scene.plants.size(); ++i) {
     const size_t r = plant_recipe[i];
-    if (r != SIZE_MAX && grown[r] && *grown[r]) scene.plants[i].skeleton = (*grown[r])->skeleton;
+    if (r == SIZE_MAX || !grown[r] || !*grown[r]) continue;
+    ScenePlant& p = scene.plants[i];
+    p.skeleton = (*grown[r])->skeleton;
+    // A recipe without its seed: this plant's own, as grow() would have recorded it.
+    if (!seed_matters(p)) p.skeleton->source.seed = p.seed.value_or(grammars.at(Source{p.grammar, p.defines})->seed);
   }
   if (progress.cancelled()) return cancelled_diagnostic();
   for (size_t r = 0; r < first_plant.size(); ++r) {

@@ -2,8 +2,11 @@
 // each is drawn through, which must put a skeleton's point where place_plant puts it.
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "core/instances.h"
 #include "tests/core/test_scenes.h"
+#include "tests/core/test_textures.h"
 
 namespace sylva {
 namespace {
@@ -30,6 +33,46 @@ TEST(PlantInstances, AnAnimatedPlantOfTheSameRecipeIsNotMerged) {
   const PlantInstances g = plant_instances(s);
   EXPECT_EQ(g.distinct(), 4u);
   EXPECT_NE(g.prototype_of_plant[0], g.prototype_of_plant[2]);
+}
+
+// Four plants of `grammar_text` with seeds 1, 2, 3 and the grammar's own, grown.
+Scene four_seeds(const test::TempFolder& dir, const std::string& grammar_text) {
+  std::ofstream(dir.file("g.lsys")) << grammar_text;
+  Scene s;
+  for (int k = 0; k < 4; ++k) {
+    ScenePlant p;
+    p.grammar = dir.file("g.lsys");
+    if (k < 3) p.seed = static_cast<uint64_t>(k + 1);
+    p.position = {2.0 * k, 0, 0};
+    s.plants.push_back(p);
+  }
+  EXPECT_TRUE(grow_scene_plants(s).ok());
+  return s;
+}
+
+TEST(PlantInstances, AGrammarWithoutRandomnessGrowsOneShapeFromEverySeedAndSharesIt) {
+  test::TempFolder dir;
+  const Scene s = four_seeds(dir, "seed: 9\naxiom: !(0.1)F(1)[+F(0.5)][-F(0.5)]F(0.8)\n");
+  for (uint32_t p = 0; p < 4; ++p) {
+    ASSERT_TRUE(s.plants[p].skeleton.has_value());
+    EXPECT_EQ(s.plants[p].skeleton->joints, s.plants[0].skeleton->joints) << "plant " << p;
+  }
+  // Each keeps its own seed in its source (the grammar's `seed:` where it has none).
+  EXPECT_EQ(s.plants[0].skeleton->source.seed, 1u);
+  EXPECT_EQ(s.plants[2].skeleton->source.seed, 3u);
+  EXPECT_EQ(s.plants[3].skeleton->source.seed, 9u);
+  const PlantInstances g = plant_instances(s);
+  EXPECT_EQ(g.distinct(), 1u);
+}
+
+TEST(PlantInstances, AGrammarThatDrawsRandomNumbersGrowsAShapePerSeed) {
+  test::TempFolder dir;
+  const Scene s = four_seeds(dir, "seed: 9\naxiom: !(0.1)A\nA -> F(uniform(0.5, 1.5))[+F(0.5)]F(0.8)\n");
+  EXPECT_NE(s.plants[0].skeleton->joints, s.plants[1].skeleton->joints);
+  EXPECT_EQ(s.plants[1].skeleton->source.seed, 2u);
+  EXPECT_EQ(s.plants[3].skeleton->source.seed, 9u);
+  const PlantInstances g = plant_instances(s);
+  EXPECT_EQ(g.distinct(), 4u);
 }
 
 TEST(PlantTransform, TakesASkeletonsPointWherePlacePlantPutsItAndBack) {
