@@ -17,12 +17,6 @@ GpuInstance gpu_instance(const PlantTransform& t, uint32_t plant, bool own) {
   return g;
 }
 
-size_t GlInstanceGroups::instanced_plants() const {
-  size_t n = 0;
-  for (const std::vector<uint32_t>& g : groups) n += g.size();
-  return n;
-}
-
 GlInstanceGroups gl_instance_groups(const Scene& scene, bool instance,
                                     const std::function<bool(uint32_t)>& instanceable) {
   const uint32_t n = static_cast<uint32_t>(scene.plants.size());

@@ -44,7 +44,6 @@ struct GlInstanceGroups {
   std::vector<std::vector<uint32_t>> groups;  // per shared skeleton its plants (≥ 2, ascending);
                                               // the first stands for the skeleton
   bool instanced() const { return !groups.empty(); }
-  size_t instanced_plants() const;
 };
 
 // Splits `scene`'s plants (every skeleton set). `instance`: RenderOptions::geometry.instance;

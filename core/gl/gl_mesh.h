@@ -124,9 +124,9 @@ class GlMesh {
   uint64_t drawn_triangles() const;  // triangles drawn (an instanced skeleton's once per plant)
   uint64_t frusta() const;           // frusta drawn (0 for the leaves)
   size_t instanced_plants() const;   // plants drawn through their transforms (0: none shared)
-  uint64_t gpu_bytes() const;   // bytes in the vertex, index and frustum buffers
-  int level() const;            // GeometryOptions::mesh_level
-  bool displaced() const;       // whether any plant was displaced (GS+R)
+  uint64_t gpu_bytes() const;        // bytes in the vertex, index, frustum and instance buffers
+  int level() const;                 // GeometryOptions::mesh_level
+  bool displaced() const;            // whether any plant was displaced (GS+R)
   // "GS 2" or "GS+R 2".
   std::string label() const;
   // The names of the passes' program variants (gl_shaders.h mesh_program).
