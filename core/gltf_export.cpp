@@ -310,18 +310,19 @@ struct EmbeddedImage {
   const char* mime = "image/png";
 };
 
-// Reads a bark albedo texture to embed it byte for byte: glTF takes PNG or JPEG only.
-Expected<EmbeddedImage> read_albedo_image(const std::string& path) {
+// Reads an albedo texture laid on segments (a bark's, or the materials table's: scene.h
+// segment_texture) to embed it byte for byte: glTF takes PNG or JPEG only.
+Expected<EmbeddedImage> read_albedo_image(const std::string& path, const std::string& what = "the bark albedo texture") {
   Expected<std::string> file = read_text_file(path);
-  if (!file) return file_diagnostic(path, "cannot read the bark albedo texture: " + file.error().message);
+  if (!file) return file_diagnostic(path, "cannot read " + what + ": " + file.error().message);
   EmbeddedImage image;
   const std::string& bytes = *file;
   if (bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) image.mime = "image/png";
   else if (bytes.compare(0, 3, "\xFF\xD8\xFF") == 0) image.mime = "image/jpeg";
-  else return file_diagnostic(path, "the bark albedo texture must be a PNG or JPEG file to be embedded in glTF");
+  else return file_diagnostic(path, what + " must be a PNG or JPEG file to be embedded in glTF");
   // It must decode too, to its last row (a viewer, and the validator, read it).
   if (Status decodes = check_image_opens(path); !decodes)
-    return file_diagnostic(path, "the bark albedo texture is not a readable image: " + decodes.error().message);
+    return file_diagnostic(path, what + " is not a readable image: " + decodes.error().message);
   image.bytes = std::move(*file);
   return image;
 }
@@ -342,11 +343,14 @@ std::string bark_key(const Bark& b) {
 
 // The material of index `material` of a plant with bark `bark` (gltf_export.h), as JSON
 // text (identical materials are written once: the text is their key).
+// `albedo_texture`: the texture segment_texture names for it (the bark's or the table's),
+// read through TEXCOORD_`texcoord`.
 std::string material_json(uint32_t material, const Bark& bark, const std::map<uint32_t, SceneMaterial>& materials,
-                          std::optional<size_t> albedo_texture, std::optional<size_t> normal_texture, double r_ref_m,
-                          const LeafImages* images) {
+                          std::optional<size_t> albedo_texture, int texcoord, std::optional<size_t> normal_texture,
+                          double r_ref_m, const LeafImages* images) {
   // A segment of a material with a leaf image: the image's mean (leaf_images.h).
   const MaterialLook look = segment_look(materials, &bark, material, images);
+  const std::optional<SegmentTexture> segment = segment_texture(materials, &bark, material);
   JsonWriter w;
   w.begin_object();
   w.key("name").string("sylva_material_" + std::to_string(material));
@@ -354,7 +358,9 @@ std::string material_json(uint32_t material, const Bark& bark, const std::map<ui
   if (albedo_texture) {
     const double white[4] = {1, 1, 1, 1};
     w.key("baseColorFactor").numbers(white, 4);
-    w.key("baseColorTexture").begin_object().key("index").integer(*albedo_texture).end_object();
+    w.key("baseColorTexture").begin_object().key("index").integer(*albedo_texture);
+    if (texcoord != 0) w.key("texCoord").integer(texcoord);
+    w.end_object();
   } else {
     const double factor[4] = {look.albedo.x, look.albedo.y, look.albedo.z, 1};
     w.key("baseColorFactor").numbers(factor, 4);
@@ -367,6 +373,15 @@ std::string material_json(uint32_t material, const Bark& bark, const std::map<ui
   w.key("material_index").integer(material);
   if (materials.count(material)) {  // an entry of the scene's table (docs/materials.md)
     w.key("specular").number(look.specular);
+  }
+  if (albedo_texture && segment && !segment->from_bark) {  // the table's image on the segments
+    w.key("segment_texture").begin_object();
+    w.key("albedo").string(segment->path);
+    w.key("u_repeat").number(segment->u_repeat);
+    w.key("v_per_metre").number(segment->v_per_metre);
+    w.key("texcoord").string("TEXCOORD_" + std::to_string(texcoord) +
+                             ": s = u * u_repeat with u in turns around the axis, t = v_m * v_per_metre");
+    w.end_object();
   }
   if (material != 0) {  // the bark is the wood's alone (materials.h)
     w.end_object().end_object();
@@ -468,6 +483,14 @@ class MaterialTable {
     Expected<std::shared_ptr<const LeafImages>> leaf = LeafImages::load(materials);
     if (!leaf) return std::move(leaf.error());
     leaf_images_ = std::move(*leaf);
+    for (uint32_t k = 0; k < kMaterialSlots; ++k) {  // the table's images on segments
+      const std::optional<SegmentTexture> t = segment_texture(materials, nullptr, k);
+      if (!t || albedo_files_.count(t->path)) continue;
+      Expected<EmbeddedImage> image =
+          read_albedo_image(t->path, "the albedo image of material " + std::to_string(k) + " (on its segments)");
+      if (!image) return std::move(image.error());
+      albedo_files_.emplace(t->path, std::move(*image));
+    }
     for (const GltfPlant& p : plants) {
       if (p.bark.albedo_texture && !albedo_files_.count(*p.bark.albedo_texture)) {
         Expected<EmbeddedImage> image = read_albedo_image(*p.bark.albedo_texture);
@@ -500,11 +523,11 @@ class MaterialTable {
     return std::optional<size_t>(add_image(key, {std::move(*png), "image/png"}));
   }
 
-  std::optional<size_t> albedo_texture(const Bark& bark) {
-    if (!bark.albedo_texture) return std::nullopt;
-    const std::string key = "albedo:" + *bark.albedo_texture;
+  // The texture of an albedo image laid on segments (read by load).
+  size_t albedo_texture(const std::string& path) {
+    const std::string key = "albedo:" + path;
     if (auto it = image_of_.find(key); it != image_of_.end()) return it->second;
-    return add_image(key, albedo_files_.at(*bark.albedo_texture));
+    return add_image(key, albedo_files_.at(path));
   }
 
   // The leaf image of material `material` (leaf_images.h: its merged RGBA layer as a PNG),
@@ -653,7 +676,6 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
             has_wood ? table.normal_texture(bark, r_ref_m) : Expected<std::optional<size_t>>(std::optional<size_t>());
         if (!normal_map) return std::move(normal_map.error());
         const std::optional<size_t> normal_texture = *normal_map;
-        const std::optional<size_t> albedo_texture = has_wood ? table.albedo_texture(bark) : std::nullopt;
 
         std::vector<float> positions, normals, texcoords;
         positions.reserve(tm.positions.size() * 3);
@@ -667,9 +689,15 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
           const float len = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
           normals.insert(normals.end(), {f[0] / len, f[1] / len, f[2] / len});
         }
-        for (const glm::dvec2& uv : tm.uvs)
-          texcoords.insert(texcoords.end(),
-                           {static_cast<float>(uv.x * bark.u_repeat), static_cast<float>(uv.y * bark.v_per_metre)});
+        // (u · u_repeat, v_m · v_per_metre) of every vertex.
+        auto scaled_uvs = [&](double u_repeat, double v_per_metre) {
+          std::vector<float> st;
+          st.reserve(tm.uvs.size() * 2);
+          for (const glm::dvec2& uv : tm.uvs)
+            st.insert(st.end(), {static_cast<float>(uv.x * u_repeat), static_cast<float>(uv.y * v_per_metre)});
+          return st;
+        };
+        texcoords = scaled_uvs(bark.u_repeat, bark.v_per_metre);
         // Accessor order NORMAL, POSITION, TANGENT, TEXCOORD_0: the order files written so
         // far have (it came from GCC's right-to-left evaluation of a string concatenation),
         // now fixed in code so that every compiler writes the same bytes.
@@ -682,15 +710,34 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
         if (normal_texture)
           attributes.key("TANGENT").integer(buffer.add_floats(vertex_tangents(tm, skinned), 4, "VEC4", kTargetArrayBuffer));
         attributes.key("TEXCOORD_0").integer(buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer));
-        attributes.end_object();
+        const std::string shared_attributes = attributes.text() + "}";
+        // A table image repeating otherwise than the bark reads TEXCOORD_1, its own
+        // (u · u_repeat, v_m · v_per_metre); one accessor per distinct pair of repeats.
+        std::map<std::pair<double, double>, std::string> attributes_with_texcoord_1;
         for (const auto& [material, indices] : triangles_of) {
           const bool wood = material == 0;  // the bark's textures are the wood's (materials.h)
-          const size_t m = table.material(material_json(material, bark, options.materials,
-                                                        wood ? albedo_texture : std::nullopt,
-                                                        wood ? normal_texture : std::nullopt, r_ref_m,
-                                                        table.leaf_images()));
+          const std::optional<SegmentTexture> segment = segment_texture(options.materials, &bark, material);
+          int texcoord = 0;
+          const std::string* primitive_attributes = &shared_attributes;
+          if (segment && (segment->u_repeat != bark.u_repeat || segment->v_per_metre != bark.v_per_metre)) {
+            texcoord = 1;
+            const std::pair<double, double> repeat{segment->u_repeat, segment->v_per_metre};
+            auto it = attributes_with_texcoord_1.find(repeat);
+            if (it == attributes_with_texcoord_1.end()) {
+              const size_t accessor =
+                  buffer.add_floats(scaled_uvs(repeat.first, repeat.second), 2, "VEC2", kTargetArrayBuffer);
+              it = attributes_with_texcoord_1
+                       .emplace(repeat, attributes.text() + ",\"TEXCOORD_1\":" + std::to_string(accessor) + "}")
+                       .first;
+            }
+            primitive_attributes = &it->second;
+          }
+          const size_t m = table.material(material_json(
+              material, bark, options.materials,
+              segment ? std::optional<size_t>(table.albedo_texture(segment->path)) : std::nullopt, texcoord,
+              wood ? normal_texture : std::nullopt, r_ref_m, table.leaf_images()));
           primitives.begin_object();
-          primitives.key("attributes").raw(attributes.text());
+          primitives.key("attributes").raw(*primitive_attributes);
           primitives.key("indices").integer(buffer.add_indices(indices));
           primitives.key("material").integer(m);
           primitives.key("mode").integer(kModeTriangles);

@@ -40,6 +40,13 @@
 //     default_material_albedo(k) (materials.h). A material the table describes also has
 //     extras.sylva "specular" (its Blinn–Phong weight, which glTF's metallic–roughness
 //     model has no slot for).
+//   - a material k whose table entry lays its albedo image on the segments (scene.h
+//     segment_texture: `u_repeat` / `v_per_metre`; material 0 only where the bark has no
+//     albedo): baseColorTexture = that image embedded byte for byte (PNG or JPEG),
+//     baseColorFactor 1, extras.sylva "segment_texture" {"albedo" (path), "u_repeat",
+//     "v_per_metre", "texcoord"}; where its repeats differ from the bark's, its primitive's
+//     attributes add TEXCOORD_1 = (u · its u_repeat, v_m · its v_per_metre) and the
+//     texture reads texCoord 1.
 //   - material 0 with a bark height map: normalTexture = a tangent-space normal map baked from it
 //     (normal_map.h, 8-bit RGB PNG, glTF's "+X right, +Y up in the image" convention,
 //     i.e. X toward increasing s, Y toward decreasing t). glTF cannot follow a radius

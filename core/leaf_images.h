@@ -26,7 +26,9 @@
 // sun rays alike (glTF doubleSided false; docs/materials.md).
 //
 // A segment (not a leaf) of a material with an albedo image has the image's mean linear
-// albedo (over its opaque texels): segments have no leaf texture coordinates.
+// albedo (over its opaque texels): segments have no leaf texture coordinates — unless the
+// entry lays the image on its segments (`u_repeat` / `v_per_metre`: scene.h
+// segment_texture, looked up as a bark texture by texture.h and bark.glsl).
 #pragma once
 
 #include <cstdint>

@@ -216,7 +216,7 @@ std::map<uint32_t, SceneMaterial> read_materials(const JsonValue& v, const std::
     const JsonValue& e = v.elements[i];
     const std::string what = "materials[" + std::to_string(i) + "]";
     expect_object(e, what);
-    check_keys(e, what, {"index", "albedo", "alpha", "specular", "two_sided"});
+    check_keys(e, what, {"index", "albedo", "alpha", "specular", "two_sided", "u_repeat", "v_per_metre"});
     const JsonValue* index = e.find("index");
     if (!index) fail(e, what + " needs an \"index\" (the material index it describes)");
     const std::optional<uint64_t> k = index->as_uint64();
@@ -241,6 +241,15 @@ std::map<uint32_t, SceneMaterial> read_materials(const JsonValue& v, const std::
     if (auto* x = e.find("two_sided")) {
       if (!x->is_bool()) fail(*x, what + ".two_sided must be true or false, not " + x->kind_name());
       m.two_sided = x->boolean;
+    }
+    for (const char* key : {"u_repeat", "v_per_metre"}) {
+      const JsonValue* x = e.find(key);
+      if (!x) continue;
+      if (!m.albedo_image)
+        fail(*x, what + "." + key + " lays an albedo image on the segments: give \"albedo\" an image file");
+      if (!m.segment_repeat) m.segment_repeat.emplace();
+      const double value = number_in(*x, what + "." + key, 0, 1e6, true, false);
+      (std::string_view(key) == "u_repeat" ? m.segment_repeat->u_repeat : m.segment_repeat->v_per_metre) = value;
     }
     table.emplace(static_cast<uint32_t>(*k), m);
   }
@@ -881,6 +890,10 @@ void write_materials(JsonWriter& w, const std::map<uint32_t, SceneMaterial>& tab
     if (m.alpha_image) w.key("alpha").string(path_for_file(*m.alpha_image, base_dir));
     w.key("specular").number(m.specular);
     if (!m.two_sided) w.key("two_sided").boolean(false);
+    if (m.segment_repeat) {
+      w.key("u_repeat").number(m.segment_repeat->u_repeat);
+      w.key("v_per_metre").number(m.segment_repeat->v_per_metre);
+    }
     w.end_object();
   }
   w.end_array();
@@ -999,6 +1012,17 @@ Expected<std::string> write_scene_json(const Scene& scene, const std::string& ba
   }
   w.end_object();
   return w.take() + "\n";
+}
+
+std::optional<SegmentTexture> segment_texture(const std::map<uint32_t, SceneMaterial>& table, const Bark* bark,
+                                              uint32_t material) {
+  if (material == 0 && bark && bark->albedo_texture)
+    return SegmentTexture{*bark->albedo_texture, bark->u_repeat, bark->v_per_metre, true};
+  if (material == 0 && bark && bark->albedo_rgb) return std::nullopt;
+  const auto entry = table.find(material);
+  if (entry == table.end() || !entry->second.albedo_image || !entry->second.segment_repeat) return std::nullopt;
+  const SceneMaterial::Repeat& r = *entry->second.segment_repeat;
+  return SegmentTexture{*entry->second.albedo_image, r.u_repeat, r.v_per_metre, false};
 }
 
 MaterialLook material_look(const std::map<uint32_t, SceneMaterial>& table, const Bark* bark, uint32_t material) {

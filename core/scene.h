@@ -136,8 +136,30 @@ struct SceneMaterial {
   std::optional<std::string> albedo_image{};  // resolved path: the leaves' albedo (leaf_images.h)
   std::optional<std::string> alpha_image{};   // resolved path: the leaves' cut-out (leaf_images.h)
   bool two_sided = true;                 // false: a leaf of it exists on its front side only
+  // Given (the entry names `u_repeat` or `v_per_metre`): the albedo image also covers the
+  // material's segments, laid as a bark's albedo texture is (texture.h: s = u·u_repeat,
+  // t = v_m·v_per_metre, periodic, MIP-mapped). None: its segments take the image's mean
+  // (leaf_images.h segment_look). Only with an albedo image.
+  struct Repeat {
+    double u_repeat = 1, v_per_metre = 1;
+    bool operator==(const Repeat&) const = default;
+  };
+  std::optional<Repeat> segment_repeat{};
   bool operator==(const SceneMaterial&) const = default;
 };
+
+// The albedo texture that covers the segments (not the leaves) of `material` on a plant
+// with `bark` (docs/materials.md, first match wins): material 0 with a bark albedo texture:
+// that texture, with the bark's repeats; material 0 with a bark albedo colour: none (the
+// colour); else the table entry's albedo image where it gives a segment_repeat; else none.
+// `bark` may be null (then only the table counts).
+struct SegmentTexture {
+  std::string path;
+  double u_repeat = 1, v_per_metre = 1;
+  bool from_bark = false;  // the bark's albedo texture (else the table entry's image)
+};
+std::optional<SegmentTexture> segment_texture(const std::map<uint32_t, SceneMaterial>& table, const Bark* bark,
+                                              uint32_t material);
 
 // The highest material index the `materials` table may name (the GL shade pass's table
 // holds kMaterialSlots entries; higher indices look like the default table's last).

@@ -59,6 +59,21 @@ def principled(material):
     return None
 
 
+def uv_map_of(node, depth=0):
+    """The UV layer a texture node reads: the uv_map of the UV Map node feeding its Vector
+    input (through any nodes in between), "" when none does (the mesh's first layer)."""
+    if node.type == "UVMAP":
+        return node.uv_map
+    if depth > 4:
+        return ""
+    for socket in node.inputs:
+        if socket.is_linked:
+            found = uv_map_of(socket.links[0].from_node, depth + 1)
+            if found:
+                return found
+    return ""
+
+
 def check(path, problems):
     import bpy
 
@@ -68,28 +83,42 @@ def check(path, problems):
     bpy.ops.import_scene.gltf(filepath=path)
 
     report = {"file": path, "meshes": [], "materials": [], "plant_nodes": plant_nodes, "extras": []}
-    objects = [o for o in bpy.context.scene.objects if o.type == "MESH"]
-    by_mesh_name = {}
-    for o in objects:
-        by_mesh_name.setdefault(o.data.name, o)
-    for expected in meshes:
-        if expected["triangles"] == 0:
-            continue  # a LINES-only mesh (the skeleton without --mesh)
-        o = by_mesh_name.get(expected["name"])
-        if o is None:
-            problems.append(f"mesh {expected['name']!r} was not imported")
-            continue
+    # Blender names a second mesh of one name "NAME.001" and so on, in an order of its own:
+    # the meshes of one name are compared as a multiset of (triangles, materials).
+    import re
+    imported, seen = {}, set()
+    for o in bpy.context.scene.objects:
+        if o.type != "MESH" or o.data.name in seen:
+            continue  # instancing: several objects share one mesh
+        seen.add(o.data.name)
         polygons = o.data.polygons
-        triangles = sum(len(p.vertices) - 2 for p in polygons)
-        slots = sorted({s.material.name for s in o.material_slots if s.material})
-        report["meshes"].append({"name": expected["name"], "triangles_file": expected["triangles"],
-                                 "triangles_blender": triangles, "materials": slots,
-                                 "uv_layers": [uv.name for uv in o.data.uv_layers]})
-        if triangles != expected["triangles"]:
-            problems.append(f"mesh {expected['name']!r}: {expected['triangles']} triangles in the file, "
-                            f"{triangles} in Blender")
-        if slots != expected["materials"]:
-            problems.append(f"mesh {expected['name']!r}: materials {expected['materials']} in the file, {slots} in Blender")
+        imported.setdefault(re.sub(r"\.\d{3}$", "", o.data.name), []).append({
+            "triangles": sum(len(p.vertices) - 2 for p in polygons),
+            "materials": sorted({s.material.name for s in o.material_slots if s.material}),
+            "uv_layers": [uv.name for uv in o.data.uv_layers]})
+    wanted = {}
+    for expected in meshes:
+        if expected["triangles"] > 0:  # not a LINES-only mesh (the skeleton without --mesh)
+            wanted.setdefault(expected["name"], []).append(expected)
+    key = lambda m: (m["triangles"], m["materials"])
+    for name, expected_list in wanted.items():
+        got = sorted(imported.get(name, []), key=key)
+        expected_list = sorted(expected_list, key=key)
+        if not got:
+            problems.append(f"mesh {name!r} was not imported")
+            continue
+        if len(got) != len(expected_list):
+            problems.append(f"mesh {name!r}: {len(expected_list)} meshes in the file, {len(got)} in Blender")
+        for expected, o in zip(expected_list, got):
+            report["meshes"].append({"name": name, "triangles_file": expected["triangles"],
+                                     "triangles_blender": o["triangles"], "materials": o["materials"],
+                                     "uv_layers": o["uv_layers"]})
+            if o["triangles"] != expected["triangles"]:
+                problems.append(f"mesh {name!r}: {expected['triangles']} triangles in the file, "
+                                f"{o['triangles']} in Blender")
+            if o["materials"] != expected["materials"]:
+                problems.append(f"mesh {name!r}: materials {expected['materials']} in the file, "
+                                f"{o['materials']} in Blender")
 
     for m in doc.get("materials", []):
         b = bpy.data.materials.get(m["name"])
@@ -107,6 +136,15 @@ def check(path, problems):
             entry["textured"] = base.is_linked
             if "baseColorTexture" in pbr and not base.is_linked:
                 problems.append(f"material {m['name']!r}: its baseColorTexture is not linked to Base Color")
+            if "baseColorTexture" in pbr and base.is_linked:
+                # Which UV layer the texture reads: the importer wires TEXCOORD_k (k > 0)
+                # through a UV Map node naming layer k ("UVMap.001"); layer 0 needs none.
+                texcoord = pbr["baseColorTexture"].get("texCoord", 0)
+                entry["uv_map"] = uv_map_of(base.links[0].from_node)
+                want = "UVMap" if texcoord == 0 else f"UVMap.{texcoord:03d}"
+                if (entry["uv_map"] or "UVMap") != want:
+                    problems.append(f"material {m['name']!r}: its baseColorTexture reads TEXCOORD_{texcoord} in the "
+                                    f"file, UV map {entry['uv_map'] or 'UVMap'!r} in Blender")
             if "baseColorTexture" not in pbr:
                 want = pbr.get("baseColorFactor", [1, 1, 1, 1])[:3]
                 got = list(base.default_value)[:3]

@@ -7,7 +7,7 @@
 // uploads each distinct image once:
 //   - as a texture with its full MIP chain (GL_REPEAT, trilinear), bound at texture unit
 //     i for u_bark_textures[i]: albedo as GL_RGBA8 holding the file's sRGB-encoded values
-//     (not an sRGB format: the filter averages encoded values and bark_albedo decodes the
+//     (not an sRGB format: the filter averages encoded values and segment_albedo decodes the
 //     result, as the CPU's TextureSystem lookup does); a height map as GL_R32F;
 //   - a height map's finest level also as floats in height_texels, sampled bilinearly in
 //     float exactly as texture.cpp's HeightTexture::height (the relief's geometry is that
@@ -15,7 +15,7 @@
 // A program that samples (BARK_TEXTURE_UNITS defined: the number of distinct images of the
 // scene) selects the texture by a loop over constant indices: an array of samplers may
 // only be indexed by a dynamically uniform expression, and the plant varies per fragment.
-// Mesh shaders include this file for the same lookups (bark_albedo).
+// Mesh shaders include this file for the same lookups (segment_albedo).
 
 #ifndef kInfinity  // ray_frustum.glsl's, where it comes first
 #define kInfinity uintBitsToFloat(0x7F800000u)
@@ -26,7 +26,8 @@ struct PlantMaps {
   float u_repeat;        // s = u·u_repeat
   float v_per_metre;     // t = v_m·v_per_metre
   float relief_depth_m;  // > 0: relief-mapped (a height map, GeometryOptions::relief, depth > 0)
-  int albedo_unit;       // u_bark_textures index of the albedo map; −1: none
+  int albedo_unit;       // u_bark_textures index of material 0's albedo map; −1: material_maps[0]
+                         // decides; −2: none (the bark's colour)
   int height_unit;       // u_bark_textures index of the height map (MIP-mapped); −1: none
   uint height_first;     // the height map's first texel in height_texels
   int height_width;      // its finest level's size in texels
@@ -110,16 +111,41 @@ float height_field_filtered(PlantMaps maps, float s, float t, float width_s, flo
                            vec2(0.0, width_t)).r;
 }
 
-// SceneTextures::albedo of texture.cpp: plant `plant`'s linear albedo at (u, v_m),
-// filtered over `footprint`, with a = 1; vec4(0) where the plant has no albedo texture
-// (then the material table or the bark colour applies: shade.frag.glsl).
-vec4 bark_albedo(uint plant, float u, float v_m, UvFootprint footprint) {
+// Per material slot: the albedo image the scene's table lays on its segments (scene.h
+// segment_texture), bindings.h's MaterialMapsRecord.
+struct MaterialMaps {
+  float u_repeat;
+  float v_per_metre;
+  int albedo_unit;  // u_bark_textures index; −1: none
+  int unused;
+};
+layout(std430, binding = MATERIAL_MAPS_BINDING) readonly buffer MaterialMapsBuffer {
+  MaterialMaps material_maps[];  // MAX_MATERIALS of them
+};
+
+// SceneTextures::albedo of texture.cpp: the linear albedo of the segments of `material` on
+// plant `plant` at (u, v_m), filtered over `footprint`, with a = 1 — material 0's bark
+// texture, else the table's image (segment_texture); vec4(0) where they have no albedo
+// texture (then the material table or the bark colour applies: shade.frag.glsl).
+vec4 segment_albedo(uint plant, uint material, float u, float v_m, UvFootprint footprint) {
   PlantMaps maps = plant_maps[plant];
-  if (maps.albedo_unit < 0) return vec4(0.0);
-  float s = u * maps.u_repeat, t = v_m * maps.v_per_metre;
-  vec4 encoded = bark_texture_grad(maps.albedo_unit, vec2(s - floor(s), t - floor(t)),
-                                   vec2(footprint.du_dx * maps.u_repeat, footprint.dv_dx * maps.v_per_metre),
-                                   vec2(footprint.du_dy * maps.u_repeat, footprint.dv_dy * maps.v_per_metre));
+  int unit = -1;
+  float u_repeat = 1.0, v_per_metre = 1.0;
+  if (material == 0u && maps.albedo_unit != -1) {
+    unit = maps.albedo_unit;  // the bark's, or −2: its colour
+    u_repeat = maps.u_repeat;
+    v_per_metre = maps.v_per_metre;
+  } else if (material < uint(MAX_MATERIALS)) {
+    MaterialMaps entry = material_maps[material];
+    unit = entry.albedo_unit;
+    u_repeat = entry.u_repeat;
+    v_per_metre = entry.v_per_metre;
+  }
+  if (unit < 0) return vec4(0.0);
+  float s = u * u_repeat, t = v_m * v_per_metre;
+  vec4 encoded = bark_texture_grad(unit, vec2(s - floor(s), t - floor(t)),
+                                   vec2(footprint.du_dx * u_repeat, footprint.dv_dx * v_per_metre),
+                                   vec2(footprint.du_dy * u_repeat, footprint.dv_dy * v_per_metre));
   return vec4(srgb_to_linear(encoded.rgb), 1.0);
 }
 #endif

@@ -19,6 +19,7 @@
 #define FOG_OVERFLOW_BINDING 10   // fog_lists.glsl FogOverflow: per pixel, 1 = list incomplete
 #define FOG_COUNTERS_BINDING 11   // fog_lists.glsl FogCounters: the frame's counts
 #define INSTANCES_BINDING 12      // instances.glsl Instances: INSTANCED's per plant transforms
+#define MATERIAL_MAPS_BINDING 13  // bark.glsl MaterialMapsBuffer: a MaterialMaps per material slot
 
 // Texture units. Bark images take units BARK_TEXTURES_UNIT .. + MAX_BARK_IMAGES − 1; the
 // G-buffer, the shadow map and the accumulated beauty sit above them, so no pass rebinds

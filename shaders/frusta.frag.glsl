@@ -156,7 +156,7 @@ void main() {
     footprint.dv_dy *= inst.scale;
   }
 #endif
-  if (fr.material == 0u) albedo = bark_albedo(plant, u, v_m, footprint);  // bark: wood only
+  albedo = segment_albedo(plant, fr.material, u, v_m, footprint);  // the bark: wood only
 #endif
   if (dot(n_geometric, view) < 0.0) n_geometric = -n_geometric;  // seen from inside
   if (dot(n_shading, view) < 0.0) n_shading = -n_shading;

@@ -8,7 +8,7 @@
 // render_cpu.cpp's shade() does; the Euclidean distance; ids; u in [0, 1), v_m.
 // SHADOW_PASS: depth only.
 //
-// BARK_TEXTURE_UNITS (bark.glsl comes first): the bark albedo of bark.glsl's bark_albedo
+// BARK_TEXTURE_UNITS (bark.glsl comes first): the segment albedo of bark.glsl's segment_albedo
 // over the footprint of texture.h's ray differentials. On a triangle (a plane with affine
 // u, v_m) the neighbouring sample's ray meets the plane where u, v_m have moved by their
 // screen derivatives, so the footprint is dFdx/dFdy of (u, v_m), one pixel / sqrt(spp)
@@ -103,9 +103,8 @@ void main() {
   bool cap = abs(duv_dx.y) + abs(duv_dy.y) <= 1e-5 * abs(v_uv.y);  // one v_m: rounding only
   UvFootprint footprint = cap ? UvFootprint(0.0, 0.0, 0.0, 0.0)
                               : UvFootprint(duv_dx.x, duv_dx.y, duv_dy.x, duv_dy.y);
-  // The bark covers the wood only (material 0, materials.h).
-  g_albedo = (v_ids.x >> PLANT_INDEX_BITS) == 0u ? bark_albedo(v_ids.x & PLANT_INDEX_MASK, u, v_uv.y, footprint)
-                                                 : vec4(0.0);
+  // The bark covers the wood only (material 0), the table's images their materials.
+  g_albedo = segment_albedo(v_ids.x & PLANT_INDEX_MASK, v_ids.x >> PLANT_INDEX_BITS, u, v_uv.y, footprint);
 #elif defined(LEAF_IMAGES)
   // A leaf image's albedo, decoded after filtering as LeafImages::albedo (and bark.glsl).
   bool image = (u_leaf_flags[min(int(leaf_material), MAX_MATERIALS - 1)] & 1u) != 0u;

@@ -229,10 +229,11 @@ class Renderer {
       if (leaf_images_ && leaf_images_->has_albedo(s.material)) albedo = leaf_images_->albedo(s.material, s.u, s.v_m);
       return lit(albedo, n, ng, s.position, view, look.specular, rng, shadow_rays);
     }
-    if (s.material == 0 && textures_ && textures_->has_albedo(s.plant)) {  // bark: wood only
+    // A texture on the segments: the bark's (wood only), or the table's (scene.h segment_texture).
+    if (textures_ && textures_->has_albedo(s.plant, s.material)) {
       const UvFootprint footprint = uv_footprint(s, {h.ray.origin, h.ray.direction + direction_dx_},
                                                  {h.ray.origin, h.ray.direction + direction_dy_});
-      albedo = textures_->albedo(s.plant, s.u, s.v_m, footprint);
+      albedo = textures_->albedo(s.plant, s.material, s.u, s.v_m, footprint);
     }
     // A relief hit's shadow ray starts a pixel footprint above it (render_cpu.h).
     const bool relief = s.material == 0 && textures_ && options_.geometry.relief && textures_->has_height(s.plant) &&
@@ -611,11 +612,13 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   RenderResult result;
   for (const ScenePlant& plant : scene.plants)
     if (!plant.skeleton) throw std::logic_error("render_cpu: a plant has no skeleton (call grow_scene_plants)");
-  // Bark textures: opened once, for the shading and for the relief or displacement.
+  // Bark textures and the table's segment images: opened once, for the shading and for
+  // the relief or displacement.
   std::unique_ptr<SceneTextures> textures;
-  if (std::any_of(scene.plants.begin(), scene.plants.end(), [](const ScenePlant& p) {
-        return p.bark.albedo_texture || p.bark.height_texture;
-      })) {
+  if (std::any_of(scene.plants.begin(), scene.plants.end(),
+                  [](const ScenePlant& p) { return p.bark.albedo_texture || p.bark.height_texture; }) ||
+      std::any_of(scene.materials.begin(), scene.materials.end(),
+                  [&](const auto& entry) { return segment_texture(scene.materials, nullptr, entry.first).has_value(); })) {
     const Clock::time_point start = Clock::now();
     Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(scene);
     if (!opened) throw std::runtime_error(opened.error().message);

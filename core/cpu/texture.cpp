@@ -51,12 +51,18 @@ UvFootprint uv_footprint(const SurfaceHit& hit, const Ray& ray_dx, const Ray& ra
 struct SceneTextures::Impl {
   TextureSystem* system = nullptr;
   uint64_t id = 0;  // distinguishes this object in the per-thread cache
+  // An albedo texture laid on segments, with its repeats.
+  struct Albedo {
+    TextureSystem::TextureHandle* handle = nullptr;
+    double u_repeat = 1, v_per_metre = 1;
+  };
   struct Plant {
-    TextureSystem::TextureHandle* albedo = nullptr;
+    Albedo wood;  // material 0's (segment_texture: the bark's, else the table's)
     TextureSystem::TextureHandle* height = nullptr;
-    double u_repeat = 1, v_per_metre = 1, depth_m = 0;
+    double u_repeat = 1, v_per_metre = 1, depth_m = 0;  // the bark's (the relief's)
   };
   std::vector<Plant> plants;
+  Albedo materials[kMaterialSlots];  // materials 1.. of the table (segment_texture)
   size_t files = 0;
 
   // The height field of one height texture.
@@ -162,6 +168,15 @@ Expected<std::unique_ptr<SceneTextures>> SceneTextures::open(const Scene& scene)
     handles[path] = h;
     return h;
   };
+  // The texture segment_texture names for `material` on a plant with `bark` (none: a null handle).
+  auto albedo_of = [&](const Bark* bark, uint32_t material, Impl::Albedo* out) {
+    const std::optional<SegmentTexture> t = segment_texture(scene.materials, bark, material);
+    if (!t) return true;
+    *out = {handle_of(t->path), t->u_repeat, t->v_per_metre};
+    return out->handle != nullptr;
+  };
+  for (uint32_t k = 1; k < kMaterialSlots; ++k)
+    if (!albedo_of(nullptr, k, &m.materials[k])) return std::move(*error);
   m.plants.resize(scene.plants.size());
   for (size_t p = 0; p < scene.plants.size(); ++p) {
     const Bark& bark = scene.plants[p].bark;
@@ -169,7 +184,7 @@ Expected<std::unique_ptr<SceneTextures>> SceneTextures::open(const Scene& scene)
     plant.u_repeat = bark.u_repeat;
     plant.v_per_metre = bark.v_per_metre;
     plant.depth_m = bark.relief_depth_m;
-    if (bark.albedo_texture && !(plant.albedo = handle_of(*bark.albedo_texture))) return std::move(*error);
+    if (!albedo_of(&bark, 0, &plant.wood)) return std::move(*error);
     if (bark.height_texture) {
       if (!(plant.height = handle_of(*bark.height_texture))) return std::move(*error);
       if (!m.height_fields.count(plant.height)) {
@@ -191,22 +206,24 @@ Expected<std::unique_ptr<SceneTextures>> SceneTextures::open(const Scene& scene)
   return textures;
 }
 
-bool SceneTextures::has_albedo(uint32_t plant) const {
-  return plant < impl_->plants.size() && impl_->plants[plant].albedo;
+bool SceneTextures::has_albedo(uint32_t plant, uint32_t material) const {
+  if (material == 0) return plant < impl_->plants.size() && impl_->plants[plant].wood.handle;
+  return material < kMaterialSlots && impl_->materials[material].handle;
 }
 
 bool SceneTextures::has_height(uint32_t plant) const {
   return plant < impl_->plants.size() && impl_->plants[plant].height;
 }
 
-glm::dvec3 SceneTextures::albedo(uint32_t plant, double u, double v_m, const UvFootprint& fp) const {
-  const Impl::Plant& p = impl_->plants[plant];
+glm::dvec3 SceneTextures::albedo(uint32_t plant, uint32_t material, double u, double v_m,
+                                 const UvFootprint& fp) const {
+  const Impl::Albedo& p = material == 0 ? impl_->plants[plant].wood : impl_->materials[material];
   const double s = u * p.u_repeat, t = v_m * p.v_per_metre;
   TextureOpt options;
   options.swrap = TextureOpt::WrapPeriodic;
   options.twrap = TextureOpt::WrapPeriodic;
   float encoded[3] = {0, 0, 0};
-  impl_->system->texture(p.albedo, impl_->perthread(), options, static_cast<float>(s - std::floor(s)),
+  impl_->system->texture(p.handle, impl_->perthread(), options, static_cast<float>(s - std::floor(s)),
                          static_cast<float>(t - std::floor(t)), static_cast<float>(fp.du_dx * p.u_repeat),
                          static_cast<float>(fp.dv_dx * p.v_per_metre), static_cast<float>(fp.du_dy * p.u_repeat),
                          static_cast<float>(fp.dv_dy * p.v_per_metre), 3, encoded);

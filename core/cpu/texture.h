@@ -1,6 +1,7 @@
-// texture.h — the bark textures of a scene (scene.md `bark`: albedo and height maps) read
-// with OpenImageIO's TextureSystem: MIP-mapped, filtered lookups (paper 000 sec. 2.3), and the
-// ray-differential footprint that drives the filter.
+// texture.h — the bark textures of a scene (scene.md `bark`: albedo and height maps), and
+// the albedo images its `materials` table lays on segments (docs/materials.md, scene.h
+// segment_texture), read with OpenImageIO's TextureSystem: MIP-mapped, filtered lookups
+// (paper 000 sec. 2.3), and the ray-differential footprint that drives the filter.
 //
 // One TextureSystem per SceneTextures (created unshared, so renders do not share caches or
 // state), with "automip" = 1 (plain PNGs are MIP-mapped on the fly), "autotile" = 0 (an
@@ -69,19 +70,23 @@ UvFootprint uv_footprint(const SurfaceHit& hit, const Ray& ray_dx, const Ray& ra
 
 class SceneTextures {
  public:
-  // Opens the bark textures of every plant of `scene` (plants naming the same file share
-  // one handle). On failure a Diagnostic for the file whose message names it and gives
-  // OIIO's reason ("cannot open texture 'bark.png': ...").
+  // Opens the bark textures of every plant of `scene` and the images its `materials` table
+  // lays on segments (scene.h segment_texture; the same file is opened once). On failure a
+  // Diagnostic for the file whose message names it and gives OIIO's reason ("cannot open
+  // texture 'bark.png': ...").
   static Expected<std::unique_ptr<SceneTextures>> open(const Scene& scene);
   ~SceneTextures();
   SceneTextures(const SceneTextures&) = delete;
   SceneTextures& operator=(const SceneTextures&) = delete;
 
-  // Whether plant `plant` has an albedo / height texture.
-  bool has_albedo(uint32_t plant) const;
+  // Whether the segments of `material` on plant `plant` have an albedo texture (scene.h
+  // segment_texture: the bark's for material 0, else the table's); whether `plant` has a
+  // height texture.
+  bool has_albedo(uint32_t plant, uint32_t material) const;
   bool has_height(uint32_t plant) const;
-  // Linear albedo of `plant` at (u, v_m), filtered over `footprint` (has_albedo(plant)).
-  glm::dvec3 albedo(uint32_t plant, double u, double v_m, const UvFootprint& footprint) const;
+  // Linear albedo of the segments of `material` on `plant` at (u, v_m), filtered over
+  // `footprint` (has_albedo(plant, material)), with that texture's repeats.
+  glm::dvec3 albedo(uint32_t plant, uint32_t material, double u, double v_m, const UvFootprint& footprint) const;
   // The relief of `plant` (has_height(plant)): its height field (owned by this object),
   // depth and repeats from its bark.
   ReliefMap relief_map(uint32_t plant) const;

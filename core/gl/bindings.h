@@ -29,6 +29,7 @@ inline constexpr uint32_t kFogHeadsBinding = 9;      // uint32 per pixel: its li
 inline constexpr uint32_t kFogOverflowBinding = 10;  // uint32 per pixel: 1 = its list is incomplete
 inline constexpr uint32_t kFogCountersBinding = 11;  // GlFogCounters
 inline constexpr uint32_t kInstancesBinding = 12;    // GpuInstance per plant drawn as an instance (INSTANCED)
+inline constexpr uint32_t kMaterialMapsBinding = 13; // MaterialMapsRecord per material slot
 
 // Texture units.
 inline constexpr uint32_t kBarkTexturesUnit = 0;  // bark image i at kBarkTexturesUnit + i
@@ -91,6 +92,7 @@ inline constexpr GlslConstant kGlslConstants[] = {
     {"FOG_OVERFLOW_BINDING", kFogOverflowBinding},
     {"FOG_COUNTERS_BINDING", kFogCountersBinding},
     {"INSTANCES_BINDING", kInstancesBinding},
+    {"MATERIAL_MAPS_BINDING", kMaterialMapsBinding},
     {"FOG_LIST_END", kFogListEnd},
     {"FOG_MAX_INTERVALS", kFogMaxIntervals},
     {"FOG_MAX_LIST_NODES", kFogMaxListNodes},
@@ -113,12 +115,26 @@ static_assert(sizeof(PlantBarkRecord) == 16);
 // bark.glsl's PlantMaps: per plant, its bark textures' parameters.
 struct PlantMapsRecord {
   float u_repeat = 1, v_per_metre = 1, relief_depth_m = 0;
-  int32_t albedo_unit = -1, height_unit = -1;  // index into u_bark_textures; −1: none
+  // Index into u_bark_textures of material 0's bark albedo; kAlbedoFromTable: none, the
+  // material table's MaterialMapsRecord decides; kAlbedoNone: none (the bark's colour).
+  int32_t albedo_unit = -1;
+  int32_t height_unit = -1;                    // index into u_bark_textures; −1: none
   uint32_t height_first = 0;                   // first texel in HeightTexels
   int32_t height_width = 1, height_height = 1;
 };
 static_assert(sizeof(PlantMapsRecord) == 32 && offsetof(PlantMapsRecord, albedo_unit) == 12 &&
               offsetof(PlantMapsRecord, height_first) == 20 && offsetof(PlantMapsRecord, height_height) == 28);
+
+inline constexpr int32_t kAlbedoFromTable = -1, kAlbedoNone = -2;  // PlantMapsRecord::albedo_unit
+
+// bark.glsl's MaterialMaps: per material slot, the albedo image the scene's table lays on
+// its segments (scene.h segment_texture), kMaxMaterials of them.
+struct MaterialMapsRecord {
+  float u_repeat = 1, v_per_metre = 1;
+  int32_t albedo_unit = -1;  // index into u_bark_textures; −1: none
+  int32_t unused = 0;
+};
+static_assert(sizeof(MaterialMapsRecord) == 16 && offsetof(MaterialMapsRecord, albedo_unit) == 8);
 
 // mesh.vert.glsl's MeshFrustum (std430: vec4, uvec4).
 struct MeshFrustumRecord {

@@ -19,6 +19,8 @@ bool relief_mapped(const ScenePlant& plant, const RenderOptions& options) {
 
 std::vector<std::string> bark_image_files(const Scene& scene, const RenderOptions& options) {
   std::set<std::string> images;
+  for (uint32_t k = 0; k < kMaterialSlots; ++k)
+    if (auto t = segment_texture(scene.materials, nullptr, k)) images.insert(t->path);
   for (const ScenePlant& plant : scene.plants) {
     if (plant.bark.albedo_texture) images.insert(*plant.bark.albedo_texture);
     if (options.geometry.kind == GeometryKind::frusta && relief_mapped(plant, options))
@@ -31,16 +33,28 @@ GlBarkMaps::GlBarkMaps(const Scene& scene, const RenderOptions& options) {
   std::map<std::string, int> albedo_unit, height_unit;
   std::map<std::string, std::pair<uint32_t, uint32_t>> height_level;  // first texel, index into height_sizes_
   std::vector<gl::PlantBarkRecord> bark;
+  auto albedo_unit_of = [&](const std::string& path) {
+    if (!albedo_unit.count(path)) albedo_unit[path] = upload(path, false, nullptr);
+    albedo_ = true;
+    return albedo_unit[path];
+  };
+  // The table's images on segments (scene.h segment_texture), per material slot.
+  gl::MaterialMapsRecord materials[gl::kMaxMaterials];
+  static_assert(gl::kMaxMaterials == kMaterialSlots);
+  for (uint32_t k = 0; k < kMaterialSlots; ++k) {
+    if (const std::optional<SegmentTexture> t = segment_texture(scene.materials, nullptr, k)) {
+      materials[k].u_repeat = static_cast<float>(t->u_repeat);
+      materials[k].v_per_metre = static_cast<float>(t->v_per_metre);
+      materials[k].albedo_unit = albedo_unit_of(t->path);
+    }
+  }
   for (const ScenePlant& plant : scene.plants) {
     gl::PlantMapsRecord r;
     r.u_repeat = static_cast<float>(plant.bark.u_repeat);
     r.v_per_metre = static_cast<float>(plant.bark.v_per_metre);
-    if (plant.bark.albedo_texture) {
-      const std::string& path = *plant.bark.albedo_texture;
-      if (!albedo_unit.count(path)) albedo_unit[path] = upload(path, false, nullptr);
-      r.albedo_unit = albedo_unit[path];
-      albedo_ = true;
-    }
+    if (plant.bark.albedo_texture) r.albedo_unit = albedo_unit_of(*plant.bark.albedo_texture);
+    else if (plant.bark.albedo_rgb) r.albedo_unit = gl::kAlbedoNone;  // its colour, not the table's image
+    else r.albedo_unit = gl::kAlbedoFromTable;
     if (relief_mapped(plant, options)) {
       // The shade pass offsets a relief plant's shadow lookups whatever the geometry
       // (render_cpu.cpp); the frusta pass marches it.
@@ -68,8 +82,9 @@ GlBarkMaps::GlBarkMaps(const Scene& scene, const RenderOptions& options) {
   maps_buffer_ = make_gl_buffer(plants_.data(), plants_.size() * sizeof(gl::PlantMapsRecord));
   height_texel_buffer_ = make_gl_buffer(height_texels_.data(), height_texels_.size() * sizeof(float));
   bark_buffer_ = make_gl_buffer(bark.data(), bark.size() * sizeof(gl::PlantBarkRecord));
+  material_maps_buffer_ = make_gl_buffer(materials, sizeof materials);
   uploaded_bytes_ += plants_.size() * sizeof(gl::PlantMapsRecord) + height_texels_.size() * sizeof(float) +
-                     bark.size() * sizeof(gl::PlantBarkRecord);
+                     bark.size() * sizeof(gl::PlantBarkRecord) + sizeof materials;
   check_gl("bark maps");
 }
 
@@ -77,6 +92,7 @@ void GlBarkMaps::bind() const {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kPlantMapsBinding, maps_buffer_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kHeightTexelsBinding, height_texel_buffer_.id());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kPlantBarkBinding, bark_buffer_.id());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kMaterialMapsBinding, material_maps_buffer_.id());
   for (size_t i = 0; i < textures_.size(); ++i)
     glBindTextureUnit(gl::kBarkTexturesUnit + static_cast<GLuint>(i), textures_[i].id());
 }

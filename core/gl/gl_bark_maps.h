@@ -1,9 +1,11 @@
-// gl_bark_maps.h — a scene's bark on the GPU (shaders/bark.glsl, the GLSL side of
+// gl_bark_maps.h — a scene's bark, and the images its materials table lays on segments
+// (scene.h segment_texture), on the GPU (shaders/bark.glsl, the GLSL side of
 // core/cpu/texture.h): each distinct image file once, as a texture with its full MIP chain
 // bound at unit kBarkTexturesUnit + i for u_bark_textures[i] (albedo GL_RGBA8 holding the
 // file's sRGB-encoded values, decoded in the shader after filtering as texture.h does;
 // height GL_R32F), the height maps' finest levels as floats (HeightTexels), one
-// PlantMapsRecord and one PlantBarkRecord per plant (bindings.h). Images are read with
+// PlantMapsRecord and one PlantBarkRecord per plant and one MaterialMapsRecord per
+// material slot (bindings.h). Images are read with
 // OpenImageIO as the CPU's TextureSystem reads them: 8-bit albedo, a gray albedo as gray
 // RGB, height channel 0 as float in [0, 1], row 0 at t = 0.
 //
@@ -41,7 +43,7 @@ class GlBarkMaps {
   const std::vector<gl::PlantMapsRecord>& plants() const { return plants_; }
   size_t images() const { return textures_.size(); }
   bool relief() const { return relief_; }  // some plant is relief-mapped (frusta geometry)
-  bool albedo() const { return albedo_; }  // some plant has an albedo texture
+  bool albedo() const { return albedo_; }  // some segments have an albedo texture
   uint64_t texture_bytes() const { return texture_bytes_; }  // with MIP chains
   uint64_t uploaded_bytes() const { return uploaded_bytes_; }  // texels and records sent
 
@@ -54,7 +56,7 @@ class GlBarkMaps {
   std::vector<std::pair<int, int>> height_sizes_;
   bool relief_ = false, albedo_ = false;
   uint64_t texture_bytes_ = 0, uploaded_bytes_ = 0;
-  GlBuffer maps_buffer_, height_texel_buffer_, bark_buffer_;
+  GlBuffer maps_buffer_, height_texel_buffer_, bark_buffer_, material_maps_buffer_;
 };
 
 }  // namespace sylva

@@ -41,7 +41,7 @@
 //                 cleared 0), and the G-buffer of frusta.frag.glsl: location 0 shading
 //                 normal toward the eye + Euclidean distance, 1 geometric normal toward the
 //                 eye + u, 2 plant | material << 24, chain, segment, v_m bits, 3 albedo:
-//                 with bark_texture_units > 0 bark.glsl's bark_albedo over the screen
+//                 with bark_texture_units > 0 bark.glsl's segment_albedo over the screen
 //                 derivatives of (u, v_m) (the ray differentials' footprint on a plane),
 //                 a = 1 where the plant has an albedo texture; else 0 (the material
 //                 table). The renderer binds bark.glsl's maps and images (render_gl.cpp).

@@ -472,7 +472,8 @@ struct GlRenderer::State {
     set_uniform(shade, "u_sky", scene.sky);
     set_uniform(shade, "u_ground_albedo", scene.ground.albedo);
     // Every slot the scene's table may fill (scene.h material_look; a material with a leaf
-    // image gives its segments the image's mean, leaf_images.h segment_look); higher
+    // image gives its segments the image's mean, leaf_images.h segment_look, unless the
+    // geometry pass decided their albedo from the image laid on them, bark.glsl); higher
     // indices look like the last slot, as default_material_albedo's past its table.
     static_assert(gl::kMaxMaterials == kMaterialSlots);
     float albedo[gl::kMaxMaterials * 3], specular[gl::kMaxMaterials];

@@ -104,6 +104,21 @@ TEST(BlenderCheck, ASceneWithBarkAndATableKeepsItsTextureAndItsColoursInBlender)
       << report;
 }
 
+TEST(BlenderCheck, TheDesertsSkinOnSegmentsArrivesTexturedThroughItsOwnUvMap) {
+  if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
+  TempDir dir;
+  // docs/materials.md: the table lays cactus.png on materials 1 and 2 with repeats other
+  // than the (absent) barks', so the textures read TEXCOORD_1, which Blender imports as
+  // a second UV map; 34 plants, their meshes sharing names ("saguaro", "cactus").
+  const std::string report = clean_blender_report(kSource + "/presets/scenes/desert.scene.json", dir.file("desert.glb"));
+  for (const char* material : {"sylva_material_1", "sylva_material_2"})
+    EXPECT_NE(report.find(std::string(R"("name": ")") + material +
+                          R"(", "double_sided": false, "blend_method": "OPAQUE", "textured": true, "uv_map": "UVMap.001")"),
+              std::string::npos)
+        << material << ": " << report;
+  EXPECT_EQ(triangle_counts(report).size(), 34u) << report;
+}
+
 // The check is not a formality: a file the validator accepts but Blender reads otherwise
 // is a problem. Two materials of one name are valid glTF; Blender renames the second
 // ("sylva_material_0.001"), so the leaves no longer have the material the file names.

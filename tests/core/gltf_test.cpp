@@ -837,6 +837,75 @@ TEST(GltfExport, TheScenesMaterialTableGivesOneSharedMaterialPerEntry) {
   EXPECT_EQ(seen[1], 1);
 }
 
+TEST(GltfExport, TheTablesImageOnSegmentsIsABaseColorTextureWithItsOwnTexcoords) {
+  // docs/materials.md: an entry with an albedo image and repeats textures its segments;
+  // where its repeats differ from the bark's TEXCOORD_0, its primitive reads TEXCOORD_1.
+  // Entry 0's image covers the wood of a plant without a bark albedo only.
+  TempFolder dir;
+  const std::string tiles = std::string(SYLVA_SOURCE_DIR) + "/presets/textures/tiles.png";
+  const std::string cactus = std::string(SYLVA_SOURCE_DIR) + "/presets/textures/cactus.png";
+  GltfPlant plain{"plain", grow_text(kGrammar)};
+  GltfPlant barked = plain;
+  barked.name = "barked";
+  barked.position_m[0] = 3;
+  barked.bark = textured_bark();  // bark.png, u_repeat 2, v_per_metre 3
+  GltfExportOptions o;
+  o.mesh = true;
+  o.segments_around = 6;
+  o.materials[1].albedo_image = tiles;
+  o.materials[1].segment_repeat = SceneMaterial::Repeat{4, 5};
+  o.materials[0].albedo_image = cactus;
+  o.materials[0].segment_repeat = SceneMaterial::Repeat{2, 3};
+  TessellateOptions to;
+  to.segments_around = 6;
+  const TriangleMesh tm = tessellate(skin_skeleton(plain.skeleton), to);
+  ASSERT_TRUE(export_gltf({plain, barked}, dir.file("p.glb"), o).ok());
+  tinygltf::Model model;
+  ASSERT_TRUE(load_with_tinygltf(dir.file("p.glb"), &model));
+  auto image_bytes = [&](int texture) {
+    const tinygltf::Image& image = model.images.at(static_cast<size_t>(model.textures.at(static_cast<size_t>(texture)).source));
+    const tinygltf::BufferView& view = model.bufferViews.at(static_cast<size_t>(image.bufferView));
+    const auto& data = model.buffers.at(0).data;
+    return std::string(data.begin() + static_cast<std::ptrdiff_t>(view.byteOffset),
+                       data.begin() + static_cast<std::ptrdiff_t>(view.byteOffset + view.byteLength));
+  };
+  ASSERT_EQ(model.meshes.size(), 2u);
+  size_t checked = 0;
+  for (const tinygltf::Mesh& mesh : model.meshes) {
+    const bool is_barked = mesh.name == "barked";
+    const double bark_u = is_barked ? 2 : 1, bark_v = is_barked ? 3 : 1;
+    for (const tinygltf::Primitive& prim : mesh.primitives) {
+      if (prim.mode != TINYGLTF_MODE_TRIANGLES) continue;
+      const tinygltf::Material& mat = model.materials.at(static_cast<size_t>(prim.material));
+      const int index = mat.extras.Get("sylva").Get("material_index").GetNumberAsInt();
+      const tinygltf::TextureInfo& base = mat.pbrMetallicRoughness.baseColorTexture;
+      if (index > 1) {
+        EXPECT_EQ(base.index, -1) << mesh.name << " " << index;
+        EXPECT_FALSE(prim.attributes.count("TEXCOORD_1")) << mesh.name << " " << index;
+        continue;
+      }
+      ASSERT_GE(base.index, 0) << mesh.name << " " << index;
+      // Which image, with which repeats: the bark's on the barked wood, else the table's.
+      const bool bark = is_barked && index == 0;
+      const std::string file = bark ? kBarkAlbedo : index == 0 ? cactus : tiles;
+      EXPECT_EQ(image_bytes(base.index), slurp(file)) << mesh.name << " " << index;
+      const double u_repeat = bark ? 2 : index == 0 ? 2 : 4, v_per_metre = bark ? 3 : index == 0 ? 3 : 5;
+      const bool own = u_repeat != bark_u || v_per_metre != bark_v;
+      EXPECT_EQ(base.texCoord, own ? 1 : 0) << mesh.name << " " << index;
+      ASSERT_EQ(prim.attributes.count("TEXCOORD_1"), own ? 1u : 0u) << mesh.name << " " << index;
+      EXPECT_EQ(mat.extras.Get("sylva").Has("segment_texture"), !bark) << mesh.name << " " << index;
+      const std::vector<float> st = floats_of(model, prim.attributes.at(own ? "TEXCOORD_1" : "TEXCOORD_0"));
+      ASSERT_EQ(st.size(), tm.uvs.size() * 2);
+      for (size_t v = 0; v < tm.uvs.size(); ++v) {
+        EXPECT_EQ(st[2 * v], static_cast<float>(tm.uvs[v].x * u_repeat)) << v;
+        EXPECT_EQ(st[2 * v + 1], static_cast<float>(tm.uvs[v].y * v_per_metre)) << v;
+      }
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 4u);  // materials 0 and 1 of both plants
+}
+
 TEST(GltfExport, TheReferenceRadiusIsTheMedianSegmentRadius) {
   EXPECT_DOUBLE_EQ(bark_reference_radius_m(cylinder(0.1)), 0.1);
   Skeleton sk;

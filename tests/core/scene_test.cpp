@@ -312,6 +312,74 @@ TEST(SceneMaterials, EveryBadEntryIsAnErrorAtItsKey) {
   EXPECT_NE(e.message.find("materials must be an array"), std::string::npos) << e.message;
 }
 
+TEST(SceneMaterials, AnImageOnTheSegmentsReadsItsRepeatsWritesThemBackAndNeedsAnImage) {
+  test::TempFolder dir;
+  test::write_rgb_png(dir.file("skin.png"), 2, 2, [](uint32_t, uint32_t) { return std::array<float, 3>{}; });
+  Expected<Scene> s = parse_scene_json(R"({"plants": [], "materials": [
+      {"index": 2, "albedo": "skin.png", "v_per_metre": 6},
+      {"index": 3, "albedo": "skin.png", "u_repeat": 4, "v_per_metre": 0.5},
+      {"index": 4, "albedo": "skin.png"}]})",
+                                       "m.scene.json", dir.path());
+  ASSERT_TRUE(s.ok()) << s.error().format();
+  EXPECT_EQ(s->materials.at(2).segment_repeat, (SceneMaterial::Repeat{1, 6}));  // u_repeat defaults to 1
+  EXPECT_EQ(s->materials.at(3).segment_repeat, (SceneMaterial::Repeat{4, 0.5}));
+  EXPECT_FALSE(s->materials.at(4).segment_repeat) << "no repeats: the segments take the image's mean";
+  Expected<std::string> written = write_scene_json(*s, dir.path());
+  ASSERT_TRUE(written.ok()) << written.error().message;
+  Expected<Scene> again = parse_scene_json(*written, "m.scene.json", dir.path());
+  ASSERT_TRUE(again.ok()) << again.error().format() << "\n" << *written;
+  EXPECT_EQ(again->materials, s->materials);
+
+  struct Bad {
+    const char* entry;
+    const char* says;
+    uint32_t column;
+  };
+  const Bad bad[] = {
+      {R"({"index": 1, "u_repeat": 2})", "materials[0].u_repeat lays an albedo image on the segments", 41},
+      {R"({"index": 1, "albedo": [1, 1, 1], "v_per_metre": 2})", "materials[0].v_per_metre lays an albedo image", 65},
+      {R"({"index": 1, "albedo": "skin.png", "u_repeat": 0})", "materials[0].u_repeat must be in (0, 1e+06]", 63},
+      {R"({"index": 1, "albedo": "skin.png", "v_per_metre": "2"})", "materials[0].v_per_metre", 66},
+  };
+  for (const Bad& b : bad) {
+    const std::string text = std::string("{\"plants\": [],\n \"materials\": [") + b.entry + "]}";
+    Expected<Scene> r = parse_scene_json(text, "s.scene.json", dir.path());
+    ASSERT_FALSE(r.ok()) << b.entry;
+    EXPECT_EQ(r.error().loc.line, 2u) << b.entry;
+    EXPECT_EQ(r.error().loc.column, b.column) << b.entry << ": " << r.error().message;
+    EXPECT_NE(r.error().message.find(b.says), std::string::npos) << b.entry << ": " << r.error().message;
+  }
+}
+
+TEST(SceneMaterials, SegmentTextureIsTheBarksOnWoodThenTheTablesWithRepeats) {
+  std::map<uint32_t, SceneMaterial> table;
+  table[0].albedo_image = "wood.png";
+  table[0].segment_repeat = SceneMaterial::Repeat{2, 3};
+  table[1].albedo_image = "leaf.png";  // no repeats: none on segments
+  table[2].albedo_image = "skin.png";
+  table[2].segment_repeat = SceneMaterial::Repeat{5, 7};
+  Bark none, textured, coloured;
+  textured.albedo_texture = "bark.png";
+  textured.u_repeat = 8;
+  coloured.albedo_rgb = glm::dvec3(0.5);
+  auto path = [&](const Bark* bark, uint32_t m) {
+    const std::optional<SegmentTexture> t = segment_texture(table, bark, m);
+    return t ? t->path : std::string("-");
+  };
+  EXPECT_EQ(path(&textured, 0), "bark.png");
+  EXPECT_EQ(segment_texture(table, &textured, 0)->u_repeat, 8);
+  EXPECT_TRUE(segment_texture(table, &textured, 0)->from_bark);
+  EXPECT_EQ(path(&coloured, 0), "-");
+  EXPECT_EQ(path(&none, 0), "wood.png");
+  EXPECT_EQ(segment_texture(table, &none, 0)->v_per_metre, 3);
+  EXPECT_FALSE(segment_texture(table, &none, 0)->from_bark);
+  EXPECT_EQ(path(nullptr, 0), "wood.png");
+  EXPECT_EQ(path(&textured, 1), "-");
+  EXPECT_EQ(path(&textured, 2), "skin.png");
+  EXPECT_EQ(segment_texture(table, &coloured, 2)->u_repeat, 5);
+  EXPECT_EQ(path(&none, 3), "-");
+}
+
 TEST(Scene, MalformedJsonIsLocated) {
   Diagnostic e = expect_error("{\"plants\": [],\n}");
   EXPECT_EQ(e.loc.line, 1u);  // the trailing comma

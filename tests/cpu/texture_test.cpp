@@ -77,7 +77,7 @@ TEST(Texture, HeightTextureIsChannelZeroPeriodicAndATexelApart) {
   const SceneTextures& t = **opened;
   EXPECT_FALSE(t.has_height(0));
   ASSERT_TRUE(t.has_height(1));
-  EXPECT_FALSE(t.has_albedo(1));
+  EXPECT_FALSE(t.has_albedo(1, 0));
   const ReliefMap map = t.relief_map(1);
   ASSERT_NE(map.field, nullptr);
   EXPECT_EQ(map.depth_m, 0.03);
@@ -130,9 +130,62 @@ TEST(Texture, PlantsNamingOneFileShareOneHandle) {
   Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(s);
   ASSERT_TRUE(opened.ok()) << opened.error().format();
   EXPECT_EQ((*opened)->file_count(), 1u);
-  EXPECT_TRUE((*opened)->has_albedo(0));
-  EXPECT_FALSE((*opened)->has_albedo(1));
+  EXPECT_TRUE((*opened)->has_albedo(0, 0));
+  EXPECT_FALSE((*opened)->has_albedo(1, 0));
+  EXPECT_FALSE((*opened)->has_albedo(0, 1)) << "the bark is the wood's alone";
   EXPECT_TRUE((*opened)->has_height(2));
+}
+
+TEST(Texture, TheTablesImagesCoverTheSegmentsOfTheirMaterialsWithTheirOwnRepeats) {
+  // docs/materials.md: an entry with an albedo image and u_repeat / v_per_metre lays the
+  // image on its material's segments; material 0's only where the bark names no albedo.
+  test::TempFolder dir;
+  const std::string a = dir.file("a.png"), b = dir.file("b.png");
+  // Ramps: the lookup's filter (OpenImageIO's smart bicubic at magnification) reproduces a
+  // linear function between texel centres away from the periodic seam.
+  auto ramp = [](uint32_t x, uint32_t y) {
+    return std::array<float, 3>{static_cast<float>(x) / 7, static_cast<float>(y) / 7, 0.25f};
+  };
+  test::write_rgb_png(a, 8, 8, ramp);
+  test::write_rgb_png(b, 2, 2, [](uint32_t, uint32_t) { return std::array<float, 3>{1.0f, 1.0f, 1.0f}; });
+  Scene s;
+  s.materials[0].albedo_image = b;
+  s.materials[0].segment_repeat = SceneMaterial::Repeat{};
+  s.materials[2].albedo_image = a;
+  s.materials[2].segment_repeat = SceneMaterial::Repeat{3, 2};
+  s.materials[3].albedo_image = a;  // no repeats: its segments take the mean (leaf_images.h)
+  s.plants.resize(3);
+  s.plants[0].bark.albedo_rgb = glm::dvec3(0.5);  // its colour, not the table's image
+  s.plants[2].bark.albedo_texture = a;
+  Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(s);
+  ASSERT_TRUE(opened.ok()) << opened.error().format();
+  const SceneTextures& t = **opened;
+  EXPECT_EQ(t.file_count(), 2u);
+  EXPECT_FALSE(t.has_albedo(0, 0));
+  EXPECT_TRUE(t.has_albedo(1, 0));
+  EXPECT_TRUE(t.has_albedo(2, 0));
+  for (uint32_t p = 0; p < 3; ++p) {
+    EXPECT_FALSE(t.has_albedo(p, 1));
+    EXPECT_TRUE(t.has_albedo(p, 2));
+    EXPECT_FALSE(t.has_albedo(p, 3));
+    EXPECT_FALSE(t.has_albedo(p, 40)) << "past the table";
+  }
+  EXPECT_NEAR(t.albedo(1, 0, 0.3, 0.7, {}).x, 1.0, 1e-6);
+  // Texel (x, y) of `a` is at s = (x + ½)/8, t = (y + ½)/8 with s = 3u, t = 2 v_m, and again
+  // a period later; 8-bit texels are within ½/255 of the ramp.
+  auto expected = [&](uint32_t x, uint32_t y, int k) { return srgb_to_linear(ramp(x, y)[k]); };
+  for (uint32_t y = 2; y < 6; ++y)
+    for (uint32_t x = 2; x < 6; ++x)
+      for (int period = 0; period < 2; ++period) {
+        const double u = ((x + 0.5) / 8 + period) / 3, v_m = ((y + 0.5) / 8 + period) / 2;
+        const glm::dvec3 albedo = t.albedo(0, 2, u, v_m, {});
+        EXPECT_NEAR(albedo.x, expected(x, y, 0), 3e-3) << x << "," << y;
+        EXPECT_NEAR(albedo.y, expected(x, y, 1), 3e-3) << x << "," << y;
+      }
+  // Plant 2's wood wears its bark (a, repeats 1), not the table's entry 0 (white).
+  const glm::dvec3 wood = t.albedo(2, 0, 3.5 / 8, 4.5 / 8, {});
+  EXPECT_NEAR(wood.x, expected(3, 4, 0), 3e-3);
+  EXPECT_NEAR(wood.y, expected(3, 4, 1), 3e-3);
 }
 
 TEST(Texture, ATextureThatCannotBeOpenedIsAnErrorNamingTheFile) {

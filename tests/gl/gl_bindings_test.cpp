@@ -99,6 +99,7 @@ TEST(GlBindings, TheDriverPutsEveryBlockAndSamplerWhereBindingsHSays) {
   EXPECT_EQ(block_binding(inside.id(), "SegmentList"), static_cast<GLint>(gl::kSegmentListBinding));
   EXPECT_EQ(block_binding(frusta.id(), "PlantMapsBuffer"), static_cast<GLint>(gl::kPlantMapsBinding));
   EXPECT_EQ(block_binding(frusta.id(), "HeightTexels"), static_cast<GLint>(gl::kHeightTexelsBinding));
+  EXPECT_EQ(block_binding(frusta.id(), "MaterialMapsBuffer"), static_cast<GLint>(gl::kMaterialMapsBinding));
   EXPECT_EQ(block_binding(shade.id(), "PlantBark"), static_cast<GLint>(gl::kPlantBarkBinding));
   EXPECT_EQ(block_binding(mesh.id(), "MeshFrusta"), static_cast<GLint>(gl::kMeshFrustaBinding));
 
@@ -150,6 +151,12 @@ TEST(GlBindings, TheDriverLaysEveryRecordOutAsItsCppMirror) {
   EXPECT_EQ(offset(f, "plant_maps[0].height_height"),
             static_cast<GLint>(offsetof(gl::PlantMapsRecord, height_height)));
   EXPECT_EQ(stride(f, "height_texels[0]"), static_cast<GLint>(sizeof(float)));
+  // bark.glsl's MaterialMaps.
+  EXPECT_EQ(stride(f, "material_maps[0].u_repeat"), static_cast<GLint>(sizeof(gl::MaterialMapsRecord)));
+  EXPECT_EQ(offset(f, "material_maps[0].v_per_metre"),
+            static_cast<GLint>(offsetof(gl::MaterialMapsRecord, v_per_metre)));
+  EXPECT_EQ(offset(f, "material_maps[0].albedo_unit"),
+            static_cast<GLint>(offsetof(gl::MaterialMapsRecord, albedo_unit)));
 
   // shade.frag.glsl's bark colours, mesh.vert.glsl's frustum records.
   EXPECT_EQ(stride(shade.id(), "plant_bark[0]"), static_cast<GLint>(sizeof(gl::PlantBarkRecord)));

@@ -421,6 +421,50 @@ TEST(RenderGl, TheScenesMaterialTableMatchesTheCpu) {
   expect_matches_cpu("material_table", scene);
 }
 
+TEST(RenderGl, TheTablesImageOnSegmentsMatchesTheCpu) {
+  SYLVA_REQUIRE_GL();
+  // docs/materials.md: an entry with an albedo image and u_repeat / v_per_metre lays the
+  // image on its segments (the needle, material 1) on both geometries and both backends;
+  // table entry 0's image gives way to the plant's bark colour on the wood.
+  Scene plain = gl_test::scene_around(test::wood_and_needle(), 128, 96);
+  plain.plants.front().bark.albedo_rgb = glm::dvec3(0.8, 0.7, 0.1);
+  Scene textured = plain;
+  textured.materials[1].albedo_image = texture_path("tiles.png");
+  textured.materials[1].segment_repeat = SceneMaterial::Repeat{2, 1.5};
+  textured.materials[0].albedo_image = texture_path("bark.png");
+  textured.materials[0].segment_repeat = SceneMaterial::Repeat{};
+  for (const GeometryKind kind : {GeometryKind::frusta, GeometryKind::mesh}) {
+    RenderOptions o;
+    o.aovs = kAovDepth | kAovId;
+    o.geometry.kind = kind;
+    const RenderResult a = render_gl(textured, o), b = render_gl(plain, o);
+    size_t needle = 0, needle_changed = 0, wood = 0, wood_changed = 0;
+    double lo = 1e9, hi = 0;  // the needle's luminance range
+    for (size_t p = 0; p < a.image.depth.size(); ++p) {
+      const float* pa = &a.image.beauty[4 * p];
+      float d = 0;
+      for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(pa[k] - b.image.beauty[4 * p + k]));
+      if (a.image.id[3 * p + 1] == 1) {
+        ++needle;
+        needle_changed += d > 0.01f;
+        lo = std::min(lo, double(pa[1])), hi = std::max(hi, double(pa[1]));
+      } else if (a.image.id[3 * p + 1] == 0) {
+        ++wood;
+        wood_changed += d > 1e-4f;
+      }
+    }
+    EXPECT_GT(needle, 400u);
+    EXPECT_GT(needle_changed, needle / 2) << "the image shows on the needle";
+    EXPECT_GT(hi, 2 * lo) << "the tiles' pattern, not one colour";
+    EXPECT_GT(wood, 400u);
+    EXPECT_EQ(wood_changed, 0u) << "the bark colour comes before the table's image";
+    RenderOptions compared;
+    compared.aovs = kAovDepth;
+    compared.geometry.kind = kind;
+    gl_test::expect_matches_cpu(kind == GeometryKind::mesh ? "segment_image_mesh" : "segment_image", textured, compared);
+  }
+}
+
 // A bundled scene (presets/scenes/) at a small size.
 Scene preset_scene(const std::string& name, uint32_t width, uint32_t height) {
   Expected<Scene> read = read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes/" + name + ".scene.json");
