@@ -40,16 +40,20 @@ uniform int u_leaf_layer[MAX_MATERIALS];
 uniform uint u_leaf_flags[MAX_MATERIALS];
 const float LEAF_ALPHA_CUTOFF = 0.5;
 
+// Material `material`'s layer and flags; a material past the table has neither (the
+// table's indices stop at MAX_MATERIALS − 1: LeafImages::layer_of).
+int leaf_layer(uint material) { return material < uint(MAX_MATERIALS) ? u_leaf_layer[material] : -1; }
+uint leaf_flags(uint material) { return material < uint(MAX_MATERIALS) ? u_leaf_flags[material] : 0u; }
+
 // The leaf image's texel at the leaf's (u, v): v = 0 the image's bottom row.
 vec4 leaf_texel(uint material) {
-  int slot = min(int(material), MAX_MATERIALS - 1);
-  return u_leaf_layer[slot] < 0 ? vec4(1.0)
-                                : texture(u_leaf_images, vec3(v_uv.x, 1.0 - v_uv.y, float(u_leaf_layer[slot])));
+  int layer = leaf_layer(material);
+  return layer < 0 ? vec4(1.0) : texture(u_leaf_images, vec3(v_uv.x, 1.0 - v_uv.y, float(layer)));
 }
 
 // Whether the leaf is missing at this fragment for a ray along `ray_direction`.
 bool leaf_missing(uint material, vec4 texel, vec3 ray_direction) {
-  uint flags = u_leaf_flags[min(int(material), MAX_MATERIALS - 1)];
+  uint flags = leaf_flags(material);
   if ((flags & 4u) != 0u && dot(ray_direction, v_normal) > 0.0) return true;
   return (flags & 2u) != 0u && texel.a < LEAF_ALPHA_CUTOFF;
 }
@@ -107,7 +111,7 @@ void main() {
   g_albedo = segment_albedo(v_ids.x & PLANT_INDEX_MASK, v_ids.x >> PLANT_INDEX_BITS, u, v_uv.y, footprint);
 #elif defined(LEAF_IMAGES)
   // A leaf image's albedo, decoded after filtering as LeafImages::albedo (and bark.glsl).
-  bool image = (u_leaf_flags[min(int(leaf_material), MAX_MATERIALS - 1)] & 1u) != 0u;
+  bool image = (leaf_flags(leaf_material) & 1u) != 0u;
   g_albedo = image ? vec4(srgb_to_linear(leaf.rgb), 1.0) : vec4(0.0);
 #else
   g_albedo = vec4(0.0);

@@ -33,6 +33,9 @@ layout(std430, binding = PLANT_BARK_BINDING) readonly buffer PlantBark { vec4 pl
 uniform vec3 u_material_albedo[MAX_MATERIALS];  // material_look (scene.h): the scene's table over materials.h's
 uniform float u_material_specular[MAX_MATERIALS];  // the Blinn–Phong lobe's weight per material
 uniform int u_material_count;
+// A material past the table (index ≥ u_material_count): default_material_albedo's last
+// colour, specular weight 1 (material_look: the table cannot describe it).
+uniform vec3 u_material_albedo_beyond;
 
 uniform vec3 u_right;        // camera frame, as frusta_common.glsl
 uniform vec3 u_up;
@@ -153,14 +156,16 @@ void main() {
     uint material = ids.x >> PLANT_INDEX_BITS;
     bool wood = material == 0u && ids.y != LEAF_CHAIN;  // a leaf is never bark (materials.md)
     vec4 decided = texelFetch(g_albedo, texel, 0);
-    int slot = min(int(material), u_material_count - 1);
+    bool in_table = material < uint(u_material_count);
+    int slot = in_table ? int(material) : 0;
     albedo = decided.a > 0.0                     ? decided.rgb
              : wood && plant_bark[plant].w > 0.0 ? plant_bark[plant].rgb
-                                                 : u_material_albedo[slot];
+             : in_table                          ? u_material_albedo[slot]
+                                                 : u_material_albedo_beyond;
     n = normal_distance.xyz;
     n_geometric = geometric_u.xyz;
     t = plant_t;
-    specular = u_material_specular[slot];
+    specular = in_table ? u_material_specular[slot] : 1.0;
 #ifdef SUN
     if (wood && plant_maps[plant].relief_depth_m > 0.0) shadow_offset_m = t * u_pixel_step_rad;
 #endif

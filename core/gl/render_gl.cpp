@@ -474,7 +474,7 @@ struct GlRenderer::State {
     // Every slot the scene's table may fill (scene.h material_look; a material with a leaf
     // image gives its segments the image's mean, leaf_images.h segment_look, unless the
     // geometry pass decided their albedo from the image laid on them, bark.glsl); higher
-    // indices look like the last slot, as default_material_albedo's past its table.
+    // indices, which the table cannot describe, default_material_albedo's colour.
     static_assert(gl::kMaxMaterials == kMaterialSlots);
     float albedo[gl::kMaxMaterials * 3], specular[gl::kMaxMaterials];
     const int count = static_cast<int>(kMaterialSlots);
@@ -486,6 +486,8 @@ struct GlRenderer::State {
     set_uniform_vec3_array(shade, "u_material_albedo", count, albedo);
     set_uniform_float_array(shade, "u_material_specular", count, specular);
     set_uniform_int(shade, "u_material_count", count);
+    const double* beyond = default_material_albedo(kMaterialSlots);
+    set_uniform(shade, "u_material_albedo_beyond", glm::dvec3(beyond[0], beyond[1], beyond[2]));
     if (f.fog_on) fog_uniforms(scene, f);
   }
 

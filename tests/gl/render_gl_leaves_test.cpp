@@ -114,6 +114,29 @@ TEST(RenderGlLeaves, TheLeafyBushInTheBundledLeafImageMatchesTheCpu) {
   EXPECT_NEAR(static_cast<double>(cut), static_cast<double>(leaf_pixels(cpu.image)), 0.02 * cut);
 }
 
+TEST(RenderGlLeaves, MaterialsPastTheTableKeepTheDefaultLookNotTheLastEntrys) {
+  SYLVA_REQUIRE_GL();
+  // docs/materials.md: the table describes indices 0 to 15; a segment or leaf of index 20
+  // has default_material_albedo's colour and specular 1 on both backends, whatever
+  // entry 15 says (here: the elm leaf image with its cut-out, matte).
+  Skeleton bush = gl_test::grow_preset("abop_1_25_bush_leaves");
+  for (Joint& j : bush.joints) j.material = 20;
+  for (Leaf& l : bush.leaves) l.material = 20;
+  Scene scene = gl_test::scene_around(bush);
+  SceneMaterial last;
+  last.albedo_image = std::string(SYLVA_SOURCE_DIR) + "/presets/textures/elm_leaf.png";
+  last.specular = 0;
+  scene.materials[15] = last;
+  RenderResult gl, cpu;
+  expect_bush_agrees(scene, "bush_material_20", &gl, &cpu);
+  Scene untabled = scene;
+  untabled.materials.clear();
+  RenderOptions options;
+  options.aovs = kAovId;
+  EXPECT_EQ(leaf_pixels(gl.image), leaf_pixels(render_gl(untabled, options).image)) << "no cut-out";
+  EXPECT_EQ(gl.image.beauty, render_gl(untabled, {}).image.beauty);
+}
+
 TEST(RenderGlLeaves, ACutOutsTransparentTexelsLetCameraAndShadowRaysThrough) {
   SYLVA_REQUIRE_GL();
   test::TempFolder dir;
