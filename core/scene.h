@@ -127,6 +127,14 @@ struct Bark {
   bool operator==(const Bark&) const = default;
 };
 
+// How an image repeats over a segment: u_repeat times around, v_per_metre times per metre
+// along (SceneMaterial::segment_repeat). Outside SceneMaterial: clang cannot default-construct
+// a nested class with member initialisers inside the optional of its enclosing class.
+struct SegmentRepeat {
+  double u_repeat = 1, v_per_metre = 1;
+  bool operator==(const SegmentRepeat&) const = default;
+};
+
 // One entry of the scene's `materials` table (docs/materials.md): how material index k
 // (the grammar's `'`, a joint's material) looks on every plant of the scene. Material 0
 // is the wood, which a plant's bark refines (materials.h).
@@ -140,10 +148,7 @@ struct SceneMaterial {
   // material's segments, laid as a bark's albedo texture is (texture.h: s = u·u_repeat,
   // t = v_m·v_per_metre, periodic, MIP-mapped). None: its segments take the image's mean
   // (leaf_images.h segment_look). Only with an albedo image.
-  struct Repeat {
-    double u_repeat = 1, v_per_metre = 1;
-    bool operator==(const Repeat&) const = default;
-  };
+  using Repeat = SegmentRepeat;
   std::optional<Repeat> segment_repeat{};
   bool operator==(const SceneMaterial&) const = default;
 };
