@@ -3,7 +3,7 @@
 // grammars are found (a texture named by the input is opened from its header, as
 // `sylva render` does). Properties beyond "no crash, no sanitizer finding": an error
 // names the file; an accepted scene writes (write_scene_json) and reads back equal but
-// for the places (file, grammar_loc), as scene.h promises.
+// for the places (file, the plants' and scatter entries' grammar_loc), as scene.h promises.
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -22,6 +22,7 @@ const std::string kBaseDir = SYLVA_SOURCE_DIR "/presets/scenes";
 void forget_places(sylva::Scene& scene) {
   scene.file.clear();
   for (sylva::ScenePlant& p : scene.plants) p.grammar_loc = {};
+  for (sylva::SceneScatter& s : scene.scatter) s.grammar_loc = {};
 }
 
 }  // namespace
