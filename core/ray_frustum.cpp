@@ -27,6 +27,7 @@
 //   10⁶ from the world origin keeps planes exact to an ulp of the segment's size.
 #include "core/ray_frustum.h"
 
+#include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <initializer_list>
@@ -274,6 +275,20 @@ FrustumHit intersect_frustum(const Ray& ray, const FrustumShape& shape, double t
   result.normal = frustum_normal(local, hit.kind, result.radial);
   result.from_inside = glm::dot(d, result.normal) > 0;
   return result;
+}
+
+bool ray_beyond_reach(const Ray& ray, const FrustumShape& shape, double reach_m) {
+  // The distance between the lines is |w·n| / |n| with w = origin − base, n = d × axis.
+  const glm::dvec3 w = ray.origin - shape.base;
+  const glm::dvec3 n = glm::cross(ray.direction, shape.axis);
+  const double wn = std::abs(glm::dot(w, n));
+  auto max_abs = [](const glm::dvec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); };
+  // Rounding: w = origin − base is correctly rounded (ε/2 of |w|), n and the dot product
+  // are off by a few ε of |w|·|d|; 1e-12 of those magnitudes (×3 for the max-abs norms)
+  // covers both with a wide margin.
+  const double slack = 3e-12 * (max_abs(w) + reach_m) * max_abs(ray.direction);
+  const double beyond = wn - slack;
+  return beyond > 0 && beyond * beyond > reach_m * reach_m * glm::dot(n, n) * (1 + 1e-12);
 }
 
 FrustumShapeF to_float_shape(const FrustumShape& shape, const glm::dvec3& segment_origin) {

@@ -56,6 +56,14 @@ const char* frustum_shape_error(const FrustumShape& shape);
 FrustumHit intersect_frustum(const Ray& ray, const FrustumShape& shape, double t_min,
                              double t_max);
 
+// True when the line of `ray` passes farther than `reach_m` from the axis line of `shape`
+// (reach_m: frustum_radial_reach, skin.h), so that the ray cannot hit it: a test of a few
+// products that accelerators run before intersect_frustum. Conservative: the rounding of
+// the triple product is allowed for (a relative 1e-12 of |origin − base|·|direction|), so
+// it never rejects a ray that intersect_frustum hits. A ray
+// parallel to the axis is never rejected; reach_m = +inf rejects nothing.
+bool ray_beyond_reach(const Ray& ray, const FrustumShape& shape, double reach_m);
+
 // ---- Float twin: the GLSL ray caster, line by line --------------------------------------
 
 // A ray in the frame of a FrustumShapeF (relative to that shape's per-segment origin).

@@ -342,6 +342,14 @@ BoundingPyramid bounding_pyramid(const FrustumShape& s, double shell_m) {
   return pyr;
 }
 
+double frustum_radial_reach(const FrustumShape& s) {
+  const BoundingPyramid pyr = bounding_pyramid(s);
+  if (!pyr.proper) return std::numeric_limits<double>::infinity();
+  double reach = std::max(s.radius0, 0.0);
+  for (const dvec3& v : pyr.vertices) reach = std::max(reach, s.radius0 + s.slope() * glm::dot(v - s.base, s.axis));
+  return reach * (1 + 1e-9);
+}
+
 double distance_outside(const BoundingPyramid& pyr, const dvec3& point) {
   double worst = -std::numeric_limits<double>::infinity();
   for (const Plane& p : pyr.planes) worst = std::max(worst, glm::dot(p.normal, point) - p.offset);

@@ -191,6 +191,13 @@ struct BoundingPyramid {
 };
 BoundingPyramid bounding_pyramid(const FrustumShape& shape, double shell_m = 0);
 
+// The largest distance from the axis line of any point of the shape's solid, in metres,
+// grown by a relative 1e-9: the larger r(y) at the lowest and highest axial coordinates of
+// its bounding pyramid's vertices, which hold the solid (r is linear in y). +inf where the
+// pyramid is not proper (no bound is claimed). A ray whose line passes farther
+// from the axis than this cannot hit the frustum (ray_beyond_reach, ray_frustum.h).
+double frustum_radial_reach(const FrustumShape& shape);
+
 // Worst signed distance (metres) of `point` outside the pyramid's 6 planes; <= 0 inside.
 double distance_outside(const BoundingPyramid& pyramid, const glm::dvec3& point);
 

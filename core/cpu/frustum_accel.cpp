@@ -11,6 +11,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace sylva {
 
@@ -23,6 +24,7 @@ constexpr float kInfF = std::numeric_limits<float>::infinity();
 struct QueryContext {
   RTCIntersectContext embree;
   const Frustum* frusta;
+  const double* reach;         // per frustum: frustum_radial_reach
   const double* custom_shell;  // nullptr: no custom frusta
   const CustomFrustumIntersector* custom;
   CustomHitDetail* detail;     // the caller's, for custom hits (nullptr: not wanted)
@@ -34,6 +36,7 @@ struct QueryContext {
 
 struct GeometryData {
   const Frustum* frusta;
+  const double* reach;
   const double* custom_shell;  // per frustum, or nullptr
   const CustomFrustumIntersector* custom;
   glm::dvec3 centre;
@@ -46,6 +49,7 @@ QueryContext start_query(const GeometryData& data, const Ray& ray, double t_min,
   QueryContext q{};
   rtcInitIntersectContext(&q.embree);
   q.frusta = data.frusta;
+  q.reach = data.reach;
   q.custom_shell = data.custom_shell;
   q.custom = data.custom;
   q.detail = detail;
@@ -65,11 +69,14 @@ void bounds_callback(const RTCBoundsFunctionArguments* args) {
   EmbreeScene::write_bounds(args->bounds_o, frustum_bounds(shape), data->centre, data->pad);
 }
 
-// Tests one candidate with the exact double ray; records it if nearer.
+// Tests one candidate with the exact double ray; records it if nearer. Embree's boxes
+// are axis-aligned, so most candidates of a slanted twig or needle are rays that pass
+// beside it: the reach test rejects those for a few products before the exact test.
 bool test_candidate(QueryContext* q, unsigned prim) {
-  FrustumHit h = q->custom_shell && q->custom_shell[prim] > 0
-                     ? q->custom->intersect(prim, q->ray, q->t_min, q->t_best, q->detail)
-                     : intersect_frustum(q->ray, q->frusta[prim].shape, q->t_min, q->t_best);
+  const bool custom = q->custom_shell && q->custom_shell[prim] > 0;
+  if (!custom && ray_beyond_reach(q->ray, q->frusta[prim].shape, q->reach[prim])) return false;
+  FrustumHit h = custom ? q->custom->intersect(prim, q->ray, q->t_min, q->t_best, q->detail)
+                        : intersect_frustum(q->ray, q->frusta[prim].shape, q->t_min, q->t_best);
   if (!h.hit()) return false;
   q->t_best = h.t;
   q->best.hit = h;
@@ -96,6 +103,7 @@ void occluded_callback(const RTCOccludedFunctionNArguments* args) {
 struct FrustumAccel::Impl {
   EmbreeScene embree;
   GeometryData data{};
+  std::vector<double> reach;
 };
 
 FrustumAccel::FrustumAccel(std::span<const Frustum> frusta, CustomFrusta custom)
@@ -113,7 +121,10 @@ FrustumAccel::FrustumAccel(std::span<const Frustum> frusta, CustomFrusta custom)
     lo = glm::min(lo, b.lo);
     hi = glm::max(hi, b.hi);
   }
+  m.reach.resize(frusta.size());
+  for (size_t i = 0; i < frusta.size(); ++i) m.reach[i] = frustum_radial_reach(frusta[i].shape);
   m.data.frusta = frusta.data();
+  m.data.reach = m.reach.data();
   m.data.custom_shell = has_custom ? custom.shell_m.data() : nullptr;
   m.data.custom = has_custom ? custom.intersector : nullptr;
   m.data.centre = frusta.empty() ? glm::dvec3(0) : 0.5 * (lo + hi);

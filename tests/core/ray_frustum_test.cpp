@@ -23,6 +23,7 @@
 // With SYLVA_ACCURACY_TABLE=path set, the suite writes the worst errors per case there as
 // the markdown table of docs/accuracy.md.
 #include "core/ray_frustum.h"
+#include "core/skin.h"
 #include "core/util/math.h"
 
 #include <gtest/gtest.h>
@@ -777,8 +778,8 @@ TEST(StiffCases, TableAgreesWithLongDoubleReference) {
   std::printf("stiff table: %zu rays\n", cases.size());
 }
 
-// Thousands of random frusta and rays, fixed seed.
-TEST(StiffCases, RandomFrustaAgreeWithLongDoubleReference) {
+// Thousands of random frusta and rays, fixed seed: 3000 shapes, 8 rays each.
+std::vector<RayCase> random_cases() {
   std::mt19937_64 rng(20240607);
   std::uniform_real_distribution<double> unit(0, 1);
   auto log_uniform = [&](double lo, double hi) {
@@ -788,7 +789,7 @@ TEST(StiffCases, RandomFrustaAgreeWithLongDoubleReference) {
     std::normal_distribution<double> normal;
     return glm::normalize(glm::dvec3(normal(rng), normal(rng), normal(rng)));
   };
-  int rays = 0;
+  std::vector<RayCase> cases;
   for (int shape_index = 0; shape_index < 3000; ++shape_index) {
     const double radius = log_uniform(1e-4, 1e2);
     const double r1 = unit(rng) < 0.2 ? 0 : radius * log_uniform(0.2, 5);
@@ -801,7 +802,7 @@ TEST(StiffCases, RandomFrustaAgreeWithLongDoubleReference) {
                                       tilt_lower, tilt_upper, caps);
     const double extent = length + std::max(radius, r1);
     const glm::dvec3 middle = s.base + 0.5 * length * s.axis;
-    for (int i = 0; i < 8; ++i, ++rays) {
+    for (int i = 0; i < 8; ++i) {
       // Toward a random point of the bounding cylinder, from near or far.
       const glm::dvec3 target = s.base + unit(rng) * length * s.axis +
                                 std::max(radius, r1) * 1.2 * unit(rng) * random_unit();
@@ -809,10 +810,131 @@ TEST(StiffCases, RandomFrustaAgreeWithLongDoubleReference) {
                                                 : extent * log_uniform(3, 1e6);
       const glm::dvec3 origin = middle + distance * random_unit();
       const glm::dvec3 direction = (target - origin) * log_uniform(1e-3, 1e3);
-      check_ray({s, {origin, direction}, {"random"}});
+      cases.push_back({s, {origin, direction}, {"random"}});
     }
   }
-  std::printf("random: %d rays\n", rays);
+  return cases;
+}
+
+TEST(StiffCases, RandomFrustaAgreeWithLongDoubleReference) {
+  const std::vector<RayCase> cases = random_cases();
+  for (const RayCase& c : cases) check_ray(c);
+  std::printf("random: %zu rays\n", cases.size());
+}
+
+// ---- The reach test accelerators run first (ray_beyond_reach) --------------------------
+
+// Every ray of the stiff table and the random frusta that intersect_frustum hits anywhere
+// on its line is kept by the reach test. (Those rays aim at the solid or just around it,
+// and most tilted random shapes have no proper pyramid, so few are rejected: the next
+// test measures the rejection itself.)
+TEST(RayBeyondReach, NeverRejectsARayThatHitsOnTheStiffAndRandomCases) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (const bool random : {false, true}) {
+    const std::vector<RayCase> cases = random ? random_cases() : stiff_table();
+    size_t hits = 0, rejected = 0;
+    for (const RayCase& c : cases) {
+      const double reach = frustum_radial_reach(c.shape);
+      const bool beyond = ray_beyond_reach(c.ray, c.shape, reach);
+      rejected += beyond;
+      const FrustumHit hit = intersect_frustum(c.ray, c.shape, -kInf, kInf);
+      if (!hit.hit()) continue;
+      ++hits;
+      ASSERT_FALSE(beyond) << (random ? "random" : "stiff") << " case " << (&c - cases.data())
+                           << ": a hit at t = " << hit.t << " rejected (reach " << reach << " m)";
+    }
+    std::printf("%s: %zu rays, %zu hit, %zu beyond reach\n", random ? "random" : "stiff", cases.size(), hits,
+                rejected);
+    EXPECT_GT(hits, cases.size() / 4);
+    if (random) {
+      EXPECT_GT(rejected, 0u);
+    }
+  }
+}
+
+// Rays that pass the axis at the reach's distance give or take a relative 1e-12 … 1e-2,
+// crossing the random frusta at every height of their pyramids: those a little farther
+// out are rejected (where the shape has a proper pyramid), and no rejected ray hits.
+TEST(RayBeyondReach, RaysGrazingTheReachOfRandomFrustaAreRejectedOnlyWhenTheyMiss) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::mt19937_64 rng(20261204);
+  std::uniform_real_distribution<double> unit(0, 1);
+  auto log_uniform = [&](double lo, double hi) {
+    return std::exp(std::log(lo) + unit(rng) * (std::log(hi) - std::log(lo)));
+  };
+  const std::vector<RayCase> cases = random_cases();
+  size_t proper = 0, outside = 0, outside_rejected = 0, hits = 0;
+  for (size_t i = 0; i < cases.size(); i += 8) {
+    const FrustumShape& s = cases[i].shape;
+    const double reach = frustum_radial_reach(s);
+    if (!std::isfinite(reach)) continue;
+    ++proper;
+    const BoundingPyramid pyramid = bounding_pyramid(s);
+    double y_lo = kInf, y_hi = -kInf;
+    for (const glm::dvec3& v : pyramid.vertices) {
+      y_lo = std::min(y_lo, glm::dot(v - s.base, s.axis));
+      y_hi = std::max(y_hi, glm::dot(v - s.base, s.axis));
+    }
+    const glm::dvec3 u1 = any_perpendicular(s.axis), u2 = glm::cross(s.axis, u1);
+    for (int k = 0; k < 16; ++k) {
+      const double phi = 2 * kPi * unit(rng);
+      const glm::dvec3 e = std::cos(phi) * u1 + std::sin(phi) * u2;   // radial
+      const glm::dvec3 across = glm::cross(s.axis, e);                 // ⊥ axis and e
+      const double delta = (k % 2 ? 1 : -1) * log_uniform(1e-12, 1e-2);
+      const double y = y_lo + unit(rng) * (y_hi - y_lo);
+      const double lean = (2 * unit(rng) - 1) * 1.5;                   // toward the axis, rad
+      const glm::dvec3 point = s.base + y * s.axis + reach * (1 + delta) * e;
+      const glm::dvec3 direction = (std::cos(lean) * across + std::sin(lean) * s.axis) * log_uniform(1e-3, 1e3);
+      const Ray ray{point - 3 * (y_hi - y_lo + reach) * glm::normalize(direction), direction};
+      const bool beyond = ray_beyond_reach(ray, s, reach);
+      const bool hit = intersect_frustum(ray, s, -kInf, kInf).hit();
+      hits += hit;
+      ASSERT_FALSE(beyond && hit) << "shape " << i << ", delta " << delta << ", y " << y << ", lean " << lean;
+      if (delta > 1e-8) {
+        ++outside;
+        outside_rejected += beyond;
+      }
+    }
+  }
+  std::printf("%zu proper shapes, %zu grazing hits, %zu of %zu rays beyond 1e-8 rejected\n", proper, hits,
+              outside_rejected, outside);
+  EXPECT_GT(proper, 500u);
+  EXPECT_GT(hits, 0u);
+  EXPECT_GE(outside_rejected, outside * 99 / 100);
+}
+
+// The reach is the largest radius of the solid: a cylinder's is its radius; a cone cut by
+// tilted planes reaches r(y) at the plane's extreme point. Rays passing a millionth beyond
+// it, at every offset, are rejected; rays a millionth inside are kept and hit.
+TEST(RayBeyondReach, RejectsRaysJustBeyondTheSolidsLargestRadius) {
+  const FrustumShape cylinder = unit_cylinder();  // radius 1 about +Y, y in [0, 2]
+  EXPECT_NEAR(frustum_radial_reach(cylinder), 1, 1e-8);
+  for (const double scale : {1 - 1e-6, 1 + 1e-6}) {
+    const Ray ray{{scale, 1, -5}, {0, 0, 1}};
+    EXPECT_EQ(ray_beyond_reach(ray, cylinder, frustum_radial_reach(cylinder)), scale > 1);
+    EXPECT_EQ(intersect_frustum(ray, cylinder, 0, 100).hit(), scale < 1);
+  }
+  for (const double offset : {0.0, 1e3, 1e6}) {
+    for (const double tilt_deg : {0.0, 20.0, 40.0}) {
+      const glm::dvec3 base = offset * glm::normalize(glm::dvec3(0.57, 0.41, -0.71));
+      const double tilt = tilt_deg * kPi / 180;
+      const FrustumShape cone = make_shape(base, {0.2, 1, 0.1}, 2, 0.3, 0.1, tilt, tilt, false);
+      const double reach = frustum_radial_reach(cone);
+      // The widest point: on the lower plane, down its tilt (make_shape tilts it toward u1).
+      const glm::dvec3 u1 = any_perpendicular(cone.axis);
+      const double y_low = -cone.radius0 * std::tan(tilt) / (1 + cone.slope() * std::tan(tilt));
+      EXPECT_NEAR(reach, cone.radius_at(y_low), 1e-8 * reach) << "tilt " << tilt_deg;
+      const glm::dvec3 across = glm::cross(cone.axis, u1);  // ⊥ axis and u1
+      for (const double scale : {1 - 1e-6, 1 + 1e-6}) {
+        const glm::dvec3 point = cone.base + y_low * cone.axis + scale * reach * u1;
+        const Ray ray{point - 5.0 * across, across};
+        const bool beyond = ray_beyond_reach(ray, cone, reach);
+        EXPECT_EQ(beyond, scale > 1) << "offset " << offset << ", tilt " << tilt_deg << ", scale " << scale;
+      }
+      EXPECT_FALSE(ray_beyond_reach({cone.base + 3.0 * u1, cone.axis}, cone, reach)) << "parallel to the axis";
+      EXPECT_FALSE(ray_beyond_reach({cone.base + 3.0 * u1, across}, cone, std::numeric_limits<double>::infinity()));
+    }
+  }
 }
 
 // Writes the table once every test has run (SYLVA_ACCURACY_TABLE).
