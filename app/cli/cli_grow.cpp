@@ -8,6 +8,7 @@
 
 #include "app/cli/batch.h"
 #include "app/cli/cli.h"
+#include "core/scene.h"  // skeleton_bounds
 #include "core/util/file_io.h"
 #include "core/turtle.h"
 #include "lsystem/derive.h"
@@ -101,20 +102,14 @@ GrowOutcome grow_to_file(const lsys::Grammar& g, const GrammarArgs& a, const std
     out.error = std::move(written.error());
     return out;
   }
-  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-  if (!sk.joints.empty()) {
-    for (int k = 0; k < 3; ++k) lo[k] = std::numeric_limits<double>::infinity(), hi[k] = -lo[k];
-    for (const Joint& j : sk.joints)
-      for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], j.position_m[k] - j.radius_m);
-        hi[k] = std::max(hi[k], j.position_m[k] + j.radius_m);
-      }
-  }
+  // The joints grown by their radii and the leaves' vertices; [0,0,0]..[0,0,0] for nothing.
+  const SkeletonBounds box = skeleton_bounds(sk);
   std::ostringstream line;
   line << a.grammar << ": " << result->modules << " modules, " << sk.chains.size() << " chains, "
-       << sk.segment_count() << " segments, bbox [" << format_number(lo[0]) << "," << format_number(lo[1]) << ","
-       << format_number(lo[2]) << "]..[" << format_number(hi[0]) << "," << format_number(hi[1]) << ","
-       << format_number(hi[2]) << "] m, " << format_number(result->seconds * 1e3) << " ms";
+       << sk.segment_count() << " segments, bbox [" << format_number(box.lo.x) << "," << format_number(box.lo.y)
+       << "," << format_number(box.lo.z) << "]..[" << format_number(box.hi.x) << "," << format_number(box.hi.y) << ","
+       << format_number(box.hi.z) << "] m, " << format_number(result->seconds * 1e3) << " ms";
+  if (!sk.leaves.empty()) line << ", " << sk.leaves.size() << (sk.leaves.size() == 1 ? " leaf" : " leaves");
   if (result->turtle.zero_length_moves) line << ", " << result->turtle.zero_length_moves << " zero-length moves";
   out.summary = line.str();
   return out;

@@ -208,8 +208,9 @@ void GlViewport::run() {
       options.progress = Progress(&sh.cancel_build);
       version = plants->version;
       bool any = false;
-      for (const ScenePlant& p : plants->scene.plants) any |= p.skeleton && p.skeleton->segment_count() > 0;
-      if (!any) error = "the plant has no segments";
+      for (const ScenePlant& p : plants->scene.plants)
+        any |= p.skeleton && (p.skeleton->segment_count() > 0 || !p.skeleton->leaves.empty());
+      if (!any) error = "the plant has no segments or leaves";
       else if (auto why = gl_unsupported(plants->scene, options)) error = *why;
       else {
         try {
@@ -352,7 +353,7 @@ ViewImage GlViewport::image(const Scene& scene) {
   if (!texture_) return {};
   bool current = shown_version_ == plants_version_;
   {
-    // New plants that cannot be drawn (no segments, an error): nothing newer will come.
+    // New plants that cannot be drawn (no segments or leaves, an error): nothing newer will come.
     std::lock_guard<std::mutex> lock(shared_->mutex);
     if (shared_->built_version == plants_version_ && !shared_->error.empty() && !shared_->working && !shared_->view)
       current = true;

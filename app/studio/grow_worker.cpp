@@ -238,6 +238,7 @@ GrowOutcome GrowWorker::grow(const GrowRequest& request, uint64_t gen, bool* can
     if (!sk) return fail(sk.error());
     record_source(*sk, first, first.seed.value_or(g.seed), out.shown_step);
     out.segments += sk->segment_count();
+    out.leaves += sk->leaves.size();
     out.skeletons.push_back(std::move(*sk));
   }
   // The other plants that grow from this text (a scene): each with its own overrides.
@@ -260,6 +261,7 @@ GrowOutcome GrowWorker::grow(const GrowRequest& request, uint64_t gen, bool* can
     if (!sk) return fail(sk.error());
     record_source(*sk, v, v.seed.value_or(parsed->seed), v.steps.value_or(parsed->steps));
     out.segments += sk->segment_count();
+    out.leaves += sk->leaves.size();
     out.skeletons.push_back(std::move(*sk));
   }
   out.worker_seconds = seconds_since(start);

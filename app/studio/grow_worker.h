@@ -66,6 +66,7 @@ struct GrowOutcome {
   int64_t shown_step = 0;            // the step whose word the first skeleton shows
   uint64_t modules = 0;              // modules in that word
   uint64_t segments = 0;             // segments of all skeletons
+  uint64_t leaves = 0;               // leaves (polygons) of all skeletons
   bool from_cache = false;           // plants[0]'s word came from the step cache
   std::string warning;               // e.g. interpretation stopped at maximum depth
   double worker_seconds = 0;         // parse + derive + build, on the worker

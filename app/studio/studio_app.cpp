@@ -717,8 +717,11 @@ void StudioApp::draw_viewport(ImVec2 size) {
     if (viewport_)
       for (const RenderPass& p : viewport_->stats().passes)
         if (p.name.find("(GPU)") != std::string::npos) gpu_ms += p.seconds * 1e3;
-    ImGui::Text("%llu segments  step %lld/%lld  %llu modules  GPU %.1f ms  frame %.1f ms",
-                static_cast<unsigned long long>(plant_->segments), static_cast<long long>(plant_->shown_step),
+    char leaves[32] = "";
+    if (plant_->leaves > 0)
+      std::snprintf(leaves, sizeof leaves, "  %llu leaves", static_cast<unsigned long long>(plant_->leaves));
+    ImGui::Text("%llu segments%s  step %lld/%lld  %llu modules  GPU %.1f ms  frame %.1f ms",
+                static_cast<unsigned long long>(plant_->segments), leaves, static_cast<long long>(plant_->shown_step),
                 static_cast<long long>(plant_->steps), static_cast<unsigned long long>(plant_->modules), gpu_ms,
                 io.DeltaTime * 1e3);
   }

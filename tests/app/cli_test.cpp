@@ -436,6 +436,22 @@ TEST_F(CliTest, GrowPrintsOneSummaryLineAndWritesTheSkeleton) {
   EXPECT_EQ(list_dir(dir_.path()), (std::vector<std::string>{"g.lsys", "plant.skel.json"}));
 }
 
+// A polygon is a leaf: the summary counts the leaves after the time, and the box holds
+// their vertices (a plant of one leaf and no segment has the leaf's box, not a point).
+TEST_F(CliTest, GrowCountsTheLeavesAndBoxesThem) {
+  const std::string g = grammar("leaf.lsys", "angle: 90\nstep: 1\naxiom: {.f.+f.+f.}\n");
+  ProcessResult r = run_sylva({"grow", g, "-o", dir_.file("leaf.skel.json")});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  // From the origin up +Y to (0,1,0), turned toward L = -X to (-1,1,0), then down to (-1,0,0).
+  EXPECT_NE(r.out.find(": 11 modules, 0 chains, 0 segments, bbox [-1,0,0]..[0,1,0] m, "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" ms, 1 leaf\n"), std::string::npos) << r.out;
+
+  const std::string two = grammar("two.lsys", "angle: 90\nstep: 1\naxiom: F[{.f.+f.}][{.+f.+f.}]\n");
+  r = run_sylva({"grow", two, "-o", dir_.file("two.skel.json")});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.out.find(" ms, 2 leaves\n"), std::string::npos) << r.out;
+}
+
 TEST_F(CliTest, GrowRecordsSeedStepsAndDefinesInTheSkeletonSource) {
   const std::string g = grammar("g.lsys", "#define N 3\naxiom: F(N)\n");
   const std::string output = dir_.file("plant.skel.json");

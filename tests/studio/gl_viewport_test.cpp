@@ -78,6 +78,23 @@ TEST_F(Viewports, AFastRendererShowsNewPlantsInFullAtOnce) {
   EXPECT_EQ(full.width, 96u);
 }
 
+// A plant of leaves alone (a grammar of one polygon) is drawn; a plant of nothing says why.
+TEST_F(Viewports, APlantOfLeavesAloneIsDrawnAndAnEmptyOneSaysWhy) {
+  GlViewport viewport({}, /*preview_above_ms=*/1e9);
+  Skeleton leaf;
+  leaf.leaves = {Leaf{std::nullopt, 1, {{0, 0, 0}, {0.1, 0.1, 0}, {0, 0.3, 0}, {-0.1, 0.1, 0}}}};
+  Scene scene = default_scene_for(leaf, 64, 48);
+  viewport.set_plants(scene, RenderOptions{});
+  const ViewImage image = settle(viewport, scene);
+  EXPECT_TRUE(viewport.stats().error.empty()) << viewport.stats().error;
+  EXPECT_TRUE(image.texture);
+
+  scene.plants[0].skeleton = Skeleton{};
+  viewport.set_plants(scene, RenderOptions{});
+  settle(viewport, scene);
+  EXPECT_EQ(viewport.stats().error, "the plant has no segments or leaves");
+}
+
 // The passes' detail of the last picture's pass named `name`, or "" when it did not run.
 std::string pass_detail(const GlViewport& viewport, const std::string& name) {
   for (const RenderPass& p : viewport.stats().passes)

@@ -70,6 +70,16 @@ TEST_F(Fixture, OpensAGrammarAndShowsItsPlant) {
   EXPECT_TRUE(app->rect("field:LEN"));
 }
 
+TEST_F(Fixture, APlantsLeavesAreCountedBesideItsSegments) {
+  auto app = opened();
+  EXPECT_EQ(app->plant()->leaves, 0u);
+  click_line_end(*app, 8);
+  ui.type(*app, "{.+f.+f.}");  // a triangle after every branching: 15 at N = 4, as the segments
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plant_drawn() && app->plant()->leaves > 0; }));
+  EXPECT_EQ(app->plant()->leaves, 15u);
+  EXPECT_EQ(app->plant()->segments, 15u);
+}
+
 TEST_F(Fixture, TypingAnErrorMarksItsLineAndKeepsThePlantThenTheFixRegrows) {
   auto app = opened();
   click_line_end(*app, 8);
