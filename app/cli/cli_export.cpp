@@ -112,11 +112,13 @@ double number_flag(const std::string& name, const std::string& text, double lo, 
 bool is_flag(const std::string& a, const std::string& name) { return a == name || a.rfind(name + "=", 0) == 0; }
 
 // The one summary line export prints on stdout, like grow's: what was read, what was
-// written, its plants, chains and segments, the file's size and the time taken.
+// written, its plants, chains and segments (and leaves, where there are any), the file's
+// size and the time taken.
 std::string export_summary(const std::string& input, const std::string& output, const std::vector<GltfPlant>& plants,
                            std::chrono::steady_clock::time_point start) {
-  size_t chains = 0, segments = 0;
-  for (const GltfPlant& p : plants) chains += p.skeleton.chains.size(), segments += p.skeleton.segment_count();
+  size_t chains = 0, segments = 0, leaves = 0;
+  for (const GltfPlant& p : plants)
+    chains += p.skeleton.chains.size(), segments += p.skeleton.segment_count(), leaves += p.skeleton.leaves.size();
   std::error_code ec;
   const uintmax_t bytes = std::filesystem::file_size(output, ec);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -124,6 +126,7 @@ std::string export_summary(const std::string& input, const std::string& output, 
   std::snprintf(time, sizeof time, "%.4g", ms);
   return input + " -> " + output + ": " + std::to_string(plants.size()) + (plants.size() == 1 ? " plant, " : " plants, ") +
          std::to_string(chains) + " chains, " + std::to_string(segments) + " segments, " +
+         (leaves ? std::to_string(leaves) + (leaves == 1 ? " leaf, " : " leaves, ") : std::string()) +
          (ec ? std::string("? bytes") : std::to_string(bytes) + " bytes") + ", " + time + " ms";
 }
 

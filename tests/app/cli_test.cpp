@@ -436,9 +436,10 @@ TEST_F(CliTest, GrowPrintsOneSummaryLineAndWritesTheSkeleton) {
   EXPECT_EQ(list_dir(dir_.path()), (std::vector<std::string>{"g.lsys", "plant.skel.json"}));
 }
 
-// A polygon is a leaf: the summary counts the leaves after the time, and the box holds
-// their vertices (a plant of one leaf and no segment has the leaf's box, not a point).
-TEST_F(CliTest, GrowCountsTheLeavesAndBoxesThem) {
+// A polygon is a leaf: grow's summary counts the leaves after the time, and its box holds
+// their vertices (a plant of one leaf and no segment has the leaf's box, not a point);
+// export's counts them after the segments.
+TEST_F(CliTest, GrowAndExportCountTheLeavesAndGrowBoxesThem) {
   const std::string g = grammar("leaf.lsys", "angle: 90\nstep: 1\naxiom: {.f.+f.+f.}\n");
   ProcessResult r = run_sylva({"grow", g, "-o", dir_.file("leaf.skel.json")});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
@@ -450,6 +451,10 @@ TEST_F(CliTest, GrowCountsTheLeavesAndBoxesThem) {
   r = run_sylva({"grow", two, "-o", dir_.file("two.skel.json")});
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_NE(r.out.find(" ms, 2 leaves\n"), std::string::npos) << r.out;
+
+  r = run_sylva({"export", two, "-o", dir_.file("two.glb")});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.out.find(": 1 plant, 1 chains, 1 segments, 2 leaves, "), std::string::npos) << r.out;
 }
 
 TEST_F(CliTest, GrowRecordsSeedStepsAndDefinesInTheSkeletonSource) {
