@@ -44,8 +44,8 @@ constexpr uint64_t kR2Step1 = 0x91E10DA5C79E7B1CULL;  // 2^64 / g²
 
 double unit_from_fixed(uint64_t x) { return static_cast<double>(x >> 11) * 0x1.0p-53; }
 
-// sin and cos of x for |x| <= π/4, by their Taylor series to x¹⁵ and x¹⁶: the first term
-// left out is below 5e-17 · x there, so both are within an ulp or two of libm's and
+// sin and cos of x for |x| <= π/4, by their Taylor series to x¹⁵ and x¹⁶: the first terms
+// left out are below 6e-17·|x| and 2e-18 there, so both are within an ulp or two of libm's and
 // several times cheaper (the photons' positions called sincos for every photon).
 glm::dvec2 cos_sin_quarter(double x) {
   const double x2 = x * x;
