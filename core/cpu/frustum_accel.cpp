@@ -152,6 +152,8 @@ bool FrustumAccel::any(const Ray& ray, double t_min, double t_max) const {
   return q.best.hit_any();
 }
 
-size_t FrustumAccel::memory_bytes() const { return impl_->embree.memory_bytes(); }
+size_t FrustumAccel::memory_bytes() const {
+  return impl_->embree.memory_bytes() + impl_->reach.capacity() * sizeof(double);
+}
 
 }  // namespace sylva

@@ -66,7 +66,7 @@ class FrustumAccel {
   BvhHit nearest(const Ray& ray, double t_min, double t_max, CustomHitDetail* detail = nullptr) const;
   // Whether anything is hit with t_min < t < t_max (shadow rays).
   bool any(const Ray& ray, double t_min, double t_max) const;
-  // Bytes Embree allocated for the structure.
+  // Bytes of the structure: Embree's allocations and each frustum's reach.
   size_t memory_bytes() const;
 
  private:
