@@ -107,7 +107,7 @@ class Rewriter {
     }
   }
 
-  // Interpretation without context (grammar.md "Interpretation rules"), depth first: each
+  // Interpretation without context (docs/spec/grammar.md "Interpretation rules"), depth first: each
   // module of `in` is expanded completely, its successors in turn up to `max_depth`, before
   // the next one, so a module without a production is copied once rather than once per
   // pass. The result, random streams and lineage keys are those of the passes (pass d

@@ -1,4 +1,4 @@
-// derive.h — parallel rewriting of a word by a compiled grammar (grammar.md).
+// derive.h — parallel rewriting of a word by a compiled grammar (docs/spec/grammar.md).
 //
 // derive() applies the grammar's productions `steps` times to the axiom. Every module is
 // rewritten in parallel using the word before the step as context; a module with no

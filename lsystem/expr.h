@@ -1,4 +1,4 @@
-// expr.h — the expression language of grammar.md, compiled once to bytecode.
+// expr.h — the expression language of docs/spec/grammar.md, compiled once to bytecode.
 //
 // Expressions (arguments, conditions, probabilities, directive values) are parsed once
 // and compiled into one flat instruction array per grammar; evaluation is a small stack
@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "core/util/diagnostic.h"
-#include "lsystem/random.h"
+#include "core/util/random.h"
 
 namespace sylva::lsys {
 

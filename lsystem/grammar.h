@@ -1,4 +1,4 @@
-// grammar.h — a parsed and compiled grammar (grammar.md), ready to derive.
+// grammar.h — a parsed and compiled grammar (docs/spec/grammar.md), ready to derive.
 //
 // parse_grammar() reads .lsys text once: it checks UTF-8, strips comments, joins
 // continuation lines, evaluates #defines (with overrides) and header directives,
@@ -57,7 +57,7 @@ struct Production {
   bool has_context() const { return !left_context.empty() || !right_context.empty(); }
 };
 
-// Turtle settings from the header (grammar.md "Header directives").
+// Turtle settings from the header (docs/spec/grammar.md "Header directives").
 struct TurtleDefaults {
   double angle_deg = 90;
   double width = 0.05;  // initial radius in metres

@@ -1,4 +1,4 @@
-// parser.cpp — reads .lsys text (grammar.md) into a compiled Grammar.
+// parser.cpp — reads .lsys text (docs/spec/grammar.md) into a compiled Grammar.
 //
 // Pipeline: validate UTF-8 → blank out /* */ comments (keeping line/column) → join
 // continuation lines into logical lines that remember each byte's place → classify each

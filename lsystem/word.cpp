@@ -1,4 +1,4 @@
-// word.cpp — symbol table, word storage and word printing (grammar.md "Printing a word").
+// word.cpp — symbol table, word storage and word printing (docs/spec/grammar.md "Printing a word").
 #include "lsystem/word.h"
 
 #include <algorithm>

@@ -110,7 +110,7 @@ struct Word {
   void clear();
 };
 
-// Prints a word as grammar.md "Printing a word" says: modules without separators,
+// Prints a word as docs/spec/grammar.md "Printing a word" says: modules without separators,
 // arguments in shortest round-trip decimal, a space after a module only where the next
 // module would otherwise merge with it when read back.
 // Its cost is the word's length times at most the longest declared name (the look-ahead

@@ -238,7 +238,7 @@ def make_cactus(n):
     return to_u8(srgb_encode(colour)), to_u16(height)
 
 
-# --- the well's stone and roof tiles (paper 000 fig. 10) --------------------------------
+# --- the well's stone and roof tiles (Bhagvat et al. 2009 fig. 10) --------------------------------
 
 STONE_COURSES = 8        # courses of blocks per repeat along t
 STONE_BLOCKS = 6         # blocks per course across s (alternate courses offset by half)

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Renders every bundled preset and scene on both backends (and the scenes' mesh baseline;
-# fog scenes on the CPU, which alone renders their default fog mode, auto, for now)
-# into a folder, so that two builds can be compared byte for byte: a refactor that must not
-# change behaviour shows `identical` for every file.
+# fog scenes on the CPU, which alone renders their default fog mode, auto, for now), grows
+# every preset's skeleton and exports every preset and scene as glTF (with and without
+# the mesh) into a folder, so that two builds can be compared byte for byte: a refactor
+# that must not change behaviour shows `identical` for every file.
 #
 #   scripts/render-identity.sh SYLVA_BINARY OUT_DIR          # render
 #   scripts/render-identity.sh --compare DIR_A DIR_B         # compare two renders
@@ -51,4 +52,15 @@ for input in presets/*.lsys presets/scenes/*.scene.json; do
     done;;
   esac
 done
-echo "rendered $(ls "$out" | wc -l) files into $out"
+# Skeletons and glTF exports: the same bytes from the same inputs.
+for input in presets/*.lsys; do
+  name=$(basename "$input" .lsys)
+  "$sylva" grow "$input" -o "$out/${name}.skel.json" >/dev/null || { echo "grow failed: $input"; exit 1; }
+  "$sylva" export "$input" -o "$out/${name}.gltf" >/dev/null || { echo "export failed: $input"; exit 1; }
+  "$sylva" export "$input" -o "$out/${name}_mesh.glb" --mesh >/dev/null || { echo "mesh export failed: $input"; exit 1; }
+done
+for input in presets/scenes/*.scene.json; do
+  name=scene_$(basename "$input" .scene.json)
+  "$sylva" export "$input" -o "$out/${name}_mesh.glb" --mesh >/dev/null || { echo "export failed: $input"; exit 1; }
+done
+echo "rendered and exported $(ls "$out" | wc -l) files into $out"

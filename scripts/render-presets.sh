@@ -22,7 +22,7 @@ out=${2:-out/presets}
 backend=${BACKEND:-cpu} width=${WIDTH:-320} height=${HEIGHT:-240} spp=${SPP:-8}
 mkdir -p "$out" docs/images
 
-# Table 1 of paper 000 (Bhagvat, Jeschke, Cline, Wonka 2009): the segment counts of its plants.
+# Table 1 of Bhagvat et al. 2009 (Bhagvat, Jeschke, Cline, Wonka 2009): the segment counts of its plants.
 paper_count() {
   case $1 in
     pine | pine_dense) echo 16997 ;; coconut_palm) echo 3713 ;; elm | elm_in_leaf) echo 1833 ;;

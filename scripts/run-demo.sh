@@ -4,7 +4,7 @@
 # saguaro with the OpenGL backend (a window-less EGL context: Mesa's llvmpipe on a machine
 # without a GPU, no X server) to out/saguaro.png, then its scene (bark texture, relief-mapped
 # ribs) to out/saguaro_ribs.png, and a stand of pines toward a low sun in fog, with
-# crepuscular rays, on the CPU (sun photons, shadow cones, the fog's in-scatter: spec/fog.md)
+# crepuscular rays, on the CPU (sun photons, shadow cones, the fog's in-scatter: docs/spec/fog.md)
 # to out/pine_stand_fog.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,7 +20,7 @@ build/release/app/sylva render presets/saguaro.lsys -o out/saguaro.png --width 8
 # The same plant in its scene: bark texture and relief-mapped ribs, marched in the shaders.
 build/release/app/sylva render presets/scenes/saguaro.scene.json -o out/saguaro_ribs.png --width 800 --height 600 \
   --backend gl
-# Crepuscular rays: the fog's shafts between the crowns (paper 002; about half a minute on
+# Crepuscular rays: the fog's shafts between the crowns (Hougs and Day 2001; about half a minute on
 # two cores: one million sun photons, their shadow cones, refined in-scatter; one sample per
 # pixel, where the default 8 would march the fog 8 times: docs/benchmarks.md "Samples per pixel").
 build/release/app/sylva render presets/scenes/pine_stand_low_sun.scene.json -o out/pine_stand_fog.png --width 480 \

@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libgtest-dev libgmock-dev libbenchmark-dev
   libembree-dev  # Embree 3: the peer that `sylva bench raycast` measures against
-  libnanoflann-dev  # kd-tree of the shadow-cone clustering (core/shadow_cones.cpp)
+  libnanoflann-dev  # kd-tree of the shadow-cone clustering (core/light/shadow_cones.cpp)
   # The design card's libraries; later stages link them (render, GUI, export).
   libglm-dev libglfw3-dev libimgui-dev libopenimageio-dev libtinygltf-dev
   # The Python module (built for /usr/bin/python3) and its tests.

@@ -1,5 +1,5 @@
 // fog.frag.glsl — the fog resolve, one fragment per pixel: what the fog adds along the
-// pixel's ray (spec/fog.md, "What a pixel sees"), by core/fog_integrator.cpp's equation with
+// pixel's ray (docs/spec/fog.md, "What a pixel sees"), by core/scene/fog_integrator.cpp's equation with
 // fog.glsl's closed forms (the file before fog_lists.glsl), added into the accumulated
 // beauty — whose surface term the shade pass already multiplied by T(0, t_end) and whose
 // sunlight by T_sun — and written, with T, to the fog AOV.

@@ -1,4 +1,4 @@
-// fog.glsl — the GLSL twin of core/fog.h / fog.cpp: the medium of spec/fog.md and its
+// fog.glsl — the GLSL twin of core/light/fog.h / fog.cpp: the medium of docs/spec/fog.md and its
 // closed forms (density, Schlick's phase function, optical depth and transmittance along a
 // segment and toward the sun, the single-scattering integrals over a lit segment and the
 // inverse of their distribution), in float. The same names, the same arguments in the

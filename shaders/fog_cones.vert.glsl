@@ -1,5 +1,5 @@
 // fog_cones.vert.glsl — vertex pulling for the shadow cones, as frusta.vert.glsl for the
-// frusta (paper 000 sec. 2.6): vertex gl_VertexID draws corner kPyramidTriangles[gl_VertexID
+// frusta (Bhagvat et al. 2009 sec. 2.6): vertex gl_VertexID draws corner kPyramidTriangles[gl_VertexID
 // % PYRAMID_VERTICES] of the bounding pyramid of cone gl_VertexID / PYRAMID_VERTICES, built
 // from its record (fog_lists.glsl); no vertex buffer.
 

@@ -1,5 +1,5 @@
 // fog_lists.glsl — the per-pixel lists of the shadow cones' intervals along the camera
-// rays (paper 002 sec. 3.3.1, in a rasteriser): what the cone pass (fog_cones.vert/
+// rays (Hougs and Day 2001 sec. 3.3.1, in a rasteriser): what the cone pass (fog_cones.vert/
 // frag.glsl) writes and the fog resolve (fog.frag.glsl) reads.
 //
 // The lists: one linked list per pixel in shader storage, appended to by every cone

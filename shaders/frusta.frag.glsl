@@ -1,4 +1,4 @@
-// frusta.frag.glsl — ray casting one frustum per fragment (paper 000, sec. 2.5): the ray
+// frusta.frag.glsl — ray casting one frustum per fragment (Bhagvat et al. 2009, sec. 2.5): the ray
 // through this fragment in the record's frame, intersect_frustum_f (ray_frustum.glsl), a
 // discard on a miss, and the real hit depth in gl_FragDepth.
 //

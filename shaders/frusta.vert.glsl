@@ -1,4 +1,4 @@
-// frusta.vert.glsl — vertex pulling (paper 000, sec. 2.6): vertex gl_VertexID draws corner
+// frusta.vert.glsl — vertex pulling (Bhagvat et al. 2009, sec. 2.6): vertex gl_VertexID draws corner
 // kPyramidTriangles[gl_VertexID % 36] of the bounding pyramid of frustum gl_VertexID / 36
 // (36: PYRAMID_VERTICES, bindings.glsl),
 // built from its GpuSegment record (around the relief's shell where the plant has one); no

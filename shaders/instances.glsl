@@ -5,7 +5,7 @@
 #ifdef INSTANCED
 // Plants that share a skeleton (docs/scatter.md "Instancing"): the skeleton's records once,
 // in its own frame, drawn once per plant through the plant's place_plant transform
-// p_world = position + R_y·(scale·p) (core/instances.h), position as hi + lo floats. own = 1:
+// p_world = position + R_y·(scale·p) (core/scene/instances.h), position as hi + lo floats. own = 1:
 // the identity standing for the plants skinned in the world, whose records keep their
 // frames and plants (drawn exactly as without INSTANCED). core/gl/gl_instances.h mirrors it.
 struct GpuInstance {

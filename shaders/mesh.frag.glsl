@@ -1,4 +1,4 @@
-// mesh.frag.glsl — the polygon baseline's fragment (paper 000 sec. 4, GS and GS+R): what
+// mesh.frag.glsl — the polygon baseline's fragment (Bhagvat et al. 2009 sec. 4, GS and GS+R): what
 // mesh_accel.cpp's MeshTracer::nearest reports for the ray through this fragment, written
 // into the G-buffer exactly as frusta.frag.glsl writes a ray-cast hit (shade.frag.glsl
 // reads both alike). No discard, no gl_FragDepth: the rasterised depth is the hit's.

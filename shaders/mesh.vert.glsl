@@ -1,4 +1,4 @@
-// mesh.vert.glsl — the polygon baseline (paper 000 sec. 4, GS and GS+R): one vertex of a
+// mesh.vert.glsl — the polygon baseline (Bhagvat et al. 2009 sec. 4, GS and GS+R): one vertex of a
 // tessellated mesh (tessellate.h) as core/gl_mesh.cpp uploads it, projected as
 // frusta.vert.glsl projects a bounding pyramid's corner (views.glsl), so both fill one
 // G-buffer alike.

@@ -1,4 +1,4 @@
-// ray_frustum.glsl — the GLSL twin of core/ray_frustum.cpp's float intersector (paper 000,
+// ray_frustum.glsl — the GLSL twin of core/geometry/ray_frustum.cpp's float intersector (Bhagvat et al. 2009,
 // sec. 2.5, eq. 9–10, made robust): the same structs and functions, same names, same
 // order, same order of operations, so the two read side by side. What each step does and
 // why is said once, in ray_frustum.cpp; only GLSL-specific points are noted here.

@@ -1,4 +1,4 @@
-// relief.glsl — the GLSL twin of core/relief.cpp (paper 000, sec. 3, eq. 11–12): the shell
+// relief.glsl — the GLSL twin of core/geometry/relief.cpp (Bhagvat et al. 2009, sec. 3, eq. 11–12): the shell
 // of a frustum, a ray's interval in a solid frustum, and the march through the shell
 // (uniform steps, then bisection) against the plant's height field. Same structs and
 // functions, same names and order as relief.cpp; what each step does and why is said once,

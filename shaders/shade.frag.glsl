@@ -1,6 +1,6 @@
 // shade.frag.glsl — deferred shading, one fragment per pixel: render_cpu.cpp's shade() and
 // lit(), reading what frusta.frag.glsl wrote, through the model's functions in shading.glsl
-// (the file before this one; the model is stated in core/shading.h). The ground plane and
+// (the file before this one; the model is stated in core/light/shading.h). The ground plane and
 // the sky are found here analytically, as the CPU does per ray.
 //
 // Sun visibility comes from a shadow map rendered by the same ray-casting shaders

@@ -1,7 +1,7 @@
-// shading.glsl — the shading model of core/shading.h in float, function by function: the
+// shading.glsl — the shading model of core/light/shading.h in float, function by function: the
 // same names, the same arguments in the same order, the same expressions in the same order
 // (the header states the model, units and preconditions; tests/gl/gl_shading_twin_test.cpp
-// compares the two case by case). The constants come from core/shading.h through
+// compares the two case by case). The constants come from core/light/shading.h through
 // #defines (gl_shaders.h shading_defines), so they cannot drift.
 
 #if !defined(SHADING_SPECULAR) || !defined(SHADING_SHININESS)

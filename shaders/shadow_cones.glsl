@@ -1,4 +1,4 @@
-// shadow_cones.glsl — the shadow cones of core/shadow_cones.h on the GPU: their record
+// shadow_cones.glsl — the shadow cones of core/light/shadow_cones.h on the GPU: their record
 // (uploaded once per plants and sun by core/gl/gl_fog.cpp), the solid as a frustum shape,
 // and a ray's interval through it, for the fog's cone pass (fog_cones.vert/frag.glsl).
 //

@@ -1,4 +1,4 @@
-// skin.glsl — the GLSL side of core/skin.h: the axis frame, u/v (eq. 7), the eq. 8 normal,
+// skin.glsl — the GLSL side of core/geometry/skin.h: the axis frame, u/v (eq. 7), the eq. 8 normal,
 // the bounding pyramid of sec. 2.6, and the 64-byte GpuSegment record with its unpacking.
 // Same names and order as skin.h / skin.cpp, in float, relative to the record's origin_hi.
 //

@@ -1,5 +1,5 @@
 // bench_fog.cpp — `sylva bench fog SCENE`: error against run time of the fog modes of
-// spec/fog.md (brute, medium, fast, refined) against the converged `reference`, with the
+// docs/spec/fog.md (brute, medium, fast, refined) against the converged `reference`, with the
 // cost and quality of the sun photons and shadow cones they use (core/cpu/photons.h), each
 // setting with several seeds.
 //
@@ -42,15 +42,16 @@
 #include "app/bench/bench_metrics.h"
 #include "app/bench/fog_view.h"
 #include "app/bench/plot.h"
-#include "app/cli/cli.h"
-#include "app/cli/render_input.h"
+#include "app/bench/bench.h"
+#include "app/front/render_input.h"
 #include "core/cpu/photons.h"
 #include "core/cpu/render_cpu.h"
-#include "core/fog_integrator.h"
-#include "core/render_common.h"
-#include "core/shading.h"
+#include "core/scene/fog_integrator.h"
+#include "core/scene/render_common.h"
+#include "core/light/shading.h"
 #include "core/util/file_io.h"
-#include "lsystem/random.h"
+#include "core/util/random.h"
+#include "core/util/clock.h"
 
 namespace sylva::cli {
 
@@ -344,7 +345,7 @@ int run_bench_fog(const std::vector<std::string>& args) {
   if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
   const Scene scene = std::move(std::get<Scene>(loaded));
   if (!a.cones_only && !scene.fog) {
-    std::cerr << "sylva bench fog: " << a.grammar.grammar << " has no fog key (spec/fog.md); --cones-only measures "
+    std::cerr << "sylva bench fog: " << a.grammar.grammar << " has no fog key (docs/spec/fog.md); --cones-only measures "
                  "its photons and cones alone\n";
     return kInputError;
   }
@@ -421,7 +422,7 @@ int run_bench_fog(const std::vector<std::string>& args) {
     o.steps = std::max(1u, row.steps);
     const FogIntegrator integrator(*medium, fog_sun_of(scene.sun), scene.sky, *g.tracer, cones, o);
     double cpu = 0;
-    const std::vector<float> image = fog_image(view, integrator, lsys::mix_pair(row.seed, 0x666f67), threads,
+    const std::vector<float> image = fog_image(view, integrator, mix_pair(row.seed, 0x666f67), threads,
                                                &row.render_s, &cpu);
     if (a.cpu_clock) row.render_s = cpu / threads;
     row.total_s = row.photon_s + row.cone_s + row.render_s;
@@ -460,9 +461,9 @@ int run_bench_fog(const std::vector<std::string>& args) {
         o.photons.seed = seed;
         o.photons.threads = threads;
         if (!automatic) o.params = a.fixed_params;
-        const double cpu_start = render_common::process_cpu_seconds();
+        const double cpu_start = process_cpu_seconds();
         const auto c = build_sun_cones(g, scene, o, &tracer);
-        const double cpu_s = render_common::process_cpu_seconds() - cpu_start;
+        const double cpu_s = process_cpu_seconds() - cpu_start;
         double params_s = 0;
         for (const RenderPass& p : c->passes)
           if (p.name == "cone params") params_s = p.seconds;
@@ -473,11 +474,11 @@ int run_bench_fog(const std::vector<std::string>& args) {
           std::vector<ConeInterval> intervals;
           Scene probe = scene;
           probe.width = 256, probe.height = 192;
-          const auto start = render_common::Clock::now();
+          const auto start = Clock::now();
           for (uint32_t y = 0; y < probe.height; ++y)
             for (uint32_t x = 0; x < probe.width; ++x)
               c->cones.intervals(camera_ray(probe, x + 0.5, y + 0.5), 0, 1e30, &intervals);
-          query_us = render_common::seconds_since(start) / (double(probe.width) * probe.height) * 1e6;
+          query_us = seconds_since(start) / (double(probe.width) * probe.height) * 1e6;
         }
         const ConeCoverage cov = c->coverage.value_or(ConeCoverage{});
         char line[512];

@@ -29,8 +29,8 @@
 #include <vector>
 
 #include "app/bench/bench_metrics.h"
-#include "app/cli/cli.h"
-#include "app/cli/render_input.h"
+#include "app/bench/bench.h"
+#include "app/front/render_input.h"
 #include "core/util/file_io.h"
 #include "app/bench/plot.h"
 #include "core/cpu/render_cpu.h"

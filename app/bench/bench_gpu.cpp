@@ -1,5 +1,5 @@
 // bench_gpu.cpp — `sylva bench gpu [INPUT...]`: error against GPU time of every way the
-// GL backend can draw the plants (docs/benchmarks.md, "Error against GPU time"; paper 000 sec. 4, Table 1 and the
+// GL backend can draw the plants (docs/benchmarks.md, "Error against GPU time"; Bhagvat et al. 2009 sec. 4, Table 1 and the
 // dancing cacti of fig. 8).
 //
 // For each input and image size, each method builds one GlRenderer (render_gl.h), renders
@@ -16,7 +16,7 @@
 //   RC+R s×b    relief-mapped frusta, s uniform and b bisection steps, v interpolated;
 //   GS m        the frusta tessellated at GS level m (16·4^m triangles a segment);
 //   GS+R m      the same meshes displaced by the height map;
-//   RC-anim     RC with every plant swaying (core/animate.h; a scene's `animation` key's
+//   RC-anim     RC with every plant swaying (core/scene/animate.h; a scene's `animation` key's
 //               motion where it has one: the dancing cacti dance) at 60 frames a second of
 //               animation time: per frame the skeletons are swayed, re-skinned and their
 //               segment records uploaded again (GlRenderer::update_plants); the CPU time
@@ -54,21 +54,20 @@
 #include "app/bench/bench_gpu_fog.h"
 #include "app/bench/bench_rows.h"
 #include "app/bench/bench_metrics.h"
-#include "app/cli/cli.h"
-#include "app/cli/render_input.h"
-#include "core/animate.h"
+#include "app/bench/bench.h"
+#include "app/front/render_input.h"
+#include "core/scene/animate.h"
 #include "core/util/file_io.h"
 #include "core/gl/gl_context.h"
 #include "app/bench/plot.h"
-#include "core/render_common.h"
+#include "core/scene/render_common.h"
 #include "core/gl/render_gl.h"
+#include "core/util/clock.h"
 
 namespace sylva::cli {
 
 namespace {
 
-using render_common::Clock;
-using render_common::seconds_since;
 
 const char* const kFamilies[] = {"RC", "RC-nocd", "RC+R", "GS", "GS+R", "RC-anim"};
 

@@ -20,10 +20,9 @@
 #include <vector>
 
 #include "app/bench/bench_lsystem_scaling.h"
-#include "app/cli/cli.h"
-#include "core/turtle.h"
-#include "lsystem/derive.h"
-#include "lsystem/grammar.h"
+#include "app/bench/bench.h"
+#include "core/grow/turtle.h"
+#include "core/grow/grow.h"
 
 namespace sylva::cli {
 

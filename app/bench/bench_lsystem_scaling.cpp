@@ -7,8 +7,7 @@
 #include <iostream>
 #include <string>
 
-#include "lsystem/derive.h"
-#include "lsystem/grammar.h"
+#include "core/grow/grow.h"
 
 namespace sylva::cli {
 

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <filesystem>
 
-#include "app/cli/cli.h"
-#include "app/cli/render_input.h"
+#include "app/front/args.h"
+#include "app/front/render_input.h"
 
 namespace sylva::cli {
 

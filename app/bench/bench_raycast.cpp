@@ -34,15 +34,15 @@
 #include <vector>
 
 #include "app/bench/bench_metrics.h"
-#include "app/cli/cli.h"
+#include "app/bench/bench.h"
 #include "core/cpu/bvh.h"
 #include "core/cpu/frustum_accel.h"
 #include "core/cpu/mesh_accel.h"
 #include "core/cpu/render_cpu.h"
-#include "core/scene.h"
-#include "core/tessellate.h"
-#include "core/turtle.h"
-#include "lsystem/grammar.h"
+#include "core/scene/scene.h"
+#include "core/geometry/tessellate.h"
+#include "core/grow/turtle.h"
+#include "core/grow/grow.h"
 
 namespace sylva::cli {
 

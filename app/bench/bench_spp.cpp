@@ -34,10 +34,11 @@
 
 #include "app/bench/bench_metrics.h"
 #include "app/bench/plot.h"
-#include "app/cli/cli.h"
-#include "app/cli/render_input.h"
+#include "app/bench/bench.h"
+#include "app/front/render_input.h"
 #include "core/cpu/render_cpu.h"
 #include "core/gl/gl_context.h"
+#include "app/front/render.h"
 #include "core/gl/render_gl.h"
 #include "core/util/color.h"
 #include "core/util/file_io.h"
@@ -185,7 +186,7 @@ RenderResult render_timed(const Scene& scene, const std::string& backend, uint32
   options.spp = spp;
   options.threads = threads;
   const auto start = std::chrono::steady_clock::now();
-  RenderResult result = backend == "gl" ? render_gl(scene, options) : render_cpu(scene, options);
+  RenderResult result = backend == "gl" ? render_gl_scene(scene, options) : render_cpu(scene, options);
   *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -6,9 +6,10 @@
 #include <limits>
 #include <thread>
 
-#include "core/render_common.h"
-#include "core/shading.h"
-#include "lsystem/random.h"
+#include "core/scene/render_common.h"
+#include "core/light/shading.h"
+#include "core/util/random.h"
+#include "core/util/clock.h"
 
 namespace sylva::cli {
 
@@ -49,14 +50,14 @@ std::vector<float> fog_image(const View& v, const FogIntegrator& integrator, uin
   const size_t n = v.origin.size();
   std::vector<float> out(n * 3);
   std::atomic<size_t> next{0};
-  const auto start = render_common::Clock::now();
-  const double cpu_start = render_common::process_cpu_seconds();
+  const auto start = Clock::now();
+  const double cpu_start = process_cpu_seconds();
   auto worker = [&] {
     for (;;) {
       const size_t begin = next.fetch_add(256);
       if (begin >= n) return;
       for (size_t i = begin; i < std::min(n, begin + 256); ++i) {
-        render_common::SampleRng rng(lsys::mix_pair(seed, i));
+        render_common::SampleRng rng(mix_pair(seed, i));
         const FogRayResult r = integrator.integrate(v.origin[i], v.direction[i], v.t_end[i], rng);
         for (int c = 0; c < 3; ++c) out[i * 3 + c] = static_cast<float>(r.inscatter[c]);
       }
@@ -66,8 +67,8 @@ std::vector<float> fog_image(const View& v, const FogIntegrator& integrator, uin
   for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
   worker();
   for (std::thread& t : pool) t.join();
-  *seconds = render_common::seconds_since(start);
-  if (cpu_seconds) *cpu_seconds = render_common::process_cpu_seconds() - cpu_start;
+  *seconds = seconds_since(start);
+  if (cpu_seconds) *cpu_seconds = process_cpu_seconds() - cpu_start;
   return out;
 }
 

@@ -1,6 +1,6 @@
 // fog_view.h — the fog AOV's in-scatter through pixel centres, as render_cpu computes it,
 // for the benchmarks that measure fog error (bench fog: the CPU modes; bench gpu --fog:
-// the GL pass) against the CPU `reference` mode (spec/fog.md).
+// the GL pass) against the CPU `reference` mode (docs/spec/fog.md).
 //
 // A View holds a scene camera's pixel-centre rays (unit directions, world metres) and
 // where each ends: the first plant or the ground, +inf for the sky. A strided view keeps a
@@ -15,9 +15,9 @@
 
 #include <glm/vec3.hpp>
 
-#include "core/fog_integrator.h"
-#include "core/scene.h"
-#include "core/surface.h"
+#include "core/scene/fog_integrator.h"
+#include "core/scene/scene.h"
+#include "core/geometry/surface.h"
 
 namespace sylva::cli {
 

@@ -1,56 +1,17 @@
-// cli.h — the `sylva` command line (../shared/spec/cli.md): shared argument handling and
-// the subcommands' entry points.
-//
-// Exit status: 0 success, 1 a failure of the input (bad grammar, unreadable file),
-// 2 a usage error, 3 an internal error. Messages go to stderr as
-// "file:line:column: error: ..." where a place is known.
+// cli.h — the `sylva` command line's subcommands (docs/spec/cli.md); app/main.cpp
+// dispatches to them, the benchmarks (app/bench/bench.h) and the studio. Shared flags and
+// exit statuses: app/front/args.h.
 #pragma once
 
-#include <cstdint>
-#include <map>
-#include <optional>
 #include <string>
 #include <vector>
 
+#include "app/front/args.h"
+
 namespace sylva::cli {
-
-enum ExitCode : int { kOk = 0, kInputError = 1, kUsageError = 2, kInternalError = 3 };
-
-// Thrown for usage errors; main() prints "sylva SUBCOMMAND: error: message" and exits 2.
-struct UsageError {
-  std::string message;
-};
-
-// The grammar-related flags shared by derive, grow (and later render/export).
-struct GrammarArgs {
-  std::string grammar;                    // positional GRAMMAR
-  std::optional<int64_t> steps;           // -n / --steps
-  std::optional<uint64_t> seed;           // --seed
-  std::map<std::string, double> defines;  // -D NAME=VALUE
-  uint64_t max_modules = 50'000'000;      // --max-modules
-  std::string output;                     // -o / --output
-  bool help = false;
-};
-
-// Parses argv (after the subcommand name). `wants_output`: accept -o. Throws UsageError.
-GrammarArgs parse_grammar_args(const std::vector<std::string>& args, bool wants_output);
-
-// Parses an unsigned 64-bit integer exactly (no doubles); nullopt if not one.
-std::optional<uint64_t> parse_u64(const std::string& text);
 
 int run_derive(const std::vector<std::string>& args);
 int run_grow(const std::vector<std::string>& args);
-int run_bench(const std::vector<std::string>& args);
-// `sylva bench raycast` (bench_raycast.cpp), dispatched by run_bench.
-int run_bench_raycast(const std::vector<std::string>& args);
-// `sylva bench geometry` (bench_geometry.cpp), dispatched by run_bench.
-int run_bench_geometry(const std::vector<std::string>& args);
-// `sylva bench gpu` (bench_gpu.cpp), dispatched by run_bench.
-int run_bench_gpu(const std::vector<std::string>& args);
-// `sylva bench fog` (bench_fog.cpp), dispatched by run_bench.
-int run_bench_fog(const std::vector<std::string>& args);
-// `sylva bench spp` (bench_spp.cpp), dispatched by run_bench.
-int run_bench_spp(const std::vector<std::string>& args);
 int run_render(const std::vector<std::string>& args);
 int run_export(const std::vector<std::string>& args);
 

@@ -1,9 +1,9 @@
 // cli_export.cpp — `sylva export INPUT -o FILE.gltf|FILE.glb [--mesh] [--segments-around N]`
-// (cli.md): a grammar, skeleton or scene to glTF 2.0 with the skeleton in the
-// node extras (core/gltf_export.h; `--extras compact|full|none`, compact by default:
+// (docs/spec/cli.md): a grammar, skeleton or scene to glTF 2.0 with the skeleton in the
+// node extras (core/io/gltf.h; `--extras compact|full|none`, compact by default:
 // docs/gltf.md); `--seed A..B` with `-o out/p_{seed}.glb` exports a
 // batch in parallel (app/batch.h). The mesh's bark comes from each plant of a scene, or
-// for a grammar or skeleton from the --bark-* flags (scene.md's bark keys as flags).
+// for a grammar or skeleton from the --bark-* flags (docs/spec/scene.md's bark keys as flags).
 #include <charconv>
 #include <chrono>
 #include <cstdio>
@@ -14,12 +14,14 @@
 #include <string>
 #include <vector>
 
-#include "app/cli/batch.h"
+#include "app/front/batch.h"
 #include "app/cli/cli.h"
-#include "core/gltf_export.h"
-#include "core/scene.h"
-#include "core/skeleton.h"
-#include "core/turtle.h"
+#include "core/grow/grow.h"
+#include "core/io/gltf.h"
+#include "core/scene/scene.h"
+#include "core/geometry/skeleton.h"
+#include "core/grow/turtle.h"
+#include "core/scene/scene_json.h"
 
 namespace sylva::cli {
 

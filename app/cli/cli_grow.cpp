@@ -1,4 +1,4 @@
-// cli_grow.cpp — `sylva derive` and `sylva grow` (cli.md).
+// cli_grow.cpp — `sylva derive` and `sylva grow` (docs/spec/cli.md).
 #include <chrono>
 #include <cinttypes>
 #include <cstdio>
@@ -6,13 +6,12 @@
 #include <limits>
 #include <sstream>
 
-#include "app/cli/batch.h"
+#include "app/front/batch.h"
 #include "app/cli/cli.h"
-#include "core/scene.h"  // skeleton_bounds
+#include "core/scene/scene.h"  // skeleton_bounds
 #include "core/util/file_io.h"
-#include "core/turtle.h"
-#include "lsystem/derive.h"
-#include "lsystem/grammar.h"
+#include "core/grow/turtle.h"
+#include "core/grow/grow.h"
 
 namespace sylva::cli {
 

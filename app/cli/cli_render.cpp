@@ -1,4 +1,4 @@
-// cli_render.cpp — `sylva render` (cli.md, scene.md): a scene, grammar or skeleton to an
+// cli_render.cpp — `sylva render` (docs/spec/cli.md, docs/spec/scene.md): a scene, grammar or skeleton to an
 // image through the OpenGL ray caster (render_gl.h, on a headless EGL context) or the CPU
 // ray caster (render_cpu.h), as --backend says.
 #include <signal.h>
@@ -11,22 +11,24 @@
 #include <cstdio>
 #include <iostream>
 
-#include "app/cli/batch.h"
-#include "app/cli/camera_flags.h"
+#include "app/front/batch.h"
+#include "app/front/camera_flags.h"
 #include "app/cli/cli.h"
-#include "app/cli/progress_bar.h"
-#include "app/cli/render_input.h"
-#include "app/cli/video.h"
-#include "core/animate.h"
-#include "core/render_output.h"
+#include "app/front/progress_bar.h"
+#include "app/front/render_input.h"
+#include "app/front/video.h"
+#include "core/scene/animate.h"
+#include "core/scene/render_output.h"
 #include "core/util/image_io.h"
 #include "core/util/limits.h"
 #include "core/gl/gl_context.h"
 #include "core/gl/gl_program.h"
-#include "core/render_common.h"
+#include "core/scene/render_common.h"
 #include "core/cpu/render_cpu.h"
+#include "app/front/render.h"
 #include "core/gl/render_gl.h"
-#include "core/scene.h"
+#include "core/scene/scene.h"
+#include "core/util/clock.h"
 
 namespace sylva::cli {
 
@@ -36,7 +38,7 @@ constexpr int kInterrupted = 130;  // 128 + SIGINT, the shell's convention
 constexpr uint32_t kMaxConeParam = 100000;  // --cone-params: any larger is a typo
 
 // Mesa's software rasterisers, by the GL_RENDERER string they report ("llvmpipe (LLVM
-// 15.0.6, 256 bits)", "softpipe", "swrast"): auto still renders with them (cli.md), and
+// 15.0.6, 256 bits)", "softpipe", "swrast"): auto still renders with them (docs/spec/cli.md), and
 // says so, since the CPU ray caster may be the faster choice on such a machine.
 bool is_software_renderer(const std::string& renderer) {
   std::string lower = renderer;
@@ -102,7 +104,7 @@ void print_render_help() {
          "                         disc points); medium (shadow rays only inside the shadow\n"
          "                         cones), fast (no sunlight inside them, no shadow rays) and\n"
          "                         refined (their edges bisected to the exact shadow) trace sun\n"
-         "                         photons into shadow cones first (paper 002)\n"
+         "                         photons into shadow cones first (Hougs and Day 2001)\n"
          "      --fog-steps N      samples along each ray, 1 to " << kFogMaxSteps << " (default 64)\n"
          "      --photons N        sun photons for the shadow cones, 1 to " << kFogMaxPhotons << "\n"
          "                         (default 1000000)\n"
@@ -155,7 +157,7 @@ uint32_t parse_size(const std::string& flag, const std::string& v, uint32_t max)
   return static_cast<uint32_t>(*n);
 }
 
-// --cone-params p1,p2,p3,p4 (paper 002 sec. 3.2.1) or auto (nullopt): four integers with
+// --cone-params p1,p2,p3,p4 (Hougs and Day 2001 sec. 3.2.1) or auto (nullopt): four integers with
 // p1 >= p3 + 1 (a ring needs its seed and p3 neighbours), p2 >= 2, p3 >= 1, p4 >= 1.
 std::optional<std::array<uint32_t, 4>> parse_cone_params(const std::string& v) {
   if (v == "auto") return std::nullopt;
@@ -285,7 +287,6 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
   return out;
 }
 
-using render_common::seconds_since;
 
 // Restores the previous SIGINT disposition when the render is over.
 class SigintGuard {
@@ -471,7 +472,7 @@ int run_render_frames(const RenderArgs& a) {
     } else {
       context->make_current();
       if (scene.fog) {
-        result = render_gl(scene, options);
+        result = render_gl_scene(scene, options);
       } else if (growth || !renderer) {
         renderer = std::make_unique<GlRenderer>(scene, options, programs);
         result = renderer->render(scene);
@@ -580,7 +581,7 @@ int run_render(const std::vector<std::string>& args) {
   options.fog = a.fog;
   ProgressBar bar("sylva render", ::isatty(STDERR_FILENO) == 1);
   options.progress = bar.progress(&g_interrupted);
-  // The backend (cli.md): gl, or for auto OpenGL where a context can be made and the scene
+  // The backend (docs/spec/cli.md): gl, or for auto OpenGL where a context can be made and the scene
   // needs nothing the GL backend lacks; otherwise the CPU, saying why.
   std::string backend_name = "CPU ray caster";
   std::optional<RenderResult> gl_result;
@@ -599,13 +600,13 @@ int run_render(const std::vector<std::string>& args) {
       } else {
         passes.push_back({"gl context", seconds_since(context_start), context.context->info().describe()});
         try {
-          gl_result = render_gl(scene, options, &gl_stats);
+          gl_result = render_gl_scene(scene, options, &gl_stats);
           // Meshes are rasterised (the polygon baseline), frusta ray cast.
           const std::string& renderer = context.context->info().renderer;
           backend_name = options.geometry.kind == GeometryKind::mesh ? "OpenGL rasteriser (meshes, " + renderer + ")"
                                                                      : "OpenGL ray caster (" + renderer + ")";
           // auto names what it chose (the fallback below names the CPU and why).
-          // auto keeps OpenGL even in software (spec/cli.md; docs/limits.md "--backend auto"),
+          // auto keeps OpenGL even in software (docs/spec/cli.md; docs/limits.md "--backend auto"),
           // and says that the CPU ray caster is the faster choice there.
           if (a.backend == "auto") {
             std::cerr << "sylva render: --backend auto: " << backend_name << "\n";

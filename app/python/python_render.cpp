@@ -1,5 +1,5 @@
 // python_render.cpp — sylva.render: the CPU reference ray caster (core/render_cpu.h)
-// on one skeleton in its default scene (scene.md: sun, sky, ground, framing camera).
+// on one skeleton in its default scene (docs/spec/scene.md: sun, sky, ground, framing camera).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -10,7 +10,7 @@
 #include "app/python/sylva_python.h"
 #include "core/cpu/render_cpu.h"
 #include "core/util/limits.h"
-#include "core/scene.h"
+#include "core/scene/scene.h"
 
 namespace py = pybind11;
 using namespace pybind11::literals;

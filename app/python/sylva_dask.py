@@ -1,7 +1,7 @@
 """sylva_dask — batches of seeds on a dask.distributed cluster, writing what the local batch writes.
 
 The command line grows or exports many seeds of one grammar in one command
-(``sylva grow GRAMMAR --seed A..B -o out/elm_{seed}.skel.json``, cli.md); when a dataset
+(``sylva grow GRAMMAR --seed A..B -o out/elm_{seed}.skel.json``, docs/spec/cli.md); when a dataset
 outgrows one machine, this module hands the same seeds to the workers of a
 ``dask.distributed`` cluster instead. Each seed is one task: the worker grows the plant
 with the ``sylva`` module (the same code as the command line) and writes its file
@@ -48,7 +48,7 @@ EXTRAS = ("compact", "full", "none")  # sylva export --extras (docs/gltf.md)
 
 
 def output_path(pattern, seed):
-    """The file of one seed: ``{seed}`` in ``pattern`` replaced by the decimal seed (cli.md)."""
+    """The file of one seed: ``{seed}`` in ``pattern`` replaced by the decimal seed (docs/spec/cli.md)."""
     if "{seed}" not in pattern:
         raise ValueError(f"the output pattern {pattern!r} has no {{seed}}: every seed would write the same file")
     return pattern.replace("{seed}", str(seed))

@@ -25,12 +25,11 @@
 
 #include "app/python/sylva_python.h"
 #include "core/util/file_io.h"
-#include "core/gltf_export.h"
-#include "core/skeleton.h"
-#include "core/tessellate.h"
-#include "core/turtle.h"
-#include "lsystem/derive.h"
-#include "lsystem/grammar.h"
+#include "core/io/gltf.h"
+#include "core/geometry/skeleton.h"
+#include "core/geometry/tessellate.h"
+#include "core/grow/turtle.h"
+#include "core/grow/grow.h"
 
 namespace py = pybind11;
 using namespace pybind11::literals;
@@ -426,7 +425,7 @@ py::sequence per_plant(const py::object& value, size_t count, const char* name) 
   return seq;
 }
 
-// The `bark` argument of export_gltf: a dict with the keys of scene.md's "bark".
+// The `bark` argument of export_gltf: a dict with the keys of docs/spec/scene.md's "bark".
 Bark bark_from_dict(const py::object& value) {
   if (!py::isinstance<py::dict>(value))
     throw py::type_error("bark must be a dict with keys albedo, height, relief_depth, u_repeat, v_per_metre");
@@ -614,7 +613,7 @@ Immutable. Array properties are numpy arrays:
       parent_joint); parent_chain = parent_joint = -1 for a root chain.
 Chain c owns joints[first_joint : first_joint + joint_count].
   leaves (L,) structured records (first_vertex, vertex_count, chain, joint int32, material
-      uint32): the grammar's polygons (skeleton.md "Leaves"); chain = joint = -1 for a
+      uint32): the grammar's polygons (docs/spec/skeleton.md "Leaves"); chain = joint = -1 for a
       leaf on no joint. leaf_vertices (V, 3) float64 holds every leaf's vertices, leaf l
       owning leaf_vertices[first_vertex : first_vertex + vertex_count].
 Make one with Grammar.grow(), Skeleton.from_file() or Skeleton.from_json().)doc");
@@ -704,7 +703,7 @@ released while growing. A RuntimeWarning reports an interpretation cut at max de
       .def_property_readonly(
           "leaves", &skeleton_leaves,
           "(L,) numpy structured array, fields first_vertex, vertex_count, chain, joint (int32;\n"
-          "-1 for a leaf on no joint) and material (uint32): the leaves (skeleton.md), one per\n"
+          "-1 for a leaf on no joint) and material (uint32): the leaves (docs/spec/skeleton.md), one per\n"
           "polygon of the grammar. A new array on every access.")
       .def_property_readonly("leaf_vertices", &skeleton_leaf_vertices,
                              "(V, 3) float64 every leaf's vertices in metres, leaf after leaf. A new array.")

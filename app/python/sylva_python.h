@@ -14,9 +14,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/skeleton.h"
+#include "core/geometry/skeleton.h"
 #include "core/util/diagnostic.h"
-#include "lsystem/grammar.h"
+#include "core/grow/grow.h"
 
 namespace sylva::python {
 

@@ -20,7 +20,7 @@
 
 #include <imgui.h>
 
-#include "app/cli/cli.h"
+#include "app/front/args.h"
 #include "app/studio/gl_viewport.h"
 #include "app/studio/studio.h"
 #include "app/studio/studio_app.h"

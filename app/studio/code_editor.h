@@ -1,6 +1,6 @@
-// code_editor.h — the studio's grammar editor (studio.md "Editor") on Dear ImGui 1.86's
-// InputTextMultiline: ImGui has no code editor and Debian packages none, so this is the
-// design of ../shared/notes/studio-gui.md sec. 3. The text widget is given the full
+// code_editor.h — the studio's grammar editor (docs/spec/studio.md "Editor") on Dear ImGui 1.86's
+// InputTextMultiline: ImGui has no code editor and Debian packages none, so the editor is
+// built around ImGui's own text widget. The text widget is given the full
 // height of its content inside a scrolling child, so it never scrolls itself and
 // everything drawn beside it on the child's draw list — the gutter's line numbers and
 // error marker, the squiggle under the error's columns, the current line's band —

@@ -1,5 +1,5 @@
 // cone_worker.h — the studio's fog cone thread: sun photons and shadow cones
-// (core/cpu/photons.h build_sun_cones, paper 002 sec. 3) for the plants and sun on screen,
+// (core/cpu/photons.h build_sun_cones, Hougs and Day 2001 sec. 3) for the plants and sun on screen,
 // built off the UI thread, because they are viewpoint independent but cost seconds on a
 // dense canopy (docs/benchmarks.md). The UI submits whenever the plants, the sun, the
 // photon count or the cone kind changed — never for a camera move — and hands each result
@@ -19,8 +19,8 @@
 #include <optional>
 #include <thread>
 
-#include "core/render_types.h"
-#include "core/scene.h"
+#include "core/scene/render_types.h"
+#include "core/scene/scene.h"
 
 namespace sylva {
 class ConeSet;

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "lsystem/word.h"
+#include "core/grow/grow.h"
 
 namespace sylva::studio {
 

@@ -1,5 +1,5 @@
 // define_controls.h — the parameter panel's view of a grammar's `#define` lines
-// (grammar.md "Header directives"): where each define's value stands in the text, and
+// (docs/spec/grammar.md "Header directives"): where each define's value stands in the text, and
 // the slider range a comment right after the value gives:
 //     #define LIMBS 3 /* [1, 8, 1] */      min 1, max 8, step 1
 //     #define ANGLE 22.5 /* [0, 90] */     min 0, max 90, continuous

@@ -1,5 +1,5 @@
-// document_files.h — what the studio does with files (studio.md "Never blocking, never
-// losing work"): saves are atomic (write_file_atomically, cli.md), an edited document is
+// document_files.h — what the studio does with files (docs/spec/studio.md "Never blocking, never
+// losing work"): saves are atomic (write_file_atomically, docs/spec/cli.md), an edited document is
 // autosaved beside itself as `.NAME.autosave`, and a file's identity on disk (mtime,
 // size) is remembered so a change by another program is noticed.
 #pragma once

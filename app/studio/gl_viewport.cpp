@@ -13,7 +13,7 @@
 #include "core/gl/gl_program.h"
 #include "core/gl/gl_target.h"
 #include "core/gl/render_gl.h"
-#include "core/render_output.h"
+#include "core/scene/render_output.h"
 
 namespace sylva::studio {
 

@@ -3,8 +3,8 @@
 
 #include <algorithm>
 
-#include "core/turtle.h"
-#include "lsystem/derive.h"
+#include "core/grow/turtle.h"
+#include "core/grow/grow.h"
 
 namespace sylva::studio {
 

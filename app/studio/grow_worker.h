@@ -1,10 +1,10 @@
-// grow_worker.h — the studio's one worker thread (studio.md "Never blocking"): it parses
+// grow_worker.h — the studio's one worker thread (docs/spec/studio.md "Never blocking"): it parses
 // the grammar text, derives, interprets and builds the skeletons while the UI thread
 // keeps drawing frames; GL work (skinning into the renderer, uploads) stays on the UI
 // thread, which takes finished results with poll().
 //
 // The mailbox holds one request, the latest: submit() replaces a request not yet started
-// and cancels the one running (../shared/notes/studio-gui.md sec. 5; L-Py's coalescing
+// and cancels the one running (L-Py's coalescing
 // "shouldrerun"). Each request gets a generation number; the worker checks between
 // derivation steps (DeriveOptions::on_step) and between phases whether its generation is
 // still the newest and stops early when it is not; poll() hands out only a result of the
@@ -29,9 +29,9 @@
 #include <thread>
 #include <vector>
 
-#include "core/skeleton.h"
+#include "core/geometry/skeleton.h"
 #include "core/util/diagnostic.h"
-#include "lsystem/grammar.h"
+#include "core/grow/grow.h"
 
 namespace sylva::studio {
 

@@ -1,4 +1,4 @@
-// orbit_camera.h — the viewport's camera as a user moves it (studio.md "Viewport"):
+// orbit_camera.h — the viewport's camera as a user moves it (docs/spec/studio.md "Viewport"):
 // orbit (left drag) about a target, pan (middle drag or Shift+left) in the view plane,
 // zoom (wheel) toward the target, frame (F) a box. Stored as target, distance, yaw and
 // pitch so orbiting never rolls; converted to the scene's pinhole Camera (scene.h:
@@ -7,7 +7,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "core/scene.h"
+#include "core/scene/scene.h"
 
 namespace sylva::studio {
 

@@ -1,5 +1,5 @@
-// studio.h — the entry point of `sylva studio` (../shared/spec/studio.md), dispatched by
-// app/cli/main.cpp.
+// studio.h — the entry point of `sylva studio` (docs/spec/studio.md), dispatched by
+// app/main.cpp.
 #pragma once
 
 #include <string>

@@ -10,8 +10,10 @@
 #include <glm/geometric.hpp>
 #include <imgui_stdlib.h>
 
-#include "core/gltf_export.h"
-#include "core/skeleton.h"
+#include "core/grow/grow.h"
+#include "core/io/gltf.h"
+#include "core/geometry/skeleton.h"
+#include "core/scene/scene_json.h"
 #include "core/util/file_io.h"
 #include "core/util/math.h"
 
@@ -318,7 +320,7 @@ void StudioApp::apply_outcome(GrowOutcome outcome) {
     scene_.plants[edited_plants_[k]].skeleton = std::move(outcome.skeletons[k]);
   outcome.skeletons.clear();
   if (!camera_set_) {
-    // A grammar's first plant: the default scene's framing (scene.md); a scene: its camera.
+    // A grammar's first plant: the default scene's framing (docs/spec/scene.md); a scene: its camera.
     if (scene_path_.empty()) {
       const Skeleton& sk = *scene_.plants[0].skeleton;
       Scene d = default_scene_for(sk, scene_.width, scene_.height);
@@ -872,7 +874,7 @@ void StudioApp::update_cones() {
   cones_->submit(ConeRequest{view_scene(), render_options_.skin, kind, scene_.fog->photons});
 }
 
-// spec/fog.md's medium, live: every control changes scene_.fog, which the viewport's next
+// docs/spec/fog.md's medium, live: every control changes scene_.fog, which the viewport's next
 // picture draws (a new picture, never a re-skin; new cones only for new photons or mode
 // kind) and save_scene writes.
 void StudioApp::draw_fog() {

@@ -1,4 +1,4 @@
-// studio_app.h — the studio's window contents and behaviour (../shared/spec/studio.md),
+// studio_app.h — the studio's window contents and behaviour (docs/spec/studio.md),
 // independent of GLFW and of GL: one call per frame between ImGui::NewFrame() and
 // ImGui::Render() builds every widget from the app's state, and the app reacts to what
 // the user did. The window (studio_main.cpp) and the headless tests (tests/studio/) drive
@@ -30,8 +30,8 @@
 #include "app/studio/orbit_camera.h"
 #include "app/studio/undo_history.h"
 #include "app/studio/viewport.h"
-#include "core/render_types.h"
-#include "core/scene.h"
+#include "core/scene/render_types.h"
+#include "core/scene/scene.h"
 #include "core/util/diagnostic.h"
 
 namespace sylva::studio {

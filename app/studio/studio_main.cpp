@@ -1,11 +1,10 @@
 // studio_main.cpp — `sylva studio [INPUT] [--screenshot OUT.png [--frames N]] [--size WxH]`
-// (../shared/spec/studio.md): the GLFW window with an OpenGL 4.5 core context, Dear
+// (docs/spec/studio.md): the GLFW window with an OpenGL 4.5 core context, Dear
 // ImGui's GLFW and OpenGL 3 backends (inside Debian's libimgui.a), the StudioApp and the
 // GL viewport, and the loop that drives them.
 //
 // Under Xvfb (llvmpipe) the front buffer cannot be read back, so --screenshot reads the
-// back buffer after ImGui has drawn it and before the swap
-// (../shared/notes/studio-gui.md sec. 4).
+// back buffer after ImGui has drawn it and before the swap.
 // OpenGL from gl_api.h (the core prototypes); GLFW must not include its own GL header.
 #include "core/gl/gl_api.h"
 #define GLFW_INCLUDE_NONE
@@ -23,7 +22,7 @@
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
-#include "app/cli/cli.h"
+#include "app/front/args.h"
 #include "app/studio/gl_viewport.h"
 #include "app/studio/studio.h"
 #include "app/studio/studio_app.h"

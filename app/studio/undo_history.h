@@ -1,8 +1,8 @@
-// undo_history.h — the studio's document-level undo (studio.md "Editor"): whole
+// undo_history.h — the studio's document-level undo (docs/spec/studio.md "Editor"): whole
 // snapshots of what the user edits — the grammar text and the parameter panel's
 // overrides — never the editor widget's keystroke history, so one slider drag or one
 // burst of typing is one step, and decorations (error marks) never enter the history
-// (the lesson of L-Py's editor, ../shared/notes/studio-gui.md sec. 1).
+// (the lesson of L-Py's editor, whose error highlight leaks into its undo stack).
 //
 // When a snapshot is taken is the caller's business (the studio: after a pause in
 // typing, on leaving the editor, when a slider is released). record() ignores a

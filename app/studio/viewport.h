@@ -18,8 +18,8 @@
 
 #include <imgui.h>
 
-#include "core/render_types.h"
-#include "core/scene.h"
+#include "core/scene/render_types.h"
+#include "core/scene/scene.h"
 
 namespace sylva {
 class ConeSet;

@@ -15,7 +15,7 @@
 // Queries: nearest hit and any hit (shadow rays), iterative with a fixed stack of
 // kBvhStackSize entries (the build limits the depth so it cannot overflow), each leaf
 // calling intersect_frustum (ray_frustum.h). Results are identical to testing every
-// frustum (tests/core/bvh_test.cpp): same nearest t, same frustum up to ties.
+// frustum (tests/cpu/bvh_test.cpp): same nearest t, same frustum up to ties.
 #pragma once
 
 #include <cstdint>
@@ -23,9 +23,9 @@
 #include <span>
 #include <vector>
 
-#include "core/ray_frustum.h"
+#include "core/geometry/ray_frustum.h"
 #include "core/util/bounds.h"
-#include "core/skin.h"
+#include "core/geometry/skin.h"
 
 namespace sylva {
 

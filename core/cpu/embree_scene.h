@@ -14,7 +14,7 @@
 #include <cstdint>
 #include <glm/vec3.hpp>
 
-#include "core/ray_frustum.h"
+#include "core/geometry/ray_frustum.h"
 #include "core/util/bounds.h"
 
 namespace sylva {

@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <glm/vec3.hpp>
 
-#include "core/ray_frustum.h"
+#include "core/geometry/ray_frustum.h"
 
 namespace sylva {
 

@@ -23,8 +23,8 @@
 #include <span>
 
 #include "core/cpu/bvh.h"
-#include "core/ray_frustum.h"
-#include "core/skin.h"
+#include "core/geometry/ray_frustum.h"
+#include "core/geometry/skin.h"
 
 namespace sylva {
 

@@ -3,7 +3,7 @@
 // exactly (ray_frustum.h) and described for shading: eq. 8 normal on the side (the cap's
 // own normal on a cap), u/v_m of skin.h, tangents for the texture footprint.
 //
-// Relief (paper 000 sec. 3, relief.h): a plant given a ReliefMap (a height field and a
+// Relief (Bhagvat et al. 2009 sec. 3, relief.h): a plant given a ReliefMap (a height field and a
 // depth > 0) has its segment frusta indexed with their shells (boxes grown by the depth)
 // and intersected by intersect_relief — nearest and shadow (`any`) rays alike — as custom
 // frusta of frustum_accel.h. Knuckle frusta (the balls closing split joints, skin.h) keep
@@ -21,9 +21,9 @@
 #include <vector>
 
 #include "core/cpu/frustum_accel.h"
-#include "core/relief.h"
-#include "core/skin.h"
-#include "core/surface.h"
+#include "core/geometry/relief.h"
+#include "core/geometry/skin.h"
+#include "core/geometry/surface.h"
 
 namespace sylva {
 

@@ -26,8 +26,8 @@
 #include <string>
 #include <vector>
 
-#include "core/instances.h"
-#include "core/surface.h"
+#include "core/scene/instances.h"
+#include "core/geometry/surface.h"
 
 namespace sylva {
 

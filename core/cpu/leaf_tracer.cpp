@@ -7,7 +7,7 @@
 
 #include "core/cpu/embree_scene.h"
 #include "core/cpu/embree_triangles.h"
-#include "core/leaf_images.h"
+#include "core/scene/leaf_images.h"
 
 namespace sylva {
 

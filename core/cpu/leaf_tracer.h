@@ -23,8 +23,8 @@
 #include <memory>
 #include <string>
 
-#include "core/leaf_mesh.h"
-#include "core/surface.h"
+#include "core/geometry/leaf_mesh.h"
+#include "core/geometry/surface.h"
 
 namespace sylva {
 

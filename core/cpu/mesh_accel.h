@@ -1,4 +1,4 @@
-// mesh_accel.h — the polygon baseline traced by the same CPU engine (paper 000 sec. 4): a
+// mesh_accel.h — the polygon baseline traced by the same CPU engine (Bhagvat et al. 2009 sec. 4): a
 // TriangleMesh (tessellate.h: the paper's GS level m, or GS+R when displaced) in Embree 3
 // triangle geometry, as a SceneTracer (surface.h), so the renderer shades, textures and
 // measures it exactly as it does the analytic frusta.
@@ -38,9 +38,9 @@
 #include <span>
 #include <string>
 
-#include "core/skin.h"
-#include "core/surface.h"
-#include "core/tessellate.h"
+#include "core/geometry/skin.h"
+#include "core/geometry/surface.h"
+#include "core/geometry/tessellate.h"
 
 namespace sylva {
 

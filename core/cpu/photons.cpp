@@ -1,4 +1,4 @@
-// photons.cpp — sun photons, shadow vectors (paper 002 sec. 3.1, Fig. 2b), the automatic
+// photons.cpp — sun photons, shadow vectors (Hougs and Day 2001 sec. 3.1, Fig. 2b), the automatic
 // choice of the cone parameters (sec. 6.1, the paper's future work) and the cones built
 // once per (plants, sun). See photons.h for the contract.
 #include "core/cpu/photons.h"
@@ -22,17 +22,15 @@
 #include "core/cpu/instance_tracer.h"
 #include "core/cpu/leaf_tracer.h"
 #include "core/cpu/render_cpu.h"
-#include "core/render_common.h"
-#include "core/relief.h"
+#include "core/scene/render_common.h"
+#include "core/geometry/relief.h"
 #include "core/util/math.h"
-#include "lsystem/random.h"
+#include "core/util/random.h"
+#include "core/util/clock.h"
 
 namespace sylva {
 namespace {
 
-using render_common::Clock;
-using render_common::seconds_since;
-using render_common::process_cpu_seconds;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr uint64_t kChunk = 1u << 15;  // photons per work item (cancellation granularity)
@@ -74,7 +72,7 @@ glm::dvec2 concentric_disc(double u, double v) {
 // disc (by rejection: no trigonometry) and h = (x² + y²)·(1 − cos α) = 1 − cos θ, which is
 // then uniform in [0, 1 − cos α] (uniform in solid angle), the direction is
 // (1 − h)·s + sin θ·(x, y)/ρ with sin θ/ρ = sqrt((1 − cos α)·(2 − h)).
-glm::dvec3 photon_direction(const glm::dvec3& to_sun, const AxisFrame& f, double one_minus_cos_alpha, lsys::Rng& rng) {
+glm::dvec3 photon_direction(const glm::dvec3& to_sun, const AxisFrame& f, double one_minus_cos_alpha, Rng& rng) {
   if (one_minus_cos_alpha == 0) return -to_sun;
   double x, y;
   do {
@@ -449,8 +447,8 @@ SunPhotons trace_photons(const SunMask& mask, const SunEmitter& e, const SunPhot
   const double cpu_start = process_cpu_seconds();
   const AxisFrame frame = axis_frame(e.to_sun);
   const double one_minus_cos = 2 * std::pow(std::sin(0.5 * e.sun_radius_rad), 2);
-  const uint64_t offset0 = lsys::mix_pair(options.seed, 0x52325f6f666673ULL);  // the rotation
-  const uint64_t offset1 = lsys::mix_pair(options.seed, 0x52325f6f666674ULL);
+  const uint64_t offset0 = mix_pair(options.seed, 0x52325f6f666673ULL);  // the rotation
+  const uint64_t offset1 = mix_pair(options.seed, 0x52325f6f666674ULL);
   const uint64_t chunks = (options.photons + kChunk - 1) / kChunk;
   std::vector<std::vector<ShadowVector>> per_chunk(chunks);
   std::vector<uint8_t> ran(chunks, 0);
@@ -460,7 +458,7 @@ SunPhotons trace_photons(const SunMask& mask, const SunEmitter& e, const SunPhot
     const uint64_t end = std::min(options.photons, (c + 1) * kChunk);
     for (uint64_t i = c * kChunk; i < end; ++i) {
       const glm::dvec2 q = concentric_disc(unit_from_fixed(offset0 + i * kR2Step0), unit_from_fixed(offset1 + i * kR2Step1));
-      lsys::Rng rng(lsys::mix_pair(options.seed, i));
+      Rng rng(mix_pair(options.seed, i));
       Ray ray;
       ray.origin = e.disc_centre + e.disc_radius_m * (q.x * frame.e0 + q.y * frame.e1);
       ray.direction = photon_direction(e.to_sun, frame, one_minus_cos, rng);
@@ -747,7 +745,7 @@ ShadowSamples sample_shadow_region(const SunPhotonTracer& tracer, const Window& 
   const AxisFrame f = axis_frame(e.to_sun);
   const double depth = 4 * e.sphere_radius_m;
   const glm::dvec3 top = e.centre + e.sphere_radius_m * e.to_sun;
-  lsys::Rng rng(lsys::mix_pair(seed, 0x636f766572616765ULL));
+  Rng rng(mix_pair(seed, 0x636f766572616765ULL));
   for (uint64_t i = 0; i < max_points && out.shadowed_count < min_shadowed; ++i) {
     double a, b;
     if (w.half_size > 0) {
@@ -1005,13 +1003,6 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
   out->cone_seconds = seconds_since(cones_start);
   out->cone_cpu_seconds = process_cpu_seconds() - cones_cpu_start;
   return out;
-}
-
-void ConeSetFogSource::intervals(const Ray& ray, double t_min, double t_max, std::vector<FogInterval>* out) const {
-  thread_local std::vector<ConeInterval> found;
-  set_.intervals(ray, t_min, t_max, &found);
-  out->clear();
-  for (const ConeInterval& i : found) out->push_back({i.t_enter, i.t_exit});
 }
 
 bool fog_mode_needs_cones(FogMode mode) {

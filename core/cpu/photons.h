@@ -1,5 +1,5 @@
-// photons.h — sun photons and the shadow cones made from them (paper 002 sec. 3.1–3.2,
-// 6.1): the viewpoint-independent half of the fog (../shared/spec/fog.md, "Photons and
+// photons.h — sun photons and the shadow cones made from them (Hougs and Day 2001 sec. 3.1–3.2,
+// 6.1): the viewpoint-independent half of the fog (docs/spec/fog.md, "Photons and
 // cones"), built once per (plants, sun) and reused by every camera, frame and fog mode.
 //
 // Photons leave a disc perpendicular to the sun that covers the plants' bounding sphere
@@ -50,12 +50,12 @@
 #include <vector>
 
 #include "core/cpu/render_cpu.h"  // SceneGeometry
-#include "core/fog_integrator.h"  // FogConeSource
-#include "core/render_types.h"
-#include "core/scene.h"
-#include "core/shadow_cones.h"
-#include "core/skin.h"
-#include "core/surface.h"
+#include "core/scene/fog_integrator.h"  // FogConeSource
+#include "core/scene/render_types.h"
+#include "core/scene/scene.h"
+#include "core/light/shadow_cones.h"
+#include "core/geometry/skin.h"
+#include "core/geometry/surface.h"
 
 namespace sylva {
 
@@ -223,18 +223,7 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
                                                 const SunConeOptions& options,
                                                 const SunPhotonTracer* tracer = nullptr);
 
-// The cone set as the fog integrator queries it (fog_integrator.h's FogConeSource): the
-// same sorted, merged intervals. `set` must outlive the source. Thread-safe.
-class ConeSetFogSource final : public FogConeSource {
- public:
-  explicit ConeSetFogSource(const ConeSet& set) : set_(set) {}
-  void intervals(const Ray& ray, double t_min, double t_max, std::vector<FogInterval>* out) const override;
-
- private:
-  const ConeSet& set_;
-};
-
-// What the fog needs of photons and cones for a render (spec/fog.md's modes): whether
+// What the fog needs of photons and cones for a render (docs/spec/fog.md's modes): whether
 // `mode` reads shadow cones (medium, fast, refined; auto is refined on the CPU) and the
 // options of build_sun_cones for it — `photons` sun photons (seeded by `seed`), the
 // clustering parameters p1..p4 given, or automatic (nullopt), the automatic choice

@@ -1,21 +1,22 @@
 // render_cpu.cpp — the CPU reference ray caster (see render_cpu.h for the shading model).
 #include "core/cpu/render_cpu.h"
-#include "core/plant_mesh.h"
+#include "core/geometry/plant_mesh.h"
 
-#include "core/culling.h"
-#include "core/fog.h"
-#include "core/fog_integrator.h"
+#include "core/scene/culling.h"
+#include "core/light/fog.h"
+#include "core/scene/fog_integrator.h"
 #include "core/cpu/frustum_tracer.h"
 #include "core/cpu/instance_tracer.h"
-#include "core/instances.h"
-#include "core/leaf_images.h"
+#include "core/scene/instances.h"
+#include "core/scene/leaf_images.h"
 #include "core/cpu/leaf_tracer.h"
 #include "core/cpu/mesh_accel.h"
 #include "core/cpu/photons.h"
-#include "core/render_common.h"
-#include "core/shading.h"
+#include "core/scene/render_common.h"
+#include "core/light/shading.h"
 #include "core/cpu/texture.h"
 #include "core/util/math.h"
+#include "core/util/clock.h"
 
 #include <algorithm>
 #include <chrono>
@@ -33,8 +34,6 @@ namespace sylva {
 namespace {
 
 using render_common::CameraFrame;
-using render_common::Clock;
-using render_common::seconds_since;
 using Rng = render_common::SampleRng;
 constexpr uint32_t kTile = 32;
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -167,7 +166,7 @@ class Renderer {
     if (!sun_on_) return shading::sky_ambient(albedo, n, scene_.sky);
     const glm::dvec3 l = sun_sample(scene_.sun, sun_direction_, cos_alpha_, sun_frame_, rng);
     const double cos_sun = shading::sun_cosine(n, n_geometric, l);
-    // Through fog the sunlight arrives attenuated by T_sun (spec/fog.md); where none arrives
+    // Through fog the sunlight arrives attenuated by T_sun (docs/spec/fog.md); where none arrives
     // no shadow ray is needed.
     const double sun_transmittance =
         fog_ && cos_sun > 0 ? fog_sun_transmittance(fog_->medium(), p, sun_direction_) : 1.0;
@@ -189,13 +188,13 @@ class Renderer {
     return f.transmittance * end + f.inscatter;
   }
 
-  // The fog along the sample's ray up to what it hit (spec/fog.md: the first surface, or
+  // The fog along the sample's ray up to what it hit (docs/spec/fog.md: the first surface, or
   // infinity; above the top the fog's closed forms see no fog).
   FogRayResult integrate_fog(const PrimaryHit& h, TileCost* cost) const {
     const Clock::time_point start = Clock::now();
     const double length = glm::length(h.ray.direction);
     const double t_hit = h.ground_t < kInf ? h.ground_t : h.surface.t;  // kInf: nothing hit
-    Rng rng(lsys::mix_pair(h.rng_state, kFogStream));
+    Rng rng(mix_pair(h.rng_state, kFogStream));
     const FogRayResult f = fog_->integrate(h.ray.origin, h.ray.direction / length, t_hit * length, rng);
     ++cost->fog_rays;
     cost->fog_shadow_rays += f.shadow_rays;
@@ -660,7 +659,7 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   if (options.aovs & kAovId) image.id.assign(pixels * 3, 0.0f);
   if ((options.aovs & kAovFog) && scene.fog) image.fog.assign(pixels * 4, 0.0f);
 
-  // The fog (spec/fog.md): only a scene with a `fog` key runs any of it, and only the
+  // The fog (docs/spec/fog.md): only a scene with a `fog` key runs any of it, and only the
   // modes that read shadow cones trace sun photons (unless the caller brought cones).
   std::optional<FogIntegrator> fog;
   std::unique_ptr<const SunCones> sun_cones;

@@ -1,19 +1,19 @@
-// render_cpu.h — the CPU reference ray caster (paper 000 sec. 2, scene.md): one ray per sample
+// render_cpu.h — the CPU reference ray caster (Bhagvat et al. 2009 sec. 2, docs/spec/scene.md): one ray per sample
 // through a pinhole camera, conical frusta (skin.h) found through Embree (frustum_accel.h) and
 // intersected exactly (ray_frustum.h), shaded under the scene's sun and sky over a
 // ground plane. The GPU ray caster must match it.
 //
-// Shading: the model of core/shading.h (sky ambient, Lambert + normalised Blinn-Phong under the
+// Shading: the model of core/light/shading.h (sky ambient, Lambert + normalised Blinn-Phong under the
 // sun, the ground, the sky seen by a miss), in double, with E_sun = scene.sun.radiance (the
 // sun's irradiance at normal incidence) and L_sky = scene.sky. The sun's visibility V: one
 // shadow ray per sample, cast where sun_cosine > 0, toward the sun's centre when its angular
 // radius is 0 (hard shadows), else toward a uniform point of the sun's disc (soft shadows
 // that converge with --spp); only plants cast shadows. The ground (y = ground.height) is
 // shaded the same way, with the plants' shadows.
-// Fog (a scene's `fog` key; spec/fog.md, docs/fog.md): the sunlight E_sun is
+// Fog (a scene's `fog` key; docs/spec/fog.md, docs/fog.md): the sunlight E_sun is
 // multiplied by T_sun(p), the fog's transmittance from p toward the sun (the sky ambient
 // is not attenuated), and each sample's pixel value becomes T(0, t_end)·L_end + the fog's
-// in-scatter along the sample's ray (core/fog_integrator.h, mode and steps from the scene
+// in-scatter along the sample's ray (core/scene/fog_integrator.h, mode and steps from the scene
 // or RenderOptions::fog), L_end the shaded surface or L_sky for a ray that hits nothing
 // (with T(0, ∞), which is 0 wherever the ray never leaves the fog). Without a `fog` key
 // none of it runs.
@@ -57,14 +57,14 @@
 #include <vector>
 
 #include "core/cpu/instance_tracer.h"  // TracedInstance
-#include "core/materials.h"  // kMaterialAlbedo: default albedo by material index
-#include "core/relief.h"
-#include "core/render_common.h"  // camera_ray: the camera convention both renderers follow
-#include "core/render_types.h"
-#include "core/scene.h"
-#include "core/skin.h"
-#include "core/surface.h"
-#include "core/tessellate.h"
+#include "core/scene/materials.h"  // kMaterialAlbedo: default albedo by material index
+#include "core/geometry/relief.h"
+#include "core/scene/render_common.h"  // camera_ray: the camera convention both renderers follow
+#include "core/scene/render_types.h"
+#include "core/scene/scene.h"
+#include "core/geometry/skin.h"
+#include "core/geometry/surface.h"
+#include "core/geometry/tessellate.h"
 
 namespace sylva {
 

@@ -11,6 +11,7 @@
 #include <map>
 #include <mutex>
 
+#include "core/scene/height_maps.h"
 #include "core/util/color.h"
 
 namespace sylva {
@@ -65,35 +66,21 @@ struct SceneTextures::Impl {
   Albedo materials[kMaterialSlots];  // materials 1.. of the table (segment_texture)
   size_t files = 0;
 
-  // The height field of one height texture.
   // The height field of one height texture. The marcher's point lookups (tens per ray)
-  // sample the finest level itself — the texels read once through the TextureSystem,
-  // bilinear and periodic as TextureSystem's MipModeNoMIP + InterpBilinear (texel i's
-  // centre at s = (i + 0.5)/width), in double, ~10× cheaper than a texture() call; the
+  // sample the finest level itself — the texels read once (height_maps.h), bilinear and
+  // periodic as TextureSystem's MipModeNoMIP + InterpBilinear (HeightTexels, relief.h),
+  // in double, ~10× cheaper than a texture() call; the
   // normal's footprint lookups go through TextureSystem::texture (trilinear MIP-mapping).
   class HeightTexture final : public HeightField {
    public:
-    HeightTexture(const Impl* impl, TextureSystem::TextureHandle* handle, int width, int height,
-                  std::vector<float> texels)
-        : impl_(impl), handle_(handle), width_(width), height_(height), texels_(std::move(texels)) {
+    HeightTexture(const Impl* impl, TextureSystem::TextureHandle* handle, HeightTexels texels)
+        : impl_(impl), handle_(handle), texels_(std::move(texels)) {
       filtered_options_.swrap = TextureOpt::WrapPeriodic;
       filtered_options_.twrap = TextureOpt::WrapPeriodic;
       filtered_options_.mipmode = TextureOpt::MipModeTrilinear;  // isotropic: 8 texel reads
       filtered_options_.interpmode = TextureOpt::InterpBilinear;
     }
-    double height(double s, double t) const override {
-      const double x = (s - std::floor(s)) * width_ - 0.5, y = (t - std::floor(t)) * height_ - 0.5;
-      const double x0 = std::floor(x), y0 = std::floor(y);
-      const double fx = x - x0, fy = y - y0;
-      auto wrap = [](int i, int n) { return i < 0 ? i + n : (i >= n ? i - n : i); };
-      const int i0 = wrap(static_cast<int>(x0), width_), i1 = wrap(i0 + 1, width_);
-      const int j0 = wrap(static_cast<int>(y0), height_), j1 = wrap(j0 + 1, height_);
-      const float* row0 = &texels_[static_cast<size_t>(j0) * width_];
-      const float* row1 = &texels_[static_cast<size_t>(j1) * width_];
-      const double top = row0[i0] + fx * (row0[i1] - row0[i0]);
-      const double bottom = row1[i0] + fx * (row1[i1] - row1[i0]);
-      return top + fy * (bottom - top);
-    }
+    double height(double s, double t) const override { return texels_.at(s, t); }
     double filtered_height(double s, double t, double width_s, double width_t) const override {
       // Periodic: move the coordinates near [0, 1) in double, so float keeps texel precision.
       const float sf = static_cast<float>(s - std::floor(s)), tf = static_cast<float>(t - std::floor(t));
@@ -103,15 +90,14 @@ struct SceneTextures::Impl {
                              static_cast<float>(width_t), 1, &value);
       return value;
     }
-    double gradient_step_s() const override { return 1.0 / width_; }
-    double gradient_step_t() const override { return 1.0 / height_; }
-    size_t bytes() const { return texels_.size() * sizeof(float); }
+    double gradient_step_s() const override { return 1.0 / texels_.width; }
+    double gradient_step_t() const override { return 1.0 / texels_.height; }
+    size_t bytes() const { return texels_.bytes(); }
 
    private:
     const Impl* impl_;
     TextureSystem::TextureHandle* handle_;
-    int width_, height_;
-    std::vector<float> texels_;    // finest level, channel 0, row-major from row 0 (t = 0)
+    HeightTexels texels_;          // finest level, channel 0 (relief.h)
     TextureOpt filtered_options_;  // MIP-mapped over a footprint: the normal's
   };
   std::map<TextureSystem::TextureHandle*, std::unique_ptr<HeightTexture>> height_fields;
@@ -188,17 +174,11 @@ Expected<std::unique_ptr<SceneTextures>> SceneTextures::open(const Scene& scene)
     if (bark.height_texture) {
       if (!(plant.height = handle_of(*bark.height_texture))) return std::move(*error);
       if (!m.height_fields.count(plant.height)) {
-        const OIIO::ImageSpec* spec = m.system->imagespec(plant.height, m.perthread(), 0);
-        const int width = std::max(1, spec->width), height = std::max(1, spec->height);
-        std::vector<float> texels(static_cast<size_t>(width) * height);
-        TextureOpt options;
-        if (!m.system->get_texels(plant.height, m.perthread(), options, 0, spec->x, spec->x + width, spec->y,
-                                  spec->y + height, 0, 1, 0, 1, OIIO::TypeDesc::FLOAT, texels.data())) {
-          return file_diagnostic(*bark.height_texture,
-                                 "cannot read texture '" + *bark.height_texture + "': " + m.system->geterror());
-        }
+        // The point lookups' texels as the GS+R displacement reads them (height_maps.h).
+        Expected<HeightTexels> texels = read_height_texels(*bark.height_texture);
+        if (!texels) return texels.error();
         m.height_fields[plant.height] =
-            std::make_unique<Impl::HeightTexture>(&m, plant.height, width, height, std::move(texels));
+            std::make_unique<Impl::HeightTexture>(&m, plant.height, std::move(*texels));
       }
     }
   }
@@ -245,11 +225,9 @@ size_t SceneTextures::file_count() const { return impl_->files; }
 HeightFn height_function_for(const SceneTextures& textures, uint32_t plant) {
   if (!textures.has_height(plant)) return {};
   const ReliefMap map = textures.relief_map(plant);
-  if (!(map.depth_m > 0)) return {};  // as the relief: no depth, nothing to displace
-  return [map](double u, double v_m) {
-    const double h = map.field->height(u * map.u_repeat, v_m * map.v_per_metre);
-    return map.depth_m * std::clamp(h, 0.0, 1.0);  // clamped as the relief marcher does
-  };
+  const HeightField* field = map.field;
+  return relief_displacement([field](double s, double t) { return field->height(s, t); }, map.depth_m,
+                             map.u_repeat, map.v_per_metre);
 }
 
 }  // namespace sylva

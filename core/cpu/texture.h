@@ -1,7 +1,7 @@
-// texture.h — the bark textures of a scene (scene.md `bark`: albedo and height maps), and
+// texture.h — the bark textures of a scene (docs/spec/scene.md `bark`: albedo and height maps), and
 // the albedo images its `materials` table lays on segments (docs/materials.md, scene.h
 // segment_texture), read with OpenImageIO's TextureSystem: MIP-mapped, filtered lookups
-// (paper 000 sec. 2.3), and the ray-differential footprint that drives the filter.
+// (Bhagvat et al. 2009 sec. 2.3), and the ray-differential footprint that drives the filter.
 //
 // One TextureSystem per SceneTextures (created unshared, so renders do not share caches or
 // state), with "automip" = 1 (plain PNGs are MIP-mapped on the fly), "autotile" = 0 (an
@@ -14,7 +14,7 @@
 // threads must have stopped looking up by then). The height maps' finest level is also
 // read once into memory for the relief marcher's point lookups (HeightField::height).
 //
-// Texture coordinates (scene.md's bark keys): s = u·u_repeat with u in turns around the
+// Texture coordinates (docs/spec/scene.md's bark keys): s = u·u_repeat with u in turns around the
 // axis, t = v_m·v_per_metre with v_m metres of arc length along the chain; image columns
 // run along s and rows along t (row 0 at t = 0). Both wrap periodically, so u_repeat
 // should be a whole number for a seamless wrap around a stem.
@@ -29,7 +29,7 @@
 //
 // Height: channel 0 as one float in [0, 1] (a 16-bit gray PNG is read at full precision),
 // 1 = the outermost relief (relief.h). The relief marcher reads it at the finest MIP level
-// with bilinear interpolation (texels fetched once with TextureSystem::get_texels, sampled
+// with bilinear interpolation (texels read once, core/scene/height_maps.h, sampled
 // exactly as texture() with MipModeNoMIP + InterpBilinear would, ~10× cheaper per call)
 // and no footprint: the relief is one fixed surface, the same
 // for primary and shadow rays and for every pixel size (its aliasing is the pixel
@@ -46,10 +46,10 @@
 
 #include <glm/vec3.hpp>
 
-#include "core/relief.h"
-#include "core/scene.h"
-#include "core/surface.h"
-#include "core/tessellate.h"
+#include "core/geometry/relief.h"
+#include "core/scene/scene.h"
+#include "core/geometry/surface.h"
+#include "core/geometry/tessellate.h"
 
 namespace sylva {
 

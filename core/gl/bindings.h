@@ -10,8 +10,8 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "core/materials.h"
-#include "core/skin.h"
+#include "core/scene/materials.h"
+#include "core/geometry/skin.h"
 
 namespace sylva::gl {
 

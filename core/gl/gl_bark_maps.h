@@ -21,8 +21,8 @@
 
 #include "core/gl/bindings.h"
 #include "core/gl/gl_objects.h"
-#include "core/render_types.h"
-#include "core/scene.h"
+#include "core/scene/render_types.h"
+#include "core/scene/scene.h"
 
 namespace sylva {
 

@@ -10,7 +10,7 @@
 
 #include "core/gl/bindings.h"
 #include "core/gl/gl_objects.h"
-#include "core/shadow_cones.h"
+#include "core/light/shadow_cones.h"
 
 namespace sylva {
 

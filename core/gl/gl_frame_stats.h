@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "core/render_types.h"
+#include "core/scene/render_types.h"
 
 namespace sylva {
 

@@ -18,8 +18,8 @@
 #include <functional>
 #include <vector>
 
-#include "core/instances.h"
-#include "core/scene.h"
+#include "core/scene/instances.h"
+#include "core/scene/scene.h"
 
 namespace sylva {
 

@@ -1,4 +1,4 @@
-// gl_mesh.cpp — the polygon baseline on the GPU (paper 000 sec. 4: the GS and GS+R
+// gl_mesh.cpp — the polygon baseline on the GPU (Bhagvat et al. 2009 sec. 4: the GS and GS+R
 // columns the ray caster is raced against): the CPU mesh path's triangles (tessellate.h,
 // displace), uploaded once and rasterised into the ray caster's G-buffer. See gl_mesh.h.
 #include "core/gl/gl_mesh.h"
@@ -16,18 +16,17 @@
 #include "core/gl/gl_objects.h"
 #include "core/gl/gl_program.h"
 #include "core/gl/gl_views.h"
-#include "core/render_common.h"
-#include "core/cpu/texture.h"
-#include "core/leaf_images.h"
-#include "core/leaf_mesh.h"
-#include "core/plant_mesh.h"
+#include "core/scene/render_common.h"
+#include "core/scene/height_maps.h"
+#include "core/scene/leaf_images.h"
+#include "core/geometry/leaf_mesh.h"
+#include "core/geometry/plant_mesh.h"
+#include "core/util/clock.h"
 
 namespace sylva {
 
 namespace {
 
-using render_common::Clock;
-using render_common::seconds_since;
 
 // One vertex as mesh.vert.glsl reads it (attributes 0–3).
 struct MeshVertex {
@@ -173,7 +172,7 @@ struct GlMesh::State {
   uint64_t triangles = 0, drawn_triangles = 0, frusta = 0, gpu_bytes = 0;
   bool displaced = false;
   int bark_texture_units = 0;  // > 0: the G-buffer program writes the bark albedo
-  std::unique_ptr<SceneTextures> own_textures;  // height maps opened here, kept for update
+  std::optional<std::vector<HeightFn>> displacements;  // per plant (GS+R), read once, kept for update
   GlVertexArray vao;
   GlBuffer vertex_buffer, index_buffer, frustum_buffer, instance_buffer;
   // Instancing (gl_instances.h): the plants in the world first under the identity, then one
@@ -185,20 +184,19 @@ struct GlMesh::State {
   std::shared_ptr<const LeafImages> leaf_images;  // leaves_of only: the table's (null: plain leaves)
   GlTexture leaf_texture;                         // its layers as one 2D array (LEAF_IMAGES)
 
-  // The height maps for GS+R: the caller's, else opened here once (update reuses them);
-  // null when no plant is displaced.
-  const SceneTextures* height_maps(const Scene& scene, const SceneTextures* textures) {
+  // The GS+R displacement of each plant (height_maps.h), read on the first build and
+  // kept for update; null when no plant is displaced.
+  const std::vector<HeightFn>* plant_displacements(const Scene& scene) {
     const bool any_height = std::any_of(scene.plants.begin(), scene.plants.end(), [](const ScenePlant& p) {
       return p.bark.height_texture.has_value() && p.bark.relief_depth_m > 0;
     });
     if (!options.geometry.displace || !any_height) return nullptr;
-    if (textures) return textures;
-    if (!own_textures) {
-      Expected<std::unique_ptr<SceneTextures>> opened = SceneTextures::open(scene);
-      if (!opened) throw std::runtime_error(opened.error().message);
-      own_textures = std::move(*opened);
+    if (!displacements) {
+      Expected<std::vector<HeightFn>> read = scene_displacements(scene);
+      if (!read) throw std::runtime_error(read.error().message);
+      displacements = std::move(*read);
     }
-    return own_textures.get();
+    return &*displacements;
   }
 
   // Appends the shared skeletons of `split` (after the world's plants, already in `arrays`):
@@ -242,7 +240,7 @@ struct GlMesh::State {
 
   // Tessellates, displaces and uploads every plant; replaces the passes' record with what
   // this did. Returns the bytes uploaded.
-  uint64_t build(const Scene& scene, const SceneTextures* textures) {
+  uint64_t build(const Scene& scene) {
     setup_passes.clear();
     if (scene.plants.size() >= gl::kMaxPlants) throw GlError("the GL backend draws at most 2^24 plants");
     for (const ScenePlant& plant : scene.plants)
@@ -252,13 +250,13 @@ struct GlMesh::State {
     const GeometryOptions& geometry = options.geometry;
     TessellateOptions tessellation;
     tessellation.level = geometry.mesh_level;
-    textures = height_maps(scene, textures);
+    const std::vector<HeightFn>* heights = plant_displacements(scene);
     // Drawn through a transform: not displaced (the relief's depth is in world metres) and,
     // with a skin twist (per world metre), at scale 1 — the frusta's rule (render_gl.cpp).
     const GlInstanceGroups split = gl_instance_groups(scene, geometry.instance, [&](uint32_t p) {
       const ScenePlant& plant = scene.plants[p];
       if (options.skin.twist_rad_per_m != 0 && plant.scale != 1) return false;
-      return !(textures && plant.bark.height_texture.has_value() && plant.bark.relief_depth_m > 0);
+      return !(heights && (*heights)[p]);
     });
     double skin_s = 0, tessellate_s = 0, displace_s = 0;
     uint64_t skinned_frusta = 0, placed_frusta = 0;
@@ -273,7 +271,7 @@ struct GlMesh::State {
       // build_scene_geometry's mesh path: the same plant_mesh, within the same limit.
       check_mesh_fits(tessellation_size(skinned.frusta.size(), tessellation),
                       arrays.vertices.size() * sizeof(MeshVertex) + arrays.indices.size() * sizeof(uint32_t));
-      const HeightFn height = geometry.displace && textures ? height_function_for(*textures, p) : HeightFn{};
+      const HeightFn height = heights ? (*heights)[p] : HeightFn{};
       const TriangleMesh part = plant_mesh(skinned, tessellation, height, plant.bark.relief_depth_m,
                                            geometry.relief_options.max_depth_per_radius, &tessellate_s, &displace_s);
       if (height) ++arrays.displaced_plants;
@@ -469,13 +467,12 @@ struct GlMesh::State {
   }
 };
 
-GlMesh::GlMesh(const Scene& scene, const RenderOptions& options, int bark_texture_units,
-               const SceneTextures* textures)
+GlMesh::GlMesh(const Scene& scene, const RenderOptions& options, int bark_texture_units)
     : state_(std::make_unique<State>()) {
   State& st = *state_;
   st.options = options;
   st.bark_texture_units = std::max(0, bark_texture_units);
-  st.build(scene, textures);
+  st.build(scene);
   double compile_s = 0;
   std::string names = st.variant(MeshPass::gbuffer).name;
   st.program(MeshPass::gbuffer, &compile_s);
@@ -493,7 +490,7 @@ GlMesh::GlMesh(const Scene& scene, const RenderOptions& options, std::shared_ptr
   st.options = options;
   st.leaves = true;
   st.leaf_images = std::move(images);
-  st.build(scene, nullptr);
+  st.build(scene);
   if (st.leaf_images) st.gpu_bytes += st.upload_leaf_images();
   double compile_s = 0;
   st.program(MeshPass::gbuffer, &compile_s);
@@ -511,7 +508,7 @@ std::unique_ptr<GlMesh> GlMesh::leaves_of(const Scene& scene, const RenderOption
 
 GlMesh::~GlMesh() = default;
 
-uint64_t GlMesh::update(const Scene& scene, const SceneTextures* textures) { return state_->build(scene, textures); }
+uint64_t GlMesh::update(const Scene& scene) { return state_->build(scene); }
 
 void GlMesh::draw_gbuffer(const GlCameraView& camera, double footprint_scale) {
   State& st = *state_;

@@ -1,4 +1,4 @@
-// gl_mesh.h — the polygon baseline on the GPU (paper 000 sec. 4, "GS" and
+// gl_mesh.h — the polygon baseline on the GPU (Bhagvat et al. 2009 sec. 4, "GS" and
 // "GS+R"): the tessellated meshes of the CPU reference's mesh path rasterised into the
 // G-buffer of the GL ray caster (render_gl.h), which then shades them exactly as it shades
 // the ray-cast frusta. GlRenderer uses it when RenderOptions::geometry.kind is mesh.
@@ -7,8 +7,8 @@
 // by the same functions: each plant placed (place_plant), skinned (skin_skeleton with
 // RenderOptions::skin), tessellated at GeometryOptions::mesh_level (tessellate.h: 16·4^m
 // triangles per segment) and, where GeometryOptions::displace and the plant's bark has a
-// height map and relief_depth_m > 0, displaced by it (GS+R: displace with
-// height_function_for, through plant_mesh). Plants are not culled (the CPU culls only
+// height map and relief_depth_m > 0, displaced by it (GS+R: displace with the plant's
+// scene_displacements function, core/scene/height_maps.h, through plant_mesh). Plants are not culled (the CPU culls only
 // plants that cannot change a pixel).
 //
 // Instancing (RenderOptions::geometry.instance; docs/scatter.md "Instancing",
@@ -69,12 +69,11 @@
 #include <glm/vec3.hpp>
 
 #include "core/gl/gl_views.h"
-#include "core/render_types.h"
-#include "core/scene.h"
+#include "core/scene/render_types.h"
+#include "core/scene/scene.h"
 
 namespace sylva {
 
-class SceneTextures;  // texture.h
 class LeafImages;     // leaf_images.h
 
 // A sphere around one frustum's triangles (displaced ones included), metres.
@@ -91,11 +90,10 @@ class GlMesh {
   // Tessellates (and displaces) every plant of `scene` as RenderOptions::geometry asks
   // and uploads the result; builds the G-buffer program, and the shadow program when the
   // scene's sun shines. `bark_texture_units` > 0: the number of bark images the renderer
-  // binds for bark.glsl (the G-buffer program then writes the bark albedo). `textures`
-  // supplies the height maps; null: opened here when a displaced mesh needs them.
-  GlMesh(const Scene& scene, const RenderOptions& options, int bark_texture_units = 0,
-         const SceneTextures* textures = nullptr);
-  // The leaves of `scene` (leaf_mesh.h; skeleton.md "Leaves") drawn the same way, with the
+  // binds for bark.glsl (the G-buffer program then writes the bark albedo). The height
+  // maps of a displaced mesh are read here once (height_maps.h) and kept for update.
+  GlMesh(const Scene& scene, const RenderOptions& options, int bark_texture_units = 0);
+  // The leaves of `scene` (leaf_mesh.h; docs/spec/skeleton.md "Leaves") drawn the same way, with the
   // same programs (without bark: a leaf is never bark, materials.md): one record per leaf
   // with ids plant | material << 24, gl::kLeafChain, the leaf's index in its plant's
   // leaves; its flat Newell normal as every vertex's shading normal (mesh.frag.glsl turns
@@ -113,7 +111,7 @@ class GlMesh {
   // Re-tessellates the plants of `scene` (moved skeletons: animation) and uploads the
   // meshes again, whole (the polygon baseline has no lighter record to send). Returns the
   // bytes uploaded.
-  uint64_t update(const Scene& scene, const SceneTextures* textures = nullptr);
+  uint64_t update(const Scene& scene);
 
   // One G-buffer pass / one shadow-map pass (see the header comment for what the caller
   // sets up). `footprint_scale`: 1 / sqrt(spp), the bark albedo's ray differentials.

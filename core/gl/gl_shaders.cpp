@@ -5,8 +5,8 @@
 #include <charconv>
 #include <stdexcept>
 
-#include "core/fog_integrator.h"
-#include "core/shading.h"
+#include "core/scene/fog_integrator.h"
+#include "core/light/shading.h"
 
 namespace sylva {
 
@@ -150,7 +150,7 @@ ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units, bool lea
 }
 
 std::string glsl_float(double value) {
-  // The shortest decimal that reads back as `value` (a double): the text core/shading.h
+  // The shortest decimal that reads back as `value` (a double): the text core/light/shading.h
   // writes, so the GLSL compiler rounds the same literal as before to float.
   char buffer[64];
   const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);

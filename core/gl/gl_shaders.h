@@ -100,23 +100,23 @@ ShaderProgramSource mesh_program(MeshPass pass, int bark_texture_units = 0, bool
 // double, with ".0" added where it has no point or exponent (40 → "40.0", 0.04 → "0.04").
 std::string glsl_float(double value);
 
-// The #defines shading.glsl needs: core/shading.h's constants, SHADING_SPECULAR (k_s) and
+// The #defines shading.glsl needs: core/light/shading.h's constants, SHADING_SPECULAR (k_s) and
 // SHADING_SHININESS (s), as glsl_float literals — how the GLSL twins get them from C++.
 std::vector<std::string> shading_defines();
 
 // The deferred shading program (fullscreen.vert.glsl + bark.glsl's per-plant maps +
 // shading.glsl's model + shade.frag.glsl), with shading_defines(); `sun` false leaves out
 // the sun and its shadow map (black or absent sun: sky only); `fog` (a scene with fog)
-// adds fog.glsl and FOG: sunlight × T_sun, what is seen × T(0, t_end) (spec/fog.md).
+// adds fog.glsl and FOG: sunlight × T_sun, what is seen × T(0, t_end) (docs/spec/fog.md).
 ShaderProgramSource shade_program(bool sun, bool fog = false);
 
-// The fog pass's modes on the GPU (spec/fog.md, docs/gl-fog.md).
+// The fog pass's modes on the GPU (docs/spec/fog.md, docs/gl-fog.md).
 enum class GlFogMode {
   brute,   // FOG_BRUTE: the shadow map marched along the whole ray
   medium,  // FOG_MEDIUM: closed form outside the cone intervals, the map marched inside
   fast,    // FOG_FAST: closed form outside the cone intervals, V = 0 inside
 };
-const char* gl_fog_mode_name(GlFogMode mode);  // "brute", "medium", "fast" (spec/fog.md's)
+const char* gl_fog_mode_name(GlFogMode mode);  // "brute", "medium", "fast" (docs/spec/fog.md's)
 
 // The fog pass (fullscreen.vert.glsl + fog.glsl [+ fog_lists.glsl] + fog.frag.glsl): the
 // light the fog scatters toward the eye, added into the accumulated beauty, and the fog

@@ -16,7 +16,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "core/render_common.h"
+#include "core/scene/render_common.h"
 
 namespace sylva {
 

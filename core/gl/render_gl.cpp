@@ -14,24 +14,23 @@
 #include <map>
 #include <stdexcept>
 
-#include "core/cpu/photons.h"
-#include "core/cpu/render_cpu.h"
 #include "core/gl/bindings.h"
 #include "core/gl/gl_api.h"
 #include "core/gl/gl_bark_maps.h"
 #include "core/gl/gl_fog.h"
 #include "core/gl/gl_frame_targets.h"
 #include "core/gl/gl_mesh.h"
-#include "core/leaf_images.h"
+#include "core/scene/leaf_images.h"
 #include "core/gl/gl_objects.h"
 #include "core/gl/gl_pass_timers.h"
 #include "core/gl/gl_program.h"
 #include "core/gl/gl_views.h"
 #include "core/gl/gl_instances.h"
-#include "core/instances.h"
-#include "core/relief.h"
-#include "core/render_common.h"
+#include "core/scene/instances.h"
+#include "core/geometry/relief.h"
+#include "core/scene/render_common.h"
 #include "core/util/math.h"
+#include "core/util/clock.h"
 
 namespace sylva {
 
@@ -39,8 +38,6 @@ namespace {
 
 using render_common::CameraFrame;
 using render_common::camera_frame;
-using render_common::Clock;
-using render_common::seconds_since;
 constexpr int kShadowTexelsMin = 1024;
 constexpr int kShadowTexelsMax = 8192;
 constexpr double kShadowNormalOffsetTexels = 2;  // receiver offset along its normal
@@ -121,7 +118,7 @@ ShadowFrame shadow_frame(const std::vector<Sphere>& spheres, const glm::dvec3& d
 namespace {
 
 // The fog pass's mode for the mode `options` or the scene ask for (auto: the cone-interval
-// pass, fast; spec/fog.md), or nullopt where the GPU has none: refined and reference
+// pass, fast; docs/spec/fog.md), or nullopt where the GPU has none: refined and reference
 // (their exact shadow transitions need shadow rays, docs/gl-fog.md).
 std::optional<GlFogMode> gl_fog_mode_of(FogMode mode) {
   switch (mode) {
@@ -1166,7 +1163,7 @@ RenderResult GlRenderer::render(const Scene& scene) {
   return result;
 }
 
-RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrameStats* stats) {
+RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrameStats* stats, const GlConeSource& cones) {
   if (auto why = gl_unsupported(scene, options)) throw GlError(*why);
   std::optional<GlRenderer> built;
   try {
@@ -1179,26 +1176,20 @@ RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrame
   GlRenderer& renderer = *built;
   std::vector<RenderPass> cone_passes;
   if (scene.fog && requested_fog_mode(scene, options) != FogMode::brute) {
-    // The cone modes: sun photons and shadow cones on the CPU (as render_cpu builds them),
-    // uploaded once; plants that share a skeleton as instances (photons.h).
+    // The cone modes: the caller's shadow cones (the CPU's sun photons), uploaded once.
+    if (!cones)
+      throw GlError("the GL fog pass's cone modes (medium, fast) need shadow cones (render_gl's cone source)");
     const FogMode mode = requested_fog_mode(scene, options) == FogMode::medium ? FogMode::medium : FogMode::fast;
-    const SceneGeometry geometry =
-        options.geometry.instance ? build_instanced_geometry(scene, options.skin, GeometryOptions{}, &cone_passes)
-                                  : build_scene_geometry(scene, options.skin, GeometryOptions{}, &cone_passes);
-    const std::unique_ptr<const SunCones> cones = build_sun_cones(
-        geometry, scene,
-        sun_cone_options_for(mode, options.fog.photons.value_or(scene.fog->photons), options.fog.cone_params,
-                             options.threads, options.progress.cancel_flag()));
-    cone_passes.insert(cone_passes.end(), cones->passes.begin(), cones->passes.end());
-    if (cones->cancelled) {
+    const std::shared_ptr<const ConeSet> made = cones(mode, cone_passes);
+    if (!made) {
       RenderResult cancelled;
       cancelled.cancelled = true;
       return cancelled;
     }
     const Clock::time_point start = Clock::now();
-    const uint64_t bytes = renderer.set_fog_cones(cones->cones);
+    const uint64_t bytes = renderer.set_fog_cones(*made);
     cone_passes.push_back({"cone upload", seconds_since(start),
-                           std::to_string(cones->cones.size()) + " cones, " + std::to_string(bytes / 1024) + " KiB"});
+                           std::to_string(made->size()) + " cones, " + std::to_string(bytes / 1024) + " KiB"});
   }
   RenderResult result = renderer.render(scene);
   result.passes.insert(result.passes.begin(), cone_passes.begin(), cone_passes.end());

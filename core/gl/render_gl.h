@@ -1,4 +1,4 @@
-// render_gl.h — the OpenGL ray caster (paper 000 sec. 2.5, 2.6, 4): the analytic frusta
+// render_gl.h — the OpenGL ray caster (Bhagvat et al. 2009 sec. 2.5, 2.6, 4): the analytic frusta
 // drawn on the GPU with the shading model of the CPU reference (render_cpu.h), so the two
 // give the same picture within the tolerances of tests/gl/render_gl_test.cpp; and the frame
 // API a window uses (GlRenderer::draw into a GlTarget, GlFrameStats).
@@ -25,7 +25,7 @@
 //   shade          one fullscreen pass: ground plane, sky, sun (Lambert + normalised
 //                  Blinn-Phong) with the shadow map, sky ambient — render_cpu.cpp's lit() —
 //                  added into the renderer's accumulation target.
-//   fog            a scene with fog only (spec/fog.md; docs/gl-fog.md): shade[FOG] has
+//   fog            a scene with fog only (docs/spec/fog.md; docs/gl-fog.md): shade[FOG] has
 //                  already multiplied the surfaces' sunlight by T_sun and what is seen by
 //                  T(0, t_end); one fullscreen pass (fog.frag.glsl) adds the in-scatter —
 //                  `brute`: N jittered samples of the unshadowed in-scatter's distribution
@@ -71,6 +71,7 @@
 //     albedo's footprint from the screen derivatives of (u, v_m).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -81,9 +82,9 @@
 #include "core/gl/gl_context.h"
 #include "core/gl/gl_frame_stats.h"
 #include "core/gl/gl_target.h"
-#include "core/render_types.h"
-#include "core/scene.h"
-#include "core/shadow_cones.h"
+#include "core/scene/render_types.h"
+#include "core/scene/scene.h"
+#include "core/light/shadow_cones.h"
 
 namespace sylva {
 
@@ -163,7 +164,7 @@ class GlRenderer {
   RenderResult render(const Scene& scene);
 
   // ---- Plants and variants ----------------------------------------------------------------
-  // Animation (paper 000 sec. 4, the dancing cacti): re-skins the plants of `scene` — the
+  // Animation (Bhagvat et al. 2009 sec. 4, the dancing cacti): re-skins the plants of `scene` — the
   // same plants as the constructor's, their skeletons moved — and re-uploads only the
   // segment records (the ids too where the number of frusta changed; the polygon baseline
   // its whole mesh). Returns the bytes uploaded (the next frame's plant_bytes_uploaded).
@@ -184,7 +185,7 @@ class GlRenderer {
   // measure what the map's resolution costs the fog (docs/gl-fog.md).
   void set_shadow_map_texels(uint32_t texels);
 
-  // The shadow cones of this scene's plants and sun (core/cpu/photons.h build_sun_cones),
+  // The shadow cones of this scene's plants and sun (the CPU's: core/cpu/photons.h build_sun_cones),
   // uploaded once for every frame in a cone mode (medium, fast, auto) until the next call
   // (a new sun). Returns the bytes uploaded. Without them the cone modes are refused
   // (GlError).
@@ -215,10 +216,20 @@ class GlRenderer {
   std::unique_ptr<State> state_;
 };
 
-// Renders `scene` on the current context: GlRenderer(scene, options).render(scene), with
-// the setup passes first; the frame's stats (GPU times in) go to *stats when given.
-// Throws GlError (gl_unsupported's reason included). Cancelled by options.progress: a
-// result with `cancelled` set (and no image), as render_cpu's.
-RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrameStats* stats = nullptr);
+// The shadow cones of a scene's plants and sun for its fog in cone mode `mode` (medium or
+// fast), made for the GL renderer by its caller — the CPU's sun photons and clustering
+// (app/front/render.h sun_cone_source) — with what that did appended to `passes`; null
+// when cancelled.
+using GlConeSource = std::function<std::shared_ptr<const ConeSet>(FogMode mode, std::vector<RenderPass>& passes)>;
+
+// Renders `scene` on the current context: GlRenderer(scene, options), then for a fog in a
+// cone mode (medium, fast, auto) the cones of `cones` uploaded (set_fog_cones), then
+// render(scene); passes: the setup passes, the cone source's and "cone upload", the
+// frame's. The frame's stats (GPU times in) go to *stats when given. Throws GlError
+// (gl_unsupported's reason included; a cone mode without a cone source). Cancelled by
+// options.progress (or a cone source that returns null): a result with `cancelled` set
+// (and no image), as render_cpu's.
+RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrameStats* stats = nullptr,
+                       const GlConeSource& cones = {});
 
 }  // namespace sylva

@@ -1,6 +1,6 @@
 // compensated.h — error-free transformations of double arithmetic: a sum and a product
 // as an unevaluated pair hi + lo that is exact (Knuth, Dekker; Ogita, Rump, Oishi 2005).
-// core/recentre.h builds the frusta's re-centred rays on them.
+// core/geometry/recentre.h builds the frusta's re-centred rays on them.
 #pragma once
 
 #include <cmath>

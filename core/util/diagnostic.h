@@ -26,7 +26,7 @@ namespace sylva {
 
 // A place in a text file: 1-based line and column. {0,0} means "no place" (a file that
 // cannot be read, an error about the whole file). Columns count bytes in grammar text
-// (grammar.md) and code points in JSON files (json.h); the two agree on ASCII lines.
+// (docs/spec/grammar.md) and code points in JSON files (json.h); the two agree on ASCII lines.
 struct SourceLoc {
   uint32_t line = 0;
   uint32_t column = 0;

@@ -1,7 +1,7 @@
-// image_io.h — writing images with OpenImageIO, atomically (cli.md): the pixels go to a
+// image_io.h — writing images with OpenImageIO, atomically (docs/spec/cli.md): the pixels go to a
 // temporary file in the target's folder through OIIO, which is fsynced and then renamed
 // over the target, so a failed or interrupted write never leaves a truncated file and
-// never damages one that was there. Knows nothing of renders: core/render_output.h lays
+// never damages one that was there. Knows nothing of renders: core/scene/render_output.h lays
 // a render's beauty and AOVs out into files.
 #pragma once
 

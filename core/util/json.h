@@ -134,7 +134,7 @@ std::string json_excerpt(std::string_view utf8);
 //   spaced   [1, 2] {"a": 1}
 //   lines    one element or member per line, indented two spaces per open container,
 //            the closing bracket on its own line ("[]" / "{}" when empty)
-// so a document can be pretty at the top and dense in its long arrays (skeleton.md's
+// so a document can be pretty at the top and dense in its long arrays (docs/spec/skeleton.md's
 // joints). Usage errors (a value without key in an object, unbalanced ends) are asserted.
 class JsonWriter {
  public:

@@ -1,6 +1,6 @@
-// batch_test.cpp — the seed pool of app/cli/batch.h: every seed once, results serialised
+// batch_test.cpp — the seed pool of app/front/batch.h: every seed once, results serialised
 // to the caller without printing, failures named, cancellation stops new seeds.
-#include "app/cli/batch.h"
+#include "app/front/batch.h"
 
 #include <gtest/gtest.h>
 

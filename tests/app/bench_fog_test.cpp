@@ -6,7 +6,7 @@
 #include <sstream>
 #include <string>
 
-#include "tests/app/process.h"
+#include "tests/support/process.h"
 
 namespace {
 

@@ -14,8 +14,9 @@
 #include <vector>
 
 #include "core/gl/render_gl.h"
-#include "core/scene.h"
-#include "tests/app/process.h"
+#include "core/scene/scene.h"
+#include "core/scene/scene_json.h"
+#include "tests/support/process.h"
 
 namespace {
 

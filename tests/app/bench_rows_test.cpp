@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "tests/app/process.h"
+#include "tests/support/process.h"
 
 namespace {
 

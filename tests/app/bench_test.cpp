@@ -2,7 +2,7 @@
 // (A smoke test on small sizes: speed targets live in the benchmark, never in tests.)
 #include <gtest/gtest.h>
 
-#include "tests/app/process.h"
+#include "tests/support/process.h"
 
 namespace {
 

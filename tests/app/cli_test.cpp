@@ -1,5 +1,5 @@
-// cli_test.cpp — the `sylva` command line contract (cli.md, grammar.md "Printing a
-// word", skeleton.md "File format"): exit statuses 0/1/2, help texts, the exact word
+// cli_test.cpp — the `sylva` command line contract (docs/spec/cli.md, docs/spec/grammar.md "Printing a
+// word", docs/spec/skeleton.md "File format"): exit statuses 0/1/2, help texts, the exact word
 // `derive` prints, how -n/--seed/-D override the grammar, grow's summary line and
 // deterministic, atomic output, and the --max-modules guard against runaway growth.
 #include <gtest/gtest.h>
@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "process.h"
+#include "tests/support/process.h"
 
 namespace {
 
@@ -313,7 +313,7 @@ TEST_F(CliTest, NotationVariantsOfTheBookAreAccepted) {
 }
 
 TEST_F(CliTest, PrintedWordWithMultiCharacterModulesReadsBackAsTheSameWord) {
-  // grammar.md: multi-character modules are followed by a space where the next module
+  // docs/spec/grammar.md: multi-character modules are followed by a space where the next module
   // would otherwise merge with them. Whatever the spacing, the printed word must parse
   // back to itself.
   const std::string g = grammar("g.lsys",

@@ -1,4 +1,4 @@
-// export_cli_test.cpp — `sylva export` (cli.md, gltf_export.h): every export variant passes
+// export_cli_test.cpp — `sylva export` (docs/spec/cli.md, gltf_export.h): every export variant passes
 // the Khronos glTF validator (scripts/validate_gltf.mjs: no error, no warning), the
 // skeleton survives the round trip, usage errors exit 2; and batches (`--seed A..B`,
 // `-o out/p_{seed}.glb`) for export and grow: every seed written, a failing seed named
@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "core/gltf_export.h"
-#include "core/skeleton.h"
-#include "process.h"
+#include "core/io/gltf.h"
+#include "core/geometry/skeleton.h"
+#include "tests/support/process.h"
 
 namespace {
 

@@ -1,5 +1,5 @@
 // malformed_test.cpp — `sylva derive` on grammars with one mistake each
-// (grammar.md "Limits and errors", cli.md): the mistake is reported on stderr as
+// (docs/spec/grammar.md "Limits and errors", docs/spec/cli.md): the mistake is reported on stderr as
 //   FILE:LINE:COLUMN: error: MESSAGE
 //   <the source line>
 //   <a caret under the column>
@@ -21,7 +21,7 @@
 #include <string_view>
 #include <vector>
 
-#include "process.h"
+#include "tests/support/process.h"
 
 namespace {
 

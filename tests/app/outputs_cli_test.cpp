@@ -1,4 +1,4 @@
-// outputs_cli_test.cpp — where `sylva` may write (cli.md, docs/limits.md "Outputs"): never
+// outputs_cli_test.cpp — where `sylva` may write (docs/spec/cli.md, docs/limits.md "Outputs"): never
 // onto one of its inputs under any name, never onto a FIFO, a device or a read-only file
 // (refused with exit 1, the file as it was), all of a render's files or none, and a
 // "{seed}" in the folder part of an output pattern creates each seed's folder.
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "process.h"
+#include "tests/support/process.h"
 
 namespace {
 

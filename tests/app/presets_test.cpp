@@ -5,9 +5,9 @@
 // when the preset was made: any change to a preset, to the grammar engine or to the
 // turtle that alters a plant shows up here, by name. If a change is meant to alter a
 // plant, look at it (scripts/view_skeleton.py), then update the pinned number.
-// The paper 000 plants must also stay within 15% of the segment counts of the paper's
+// The Bhagvat et al. 2009 plants must also stay within 15% of the segment counts of the paper's
 // Table 1, and every preset must open with the comment block that says what it models,
-// where it comes from and which knobs to turn. Polygon leaves (grammar.md `{ . }`) are
+// where it comes from and which knobs to turn. Polygon leaves (docs/spec/grammar.md `{ . }`) are
 // not segments; their number in the skeleton is pinned beside the segments.
 #include <gtest/gtest.h>
 
@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "core/skeleton.h"
-#include "process.h"
+#include "core/geometry/skeleton.h"
+#include "tests/support/process.h"
 
 namespace {
 
@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 struct Preset {
   const char* name;             // file stem under presets/
   uint64_t segments;            // pinned: measured at the preset's default seed and steps
-  std::optional<double> paper;  // paper 000 Table 1 segment count, for the paper's plants
+  std::optional<double> paper;  // Bhagvat et al. 2009 Table 1 segment count, for the paper's plants
   uint64_t leaves = 0;          // pinned: polygon leaves in the skeleton
 };
 
@@ -53,7 +53,7 @@ const Preset kPresets[] = {
     // Honda's tree in leaf: the book's branching, polygon leaves on its lateral axes.
     {"abop_2_6_honda_leaves", 1023, std::nullopt, 5098},
     {"abop_2_8_ternary", 1457, std::nullopt},
-    // The plants of paper 000, modelled for sylva; Table 1 gives their segment counts.
+    // The plants of Bhagvat et al. 2009, modelled for sylva; Table 1 gives their segment counts.
     {"saguaro", 30, 30},
     {"aloe_vera", 229, 229, 456},  // a keel of frusta under two blade halves a segment
     {"elm", 1769, 1833},           // leaves of frusta (the grove scenes' elm)
@@ -61,10 +61,10 @@ const Preset kPresets[] = {
     {"coconut_palm", 3626, 3713, 3024},  // three blades over each leaflet's frusta
     {"pine", 17468, 16997},        // needles of true size (the benchmarks' pine)
     {"pine_dense", 17509, 16997},  // needles drawn as tufts, twice the fascicles
-    // A small cactus for the dancing-cacti scene (paper 000, Figure 8).
+    // A small cactus for the dancing-cacti scene (Bhagvat et al. 2009, Figure 8).
     {"cactus", 25, std::nullopt},
-    // The well of paper 000, Figure 10, one part per PART (presets/scenes/well.scene.json
-    // holds all four: 8 segments, tests/core/paper_scenes_test.cpp); PART 0 is the wall.
+    // The well of Bhagvat et al. 2009, Figure 10, one part per PART (presets/scenes/well.scene.json
+    // holds all four: 8 segments, tests/grow/paper_scenes_test.cpp); PART 0 is the wall.
     {"well", 1, std::nullopt},
 };
 

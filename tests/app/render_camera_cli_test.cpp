@@ -1,4 +1,4 @@
-// render_camera_cli_test.cpp — `sylva render --eye X,Y,Z --target X,Y,Z --fov DEG` (cli.md):
+// render_camera_cli_test.cpp — `sylva render --eye X,Y,Z --target X,Y,Z --fov DEG` (docs/spec/cli.md):
 // the camera of a grammar, skeleton or scene set on the command line.
 //
 // The saguaro stands at the origin, its trunk a column about 0.3 m in radius up to 6.2 m
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/app/process.h"
+#include "tests/support/process.h"
 
 namespace {
 

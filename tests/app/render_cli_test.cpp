@@ -1,4 +1,4 @@
-// render_cli_test.cpp — `sylva render` as a user runs it (cli.md, scene.md).
+// render_cli_test.cpp — `sylva render` as a user runs it (docs/spec/cli.md, docs/spec/scene.md).
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "tests/app/process.h"
+#include "tests/support/process.h"
 
 namespace {
 
@@ -269,7 +269,7 @@ TEST(RenderCli, BadGrammarInSceneIsExitOneWithThePlace) {
 }
 
 TEST(RenderCli, AGrammarErrorInASceneShowsTheGrammarsPlaceThenTheSceneKeyThatNamedIt) {
-  // cli.md: the grammar's own file:line:column, source line and caret, then a note at
+  // docs/spec/cli.md: the grammar's own file:line:column, source line and caret, then a note at
   // the scene's "grammar" value, so an editor can underline both; nothing is written.
   TempDir dir;
   dir.write("bad.lsys", "axiom: A\nA -> F(foo(2))\n");

@@ -1,5 +1,5 @@
-// render_fog_cli_test.cpp — `sylva render` on scenes with fog (cli.md's fog flags,
-// spec/fog.md's `fog` AOV), as a user runs it.
+// render_fog_cli_test.cpp — `sylva render` on scenes with fog (docs/spec/cli.md's fog flags,
+// docs/spec/fog.md's `fog` AOV), as a user runs it.
 // Every render here passes --spp 1 (the pixel centres): these tests are about what is
 // drawn, not how it is sampled, and the default of 8 samples would cost 8 times the time
 // (RenderCli.TheDefaultIsEightSamplesPerPixel pins the default).
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/app/process.h"
+#include "tests/support/process.h"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/app/process.h"
+#include "tests/support/process.h"
 
 namespace {
 

@@ -1,7 +1,7 @@
-// culling_test.cpp — a plant that can affect no pixel is left out (scene.md), and only
+// culling_test.cpp — a plant that can affect no pixel is left out (docs/spec/scene.md), and only
 // such a plant: not one whose shadow falls into the view, never one in view, and leaving
 // plants out changes no pixel.
-#include "core/culling.h"
+#include "core/scene/culling.h"
 
 #include <gtest/gtest.h>
 
@@ -10,9 +10,8 @@
 #include <glm/geometric.hpp>
 
 #include "core/cpu/render_cpu.h"
-#include "core/tessellate.h"
-#include "core/turtle.h"
-#include "lsystem/grammar.h"
+#include "core/geometry/tessellate.h"
+#include "tests/support/plants.h"
 
 namespace sylva {
 namespace {
@@ -155,13 +154,8 @@ TEST(Culling, ThePlantBoxHoldsTheWholeSkinnedSurfaceOfEveryPreset) {
   // Mitred cuts reach beyond the joints' spheres, knuckles too: every tessellated vertex
   // (on the analytic surface, 64 around every cut curve) lies in plant_box.
   for (const char* name : {"saguaro", "elm", "pine", "aloe_vera", "coconut_palm", "cactus", "abop_1_24a"}) {
-    const std::string path = std::string(SYLVA_SOURCE_DIR) + "/presets/" + name + ".lsys";
-    auto grammar = lsys::load_grammar(path);
-    ASSERT_TRUE(grammar) << name;
-    auto grown = grow(*grammar, {}, path, {});
-    ASSERT_TRUE(grown) << name;
     ScenePlant plant;
-    plant.skeleton = grown->skeleton;
+    plant.skeleton = test::grow_preset(name);
     plant.position = {5, 1, -2};
     plant.rotate_y_deg = 30;
     plant.scale = 1.7;

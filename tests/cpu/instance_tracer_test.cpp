@@ -8,8 +8,8 @@
 
 #include "core/cpu/photons.h"
 #include "core/cpu/render_cpu.h"
-#include "tests/core/test_scenes.h"
-#include "tests/core/test_textures.h"
+#include "tests/support/test_scenes.h"
+#include "tests/support/test_textures.h"
 
 namespace sylva {
 namespace {

@@ -16,6 +16,7 @@
 #include "core/cpu/render_cpu.h"
 #include "core/cpu/texture.h"
 #include "core/util/math.h"
+#include "tests/support/plants.h"
 
 namespace sylva {
 namespace {
@@ -304,12 +305,7 @@ TEST(MeshTracer, DescribesItselfAndCountsItsMemory) {
 }
 
 Scene saguaro_scene(uint32_t width, uint32_t height) {
-  Scene scene;
-  ScenePlant plant;
-  plant.grammar = std::string(SYLVA_SOURCE_DIR) + "/presets/saguaro.lsys";
-  scene.plants.push_back(plant);
-  EXPECT_TRUE(grow_scene_plants(scene).ok());
-  return default_scene_for(*scene.plants[0].skeleton, width, height);
+  return default_scene_for(test::grow_preset("saguaro"), width, height);
 }
 
 TEST(MeshTracer, SaguaroRenderAtLevelThreeAgreesWithTheAnalyticOnHitAndMiss) {

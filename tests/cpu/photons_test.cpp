@@ -1,4 +1,4 @@
-// Tests for core/cpu/photons.h: sun photons, shadow vectors (paper 002 sec. 3.1, Fig. 2b),
+// Tests for core/cpu/photons.h: sun photons, shadow vectors (Hougs and Day 2001 sec. 3.1, Fig. 2b),
 // the automatic cone parameters (sec. 6.1) and the cones built once per (plants, sun).
 #include "core/cpu/photons.h"
 
@@ -10,11 +10,10 @@
 #include <random>
 #include <string>
 
-#include "../core/test_scenes.h"
+#include "tests/support/test_scenes.h"
 #include "core/cpu/render_cpu.h"
-#include "core/turtle.h"
 #include "core/util/math.h"
-#include "lsystem/grammar.h"
+#include "tests/support/plants.h"
 
 namespace sylva {
 namespace {
@@ -38,12 +37,7 @@ SceneGeometry exact_geometry(const Scene& s) {
 // The pine preset, grown once: thousands of frusta of every size and direction.
 const Scene& pine_scene() {
   static const Scene scene = [] {
-    const std::string path = std::string(SYLVA_SOURCE_DIR) + "/presets/pine.lsys";
-    auto grammar = lsys::load_grammar(path);
-    EXPECT_TRUE(grammar);
-    auto grown = grow(*grammar, {}, path, {});
-    EXPECT_TRUE(grown);
-    Scene s = test::scene_around(grown->skeleton, {6, 2, 6}, {0, 2, 0}, 64, 48, 0);
+    Scene s = test::scene_around(test::grow_preset("pine"), {6, 2, 6}, {0, 2, 0}, 64, 48, 0);
     s.sun.direction = glm::normalize(glm::dvec3(0.8, 0.9, 0.45));
     s.sun.angular_radius_deg = kSunRadiusDeg;
     return s;

@@ -11,7 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "tests/core/test_scenes.h"
+#include "tests/support/test_scenes.h"
+#include "tests/support/plants.h"
 
 namespace sylva {
 namespace {
@@ -159,12 +160,7 @@ TEST(RenderCpu, PlacementRotatesScalesAndMoves) {
 }
 
 TEST(RenderCpu, SaguaroPresetIsLitAndShaded) {
-  Scene scene;
-  ScenePlant plant;
-  plant.grammar = std::string(SYLVA_SOURCE_DIR) + "/presets/saguaro.lsys";
-  scene.plants.push_back(plant);
-  ASSERT_TRUE(grow_scene_plants(scene).ok());
-  scene = default_scene_for(*scene.plants[0].skeleton, 160, 120);
+  Scene scene = default_scene_for(test::grow_preset("saguaro"), 160, 120);
   RenderOptions o;
   o.aovs = kAovId;
   RenderResult r = render_cpu(scene, o);

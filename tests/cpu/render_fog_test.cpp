@@ -1,4 +1,4 @@
-// render_fog_test.cpp — the CPU renderer through fog (spec/fog.md, "What a pixel sees" and
+// render_fog_test.cpp — the CPU renderer through fog (docs/spec/fog.md, "What a pixel sees" and
 // "Outputs"): beauty = fog.T·L_end + fog.RGB with L_end computed here independently, the
 // sunlight on surfaces attenuated by T_sun, what a ray that leaves the fog sees, and that a
 // scene without fog runs none of it.
@@ -13,10 +13,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/fog.h"
-#include "core/fog_integrator.h"
+#include "core/light/fog.h"
+#include "core/scene/fog_integrator.h"
 #include "core/util/math.h"
-#include "tests/core/test_scenes.h"
+#include "tests/support/test_scenes.h"
 
 namespace sylva {
 namespace {

@@ -1,6 +1,6 @@
 // render_joints_test.cpp — branch joints and elbows in the CPU ray caster (docs/joints.md):
 // close-ups of a crown, an axis going on past a branch, a lateral and a 60° elbow
-// (tests/core/joint_scenes.h) show no convex crease — no rim, lip or radius step where
+// (tests/support/joint_scenes.h) show no convex crease — no rim, lip or radius step where
 // a chain meets its parent, no facet line at an elbow — in the depth field or the normal
 // AOV; with the paper's plain skinning (SkinOptions::paper) the same close-ups do.
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <cstdio>
 
 #include "core/cpu/render_cpu.h"
-#include "tests/core/joint_scenes.h"
+#include "tests/support/joint_scenes.h"
 
 namespace sylva {
 namespace {

@@ -1,13 +1,13 @@
-// render_leaves_test.cpp — leaves (skeleton.md "Leaves", docs/leaves.md) in the CPU ray
+// render_leaves_test.cpp — leaves (docs/spec/skeleton.md "Leaves", docs/leaves.md) in the CPU ray
 // caster: a grammar's one known square leaf lands on the pixels its projection covers,
 // with its material's colour, its id and its distance; it is two-sided, opaque, and it
 // shadows the ground.
 #include <gtest/gtest.h>
 
 #include "core/cpu/render_cpu.h"
-#include "core/shading.h"
-#include "tests/core/leaf_checks.h"
-#include "tests/core/test_scenes.h"
+#include "core/light/shading.h"
+#include "tests/support/leaf_checks.h"
+#include "tests/support/test_scenes.h"
 
 namespace sylva {
 namespace {

@@ -9,10 +9,10 @@
 #include <numbers>
 
 #include "core/cpu/frustum_tracer.h"
-#include "core/relief.h"
+#include "core/geometry/relief.h"
 #include "core/cpu/render_cpu.h"
-#include "tests/core/test_scenes.h"
-#include "tests/core/test_textures.h"
+#include "tests/support/test_scenes.h"
+#include "tests/support/test_textures.h"
 
 namespace sylva {
 namespace {

@@ -1,5 +1,5 @@
 // render_shading_test.cpp — the CPU renderer's beauty where it is known in closed form
-// (tests/core/shading_scenes.h works the values out by hand): a sunlit ground pixel, the
+// (tests/support/shading_scenes.h works the values out by hand): a sunlit ground pixel, the
 // ground under a sun below the horizon, a lit frustum at a known normal, the specular
 // peak, a shadowed point, the ground under a sun on the horizon, the sky. The GL renderer
 // is held to the same pixels by tests/gl/render_gl_shading_test.cpp.
@@ -9,7 +9,7 @@
 
 #include <initializer_list>
 
-#include "tests/core/shading_scenes.h"
+#include "tests/support/shading_scenes.h"
 
 namespace sylva {
 namespace {

@@ -13,8 +13,8 @@
 #include "core/cpu/render_cpu.h"
 #include "core/util/color.h"
 #include "core/util/image_io.h"
-#include "tests/core/test_scenes.h"
-#include "tests/core/test_textures.h"
+#include "tests/support/test_scenes.h"
+#include "tests/support/test_textures.h"
 
 namespace sylva {
 namespace {

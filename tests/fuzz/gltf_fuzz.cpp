@@ -9,8 +9,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "core/gltf_export.h"
-#include "core/skeleton.h"
+#include "core/io/gltf.h"
+#include "core/geometry/skeleton.h"
 #include "tests/fuzz/fuzz_check.h"
 
 namespace {

@@ -2,15 +2,16 @@
 // (at most kMaxSteps steps and kMaxModules modules, so one input stays milliseconds),
 // interpreted and read by the turtle, as `sylva grow` does. Properties beyond "no crash,
 // no sanitizer finding": every error formats to a message naming the file, and a grown
-// skeleton passes validate_skeleton and reads back equal from its JSON (skeleton.md).
+// skeleton passes validate_skeleton and reads back equal from its JSON (docs/spec/skeleton.md).
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <string_view>
 
-#include "core/skeleton.h"
-#include "core/turtle.h"
+#include "core/geometry/skeleton.h"
+#include "core/grow/grow.h"
+#include "core/grow/turtle.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 #include "tests/fuzz/fuzz_check.h"

@@ -13,7 +13,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "core/normal_map.h"
+#include "core/io/normal_map.h"
 #include "core/util/image_io.h"
 #include "tests/fuzz/fuzz_check.h"
 

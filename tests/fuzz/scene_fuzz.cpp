@@ -1,4 +1,4 @@
-// scene_fuzz.cpp — libFuzzer target: any bytes as a `.scene.json` scene (scene.md), its
+// scene_fuzz.cpp — libFuzzer target: any bytes as a `.scene.json` scene (docs/spec/scene.md), its
 // relative paths resolved against presets/scenes/ so that the presets' textures and
 // grammars are found (a texture named by the input is opened from its header, as
 // `sylva render` does). Properties beyond "no crash, no sanitizer finding": an error
@@ -10,7 +10,8 @@
 #include <string>
 #include <string_view>
 
-#include "core/scene.h"
+#include "core/scene/scene.h"
+#include "core/scene/scene_json.h"
 #include "tests/fuzz/fuzz_check.h"
 
 namespace {

@@ -1,5 +1,5 @@
 // skeleton_fuzz.cpp — libFuzzer target: any bytes as a `.skel.json` skeleton
-// (skeleton.md). Properties beyond "no crash, no sanitizer finding": an error names the
+// (docs/spec/skeleton.md). Properties beyond "no crash, no sanitizer finding": an error names the
 // file; a skeleton the reader accepts passes validate_skeleton, and writing it reads back
 // equal (the format round-trips every double).
 #include <cstdint>
@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "core/skeleton.h"
+#include "core/geometry/skeleton.h"
 #include "tests/fuzz/fuzz_check.h"
 
 namespace {

@@ -15,7 +15,7 @@
 #include "core/gl/gl_objects.h"
 #include "core/gl/gl_program.h"
 #include "core/gl/gl_shaders.h"
-#include "tests/gl/gl_test_util.h"
+#include "tests/support/gl_checks.h"
 
 namespace sylva {
 namespace {

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "core/gl/gl_api.h"
-#include "tests/gl/gl_test_util.h"
+#include "tests/support/gl_checks.h"
 
 namespace sylva {
 namespace {

@@ -1,6 +1,6 @@
-// gl_fog_twin_test.cpp — shaders/fog.glsl against core/fog.h, function by function on the
+// gl_fog_twin_test.cpp — shaders/fog.glsl against core/light/fog.h, function by function on the
 // same inputs (rounded to float first, so only the arithmetic differs): run in a compute
-// shader over the stiff matrix of tests/core/fog_test.cpp (σ_t from 1e-12 to 1e3 per
+// shader over the stiff matrix of tests/light/fog_test.cpp (σ_t from 1e-12 to 1e3 per
 // metre, h = 0, 1e-9, 1, with and without a top, horizontal, vertical, oblique, near-
 // horizontal and sun-parallel rays, segments from 1 mm to unbounded, suns from the zenith
 // to 1e-3 above the horizon), plus the elementary functions through their limits.
@@ -26,10 +26,10 @@
 #include <string>
 #include <vector>
 
-#include "core/fog.h"
+#include "core/light/fog.h"
 #include "core/gl/gl_api.h"
 #include "core/gl/gl_shaders.h"
-#include "tests/gl/gl_test_util.h"
+#include "tests/support/gl_checks.h"
 
 namespace sylva {
 namespace {

@@ -17,14 +17,15 @@
 #include "core/gl/gl_frame_targets.h"
 #include "core/gl/render_gl.h"
 #include "core/util/color.h"
-#include "tests/gl/gl_test_util.h"
+#include "tests/support/gl_checks.h"
+#include "tests/support/plants.h"
 
 namespace sylva {
 namespace {
 
 // The saguaro at a small size: a sunlit plant, enough frusta for a real frame.
 Scene saguaro(uint32_t width = 64, uint32_t height = 48) {
-  return gl_test::scene_around(gl_test::grow_preset("saguaro"), width, height);
+  return gl_test::scene_around(test::grow_preset("saguaro"), width, height);
 }
 
 RenderOptions two_samples_with_depth() {
@@ -45,7 +46,7 @@ TEST(GlFrame, DrawingIntoACallersTargetThenReadingBackGivesTheCliReadback) {
   SYLVA_REQUIRE_GL();
   const Scene scene = saguaro();
   const RenderOptions options = two_samples_with_depth();
-  const RenderResult cli = render_gl(scene, options);  // what `sylva render` writes
+  const RenderResult cli = gl_test::gl_render(scene, options);  // what `sylva render` writes
 
   GlRenderer renderer(scene, options);
   GlTextureTarget target(scene.width, scene.height);
@@ -109,13 +110,13 @@ TEST(GlFrame, ANewCameraOrSunRedrawsWithoutSendingThePlants) {
   EXPECT_EQ(moved.geometry_bytes, first.geometry_bytes);
   EXPECT_EQ(moved.compile_s, 0.0) << moved.compiled;
   const RenderImage moved_image = renderer.read_back();
-  EXPECT_EQ(moved_image.beauty, render_gl(scene, options).image.beauty) << "the moved camera's own picture";
+  EXPECT_EQ(moved_image.beauty, gl_test::gl_render(scene, options).image.beauty) << "the moved camera's own picture";
 
   scene.sun.direction = {-0.6, 0.8, 0.1};
   const GlFrameStats sunset = renderer.draw(scene);
   EXPECT_EQ(sunset.plant_bytes_uploaded, 0u);
   EXPECT_EQ(sunset.targets_allocated, 0u);
-  EXPECT_EQ(renderer.read_back().beauty, render_gl(scene, options).image.beauty);
+  EXPECT_EQ(renderer.read_back().beauty, gl_test::gl_render(scene, options).image.beauty);
 
   // Only update_plants sends plant data, and the next frame says how much.
   const uint64_t sent = renderer.update_plants(scene);
@@ -138,7 +139,7 @@ TEST(GlFrame, AResizeReallocatesTheRenderTargetsAlone) {
   EXPECT_EQ(large.target_bytes, GlFrameTargets::kBytesPerPixel * 96 * 72 + 4ull * large.shadow_texels * large.shadow_texels);
   const RenderImage image = renderer.read_back();
   EXPECT_EQ(image.width, 96u);
-  EXPECT_EQ(image.beauty, render_gl(scene, options).image.beauty);
+  EXPECT_EQ(image.beauty, gl_test::gl_render(scene, options).image.beauty);
   EXPECT_EQ(renderer.draw(scene).targets_allocated, 0u) << "the same size again: nothing reallocated";
 
   // A caller's texture target follows the same rule.
@@ -197,7 +198,7 @@ TEST(GlFrame, SkinningStopsWhenCancelledAndRenderGlFlagsIt) {
   RenderOptions options;
   options.progress = Progress(&cancel);
   EXPECT_THROW(GlRenderer(scene, options), GlCancelled);
-  const RenderResult flagged = render_gl(scene, options);
+  const RenderResult flagged = gl_test::gl_render(scene, options);
   EXPECT_TRUE(flagged.cancelled);
   EXPECT_TRUE(flagged.image.beauty.empty());
 

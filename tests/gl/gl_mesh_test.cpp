@@ -14,7 +14,9 @@
 #include <cstdio>
 
 #include "core/gl/render_gl.h"
-#include "tests/gl/gl_test_util.h"
+#include "core/scene/scene_json.h"
+#include "tests/support/gl_checks.h"
+#include "tests/support/plants.h"
 
 namespace sylva {
 namespace {
@@ -55,10 +57,7 @@ Agreement expect_mesh_matches_cpu(const std::string& name, const Scene& scene, c
 // The bundled ribbed saguaro (presets/scenes), small: a bark albedo texture and a height
 // map (GS+R displaces by it).
 Scene saguaro_scene(uint32_t width, uint32_t height) {
-  Expected<Scene> read = read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes/saguaro.scene.json");
-  if (!read) throw std::runtime_error(read.error().format());
-  Scene scene = std::move(*read);
-  if (Status grown = grow_scene_plants(scene); !grown) throw std::runtime_error(grown.error().format());
+  Scene scene = test::grown_preset_scene("saguaro");
   scene.width = width;
   scene.height = height;
   return scene;
@@ -101,7 +100,7 @@ TEST(GlMesh, TheSaguaroDisplacedByItsHeightMapMatchesTheCpuMesh) {
   expect_mesh_matches_cpu("saguaro_gsr2", scene, mesh_options(2, true), "mesh[GBUFFER_PASS TEXTURE_UNITS=1]");
   // And the displacement is really there: the GS+R picture is not the GS one.
   RenderOptions flat = mesh_options(2, false), ribbed = mesh_options(2, true);
-  const Agreement a = gl_test::compare(render_gl(scene, ribbed).image, render_gl(scene, flat).image);
+  const Agreement a = gl_test::compare(gl_test::gl_render(scene, ribbed).image, gl_test::gl_render(scene, flat).image);
   EXPECT_GT(a.depth_max_rel, 1e-3) << a.describe();
 }
 
@@ -122,8 +121,8 @@ TEST(GlMesh, MoreSamplesConvergeToTheCpuMesh) {
   RenderOptions options = mesh_options(2, true);
   options.spp = 9;
   const Scene scene = saguaro_scene(120, 90);
-  const RenderResult cpu = render_cpu(scene, options);
-  const RenderResult gl = render_gl(scene, options);
+  const RenderResult cpu = gl_test::cpu_render(scene, options);
+  const RenderResult gl = gl_test::gl_render(scene, options);
   const Agreement a = gl_test::compare(gl.image, cpu.image);
   std::printf("[ agreement ] saguaro GS+R 2, 9 spp 120x90: %s\n", a.describe().c_str());
   EXPECT_LE(a.beauty_mad_srgb, 1.0 / 255) << a.describe() << "\n  images: "
@@ -141,8 +140,8 @@ TEST(GlMesh, AovsFollowTheCpuMesh) {
   // shading normal turns 0.39 rad across a triangle a few pixels wide here (measured: up to
   // 2.3e-4). The CPU's barycentrics are exact. Ids must agree exactly.
   constexpr double kNormalTolerance = 1e-3, kUvTolerance = 5e-4;
-  const RenderResult cpu = render_cpu(scene, options);
-  const RenderResult gl = render_gl(scene, options);
+  const RenderResult cpu = gl_test::cpu_render(scene, options);
+  const RenderResult gl = gl_test::gl_render(scene, options);
   ASSERT_EQ(gl.image.normal.size(), cpu.image.normal.size());
   int both = 0;
   for (size_t p = 0; p < gl.image.depth.size(); ++p) {
@@ -191,7 +190,7 @@ TEST(GlMesh, MovedPlantsAreTessellatedAgain) {
   top[0] = 0.4, top[1] = 1.9;
   EXPECT_EQ(renderer.update_plants(moved), renderer.uploaded_bytes());
   const RenderResult updated = renderer.render(moved);
-  const RenderResult fresh = render_gl(moved, options);
+  const RenderResult fresh = gl_test::gl_render(moved, options);
   EXPECT_EQ(updated.image.beauty, fresh.image.beauty);
 }
 

@@ -11,8 +11,8 @@
 
 #include "core/gl/gl_api.h"
 #include "core/gl/gl_program.h"
-#include "tests/app/process.h"
-#include "tests/gl/gl_test_util.h"
+#include "tests/support/process.h"
+#include "tests/support/gl_checks.h"
 
 namespace sylva {
 namespace {

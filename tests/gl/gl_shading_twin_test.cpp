@@ -1,6 +1,6 @@
-// gl_shading_twin_test.cpp — shaders/shading.glsl against core/shading.h, function by
+// gl_shading_twin_test.cpp — shaders/shading.glsl against core/light/shading.h, function by
 // function on the same inputs (rounded to float first, so only the arithmetic differs):
-// run in a compute shader over hand-picked cases (those of tests/core/shading_test.cpp)
+// run in a compute shader over hand-picked cases (those of tests/light/shading_test.cpp)
 // and random ones, and the constants the GLSL got from C++ read back.
 #include <gtest/gtest.h>
 
@@ -15,8 +15,8 @@
 
 #include "core/gl/gl_api.h"
 #include "core/gl/gl_shaders.h"
-#include "core/shading.h"
-#include "tests/gl/gl_test_util.h"
+#include "core/light/shading.h"
+#include "tests/support/gl_checks.h"
 
 namespace sylva {
 namespace {

@@ -11,10 +11,10 @@
 
 #include "core/gl/gl_api.h"
 #include "core/gl/gl_shaders.h"
-#include "core/ray_frustum.h"
-#include "core/cpu/render_cpu.h"
-#include "core/skin.h"
-#include "tests/gl/gl_test_util.h"
+#include "core/geometry/ray_frustum.h"
+#include "core/geometry/skin.h"
+#include "tests/support/gl_checks.h"
+#include "tests/support/plants.h"
 
 namespace sylva {
 namespace {
@@ -49,7 +49,7 @@ GLuint compute_program(std::string* log) {
 TEST(GlTwin, UnpackAndIntersectMatchTheCppFloatTwin) {
   SYLVA_REQUIRE_GL();
   // The elm's frusta, one world 10^6 m away too, and rays from all around each.
-  Scene scene = gl_test::scene_around(gl_test::grow_preset("elm"));
+  Scene scene = gl_test::scene_around(test::grow_preset("elm"));
   std::vector<Frustum> frusta = skin_skeleton(place_plant(scene.plants.front())).frusta;
   const size_t elm = frusta.size();
   for (size_t i = 0; i < elm; i += 7) {

@@ -1,4 +1,4 @@
-// gl_update_test.cpp — GlRenderer::update_plants (animation, paper 000 sec. 4): moving a
+// gl_update_test.cpp — GlRenderer::update_plants (animation, Bhagvat et al. 2009 sec. 4): moving a
 // skeleton and re-uploading its records gives the picture a renderer built on the moved
 // scene gives, for the bytes of the records alone.
 #include <gtest/gtest.h>
@@ -8,8 +8,8 @@
 #include <stdexcept>
 
 #include "core/gl/render_gl.h"
-#include "core/skin.h"
-#include "tests/gl/gl_test_util.h"
+#include "core/geometry/skin.h"
+#include "tests/support/gl_checks.h"
 
 namespace sylva {
 namespace {

@@ -1,5 +1,5 @@
 // render_gl_fog_test.cpp — the GL fog pass (render_gl.h, shaders/fog.frag.glsl) against the
-// CPU's fog (render_cpu.h, fog_integrator.h), through the fog AOV (spec/fog.md "Outputs").
+// CPU's fog (render_cpu.h, fog_integrator.h), through the fog AOV (docs/spec/fog.md "Outputs").
 // What is deterministic must agree to float precision: fog.T everywhere, and the
 // in-scatter of every ray that no shadow crosses (V = 1 all along: brute's estimate is then
 // the closed form whatever its jitter). What is random (brute's samples, where shadows
@@ -19,11 +19,11 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/cpu/photons.h"
-#include "core/cpu/render_cpu.h"
-#include "core/fog_integrator.h"
-#include "tests/core/test_scenes.h"
-#include "tests/gl/gl_test_util.h"
+#include "core/scene/fog_integrator.h"
+#include "core/scene/scene_json.h"
+#include "tests/support/test_scenes.h"
+#include "tests/support/gl_checks.h"
+#include "tests/support/plants.h"
 
 namespace sylva {
 namespace {
@@ -35,10 +35,7 @@ Scene foggy_cylinder(uint32_t steps) { return test::foggy_cylinder(FogMode::brut
 // sun behind them, height fog; at w × h, with a point sun so that one GL sample (the disc's
 // centre, render_gl.h) and the CPU's estimates look at the same shadows.
 Scene elm_grove(uint32_t w, uint32_t h, uint32_t steps) {
-  Expected<Scene> read = read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes/elm_grove_low_sun.scene.json");
-  if (!read) throw std::runtime_error(read.error().format());
-  Scene scene = std::move(*read);
-  if (Status grown = grow_scene_plants(scene); !grown) throw std::runtime_error(grown.error().format());
+  Scene scene = test::grown_preset_scene("elm_grove_low_sun");
   scene.width = w;
   scene.height = h;
   scene.sun.angular_radius_deg = 0;
@@ -51,7 +48,7 @@ RenderImage render(const Scene& scene, bool gl, FogMode mode, GlFrameStats* stat
   RenderOptions options;
   options.aovs = kAovFog | kAovDepth;
   options.fog.mode = mode;
-  return gl ? render_gl(scene, options, stats).image : render_cpu(scene, options).image;
+  return gl ? gl_test::gl_render(scene, options, stats).image : gl_test::cpu_render(scene, options).image;
 }
 
 // The in-scatter (fog.R fog.G fog.B) of `test` against `ref`'s: RMSE over pixels and
@@ -92,7 +89,7 @@ TEST(GlFog, ASceneWithoutFogRunsNoneOfIt) {
   RenderOptions options;
   options.aovs = kAovFog;
   GlFrameStats stats;
-  const RenderResult r = render_gl(s, options, &stats);
+  const RenderResult r = gl_test::gl_render(s, options, &stats);
   EXPECT_EQ(stats.pass(GlPass::fog).runs, 0u);
   EXPECT_TRUE(stats.fog_mode.empty());
   EXPECT_EQ(stats.pass(GlPass::shade).program, "shade[SUN]");
@@ -195,9 +192,9 @@ TEST(GlFog, BeautyIsTransmittanceTimesWhatIsSeenPlusTheFogsLight) {
   RenderOptions options;
   options.aovs = kAovFog;
   GlFrameStats stats;
-  const RenderImage f = render_gl(foggy, options, &stats).image;
+  const RenderImage f = gl_test::gl_render(foggy, options, &stats).image;
   EXPECT_EQ(stats.pass(GlPass::fog).program, "fog[FOG_BRUTE]");
-  const RenderImage c = render_gl(clear, RenderOptions{}).image;
+  const RenderImage c = gl_test::gl_render(clear, RenderOptions{}).image;
   double worst = 0;
   for (size_t p = 0; p < size_t{foggy.width} * foggy.height; ++p)
     for (int k = 0; k < 3; ++k) {
@@ -226,7 +223,7 @@ TEST(GlFog, AtSeveralSamplesTheFogAovHasItsOwnPassAtThePixelCentres) {
   options.aovs = kAovFog;
   options.spp = 4;
   GlFrameStats stats;
-  const RenderImage four = render_gl(s, options, &stats).image;
+  const RenderImage four = gl_test::gl_render(s, options, &stats).image;
   EXPECT_EQ(stats.pass(GlPass::fog).runs, 5u) << "four samples and the AOV";
   const RenderImage one = render(s, true, FogMode::brute);
   const FogError e = fog_error(four, one);
@@ -293,12 +290,6 @@ TEST(GlFog, TheShadowMapsErrorShrinksWithItsResolution) {
   EXPECT_LE(floors[1], 0.03);
 }
 
-// Sun photons and shadow cones for `scene` in `mode`, as render_cpu and render_gl build
-// them (few photons: these are tests of the passes, not of the cones).
-std::unique_ptr<const SunCones> cones_for(const Scene& scene, FogMode mode, uint64_t photons) {
-  const SceneGeometry geometry = build_scene_geometry(scene, SkinOptions{});
-  return build_sun_cones(geometry, scene, sun_cone_options_for(mode, photons, std::nullopt, 0, nullptr));
-}
 
 // `scene` in `mode` with `cones` on both backends: the CPU through ConeSetFogSource, the GL
 // backend through set_fog_cones (the same cones on both sides).
@@ -313,7 +304,7 @@ ConeRenders render_with_cones(const Scene& scene, FogMode mode, const ConeSet& c
   options.aovs = kAovFog | kAovDepth;
   options.fog.mode = mode;
   options.fog.cones = &source;
-  out.cpu = render_cpu(scene, options).image;
+  out.cpu = gl_test::cpu_render(scene, options).image;
   GlRenderer renderer(scene, options);
   renderer.set_fog_cones(cones);
   for (uint32_t i = 0; i < frames; ++i) out.gl = renderer.render(scene).image;
@@ -331,11 +322,11 @@ struct FastMatch {
   FogError error;
 };
 FastMatch fast_against_the_cpu(const char* what, const Scene& s, uint64_t photons) {
-  const auto cones = cones_for(s, FogMode::fast, photons);
-  EXPECT_GT(cones->cones.size(), 0u);
-  const ConeRenders r = render_with_cones(s, FogMode::fast, cones->cones);
+  const auto cones = gl_test::cpu_cones(s, FogMode::fast, photons);
+  EXPECT_GT(cones->size(), 0u);
+  const ConeRenders r = render_with_cones(s, FogMode::fast, *cones);
   EXPECT_EQ(r.stats.fog_mode, "fast");
-  EXPECT_EQ(r.stats.fog_cones, cones->cones.size());
+  EXPECT_EQ(r.stats.fog_cones, cones->size());
   EXPECT_EQ(r.stats.pass(GlPass::fog).program, "fog[FOG_FAST SUN]");
   EXPECT_TRUE(r.stats.fog_counted);
   EXPECT_GT(r.stats.fog_fragments, 0u);
@@ -353,7 +344,7 @@ FastMatch fast_against_the_cpu(const char* what, const Scene& s, uint64_t photon
   m.error = fog_error(r.gl, r.cpu);
   std::printf("[ fog ] %s, fast, %zu cones: %zu of %zu pixels within 1e-3, RMSE %.3g of the mean, bias %+.3g, %llu "
               "intervals\n",
-              what, cones->cones.size(), m.close, m.same, m.error.relative_rmse(), m.error.relative_bias(),
+              what, cones->size(), m.close, m.same, m.error.relative_rmse(), m.error.relative_bias(),
               static_cast<unsigned long long>(r.stats.fog_fragments));
   return m;
 }
@@ -421,17 +412,17 @@ TEST(GlFog, MediumEqualsBruteWhereOneConeHoldsTheEyeAndEveryTree) {
 // and its bias within 1 % of the CPU medium's (the same expectation up to the map). On the
 // foggy cylinder (20 000 photons) and on the canopy (the grove, 200 000 photons, 64 steps).
 void expect_medium_matches_the_cpu(const char* what, const Scene& s, uint64_t photons) {
-  const auto cones = cones_for(s, FogMode::medium, photons);
-  ASSERT_GT(cones->cones.size(), 0u);
+  const auto cones = gl_test::cpu_cones(s, FogMode::medium, photons);
+  ASSERT_GT(cones->size(), 0u);
   const RenderImage ref = render(s, false, FogMode::reference);
-  const ConeRenders r = render_with_cones(s, FogMode::medium, cones->cones);
+  const ConeRenders r = render_with_cones(s, FogMode::medium, *cones);
   EXPECT_EQ(r.stats.fog_mode, "medium");
   EXPECT_EQ(r.stats.pass(GlPass::fog).program, "fog[FOG_MEDIUM SUN]");
   EXPECT_EQ(r.stats.pass(GlPass::fog_cones).runs, r.stats.pass(GlPass::fog).runs);
   const FogError gl = fog_error(r.gl, ref), cpu = fog_error(r.cpu, ref), direct = fog_error(r.gl, r.cpu);
   std::printf("[ fog ] %s, medium %u steps, %zu cones: GL RMSE %.4f bias %+.4f; CPU RMSE %.4f bias %+.4f; GL against "
               "CPU %.4f, bias %+.4f\n",
-              what, s.fog->steps, cones->cones.size(), gl.relative_rmse(), gl.relative_bias(), cpu.relative_rmse(),
+              what, s.fog->steps, cones->size(), gl.relative_rmse(), gl.relative_bias(), cpu.relative_rmse(),
               cpu.relative_bias(), direct.relative_rmse(), direct.relative_bias());
   EXPECT_LE(gl.relative_rmse(), 1.3 * cpu.relative_rmse() + 0.03) << what;
   EXPECT_LE(std::abs(direct.relative_bias()), 0.01) << what;
@@ -453,12 +444,12 @@ TEST(GlFog, MediumOnTheGpuMatchesTheCpusMediumOnTheCanopy) {
 TEST(GlFog, OverflowingIntervalListsAreCountedMarchedWholeAndGrown) {
   SYLVA_REQUIRE_GL();
   const Scene grove = elm_grove(120, 90, 16);
-  const auto cones = cones_for(grove, FogMode::fast, 200000);
+  const auto cones = gl_test::cpu_cones(grove, FogMode::fast, 200000);
   RenderOptions options;
   options.aovs = kAovFog;
   options.fog.mode = FogMode::fast;
   GlRenderer renderer(grove, options);
-  renderer.set_fog_cones(cones->cones);
+  renderer.set_fog_cones(*cones);
   renderer.draw(grove);
   const GlFrameStats first = renderer.wait_for_frame();
   std::printf("[ fog ] grove fast: %llu intervals for %u nodes, %llu overflowed fragments, %llu pixels\n",

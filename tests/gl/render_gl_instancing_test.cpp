@@ -11,8 +11,8 @@
 #include <cstdio>
 #include <string>
 
-#include "tests/core/test_scenes.h"
-#include "tests/gl/gl_test_util.h"
+#include "tests/support/test_scenes.h"
+#include "tests/support/gl_checks.h"
 
 namespace sylva {
 namespace {
@@ -22,7 +22,7 @@ RenderResult render(const Scene& s, bool instance, GeometryKind kind = GeometryK
   o.aovs = kAovDepth | kAovNormal | kAovUv | kAovId;
   o.geometry.instance = instance;
   o.geometry.kind = kind;
-  return render_gl(s, o);
+  return gl_test::gl_render(s, o);
 }
 
 // The grove drawn both ways agrees: ids, depth, normals, v and beauty (see below).

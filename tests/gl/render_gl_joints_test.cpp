@@ -8,9 +8,8 @@
 
 #include <cstdio>
 
-#include "core/cpu/render_cpu.h"
-#include "tests/core/joint_scenes.h"
-#include "tests/gl/gl_test_util.h"
+#include "tests/support/joint_scenes.h"
+#include "tests/support/gl_checks.h"
 
 namespace sylva {
 namespace {
@@ -22,7 +21,7 @@ TEST(RenderGlJoints, CloseUpsOfJointsAndElbowsMatchTheCpuAndShowNoConvexCrease) 
   RenderOptions o;
   o.aovs = kAovDepth | kAovNormal;
   for (const test::JointCloseUp& c : test::joint_close_ups()) {
-    const RenderResult gl = render_gl(c.scene, o), cpu = render_cpu(c.scene, o);
+    const RenderResult gl = gl_test::gl_render(c.scene, o), cpu = gl_test::cpu_render(c.scene, o);
     const gl_test::Agreement a = gl_test::compare(gl.image, cpu.image);
     const test::SurfaceDefects d = test::surface_defects(c.scene, gl.image);
     std::printf("[ joints ] %-12s GL vs CPU %s; GL %s\n", c.name.c_str(), a.describe().c_str(),

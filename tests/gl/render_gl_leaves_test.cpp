@@ -9,9 +9,10 @@
 
 #include <cstdio>
 
-#include "tests/core/leaf_checks.h"
-#include "tests/core/test_scenes.h"
-#include "tests/gl/gl_test_util.h"
+#include "tests/support/leaf_checks.h"
+#include "tests/support/plants.h"
+#include "tests/support/test_scenes.h"
+#include "tests/support/gl_checks.h"
 
 namespace sylva {
 namespace {
@@ -19,7 +20,7 @@ namespace {
 RenderResult render_gl_with_aovs(const Scene& s) {
   RenderOptions o;
   o.aovs = kAovDepth | kAovId | kAovNormal | kAovUv;
-  return render_gl(s, o);
+  return gl_test::gl_render(s, o);
 }
 
 // GL's float G-buffer and shading: depth to 1e-4, radiance to 1e-3 (linear).
@@ -42,7 +43,7 @@ TEST(RenderGlLeaves, ALeafShadowsTheGroundThroughTheShadowMap) {
   const Scene s = test::leaf_shadow_scene();
   Scene bare = s;
   bare.plants[0].skeleton->leaves.clear();
-  test::expect_the_leaf_shadow(s, render_gl(s, {}).image, render_gl(bare, {}).image, kRadianceAbs);
+  test::expect_the_leaf_shadow(s, gl_test::gl_render(s, {}).image, gl_test::gl_render(bare, {}).image, kRadianceAbs);
 }
 
 // The bush `scene` on both backends, within the geometry's and the beauty's tolerances
@@ -50,8 +51,8 @@ TEST(RenderGlLeaves, ALeafShadowsTheGroundThroughTheShadowMap) {
 void expect_bush_agrees(const Scene& scene, const std::string& name, RenderResult* gl, RenderResult* cpu) {
   RenderOptions options;
   options.aovs = kAovDepth | kAovId;
-  *gl = render_gl(scene, options);
-  *cpu = render_cpu(scene, options);
+  *gl = gl_test::gl_render(scene, options);
+  *cpu = gl_test::cpu_render(scene, options);
   const gl_test::Agreement a = gl_test::compare(gl->image, cpu->image);
   std::printf("[ agreement ] %s %ux%u: %s\n", name.c_str(), scene.width, scene.height, a.describe().c_str());
   // The geometry as the frusta's tolerances demand.
@@ -73,7 +74,7 @@ size_t leaf_pixels(const RenderImage& image) {
 
 TEST(RenderGlLeaves, TheLeafyBushMatchesTheCpu) {
   SYLVA_REQUIRE_GL();
-  const Skeleton bush = gl_test::grow_preset("abop_1_25_bush_leaves");
+  const Skeleton bush = test::grow_preset("abop_1_25_bush_leaves");
   ASSERT_GT(bush.leaves.size(), 1000u);
   RenderResult gl, cpu;
   expect_bush_agrees(gl_test::scene_around(bush), "bush_leaves", &gl, &cpu);
@@ -93,7 +94,7 @@ TEST(RenderGlLeaves, TheLeafyBushInTheBundledLeafImageMatchesTheCpu) {
   SYLVA_REQUIRE_GL();
   // The bush's leaves (material 3: ''' past the wood's 0) in the bundled elm leaf: its
   // albedo and its alpha cut-out (leaf_images.h), on both backends.
-  const Skeleton bush = gl_test::grow_preset("abop_1_25_bush_leaves");
+  const Skeleton bush = test::grow_preset("abop_1_25_bush_leaves");
   Scene scene = gl_test::scene_around(bush);
   SceneMaterial leaf;
   leaf.albedo_image = std::string(SYLVA_SOURCE_DIR) + "/presets/textures/elm_leaf.png";
@@ -106,7 +107,7 @@ TEST(RenderGlLeaves, TheLeafyBushInTheBundledLeafImageMatchesTheCpu) {
   plain.materials.erase(3);
   RenderOptions options;
   options.aovs = kAovId;
-  const size_t cut = leaf_pixels(gl.image), whole = leaf_pixels(render_gl(plain, options).image);
+  const size_t cut = leaf_pixels(gl.image), whole = leaf_pixels(gl_test::gl_render(plain, options).image);
   std::printf("[ agreement ] leaf pixels: %zu GL cut out, %zu CPU cut out, %zu GL whole\n", cut, leaf_pixels(cpu.image),
               whole);
   EXPECT_GT(cut, 0u);
@@ -119,7 +120,7 @@ TEST(RenderGlLeaves, MaterialsPastTheTableKeepTheDefaultLookNotTheLastEntrys) {
   // docs/materials.md: the table describes indices 0 to 15; a segment or leaf of index 20
   // has default_material_albedo's colour and specular 1 on both backends, whatever
   // entry 15 says (here: the elm leaf image with its cut-out, matte).
-  Skeleton bush = gl_test::grow_preset("abop_1_25_bush_leaves");
+  Skeleton bush = test::grow_preset("abop_1_25_bush_leaves");
   for (Joint& j : bush.joints) j.material = 20;
   for (Leaf& l : bush.leaves) l.material = 20;
   Scene scene = gl_test::scene_around(bush);
@@ -133,8 +134,8 @@ TEST(RenderGlLeaves, MaterialsPastTheTableKeepTheDefaultLookNotTheLastEntrys) {
   untabled.materials.clear();
   RenderOptions options;
   options.aovs = kAovId;
-  EXPECT_EQ(leaf_pixels(gl.image), leaf_pixels(render_gl(untabled, options).image)) << "no cut-out";
-  EXPECT_EQ(gl.image.beauty, render_gl(untabled, {}).image.beauty);
+  EXPECT_EQ(leaf_pixels(gl.image), leaf_pixels(gl_test::gl_render(untabled, options).image)) << "no cut-out";
+  EXPECT_EQ(gl.image.beauty, gl_test::gl_render(untabled, {}).image.beauty);
 }
 
 TEST(RenderGlLeaves, ACutOutsTransparentTexelsLetCameraAndShadowRaysThrough) {
@@ -146,7 +147,7 @@ TEST(RenderGlLeaves, ACutOutsTransparentTexelsLetCameraAndShadowRaysThrough) {
   const Scene s = test::cut_out_leaf_scene(test::leaf_shadow_scene(), dir.file("mask.png"));
   Scene bare = s;
   bare.plants[0].skeleton->leaves.clear();
-  test::expect_the_cut_out_shadow(s, render_gl(s, {}).image, render_gl(bare, {}).image, kRadianceAbs);
+  test::expect_the_cut_out_shadow(s, gl_test::gl_render(s, {}).image, gl_test::gl_render(bare, {}).image, kRadianceAbs);
 }
 
 TEST(RenderGlLeaves, AOneSidedLeafIsThereFromItsFrontOnlyForEveryRay) {
@@ -164,7 +165,7 @@ TEST(RenderGlLeaves, AOneSidedLeafIsThereFromItsFrontOnlyForEveryRay) {
   s.materials[test::kOneLeafMaterial].two_sided = false;
   Scene bare = s;
   bare.plants[0].skeleton->leaves.clear();
-  const RenderImage with = render_gl(s, {}).image, without = render_gl(bare, {}).image;
+  const RenderImage with = gl_test::gl_render(s, {}).image, without = gl_test::gl_render(bare, {}).image;
   const glm::dvec2 c = test::pixel_of(s, {-0.5, 0, -1.5});
   const glm::dvec3 a = test::beauty_at(with, static_cast<uint32_t>(c.x), static_cast<uint32_t>(c.y));
   const glm::dvec3 b = test::beauty_at(without, static_cast<uint32_t>(c.x), static_cast<uint32_t>(c.y));

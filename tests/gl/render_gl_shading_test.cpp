@@ -1,5 +1,5 @@
 // render_gl_shading_test.cpp — the GL renderer's beauty where it is known in closed form
-// (tests/core/shading_scenes.h works the values out by hand), the same pixels the CPU
+// (tests/support/shading_scenes.h works the values out by hand), the same pixels the CPU
 // renderer is held to by tests/cpu/render_shading_test.cpp: checked against the numbers
 // themselves, not against the CPU, so an error in the model both shared would fail.
 #include "core/gl/render_gl.h"
@@ -8,8 +8,8 @@
 
 #include <initializer_list>
 
-#include "tests/core/shading_scenes.h"
-#include "tests/gl/gl_test_util.h"
+#include "tests/support/shading_scenes.h"
+#include "tests/support/gl_checks.h"
 
 namespace sylva {
 namespace {
@@ -19,7 +19,7 @@ using test::KnownPixel;
 // Float shading of float ray casting: the normal to ~1e-6 rad, which (n·h)^40 turns into
 // ~1e-5 of the specular term; sums of a few float products otherwise.
 void expect_pixels(const Scene& scene, std::initializer_list<KnownPixel> pixels) {
-  const RenderResult r = render_gl(scene, {});
+  const RenderResult r = gl_test::gl_render(scene, {});
   for (const KnownPixel& known : pixels) {
     const float* px = &r.image.beauty[(static_cast<size_t>(known.y) * scene.width + known.x) * 4];
     for (int k = 0; k < 3; ++k)

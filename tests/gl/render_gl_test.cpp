@@ -14,8 +14,10 @@
 #include <map>
 
 #include "core/gl/gl_program.h"
-#include "tests/core/test_scenes.h"
-#include "tests/gl/gl_test_util.h"
+#include "core/scene/scene_json.h"
+#include "tests/support/plants.h"
+#include "tests/support/test_scenes.h"
+#include "tests/support/gl_checks.h"
 
 namespace sylva {
 namespace {
@@ -70,12 +72,12 @@ TEST(RenderGl, TipMatchesTheCpu) {
 
 TEST(RenderGl, SaguaroMatchesTheCpu) {
   SYLVA_REQUIRE_GL();
-  expect_matches_cpu("saguaro", gl_test::scene_around(gl_test::grow_preset("saguaro")));
+  expect_matches_cpu("saguaro", gl_test::scene_around(test::grow_preset("saguaro")));
 }
 
 TEST(RenderGl, ElmMatchesTheCpu) {
   SYLVA_REQUIRE_GL();
-  expect_matches_cpu("elm", gl_test::scene_around(gl_test::grow_preset("elm")));
+  expect_matches_cpu("elm", gl_test::scene_around(test::grow_preset("elm")));
 }
 
 // ---- Stiff cases (the skinning issue's): no NaN, and still the CPU's picture ----------
@@ -118,7 +120,7 @@ TEST(RenderGl, EyeInsideABoundingPyramidStillSeesTheSurface) {
   scene.camera.target = {0, 2.5, -3};
   scene.camera.fov_y_deg = 60;
   expect_matches_cpu("eye_inside_pyramid", scene);
-  const RenderResult gl = render_gl(scene, {});
+  const RenderResult gl = gl_test::gl_render(scene, {});
   bool drawn_from_inside = false;
   for (const RenderPass& p : gl.passes) drawn_from_inside |= p.detail.find("1 around the eye") != std::string::npos;
   EXPECT_TRUE(drawn_from_inside) << "the EYE_INSIDE pass did not run";
@@ -129,8 +131,8 @@ TEST(RenderGl, AovsFollowTheCpuConventions) {
   Scene scene = gl_test::scene_around(chain_of({{{0, 0, 0}, 0.3, 0}, {{0, 2, 0}, 0.2, 2}}), 64, 48);
   RenderOptions options;
   options.aovs = kAovDepth | kAovNormal | kAovUv | kAovId;
-  const RenderResult cpu = render_cpu(scene, options);
-  const RenderResult gl = render_gl(scene, options);
+  const RenderResult cpu = gl_test::cpu_render(scene, options);
+  const RenderResult gl = gl_test::gl_render(scene, options);
   ASSERT_EQ(gl.image.normal.size(), cpu.image.normal.size());
   ASSERT_EQ(gl.image.uv.size(), cpu.image.uv.size());
   ASSERT_EQ(gl.image.id.size(), cpu.image.id.size());
@@ -159,12 +161,12 @@ TEST(RenderGl, AovsFollowTheCpuConventions) {
 TEST(RenderGl, MoreSamplesConvergeToTheCpu) {
   SYLVA_REQUIRE_GL();
   // --spp 16: both average 16 stratified positions and (disc sun) 16 sun directions.
-  Scene scene = gl_test::scene_around(gl_test::grow_preset("saguaro"), 128, 96);
+  Scene scene = gl_test::scene_around(test::grow_preset("saguaro"), 128, 96);
   RenderOptions options;
   options.spp = 16;
   options.aovs = kAovDepth;
-  const RenderResult cpu = render_cpu(scene, options);
-  const RenderResult gl = render_gl(scene, options);
+  const RenderResult cpu = gl_test::cpu_render(scene, options);
+  const RenderResult gl = gl_test::gl_render(scene, options);
   const Agreement a = gl_test::compare(gl.image, cpu.image);
   std::printf("[ agreement ] saguaro 16 spp 128x96: %s\n", a.describe().c_str());
   EXPECT_LE(a.beauty_mad_srgb, 1.0 / 255) << a.describe() << "\n  images: "
@@ -192,7 +194,7 @@ TEST(RenderGl, ScenesTheGlBackendCannotDrawAreNamed) {
   EXPECT_FALSE(gl_unsupported(scene, no_relief));
 }
 
-// ---- Bark: relief mapping (paper 000 sec. 3) and albedo textures ------------------------
+// ---- Bark: relief mapping (Bhagvat et al. 2009 sec. 3) and albedo textures ------------------------
 
 std::string texture_path(const std::string& name) { return std::string(SYLVA_SOURCE_DIR) + "/presets/textures/" + name; }
 
@@ -221,7 +223,7 @@ TEST(RenderGl, ReliefMappedSegmentMatchesTheCpu) {
   SYLVA_REQUIRE_GL();
   const Scene scene = bark_segment(nullptr, "cactus_height.png");
   expect_matches_cpu("relief_segment", scene);
-  const std::string names = program_names(render_gl(scene, {}));
+  const std::string names = program_names(gl_test::gl_render(scene, {}));
   EXPECT_NE(names.find("frusta[GBUFFER_PASS RELIEF TEXTURE_UNITS=1]"), std::string::npos) << names;
   EXPECT_NE(names.find("frusta[SHADOW_PASS RELIEF]"), std::string::npos) << names;
 }
@@ -236,8 +238,8 @@ TEST(RenderGl, ReliefShowsInTheSilhouetteAndTheShading) {
   const Scene relief = bark_segment(nullptr, "cactus_height.png");
   Scene plain = relief;
   plain.plants.front().bark.height_texture.reset();
-  const RenderResult gl_relief = render_gl(relief, options), gl_plain = render_gl(plain, options);
-  const RenderResult cpu_relief = render_cpu(relief, options);
+  const RenderResult gl_relief = gl_test::gl_render(relief, options), gl_plain = gl_test::gl_render(plain, options);
+  const RenderResult cpu_relief = gl_test::cpu_render(relief, options);
   size_t changed = 0, changed_on_cpu_too = 0, beauty_changed = 0;
   for (size_t p = 0; p < gl_relief.image.depth.size(); ++p) {
     const bool hit = !std::isinf(gl_relief.image.depth[p]), plain_hit = !std::isinf(gl_plain.image.depth[p]);
@@ -258,7 +260,7 @@ TEST(RenderGl, BarkTexturedSegmentMatchesTheCpu) {
   SYLVA_REQUIRE_GL();
   const Scene scene = bark_segment("bark.png", nullptr);
   expect_matches_cpu("bark_segment", scene);
-  const std::string names = program_names(render_gl(scene, {}));
+  const std::string names = program_names(gl_test::gl_render(scene, {}));
   EXPECT_NE(names.find("frusta[GBUFFER_PASS BARK TEXTURE_UNITS=1]"), std::string::npos) << names;
   EXPECT_EQ(names.find("RELIEF"), std::string::npos) << names;
 }
@@ -277,14 +279,14 @@ TEST(RenderGl, ReliefAndBarkTogetherMatchTheCpu) {
   SYLVA_REQUIRE_GL();
   const Scene scene = bark_segment("cactus.png", "cactus_height.png");
   expect_matches_cpu("relief_bark_segment", scene);
-  const std::string names = program_names(render_gl(scene, {}));
+  const std::string names = program_names(gl_test::gl_render(scene, {}));
   EXPECT_NE(names.find("frusta[GBUFFER_PASS RELIEF BARK TEXTURE_UNITS=2]"), std::string::npos) << names;
 }
 
 TEST(RenderGl, PlantsWithoutBarkCompileNoBarkOrReliefCode) {
   SYLVA_REQUIRE_GL();
   Scene scene = bark_segment(nullptr, nullptr);
-  const std::string names = program_names(render_gl(scene, {}));
+  const std::string names = program_names(gl_test::gl_render(scene, {}));
   EXPECT_NE(names.find("frusta[GBUFFER_PASS]"), std::string::npos) << names;
   EXPECT_EQ(names.find("RELIEF"), std::string::npos) << names;
   EXPECT_EQ(names.find("BARK"), std::string::npos) << names;
@@ -292,7 +294,7 @@ TEST(RenderGl, PlantsWithoutBarkCompileNoBarkOrReliefCode) {
   scene = bark_segment(nullptr, "cactus_height.png");
   RenderOptions options;
   options.geometry.relief = false;
-  EXPECT_EQ(program_names(render_gl(scene, options)).find("RELIEF"), std::string::npos);
+  EXPECT_EQ(program_names(gl_test::gl_render(scene, options)).find("RELIEF"), std::string::npos);
 }
 
 // The programs a renderer built itself ("programs" setup pass, and any a frame added).
@@ -378,7 +380,7 @@ TEST(RenderGl, BarkCoversTheWoodOnlyAndNeedlesKeepTheirColour) {
     RenderOptions o;
     o.aovs = kAovDepth | kAovId;
     o.geometry.kind = kind;
-    const RenderResult a = render_gl(barked, o), b = render_gl(plain, o);
+    const RenderResult a = gl_test::gl_render(barked, o), b = gl_test::gl_render(plain, o);
     size_t needle = 0, needle_changed = 0, wood_changed = 0;
     for (size_t p = 0; p < a.image.depth.size(); ++p) {
       if (a.image.id[3 * p + 1] == 1 && b.image.id[3 * p + 1] == 1) {
@@ -409,7 +411,7 @@ TEST(RenderGl, TheScenesMaterialTableMatchesTheCpu) {
   scene.plants.front().bark.albedo_rgb = glm::dvec3(0.8, 0.7, 0.1);
   RenderOptions o;
   o.aovs = kAovDepth | kAovId;
-  const RenderResult gl = render_gl(scene, o);
+  const RenderResult gl = gl_test::gl_render(scene, o);
   size_t needle = 0, wood = 0;
   for (size_t p = 0; p < gl.image.depth.size(); ++p) {
     const float* px = &gl.image.beauty[4 * p];
@@ -437,7 +439,7 @@ TEST(RenderGl, TheTablesImageOnSegmentsMatchesTheCpu) {
     RenderOptions o;
     o.aovs = kAovDepth | kAovId;
     o.geometry.kind = kind;
-    const RenderResult a = render_gl(textured, o), b = render_gl(plain, o);
+    const RenderResult a = gl_test::gl_render(textured, o), b = gl_test::gl_render(plain, o);
     size_t needle = 0, needle_changed = 0, wood = 0, wood_changed = 0;
     double lo = 1e9, hi = 0;  // the needle's luminance range
     for (size_t p = 0; p < a.image.depth.size(); ++p) {
@@ -467,12 +469,9 @@ TEST(RenderGl, TheTablesImageOnSegmentsMatchesTheCpu) {
 
 // A bundled scene (presets/scenes/) at a small size.
 Scene preset_scene(const std::string& name, uint32_t width, uint32_t height) {
-  Expected<Scene> read = read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes/" + name + ".scene.json");
-  if (!read) throw std::runtime_error("cannot read scene " + name);
-  Scene scene = *read;
+  Scene scene = test::grown_preset_scene(name);
   scene.width = width;
   scene.height = height;
-  if (Status grown = grow_scene_plants(scene); !grown) throw std::runtime_error(grown.error().format());
   return scene;
 }
 
@@ -496,8 +495,8 @@ TEST(RenderGl, PineSceneWithReliefAndBarkMatchesTheCpu) {
   options.aovs = kAovDepth;
   Scene no_bark = scene;
   no_bark.plants.front().bark = Bark{};
-  const Agreement plain = gl_test::compare(render_gl(no_bark, options).image, render_cpu(no_bark, options).image);
-  const RenderResult gl = render_gl(scene, options), cpu = render_cpu(scene, options);
+  const Agreement plain = gl_test::compare(gl_test::gl_render(no_bark, options).image, gl_test::cpu_render(no_bark, options).image);
+  const RenderResult gl = gl_test::gl_render(scene, options), cpu = gl_test::cpu_render(scene, options);
   const Agreement a = gl_test::compare(gl.image, cpu.image);
   std::printf("[ agreement ] pine_scene sunlit: %s\n  (without bark: %s)\n", a.describe().c_str(),
               plain.describe().c_str());
@@ -541,7 +540,7 @@ TEST(RenderGl, DISABLED_FrameTimes) {
   for (const char* preset : {"saguaro", "pine"})
     for (bool bark : {false, true}) {
       const Scene scene = bark ? preset_scene(preset, 1024, 768)
-                               : gl_test::scene_around(gl_test::grow_preset(preset), 1024, 768);
+                               : gl_test::scene_around(test::grow_preset(preset), 1024, 768);
       GlRenderer renderer(scene, {});
       for (bool conservative : {true, false}) {
         renderer.set_conservative_depth(conservative);
@@ -573,10 +572,10 @@ TEST(RenderGl, EveryPresetRendersWithoutNaN) {
   for (const auto& entry : std::filesystem::directory_iterator(std::string(SYLVA_SOURCE_DIR) + "/presets")) {
     if (entry.path().extension() != ".lsys") continue;
     const std::string name = entry.path().stem().string();
-    Scene scene = gl_test::scene_around(gl_test::grow_preset(name), 96, 72);
+    Scene scene = gl_test::scene_around(test::grow_preset(name), 96, 72);
     RenderOptions options;
     options.aovs = kAovDepth;
-    const RenderResult r = render_gl(scene, options);
+    const RenderResult r = gl_test::gl_render(scene, options);
     size_t nan = 0, hits = 0;
     for (float v : r.image.beauty) nan += std::isnan(v);
     for (float z : r.image.depth) hits += !std::isinf(z), nan += std::isnan(z);

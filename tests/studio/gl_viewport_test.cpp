@@ -10,8 +10,9 @@
 #include "app/studio/cone_worker.h"
 #include "app/studio/gl_viewport.h"
 #include "core/gl/gl_context.h"
-#include "core/scene.h"
-#include "core/shadow_cones.h"
+#include "core/grow/grow.h"
+#include "core/scene/scene.h"
+#include "core/light/shadow_cones.h"
 
 namespace sylva::studio {
 namespace {

@@ -1,5 +1,5 @@
-// headless_ui.h — Dear ImGui without a window or GL (../shared/notes/studio-gui.md sec. 4,
-// tier 1): a context with a built font atlas, a fixed display size and simulated input,
+// headless_ui.h — Dear ImGui without a window or GL (the first of the studio's three test
+// tiers: headless, screenshots, the real window driven by xdotool): a context with a built font atlas, a fixed display size and simulated input,
 // one frame per call, driving a StudioApp exactly as the window's loop does. Keys are
 // mapped as GLFW maps them (letters are their upper-case ASCII codes), and the text
 // widget's own undo keys are unmapped as in studio_main.cpp.

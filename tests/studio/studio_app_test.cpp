@@ -7,9 +7,10 @@
 #include <fstream>
 
 #include "app/studio/document_files.h"
-#include "core/gltf_export.h"
-#include "core/scene.h"
-#include "core/skeleton.h"
+#include "core/io/gltf.h"
+#include "core/scene/scene.h"
+#include "core/geometry/skeleton.h"
+#include "core/scene/scene_json.h"
 #include "core/util/file_io.h"
 #include "tests/studio/headless_ui.h"
 

@@ -6,7 +6,8 @@
 
 #include <string>
 
-#include "core/scene.h"
+#include "core/scene/scene.h"
+#include "core/scene/scene_json.h"
 #include "core/util/file_io.h"
 #include "tests/studio/headless_ui.h"
 

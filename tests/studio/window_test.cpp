@@ -1,5 +1,5 @@
-// window_test.cpp — the studio's real window under Xvfb (../shared/notes/studio-gui.md
-// sec. 4, tiers 2 and 3): `sylva studio --screenshot` of presets and a scene against
+// window_test.cpp — the studio's real window under Xvfb (the test tiers after
+// headless_ui.h's): `sylva studio --screenshot` of presets and a scene against
 // golden images with tolerances, and one smoke test that drives the window with xdotool
 // (click, type, save). Each test skips, saying why, where xvfb-run (Debian: xvfb) or
 // xdotool is missing.
@@ -16,7 +16,7 @@
 #include <cstring>
 #include <filesystem>
 
-#include "tests/app/process.h"
+#include "tests/support/process.h"
 
 namespace {
 

@@ -126,7 +126,7 @@ def test_repr_names_grammar_seed_and_counts(elm):
 
 
 def test_leaves_are_arrays_matching_the_json():
-    # grammar.md's polygons become leaves (skeleton.md "Leaves", version 2).
+    # docs/spec/grammar.md's polygons become leaves (docs/spec/skeleton.md "Leaves", version 2).
     sk = sylva.Grammar("angle: 60\naxiom: F[&F'(1){.+f.-f.-f.}]F{.+f.-f.-f.+|+f.-f.}\n").grow()
     assert sk.leaf_count == 2
     assert sk.leaves.dtype.names == ("first_vertex", "vertex_count", "chain", "joint", "material")

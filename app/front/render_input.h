@@ -1,0 +1,29 @@
+// render_input.h — what `sylva render` and `sylva bench geometry` draw: INPUT (a .lsys
+// grammar, .skel.json skeleton, .scene.json scene, or a .glb/.gltf written by `sylva
+// export`) made into a Scene whose plants all have their skeletons (docs/spec/scene.md: a bare
+// grammar or skeleton is wrapped in the default scene).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "app/front/args.h"
+#include "core/cpu/render_cpu.h"
+#include "core/scene/scene.h"
+
+namespace sylva::cli {
+
+// Whether `path` names an input render understands (by its extension).
+bool is_render_input(const std::string& path);
+bool is_grammar_input(const std::string& path);  // .lsys
+
+// Loads INPUT (grammar.grammar; -n/--seed/-D/--max-modules apply to a grammar) and grows
+// every plant; `width`/`height` override the scene's image size. Appends what it did to
+// `passes`. On failure prints the located error to stderr and returns the exit code.
+std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std::optional<uint32_t> width,
+                                                std::optional<uint32_t> height,
+                                                std::vector<RenderPass>& passes);
+
+}  // namespace sylva::cli

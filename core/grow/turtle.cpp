@@ -1,0 +1,354 @@
+// turtle.cpp — the 3D turtle (ABOP ch. 1.5, 2.2) building skeleton chains (docs/spec/skeleton.md).
+#include "core/grow/turtle.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+#include "core/util/limits.h"
+#include "lsystem/expr.h"
+
+namespace sylva {
+
+namespace {
+
+using glm::dvec3;
+
+// Cancellation is checked, and progress reported, once per 64 Ki modules.
+constexpr size_t kProgressChunkMask = (size_t{1} << 16) - 1;
+
+struct TurtleState {
+  dvec3 position{0, 0, 0};
+  dvec3 heading{0, 1, 0};
+  dvec3 left{-1, 0, 0};
+  dvec3 up{0, 0, 1};
+  double radius = 0.05;
+  uint32_t material = 0;
+  double tropism_e = 0;
+  int64_t chain = -1;          // chain the turtle stands on, or -1
+  int64_t joint = -1;          // joint index within that chain
+  bool branch_pending = false; // set by '[': the next F starts a new chain
+};
+
+// A polygon between `{` and `}` (docs/spec/grammar.md, ABOP 1.10 and 5.1): the joint the turtle
+// stood on at `{` and the positions `.` recorded.
+struct OpenPolygon {
+  size_t module;                          // the `{`'s index in the word, for messages
+  std::optional<ChainParent> joint;
+  std::vector<std::array<double, 3>> vertices;
+};
+
+struct PendingJoint {
+  uint32_t chain;
+  Joint joint;
+};
+
+struct TurtleFailure {
+  std::string message;
+};
+
+// Positions stay within the coordinate limit (docs/limits.md), finite a fortiori.
+void check_position(const dvec3& p) {
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+    throw TurtleFailure{"the turtle's position is no longer finite"};
+  if (std::abs(p.x) > kMaxCoordinateM || std::abs(p.y) > kMaxCoordinateM || std::abs(p.z) > kMaxCoordinateM)
+    throw TurtleFailure{"the turtle's position exceeds the limit of 1e12 m from the origin (docs/limits.md)"};
+}
+
+// Keeps the frame orthonormal and right-handed after a rotation (cheap Gram–Schmidt).
+void orthonormalize(TurtleState& t) {
+  t.heading = glm::normalize(t.heading);
+  t.left = glm::normalize(t.left - glm::dot(t.left, t.heading) * t.heading);
+  t.up = glm::cross(t.heading, t.left);
+}
+
+// Cosine and sine of a turn: the grammar's default angle is computed once.
+struct Turn {
+  double c, s;
+};
+Turn turn_of(double angle_deg) { return {lsys::cos_deg(angle_deg), lsys::sin_deg(angle_deg)}; }
+
+// Rotates the pair (a, b) in their plane by a turn, turning a toward b.
+void rotate_pair(dvec3& a, dvec3& b, Turn t) {
+  const double c = t.c, s = t.s;
+  const dvec3 a2 = a * c + b * s;
+  const dvec3 b2 = b * c - a * s;
+  a = a2;
+  b = b2;
+}
+
+// Rodrigues rotation of v about unit axis k by angle (radians).
+dvec3 rotate_about(const dvec3& v, const dvec3& k, double angle_rad) {
+  const double c = std::cos(angle_rad), s = std::sin(angle_rad);
+  return v * c + glm::cross(k, v) * s + k * glm::dot(k, v) * (1 - c);
+}
+
+// The places of the grammar that write a module with `symbol`: the axiom, then every
+// production and interpretation production whose successor holds it, in file order.
+// Modules carry no source place (derive.h), so this is where a turtle error can point.
+std::vector<SourceLoc> places_writing(const lsys::Grammar& g, lsys::SymbolId symbol) {
+  std::vector<SourceLoc> places;
+  for (const lsys::Module& m : g.axiom.modules)
+    if (m.symbol == symbol) {
+      places.push_back(g.axiom_loc);
+      break;
+    }
+  for (const auto* list : {&g.productions, &g.homomorphism})
+    for (const lsys::Production& p : *list)
+      for (const lsys::SuccessorModule& m : p.successor.modules)
+        if (m.symbol == symbol) {
+          places.push_back(p.loc);
+          break;
+        }
+  std::sort(places.begin(), places.end(),
+            [](SourceLoc a, SourceLoc b) { return a.line != b.line ? a.line < b.line : a.column < b.column; });
+  return places;
+}
+
+}  // namespace
+
+Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g, TurtleStats* stats,
+                                  const Progress& progress) {
+  using namespace lsys;
+  auto t0 = std::chrono::steady_clock::now();
+  const TurtleDefaults& d = g.turtle;
+  const dvec3 tropism(d.tropism[0], d.tropism[1], d.tropism[2]);
+  TurtleState t;
+  t.radius = d.width;
+  t.tropism_e = d.has_tropism ? d.tropism_e : 0.0;
+  std::vector<TurtleState> stack;
+  std::vector<PendingJoint> joints;
+  std::vector<uint32_t> chain_joint_count;
+  std::vector<std::optional<ChainParent>> chain_parent;
+  uint64_t zero_moves = 0;
+  // `{ . } G` are looked up by name: making them built-in symbols would renumber every
+  // grammar's own modules.
+  auto id_of = [&](const char* name) {
+    SymbolId id = 0;
+    return g.symbols.find(name, &id) ? std::optional<SymbolId>(id) : std::nullopt;
+  };
+  const std::optional<SymbolId> sym_open = id_of("{"), sym_vertex = id_of("."), sym_close = id_of("}"),
+                                sym_move = id_of("G");
+  std::vector<OpenPolygon> polygons;  // a stack: polygons nest
+  std::vector<Leaf> leaves;
+  const size_t n = word.size();
+  const Turn default_turn = turn_of(d.angle_deg);
+  const Turn default_turn_back = turn_of(-d.angle_deg);
+  auto turn = [&](const Module& m, const double* p, bool negate) {
+    if (m.param_count == 0) return negate ? default_turn_back : default_turn;
+    return turn_of(negate ? -p[0] : p[0]);
+  };
+  // Rotations keep the frame orthonormal up to rounding; re-orthonormalise every 16 of
+  // them (and after tropism) so drift stays at the level of one rounding error.
+  unsigned rotations = 0;
+  auto rotated = [&](TurtleState& s) {
+    if ((++rotations & 15u) == 0) orthonormalize(s);
+    else s.up = glm::cross(s.heading, s.left);
+  };
+  {
+    size_t moves = 0;
+    for (const Module& m : word.modules) moves += m.symbol == kSymF;
+    joints.reserve(moves + moves / 4);
+  }
+  size_t i = 0;
+  try {
+    for (; i < n; ++i) {
+      if ((i & kProgressChunkMask) == 0 && i != 0) {  // between chunks of modules
+        if (progress.cancelled()) return cancelled_diagnostic();
+        progress.report(static_cast<double>(i) / static_cast<double>(n), "turtle");
+      }
+      const Module& m = word.modules[i];
+      const double* p = word.params_of(m);
+      const bool has = m.param_count > 0;
+      if (m.symbol == sym_open) {
+        std::optional<ChainParent> joint;
+        if (t.chain >= 0) joint = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
+        polygons.push_back({i, joint, {}});
+        continue;
+      }
+      if (m.symbol == sym_vertex) {  // outside a polygon a '.' records nothing (as in cpfg)
+        if (!polygons.empty()) polygons.back().vertices.push_back({t.position.x, t.position.y, t.position.z});
+        continue;
+      }
+      if (m.symbol == sym_close) {
+        if (polygons.empty()) throw TurtleFailure{"'}' without matching '{'"};
+        OpenPolygon& polygon = polygons.back();
+        if (auto problem = leaf_polygon_problem(polygon.vertices)) throw TurtleFailure{"bad leaf: " + *problem};
+        if (leaves.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
+        leaves.push_back(Leaf{polygon.joint, t.material, std::move(polygon.vertices)});
+        polygons.pop_back();
+        continue;
+      }
+      if (m.symbol == sym_move) {  // G: move without drawing and without ending the chain
+        t.position += t.heading * (has ? p[0] : d.step);
+        check_position(t.position);
+        continue;
+      }
+      switch (m.symbol) {
+        case kSymF: {
+          const double len = has ? p[0] : d.step;
+          if (len == 0) {
+            ++zero_moves;
+            break;
+          }
+          const bool start_chain = t.chain < 0 || t.branch_pending ||
+                                   t.joint + 1 != static_cast<int64_t>(chain_joint_count[t.chain]);
+          if (start_chain) {
+            if (chain_joint_count.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many chains"};
+            std::optional<ChainParent> parent;
+            if (t.chain >= 0) parent = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
+            const uint32_t c = static_cast<uint32_t>(chain_joint_count.size());
+            chain_joint_count.push_back(1);
+            chain_parent.push_back(parent);
+            joints.push_back({c, Joint{{t.position.x, t.position.y, t.position.z}, t.radius, t.material}});
+            t.chain = c;
+            t.joint = 0;
+            t.branch_pending = false;
+          }
+          t.position += t.heading * len;
+          check_position(t.position);
+          if (chain_joint_count[t.chain] == 0xFFFFFFFFu) throw TurtleFailure{"a chain has too many joints"};
+          joints.push_back({static_cast<uint32_t>(t.chain),
+                            Joint{{t.position.x, t.position.y, t.position.z}, t.radius, t.material}});
+          ++chain_joint_count[t.chain];
+          ++t.joint;
+          if (t.tropism_e != 0.0) {
+            // ABOP 2.2: rotate the frame about H × T by e·|H × T|.
+            const dvec3 axis = glm::cross(t.heading, tropism);
+            const double len_axis = glm::length(axis);
+            if (len_axis > 1e-12) {
+              const dvec3 k = axis / len_axis;
+              const double alpha = t.tropism_e * len_axis;
+              t.heading = rotate_about(t.heading, k, alpha);
+              t.left = rotate_about(t.left, k, alpha);
+              orthonormalize(t);
+            }
+          }
+          break;
+        }
+        case kSymf: {
+          const double len = has ? p[0] : d.step;
+          if (len == 0) ++zero_moves;
+          t.position += t.heading * len;
+          check_position(t.position);
+          if (!polygons.empty()) break;  // inside a polygon f does not end the chain (docs/spec/grammar.md)
+          t.chain = -1;
+          t.joint = -1;
+          t.branch_pending = false;
+          break;
+        }
+        case kSymTurnLeft: rotate_pair(t.heading, t.left, turn(m, p, false)); rotated(t); break;
+        case kSymTurnRight: rotate_pair(t.heading, t.left, turn(m, p, true)); rotated(t); break;
+        case kSymPitchDown: rotate_pair(t.heading, t.up, turn(m, p, true)); rotated(t); break;  // H toward −U
+        case kSymPitchUp: rotate_pair(t.heading, t.up, turn(m, p, false)); rotated(t); break;
+        case kSymRollLeft: {  // U toward L; H is unchanged, so recompute L from U and H
+          rotate_pair(t.up, t.left, turn(m, p, false));
+          if ((++rotations & 15u) == 0) orthonormalize(t);
+          break;
+        }
+        case kSymRollRight: {
+          rotate_pair(t.up, t.left, turn(m, p, true));
+          if ((++rotations & 15u) == 0) orthonormalize(t);
+          break;
+        }
+        case kSymTurnAround:
+          t.heading = -t.heading;
+          t.left = -t.left;
+          break;
+        case kSymLevel: {
+          // ABOP 2.2: L = (V × H) / |V × H|, U = H × L, with V = +Y.
+          const dvec3 v(0, 1, 0);
+          const dvec3 c = glm::cross(v, t.heading);
+          const double len = glm::length(c);
+          if (len > 1e-9) {
+            t.left = c / len;
+            t.up = glm::cross(t.heading, t.left);
+          }
+          break;
+        }
+        case kSymPush:
+          stack.push_back(t);
+          t.branch_pending = true;
+          break;
+        case kSymPop:
+          if (stack.empty()) throw TurtleFailure{"']' without matching '['"};
+          t = stack.back();
+          stack.pop_back();
+          break;
+        case kSymWidth:
+          if (has) t.radius = p[0];
+          else t.radius *= d.width_decrement;
+          if (!(t.radius >= 0) || !std::isfinite(t.radius)) throw TurtleFailure{"the radius must be finite and not negative"};
+          if (t.radius > kMaxCoordinateM) throw TurtleFailure{"the radius exceeds the limit of 1e12 m (docs/limits.md)"};
+          break;
+        case kSymMaterial:
+          if (has) {
+            if (!(p[0] >= 0) || p[0] != std::floor(p[0]) || p[0] > 4294967295.0)
+              throw TurtleFailure{"a material index must be a non-negative integer"};
+            t.material = static_cast<uint32_t>(p[0]);
+          } else {
+            if (t.material == 0xFFFFFFFFu) throw TurtleFailure{"material index overflow"};
+            ++t.material;
+          }
+          break;
+        case kSymTropism:
+          if (!has) throw TurtleFailure{"@T needs the susceptibility: @T(e)"};
+          t.tropism_e = p[0];
+          break;
+        default:
+          break;  // carried through, ignored by the turtle
+      }
+    }
+    if (!polygons.empty()) {
+      i = polygons.back().module;
+      throw TurtleFailure{"'{' without matching '}'"};
+    }
+  } catch (const TurtleFailure& f) {
+    Word one;
+    const Module& m = word.modules[i];
+    one.modules.push_back(Module{m.symbol, m.param_count, 0});
+    one.params.assign(word.params_of(m), word.params_of(m) + m.param_count);
+    const std::string module = print_word(one, g.symbols);
+    const std::string message =
+        "turtle: " + f.message + " at module " + std::to_string(i) + " (" + module + ") of the interpreted word";
+    // The error at the one place that writes the module; where several could have, at the
+    // file, with a note at each of them.
+    const std::vector<SourceLoc> places = places_writing(g, m.symbol);
+    if (places.size() == 1) return g.error_at(places[0], message + ", written here");
+    Diagnostic d = g.error_at({}, message);
+    constexpr size_t kMaxNotes = 4;
+    for (size_t k = 0; k < places.size() && k < kMaxNotes; ++k)
+      d = std::move(d).with_note(g.error_at(places[k], "a module '" + g.symbols.name(m.symbol) + "' is written here"));
+    if (places.size() > kMaxNotes)
+      d = std::move(d).with_note(g.error_at({}, "and by " + std::to_string(places.size() - kMaxNotes) +
+                                                    " more productions"));
+    return d;
+  }
+
+  // Flatten: chains' joints were interleaved in creation order; a counting sort by chain
+  // keeps each chain's joints in order and makes every chain one contiguous range.
+  Skeleton sk;
+  sk.chains.resize(chain_joint_count.size());
+  uint32_t offset = 0;
+  for (size_t c = 0; c < chain_joint_count.size(); ++c) {
+    sk.chains[c] = Chain{offset, 0, chain_parent[c]};
+    offset += chain_joint_count[c];
+  }
+  sk.leaves = std::move(leaves);
+  sk.joints.resize(joints.size());
+  for (const PendingJoint& pj : joints) {
+    Chain& c = sk.chains[pj.chain];
+    sk.joints[c.first_joint + c.joint_count++] = pj.joint;
+  }
+  if (stats) {
+    stats->zero_length_moves = zero_moves;
+    stats->modules_read = n;
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  progress.report(1, "turtle");
+  return sk;
+}
+
+}  // namespace sylva

@@ -1,0 +1,970 @@
+// gltf_writer.cpp — skeletons to glTF 2.0 (core/io/gltf.h); the reader is gltf_reader.cpp.
+//
+// The glTF JSON is written with json.h's JsonWriter rather than tinygltf: the file then
+// has the same guarantees as a skeleton file (fixed key order, shortest round-trip
+// numbers, byte-identical output for identical input), and none of tinygltf 2.7's
+// writer traps can reach it (mode -1 when Primitive::mode is unset, empty nodes as
+// `null`, Value("text") turned into a bool, accessor min/max left empty). The tests read
+// every exported file with tinygltf as well, as an independent second reader.
+//
+// Buffer layout: one buffer; one tightly packed bufferView per accessor, each starting
+// at a multiple of 4 bytes, then (.glb only) one bufferView per embedded image. Floats
+// are little-endian IEEE 754 (as the machine's).
+#include "core/io/gltf.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <string_view>
+#include <utility>
+
+#include <OpenImageIO/imageio.h>
+
+#include <glm/geometric.hpp>
+
+#include "core/io/gltf_format.h"
+#include "core/util/file_io.h"
+#include "core/util/image_io.h"
+#include "core/util/json.h"
+#include "core/geometry/leaf_mesh.h"
+#include "core/scene/leaf_images.h"
+#include "core/scene/materials.h"
+#include "core/io/normal_map.h"
+#include "core/geometry/skin.h"
+#include "core/geometry/tessellate.h"
+
+static_assert(std::endian::native == std::endian::little, "glTF buffers are little-endian");
+
+namespace sylva {
+namespace {
+
+using namespace gltf_format;
+
+constexpr uint32_t kComponentFloat = 5126;
+constexpr uint32_t kComponentUint32 = 5125;
+constexpr int kTargetArrayBuffer = 34962;
+constexpr int kTargetElementArrayBuffer = 34963;
+constexpr int kModeLines = 1;
+constexpr int kModeTriangles = 4;
+constexpr int kFilterLinear = 9729;
+constexpr int kFilterLinearMipmapLinear = 9987;
+constexpr int kWrapRepeat = 10497;
+
+struct BufferView {
+  size_t offset = 0;
+  size_t length = 0;
+  int target = 0;  // 0: none (instancing attributes)
+};
+
+struct Accessor {
+  size_t view = 0;
+  uint32_t component = kComponentFloat;
+  size_t count = 0;
+  const char* type = "SCALAR";
+  std::vector<double> min, max;  // per component, exact values of the stored elements
+};
+
+// The binary buffer and the views/accessors describing it.
+class BufferBuilder {
+ public:
+  // Appends `values` (count × components floats) and returns the accessor index.
+  // min/max are those of the floats actually stored (the validator compares exactly).
+  size_t add_floats(const std::vector<float>& values, int components, const char* type, int target) {
+    const size_t count = values.size() / static_cast<size_t>(components);
+    Accessor a;
+    a.type = type;
+    a.count = count;
+    a.min.assign(static_cast<size_t>(components), std::numeric_limits<double>::infinity());
+    a.max.assign(static_cast<size_t>(components), -std::numeric_limits<double>::infinity());
+    for (size_t i = 0; i < values.size(); ++i) {
+      const size_t k = i % static_cast<size_t>(components);
+      a.min[k] = std::min(a.min[k], static_cast<double>(values[i]));
+      a.max[k] = std::max(a.max[k], static_cast<double>(values[i]));
+    }
+    a.view = add_view(values.data(), values.size() * sizeof(float), target);
+    accessors_.push_back(std::move(a));
+    return accessors_.size() - 1;
+  }
+
+  size_t add_indices(const std::vector<uint32_t>& indices) {
+    Accessor a;
+    a.component = kComponentUint32;
+    a.count = indices.size();
+    uint32_t lo = std::numeric_limits<uint32_t>::max(), hi = 0;
+    for (uint32_t i : indices) lo = std::min(lo, i), hi = std::max(hi, i);
+    a.min = {static_cast<double>(lo)};
+    a.max = {static_cast<double>(hi)};
+    a.view = add_view(indices.data(), indices.size() * sizeof(uint32_t), kTargetElementArrayBuffer);
+    accessors_.push_back(std::move(a));
+    return accessors_.size() - 1;
+  }
+
+  // Appends raw bytes (an image) as a bufferView without target; returns the view index.
+  size_t add_bytes(std::string_view data) { return add_view(data.data(), data.size(), 0); }
+
+  // Appends raw little-endian values (extras "compact", gltf_export.h) as a bufferView
+  // without target or accessor, 8-byte aligned for the float64 ones; returns its index.
+  template <class T>
+  size_t add_raw(const std::vector<T>& values) {
+    return add_view(values.data(), values.size() * sizeof(T), 0, 8);
+  }
+
+  const std::string& bytes() const { return bytes_; }
+  const std::vector<BufferView>& views() const { return views_; }
+  const std::vector<Accessor>& accessors() const { return accessors_; }
+
+ private:
+  size_t add_view(const void* data, size_t length, int target, size_t alignment = 4) {
+    while (bytes_.size() % alignment != 0) bytes_.push_back('\0');
+    views_.push_back({bytes_.size(), length, target});
+    bytes_.append(static_cast<const char*>(data), length);
+    return views_.size() - 1;
+  }
+
+  std::string bytes_;
+  std::vector<BufferView> views_;
+  std::vector<Accessor> accessors_;
+};
+
+void write_vec3(JsonWriter& w, const glm::dvec3& v) {
+  const double a[3] = {v.x, v.y, v.z};
+  w.numbers(a, 3);
+}
+
+
+// Extras "compact": `key` = the bufferView of `values`, left out when there are none.
+template <class T>
+void write_view(JsonWriter& w, const char* key, const std::vector<T>& values, BufferBuilder& buffer) {
+  if (!values.empty()) w.key(key).integer(buffer.add_raw(values));
+}
+
+void push_ref(std::vector<uint32_t>& out, const std::optional<ChainParent>& ref) {
+  out.push_back(ref ? ref->chain : kNoIndex);
+  out.push_back(ref ? ref->joint : kNoIndex);
+}
+
+// Extras "compact" (gltf_export.h): the skeleton document's header, then its chains and
+// leaves as bufferViews.
+void write_compact_skeleton(JsonWriter& w, const Skeleton& sk, BufferBuilder& buffer) {
+  write_skeleton_members(w, sk, {.compact = true, .seed_as_string = true, .header_only = true});
+  std::vector<uint32_t> counts, parents, materials;
+  std::vector<double> joints;
+  for (const Chain& c : sk.chains) {
+    counts.push_back(c.joint_count);
+    push_ref(parents, c.parent);
+    for (uint32_t j = 0; j < c.joint_count; ++j) {
+      const Joint& joint = sk.joints[c.first_joint + j];
+      joints.insert(joints.end(), {joint.position_m[0], joint.position_m[1], joint.position_m[2], joint.radius_m});
+      materials.push_back(joint.material);
+    }
+  }
+  w.key("chains").begin_object().key("count").integer(sk.chains.size());
+  write_view(w, "joint_count", counts, buffer);
+  write_view(w, "parent", parents, buffer);
+  write_view(w, "joints", joints, buffer);
+  write_view(w, "material", materials, buffer);
+  w.end_object();
+  if (sk.leaves.empty()) return;
+  std::vector<uint32_t> vertex_counts, leaf_joints, leaf_materials;
+  std::vector<double> vertices;
+  for (const Leaf& leaf : sk.leaves) {
+    vertex_counts.push_back(static_cast<uint32_t>(leaf.vertices_m.size()));
+    push_ref(leaf_joints, leaf.joint);
+    leaf_materials.push_back(leaf.material);
+    for (const auto& v : leaf.vertices_m) vertices.insert(vertices.end(), v.begin(), v.end());
+  }
+  w.key("leaves").begin_object().key("count").integer(sk.leaves.size());
+  write_view(w, "vertex_count", vertex_counts, buffer);
+  write_view(w, "joint", leaf_joints, buffer);
+  write_view(w, "material", leaf_materials, buffer);
+  write_view(w, "vertices", vertices, buffer);
+  w.end_object();
+}
+
+// Per frustum of skin_skeleton (default options): what a renderer needs beyond the
+// skeleton to reproduce the surface parametrization. With `binary` (extras "compact")
+// the frusta go to bufferViews.
+void write_skinning(JsonWriter& w, const SkinnedSkeleton& skinned, BufferBuilder* binary) {
+  const SkinOptions defaults;
+  w.key("skinning").begin_object();
+  w.key("max_tilt_deg").number(defaults.max_tilt_deg);
+  w.key("columns").begin_array();
+  for (const char* column : {"chain", "segment", "knuckle", "lower_normal", "lower_offset_m", "upper_normal",
+                             "upper_offset_m", "u_offset"})
+    w.string(column);
+  w.end_array();
+  if (binary) {
+    std::vector<uint32_t> ids;
+    std::vector<double> planes;
+    for (const Frustum& fr : skinned.frusta) {
+      ids.insert(ids.end(), {fr.chain, fr.segment, fr.kind == FrustumKind::knuckle ? 1u : 0u});
+      const glm::dvec3 lo = fr.shape.lower.normal, up = fr.shape.upper.normal;
+      planes.insert(planes.end(), {lo.x, lo.y, lo.z, fr.shape.lower.offset, up.x, up.y, up.z, fr.shape.upper.offset,
+                                   fr.u_offset});
+    }
+    w.key("frusta").begin_object().key("count").integer(skinned.frusta.size());
+    write_view(w, "ids", ids, *binary);
+    write_view(w, "planes", planes, *binary);
+    w.end_object().end_object();
+    return;
+  }
+  w.key("frusta").begin_array();
+  for (const Frustum& fr : skinned.frusta) {
+    w.begin_array().integer(fr.chain).integer(fr.segment).boolean(fr.kind == FrustumKind::knuckle);
+    write_vec3(w, fr.shape.lower.normal);
+    w.number(fr.shape.lower.offset);
+    write_vec3(w, fr.shape.upper.normal);
+    w.number(fr.shape.upper.offset).number(fr.u_offset).end_array();
+  }
+  w.end_array();
+  w.end_object();
+}
+
+void write_instance(JsonWriter& w, const GltfPlant& p) {
+  w.begin_object();
+  w.key("name").string(p.name);
+  w.key("position_m").numbers(p.position_m, 3);
+  w.key("rotate_y_deg").number(p.rotate_y_deg);
+  w.key("scale").number(p.scale);
+  w.end_object();
+}
+
+// Unit quaternion (x, y, z, w) of a rotation about +Y.
+std::array<double, 4> quaternion_about_y(double angle_deg) {
+  const double half = angle_deg * std::numbers::pi / 360.0;
+  return {0.0, std::sin(half), 0.0, std::cos(half)};
+}
+
+std::string base64(std::string_view bytes) {
+  static constexpr char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const uint32_t v = (uint32_t{static_cast<uint8_t>(bytes[i])} << 16) |
+                       (uint32_t{static_cast<uint8_t>(bytes[i + 1])} << 8) | static_cast<uint8_t>(bytes[i + 2]);
+    out += kDigits[(v >> 18) & 63], out += kDigits[(v >> 12) & 63], out += kDigits[(v >> 6) & 63], out += kDigits[v & 63];
+  }
+  if (i + 1 == bytes.size()) {
+    const uint32_t v = uint32_t{static_cast<uint8_t>(bytes[i])} << 16;
+    out += kDigits[(v >> 18) & 63], out += kDigits[(v >> 12) & 63], out += "==";
+  } else if (i + 2 == bytes.size()) {
+    const uint32_t v = (uint32_t{static_cast<uint8_t>(bytes[i])} << 16) | (uint32_t{static_cast<uint8_t>(bytes[i + 1])} << 8);
+    out += kDigits[(v >> 18) & 63], out += kDigits[(v >> 12) & 63], out += kDigits[(v >> 6) & 63], out += '=';
+  }
+  return out;
+}
+
+void append_u32(std::string& out, uint32_t v) {
+  char b[4];
+  std::memcpy(b, &v, 4);
+  out.append(b, 4);
+}
+
+bool ends_with(std::string_view s, std::string_view suffix) {
+  return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
+}
+
+std::string lower_case(std::string s) {
+  for (char& c : s)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return s;
+}
+
+// One group of plants sharing a skeleton (instancing) or a single plant.
+struct PlantGroup {
+  std::vector<size_t> plants;  // indices into the caller's vector, first one names the node
+};
+
+// Why plant `index` cannot be exported, or nothing.
+std::optional<std::string> plant_problem(const GltfPlant& p, size_t index) {
+  const std::string which = "plant " + std::to_string(index) + " (" + json_excerpt(p.name) + ")";
+  for (double v : p.position_m)
+    if (!std::isfinite(v)) return which + ": the position is not finite";
+  if (!std::isfinite(p.rotate_y_deg)) return which + ": rotate_y_deg is not finite";
+  if (!std::isfinite(p.scale) || p.scale <= 0) return which + ": the scale must be a finite number > 0";
+  if (Status valid = validate_skeleton(p.skeleton); !valid) return which + ": " + valid.error().message;
+  if (auto far = plant_extent_problem(p.skeleton, {p.position_m[0], p.position_m[1], p.position_m[2]}, p.scale))
+    return which + ": " + *far;
+  if (!std::isfinite(p.bark.u_repeat) || p.bark.u_repeat <= 0) return which + ": bark u_repeat must be a finite number > 0";
+  if (!std::isfinite(p.bark.v_per_metre) || p.bark.v_per_metre <= 0)
+    return which + ": bark v_per_metre must be a finite number > 0";
+  if (!std::isfinite(p.bark.relief_depth_m) || p.bark.relief_depth_m < 0)
+    return which + ": bark relief_depth must be a finite number >= 0";
+  return std::nullopt;
+}
+
+// An image embedded in the file.
+struct EmbeddedImage {
+  std::string bytes;
+  const char* mime = "image/png";
+};
+
+// Reads an albedo texture laid on segments (a bark's, or the materials table's: scene.h
+// segment_texture) to embed it byte for byte: glTF takes PNG or JPEG only.
+Expected<EmbeddedImage> read_albedo_image(const std::string& path, const std::string& what = "the bark albedo texture") {
+  Expected<std::string> file = read_text_file(path);
+  if (!file) return file_diagnostic(path, "cannot read " + what + ": " + file.error().message);
+  EmbeddedImage image;
+  const std::string& bytes = *file;
+  if (bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) image.mime = "image/png";
+  else if (bytes.compare(0, 3, "\xFF\xD8\xFF") == 0) image.mime = "image/jpeg";
+  else return file_diagnostic(path, what + " must be a PNG or JPEG file to be embedded in glTF");
+  // It must decode too, to its last row (a viewer, and the validator, read it).
+  if (Status decodes = check_image_opens(path); !decodes)
+    return file_diagnostic(path, what + " is not a readable image: " + decodes.error().message);
+  image.bytes = std::move(*file);
+  return image;
+}
+
+// Identifies a bark for grouping identical plants (instancing).
+std::string bark_key(const Bark& b) {
+  std::string key = "albedo:";
+  if (b.albedo_texture) key += "file:" + *b.albedo_texture;
+  if (b.albedo_rgb) {
+    JsonWriter rgb;
+    write_vec3(rgb, *b.albedo_rgb);
+    key += rgb.text();
+  }
+  key += "\nheight:" + b.height_texture.value_or("") + "\n";
+  for (double v : {b.relief_depth_m, b.u_repeat, b.v_per_metre}) append_json_number(key, v), key += ',';
+  return key;
+}
+
+// The material of index `material` of a plant with bark `bark` (gltf_export.h), as JSON
+// text (identical materials are written once: the text is their key).
+// `albedo_texture`: the texture segment_texture names for it (the bark's or the table's),
+// read through TEXCOORD_`texcoord`.
+std::string material_json(uint32_t material, const Bark& bark, const std::map<uint32_t, SceneMaterial>& materials,
+                          std::optional<size_t> albedo_texture, int texcoord, std::optional<size_t> normal_texture,
+                          double r_ref_m, const LeafImages* images) {
+  // A segment of a material with a leaf image: the image's mean (leaf_images.h).
+  const MaterialLook look = segment_look(materials, &bark, material, images);
+  const std::optional<SegmentTexture> segment = segment_texture(materials, &bark, material);
+  JsonWriter w;
+  w.begin_object();
+  w.key("name").string("sylva_material_" + std::to_string(material));
+  w.key("pbrMetallicRoughness").begin_object();
+  if (albedo_texture) {
+    const double white[4] = {1, 1, 1, 1};
+    w.key("baseColorFactor").numbers(white, 4);
+    w.key("baseColorTexture").begin_object().key("index").integer(*albedo_texture);
+    if (texcoord != 0) w.key("texCoord").integer(texcoord);
+    w.end_object();
+  } else {
+    const double factor[4] = {look.albedo.x, look.albedo.y, look.albedo.z, 1};
+    w.key("baseColorFactor").numbers(factor, 4);
+  }
+  w.key("metallicFactor").number(0);
+  w.key("roughnessFactor").number(0.9);
+  w.end_object();
+  if (normal_texture) w.key("normalTexture").begin_object().key("index").integer(*normal_texture).end_object();
+  w.key("extras").begin_object().key("sylva").begin_object();
+  w.key("material_index").integer(material);
+  if (materials.count(material)) {  // an entry of the scene's table (docs/materials.md)
+    w.key("specular").number(look.specular);
+  }
+  if (albedo_texture && segment && !segment->from_bark) {  // the table's image on the segments
+    w.key("segment_texture").begin_object();
+    w.key("albedo").string(segment->path);
+    w.key("u_repeat").number(segment->u_repeat);
+    w.key("v_per_metre").number(segment->v_per_metre);
+    w.key("texcoord").string("TEXCOORD_" + std::to_string(texcoord) +
+                             ": s = u * u_repeat with u in turns around the axis, t = v_m * v_per_metre");
+    w.end_object();
+  }
+  if (material != 0) {  // the bark is the wood's alone (materials.h)
+    w.end_object().end_object();
+    w.end_object();
+    return w.take();
+  }
+  if (bark.albedo_texture) w.key("albedo").string(*bark.albedo_texture);
+  else if (bark.albedo_rgb) write_vec3(w.key("albedo"), *bark.albedo_rgb);
+  if (bark.height_texture) w.key("height").string(*bark.height_texture);
+  w.key("relief_depth_m").number(bark.relief_depth_m);
+  w.key("u_repeat").number(bark.u_repeat);
+  w.key("v_per_metre").number(bark.v_per_metre);
+  if (normal_texture) w.key("r_ref_m").number(r_ref_m);
+  w.key("texcoord_0").string("s = u * u_repeat with u in turns around the axis, t = v_m * v_per_metre with v_m the "
+                             "arc length in metres");
+  w.end_object().end_object();
+  w.end_object();
+  return w.take();
+}
+
+// The material of the leaves of index `material` (gltf_export.h): the table's look, never
+// the bark's (docs/leaves.md); with the table's leaf image (leaf_images.h) `texture` as
+// baseColorTexture (its RGB white where the entry has only an alpha image: the colour is
+// then the factor), alphaMode MASK at kLeafAlphaCutoff for a cut-out, doubleSided unless
+// the entry is one-sided.
+std::string leaf_material_json(uint32_t material, const std::map<uint32_t, SceneMaterial>& materials,
+                               const LeafImages* images, std::optional<size_t> texture) {
+  const MaterialLook look = material_look(materials, nullptr, material);
+  const bool image_albedo = images && images->has_albedo(material);
+  JsonWriter w;
+  w.begin_object();
+  w.key("name").string("sylva_leaf_material_" + std::to_string(material));
+  w.key("pbrMetallicRoughness").begin_object();
+  const double factor[4] = {image_albedo ? 1 : look.albedo.x, image_albedo ? 1 : look.albedo.y,
+                            image_albedo ? 1 : look.albedo.z, 1};
+  w.key("baseColorFactor").numbers(factor, 4);
+  if (texture) w.key("baseColorTexture").begin_object().key("index").integer(*texture).end_object();
+  w.key("metallicFactor").number(0);
+  w.key("roughnessFactor").number(0.9);
+  w.end_object();
+  if (texture && images->has_cutout(material)) {
+    w.key("alphaMode").string("MASK");
+    w.key("alphaCutoff").number(kLeafAlphaCutoff);
+  }
+  w.key("doubleSided").boolean(!(images && images->one_sided(material)));
+  w.key("extras").begin_object().key("sylva").begin_object();
+  w.key("material_index").integer(material);
+  w.key("leaf").boolean(true);
+  if (materials.count(material)) w.key("specular").number(look.specular);
+  w.end_object().end_object();
+  w.end_object();
+  return w.take();
+}
+
+double median_segment_radius(const SkinnedSkeleton& skinned) {
+  std::vector<double> radii;
+  for (const Frustum& f : skinned.frusta)
+    if (f.kind == FrustumKind::segment && (f.shape.radius0 > 0 || f.shape.radius1 > 0))
+      radii.push_back(0.5 * (f.shape.radius0 + f.shape.radius1));
+  if (radii.empty()) return 0;
+  const size_t mid = radii.size() / 2;
+  std::nth_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(mid), radii.end());
+  if (radii.size() % 2 == 1) return radii[mid];
+  const double upper = radii[mid];
+  return 0.5 * (*std::max_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(mid)) + upper);
+}
+
+// Per vertex of `tm`: TANGENT (gltf_export.h) as 4 floats, xyz unit in float.
+std::vector<float> vertex_tangents(const TriangleMesh& tm, const SkinnedSkeleton& skinned) {
+  // Each vertex belongs to one frustum (tessellate.h makes every frustum's own vertices).
+  std::vector<int64_t> frustum_of(tm.positions.size(), -1);
+  for (size_t t = 0; t < tm.triangle_count(); ++t)
+    for (int c = 0; c < 3; ++c) frustum_of[tm.indices[3 * t + static_cast<size_t>(c)]] = tm.triangle_frustum[t];
+  std::vector<float> tangents;
+  tangents.reserve(tm.positions.size() * 4);
+  for (size_t v = 0; v < tm.positions.size(); ++v) {
+    const glm::dvec3 n = tm.normals[v];
+    const glm::dvec3 axis = frustum_of[v] >= 0 ? skinned.frusta[static_cast<size_t>(frustum_of[v])].shape.axis
+                                               : glm::dvec3(0, 1, 0);
+    glm::dvec3 t = glm::cross(axis, n);  // u grows counter-clockwise about the axis
+    // On a cap (normal ∥ axis) any direction ⊥ the normal will do.
+    if (glm::length(t) < 1e-6) t = axis_frame(glm::normalize(n)).e0;
+    t = glm::normalize(t);
+    // cross(N, T)·w must point toward decreasing t, i.e. against the axis.
+    const float w = glm::dot(glm::cross(n, t), axis) > 0 ? -1.0f : 1.0f;
+    float f[3] = {static_cast<float>(t.x), static_cast<float>(t.y), static_cast<float>(t.z)};
+    const float len = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    tangents.insert(tangents.end(), {f[0] / len, f[1] / len, f[2] / len, w});
+  }
+  return tangents;
+}
+
+// Everything the materials of one export refer to, read and baked once.
+class MaterialTable {
+ public:
+  // Reads every texture the plants' barks and the table's leaves name (before anything is
+  // written).
+  Status load(const std::vector<GltfPlant>& plants, const std::map<uint32_t, SceneMaterial>& materials) {
+    Expected<std::shared_ptr<const LeafImages>> leaf = LeafImages::load(materials);
+    if (!leaf) return std::move(leaf.error());
+    leaf_images_ = std::move(*leaf);
+    for (uint32_t k = 0; k < kMaterialSlots; ++k) {  // the table's images on segments
+      const std::optional<SegmentTexture> t = segment_texture(materials, nullptr, k);
+      if (!t || albedo_files_.count(t->path)) continue;
+      Expected<EmbeddedImage> image =
+          read_albedo_image(t->path, "the albedo image of material " + std::to_string(k) + " (on its segments)");
+      if (!image) return std::move(image.error());
+      albedo_files_.emplace(t->path, std::move(*image));
+    }
+    for (const GltfPlant& p : plants) {
+      if (p.bark.albedo_texture && !albedo_files_.count(*p.bark.albedo_texture)) {
+        Expected<EmbeddedImage> image = read_albedo_image(*p.bark.albedo_texture);
+        if (!image) return std::move(image.error());
+        albedo_files_.emplace(*p.bark.albedo_texture, std::move(*image));
+      }
+      if (p.bark.height_texture && !height_files_.count(*p.bark.height_texture)) {
+        Expected<HeightMap> map = read_height_map(*p.bark.height_texture);
+        if (!map) return std::move(map.error());
+        height_files_.emplace(*p.bark.height_texture, std::move(*map));
+      }
+    }
+    return {};
+  }
+
+  // The normal map texture of `bark` at radius r_ref_m (baked on first use), or nothing
+  // when the bark has no height map or the plant no radius.
+  Expected<std::optional<size_t>> normal_texture(const Bark& bark, double r_ref_m) {
+    if (!bark.height_texture || !(r_ref_m > 0)) return std::optional<size_t>();
+    std::string key = "normal:" + *bark.height_texture + "\n";
+    for (double v : {r_ref_m, bark.u_repeat, bark.v_per_metre, bark.relief_depth_m}) append_json_number(key, v), key += ',';
+    if (auto it = image_of_.find(key); it != image_of_.end()) return std::optional<size_t>(it->second);
+    const HeightMap& map = height_files_.at(*bark.height_texture);
+    const NormalMapMetric metric =
+        bark_normal_map_metric(map.width, map.height, r_ref_m, bark.u_repeat, bark.v_per_metre, bark.relief_depth_m);
+    std::optional<std::string> png =
+        encode_png_in_memory(map.width, map.height, 3, encode_normals_rgb8(bake_tangent_normals(map, metric)));
+    if (!png)
+      return file_diagnostic(*bark.height_texture, "cannot encode the normal map baked from this height map as PNG");
+    return std::optional<size_t>(add_image(key, {std::move(*png), "image/png"}));
+  }
+
+  // The texture of an albedo image laid on segments (read by load).
+  size_t albedo_texture(const std::string& path) {
+    const std::string key = "albedo:" + path;
+    if (auto it = image_of_.find(key); it != image_of_.end()) return it->second;
+    return add_image(key, albedo_files_.at(path));
+  }
+
+  // The leaf image of material `material` (leaf_images.h: its merged RGBA layer as a PNG),
+  // or nothing when the table names none for it.
+  Expected<std::optional<size_t>> leaf_texture(uint32_t material) {
+    const int k = leaf_images_ ? leaf_images_->layer_of(material) : -1;
+    if (k < 0) return std::optional<size_t>();
+    const std::string key = "leaf:" + std::to_string(material);
+    if (auto it = image_of_.find(key); it != image_of_.end()) return std::optional<size_t>(it->second);
+    std::optional<std::string> png = encode_png_in_memory(leaf_images_->width(), leaf_images_->height(), 4,
+                                                          leaf_images_->layer(static_cast<size_t>(k)));
+    if (!png) return file_diagnostic("", "cannot encode the leaf image of material " + std::to_string(material) + " as PNG");
+    return std::optional<size_t>(add_image(key, {std::move(*png), "image/png"}));
+  }
+  const LeafImages* leaf_images() const { return leaf_images_.get(); }
+
+  // The index of a material, written once however many plants use it.
+  size_t material(const std::string& json) {
+    auto [it, inserted] = material_of_.emplace(json, materials_.size());
+    if (inserted) materials_.push_back(json);
+    return it->second;
+  }
+
+  const std::vector<std::string>& materials() const { return materials_; }
+  const std::vector<EmbeddedImage>& images() const { return images_; }  // texture i = image i
+
+ private:
+  size_t add_image(const std::string& key, EmbeddedImage image) {
+    images_.push_back(std::move(image));
+    image_of_.emplace(key, images_.size() - 1);
+    return images_.size() - 1;
+  }
+
+  std::map<std::string, EmbeddedImage> albedo_files_;
+  std::map<std::string, HeightMap> height_files_;
+  std::shared_ptr<const LeafImages> leaf_images_;
+  std::map<std::string, size_t> image_of_;
+  std::vector<EmbeddedImage> images_;
+  std::map<std::string, size_t> material_of_;
+  std::vector<std::string> materials_;
+};
+
+}  // namespace
+
+Status check_bark_textures(const Bark& bark) {
+  if (bark.albedo_texture) {
+    Expected<EmbeddedImage> image = read_albedo_image(*bark.albedo_texture);
+    if (!image) return std::move(image.error());
+  }
+  if (bark.height_texture) {
+    Expected<HeightMap> map = read_height_map(*bark.height_texture);
+    if (!map) return std::move(map.error());
+  }
+  return {};
+}
+
+double bark_reference_radius_m(const Skeleton& skeleton) { return median_segment_radius(skin_skeleton(skeleton)); }
+
+Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path, const GltfExportOptions& options) {
+  const std::string ext = lower_case(path);
+  const bool glb = ends_with(ext, ".glb");
+  if (!glb && !ends_with(ext, ".gltf")) return file_diagnostic(path, "the output must end in .gltf or .glb");
+  if (plants.empty()) return file_diagnostic(path, "no plants to export");
+  if (options.segments_around < 3 || options.segments_around > 4096)
+    return file_diagnostic(path, "segments around must be an integer from 3 to 4096");
+  for (size_t i = 0; i < plants.size(); ++i)
+    if (auto problem = plant_problem(plants[i], i)) return file_diagnostic(path, *problem);
+  MaterialTable table;
+  if (options.mesh)
+    if (Status loaded = table.load(plants, options.materials); !loaded) return loaded;
+
+  // Group identical skeletons when instancing (compared by their exact serialization,
+  // and by their barks when those shape the mesh).
+  std::vector<PlantGroup> groups;
+  if (options.instancing) {
+    std::map<std::string, size_t> group_of;
+    for (size_t i = 0; i < plants.size(); ++i) {
+      std::string key = write_skeleton_json(plants[i].skeleton);
+      if (options.mesh) key += bark_key(plants[i].bark);
+      auto [it, inserted] = group_of.emplace(std::move(key), groups.size());
+      if (inserted) groups.emplace_back();
+      groups[it->second].plants.push_back(i);
+    }
+  } else {
+    for (size_t i = 0; i < plants.size(); ++i) groups.push_back({{i}});
+  }
+
+  BufferBuilder buffer;
+  std::vector<std::string> meshes, nodes;  // each one JSON object, written in order below
+  bool any_instancing = false;
+  for (const PlantGroup& group : groups) {
+    const GltfPlant& plant = plants[group.plants.front()];
+    const Skeleton& sk = plant.skeleton;
+    const SkinnedSkeleton skinned = skin_skeleton(sk);
+
+    // The skeleton as LINES: vertex i is joint i; one (parent joint, child joint) pair
+    // per segment, a branch's first segment starting at the joint it grows from.
+    JsonWriter primitives;
+    size_t primitive_count = 0;
+    primitives.begin_array();
+    if (sk.segment_count() > 0) {
+      std::vector<float> positions, radii;
+      positions.reserve(sk.joints.size() * 3);
+      for (const Joint& j : sk.joints) {
+        for (double x : j.position_m) positions.push_back(static_cast<float>(x));
+        radii.push_back(static_cast<float>(j.radius_m));
+      }
+      std::vector<uint32_t> pairs;
+      pairs.reserve(sk.segment_count() * 2);
+      for (const Chain& c : sk.chains) {
+        for (uint32_t j = 1; j < c.joint_count; ++j) {
+          uint32_t lower = c.first_joint + j - 1;
+          if (j == 1 && c.parent) lower = sk.chains[c.parent->chain].first_joint + c.parent->joint;
+          pairs.push_back(lower);
+          pairs.push_back(c.first_joint + j);
+        }
+      }
+      const size_t pos = buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer);
+      const size_t rad = buffer.add_floats(radii, 1, "SCALAR", kTargetArrayBuffer);
+      const size_t idx = buffer.add_indices(pairs);
+      primitives.begin_object();
+      primitives.key("attributes").begin_object().key("POSITION").integer(pos).key("_RADIUS").integer(rad).end_object();
+      primitives.key("indices").integer(idx);
+      primitives.key("mode").integer(kModeLines);
+      primitives.end_object();
+      ++primitive_count;
+    }
+    if (options.mesh && !skinned.frusta.empty()) {
+      TessellateOptions to;
+      to.segments_around = options.segments_around;
+      const TriangleMesh tm = tessellate(skinned, to);
+      if (!tm.indices.empty()) {
+        // One primitive per material index, in increasing order.
+        std::map<uint32_t, std::vector<uint32_t>> triangles_of;
+        for (size_t t = 0; t < tm.triangle_count(); ++t) {
+          std::vector<uint32_t>& list = triangles_of[skinned.frusta[tm.triangle_frustum[t]].material];
+          list.insert(list.end(), tm.indices.begin() + static_cast<std::ptrdiff_t>(3 * t),
+                      tm.indices.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
+        }
+        // The bark's textures are the wood's (material 0, materials.h): a plant without
+        // wood embeds none.
+        const bool has_wood = triangles_of.count(0) > 0;
+        const Bark& bark = plant.bark;
+        const double r_ref_m = median_segment_radius(skinned);
+        Expected<std::optional<size_t>> normal_map =
+            has_wood ? table.normal_texture(bark, r_ref_m) : Expected<std::optional<size_t>>(std::optional<size_t>());
+        if (!normal_map) return std::move(normal_map.error());
+        const std::optional<size_t> normal_texture = *normal_map;
+
+        std::vector<float> positions, normals, texcoords;
+        positions.reserve(tm.positions.size() * 3);
+        normals.reserve(tm.normals.size() * 3);
+        texcoords.reserve(tm.uvs.size() * 2);
+        for (const glm::dvec3& p : tm.positions)
+          positions.insert(positions.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
+        for (const glm::dvec3& n : tm.normals) {
+          // Renormalised in float so the validator's unit-length check holds exactly.
+          float f[3] = {static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z)};
+          const float len = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+          normals.insert(normals.end(), {f[0] / len, f[1] / len, f[2] / len});
+        }
+        // (u · u_repeat, v_m · v_per_metre) of every vertex.
+        auto scaled_uvs = [&](double u_repeat, double v_per_metre) {
+          std::vector<float> st;
+          st.reserve(tm.uvs.size() * 2);
+          for (const glm::dvec2& uv : tm.uvs)
+            st.insert(st.end(), {static_cast<float>(uv.x * u_repeat), static_cast<float>(uv.y * v_per_metre)});
+          return st;
+        };
+        texcoords = scaled_uvs(bark.u_repeat, bark.v_per_metre);
+        // Accessor order NORMAL, POSITION, TANGENT, TEXCOORD_0: the order files written so
+        // far have (it came from GCC's right-to-left evaluation of a string concatenation),
+        // now fixed in code so that every compiler writes the same bytes.
+        const size_t normal_accessor = buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer);
+        const size_t position_accessor = buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer);
+        JsonWriter attributes;
+        attributes.begin_object();
+        attributes.key("POSITION").integer(position_accessor);
+        attributes.key("NORMAL").integer(normal_accessor);
+        if (normal_texture)
+          attributes.key("TANGENT").integer(buffer.add_floats(vertex_tangents(tm, skinned), 4, "VEC4", kTargetArrayBuffer));
+        attributes.key("TEXCOORD_0").integer(buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer));
+        const std::string shared_attributes = attributes.text() + "}";
+        // A table image repeating otherwise than the bark reads TEXCOORD_1, its own
+        // (u · u_repeat, v_m · v_per_metre); one accessor per distinct pair of repeats.
+        std::map<std::pair<double, double>, std::string> attributes_with_texcoord_1;
+        for (const auto& [material, indices] : triangles_of) {
+          const bool wood = material == 0;  // the bark's textures are the wood's (materials.h)
+          const std::optional<SegmentTexture> segment = segment_texture(options.materials, &bark, material);
+          int texcoord = 0;
+          const std::string* primitive_attributes = &shared_attributes;
+          if (segment && (segment->u_repeat != bark.u_repeat || segment->v_per_metre != bark.v_per_metre)) {
+            texcoord = 1;
+            const std::pair<double, double> repeat{segment->u_repeat, segment->v_per_metre};
+            auto it = attributes_with_texcoord_1.find(repeat);
+            if (it == attributes_with_texcoord_1.end()) {
+              const size_t accessor =
+                  buffer.add_floats(scaled_uvs(repeat.first, repeat.second), 2, "VEC2", kTargetArrayBuffer);
+              it = attributes_with_texcoord_1
+                       .emplace(repeat, attributes.text() + ",\"TEXCOORD_1\":" + std::to_string(accessor) + "}")
+                       .first;
+            }
+            primitive_attributes = &it->second;
+          }
+          const size_t m = table.material(material_json(
+              material, bark, options.materials,
+              segment ? std::optional<size_t>(table.albedo_texture(segment->path)) : std::nullopt, texcoord,
+              wood ? normal_texture : std::nullopt, r_ref_m, table.leaf_images()));
+          primitives.begin_object();
+          primitives.key("attributes").raw(*primitive_attributes);
+          primitives.key("indices").integer(buffer.add_indices(indices));
+          primitives.key("material").integer(m);
+          primitives.key("mode").integer(kModeTriangles);
+          primitives.end_object();
+          ++primitive_count;
+        }
+      }
+    }
+    if (options.mesh && !sk.leaves.empty()) {
+      // The leaves (leaf_mesh.h): flat triangles with their leaf's normal at each vertex,
+      // one primitive per material index in increasing order, double-sided materials;
+      // TEXCOORD_0 = (u, 1 − v) of leaf_uvs (glTF's t runs down the image: an image drawn
+      // upright, petiole at its bottom row, covers the leaf as the renderers map it).
+      LeafMesh leaves;
+      append_leaves(leaves, sk, 0);
+      std::map<uint32_t, std::vector<uint32_t>> triangles_of;
+      std::vector<float> positions, normals, texcoords;
+      for (const glm::dvec2& t : leaves.uvs)
+        texcoords.insert(texcoords.end(), {static_cast<float>(t.x), static_cast<float>(1 - t.y)});
+      for (const glm::dvec3& q : leaves.positions)
+        positions.insert(positions.end(), {static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z)});
+      for (uint32_t l : leaves.vertex_leaf) {
+        // Renormalised in float so the validator's unit-length check holds exactly.
+        const glm::dvec3& n = leaves.leaves[l].normal;
+        const float f[3] = {static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z)};
+        const float len = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+        normals.insert(normals.end(), {f[0] / len, f[1] / len, f[2] / len});
+      }
+      for (size_t t = 0; t < leaves.triangle_count(); ++t) {
+        std::vector<uint32_t>& list = triangles_of[leaves.leaves[leaves.triangle_leaf[t]].material];
+        list.insert(list.end(), leaves.indices.begin() + static_cast<std::ptrdiff_t>(3 * t),
+                    leaves.indices.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
+      }
+      if (!triangles_of.empty()) {
+        JsonWriter attributes;
+        attributes.begin_object();
+        attributes.key("POSITION").integer(buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer));
+        attributes.key("NORMAL").integer(buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer));
+        attributes.key("TEXCOORD_0").integer(buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer));
+        attributes.end_object();
+        for (const auto& [material, indices] : triangles_of) {
+          primitives.begin_object();
+          primitives.key("attributes").raw(attributes.text());
+          primitives.key("indices").integer(buffer.add_indices(indices));
+          Expected<std::optional<size_t>> texture = table.leaf_texture(material);
+          if (!texture) return std::move(texture.error());
+          primitives.key("material").integer(
+              table.material(leaf_material_json(material, options.materials, table.leaf_images(), *texture)));
+          primitives.key("mode").integer(kModeTriangles);
+          primitives.end_object();
+          ++primitive_count;
+        }
+      }
+    }
+    primitives.end_array();
+
+    JsonWriter node;
+    node.begin_object();
+    node.key("name").string(plant.name);
+    if (primitive_count > 0) {
+      JsonWriter mesh;
+      mesh.begin_object();
+      mesh.key("name").string(plant.name);
+      mesh.key("primitives").raw(primitives.text());
+      mesh.end_object();
+      meshes.push_back(mesh.take());
+      node.key("mesh").integer(meshes.size() - 1);
+    }
+    const bool instanced = group.plants.size() > 1;
+    if (instanced) {
+      // EXT_mesh_gpu_instancing: the node keeps the identity transform; each instance's
+      // TRS is in the attributes (float), exact values in extras.sylva.instances.
+      std::vector<float> translation, rotation, scale;
+      for (size_t i : group.plants) {
+        const GltfPlant& p = plants[i];
+        for (double x : p.position_m) translation.push_back(static_cast<float>(x));
+        for (double q : quaternion_about_y(p.rotate_y_deg)) rotation.push_back(static_cast<float>(q));
+        for (int k = 0; k < 3; ++k) scale.push_back(static_cast<float>(p.scale));
+      }
+      const size_t t = buffer.add_floats(translation, 3, "VEC3", 0);
+      const size_t r = buffer.add_floats(rotation, 4, "VEC4", 0);
+      const size_t s = buffer.add_floats(scale, 3, "VEC3", 0);
+      node.key("extensions").begin_object().key("EXT_mesh_gpu_instancing").begin_object();
+      node.key("attributes").begin_object().key("TRANSLATION").integer(t).key("ROTATION").integer(r);
+      node.key("SCALE").integer(s).end_object();
+      node.end_object().end_object();
+      any_instancing = true;
+    } else {
+      if (plant.position_m[0] != 0 || plant.position_m[1] != 0 || plant.position_m[2] != 0)
+        node.key("translation").numbers(plant.position_m, 3);
+      if (plant.rotate_y_deg != 0) node.key("rotation").numbers(quaternion_about_y(plant.rotate_y_deg).data(), 4);
+      if (plant.scale != 1) {
+        const double s[3] = {plant.scale, plant.scale, plant.scale};
+        node.key("scale").numbers(s, 3);
+      }
+    }
+    // The skeleton document of docs/spec/skeleton.md, the seed as a string (JSON consumers read
+    // numbers as doubles, which cannot hold every 64-bit seed).
+    // "compact": the same document with its large arrays in bufferViews (gltf_export.h).
+    if (options.extras == GltfExtras::full) {
+      node.key("extras").begin_object().key("sylva").begin_object();
+      write_skeleton_members(node, sk, {.compact = true, .seed_as_string = true});
+      write_skinning(node, skinned, nullptr);
+      node.key("instances").begin_array();
+      for (size_t i : group.plants) write_instance(node, plants[i]);
+      node.end_array();
+      node.end_object().end_object();
+    } else if (options.extras == GltfExtras::compact) {
+      node.key("extras").begin_object().key("sylva").begin_object();
+      write_compact_skeleton(node, sk, buffer);
+      write_skinning(node, skinned, &buffer);
+      std::vector<double> placement;
+      node.key("instances").begin_object().key("count").integer(group.plants.size());
+      node.key("names").begin_array();
+      for (size_t i : group.plants) {
+        const GltfPlant& p = plants[i];
+        node.string(p.name);
+        placement.insert(placement.end(), {p.position_m[0], p.position_m[1], p.position_m[2], p.rotate_y_deg, p.scale});
+      }
+      node.end_array();
+      write_view(node, "placement", placement, buffer);
+      node.end_object();
+      node.end_object().end_object();
+    }
+    node.end_object();
+    nodes.push_back(node.take());
+  }
+
+  // The document. Arrays that would be empty are left out (glTF forbids empty arrays).
+  JsonWriter json;
+  json.begin_object();
+  json.key("asset").begin_object().key("version").string("2.0").key("generator").string("sylva").end_object();
+  // The instances' placements exist only in the extension (the node has no fallback
+  // transform per instance): a viewer without it would show one plant at the origin, so
+  // the extension is required, not merely used (glTF 2.0 sec. 3.12).
+  if (any_instancing) {
+    json.key("extensionsUsed").begin_array().string("EXT_mesh_gpu_instancing").end_array();
+    json.key("extensionsRequired").begin_array().string("EXT_mesh_gpu_instancing").end_array();
+  }
+  json.key("scene").integer(0);
+  json.key("scenes").begin_array().begin_object().key("nodes").begin_array();
+  for (size_t i = 0; i < nodes.size(); ++i) json.integer(i);
+  json.end_array().end_object().end_array();
+  json.key("nodes").begin_array();
+  for (const std::string& node : nodes) json.raw(node);
+  json.end_array();
+  if (!meshes.empty()) {
+    json.key("meshes").begin_array();
+    for (const std::string& mesh : meshes) json.raw(mesh);
+    json.end_array();
+  }
+  if (!table.materials().empty()) {
+    json.key("materials").begin_array();
+    for (const std::string& material : table.materials()) json.raw(material);
+    json.end_array();
+  }
+  if (!table.images().empty()) {
+    // Texture i shows image i; one sampler: linear, mipmapped, repeating (the bark tiles).
+    json.key("samplers").begin_array().begin_object();
+    json.key("magFilter").integer(kFilterLinear).key("minFilter").integer(kFilterLinearMipmapLinear);
+    json.key("wrapS").integer(kWrapRepeat).key("wrapT").integer(kWrapRepeat);
+    json.end_object().end_array();
+    json.key("textures").begin_array();
+    for (size_t i = 0; i < table.images().size(); ++i)
+      json.begin_object().key("sampler").integer(0).key("source").integer(i).end_object();
+    json.end_array();
+    json.key("images").begin_array();
+    for (const EmbeddedImage& image : table.images()) {
+      json.begin_object();
+      if (glb)
+        json.key("bufferView").integer(buffer.add_bytes(image.bytes)).key("mimeType").string(image.mime);
+      else
+        json.key("uri").string("data:" + std::string(image.mime) + ";base64," + base64(image.bytes));
+      json.end_object();
+    }
+    json.end_array();
+  }
+  const std::string& bin = buffer.bytes();
+  if (!buffer.accessors().empty()) {
+    json.key("accessors").begin_array();
+    for (const Accessor& a : buffer.accessors()) {
+      json.begin_object();
+      json.key("bufferView").integer(a.view).key("componentType").integer(a.component).key("count").integer(a.count);
+      json.key("type").string(a.type);
+      json.key("min").numbers(a.min.data(), a.min.size());
+      json.key("max").numbers(a.max.data(), a.max.size());
+      json.end_object();
+    }
+    json.end_array();
+  }
+  if (!buffer.views().empty()) {  // extras "compact" may have views without accessors
+    json.key("bufferViews").begin_array();
+    for (const BufferView& v : buffer.views()) {
+      json.begin_object();
+      json.key("buffer").integer(0).key("byteOffset").integer(v.offset).key("byteLength").integer(v.length);
+      if (v.target) json.key("target").integer(v.target);
+      json.end_object();
+    }
+    json.end_array();
+    json.key("buffers").begin_array().begin_object().key("byteLength").integer(bin.size());
+    if (!glb) json.key("uri").string("data:application/octet-stream;base64," + base64(bin));
+    json.end_object().end_array();
+  }
+  json.end_object();
+  const std::string text = json.take() + "\n";
+
+  std::string file;
+  if (glb) {
+    std::string json_chunk = text;
+    while (json_chunk.size() % 4 != 0) json_chunk += ' ';
+    std::string bin_chunk = bin;
+    while (bin_chunk.size() % 4 != 0) bin_chunk += '\0';
+    const size_t total = 12 + 8 + json_chunk.size() + (bin_chunk.empty() ? 0 : 8 + bin_chunk.size());
+    if (total > std::numeric_limits<uint32_t>::max())
+      return file_diagnostic(path, "the model exceeds the 4 GiB of a GLB file");
+    file.reserve(total);
+    append_u32(file, kGlbMagic);
+    append_u32(file, 2);
+    append_u32(file, static_cast<uint32_t>(total));
+    append_u32(file, static_cast<uint32_t>(json_chunk.size()));
+    append_u32(file, kGlbChunkJson);
+    file += json_chunk;
+    if (!bin_chunk.empty()) {
+      append_u32(file, static_cast<uint32_t>(bin_chunk.size()));
+      append_u32(file, kGlbChunkBin);
+      file += bin_chunk;
+    }
+  } else {
+    file = text;
+  }
+  return write_file_atomically(path, file);
+}
+
+}  // namespace sylva

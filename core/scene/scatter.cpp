@@ -1,0 +1,115 @@
+// scatter.cpp — see scatter.h.
+#include "core/scene/scatter.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <unordered_map>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "core/util/random.h"
+
+namespace sylva {
+
+namespace {
+
+bool inside_polygon(const std::vector<glm::dvec2>& poly, glm::dvec2 p) {
+  bool in = false;
+  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const glm::dvec2 a = poly[i], b = poly[j];
+    if ((a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x) in = !in;
+  }
+  return in;
+}
+
+}  // namespace
+
+double scatter_area_m2(const SceneScatter& s) {
+  if (s.disc_centre) return std::numbers::pi * s.disc_radius * s.disc_radius;
+  double twice = 0;
+  for (size_t i = 0, j = s.polygon.size() - 1; i < s.polygon.size(); j = i++)
+    twice += s.polygon[j].x * s.polygon[i].y - s.polygon[i].x * s.polygon[j].y;
+  return std::abs(twice) / 2;
+}
+
+Expected<std::vector<ScatterPlacement>> place_scatter(const SceneScatter& s) {
+  glm::dvec2 lo, hi;
+  if (s.disc_centre) {
+    lo = *s.disc_centre - glm::dvec2(s.disc_radius);
+    hi = *s.disc_centre + glm::dvec2(s.disc_radius);
+  } else {
+    lo = hi = s.polygon.front();
+    for (const glm::dvec2& p : s.polygon) {
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+  }
+  auto inside = [&](glm::dvec2 p) {
+    if (s.disc_centre) {
+      const glm::dvec2 d = p - *s.disc_centre;
+      return glm::dot(d, d) <= s.disc_radius * s.disc_radius;
+    }
+    return inside_polygon(s.polygon, p);
+  };
+  Rng darts(s.seed), attributes(s.seed ^ 0x5ca77e5eed5ca77eull);
+  std::vector<ScatterPlacement> out;
+  out.reserve(static_cast<size_t>(s.count));
+  // The spacing grid: cells min_spacing wide, keyed by their integer coordinates.
+  const double cell = s.min_spacing;
+  std::unordered_map<uint64_t, std::vector<uint32_t>> grid;
+  auto key = [](int64_t i, int64_t j) { return (static_cast<uint64_t>(i) << 32) ^ static_cast<uint64_t>(j & 0xffffffff); };
+  auto cell_of = [&](glm::dvec2 p) {
+    return std::pair<int64_t, int64_t>{static_cast<int64_t>(std::floor((p.x - lo.x) / cell)),
+                                       static_cast<int64_t>(std::floor((p.y - lo.y) / cell))};
+  };
+  const uint64_t max_darts = 30 * s.count + 1000;
+  for (uint64_t dart = 0; dart < max_darts && out.size() < s.count; ++dart) {
+    const glm::dvec2 p(lo.x + darts.next_double() * (hi.x - lo.x), lo.y + darts.next_double() * (hi.y - lo.y));
+    if (!inside(p)) continue;
+    if (cell > 0) {
+      const auto [ci, cj] = cell_of(p);
+      bool free = true;
+      for (int64_t di = -1; di <= 1 && free; ++di)
+        for (int64_t dj = -1; dj <= 1 && free; ++dj) {
+          auto found = grid.find(key(ci + di, cj + dj));
+          if (found == grid.end()) continue;
+          for (uint32_t k : found->second) {
+            const glm::dvec2 d = out[k].xz - p;
+            if (glm::dot(d, d) < cell * cell) {
+              free = false;
+              break;
+            }
+          }
+        }
+      if (!free) continue;
+      grid[key(ci, cj)].push_back(static_cast<uint32_t>(out.size()));
+    }
+    ScatterPlacement placed;
+    placed.xz = p;
+    placed.rotate_y_deg = s.rotate_min_deg + attributes.next_double() * (s.rotate_max_deg - s.rotate_min_deg);
+    placed.scale = s.scale_min + attributes.next_double() * (s.scale_max - s.scale_min);
+    if (s.plant_seeds) {
+      const auto [first, last] = *s.plant_seeds;
+      const uint64_t span = last - first;  // the whole 2^64 range: any draw
+      placed.plant_seed = span == UINT64_MAX ? attributes.next_u64() : first + attributes.below(span + 1);
+    } else {
+      placed.plant_seed = attributes.next_u64();
+    }
+    out.push_back(placed);
+  }
+  if (out.size() < s.count) {
+    char why[200];
+    std::snprintf(why, sizeof why,
+                  "only %zu of the %llu plants fit %g m apart in the area of %g m^2 (after %llu tries); lower count, "
+                  "density or min_spacing, or widen the area",
+                  out.size(), static_cast<unsigned long long>(s.count), s.min_spacing, scatter_area_m2(s),
+                  static_cast<unsigned long long>(max_darts));
+    return file_diagnostic("", why);
+  }
+  return out;
+}
+
+}  // namespace sylva

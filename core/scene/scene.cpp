@@ -1,0 +1,184 @@
+// scene.cpp — the scene model: fog mode names, bounds and framing, the default scene
+// around a skeleton, plant extents, animation defaults, material looks, placing a plant.
+// Reading and writing `.scene.json`: scene_json.cpp.
+#include "core/scene/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "core/geometry/leaf_mesh.h"
+#include "core/scene/materials.h"
+#include "core/util/limits.h"
+
+namespace sylva {
+
+const char* fog_mode_name(FogMode mode) {
+  switch (mode) {
+    case FogMode::automatic: return "auto";
+    case FogMode::brute: return "brute";
+    case FogMode::medium: return "medium";
+    case FogMode::fast: return "fast";
+    case FogMode::refined: return "refined";
+    case FogMode::reference: return "reference";
+  }
+  return "auto";
+}
+
+std::optional<FogMode> fog_mode_from_name(std::string_view name) {
+  for (FogMode m : {FogMode::automatic, FogMode::brute, FogMode::medium, FogMode::fast, FogMode::refined,
+                    FogMode::reference})
+    if (name == fog_mode_name(m)) return m;
+  return std::nullopt;
+}
+
+SkeletonBounds skeleton_bounds(const Skeleton& skeleton) {
+  SkeletonBounds b;
+  if (skeleton.joints.empty() && skeleton.leaves.empty()) return b;
+  const double inf = std::numeric_limits<double>::infinity();
+  b.lo = glm::dvec3(inf);
+  b.hi = glm::dvec3(-inf);
+  for (const Joint& j : skeleton.joints) {
+    glm::dvec3 p(j.position_m[0], j.position_m[1], j.position_m[2]);
+    b.lo = glm::min(b.lo, p - glm::dvec3(j.radius_m));
+    b.hi = glm::max(b.hi, p + glm::dvec3(j.radius_m));
+  }
+  grow(b, leaf_bounds(skeleton));  // empty without leaves
+  return b;
+}
+
+Camera framing_camera(const glm::dvec3& lo, const glm::dvec3& hi, uint32_t width, uint32_t height) {
+  Camera c;
+  c.fov_y_deg = 35;
+  const glm::dvec3 centre = 0.5 * (lo + hi);
+  const double deg = std::numbers::pi / 180;
+  const double elevation = 12 * deg, azimuth = 35 * deg;
+  const glm::dvec3 toward_eye(std::cos(elevation) * std::sin(azimuth), std::sin(elevation),
+                              std::cos(elevation) * std::cos(azimuth));
+  const glm::dvec3 right = glm::normalize(glm::cross(-toward_eye, glm::dvec3(0, 1, 0)));
+  const glm::dvec3 up = glm::cross(right, -toward_eye);
+  // The box's 8 corners fit the field of view with 8% margin: a corner q (relative to
+  // the centre) at camera distance d − q·w is inside when |q·right| <= kx·(d − q·w) and
+  // |q·up| <= ky·(d − q·w), so d is the largest of q·w + |q·right|/kx, q·w + |q·up|/ky.
+  const double aspect = static_cast<double>(width) / std::max<uint32_t>(height, 1);
+  const double ky = std::tan(0.5 * c.fov_y_deg * deg) / 1.08, kx = ky * aspect;
+  const double size = std::max(glm::length(hi - lo), 1e-3);
+  double distance = 0;
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+    const glm::dvec3 q = corner - centre;
+    const double along = glm::dot(q, toward_eye);
+    distance = std::max({distance, along + std::abs(glm::dot(q, right)) / kx,
+                         along + std::abs(glm::dot(q, up)) / ky, along + 0.05 * size});
+  }
+  c.target = centre;
+  c.eye = centre + distance * toward_eye;
+  c.up = {0, 1, 0};
+  return c;
+}
+
+Scene default_scene_for(const Skeleton& skeleton, uint32_t width, uint32_t height) {
+  Scene s;
+  s.width = width;
+  s.height = height;
+  s.sun.direction = glm::normalize(glm::dvec3(0.5, 1, 0.3));
+  s.fog.reset();
+  ScenePlant plant;
+  plant.skeleton = skeleton;
+  s.plants.push_back(std::move(plant));
+  SkeletonBounds b = skeleton_bounds(skeleton);
+  double lowest = 0;
+  for (const Joint& j : skeleton.joints) lowest = std::min(lowest, j.position_m[1]);
+  s.ground.height = lowest;
+  s.camera = framing_camera(b.lo, b.hi, width, height);
+  return s;
+}
+
+std::optional<std::string> plant_extent_problem(const Skeleton& skeleton, const glm::dvec3& position, double scale) {
+  double reach = 0;  // bounds |x|, |y|, |z| of a joint after the rotation about y
+  for (const Joint& j : skeleton.joints)
+    reach = std::max({reach, std::abs(j.position_m[0]) + std::abs(j.position_m[2]) + j.radius_m,
+                      std::abs(j.position_m[1]) + j.radius_m});
+  const double extent =
+      std::max({std::abs(position.x), std::abs(position.y), std::abs(position.z)}) + scale * reach;
+  if (extent <= kMaxCoordinateM) return std::nullopt;
+  char reaches[64];
+  std::snprintf(reaches, sizeof reaches, "%g", extent);
+  return std::string("the plant reaches ") + reaches +
+         " m from the origin once placed and scaled, beyond the limit of 1e12 m (docs/limits.md)";
+}
+
+SceneAnimation animation_defaults(AnimationMotion motion) {
+  SceneAnimation a;
+  a.motion = motion;
+  if (motion == AnimationMotion::dance) {
+    a.amplitude_deg = 12;
+    a.frequency_hz = 1.2;
+    a.branch_amplitude_deg = 8;
+    a.branch_frequency_hz = 2.5;
+  }
+  return a;
+}
+
+const char* animation_motion_name(AnimationMotion motion) {
+  return motion == AnimationMotion::dance ? "dance" : "sway";
+}
+
+uint64_t animation_frame_count(const SceneAnimation& a) {
+  return std::max<uint64_t>(1, static_cast<uint64_t>(std::ceil(a.duration_s * a.fps - 1e-9)));
+}
+
+glm::dvec3 unit_sun_direction(const glm::dvec3& toward_sun) {
+  // read_sun normalises what it reads, and read_scene normalises sun.direction once more.
+  return glm::normalize(glm::normalize(toward_sun));
+}
+
+
+std::optional<SegmentTexture> segment_texture(const std::map<uint32_t, SceneMaterial>& table, const Bark* bark,
+                                              uint32_t material) {
+  if (material == 0 && bark && bark->albedo_texture)
+    return SegmentTexture{*bark->albedo_texture, bark->u_repeat, bark->v_per_metre, true};
+  if (material == 0 && bark && bark->albedo_rgb) return std::nullopt;
+  const auto entry = table.find(material);
+  if (entry == table.end() || !entry->second.albedo_image || !entry->second.segment_repeat) return std::nullopt;
+  const SceneMaterial::Repeat& r = *entry->second.segment_repeat;
+  return SegmentTexture{*entry->second.albedo_image, r.u_repeat, r.v_per_metre, false};
+}
+
+MaterialLook material_look(const std::map<uint32_t, SceneMaterial>& table, const Bark* bark, uint32_t material) {
+  const auto entry = table.find(material);
+  const SceneMaterial* m = entry == table.end() ? nullptr : &entry->second;
+  const double* fallback = default_material_albedo(material);
+  MaterialLook look{{fallback[0], fallback[1], fallback[2]}, m ? m->specular : 1.0};
+  if (material == 0 && bark && bark->albedo_rgb) look.albedo = *bark->albedo_rgb;
+  else if (m && m->albedo_rgb) look.albedo = *m->albedo_rgb;
+  return look;
+}
+
+Skeleton place_plant(const ScenePlant& plant) {
+  Skeleton sk = *plant.skeleton;
+  const double angle = plant.rotate_y_deg * std::numbers::pi / 180;
+  const double c = std::cos(angle), s = std::sin(angle);
+  for (Joint& j : sk.joints) {
+    const double x = plant.scale * j.position_m[0], y = plant.scale * j.position_m[1],
+                 z = plant.scale * j.position_m[2];
+    // R_y: x' = c x + s z, z' = −s x + c z (right-handed, counter-clockwise seen from +Y).
+    j.position_m[0] = plant.position.x + c * x + s * z;
+    j.position_m[1] = plant.position.y + y;
+    j.position_m[2] = plant.position.z - s * x + c * z;
+    j.radius_m *= plant.scale;
+  }
+  for (Leaf& leaf : sk.leaves)
+    for (auto& v : leaf.vertices_m) {
+      const double x = plant.scale * v[0], y = plant.scale * v[1], z = plant.scale * v[2];
+      v = {plant.position.x + c * x + s * z, plant.position.y + y, plant.position.z - s * x + c * z};
+    }
+  return sk;
+}
+
+}  // namespace sylva

@@ -1,0 +1,816 @@
+// Tests for core/grow/turtle.h: the 3D turtle of docs/spec/grammar.md ("Turtle commands") and the chain
+// building rules of docs/spec/skeleton.md ("How the turtle builds chains").
+//
+// The frame starts at H = +Y, L = −X, U = +Z (H × L = U). Every expected position below is
+// worked out by hand from that frame; sin/cos of multiples of 90° are exact in sylva, so
+// right-angle turns give exact coordinates and are compared with EXPECT_EQ. Anything that
+// involves other angles is compared with a tolerance of 1e-12.
+#include "core/grow/turtle.h"
+#include "core/grow/grow.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sylva {
+namespace {
+
+using Position = std::array<double, 3>;
+
+constexpr double kTolerance = 1e-12;
+
+// Parses `text` as test.lsys and grows it with default options.
+sylva::Expected<GrowResult> grow_text(std::string_view text) {
+  sylva::Expected<lsys::Grammar> grammar = lsys::parse_grammar(text, "test.lsys", {});
+  if (!grammar.ok()) return grammar.error();
+  return grow(*grammar, {}, "test.lsys", {});
+}
+
+// The skeleton `text` grows into; an empty skeleton (and a test failure) if it does not.
+Skeleton skeleton_of(std::string_view text) {
+  sylva::Expected<GrowResult> result = grow_text(text);
+  if (!result.ok()) {
+    ADD_FAILURE() << "grammar failed to grow:\n" << result.error().format();
+    return {};
+  }
+  return std::move(result->skeleton);
+}
+
+// The formatted error `text` fails with, or "no error".
+std::string grow_error(std::string_view text) {
+  sylva::Expected<GrowResult> result = grow_text(text);
+  return result.ok() ? "no error" : result.error().format();
+}
+
+// Joint `joint` of chain `chain`; callers ASSERT the counts first (at() guards the rest).
+const Joint& joint_at(const Skeleton& skeleton, size_t chain, size_t joint) {
+  const Chain& c = skeleton.chains.at(chain);
+  EXPECT_LT(joint, c.joint_count);
+  return skeleton.joints.at(c.first_joint + joint);
+}
+
+Position position(const Joint& joint) {
+  return {joint.position_m[0], joint.position_m[1], joint.position_m[2]};
+}
+
+Position position_at(const Skeleton& skeleton, size_t chain, size_t joint) {
+  return position(joint_at(skeleton, chain, joint));
+}
+
+// Where the turtle ends after `axiom`, for a word that draws a single chain.
+Position tip_of(std::string_view header, std::string_view axiom) {
+  const Skeleton skeleton = skeleton_of(std::string(header) + "axiom: " + std::string(axiom) + "\n");
+  if (skeleton.chains.size() != 1) {
+    ADD_FAILURE() << "expected one chain, got " << skeleton.chains.size();
+    return {NAN, NAN, NAN};
+  }
+  return position(skeleton.joints.back());
+}
+Position tip_of(std::string_view axiom) { return tip_of("", axiom); }
+
+testing::AssertionResult near(const Position& actual, const Position& expected) {
+  for (int k = 0; k < 3; ++k) {
+    if (!(std::abs(actual[k] - expected[k]) <= kTolerance)) {
+      return testing::AssertionFailure()
+             << "(" << actual[0] << ", " << actual[1] << ", " << actual[2] << ") differs from ("
+             << expected[0] << ", " << expected[1] << ", " << expected[2] << ") in component " << k
+             << " by " << actual[k] - expected[k];
+    }
+  }
+  return testing::AssertionSuccess();
+}
+
+std::optional<ChainParent> parent(uint32_t chain, uint32_t joint) { return ChainParent{chain, joint}; }
+
+// ---- moving: F, f, step ----------------------------------------------------------
+
+TEST(TurtleMove, FDrawsOneSegmentAlongPlusYFromTheOrigin) {
+  const Skeleton skeleton = skeleton_of("axiom: F\n");
+  ASSERT_EQ(skeleton.chains.size(), 1u);
+  ASSERT_EQ(skeleton.chains[0].joint_count, 2u);
+  EXPECT_EQ(skeleton.chains[0].parent, std::nullopt);
+  EXPECT_EQ(position_at(skeleton, 0, 0), (Position{0, 0, 0}));
+  EXPECT_EQ(position_at(skeleton, 0, 1), (Position{0, 1, 0}));
+  EXPECT_EQ(skeleton.segment_count(), 1u);
+}
+
+TEST(TurtleMove, FWithoutParameterMovesTheDefaultStepOfOne) {
+  EXPECT_EQ(tip_of("FF"), (Position{0, 2, 0}));
+}
+
+TEST(TurtleMove, StepDirectiveSetsTheDefaultLengthOfFAndf) {
+  EXPECT_EQ(tip_of("step: 2\n", "F"), (Position{0, 2, 0}));
+  const Skeleton skeleton = skeleton_of("step: 2\naxiom: fF\n");
+  ASSERT_EQ(skeleton.chains.size(), 1u);
+  EXPECT_EQ(position_at(skeleton, 0, 0), (Position{0, 2, 0}));
+  EXPECT_EQ(position_at(skeleton, 0, 1), (Position{0, 4, 0}));
+}
+
+TEST(TurtleMove, FParameterOverridesTheStep) {
+  EXPECT_EQ(tip_of("step: 2\n", "F(2.5)"), (Position{0, 2.5, 0}));
+}
+
+TEST(TurtleMove, SmallfMovesWithoutAJointAndTheNextFStartsANewRootChain) {
+  const Skeleton skeleton = skeleton_of("axiom: FfF\n");
+  ASSERT_EQ(skeleton.chains.size(), 2u);
+  ASSERT_EQ(skeleton.chains[0].joint_count, 2u);
+  ASSERT_EQ(skeleton.chains[1].joint_count, 2u);
+  EXPECT_EQ(position_at(skeleton, 0, 0), (Position{0, 0, 0}));
+  EXPECT_EQ(position_at(skeleton, 0, 1), (Position{0, 1, 0}));
+  EXPECT_EQ(skeleton.chains[1].parent, std::nullopt);
+  EXPECT_EQ(position_at(skeleton, 1, 0), (Position{0, 2, 0}));
+  EXPECT_EQ(position_at(skeleton, 1, 1), (Position{0, 3, 0}));
+  EXPECT_EQ(skeleton.segment_count(), 2u);
+}
+
+TEST(TurtleMove, SmallfInsideABranchStartsARootChainNotAChildOfTheBranchPoint) {
+  const Skeleton skeleton = skeleton_of("axiom: F[fF]F\n");
+  ASSERT_EQ(skeleton.chains.size(), 2u);
+  EXPECT_EQ(skeleton.chains[0].joint_count, 3u);  // the main axis continues after ]
+  EXPECT_EQ(skeleton.chains[1].parent, std::nullopt);
+  EXPECT_EQ(position_at(skeleton, 1, 0), (Position{0, 2, 0}));
+  EXPECT_EQ(position_at(skeleton, 1, 1), (Position{0, 3, 0}));
+}
+
+TEST(TurtleMove, ZeroLengthFMakesNoJointAndIsCounted) {
+  sylva::Expected<GrowResult> result = grow_text("axiom: FF(0)F\n");
+  ASSERT_TRUE(result.ok()) << result.error().format();
+  const Skeleton& skeleton = result->skeleton;
+  ASSERT_EQ(skeleton.chains.size(), 1u);
+  ASSERT_EQ(skeleton.chains[0].joint_count, 3u);
+  EXPECT_EQ(position_at(skeleton, 0, 1), (Position{0, 1, 0}));
+  EXPECT_EQ(position_at(skeleton, 0, 2), (Position{0, 2, 0}));
+  EXPECT_EQ(result->turtle.zero_length_moves, 1u);
+}
+
+TEST(TurtleMove, ZeroLengthMovesAreCountedForFAndf) {
+  sylva::Expected<GrowResult> result = grow_text("axiom: F(0)Ff(0)F(0)\n");
+  ASSERT_TRUE(result.ok()) << result.error().format();
+  EXPECT_EQ(result->turtle.zero_length_moves, 3u);
+  EXPECT_EQ(result->skeleton.segment_count(), 1u);
+}
+
+TEST(TurtleMove, AWordWithoutFGivesAnEmptySkeleton) {
+  const Skeleton skeleton = skeleton_of("axiom: +f[A]\n");
+  EXPECT_TRUE(skeleton.chains.empty());
+  EXPECT_TRUE(skeleton.joints.empty());
+}
+
+TEST(TurtleMove, ModulesTheTurtleDoesNotKnowAreIgnored) {
+  const Skeleton plain = skeleton_of("axiom: F+F\n");
+  const Skeleton with_others = skeleton_of("axiom: AFX+BFC(1,2)\n");
+  ASSERT_EQ(with_others.chains.size(), 1u);
+  ASSERT_EQ(with_others.joints.size(), plain.joints.size());
+  for (size_t j = 0; j < plain.joints.size(); ++j)
+    EXPECT_EQ(position(with_others.joints[j]), position(plain.joints[j])) << "joint " << j;
+  EXPECT_EQ(position(with_others.joints.back()), (Position{-1, 1, 0}));
+}
+
+// ---- turning: + - & ^ \ / | $ and the default angle ------------------------------
+
+TEST(TurtleTurn, PlusTurnsHeadingTowardLeftThatIsMinusX) {
+  EXPECT_EQ(tip_of("+(90)F"), (Position{-1, 0, 0}));
+}
+
+TEST(TurtleTurn, MinusTurnsHeadingTowardMinusLeftThatIsPlusX) {
+  EXPECT_EQ(tip_of("-(90)F"), (Position{1, 0, 0}));
+}
+
+TEST(TurtleTurn, PlusIsCounterclockwiseSeenFromPlusZ) {
+  // Four quarter turns to the left walk the square (0,1) (-1,1) (-1,0) (0,0).
+  const Skeleton skeleton = skeleton_of("axiom: F+(90)F+(90)F+(90)F\n");
+  ASSERT_EQ(skeleton.chains.size(), 1u);
+  ASSERT_EQ(skeleton.chains[0].joint_count, 5u);
+  EXPECT_EQ(position_at(skeleton, 0, 1), (Position{0, 1, 0}));
+  EXPECT_EQ(position_at(skeleton, 0, 2), (Position{-1, 1, 0}));
+  EXPECT_EQ(position_at(skeleton, 0, 3), (Position{-1, 0, 0}));
+  EXPECT_EQ(position_at(skeleton, 0, 4), (Position{0, 0, 0}));
+}
+
+TEST(TurtleTurn, AmpersandPitchesHeadingDownTowardMinusUpThatIsMinusZ) {
+  EXPECT_EQ(tip_of("&(90)F"), (Position{0, 0, -1}));
+}
+
+TEST(TurtleTurn, CaretPitchesHeadingUpTowardUpThatIsPlusZ) {
+  EXPECT_EQ(tip_of("^(90)F"), (Position{0, 0, 1}));
+}
+
+TEST(TurtleTurn, AmpersandRotatesUpWithHeadingSoTurnsAfterAPitchStayAboutTheNewUp) {
+  // &(90): H = −Z, U = +Y, L = −X unchanged; + then turns H toward L.
+  EXPECT_EQ(tip_of("&(90)+(90)F"), (Position{-1, 0, 0}));
+  // ^(90): H = +Z, U = −Y; a further ^(90) turns H toward the new U.
+  EXPECT_EQ(tip_of("^(90)^(90)F"), (Position{0, -1, 0}));
+}
+
+TEST(TurtleTurn, BackslashRollsUpTowardLeft) {
+  // \(90): U turns toward L, so U = −X and L = −U_old = −Z; H stays +Y.
+  EXPECT_EQ(tip_of("\\(90)F"), (Position{0, 1, 0}));
+  // & now turns H toward −U = +X.
+  EXPECT_EQ(tip_of("\\(90)&(90)F"), (Position{1, 0, 0}));
+  // + now turns H toward L = −Z.
+  EXPECT_EQ(tip_of("\\(90)+(90)F"), (Position{0, 0, -1}));
+}
+
+TEST(TurtleTurn, SlashRollsUpTowardMinusLeft) {
+  // /(90): U turns toward −L, so U = +X and L = U_old = +Z; H stays +Y.
+  EXPECT_EQ(tip_of("/(90)&(90)F"), (Position{-1, 0, 0}));
+  EXPECT_EQ(tip_of("/(90)+(90)F"), (Position{0, 0, 1}));
+}
+
+TEST(TurtleTurn, BarTurnsAroundAboutUp) {
+  EXPECT_EQ(tip_of("|F"), (Position{0, -1, 0}));
+  // About U: U stays +Z, L flips to +X, so + now turns toward +X.
+  EXPECT_EQ(tip_of("|+(90)F"), (Position{1, 0, 0}));
+  EXPECT_EQ(tip_of("|&(90)F"), (Position{0, 0, -1}));
+}
+
+TEST(TurtleTurn, BarIgnoresTheDefaultAngle) {
+  EXPECT_EQ(tip_of("angle: 30\n", "|F"), (Position{0, -1, 0}));
+}
+
+TEST(TurtleTurn, DollarRollsLeftBackToHorizontal) {
+  // &(30) pitches H to (0, cos 30, −sin 30) and keeps L = −X; \(40) rolls L out of the
+  // horizontal plane. $ sets L = (Y × H)/|Y × H| = (−1, 0, 0) again, so + turns H there.
+  const Position leveled = tip_of("&(30)\\(40)$+(90)F");
+  EXPECT_EQ(leveled, (Position{-1, 0, 0}));
+  EXPECT_EQ(leveled[1], 0.0);  // L · Y == 0
+  // Without $, the rolled L is not horizontal: the same turn climbs or falls.
+  const Position rolled = tip_of("&(30)\\(40)+(90)F");
+  EXPECT_GT(std::abs(rolled[1]), 0.1);
+}
+
+TEST(TurtleTurn, DollarLeavesTheFrameAloneWhenHeadingIsVertical) {
+  // H = +Y is parallel to V: no change, so the roll \(90) (L = −Z) survives the $.
+  EXPECT_EQ(tip_of("\\(90)$+(90)F"), (Position{0, 0, -1}));
+}
+
+TEST(TurtleTurn, DefaultAngleIsNinetyDegrees) {
+  EXPECT_EQ(tip_of("+F"), (Position{-1, 0, 0}));
+  EXPECT_EQ(tip_of("&F"), (Position{0, 0, -1}));
+}
+
+TEST(TurtleTurn, AngleDirectiveSetsTheDefaultForEveryTurn) {
+  const double s = std::sin(45 * std::numbers::pi / 180), c = std::cos(45 * std::numbers::pi / 180);
+  EXPECT_TRUE(near(tip_of("angle: 45\n", "+F"), {-s, c, 0}));
+  EXPECT_TRUE(near(tip_of("angle: 45\n", "-F"), {s, c, 0}));
+  EXPECT_TRUE(near(tip_of("angle: 45\n", "&F"), {0, c, -s}));
+  EXPECT_TRUE(near(tip_of("angle: 45\n", "^F"), {0, c, s}));
+  // Rolls use it too: \ then & (both 45°): U = (−s, 0, c), H turns toward −U.
+  EXPECT_TRUE(near(tip_of("angle: 45\n", "\\&F"), {s * s, c, -s * c}));
+  EXPECT_TRUE(near(tip_of("angle: 45\n", "/&F"), {-s * s, c, -s * c}));
+}
+
+TEST(TurtleTurn, TurnParameterOverridesTheDefaultAngle) {
+  EXPECT_EQ(tip_of("angle: 45\n", "+(90)F"), (Position{-1, 0, 0}));
+  const double s = std::sin(30 * std::numbers::pi / 180), c = std::cos(30 * std::numbers::pi / 180);
+  EXPECT_TRUE(near(tip_of("+(30)F"), {-s, c, 0}));
+}
+
+TEST(TurtleTurn, NegativeAnglesTurnTheOtherWay) {
+  EXPECT_EQ(tip_of("+(-90)F"), (Position{1, 0, 0}));
+  EXPECT_EQ(tip_of("&(-90)F"), (Position{0, 0, 1}));
+}
+
+// ---- radius: width, !, !(r) --------------------------------------------------------
+
+TEST(TurtleRadius, DefaultInitialRadiusIsFiveCentimetres) {
+  const Skeleton skeleton = skeleton_of("axiom: F\n");
+  ASSERT_EQ(skeleton.joints.size(), 2u);
+  EXPECT_EQ(skeleton.joints[0].radius_m, 0.05);
+  EXPECT_EQ(skeleton.joints[1].radius_m, 0.05);
+}
+
+TEST(TurtleRadius, WidthDirectiveIsTheInitialRadius) {
+  const Skeleton skeleton = skeleton_of("width: 0.2\naxiom: FF\n");
+  ASSERT_EQ(skeleton.joints.size(), 3u);
+  for (const Joint& joint : skeleton.joints) EXPECT_EQ(joint.radius_m, 0.2);
+}
+
+TEST(TurtleRadius, BangMultipliesTheRadiusByTheDefaultDecrementOfPointSeven) {
+  const Skeleton skeleton = skeleton_of("axiom: F!F!F\n");
+  ASSERT_EQ(skeleton.joints.size(), 4u);
+  EXPECT_EQ(skeleton.joints[0].radius_m, 0.05);
+  EXPECT_EQ(skeleton.joints[1].radius_m, 0.05);
+  EXPECT_EQ(skeleton.joints[2].radius_m, 0.05 * 0.7);
+  EXPECT_EQ(skeleton.joints[3].radius_m, 0.05 * 0.7 * 0.7);
+}
+
+TEST(TurtleRadius, WidthDecrementDirectiveSetsTheFactorOfBang) {
+  const Skeleton skeleton = skeleton_of("width: 0.2\nwidth decrement: 0.5\naxiom: F!F\n");
+  ASSERT_EQ(skeleton.joints.size(), 3u);
+  EXPECT_EQ(skeleton.joints[1].radius_m, 0.2);
+  EXPECT_EQ(skeleton.joints[2].radius_m, 0.1);
+}
+
+TEST(TurtleRadius, BangWithParameterSetsTheRadiusAndTapersOnlyTheNextSegment) {
+  // F !(0.5) F: the first segment is 0.05 → 0.05, the second 0.05 → 0.5.
+  const Skeleton skeleton = skeleton_of("axiom: F!(0.5)F\n");
+  ASSERT_EQ(skeleton.chains.size(), 1u);
+  ASSERT_EQ(skeleton.joints.size(), 3u);
+  EXPECT_EQ(skeleton.joints[0].radius_m, 0.05);
+  EXPECT_EQ(skeleton.joints[1].radius_m, 0.05);
+  EXPECT_EQ(skeleton.joints[2].radius_m, 0.5);
+}
+
+TEST(TurtleRadius, ZeroRadiusIsAllowedAsATip) {
+  const Skeleton skeleton = skeleton_of("axiom: F!(0)F\n");
+  ASSERT_EQ(skeleton.joints.size(), 3u);
+  EXPECT_EQ(skeleton.joints[2].radius_m, 0.0);
+}
+
+TEST(TurtleRadius, ABranchStartsWithTheRadiusInForceAtItsFirstF) {
+  // The branch's first joint is the turtle's position with the *current* radius.
+  const Skeleton skeleton = skeleton_of("axiom: F[!(0.01)+F]F\n");
+  ASSERT_EQ(skeleton.chains.size(), 2u);
+  EXPECT_EQ(joint_at(skeleton, 1, 0).radius_m, 0.01);
+  EXPECT_EQ(joint_at(skeleton, 1, 1).radius_m, 0.01);
+  EXPECT_EQ(joint_at(skeleton, 0, 1).radius_m, 0.05);
+}
+
+// ---- material: ', '(i) -------------------------------------------------------------
+
+TEST(TurtleMaterial, JointsCarryTheMaterialOfTheSegmentEndingAtThem) {
+  // Segments: F (0), ' F (1), '(3) F (3), ' F (4).
+  const Skeleton skeleton = skeleton_of("axiom: F'F'(3)F'F\n");
+  ASSERT_EQ(skeleton.chains.size(), 1u);
+  ASSERT_EQ(skeleton.joints.size(), 5u);
+  EXPECT_EQ(skeleton.joints[0].material, 0u);
+  EXPECT_EQ(skeleton.joints[1].material, 0u);
+  EXPECT_EQ(skeleton.joints[2].material, 1u);
+  EXPECT_EQ(skeleton.joints[3].material, 3u);
+  EXPECT_EQ(skeleton.joints[4].material, 4u);
+}
+
+TEST(TurtleMaterial, MaterialChangeAfterTheLastFColoursNothing) {
+  const Skeleton skeleton = skeleton_of("axiom: FF'(7)\n");
+  ASSERT_EQ(skeleton.joints.size(), 3u);
+  for (const Joint& joint : skeleton.joints) EXPECT_EQ(joint.material, 0u);
+}
+
+// ---- brackets restore the whole turtle state ---------------------------------------
+
+TEST(TurtleBranch, ClosingBracketRestoresPositionFrameRadiusAndMaterial) {
+  // Inside the branch: a turn, a roll, a new radius and material; after ] the main axis
+  // goes on straight up with radius 0.05 and material 0 (cpfg keeps width and colour in
+  // the turtle state).
+  const Skeleton skeleton = skeleton_of("axiom: F[+(90)\\(90)!(0.01)'(5)F]F\n");
+  ASSERT_EQ(skeleton.chains.size(), 2u);
+  ASSERT_EQ(skeleton.chains[0].joint_count, 3u);
+  const Joint& after = joint_at(skeleton, 0, 2);
+  EXPECT_EQ(position(after), (Position{0, 2, 0}));
+  EXPECT_EQ(after.radius_m, 0.05);
+  EXPECT_EQ(after.material, 0u);
+  EXPECT_EQ(position_at(skeleton, 1, 1), (Position{-1, 1, 0}));
+  EXPECT_EQ(joint_at(skeleton, 1, 1).material, 5u);
+}
+
+// ---- tropism: tropism: x y z e, @T(e) ------------------------------------------------
+
+// With T = (a, 0, 0), a > 0, and H = (sin θ, cos θ, 0) in the XY plane, H × T = −a cos θ·Z:
+// the Rodrigues rotation about −Z by e·a·cos θ turns H toward +X inside the XY plane, so
+// θ grows by e·a·cos θ after every F (ABOP 2.2, α = e·|H × T|, angles in radians).
+TEST(TurtleTropism, TropismBendsHeadingTowardTAfterEveryF) {
+  const Skeleton skeleton = skeleton_of("tropism: 1 0 0 0.5\naxiom: FFF\n");
+  ASSERT_EQ(skeleton.chains.size(), 1u);
+  ASSERT_EQ(skeleton.chains[0].joint_count, 4u);
+  // The first segment is straight: the bend comes after the F.
+  EXPECT_EQ(position_at(skeleton, 0, 1), (Position{0, 1, 0}));
+  const double theta1 = 0.5;                                // e·|Y × X| = 0.5
+  const double theta2 = theta1 + 0.5 * std::cos(theta1);    // e·|H × T| = 0.5 cos θ1
+  const Position j2 = {std::sin(theta1), 1 + std::cos(theta1), 0};
+  const Position j3 = {j2[0] + std::sin(theta2), j2[1] + std::cos(theta2), 0};
+  EXPECT_TRUE(near(position_at(skeleton, 0, 2), j2));
+  EXPECT_TRUE(near(position_at(skeleton, 0, 3), j3));
+}
+
+TEST(TurtleTropism, TropismAngleScalesWithTheLengthOfT) {
+  // T = (2, 0, 0), e = 0.25: α = 0.25·|Y × 2X| = 0.5, the same first bend as above.
+  const Skeleton skeleton = skeleton_of("tropism: 2 0 0 0.25\naxiom: FF\n");
+  ASSERT_EQ(skeleton.joints.size(), 3u);
+  EXPECT_TRUE(near(position(skeleton.joints[2]), {std::sin(0.5), 1 + std::cos(0.5), 0}));
+}
+
+TEST(TurtleTropism, TropismOutOfPlaneMatchesRodriguesRotation) {
+  // H = Y, T = (1, 0, 1): H × T = (1, 0, −1), |H × T| = √2, α = e·√2, k = (1, 0, −1)/√2.
+  // Rodrigues: H' = H cos α + (k × H) sin α + k (k·H)(1 − cos α), with k·H = 0 and
+  // k × H = (1, 0, 1)/√2, so H' = (sin α/√2, cos α, sin α/√2).
+  const Skeleton skeleton = skeleton_of("tropism: 1 0 1 0.25\naxiom: FF\n");
+  ASSERT_EQ(skeleton.joints.size(), 3u);
+  const double alpha = 0.25 * std::sqrt(2.0);
+  const double side = std::sin(alpha) / std::sqrt(2.0);
+  EXPECT_TRUE(near(position(skeleton.joints[2]), {side, 1 + std::cos(alpha), side}));
+}
+
+TEST(TurtleTropism, NoBendWhenHeadingIsParallelToT) {
+  // T = −Y (gravity) against H = +Y, and T = +Y along it: H × T = 0.
+  EXPECT_EQ(tip_of("tropism: 0 -1 0 0.8\n", "FFF"), (Position{0, 3, 0}));
+  EXPECT_EQ(tip_of("tropism: 0 1 0 0.8\n", "FFF"), (Position{0, 3, 0}));
+}
+
+TEST(TurtleTropism, AtTSetsTheSusceptibility) {
+  // The header's e is 0 (no bend) until @T(0.5) gives the first test's bend.
+  EXPECT_EQ(tip_of("tropism: 1 0 0 0\n", "FF"), (Position{0, 2, 0}));
+  EXPECT_TRUE(near(tip_of("tropism: 1 0 0 0\n", "@T(0.5)FF"), {std::sin(0.5), 1 + std::cos(0.5), 0}));
+  // @T(0) switches the header's tropism off.
+  EXPECT_EQ(tip_of("tropism: 1 0 0 0.5\n", "@T(0)FF"), (Position{0, 2, 0}));
+}
+
+TEST(TurtleTropism, AtTHoldsForTheRestOfTheBranchOnly) {
+  const Skeleton skeleton = skeleton_of("tropism: 1 0 0 0\naxiom: F[@T(0.5)FF]FF\n");
+  ASSERT_EQ(skeleton.chains.size(), 2u);
+  ASSERT_EQ(skeleton.chains[0].joint_count, 4u);
+  EXPECT_EQ(position_at(skeleton, 0, 3), (Position{0, 3, 0}));  // main axis: unbent
+  ASSERT_EQ(skeleton.chains[1].joint_count, 3u);
+  EXPECT_TRUE(near(position_at(skeleton, 1, 2), {std::sin(0.5), 2 + std::cos(0.5), 0}));
+}
+
+// ---- chains (docs/spec/skeleton.md) ------------------------------------------------------------
+
+TEST(TurtleChains, MainAxisContinuesThroughABranchPoint) {
+  // F[+F]F: chain 0 = (0,0) (0,1) (0,2); chain 1 = (0,1) (−1,1), attached at (0, 1).
+  const Skeleton skeleton = skeleton_of("axiom: F[+F]F\n");
+  ASSERT_EQ(skeleton.chains.size(), 2u);
+  ASSERT_EQ(skeleton.chains[0].joint_count, 3u);
+  ASSERT_EQ(skeleton.chains[1].joint_count, 2u);
+  EXPECT_EQ(skeleton.chains[0].parent, std::nullopt);
+  EXPECT_EQ(skeleton.chains[1].parent, parent(0, 1));
+  EXPECT_EQ(position_at(skeleton, 0, 0), (Position{0, 0, 0}));
+  EXPECT_EQ(position_at(skeleton, 0, 1), (Position{0, 1, 0}));
+  EXPECT_EQ(position_at(skeleton, 0, 2), (Position{0, 2, 0}));
+  EXPECT_EQ(position_at(skeleton, 1, 0), (Position{0, 1, 0}));
+  EXPECT_EQ(position_at(skeleton, 1, 1), (Position{-1, 1, 0}));
+  EXPECT_EQ(skeleton.segment_count(), 3u);
+}
+
+TEST(TurtleChains, TwoBranchesAtOneJointAreTwoChainsAttachedThere) {
+  const Skeleton skeleton = skeleton_of("axiom: F[+F][-F]F\n");
+  ASSERT_EQ(skeleton.chains.size(), 3u);
+  ASSERT_EQ(skeleton.chains[0].joint_count, 3u);
+  EXPECT_EQ(position_at(skeleton, 0, 2), (Position{0, 2, 0}));
+  EXPECT_EQ(skeleton.chains[1].parent, parent(0, 1));
+  EXPECT_EQ(position_at(skeleton, 1, 1), (Position{-1, 1, 0}));
+  EXPECT_EQ(skeleton.chains[2].parent, parent(0, 1));
+  EXPECT_EQ(position_at(skeleton, 2, 0), (Position{0, 1, 0}));
+  EXPECT_EQ(position_at(skeleton, 2, 1), (Position{1, 1, 0}));
+  EXPECT_EQ(skeleton.segment_count(), 4u);
+}
+
+TEST(TurtleChains, NestedBranchesAttachToTheBranchTheyGrowFrom) {
+  // F[+F[-F]F]F: chain 0 = (0,0) (0,1) (0,2); chain 1 = (0,1) (−1,1) (−2,1) continues
+  // through its own branch point; chain 2 = (−1,1) (−1,2) hangs from chain 1's joint 1.
+  const Skeleton skeleton = skeleton_of("axiom: F[+F[-F]F]F\n");
+  ASSERT_EQ(skeleton.chains.size(), 3u);
+  ASSERT_EQ(skeleton.chains[0].joint_count, 3u);
+  ASSERT_EQ(skeleton.chains[1].joint_count, 3u);
+  ASSERT_EQ(skeleton.chains[2].joint_count, 2u);
+  EXPECT_EQ(skeleton.chains[1].parent, parent(0, 1));
+  EXPECT_EQ(skeleton.chains[2].parent, parent(1, 1));
+  EXPECT_EQ(position_at(skeleton, 0, 2), (Position{0, 2, 0}));
+  EXPECT_EQ(position_at(skeleton, 1, 0), (Position{0, 1, 0}));
+  EXPECT_EQ(position_at(skeleton, 1, 1), (Position{-1, 1, 0}));
+  EXPECT_EQ(position_at(skeleton, 1, 2), (Position{-2, 1, 0}));
+  EXPECT_EQ(position_at(skeleton, 2, 0), (Position{-1, 1, 0}));
+  EXPECT_EQ(position_at(skeleton, 2, 1), (Position{-1, 2, 0}));
+  EXPECT_EQ(skeleton.segment_count(), 5u);
+}
+
+TEST(TurtleChains, BranchGroupInsideABranchLeavesTheMainAxisToTheFAfterTheOuterBracket) {
+  // F[[+F]F]F: both F inside the outer brackets are lateral; the last F continues
+  // chain 0. chain 1 = +F, chain 2 = the inner straight F, both attached at (0, 1).
+  const Skeleton skeleton = skeleton_of("axiom: F[[+F]F]F\n");
+  ASSERT_EQ(skeleton.chains.size(), 3u);
+  ASSERT_EQ(skeleton.chains[0].joint_count, 3u);
+  EXPECT_EQ(position_at(skeleton, 0, 2), (Position{0, 2, 0}));
+  EXPECT_EQ(skeleton.chains[1].parent, parent(0, 1));
+  EXPECT_EQ(position_at(skeleton, 1, 1), (Position{-1, 1, 0}));
+  ASSERT_EQ(skeleton.chains[2].joint_count, 2u);
+  EXPECT_EQ(skeleton.chains[2].parent, parent(0, 1));
+  EXPECT_EQ(position_at(skeleton, 2, 0), (Position{0, 1, 0}));
+  EXPECT_EQ(position_at(skeleton, 2, 1), (Position{0, 2, 0}));
+}
+
+TEST(TurtleChains, SecondBranchOfABranchGroupIsLateralNotTheMainAxis) {
+  // ABOP Fig. 1.24f writes F-[[X]+X]+F...: in F[[+F]-F]F the -F is a lateral branch
+  // (docs/spec/skeleton.md: "a lateral branch is a new chain"), and the main axis continues with the
+  // F after the outer ]. chain 0 = (0,0) (0,1) (0,2); chain 1 = +F; chain 2 = -F.
+  const Skeleton skeleton = skeleton_of("axiom: F[[+F]-F]F\n");
+  ASSERT_EQ(skeleton.chains.size(), 3u);
+  ASSERT_EQ(skeleton.chains[0].joint_count, 3u);
+  EXPECT_EQ(position_at(skeleton, 0, 2), (Position{0, 2, 0}));
+  EXPECT_EQ(skeleton.chains[1].parent, parent(0, 1));
+  EXPECT_EQ(position_at(skeleton, 1, 1), (Position{-1, 1, 0}));
+  ASSERT_EQ(skeleton.chains[2].joint_count, 2u);
+  EXPECT_EQ(skeleton.chains[2].parent, parent(0, 1));
+  EXPECT_EQ(position_at(skeleton, 2, 1), (Position{1, 1, 0}));
+}
+
+TEST(TurtleChains, EmptyBracketsDoNotBreakTheChain) {
+  const Skeleton skeleton = skeleton_of("axiom: F[]F[+]F\n");
+  ASSERT_EQ(skeleton.chains.size(), 1u);
+  EXPECT_EQ(skeleton.chains[0].joint_count, 4u);
+  EXPECT_EQ(position_at(skeleton, 0, 3), (Position{0, 3, 0}));
+}
+
+TEST(TurtleChains, BranchBeforeAnyFIsARootChainAndSoIsTheFAfterIt) {
+  // [F]F: the turtle stands on no joint at [ and after ], so both chains are roots.
+  const Skeleton skeleton = skeleton_of("axiom: [F]F\n");
+  ASSERT_EQ(skeleton.chains.size(), 2u);
+  EXPECT_EQ(skeleton.chains[0].parent, std::nullopt);
+  EXPECT_EQ(skeleton.chains[1].parent, std::nullopt);
+  EXPECT_EQ(position_at(skeleton, 0, 0), (Position{0, 0, 0}));
+  EXPECT_EQ(position_at(skeleton, 0, 1), (Position{0, 1, 0}));
+  EXPECT_EQ(position_at(skeleton, 1, 0), (Position{0, 0, 0}));
+  EXPECT_EQ(position_at(skeleton, 1, 1), (Position{0, 1, 0}));
+}
+
+TEST(TurtleChains, BranchAfterTurnsStartsFromTheJointNotFromAnEarlierOne) {
+  // F+F[&F]: the branch hangs from chain 0's last joint (−1, 1), index 2.
+  const Skeleton skeleton = skeleton_of("axiom: F+F[&F]\n");
+  ASSERT_EQ(skeleton.chains.size(), 2u);
+  EXPECT_EQ(skeleton.chains[1].parent, parent(0, 2));
+  EXPECT_EQ(position_at(skeleton, 1, 0), (Position{-1, 1, 0}));
+  EXPECT_EQ(position_at(skeleton, 1, 1), (Position{-1, 1, -1}));
+}
+
+// ABOP Fig. 1.24f (δ = 22.5°), five steps: every chain invariant of docs/spec/skeleton.md holds.
+TEST(TurtleChains, ParentsComeBeforeChildrenAndSegmentsAreOnePerF) {
+  const std::string text =
+      "angle: 22.5\n"
+      "derivation length: 5\n"
+      "axiom: X\n"
+      "X -> F-[[X]+X]+F[+FX]-X\n"
+      "F -> FF\n";
+  sylva::Expected<lsys::Grammar> grammar = lsys::parse_grammar(text, "test.lsys", {});
+  ASSERT_TRUE(grammar.ok()) << grammar.error().format();
+  sylva::Expected<lsys::Word> word = lsys::derive(*grammar);
+  ASSERT_TRUE(word.ok()) << word.error().format();
+  uint64_t f_count = 0;
+  for (const lsys::Module& m : word->modules) f_count += m.symbol == lsys::kSymF;
+
+  sylva::Expected<GrowResult> grown = grow(*grammar, {}, "test.lsys", {});
+  ASSERT_TRUE(grown.ok()) << grown.error().format();
+  const Skeleton& skeleton = grown->skeleton;
+  ASSERT_GT(skeleton.chains.size(), 10u);
+
+  uint64_t segments = 0;
+  uint32_t next_joint = 0;
+  for (size_t c = 0; c < skeleton.chains.size(); ++c) {
+    const Chain& chain = skeleton.chains[c];
+    SCOPED_TRACE("chain " + std::to_string(c));
+    EXPECT_EQ(chain.first_joint, next_joint);  // chains are contiguous and in order
+    EXPECT_GE(chain.joint_count, 2u);
+    next_joint += chain.joint_count;
+    segments += chain.joint_count - 1;
+    if (c == 0) {
+      EXPECT_EQ(chain.parent, std::nullopt);
+      continue;
+    }
+    ASSERT_TRUE(chain.parent.has_value());
+    ASSERT_LT(chain.parent->chain, c);
+    ASSERT_LT(chain.parent->joint, skeleton.chains[chain.parent->chain].joint_count);
+    // A branch starts exactly where its parent joint is.
+    EXPECT_EQ(position_at(skeleton, c, 0), position_at(skeleton, chain.parent->chain, chain.parent->joint));
+  }
+  EXPECT_EQ(next_joint, skeleton.joints.size());
+  EXPECT_EQ(skeleton.segment_count(), segments);
+  EXPECT_EQ(skeleton.segment_count(), f_count);
+  EXPECT_TRUE(validate_skeleton(skeleton).ok());
+}
+
+TEST(TurtleChains, GrowRecordsTheSourceOfTheSkeleton) {
+  const Skeleton skeleton = skeleton_of("seed: 9\nderivation length: 3\naxiom: F\n");
+  EXPECT_EQ(skeleton.source.grammar, "test.lsys");
+  EXPECT_EQ(skeleton.source.seed, 9u);
+  EXPECT_EQ(skeleton.source.steps, 3);
+}
+
+// ---- errors ----------------------------------------------------------------------
+
+TEST(TurtleErrors, NegativeRadiusIsAnErrorNamingTheModule) {
+  sylva::Expected<GrowResult> result = grow_text("axiom: F!(-1)F\n");
+  ASSERT_FALSE(result.ok());
+  const std::string message = result.error().format();
+  EXPECT_NE(message.find("test.lsys"), std::string::npos) << message;
+  EXPECT_NE(message.find("error"), std::string::npos) << message;
+  EXPECT_NE(message.find("negative"), std::string::npos) << message;
+  EXPECT_NE(message.find("!(-1)"), std::string::npos) << message;
+  EXPECT_NE(message.find("module 1"), std::string::npos) << message;  // its index in the word
+}
+
+// docs/limits.md: a length like 1e300 is finite, but no renderer can place it.
+TEST(TurtleErrors, PositionsAndRadiiBeyondTheLimitAreErrorsNamingTheModule) {
+  std::string message = grow_error("axiom: F(1e300)\n");
+  EXPECT_NE(message.find("exceeds the limit of 1e12 m"), std::string::npos) << message;
+  EXPECT_NE(message.find("F(1e+300)"), std::string::npos) << message;
+  message = grow_error("axiom: f(2e12)F\n");
+  EXPECT_NE(message.find("exceeds the limit of 1e12 m"), std::string::npos) << message;
+  message = grow_error("axiom: !(1e13)F\n");
+  EXPECT_NE(message.find("radius exceeds the limit"), std::string::npos) << message;
+  EXPECT_TRUE(grow_text("axiom: F(1e11)!(1e11)F\n").ok());
+}
+
+// A turtle error points into the grammar: at the one production (or the axiom) that
+// writes the module, or, where several could have, a note at each of them.
+TEST(TurtleErrors, AreLocatedAtTheProductionThatWritesTheModule) {
+  sylva::Expected<GrowResult> result = grow_text("derivation length: 1\naxiom: A\nA -> F!(-1)F\n");
+  ASSERT_FALSE(result.ok());
+  const Diagnostic& d = result.error();
+  EXPECT_EQ(d.loc, (SourceLoc{3, 1})) << d.format();
+  EXPECT_EQ(d.source_line, "A -> F!(-1)F") << d.format();
+  EXPECT_NE(d.message.find("the radius must be finite and not negative at module 1 (!(-1))"), std::string::npos)
+      << d.format();
+  EXPECT_EQ(d.format().rfind("test.lsys:3:1: error: turtle: ", 0), 0u) << d.format();
+
+  result = grow_text("axiom: F!(1e13)\n");
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.error().loc, (SourceLoc{1, 1})) << result.error().format();
+
+  // F is written by the axiom and by two productions: the file, and a note at each.
+  result = grow_text("derivation length: 1\naxiom: F(1e300)B\nB -> F\nC -> FF\n");
+  ASSERT_FALSE(result.ok());
+  const Diagnostic& many = result.error();
+  EXPECT_EQ(many.loc, (SourceLoc{0, 0})) << many.format();
+  EXPECT_NE(many.message.find("exceeds the limit of 1e12 m"), std::string::npos) << many.format();
+  ASSERT_EQ(many.notes.size(), 3u) << many.format();
+  EXPECT_EQ(many.notes[0].loc, (SourceLoc{2, 1})) << many.format();
+  EXPECT_EQ(many.notes[1].loc, (SourceLoc{3, 1})) << many.format();
+  EXPECT_EQ(many.notes[2].loc, (SourceLoc{4, 1})) << many.format();
+  EXPECT_EQ(many.notes[1].message, "a module 'F' is written here") << many.format();
+}
+
+TEST(TurtleErrors, FractionalMaterialIsAnErrorNamingTheModule) {
+  const std::string message = grow_error("axiom: F'(1.5)F\n");
+  EXPECT_NE(message.find("material"), std::string::npos) << message;
+  EXPECT_NE(message.find("non-negative integer"), std::string::npos) << message;
+  EXPECT_NE(message.find("'(1.5)"), std::string::npos) << message;
+}
+
+TEST(TurtleErrors, NegativeMaterialIsAnError) {
+  const std::string message = grow_error("axiom: F'(-1)F\n");
+  EXPECT_NE(message.find("non-negative integer"), std::string::npos) << message;
+}
+
+TEST(TurtleErrors, PositionThatOverflowsToInfinityIsAnError) {
+  // Stopped at the coordinate limit (docs/limits.md), before the sum overflows.
+  const std::string message = grow_error("axiom: F(1e308)F(1e308)\n");
+  EXPECT_NE(message.find("position"), std::string::npos) << message;
+  EXPECT_NE(message.find("limit"), std::string::npos) << message;
+  EXPECT_NE(message.find("module 0"), std::string::npos) << message;  // the first F
+}
+
+TEST(TurtleErrors, MoveThatOverflowsWithSmallfIsAnErrorToo) {
+  const std::string message = grow_error("axiom: f(1e308)f(1e308)F\n");
+  EXPECT_NE(message.find("limit"), std::string::npos) << message;
+}
+
+TEST(TurtleErrors, AtTWithoutSusceptibilityIsAnError) {
+  const std::string message = grow_error("tropism: 0 -1 0 0.2\naxiom: F@TF\n");
+  EXPECT_NE(message.find("@T"), std::string::npos) << message;
+  EXPECT_NE(message.find("susceptibility"), std::string::npos) << message;
+}
+
+// ---- limits ------------------------------------------------------------------------
+
+TEST(TurtleLimits, MillionNestedBranchesGrowWithoutRecursion) {
+  constexpr size_t kDepth = 1'000'000;
+  std::string text = "axiom: ";
+  text.reserve(text.size() + 3 * kDepth + 1);
+  for (size_t i = 0; i < kDepth; ++i) text += "[F";
+  text.append(kDepth, ']');
+  text += '\n';
+  const Skeleton skeleton = skeleton_of(text);
+  ASSERT_EQ(skeleton.chains.size(), kDepth);
+  EXPECT_EQ(skeleton.joints.size(), 2 * kDepth);
+  EXPECT_EQ(skeleton.segment_count(), kDepth);
+  // Chain i runs from (0, i) to (0, i + 1) and hangs from the end of chain i − 1.
+  EXPECT_EQ(skeleton.chains[0].parent, std::nullopt);
+  EXPECT_EQ(skeleton.chains[1].parent, parent(0, 1));
+  const uint32_t last = kDepth - 1;
+  EXPECT_EQ(skeleton.chains[last].parent, parent(last - 1, 1));
+  EXPECT_EQ(position_at(skeleton, last, 0), (Position{0, static_cast<double>(last), 0}));
+  EXPECT_EQ(position_at(skeleton, last, 1), (Position{0, static_cast<double>(kDepth), 0}));
+}
+
+// ---- progress and cancellation (core/util/progress.h) ---------------------------------
+
+TEST(GrowProgress, DeriveInterpretAndTurtleReportInOrderEndingAtOne) {
+  auto grammar = lsys::parse_grammar("derivation length: 14\naxiom: A\nA -> AB\nB -> A\nhomomorphism:\nA -> F\n"
+                                     "B -> +F\n", "test.lsys", {});
+  ASSERT_TRUE(grammar.ok()) << grammar.error().format();
+  std::vector<double> fractions;
+  std::vector<std::string> stages;
+  lsys::DeriveOptions options;
+  options.progress = Progress([&](double f, std::string_view stage) {
+    fractions.push_back(f);
+    if (stages.empty() || stages.back() != stage) stages.emplace_back(stage);
+  });
+  ASSERT_TRUE(grow(*grammar, options, "test.lsys", {}).ok());
+  for (size_t i = 1; i < fractions.size(); ++i) EXPECT_LE(fractions[i - 1], fractions[i]);
+  EXPECT_EQ(fractions.back(), 1.0);
+  EXPECT_EQ(stages, (std::vector<std::string>{"derive", "interpret", "turtle"}));
+}
+
+TEST(GrowProgress, CancellingMidTurtleStopsWithTheCancelledResult) {
+  // 2^18 F: the turtle checks the flag every 64 Ki modules.
+  auto grammar = lsys::parse_grammar("derivation length: 18\naxiom: F\nF -> FF\n", "test.lsys", {});
+  ASSERT_TRUE(grammar.ok());
+  auto word = lsys::derive(*grammar);
+  ASSERT_TRUE(word.ok());
+  std::atomic<bool> cancel{false};
+  double last = 0;
+  const Progress progress([&](double f, std::string_view) {
+    last = f;
+    cancel.store(true);
+  }, &cancel);
+  Expected<Skeleton> sk = build_skeleton(*word, *grammar, nullptr, progress);
+  EXPECT_TRUE(sk.cancelled());
+  EXPECT_EQ(last, 0.25);  // the first chunk of four, then stopped
+  EXPECT_TRUE(build_skeleton(*word, *grammar).ok());
+}
+
+// ---- Polygons and leaves (docs/spec/grammar.md `{ . }`, `G`; docs/spec/skeleton.md "Leaves") ---------------
+
+TEST(TurtleLeaves, GrammarMdsPolygonIsOneLeafOnTheJointTheTurtleStoodOnAndfDoesNotEndTheChain) {
+  const Skeleton sk = skeleton_of("angle: 45\naxiom: F{.-f.+f.+f.-|-f.+f.+f.}F\n");
+  ASSERT_EQ(sk.leaves.size(), 1u);
+  const Leaf& leaf = sk.leaves[0];
+  EXPECT_EQ(leaf.joint, parent(0, 1));
+  EXPECT_EQ(leaf.material, 0u);
+  ASSERT_EQ(leaf.vertices_m.size(), 7u);  // one per '.'
+  EXPECT_TRUE(near(leaf.vertices_m[0], {0, 1, 0}));  // '.' right after F: the joint's position
+  for (const auto& v : leaf.vertices_m) EXPECT_NEAR(v[2], 0, kTolerance);  // turns about U: the XY plane
+  EXPECT_FALSE(leaf_polygon_problem(leaf.vertices_m).has_value());
+  // The f moves inside the polygon did not end chain 0: the last F continues it.
+  ASSERT_EQ(sk.chains.size(), 1u);
+  EXPECT_EQ(sk.chains[0].joint_count, 3u);
+}
+
+TEST(TurtleLeaves, TheMaterialIsTheOneInForceAtTheClosingBrace) {
+  const Skeleton sk = skeleton_of("axiom: F'(1){.f.+f.'(3)}\n");
+  ASSERT_EQ(sk.leaves.size(), 1u);
+  EXPECT_EQ(sk.leaves[0].material, 3u);
+}
+
+TEST(TurtleLeaves, APolygonBeforeTheFirstFHangsFromNoJoint) {
+  const Skeleton sk = skeleton_of("axiom: {.f.+f.}\n");
+  ASSERT_EQ(sk.leaves.size(), 1u);
+  EXPECT_EQ(sk.leaves[0].joint, std::nullopt);
+  EXPECT_TRUE(sk.chains.empty());
+}
+
+TEST(TurtleLeaves, PolygonsNestAndTheInnerClosesFirst) {
+  const Skeleton sk = skeleton_of("axiom: F{.f.{.+f.+f.}f.}\n");
+  ASSERT_EQ(sk.leaves.size(), 2u);
+  EXPECT_EQ(sk.leaves[0].vertices_m.size(), 3u);  // the inner one
+  EXPECT_TRUE(near(sk.leaves[0].vertices_m[0], {0, 2, 0}));
+  EXPECT_EQ(sk.leaves[1].vertices_m.size(), 3u);
+  EXPECT_TRUE(near(sk.leaves[1].vertices_m[0], {0, 1, 0}));
+  EXPECT_EQ(sk.leaves[0].joint, sk.leaves[1].joint);
+}
+
+TEST(TurtleLeaves, InABranchTheLeafHangsFromTheBranchPoint) {
+  const Skeleton sk = skeleton_of("axiom: FF[+F{.f.+f.}]F\n");
+  ASSERT_EQ(sk.leaves.size(), 1u);
+  EXPECT_EQ(sk.leaves[0].joint, parent(1, 1));  // the lateral chain's tip
+}
+
+TEST(TurtleLeaves, GMovesWithoutDrawingAndWithoutEndingTheChain) {
+  const Skeleton sk = skeleton_of("axiom: FG(2)F\n");
+  ASSERT_EQ(sk.chains.size(), 1u);
+  ASSERT_EQ(sk.chains[0].joint_count, 3u);
+  EXPECT_TRUE(near(position_at(sk, 0, 2), {0, 4, 0}));
+  EXPECT_EQ(sk.segment_count(), 2u);  // the G gap is no segment of its own: F's segment spans it
+}
+
+TEST(TurtleLeaves, PolygonsThatCannotBeLeavesAreErrorsNamingTheClosingModule) {
+  struct Bad {
+    const char* word;
+    const char* says;
+    const char* module;  // "module N (...)" of the interpreted word
+  };
+  const Bad bad[] = {
+      {"F{.f.}", "at least 3 distinct vertices, this polygon has 2", "module 5 (})"},
+      {"F{...}", "at least 3 distinct vertices, this polygon has 1", "module 5 (})"},
+      {"{.f.f.}", "no area", "module 6 (})"},
+      {"{.f.+f.+f&f.}", "not planar: vertex", "module 12 (})"},
+      {"F}", "'}' without matching '{'", "module 1 (})"},
+      {"F{.f.+f.", "'{' without matching '}'", "module 1 ({)"},
+  };
+  for (const Bad& b : bad) {
+    const std::string message = grow_error(std::string("angle: 90\naxiom: ") + b.word + "\n");
+    EXPECT_NE(message.find("test.lsys"), std::string::npos) << b.word << ": " << message;
+    EXPECT_NE(message.find(b.says), std::string::npos) << b.word << ": " << message;
+    EXPECT_NE(message.find(b.module), std::string::npos) << b.word << ": " << message;
+  }
+}
+
+}  // namespace
+}  // namespace sylva

@@ -1,0 +1,203 @@
+// joint_scenes.h — close-ups of branch joints and elbows (docs/joints.md) and the
+// measure of their surface's defects, shared by the CPU test (tests/cpu/render_joints_
+// test.cpp) and the GL one (tests/gl/render_gl_joints_test.cpp).
+//
+// A rim, a lip or a radius step is a convex crease: a line across which the surface
+// turns outward by a large angle (90° at a flat cap's edge), and so is the facet line of
+// a mitred elbow (the bend angle, on the outer side). Where two solids join — a branch
+// leaving its parent — the crease is concave, as a branch crotch is. So the measure is the
+// largest convex turn of the surface between points 4 pixels apart, both on one
+// continuous piece of surface seen not too obliquely and away from the outline, with the surface's normals taken
+// from the depth field (so the shading normal's smoothing, Bhagvat et al. 2009 eq. 8, cannot hide a
+// facet) and, separately, from the normal AOV (what shading sees).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/scene/render_common.h"
+#include "core/scene/render_types.h"
+#include "core/scene/scene.h"
+#include "core/util/math.h"
+
+namespace sylva::test {
+
+inline Joint joint_at(glm::dvec3 p, double radius) { return Joint{{p.x, p.y, p.z}, radius, 0}; }
+
+// Appends a chain through `points` with `radii`, attached to `parent`.
+inline void add_chain(Skeleton& sk, const std::vector<glm::dvec3>& points, const std::vector<double>& radii,
+                      std::optional<ChainParent> parent) {
+  const auto first = static_cast<uint32_t>(sk.joints.size());
+  for (size_t i = 0; i < points.size(); ++i) sk.joints.push_back(joint_at(points[i], radii[i]));
+  sk.chains.push_back(Chain{first, static_cast<uint32_t>(points.size()), parent});
+}
+
+struct JointCloseUp {
+  std::string name;
+  Scene scene;
+};
+
+inline Scene close_up(const Skeleton& sk, glm::dvec3 eye, glm::dvec3 target, double fov_y_deg) {
+  Scene s;
+  s.width = 200;
+  s.height = 150;
+  s.camera = Camera{eye, target, {0, 1, 0}, fov_y_deg};
+  s.ground.height = -100;
+  s.sun.angular_radius_deg = 0;
+  ScenePlant plant;
+  plant.skeleton = sk;
+  s.plants.push_back(plant);
+  return s;
+}
+
+// The four close-ups: an elm-like crown (three limbs from the end of the trunk), an axis
+// that goes on thinner past a branch, a lateral at 45° from the side of its parent, and a
+// 60° elbow seen from its outer side.
+inline std::vector<JointCloseUp> joint_close_ups() {
+  std::vector<JointCloseUp> out;
+  {
+    Skeleton sk;
+    add_chain(sk, {{0, 0, 0}, {0, 2, 0}}, {0.3, 0.28}, std::nullopt);
+    for (int k = 0; k < 3; ++k) {
+      const double az = 2 * kPi * k / 3 + 0.3, tilt = 25 * kPi / 180;
+      const glm::dvec3 d{std::sin(tilt) * std::cos(az), std::cos(tilt), std::sin(tilt) * std::sin(az)};
+      add_chain(sk, {{0, 2, 0}, glm::dvec3(0, 2, 0) + 1.4 * d}, {0.22, 0.18}, ChainParent{0, 1});
+    }
+    out.push_back({"crown", close_up(sk, {2.2, 2.6, 0.9}, {0, 2.05, 0}, 32)});
+  }
+  {
+    Skeleton sk;
+    add_chain(sk, {{0, 0, 0}, {0, 1.5, 0}}, {0.3, 0.3}, std::nullopt);
+    add_chain(sk, {{0, 1.5, 0}, {0.1, 3.0, 0}}, {0.2, 0.18}, ChainParent{0, 1});
+    add_chain(sk, {{0, 1.5, 0}, {1.0, 2.1, 0}}, {0.15, 0.12}, ChainParent{0, 1});
+    out.push_back({"continuation", close_up(sk, {0.6, 2.3, 2.8}, {0.1, 1.6, 0}, 35)});
+  }
+  {
+    Skeleton sk;
+    add_chain(sk, {{0, 0, 0}, {0, 1, 0}, {0, 2, 0}}, {0.3, 0.28, 0.25}, std::nullopt);
+    add_chain(sk, {{0, 1, 0}, {0.85, 1.85, 0}}, {0.15, 0.12}, ChainParent{0, 1});
+    out.push_back({"fork", close_up(sk, {0.5, 1.6, 2.8}, {0.2, 1.2, 0}, 35)});
+  }
+  {
+    Skeleton sk;
+    const double a = 60 * kPi / 180;
+    add_chain(sk, {{0, 0, 0}, {0, 1, 0}, {std::sin(a), 1 + std::cos(a), 0}}, {0.2, 0.2, 0.2}, std::nullopt);
+    const glm::dvec3 outer = glm::normalize(glm::dvec3(-0.866, 0.5, 0.35));
+    out.push_back({"elbow", close_up(sk, glm::dvec3(0, 1, 0) + 2.4 * outer, {0, 1, 0}, 30)});
+  }
+  return out;
+}
+
+struct SurfaceDefects {
+  double convex_crease_deg = 0;  // from the depth field's normals
+  double convex_normal_jump_deg = 0;  // from the normal AOV
+  uint64_t pairs = 0;            // pixel pairs measured
+  int x = -1, y = -1;            // the pixel where the largest crease (depth) begins
+  std::string describe() const {
+    return "largest convex crease " + std::to_string(convex_crease_deg) + "° (depth, at pixel " +
+           std::to_string(x) + ", " + std::to_string(y) + "), " +
+           std::to_string(convex_normal_jump_deg) + "° (normal AOV) over " + std::to_string(pairs) + " pairs";
+  }
+};
+
+// The measure of this header's comment on `image` (depth and normal AOVs) of `scene`.
+inline SurfaceDefects surface_defects(const Scene& scene, const RenderImage& image) {
+  const render_common::CameraFrame f = render_common::camera_frame(scene);
+  const int w = static_cast<int>(image.width), h = static_cast<int>(image.height);
+  const auto idx = [&](int x, int y) { return static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x); };
+  std::vector<glm::dvec3> p(static_cast<size_t>(w) * static_cast<size_t>(h));
+  std::vector<double> footprint(p.size(), 0);
+  std::vector<bool> hit(p.size(), false);
+  const double pixel_at_1m = 2 * f.half_height / f.height;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const double z = image.depth[idx(x, y)];
+      if (!std::isfinite(z)) continue;
+      const Ray r = render_common::frame_ray(f, x + 0.5, y + 0.5);
+      p[idx(x, y)] = r.origin + z * glm::normalize(r.direction);
+      footprint[idx(x, y)] = z * pixel_at_1m;
+      hit[idx(x, y)] = true;
+    }
+  }
+  // Geometric normal by central differences, toward the eye; none off the surface, across
+  // a depth jump, or seen at more than 60° from the view direction.
+  std::vector<std::optional<glm::dvec3>> n(p.size());
+  const auto near = [&](int ax, int ay, int bx, int by, double spans) {
+    return glm::length(p[idx(ax, ay)] - p[idx(bx, by)]) < spans * footprint[idx(ax, ay)];
+  };
+  for (int y = 1; y + 1 < h; ++y) {
+    for (int x = 1; x + 1 < w; ++x) {
+      if (!hit[idx(x, y)] || !hit[idx(x - 1, y)] || !hit[idx(x + 1, y)] || !hit[idx(x, y - 1)] ||
+          !hit[idx(x, y + 1)])
+        continue;
+      if (!near(x - 1, y, x + 1, y, 8) || !near(x, y - 1, x, y + 1, 8)) continue;
+      glm::dvec3 g = glm::cross(p[idx(x + 1, y)] - p[idx(x - 1, y)], p[idx(x, y + 1)] - p[idx(x, y - 1)]);
+      if (!(glm::length(g) > 0)) continue;
+      g = glm::normalize(g);
+      const glm::dvec3 view = glm::normalize(f.eye - p[idx(x, y)]);
+      if (glm::dot(g, view) < 0) g = -g;
+      if (glm::dot(g, view) < 0.5) continue;
+      n[idx(x, y)] = g;
+    }
+  }
+  // Near the outline (3 pixels from a miss) the stencils straddle surfaces that touch
+  // only in the picture: no normal there.
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int dy = -3; dy <= 3 && n[idx(x, y)]; ++dy) {
+        for (int dx = -3; dx <= 3; ++dx) {
+          const int qx = std::clamp(x + dx, 0, w - 1), qy = std::clamp(y + dy, 0, h - 1);
+          if (!hit[idx(qx, qy)]) {
+            n[idx(x, y)].reset();
+            break;
+          }
+        }
+      }
+    }
+  }
+  const auto angle_deg = [](glm::dvec3 a, glm::dvec3 b) {
+    return std::acos(std::clamp(glm::dot(glm::normalize(a), glm::normalize(b)), -1.0, 1.0)) * 180 / kPi;
+  };
+  SurfaceDefects d;
+  const int step = 4;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int dir = 0; dir < 2; ++dir) {
+        const int cx = x + (dir == 0 ? step : 0), cy = y + (dir == 1 ? step : 0);
+        if (cx >= w || cy >= h || !n[idx(x, y)] || !n[idx(cx, cy)]) continue;
+        bool continuous = true;  // every pixel between them on the surface, no jump
+        for (int k = 1; k <= step && continuous; ++k) {
+          const int bx = x + (dir == 0 ? k : 0), by = y + (dir == 1 ? k : 0);
+          const int qx = bx - (dir == 0 ? 1 : 0), qy = by - (dir == 1 ? 1 : 0);
+          continuous = hit[idx(bx, by)] && near(qx, qy, bx, by, 4);
+        }
+        if (!continuous) continue;
+        const glm::dvec3 a = p[idx(x, y)], c = p[idx(cx, cy)];
+        const glm::dvec3 na = *n[idx(x, y)], nc = *n[idx(cx, cy)];
+        const double tiny = 1e-3 * footprint[idx(x, y)];
+        if (!(glm::dot(na, c - a) < -tiny && glm::dot(nc, a - c) < -tiny)) continue;  // not convex
+        ++d.pairs;
+        if (angle_deg(na, nc) > d.convex_crease_deg) {
+          d.convex_crease_deg = angle_deg(na, nc);
+          d.x = x, d.y = y;
+        }
+        if (!image.normal.empty()) {
+          const auto aov = [&](int px, int py) {
+            const size_t i = 3 * idx(px, py);
+            return glm::dvec3(image.normal[i], image.normal[i + 1], image.normal[i + 2]);
+          };
+          d.convex_normal_jump_deg = std::max(d.convex_normal_jump_deg, angle_deg(aov(x, y), aov(cx, cy)));
+        }
+      }
+    }
+  }
+  return d;
+}
+
+}  // namespace sylva::test
