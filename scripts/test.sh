@@ -17,6 +17,9 @@ done
 if command -v clang++ >/dev/null 2>&1; then
   echo "== fuzz: 20 s per target (docs/fuzzing.md)"
   bash scripts/fuzz.sh 20
+elif [ "${SYLVA_REQUIRE_TOOLS:-}" = 1 ]; then
+  echo "== fuzz: clang++ is missing and SYLVA_REQUIRE_TOOLS=1 requires it (scripts/setup.sh installs it)"
+  exit 1
 else
   echo "== fuzz: skipped (no clang++; scripts/setup.sh installs it)"
 fi

@@ -2,7 +2,7 @@
 // viewport (gl_viewport.h) in the window, a recording fake in the headless tests. The
 // UI thread calls every method; nothing here may block on the worker.
 //
-// The redo ladder (cpfg's New L-system / New view / New rendering, studio-gui.md sec. 1):
+// The redo ladder (cpfg's New L-system / New view / New rendering menu items):
 // set_plants() is called when the plants or how they are skinned changed (a regrow, a
 // skin or geometry option, bark on/off); image() re-renders only when the camera, sun or
 // size changed since the last picture, and never re-skins or re-uploads. A viewport may

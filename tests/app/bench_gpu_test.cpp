@@ -17,6 +17,7 @@
 #include "core/scene/scene.h"
 #include "core/scene/scene_json.h"
 #include "tests/support/process.h"
+#include "tests/support/requirements.h"
 
 namespace {
 
@@ -156,7 +157,7 @@ void expect_rows(const std::vector<CsvRow>& rows, const std::string& input, cons
 
 TEST(BenchGpu, QuickRunOnAGrammarMeasuresEveryMethodTheGlBackendDraws) {
   const auto rows = run_bench_gpu({kGrammar, "--quick"});
-  if (!rows) GTEST_SKIP() << "no OpenGL context on this machine";
+  if (!rows) SYLVA_SKIP_WITHOUT_GL("no OpenGL context on this machine");
   Scene bare;  // the grammar's default scene: one plant, no bark
   bare.plants.resize(1);
   const std::vector<ExpectedMethod> methods = {{"RC", GeometryKind::frusta, false, 0, false},
@@ -192,7 +193,7 @@ TEST(BenchGpu, QuickRunOnAGrammarMeasuresEveryMethodTheGlBackendDraws) {
 TEST(BenchGpu, ReliefRowsOnASceneWithAHeightMap) {
   const auto rows = run_bench_gpu(
       {kScene, "--quick", "--methods", "RC+R,GS+R", "--width", "64", "--height", "48", "--frames", "1", "--warmup", "1"});
-  if (!rows) GTEST_SKIP() << "no OpenGL context on this machine";
+  if (!rows) SYLVA_SKIP_WITHOUT_GL("no OpenGL context on this machine");
   const sylva::Expected<sylva::Scene> read = sylva::read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/" + kScene);
   ASSERT_TRUE(read.ok()) << read.error().format();
   const std::vector<ExpectedMethod> methods = {{"RC+R 16x4", GeometryKind::frusta, true, 0, false},
@@ -226,7 +227,7 @@ TEST(BenchGpu, MethodsTheGlBackendRefusesAreSkippedRowsWithTheReason) {
                                     dir.path().string(), 240);
   ASSERT_FALSE(crashed(r)) << describe(r);
   if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 context") != std::string::npos)
-    GTEST_SKIP() << "no OpenGL context on this machine: " << r.err;
+    SYLVA_SKIP_WITHOUT_GL("no OpenGL context on this machine: " << r.err);
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_EQ(r.err.find("CPU reference"), std::string::npos) << "no method ran, so no reference is rendered";
   const std::vector<CsvRow> rows = read_csv(read_file(dir.file("gpu.csv")), kColumns);
@@ -271,7 +272,7 @@ TEST(BenchGpu, EachRowGetsAProgressLineWithElapsedAndTimeLeft) {
                                      dir.file("gpu.png")},
                                     SYLVA_SOURCE_DIR, 240);
   ASSERT_FALSE(crashed(r)) << describe(r);
-  if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 context") != std::string::npos) GTEST_SKIP() << "no OpenGL";
+  if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 context") != std::string::npos) SYLVA_SKIP_WITHOUT_GL("no OpenGL");
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   for (int k = 1; k <= 5; ++k) {
     const std::string head = "sylva bench gpu: row " + std::to_string(k) + "/5 done in ";
@@ -326,7 +327,7 @@ TEST(BenchGpu, AStoppedRunLeavesAValidCsvOfTheRowsItFinished) {
   }
   if (exited) {
     const std::string err = read_file(dir.file("err.txt"));
-    if (err.find("no OpenGL 4.5 context") != std::string::npos) GTEST_SKIP() << "no OpenGL";
+    if (err.find("no OpenGL 4.5 context") != std::string::npos) SYLVA_SKIP_WITHOUT_GL("no OpenGL");
     FAIL() << "the run ended before it could be stopped: " << err;
   }
   ASSERT_EQ(kill(pid, SIGTERM), 0);
@@ -361,7 +362,7 @@ TEST(BenchGpu, TheDefaultRunMeasuresTheSetTheHelpNames) {
   const ProcessResult both = run_sylva({"bench", "gpu", "--full", "--quick"});
   EXPECT_EQ(both.exit_code, 2) << describe(both);
   const auto rows = run_bench_gpu({kScene, "--width", "64", "--height", "48"});
-  if (!rows) GTEST_SKIP() << "no OpenGL context on this machine";
+  if (!rows) SYLVA_SKIP_WITHOUT_GL("no OpenGL context on this machine");
   const sylva::Expected<sylva::Scene> read = sylva::read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/" + kScene);
   ASSERT_TRUE(read.ok()) << read.error().format();
   std::vector<ExpectedMethod> methods = {{"RC", GeometryKind::frusta, false, 0, false},
@@ -394,7 +395,7 @@ TEST(BenchGpuFog, QuickRunWritesTheFogRowsWithTimesAndErrors) {
                                      dir.file("fog.png")},
                                     SYLVA_SOURCE_DIR, 240);
   ASSERT_FALSE(crashed(r)) << describe(r);
-  if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 context") != std::string::npos) GTEST_SKIP() << "no OpenGL";
+  if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 context") != std::string::npos) SYLVA_SKIP_WITHOUT_GL("no OpenGL");
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_EQ(read_file(dir.file("fog.png")).substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   const std::vector<CsvRow> rows = read_csv(read_file(dir.file("fog.csv")), kFogColumns);
@@ -428,7 +429,7 @@ TEST(BenchGpuFog, AStridedReferenceMeasuresTheErrorOnItsGrid) {
                                      dir.file("fog.csv"), "--plot", dir.file("fog.png")},
                                     SYLVA_SOURCE_DIR, 240);
   ASSERT_FALSE(crashed(r)) << describe(r);
-  if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 context") != std::string::npos) GTEST_SKIP() << "no OpenGL";
+  if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 context") != std::string::npos) SYLVA_SKIP_WITHOUT_GL("no OpenGL");
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   // 96x72 every 4th pixel each way: 24 x 18.
   EXPECT_NE(r.err.find("reference of 432 pixels"), std::string::npos) << r.err;

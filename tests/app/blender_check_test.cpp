@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tests/support/process.h"
+#include "tests/support/requirements.h"
 
 namespace {
 
@@ -59,7 +60,7 @@ std::string clean_blender_report(const std::string& input, const std::string& ou
 }
 
 TEST(BlenderCheck, TheElmInLeafImportsWithEveryTriangleItsDoubleSidedLeavesAndItsSkeleton) {
-  if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
+  if (!have_blender()) SYLVA_SKIP_WITHOUT_TOOL("blender is not installed (scripts/setup.sh installs it)");
   TempDir dir;
   const std::string glb = dir.file("elm.glb");
   ASSERT_TRUE(export_mesh(kSource + "/presets/elm_in_leaf.lsys", glb));
@@ -78,7 +79,7 @@ TEST(BlenderCheck, TheElmInLeafImportsWithEveryTriangleItsDoubleSidedLeavesAndIt
 }
 
 TEST(BlenderCheck, TheElmInLeafScenesLeafImageArrivesAsATexturedCutOutInBlender) {
-  if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
+  if (!have_blender()) SYLVA_SKIP_WITHOUT_TOOL("blender is not installed (scripts/setup.sh installs it)");
   TempDir dir;
   const std::string report =
       clean_blender_report(kSource + "/presets/scenes/elm_in_leaf.scene.json", dir.file("elm_leaf.glb"));
@@ -90,7 +91,7 @@ TEST(BlenderCheck, TheElmInLeafScenesLeafImageArrivesAsATexturedCutOutInBlender)
 }
 
 TEST(BlenderCheck, ASceneWithBarkAndATableKeepsItsTextureAndItsColoursInBlender) {
-  if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
+  if (!have_blender()) SYLVA_SKIP_WITHOUT_TOOL("blender is not installed (scripts/setup.sh installs it)");
   TempDir dir;
   // A .gltf: JSON with the textures as data URIs.
   const std::string report =
@@ -105,7 +106,7 @@ TEST(BlenderCheck, ASceneWithBarkAndATableKeepsItsTextureAndItsColoursInBlender)
 }
 
 TEST(BlenderCheck, TheDesertsSkinOnSegmentsArrivesTexturedThroughItsOwnUvMap) {
-  if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
+  if (!have_blender()) SYLVA_SKIP_WITHOUT_TOOL("blender is not installed (scripts/setup.sh installs it)");
   TempDir dir;
   // docs/materials.md: the table lays cactus.png on materials 1 and 2 with repeats other
   // than the (absent) barks', so the textures read TEXCOORD_1, which Blender imports as
@@ -123,7 +124,7 @@ TEST(BlenderCheck, TheDesertsSkinOnSegmentsArrivesTexturedThroughItsOwnUvMap) {
 // is a problem. Two materials of one name are valid glTF; Blender renames the second
 // ("sylva_material_0.001"), so the leaves no longer have the material the file names.
 TEST(BlenderCheck, AFileBlenderReadsOtherwiseThanItSaysIsAProblem) {
-  if (!have_blender()) GTEST_SKIP() << "blender is not installed (scripts/setup.sh installs it)";
+  if (!have_blender()) SYLVA_SKIP_WITHOUT_TOOL("blender is not installed (scripts/setup.sh installs it)");
   TempDir dir;
   const std::string gltf = dir.file("elm.gltf");
   ASSERT_TRUE(export_mesh(kSource + "/presets/elm_in_leaf.lsys", gltf));

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "tests/support/process.h"
+#include "tests/support/requirements.h"
 
 namespace {
 
@@ -152,7 +153,7 @@ TEST(RenderCli, GlBackendDrawsTheMeshBaseline) {
   ProcessResult r = run_sylva({"render", kSaguaro, "-o", dir.file("m.png"), "--width", "32", "--height", "24",
                                "--backend", "gl", "--geometry", "mesh", "--mesh-level", "1", "--verbose"});
   if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 core context") != std::string::npos)
-    GTEST_SKIP() << "no OpenGL context on this machine: " << r.err;
+    SYLVA_SKIP_WITHOUT_GL("no OpenGL context on this machine: " << r.err);
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_NE(r.err.find("mesh (GPU)"), std::string::npos) << describe(r);
   EXPECT_NE(r.err.find("OpenGL rasteriser (meshes, "), std::string::npos) << describe(r);
@@ -165,7 +166,7 @@ TEST(RenderCli, GlBackendRendersWithOpenGl) {
   ProcessResult r = run_sylva({"render", kSaguaro, "-o", dir.file("s.png"), "--width", "64", "--height", "48",
                                "--backend", "gl", "--aov", "depth", "--verbose"});
   if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 core context") != std::string::npos)
-    GTEST_SKIP() << "no OpenGL context on this machine: " << r.err;
+    SYLVA_SKIP_WITHOUT_GL("no OpenGL context on this machine: " << r.err);
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_NE(r.err.find("OpenGL ray caster ("), std::string::npos) << describe(r);
   EXPECT_EQ(r.err.find("CPU ray caster"), std::string::npos) << describe(r);

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "tests/support/process.h"
+#include "tests/support/requirements.h"
 
 namespace {
 
@@ -78,7 +79,7 @@ TEST(RenderFogCli, AFoggySceneRendersOnTheCpuWithTheFogPassAndTheFogAov) {
 }
 
 TEST(RenderFogCli, AFoggySceneInBruteRendersWithOpenGlWithTheFogPassAndTheFogAov) {
-  if (!expect_fog_render("gl", "fog (GPU)")) GTEST_SKIP() << "no OpenGL context on this machine";
+  if (!expect_fog_render("gl", "fog (GPU)")) SYLVA_SKIP_WITHOUT_GL("no OpenGL context on this machine");
 }
 
 // medium draws on the GL backend (its cones built as for fast, the map marched inside them).
@@ -88,7 +89,7 @@ TEST(RenderFogCli, MediumRendersWithOpenGlWithItsConesAndTheFogPass) {
   ProcessResult r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "gl", "--fog-mode", "medium",
                                "--verbose"});
   if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 core context") != std::string::npos)
-    GTEST_SKIP() << "no OpenGL context on this machine";
+    SYLVA_SKIP_WITHOUT_GL("no OpenGL context on this machine");
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_NE(r.err.find("medium, 4 steps"), std::string::npos) << describe(r);
   EXPECT_NE(r.err.find("fog[FOG_MEDIUM SUN]"), std::string::npos) << describe(r);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "tests/support/process.h"
+#include "tests/support/requirements.h"
 
 namespace {
 
@@ -81,7 +82,7 @@ TEST(RenderFrames, OnOpenGlTheRendererReuploadsEachPoseAndMatchesTheCpu) {
   TempDir dir;
   const std::string scene = write_scene(dir, kDance);
   ProcessResult gl = run_sylva({"render", "--spp", "1", scene, "--frames", "0..3", "-o", dir.file("gl_{frame}.png"), "--backend", "gl"});
-  if (gl_missing(gl)) GTEST_SKIP() << "no OpenGL: " << gl.err;
+  if (gl_missing(gl)) SYLVA_SKIP_WITHOUT_GL("no OpenGL: " << gl.err);
   ASSERT_EQ(gl.exit_code, 0) << describe(gl);
   EXPECT_NE(gl.err.find("re-skin + upload"), std::string::npos) << describe(gl);  // 3 updates, one renderer
   ProcessResult cpu = run_sylva({"render", "--spp", "1", scene, "--frames", "0..3", "-o", dir.file("cpu_{frame}.png"), "--backend", "cpu"});
@@ -126,7 +127,7 @@ TEST(RenderFrames, TheVideoIsEncodedWithFfmpegOrRefusedBeforeAnyFrame) {
   EXPECT_NE(none.err.find("--video needs ffmpeg"), std::string::npos) << describe(none);
   EXPECT_FALSE(fs::exists(dir.file("n_0000.png")));
   EXPECT_FALSE(fs::exists(dir.file("n.mp4")));
-  if (run_process({"/bin/sh", "-c", "command -v ffmpeg"}).exit_code != 0) GTEST_SKIP() << "ffmpeg is not installed";
+  if (run_process({"/bin/sh", "-c", "command -v ffmpeg"}).exit_code != 0) SYLVA_SKIP_WITHOUT_TOOL("ffmpeg is not installed");
   ProcessResult r = run_sylva({"render", "--spp", "1", scene, "--frames", "0..3", "-o", dir.file("v_{frame}.png"), "--video",
                                dir.file("dance.mp4"), "--fps", "12", "--backend", "cpu"});
   ASSERT_EQ(r.exit_code, 0) << describe(r);

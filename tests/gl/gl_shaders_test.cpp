@@ -13,13 +13,14 @@
 #include "core/gl/gl_program.h"
 #include "tests/support/process.h"
 #include "tests/support/gl_checks.h"
+#include "tests/support/requirements.h"
 
 namespace sylva {
 namespace {
 
 TEST(GlShaders, EveryVariantPassesGlslangValidator) {
   const std::string validator = SYLVA_GLSLANG_VALIDATOR;
-  if (validator.empty()) GTEST_SKIP() << "glslangValidator was not found at configure time (Debian: glslang-tools)";
+  if (validator.empty()) SYLVA_SKIP_WITHOUT_TOOL("glslangValidator was not found at configure time (Debian: glslang-tools)");
   TempDir dir;
   int checked = 0;
   for (const ShaderProgramSource& program : all_shader_programs())

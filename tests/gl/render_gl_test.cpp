@@ -11,7 +11,6 @@
 #include <cstdio>
 #include <algorithm>
 #include <filesystem>
-#include <map>
 
 #include "core/gl/gl_program.h"
 #include "core/scene/scene_json.h"
@@ -523,41 +522,6 @@ TEST(RenderGl, ConservativeDepthCanBeSwitchedOffForTiming) {
   // The same picture: only the promise to the depth test differs.
   EXPECT_EQ(with.image.depth, without.image.depth);
   EXPECT_EQ(with.image.beauty, without.image.beauty);
-}
-
-}  // namespace
-}  // namespace sylva
-
-namespace sylva {
-namespace {
-
-// Not a check: frame times for the report and docs until `sylva bench gpu` exists, with and
-// without the conservative depth layouts (what early depth testing is worth), for the
-// bare presets and their bark scenes (relief + albedo). Run by hand:
-// sylva_gl_tests --gtest_also_run_disabled_tests --gtest_filter='*FrameTimes*'
-TEST(RenderGl, DISABLED_FrameTimes) {
-  SYLVA_REQUIRE_GL();
-  for (const char* preset : {"saguaro", "pine"})
-    for (bool bark : {false, true}) {
-      const Scene scene = bark ? preset_scene(preset, 1024, 768)
-                               : gl_test::scene_around(test::grow_preset(preset), 1024, 768);
-      GlRenderer renderer(scene, {});
-      for (bool conservative : {true, false}) {
-        renderer.set_conservative_depth(conservative);
-        renderer.render(scene);  // warm-up: llvmpipe compiles its shader variants on first draw
-        std::map<std::string, std::vector<double>> ms;
-        for (int frame = 0; frame < 5; ++frame)
-          for (const RenderPass& p : renderer.render(scene).passes) ms[p.name].push_back(p.seconds * 1e3);
-        std::printf("%s%s 1024x768, %llu frusta, conservative depth %s, median of 5 frames:", preset,
-                    bark ? " scene (relief, bark)" : "", static_cast<unsigned long long>(renderer.frusta()),
-                    conservative ? "on" : "off");
-        for (auto& [name, v] : ms) {
-          std::sort(v.begin(), v.end());
-          std::printf("  %s %.1f ms", name.c_str(), v[v.size() / 2]);
-        }
-        std::printf("\n");
-      }
-    }
 }
 
 }  // namespace

@@ -258,11 +258,13 @@ TEST(LayeringOfTheTest, AllowedIncludesPass) {
 // ---- Comments point inside the repository -------------------------------------------------
 
 // Places in code (C++, GLSL, CMake, scripts) that point outside the repository: the shared
-// folders beside it ("../shared/…"), a contract cited as "spec/NAME.md" without docs/, or
-// a paper by its number ("paper 000"): the contracts are docs/spec/, the papers are
-// cited by authors and year (docs/papers.md).
+// folders beside it ("../shared/…"), a contract cited as "spec/NAME.md" without docs/, the
+// research notes beside it (notes/, studio-gui.md, fog-speed.md, light-growth.md), or a
+// paper by its number ("paper 000"): the contracts are docs/spec/, the papers are cited
+// by authors and year (docs/papers.md).
 std::vector<Violation> outside_pointers(const fs::path& root) {
-  static const std::regex outside(R"re((\.\./shared/|(^|[^/a-z_])spec/[a-z]+\.md|\bpapers?/0\d\d|\bpaper 00\d))re");
+  static const std::regex outside(
+      R"re((\.\./shared/|(^|[^/a-z_])spec/[a-z]+\.md|(^|[^/a-z_-])(notes/|studio-gui\.md|fog-speed\.md|light-growth\.md)|\bpapers?/0\d\d|\bpaper 00\d))re");
   std::vector<Violation> out;
   for (const char* top : {"lsystem", "core", "app", "tests", "shaders", "scripts"}) {
     if (!fs::exists(root / top)) continue;
@@ -292,12 +294,13 @@ TEST(Comments, NoCodePointsOutsideTheRepository) {
 TEST(CommentsOfTheTest, TheSharedFolderABareSpecAndAPaperNumberAreFound) {
   Tree t;
   t.write("core/a.h", "// see ../shared/spec/fog.md\n// spec/fog.md sec. 2\n// docs/spec/fog.md is fine\n");
-  t.write("shaders/b.glsl", "// paper 000, eq. 7\n// Bhagvat et al. 2009, eq. 7\n");
+  t.write("shaders/b.glsl", "// paper 000, eq. 7\n// Bhagvat et al. 2009, eq. 7\n// as studio-gui.md sec. 1 says\n");
   const std::vector<Violation> v = outside_pointers(t.root());
-  ASSERT_EQ(v.size(), 3u) << describe(v);
+  ASSERT_EQ(v.size(), 4u) << describe(v);
   EXPECT_EQ(v[0].line, 1);
   EXPECT_EQ(v[1].line, 2);
   EXPECT_EQ(v[2].file, "shaders/b.glsl");
+  EXPECT_EQ(v[3].line, 3);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "core/grow/grow.h"
 #include "core/scene/scene.h"
 #include "core/light/shadow_cones.h"
+#include "tests/support/requirements.h"
 
 namespace sylva::studio {
 namespace {
@@ -42,7 +43,7 @@ ViewImage settle(GlViewport& viewport, const Scene& scene) {
 struct Viewports : ::testing::Test {
   void SetUp() override {
     context = create_headless_gl_context();  // the window's context, for the UI texture
-    if (!context.context) GTEST_SKIP() << "no OpenGL 4.5 context: " << context.error;
+    if (!context.context) SYLVA_SKIP_WITHOUT_GL("no OpenGL 4.5 context: " << context.error);
   }
   GlContextResult context;
 };

@@ -17,6 +17,7 @@
 #include <filesystem>
 
 #include "tests/support/process.h"
+#include "tests/support/requirements.h"
 
 namespace {
 
@@ -79,7 +80,7 @@ std::vector<std::string> xvfb(const TempDir& dir, std::vector<std::string> comma
 // figures under the viewport change from run to run, about 0.01% of the pixels;
 // llvmpipe's pictures do not); the mean difference is below 0.004.
 void expect_matches_golden(const std::string& input, const std::string& name) {
-  if (!on_path("xvfb-run")) GTEST_SKIP() << "xvfb-run not found (Debian: xvfb; scripts/setup.sh installs it)";
+  if (!on_path("xvfb-run")) SYLVA_SKIP_WITHOUT_TOOL("xvfb-run not found (Debian: xvfb; scripts/setup.sh installs it)");
   TempDir dir;
   const std::string shot = dir.file(name + ".png");
   ProcessResult r = run_process(xvfb(dir, {SYLVA_BINARY, "studio", input, "--screenshot", shot, "--size", "800x500"}), {}, 240);
@@ -131,7 +132,7 @@ TEST(StudioWindow, SceneScreenshotMatchesItsGolden) {
 }
 
 TEST(StudioWindow, ABadGrammarExitsOneWithTheLocatedErrorAndWritesNothing) {
-  if (!on_path("xvfb-run")) GTEST_SKIP() << "xvfb-run not found (Debian: xvfb)";
+  if (!on_path("xvfb-run")) SYLVA_SKIP_WITHOUT_TOOL("xvfb-run not found (Debian: xvfb)");
   TempDir dir;
   const std::string g = dir.write("bad.lsys", "axiom: A\nproductions:\nA -> F[+A\n");
   const std::string shot = dir.file("bad.png");
@@ -143,8 +144,8 @@ TEST(StudioWindow, ABadGrammarExitsOneWithTheLocatedErrorAndWritesNothing) {
 }
 
 TEST(StudioWindow, XdotoolClicksAndTypesIntoTheRealWindow) {
-  if (!on_path("xvfb-run")) GTEST_SKIP() << "xvfb-run not found (Debian: xvfb)";
-  if (!on_path("xdotool")) GTEST_SKIP() << "xdotool not found (Debian: xdotool; scripts/setup.sh installs it)";
+  if (!on_path("xvfb-run")) SYLVA_SKIP_WITHOUT_TOOL("xvfb-run not found (Debian: xvfb)");
+  if (!on_path("xdotool")) SYLVA_SKIP_WITHOUT_TOOL("xdotool not found (Debian: xdotool; scripts/setup.sh installs it)");
   TempDir dir;
   const std::string g = dir.write("tree.lsys",
                                   "#define N 4 /* [1, 8, 1] */\n"

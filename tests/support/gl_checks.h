@@ -15,18 +15,20 @@
 #include "core/light/shadow_cones.h"
 #include "core/scene/render_types.h"
 #include "core/scene/scene.h"
+#include "tests/support/requirements.h"
 
 namespace sylva::gl_test {
 
 // The process's context, made on first use; null when none can be made (then *why says why).
 GlContext* shared_context(std::string* why);
 
-// Skips the current test unless a GL 4.5 core context is current.
+// Skips the current test unless a GL 4.5 core context is current (fails instead under
+// SYLVA_REQUIRE_GL=1: requirements.h).
 #define SYLVA_REQUIRE_GL()                                                             \
   do {                                                                                 \
     std::string why_no_gl;                                                             \
     if (!::sylva::gl_test::shared_context(&why_no_gl))                                  \
-      GTEST_SKIP() << "no OpenGL 4.5 core context through EGL: " << why_no_gl;         \
+      SYLVA_SKIP_WITHOUT_GL(why_no_gl);                                                \
   } while (0)
 
 // A compute program from the whole GLSL `text` (the GlTwin tests: shader files under test
