@@ -267,10 +267,6 @@ void append_u32(std::string& out, uint32_t v) {
   out.append(b, 4);
 }
 
-bool ends_with(std::string_view s, std::string_view suffix) {
-  return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
-}
-
 std::string lower_case(std::string s) {
   for (char& c : s)
     if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
@@ -584,8 +580,8 @@ double bark_reference_radius_m(const Skeleton& skeleton) { return median_segment
 
 Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path, const GltfExportOptions& options) {
   const std::string ext = lower_case(path);
-  const bool glb = ends_with(ext, ".glb");
-  if (!glb && !ends_with(ext, ".gltf")) return file_diagnostic(path, "the output must end in .gltf or .glb");
+  const bool glb = ext.ends_with(".glb");
+  if (!glb && !ext.ends_with(".gltf")) return file_diagnostic(path, "the output must end in .gltf or .glb");
   if (plants.empty()) return file_diagnostic(path, "no plants to export");
   if (options.segments_around < 3 || options.segments_around > 4096)
     return file_diagnostic(path, "segments around must be an integer from 3 to 4096");
