@@ -71,9 +71,8 @@ bool find_func(const std::string& name, Func* f) {
 
 double Program::run(const Expr& e, const double* slots, Rng* rng) const {
   // Expressions are shallow (the parser bounds nesting), so a fixed stack suffices; the
-  // compiler checks the depth it needs against kMaxStack.
-  constexpr int kMaxStack = 512;
-  double stack[kMaxStack];
+  // compiler checks the depth it needs against kMaxEvalStack.
+  double stack[kMaxEvalStack];
   int sp = 0;
   const Instr* code_ptr = code.data();
   for (uint32_t pc = e.begin; pc < e.end; ++pc) {

@@ -58,6 +58,10 @@ struct EvalError {
   std::string message;
 };
 
+// The evaluation stack's size in values: Program::run's fixed stack, and the depth the
+// parser lets a compiled expression need ("expression nested too deeply" beyond).
+inline constexpr int kMaxEvalStack = 512;
+
 // All compiled code of one grammar.
 struct Program {
   std::vector<Instr> code;

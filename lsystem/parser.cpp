@@ -15,6 +15,7 @@
 #include <unordered_map>
 
 #include "core/util/file_io.h"
+#include "lsystem/expr.h"
 #include "lsystem/grammar.h"
 
 namespace sylva::lsys {
@@ -22,7 +23,6 @@ namespace sylva::lsys {
 namespace {
 
 constexpr int kMaxNesting = 128;     // parentheses / unary operators / calls
-constexpr int kMaxEvalStack = 512;   // must match Program::run
 constexpr int64_t kMaxSteps = 1000000;
 constexpr int kMaxDepthLimit = 1000;
 

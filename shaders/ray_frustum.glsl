@@ -80,6 +80,29 @@ bool frustum_inside_planes(LocalShape s, vec3 p) {
   return dot(s.lower_normal, p) >= s.lower_offset && dot(s.upper_normal, p) <= s.upper_offset;
 }
 
+// core/geometry/cone_quadric.h, shared with relief.glsl as the C++ shares it.
+struct ConeQuadric {
+  float A;
+  float half_b;
+  float C;
+  float radial_sq;
+  float moment_sq;
+  float discriminant;
+};
+
+ConeQuadric cone_quadric(vec3 origin_perp, vec3 dir_perp, float rho, float slope_dir_y) {
+  ConeQuadric f;
+  f.A = dot(dir_perp, dir_perp) - slope_dir_y * slope_dir_y;
+  f.half_b = dot(origin_perp, dir_perp) - rho * slope_dir_y;
+  f.C = dot(origin_perp, origin_perp) - rho * rho;
+  vec3 radial_term = rho * dir_perp - slope_dir_y * origin_perp;
+  vec3 moment = cross(origin_perp, dir_perp);
+  f.radial_sq = dot(radial_term, radial_term);
+  f.moment_sq = dot(moment, moment);
+  f.discriminant = f.radial_sq - f.moment_sq;
+  return f;
+}
+
 int frustum_side_roots(float A, float half_b, float C, float discriminant, out float roots[2]) {
   roots[0] = 0.0;
   roots[1] = 0.0;
@@ -104,14 +127,9 @@ void frustum_side_hit(LocalShape s, vec3 origin, vec3 dir, RayRange range, inout
   vec3 dir_perp = dir - dir_y * s.axis;
   float rho = s.radius0 + s.slope * origin_y;
   float slope_dir_y = s.slope * dir_y;
-  float A = dot(dir_perp, dir_perp) - slope_dir_y * slope_dir_y;
-  float half_b = dot(origin_perp, dir_perp) - rho * slope_dir_y;
-  float C = dot(origin_perp, origin_perp) - rho * rho;
-  vec3 radial_term = rho * dir_perp - slope_dir_y * origin_perp;
-  vec3 moment = cross(origin_perp, dir_perp);
-  float discriminant = dot(radial_term, radial_term) - dot(moment, moment);
+  ConeQuadric f = cone_quadric(origin_perp, dir_perp, rho, slope_dir_y);
   float roots[2];
-  int count = frustum_side_roots(A, half_b, C, discriminant, roots);
+  int count = frustum_side_roots(f.A, f.half_b, f.C, f.discriminant, roots);
   for (int i = 0; i < count; ++i) {
     float t = roots[i];
     if (!(t < best.t_local) || !ray_range_contains(range, t)) continue;

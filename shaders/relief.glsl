@@ -105,6 +105,41 @@ bool linear_at_least(inout Bounds b, float a, float c, uint by) {
   return !bounds_empty(b);
 }
 
+bool inside_quadric(inout Bounds b, float A, float r0, float r1) {
+  if (A > 0.0) {
+    bounds_at_least(b, r0, kBoundarySide);
+    bounds_at_most(b, r1, kBoundarySide);
+    return !bounds_empty(b);
+  }
+  Bounds first = b, second = b;
+  bounds_at_most(first, r0, kBoundarySide);
+  bounds_at_least(second, r1, kBoundarySide);
+  bool first_ok = !bounds_empty(first), second_ok = !bounds_empty(second);
+  if (!first_ok && !second_ok) return false;
+  if (first_ok && second_ok)
+    b = (first.hi - first.lo >= second.hi - second.lo) ? first : second;
+  else
+    b = first_ok ? first : second;
+  return true;
+}
+
+// The other root is C/q in float (no SecondRoot: the error bounds are the double's).
+bool inside_cone(inout Bounds b, vec3 origin_perp, vec3 dir_perp, float rho, float slope_dir_y) {
+  ConeQuadric f = cone_quadric(origin_perp, dir_perp, rho, slope_dir_y);
+  if (f.A == 0.0) return linear_at_least(b, -2.0 * f.half_b, f.C, kBoundarySide);
+  // C++: A > 0 || isnan(discriminant); a NaN fails both comparisons.
+  if (!(f.discriminant >= 0.0)) return !(f.A > 0.0 || !(f.discriminant < 0.0));
+  float sign_b = f.half_b >= 0.0 ? 1.0 : -1.0;
+  float q = -(f.half_b + sign_b * sqrt(f.discriminant));
+  float r0 = q / f.A, r1 = q != 0.0 ? f.C / q : r0;
+  if (r1 < r0) {
+    float swap_value = r0;
+    r0 = r1;
+    r1 = swap_value;
+  }
+  return inside_quadric(b, f.A, r0, r1);
+}
+
 struct LocalInterval {
   bool hit;
   float lo;
@@ -129,42 +164,7 @@ LocalInterval local_solid_interval(FrustumShapeF s, LocalRay r, float lower_offs
   if (!linear_at_least(b, slope_dir_y, -rho, kBoundarySide)) return none;
   vec3 origin_perp = o - origin_y * s.axis;
   vec3 dir_perp = d - dir_y * s.axis;
-  float A = dot(dir_perp, dir_perp) - slope_dir_y * slope_dir_y;
-  float half_b = dot(origin_perp, dir_perp) - rho * slope_dir_y;
-  float C = dot(origin_perp, origin_perp) - rho * rho;
-  vec3 radial_term = rho * dir_perp - slope_dir_y * origin_perp;
-  vec3 moment = cross(origin_perp, dir_perp);
-  float discriminant = dot(radial_term, radial_term) - dot(moment, moment);
-  if (A == 0.0) {
-    if (!linear_at_least(b, -2.0 * half_b, C, kBoundarySide)) return none;
-  } else if (!(discriminant >= 0.0)) {
-    // C++: A > 0 || isnan(discriminant); a NaN fails both comparisons.
-    if (A > 0.0 || !(discriminant < 0.0)) return none;
-  } else {
-    float sign_b = half_b >= 0.0 ? 1.0 : -1.0;
-    float q = -(half_b + sign_b * sqrt(discriminant));
-    float r0 = q / A, r1 = q != 0.0 ? C / q : r0;
-    if (r1 < r0) {
-      float swap_value = r0;
-      r0 = r1;
-      r1 = swap_value;
-    }
-    if (A > 0.0) {
-      bounds_at_least(b, r0, kBoundarySide);
-      bounds_at_most(b, r1, kBoundarySide);
-      if (bounds_empty(b)) return none;
-    } else {
-      Bounds first = b, second = b;
-      bounds_at_most(first, r0, kBoundarySide);
-      bounds_at_least(second, r1, kBoundarySide);
-      bool first_ok = !bounds_empty(first), second_ok = !bounds_empty(second);
-      if (!first_ok && !second_ok) return none;
-      if (first_ok && second_ok)
-        b = (first.hi - first.lo >= second.hi - second.lo) ? first : second;
-      else
-        b = first_ok ? first : second;
-    }
-  }
+  if (!inside_cone(b, origin_perp, dir_perp, rho, slope_dir_y)) return none;
   if (!(abs(b.lo) < kInfinity) || !(abs(b.hi) < kInfinity)) return none;
   return LocalInterval(true, b.lo, b.hi, b.lo_by, b.hi_by);
 }

@@ -332,6 +332,345 @@ Expected<std::vector<Row>> read_rows(const std::string& path, const std::string&
   return rows;
 }
 
+// The first line of both CSVs' run setting: what a --merge file must agree with.
+std::string run_header(const Args& a, const Scene& scene, unsigned threads) {
+  return "# sylva bench fog " + a.grammar.grammar + ", " + std::to_string(scene.width) + "x" +
+         std::to_string(scene.height) + ", " + std::to_string(threads) + " threads, reference " +
+         std::to_string(a.reference_steps) + " steps on every " + std::to_string(a.reference_stride) +
+         "-th pixel each way" + (a.cpu_clock ? ", CPU clock" : "") + "\n";
+}
+
+// The rows of every --merge file, in order; a diagnostic for the first that cannot be read.
+Expected<std::vector<Row>> read_merge_files(const std::vector<std::string>& paths, const std::string& header) {
+  std::vector<Row> merged;
+  for (const std::string& path : paths) {
+    auto more = read_rows(path, header);
+    if (!more) return std::move(more.error());
+    merged.insert(merged.end(), more->begin(), more->end());
+  }
+  return merged;
+}
+
+// The photon rate of one core, printed.
+void print_per_core_photon_rate(const SunPhotonTracer& tracer, uint64_t photons) {
+  SunPhotonOptions o;
+  o.photons = photons;
+  o.threads = 1;
+  const SunPhotons p = tracer.trace(o);
+  std::printf("photons on 1 thread: %llu in %.3f s wall, %.3f s CPU = %.3g M photons/s per core (CPU time), "
+              "%zu shadow vectors (%.1f%%)\n",
+              static_cast<unsigned long long>(p.traced), p.seconds, p.cpu_seconds, p.traced / p.cpu_seconds * 1e-6,
+              p.vectors.vectors.size(), 100.0 * p.vectors.vectors.size() / std::max<uint64_t>(1, p.traced));
+}
+
+// One run's measurements: the scene and the plants as the photons see them, the
+// reference, and the rows measured so far with each setting's images summed over its
+// seeds (for the bias).
+class FogBench {
+ public:
+  FogBench(const Args& a, const Scene& scene, const SceneGeometry& g, const SunPhotonTracer& tracer, unsigned threads)
+      : a_(a), scene_(scene), g_(g), tracer_(tracer), threads_(threads) {}
+
+  bool wants(const std::string& m) const { return std::find(a_.modes.begin(), a_.modes.end(), m) != a_.modes.end(); }
+
+  // The converged reference mode on every --reference-stride-th pixel each way.
+  void render_reference() {
+    view_ = pixel_rays(scene_, *g_.tracer);
+    medium_ = fog_medium_of(scene_);
+    FogIntegratorOptions ro;
+    ro.mode = FogMode::reference;
+    ro.steps = a_.reference_steps;
+    const FogIntegrator ref(*medium_, fog_sun_of(scene_.sun), scene_.sky, *g_.tracer, nullptr, ro);
+    double seconds = 0;
+    const View sparse = strided(view_, a_.reference_stride, &reference_pixels_);
+    const std::vector<float> image = fog_image(sparse, ref, 0, threads_, &seconds);
+    reference_.assign(image.begin(), image.end());
+    double mean = 0;
+    for (double v : reference_) mean += v;
+    mean /= std::max<size_t>(1, reference_.size());
+    std::printf("reference: %u steps (%u probes per disc point), %zu pixels (stride %u), %.2f s, mean in-scatter "
+                "%.4g\n",
+                a_.reference_steps, a_.reference_steps * kReferenceProbesPerStep, reference_pixels_.size(),
+                a_.reference_stride, seconds, mean);
+    std::fflush(stdout);
+  }
+
+  // brute at each --brute-steps, each seed.
+  void run_brute_rows() {
+    for (uint32_t steps : a_.brute_steps)
+      for (uint32_t seed = 1; seed <= a_.seeds; ++seed) {
+        Row row;
+        row.mode = "brute", row.steps = steps, row.seed = seed;
+        render_row(row, FogMode::brute, nullptr);
+      }
+  }
+
+  // The photons and cones of each photon count, cone parameters and seed (a cones row
+  // and a line of the cones' CSV each), and with `fog_rows` the modes that use them.
+  void run_cone_rows(bool fog_rows) {
+    cones_csv_ << "# sylva bench fog " << a_.grammar.grammar << ", " << threads_ << " threads\n";
+    cones_csv_ << "photons,seed,params_kind,photon_s,cone_s,params_s,cpu_s,params,vectors,covered,cones,missed_shadow,"
+                  "covered_lit,coverage_points,shadowed_points,query_us\n";
+    const bool cone_modes = wants("medium") || wants("fast") || wants("refined");
+    for (uint64_t photons : a_.photons)
+      for (const bool automatic : {true, false})
+        for (uint32_t seed = 1; seed <= a_.seeds; ++seed) {
+          SunConeOptions o;
+          o.photons.photons = photons;
+          o.photons.seed = seed;
+          o.photons.threads = threads_;
+          if (!automatic) o.params = a_.fixed_params;
+          const double cpu_start = process_cpu_seconds();
+          const auto c = build_sun_cones(g_, scene_, o, &tracer_);
+          const double cpu_s = process_cpu_seconds() - cpu_start;
+          const Row base = cones_row(*c, photons, seed, automatic, cpu_s);
+          if (!fog_rows || !cone_modes) continue;
+          const ConeSetFogSource source(c->cones);
+          const std::string suffix = automatic ? "-auto" : "-fixed";
+          for (const char* mode_name : {"medium", "refined"}) {
+            if (!wants(mode_name)) continue;
+            for (uint32_t steps : a_.cone_steps) {
+              Row row = base;
+              row.mode = mode_name + suffix, row.steps = steps;
+              render_row(row, std::string(mode_name) == "medium" ? FogMode::medium : FogMode::refined, &source);
+            }
+          }
+          if (wants("fast")) {
+            Row row = base;
+            row.mode = "fast" + suffix;
+            render_row(row, FogMode::fast, &source);
+          }
+        }
+  }
+
+  // Each setting's bias: the mean image of its seeds against the reference.
+  std::map<std::string, double> bias() const {
+    std::map<std::string, double> out;
+    for (const auto& [setting, sum] : sums_) {
+      std::vector<double> mean(sum.size());
+      for (size_t i = 0; i < sum.size(); ++i) mean[i] = sum[i] / counts_.at(setting);
+      out[setting] = rmse(mean, reference_, reference_pixels_);
+    }
+    return out;
+  }
+
+  std::vector<Row>& rows() { return rows_; }
+  std::string cones_csv() const { return cones_csv_.str(); }
+
+ private:
+  // The fog of every pixel by `mode` for `row`'s setting and seed: its time and RMSE, printed
+  // and kept.
+  void render_row(Row row, FogMode mode, const FogConeSource* cones) {
+    FogIntegratorOptions o;
+    o.mode = mode;
+    o.steps = std::max(1u, row.steps);
+    const FogIntegrator integrator(*medium_, fog_sun_of(scene_.sun), scene_.sky, *g_.tracer, cones, o);
+    double cpu = 0;
+    const std::vector<float> image = fog_image(view_, integrator, mix_pair(row.seed, 0x666f67), threads_,
+                                               &row.render_s, &cpu);
+    if (a_.cpu_clock) row.render_s = cpu / threads_;
+    row.total_s = row.photon_s + row.cone_s + row.render_s;
+    row.rmse = rmse(image, reference_, reference_pixels_);
+    std::vector<double>& sum = sums_[row.setting()];
+    if (sum.empty()) sum.assign(image.size(), 0.0);
+    for (size_t i = 0; i < image.size(); ++i) sum[i] += image[i];
+    ++counts_[row.setting()];
+    std::printf("%-14s %5u %9llu %4u %9.3f %9.3f %9.3f %9.3f %11.4g %6zu\n", row.mode.c_str(), row.steps,
+                static_cast<unsigned long long>(row.photons), row.seed, row.photon_s, row.cone_s, row.render_s,
+                row.total_s, row.rmse, row.cones);
+    std::fflush(stdout);
+    rows_.push_back(row);
+  }
+
+  // The cones `c` built from `photons` photons of `seed`: the line of the cones' CSV, the
+  // cones row (printed and kept), and the row the modes using them start from.
+  Row cones_row(const SunCones& c, uint64_t photons, uint32_t seed, bool automatic, double cpu_s) {
+    double params_s = 0;
+    for (const RenderPass& p : c.passes)
+      if (p.name == "cone params") params_s = p.seconds;
+    if (seed == 1 && c.automatic) std::cerr << c.automatic->describe();
+    const double query_us = cone_query_us(c);
+    const ConeCoverage cov = c.coverage.value_or(ConeCoverage{});
+    char line[512];
+    std::snprintf(line, sizeof line, "%llu,%u,%s,%.6g,%.6g,%.6g,%.6g,%s,%llu,%llu,%zu,%.6g,%.6g,%llu,%llu,%.4g\n",
+                  static_cast<unsigned long long>(photons), seed, automatic ? "auto" : "fixed", c.photon_seconds,
+                  c.cone_seconds, params_s, cpu_s, params_text(c.params).c_str(),
+                  static_cast<unsigned long long>(c.cluster.vectors), static_cast<unsigned long long>(c.cluster.covered),
+                  c.cones.size(), cov.missed_shadow, cov.covered_lit, static_cast<unsigned long long>(cov.points),
+                  static_cast<unsigned long long>(cov.shadowed), query_us);
+    cones_csv_ << line;
+    Row base;
+    // The final coverage is a report (the cones' CSV), not a cost of rendering.
+    base.photons = photons, base.seed = seed;
+    base.photon_s = a_.cpu_clock ? c.photon_cpu_seconds / threads_ : c.photon_seconds;
+    base.cone_s = a_.cpu_clock ? (c.cone_cpu_seconds - c.coverage_cpu_seconds) / threads_
+                               : c.cone_seconds - c.coverage_seconds;
+    base.cones = c.cones.size();
+    Row row = base;
+    row.mode = automatic ? "cones-auto" : "cones-fixed";
+    row.total_s = row.photon_s + row.cone_s;
+    std::printf("%-14s %5s %9llu %4u %9.3f %9.3f %9s %9.3f %11s %6zu  missed %.3f, covered lit %.3f, %s, "
+                "query %.3g us/ray, cpu %.3f s\n",
+                row.mode.c_str(), "-", static_cast<unsigned long long>(photons), seed, row.photon_s, row.cone_s, "-",
+                row.total_s, "-", row.cones, cov.missed_shadow, cov.covered_lit, params_text(c.params).c_str(),
+                query_us, cpu_s);
+    rows_.push_back(row);
+    return base;
+  }
+
+  // The camera's rays against the cones, one thread: microseconds a ray.
+  double cone_query_us(const SunCones& c) const {
+    std::vector<ConeInterval> intervals;
+    Scene probe = scene_;
+    probe.width = 256, probe.height = 192;
+    const auto start = Clock::now();
+    for (uint32_t y = 0; y < probe.height; ++y)
+      for (uint32_t x = 0; x < probe.width; ++x)
+        c.cones.intervals(camera_ray(probe, x + 0.5, y + 0.5), 0, 1e30, &intervals);
+    return seconds_since(start) / (double(probe.width) * probe.height) * 1e6;
+  }
+
+  const Args& a_;
+  const Scene& scene_;
+  const SceneGeometry& g_;
+  const SunPhotonTracer& tracer_;
+  const unsigned threads_;
+  View view_;
+  std::vector<double> reference_;
+  std::vector<size_t> reference_pixels_;  // of the view, in the reference's order
+  std::optional<FogMedium> medium_;
+  std::vector<Row> rows_;
+  std::map<std::string, std::vector<double>> sums_;  // setting → sum of its seeds' images
+  std::map<std::string, uint32_t> counts_;
+  std::ostringstream cones_csv_;
+};
+
+// Appends the merged runs' rows to `rows`, less the settings this run measured again.
+void merge_rows(std::vector<Row>& rows, const std::vector<Row>& merged, size_t files) {
+  std::set<std::string> measured;
+  for (const Row& r : rows) measured.insert(r.setting());
+  size_t replaced = 0;
+  for (const Row& r : merged)
+    if (measured.count(r.setting())) ++replaced;
+    else rows.push_back(r);
+  if (!merged.empty())
+    std::printf("merged %zu rows of %zu file(s)%s\n", merged.size() - replaced, files,
+                replaced ? (", " + std::to_string(replaced) + " replaced by this run's").c_str() : "");
+}
+
+// The rows' CSV under `header`; a rendered row of this run gets its setting's `bias`.
+std::string rows_csv(const std::string& header, std::vector<Row>& rows, std::map<std::string, double>& bias) {
+  std::ostringstream csv;
+  csv << header;
+  csv << "mode,steps,photons,seed,photon_s,cone_s,render_s,total_s,rmse,bias,cones\n";
+  for (Row& r : rows) {
+    char line[512];
+    const bool rendered = r.rmse >= 0;
+    if (rendered && !r.merged) r.bias = bias[r.setting()];
+    char rm[32] = "", bi[32] = "";
+    if (rendered) std::snprintf(rm, sizeof rm, "%.6g", r.rmse), std::snprintf(bi, sizeof bi, "%.6g", r.bias);
+    std::snprintf(line, sizeof line, "%s,%u,%llu,%u,%.6g,%.6g,%.6g,%.6g,%s,%s,%zu\n", r.mode.c_str(), r.steps,
+                  static_cast<unsigned long long>(r.photons), r.seed, r.photon_s, r.cone_s, r.render_s, r.total_s, rm,
+                  bi, r.cones);
+    csv << line;
+  }
+  return csv.str();
+}
+
+// Each setting's mean time and RMSE over its seeds; families: the mode (with its cone
+// parameters).
+struct Families {
+  std::map<std::string, std::map<std::string, Point>> totals;  // family → setting → sums over seeds
+  std::map<std::string, std::map<std::string, uint32_t>> n;  // the same → seeds
+  std::map<std::string, std::vector<Point>> curves;         // family → means, total time
+  std::map<std::string, std::vector<Point>> render_curves;  // the same, render_s only
+};
+
+Families families_of(const std::vector<Row>& rows) {
+  Families f;
+  std::map<std::string, std::map<std::string, double>> render_time;  // family → setting → sum of render_s
+  for (const Row& r : rows) {
+    if (r.rmse < 0) continue;
+    Point& p = f.totals[r.mode][r.setting()];
+    p.time += r.total_s, p.rmse += r.rmse;
+    render_time[r.mode][r.setting()] += r.render_s;
+    ++f.n[r.mode][r.setting()];
+  }
+  for (auto& [family, settings] : f.totals)
+    for (auto& [setting, p] : settings) {
+      const uint32_t k = f.n[family][setting];
+      f.curves[family].push_back({p.time / k, p.rmse / k});
+      f.render_curves[family].push_back({render_time[family][setting] / k, p.rmse / k});
+    }
+  return f;
+}
+
+// The time each family needs to reach brute's mean RMSE at its settings' step counts
+// (1024 the issue's), photons and cones included (one image), and the render alone (the
+// cones amortised over every frame and camera that reuses them).
+void print_times_to_reach(const std::vector<Row>& rows, Families& f) {
+  std::vector<std::pair<std::string, double>> targets;
+  std::set<uint32_t> brute_steps;  // this run's and the merged files'
+  for (const Row& r : rows)
+    if (r.mode == "brute" && r.rmse >= 0) brute_steps.insert(r.steps);
+  if (f.curves.count("brute"))
+    for (uint32_t steps : brute_steps) {
+      const std::string key = "brute/" + std::to_string(steps) + "/0";
+      if (f.totals["brute"].count(key))
+        targets.push_back({"brute " + std::to_string(steps), f.totals["brute"][key].rmse / f.n["brute"][key]});
+    }
+  for (const bool with_cones : {true, false}) {
+    std::printf(with_cones ? "\ntime (s, mean over seeds, photons and cones included) to reach the RMSE of:\n%-16s"
+                           : "\nrender time alone (s, mean over seeds; the cones reused) to reach the RMSE of:\n%-16s",
+                "family");
+    for (const auto& t : targets) std::printf(" %12s", t.first.c_str());
+    std::printf("\n%-16s", "");
+    for (const auto& t : targets) std::printf(" %12.4g", t.second);
+    std::printf("\n");
+    for (const auto& [family, points] : with_cones ? f.curves : f.render_curves) {
+      std::printf("%-16s", family.c_str());
+      for (const auto& t : targets) {
+        const double s = time_to_reach(points, t.second);
+        if (s < 0) std::printf(" %12s", "-");
+        else std::printf(" %12.4g", s);
+      }
+      std::printf("\n");
+    }
+  }
+}
+
+// Fast mode's bias floor: the smallest bias of its settings, and when brute gets there.
+void print_bias_floors(const std::vector<Row>& rows, Families& f) {
+  for (const char* kind : {"fast-auto", "fast-fixed"}) {
+    double floor = -1;
+    std::string at;
+    double time = 0;
+    for (const Row& r : rows)
+      if (r.mode == kind && r.bias >= 0 && (floor < 0 || r.bias < floor)) floor = r.bias, at = r.setting();
+    if (floor < 0) continue;
+    for (const auto& [setting, p] : f.totals[kind])
+      if (setting == at) time = p.time / f.n[kind][setting];
+    const double brute_time = f.curves.count("brute") ? time_to_reach(f.curves["brute"], floor) : -1;
+    std::printf("%s bias floor: %.4g at %s (%.3g s); brute reaches that RMSE in %s\n", kind, floor, at.c_str(), time,
+                brute_time < 0 ? "- (not within its settings)" : (std::to_string(brute_time) + " s").c_str());
+  }
+}
+
+// The log-log plot of each family's RMSE against total time, to --plot.
+Status write_plot(const Families& f, const Args& a) {
+  std::vector<PlotSeries> series;
+  for (const auto& [family, points] : f.curves) {
+    PlotSeries& s = series_named(series, family);
+    std::vector<Point> sorted = points;
+    std::sort(sorted.begin(), sorted.end(), [](const Point& x, const Point& y) { return x.time < y.time; });
+    for (const Point& p : sorted) s.points.push_back({p.time, p.rmse});
+    s.connect = false;
+  }
+  return write_loglog_plot({{input_stem(a.grammar.grammar) + ": fog in-scatter against the reference",
+                             "total time: photons + cones + fog (s)", "RMSE (linear RGB)", series}},
+                           a.plot);
+}
+
 }  // namespace
 
 int run_bench_fog(const std::vector<std::string>& args) {
@@ -350,19 +689,12 @@ int run_bench_fog(const std::vector<std::string>& args) {
     return kInputError;
   }
   const unsigned threads = a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency());
-  const std::string header = "# sylva bench fog " + a.grammar.grammar + ", " + std::to_string(scene.width) + "x" +
-                             std::to_string(scene.height) + ", " + std::to_string(threads) + " threads, reference " +
-                             std::to_string(a.reference_steps) + " steps on every " +
-                             std::to_string(a.reference_stride) + "-th pixel each way" +
-                             (a.cpu_clock ? ", CPU clock" : "") + "\n";
-  std::vector<Row> merged;  // read before the run: a bad file fails in a second, not after an hour
-  for (const std::string& path : a.merge) {
-    auto more = read_rows(path, header);
-    if (!more) {
-      std::cerr << more.error().format();
-      return kInputError;
-    }
-    merged.insert(merged.end(), more->begin(), more->end());
+  const std::string header = run_header(a, scene, threads);
+  // Read before the run: a bad file fails in a second, not after an hour.
+  Expected<std::vector<Row>> merged = read_merge_files(a.merge, header);
+  if (!merged) {
+    std::cerr << merged.error().format();
+    return kInputError;
   }
   GeometryOptions geometry;
   geometry.cull = false;     // a plant outside the view still casts shafts into it
@@ -374,273 +706,30 @@ int run_bench_fog(const std::vector<std::string>& args) {
   // The plants as the photons see them, built once for every photon count and seed.
   const SunPhotonTracer tracer(g.frusta, scene.sun, threads);
   std::printf("photon tracer: accelerator and occupancy mask built in %.3f s\n", tracer.build_seconds());
-  // The photon rate of one core.
-  {
-    SunPhotonOptions o;
-    o.photons = a.per_core_photons;
-    o.threads = 1;
-    const SunPhotons p = tracer.trace(o);
-    std::printf("photons on 1 thread: %llu in %.3f s wall, %.3f s CPU = %.3g M photons/s per core (CPU time), "
-                "%zu shadow vectors (%.1f%%)\n",
-                static_cast<unsigned long long>(p.traced), p.seconds, p.cpu_seconds, p.traced / p.cpu_seconds * 1e-6,
-                p.vectors.vectors.size(), 100.0 * p.vectors.vectors.size() / std::max<uint64_t>(1, p.traced));
-  }
+  print_per_core_photon_rate(tracer, a.per_core_photons);
 
-  const auto wants = [&](const std::string& m) { return std::find(a.modes.begin(), a.modes.end(), m) != a.modes.end(); };
+  FogBench bench(a, scene, g, tracer, threads);
   const bool fog_rows = !a.cones_only;
-  View view;
-  std::vector<double> reference;
-  std::vector<size_t> reference_pixels;  // of the view, in the reference's order
-  std::optional<FogMedium> medium;
-  if (fog_rows) {
-    view = pixel_rays(scene, *g.tracer);
-    medium = fog_medium_of(scene);
-    FogIntegratorOptions ro;
-    ro.mode = FogMode::reference;
-    ro.steps = a.reference_steps;
-    const FogIntegrator ref(*medium, fog_sun_of(scene.sun), scene.sky, *g.tracer, nullptr, ro);
-    double seconds = 0;
-    const View sparse = strided(view, a.reference_stride, &reference_pixels);
-    const std::vector<float> image = fog_image(sparse, ref, 0, threads, &seconds);
-    reference.assign(image.begin(), image.end());
-    double mean = 0;
-    for (double v : reference) mean += v;
-    mean /= std::max<size_t>(1, reference.size());
-    std::printf("reference: %u steps (%u probes per disc point), %zu pixels (stride %u), %.2f s, mean in-scatter "
-                "%.4g\n",
-                a.reference_steps, a.reference_steps * kReferenceProbesPerStep, reference_pixels.size(),
-                a.reference_stride, seconds, mean);
-    std::fflush(stdout);
-  }
-
-  std::vector<Row> rows;
-  std::map<std::string, std::vector<double>> sums;  // setting → sum of its seeds' images
-  std::map<std::string, uint32_t> counts;
-  auto render_row = [&](Row row, FogMode mode, const FogConeSource* cones) {
-    FogIntegratorOptions o;
-    o.mode = mode;
-    o.steps = std::max(1u, row.steps);
-    const FogIntegrator integrator(*medium, fog_sun_of(scene.sun), scene.sky, *g.tracer, cones, o);
-    double cpu = 0;
-    const std::vector<float> image = fog_image(view, integrator, mix_pair(row.seed, 0x666f67), threads,
-                                               &row.render_s, &cpu);
-    if (a.cpu_clock) row.render_s = cpu / threads;
-    row.total_s = row.photon_s + row.cone_s + row.render_s;
-    row.rmse = rmse(image, reference, reference_pixels);
-    std::vector<double>& sum = sums[row.setting()];
-    if (sum.empty()) sum.assign(image.size(), 0.0);
-    for (size_t i = 0; i < image.size(); ++i) sum[i] += image[i];
-    ++counts[row.setting()];
-    std::printf("%-14s %5u %9llu %4u %9.3f %9.3f %9.3f %9.3f %11.4g %6zu\n", row.mode.c_str(), row.steps,
-                static_cast<unsigned long long>(row.photons), row.seed, row.photon_s, row.cone_s, row.render_s,
-                row.total_s, row.rmse, row.cones);
-    std::fflush(stdout);
-    rows.push_back(row);
-  };
-
+  if (fog_rows) bench.render_reference();
   std::printf("%-14s %5s %9s %4s %9s %9s %9s %9s %11s %6s\n", "mode", "steps", "photons", "seed", "photon_s", "cone_s",
               "render_s", "total_s", "rmse", "cones");
-  if (fog_rows && wants("brute"))
-    for (uint32_t steps : a.brute_steps)
-      for (uint32_t seed = 1; seed <= a.seeds; ++seed) {
-        Row row;
-        row.mode = "brute", row.steps = steps, row.seed = seed;
-        render_row(row, FogMode::brute, nullptr);
-      }
+  if (fog_rows && bench.wants("brute")) bench.run_brute_rows();
+  bench.run_cone_rows(fog_rows);
 
-  std::ostringstream cones_csv;
-  cones_csv << "# sylva bench fog " << a.grammar.grammar << ", " << threads << " threads\n";
-  cones_csv << "photons,seed,params_kind,photon_s,cone_s,params_s,cpu_s,params,vectors,covered,cones,missed_shadow,"
-               "covered_lit,coverage_points,shadowed_points,query_us\n";
-  const bool cone_modes = wants("medium") || wants("fast") || wants("refined");
-  for (uint64_t photons : a.photons)
-    for (const bool automatic : {true, false})
-      for (uint32_t seed = 1; seed <= a.seeds; ++seed) {
-        SunConeOptions o;
-        o.photons.photons = photons;
-        o.photons.seed = seed;
-        o.photons.threads = threads;
-        if (!automatic) o.params = a.fixed_params;
-        const double cpu_start = process_cpu_seconds();
-        const auto c = build_sun_cones(g, scene, o, &tracer);
-        const double cpu_s = process_cpu_seconds() - cpu_start;
-        double params_s = 0;
-        for (const RenderPass& p : c->passes)
-          if (p.name == "cone params") params_s = p.seconds;
-        if (seed == 1 && c->automatic) std::cerr << c->automatic->describe();
-        // The camera's rays against the cones, one thread.
-        double query_us = 0;
-        {
-          std::vector<ConeInterval> intervals;
-          Scene probe = scene;
-          probe.width = 256, probe.height = 192;
-          const auto start = Clock::now();
-          for (uint32_t y = 0; y < probe.height; ++y)
-            for (uint32_t x = 0; x < probe.width; ++x)
-              c->cones.intervals(camera_ray(probe, x + 0.5, y + 0.5), 0, 1e30, &intervals);
-          query_us = seconds_since(start) / (double(probe.width) * probe.height) * 1e6;
-        }
-        const ConeCoverage cov = c->coverage.value_or(ConeCoverage{});
-        char line[512];
-        std::snprintf(line, sizeof line, "%llu,%u,%s,%.6g,%.6g,%.6g,%.6g,%s,%llu,%llu,%zu,%.6g,%.6g,%llu,%llu,%.4g\n",
-                      static_cast<unsigned long long>(photons), seed, automatic ? "auto" : "fixed", c->photon_seconds,
-                      c->cone_seconds, params_s, cpu_s, params_text(c->params).c_str(),
-                      static_cast<unsigned long long>(c->cluster.vectors),
-                      static_cast<unsigned long long>(c->cluster.covered), c->cones.size(), cov.missed_shadow,
-                      cov.covered_lit, static_cast<unsigned long long>(cov.points),
-                      static_cast<unsigned long long>(cov.shadowed), query_us);
-        cones_csv << line;
-        Row base;
-        // The final coverage is a report (the cones' CSV), not a cost of rendering.
-        base.photons = photons, base.seed = seed;
-        base.photon_s = a.cpu_clock ? c->photon_cpu_seconds / threads : c->photon_seconds;
-        base.cone_s = a.cpu_clock ? (c->cone_cpu_seconds - c->coverage_cpu_seconds) / threads
-                                  : c->cone_seconds - c->coverage_seconds;
-        base.cones = c->cones.size();
-        {
-          Row row = base;
-          row.mode = automatic ? "cones-auto" : "cones-fixed";
-          row.total_s = row.photon_s + row.cone_s;
-          std::printf("%-14s %5s %9llu %4u %9.3f %9.3f %9s %9.3f %11s %6zu  missed %.3f, covered lit %.3f, %s, "
-                      "query %.3g us/ray, cpu %.3f s\n",
-                      row.mode.c_str(), "-", static_cast<unsigned long long>(photons), seed, row.photon_s, row.cone_s,
-                      "-", row.total_s, "-", row.cones, cov.missed_shadow, cov.covered_lit,
-                      params_text(c->params).c_str(), query_us, cpu_s);
-          rows.push_back(row);
-        }
-        if (!fog_rows || !cone_modes) continue;
-        const ConeSetFogSource source(c->cones);
-        const std::string suffix = automatic ? "-auto" : "-fixed";
-        for (const char* mode_name : {"medium", "refined"}) {
-          if (!wants(mode_name)) continue;
-          for (uint32_t steps : a.cone_steps) {
-            Row row = base;
-            row.mode = mode_name + suffix, row.steps = steps;
-            render_row(row, std::string(mode_name) == "medium" ? FogMode::medium : FogMode::refined, &source);
-          }
-        }
-        if (wants("fast")) {
-          Row row = base;
-          row.mode = "fast" + suffix;
-          render_row(row, FogMode::fast, &source);
-        }
-      }
-
-  // Bias: the mean image of each setting's seeds against the reference.
-  std::map<std::string, double> bias;
-  for (const auto& [setting, sum] : sums) {
-    std::vector<double> mean(sum.size());
-    for (size_t i = 0; i < sum.size(); ++i) mean[i] = sum[i] / counts[setting];
-    bias[setting] = rmse(mean, reference, reference_pixels);
-  }
-  // The merged runs' rows, less the settings this run measured again.
-  {
-    std::set<std::string> measured;
-    for (const Row& r : rows) measured.insert(r.setting());
-    size_t replaced = 0;
-    for (const Row& r : merged)
-      if (measured.count(r.setting())) ++replaced;
-      else rows.push_back(r);
-    if (!merged.empty())
-      std::printf("merged %zu rows of %zu file(s)%s\n", merged.size() - replaced, a.merge.size(),
-                  replaced ? (", " + std::to_string(replaced) + " replaced by this run's").c_str() : "");
-  }
-  std::ostringstream csv;
-  csv << header;
-  csv << "mode,steps,photons,seed,photon_s,cone_s,render_s,total_s,rmse,bias,cones\n";
-  for (Row& r : rows) {
-    char line[512];
-    const bool rendered = r.rmse >= 0;
-    if (rendered && !r.merged) r.bias = bias[r.setting()];
-    char rm[32] = "", bi[32] = "";
-    if (rendered) std::snprintf(rm, sizeof rm, "%.6g", r.rmse), std::snprintf(bi, sizeof bi, "%.6g", r.bias);
-    std::snprintf(line, sizeof line, "%s,%u,%llu,%u,%.6g,%.6g,%.6g,%.6g,%s,%s,%zu\n", r.mode.c_str(), r.steps,
-                  static_cast<unsigned long long>(r.photons), r.seed, r.photon_s, r.cone_s, r.render_s, r.total_s, rm,
-                  bi, r.cones);
-    csv << line;
-  }
-
+  std::map<std::string, double> bias = bench.bias();
+  std::vector<Row>& rows = bench.rows();
+  merge_rows(rows, *merged, a.merge.size());
+  const std::string csv = rows_csv(header, rows, bias);
   if (fog_rows) {
-    // Each setting's mean time and RMSE; families: the mode (with its cone parameters).
-    std::map<std::string, std::map<std::string, Point>> families;  // family → setting → mean
-    std::map<std::string, std::map<std::string, double>> render_time;  // the same, render_s only
-    std::map<std::string, std::map<std::string, uint32_t>> n;
-    for (const Row& r : rows) {
-      if (r.rmse < 0) continue;
-      Point& p = families[r.mode][r.setting()];
-      p.time += r.total_s, p.rmse += r.rmse;
-      render_time[r.mode][r.setting()] += r.render_s;
-      ++n[r.mode][r.setting()];
-    }
-    std::map<std::string, std::vector<Point>> curves, render_curves;
-    for (auto& [family, settings] : families)
-      for (auto& [setting, p] : settings) {
-        const uint32_t k = n[family][setting];
-        curves[family].push_back({p.time / k, p.rmse / k});
-        render_curves[family].push_back({render_time[family][setting] / k, p.rmse / k});
-      }
-    // Targets: brute's mean RMSE at its settings' step counts (1024 the issue's).
-    std::vector<std::pair<std::string, double>> targets;
-    std::set<uint32_t> brute_steps;  // this run's and the merged files'
-    for (const Row& r : rows)
-      if (r.mode == "brute" && r.rmse >= 0) brute_steps.insert(r.steps);
-    if (curves.count("brute"))
-      for (uint32_t steps : brute_steps) {
-        const std::string key = "brute/" + std::to_string(steps) + "/0";
-        if (families["brute"].count(key))
-          targets.push_back({"brute " + std::to_string(steps), families["brute"][key].rmse / n["brute"][key]});
-      }
-    // The time to reach each target, photons and cones included (one image), and the
-    // render alone (the cones amortised over every frame and camera that reuses them).
-    for (const bool with_cones : {true, false}) {
-      std::printf(with_cones ? "\ntime (s, mean over seeds, photons and cones included) to reach the RMSE of:\n%-16s"
-                             : "\nrender time alone (s, mean over seeds; the cones reused) to reach the RMSE of:\n%-16s",
-                  "family");
-      for (const auto& t : targets) std::printf(" %12s", t.first.c_str());
-      std::printf("\n%-16s", "");
-      for (const auto& t : targets) std::printf(" %12.4g", t.second);
-      std::printf("\n");
-      for (const auto& [family, points] : with_cones ? curves : render_curves) {
-        std::printf("%-16s", family.c_str());
-        for (const auto& t : targets) {
-          const double s = time_to_reach(points, t.second);
-          if (s < 0) std::printf(" %12s", "-");
-          else std::printf(" %12.4g", s);
-        }
-        std::printf("\n");
-      }
-    }
-    // Fast mode's bias floor: the smallest bias of its settings, and when brute gets there.
-    for (const char* kind : {"fast-auto", "fast-fixed"}) {
-      double floor = -1;
-      std::string at;
-      double time = 0;
-      for (const Row& r : rows)
-        if (r.mode == kind && r.bias >= 0 && (floor < 0 || r.bias < floor)) floor = r.bias, at = r.setting();
-      if (floor < 0) continue;
-      for (const auto& [setting, p] : families[kind])
-        if (setting == at) time = p.time / n[kind][setting];
-      const double brute_time = curves.count("brute") ? time_to_reach(curves["brute"], floor) : -1;
-      std::printf("%s bias floor: %.4g at %s (%.3g s); brute reaches that RMSE in %s\n", kind, floor, at.c_str(), time,
-                  brute_time < 0 ? "- (not within its settings)" : (std::to_string(brute_time) + " s").c_str());
-    }
-    std::vector<PlotSeries> series;
-    for (const auto& [family, points] : curves) {
-      PlotSeries& s = series_named(series, family);
-      std::vector<Point> sorted = points;
-      std::sort(sorted.begin(), sorted.end(), [](const Point& x, const Point& y) { return x.time < y.time; });
-      for (const Point& p : sorted) s.points.push_back({p.time, p.rmse});
-      s.connect = false;
-    }
-    if (Status e = write_loglog_plot({{input_stem(a.grammar.grammar) + ": fog in-scatter against the reference",
-                                       "total time: photons + cones + fog (s)", "RMSE (linear RGB)", series}},
-                                     a.plot);
-        !e) {
+    Families families = families_of(rows);
+    print_times_to_reach(rows, families);
+    print_bias_floors(rows, families);
+    if (Status e = write_plot(families, a); !e) {
       std::cerr << e.error().format();
       return kInputError;
     }
   }
-  for (const auto& [path, text] : {std::pair{a.csv, csv.str()}, std::pair{a.cones_csv, cones_csv.str()}}) {
+  for (const auto& [path, text] : {std::pair{a.csv, csv}, std::pair{a.cones_csv, bench.cones_csv()}}) {
     if (Status e = write_file_atomically(path, text); !e) {
       std::cerr << e.error().format();
       return kInputError;

@@ -1,14 +1,7 @@
 // ray_frustum.cpp — ray casting conical frusta, Bhagvat et al. 2009 sec. 2.5 (eq. 9–10), robust.
 //
-// Eq. 9–10 put the ray E + tD into the cone of eq. 1, h'²(x² + z²) = r1²(y − h')², with
-// the apex height h' = r1·h/(r1 − r2) of eq. 2, and solve a t² + b t + c = 0 with
-//   a = Dx² + Dz² − Dy²(r1/h')²,  b = 2(Ex Dx + Ez Dz − Dy(Ey − h')(r1/h')²),
-//   c = Ex² + Ez² − (Ey − h')²(r1/h')².
-// With slope k = (r2 − r1)/h = −r1/h' and ρ = r1 + k·Ey the radius at the origin's height:
-//   (Ey − h')·(r1/h') = −ρ  and  (r1/h')² = k², so
-//   a = D⊥·D⊥ − k²Dy²,  b = 2(E⊥·D⊥ − k ρ Dy),  c = E⊥·E⊥ − ρ²,
-// which is the apex-free form used here (A, B = 2·half_b, C): it never forms h' (infinite
-// for a cylinder), and it is the same equation for the base radius r0 = r1 of the paper.
+// The cone's quadratic is eq. 9–10 in the apex-free form of cone_quadric.h (it never forms
+// the apex height h', infinite for a cylinder), with the regrouped discriminant.
 //
 // What the paper's version lacks, and this one adds:
 // - Re-centring. C ~ |E|² and B ~ |E|: with the eye 10⁶ away the textbook roots lose
@@ -33,6 +26,7 @@
 #include <initializer_list>
 #include <limits>
 
+#include "core/geometry/cone_quadric.h"
 #include "core/geometry/recentre.h"
 
 namespace sylva {
@@ -122,18 +116,9 @@ void frustum_side_hit(const LocalShape<Real>& s, const Vec3<Real>& origin,
   const Vec3<Real> dir_perp = dir - dir_y * s.axis;
   const Real rho = s.radius0 + s.slope * origin_y;  // radius at the origin's height
   const Real slope_dir_y = s.slope * dir_y;
-  const Real A = dot(dir_perp, dir_perp) - slope_dir_y * slope_dir_y;
-  const Real half_b = dot(origin_perp, dir_perp) - rho * slope_dir_y;
-  const Real C = dot(origin_perp, origin_perp) - rho * rho;
-  // D' = half_b² − A·C expanded and regrouped: the terms ρ²k²dy² cancel algebraically,
-  //   D' = |ρ·d⊥ − k·dy·w⊥|² − |w⊥ × d⊥|²,
-  // so a ray through or near the apex (where half_b² and A·C are both ≈ ρ²k²dy²) keeps
-  // its small discriminant to full relative precision instead of sqrt(ε).
-  const Vec3<Real> radial_term = rho * dir_perp - slope_dir_y * origin_perp;
-  const Vec3<Real> moment = cross(origin_perp, dir_perp);
-  const Real discriminant = dot(radial_term, radial_term) - dot(moment, moment);
+  const ConeQuadric<Real> f = cone_quadric(origin_perp, dir_perp, rho, slope_dir_y);
   Real roots[2];
-  const int count = frustum_side_roots(A, half_b, C, discriminant, roots);
+  const int count = frustum_side_roots(f.A, f.half_b, f.C, f.discriminant, roots);
   for (int i = 0; i < count; ++i) {
     const Real t = roots[i];
     if (!(t < best.t_local) || !range.contains(t)) continue;  // also drops ±inf

@@ -267,10 +267,6 @@ void append_u32(std::string& out, uint32_t v) {
   out.append(b, 4);
 }
 
-bool ends_with(std::string_view s, std::string_view suffix) {
-  return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
-}
-
 std::string lower_case(std::string s) {
   for (char& c : s)
     if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
@@ -445,6 +441,19 @@ double median_segment_radius(const SkinnedSkeleton& skinned) {
   return 0.5 * (*std::max_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(mid)) + upper);
 }
 
+// float(v) of each component, appended.
+void append_float3(std::vector<float>& out, const glm::dvec3& v) {
+  out.insert(out.end(), {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)});
+}
+
+// A unit vector appended as floats, renormalised in float so the validator's unit-length
+// check holds exactly.
+void append_unit_float3(std::vector<float>& out, const glm::dvec3& n) {
+  const float f[3] = {static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z)};
+  const float len = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+  out.insert(out.end(), {f[0] / len, f[1] / len, f[2] / len});
+}
+
 // Per vertex of `tm`: TANGENT (gltf_export.h) as 4 floats, xyz unit in float.
 std::vector<float> vertex_tangents(const TriangleMesh& tm, const SkinnedSkeleton& skinned) {
   // Each vertex belongs to one frustum (tessellate.h makes every frustum's own vertices).
@@ -463,9 +472,8 @@ std::vector<float> vertex_tangents(const TriangleMesh& tm, const SkinnedSkeleton
     t = glm::normalize(t);
     // cross(N, T)·w must point toward decreasing t, i.e. against the axis.
     const float w = glm::dot(glm::cross(n, t), axis) > 0 ? -1.0f : 1.0f;
-    float f[3] = {static_cast<float>(t.x), static_cast<float>(t.y), static_cast<float>(t.z)};
-    const float len = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-    tangents.insert(tangents.end(), {f[0] / len, f[1] / len, f[2] / len, w});
+    append_unit_float3(tangents, t);
+    tangents.push_back(w);
   }
   return tangents;
 }
@@ -566,37 +574,23 @@ class MaterialTable {
   std::vector<std::string> materials_;
 };
 
-}  // namespace
-
-Status check_bark_textures(const Bark& bark) {
-  if (bark.albedo_texture) {
-    Expected<EmbeddedImage> image = read_albedo_image(*bark.albedo_texture);
-    if (!image) return std::move(image.error());
+// The triangles of `indices` (3 a triangle), grouped by `material_of(triangle)`, in
+// increasing material order: one primitive each.
+template <class MaterialOf>
+std::map<uint32_t, std::vector<uint32_t>> triangles_by_material(const std::vector<uint32_t>& indices,
+                                                                size_t triangle_count, MaterialOf material_of) {
+  std::map<uint32_t, std::vector<uint32_t>> triangles_of;
+  for (size_t t = 0; t < triangle_count; ++t) {
+    std::vector<uint32_t>& list = triangles_of[material_of(t)];
+    list.insert(list.end(), indices.begin() + static_cast<std::ptrdiff_t>(3 * t),
+                indices.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
   }
-  if (bark.height_texture) {
-    Expected<HeightMap> map = read_height_map(*bark.height_texture);
-    if (!map) return std::move(map.error());
-  }
-  return {};
+  return triangles_of;
 }
 
-double bark_reference_radius_m(const Skeleton& skeleton) { return median_segment_radius(skin_skeleton(skeleton)); }
-
-Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path, const GltfExportOptions& options) {
-  const std::string ext = lower_case(path);
-  const bool glb = ends_with(ext, ".glb");
-  if (!glb && !ends_with(ext, ".gltf")) return file_diagnostic(path, "the output must end in .gltf or .glb");
-  if (plants.empty()) return file_diagnostic(path, "no plants to export");
-  if (options.segments_around < 3 || options.segments_around > 4096)
-    return file_diagnostic(path, "segments around must be an integer from 3 to 4096");
-  for (size_t i = 0; i < plants.size(); ++i)
-    if (auto problem = plant_problem(plants[i], i)) return file_diagnostic(path, *problem);
-  MaterialTable table;
-  if (options.mesh)
-    if (Status loaded = table.load(plants, options.materials); !loaded) return loaded;
-
-  // Group identical skeletons when instancing (compared by their exact serialization,
-  // and by their barks when those shape the mesh).
+// Groups the plants that share a skeleton when instancing (compared by their exact
+// serialization, and by their barks when those shape the mesh); else one group a plant.
+std::vector<PlantGroup> group_plants(const std::vector<GltfPlant>& plants, const GltfExportOptions& options) {
   std::vector<PlantGroup> groups;
   if (options.instancing) {
     std::map<std::string, size_t> group_of;
@@ -610,307 +604,319 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
   } else {
     for (size_t i = 0; i < plants.size(); ++i) groups.push_back({{i}});
   }
+  return groups;
+}
 
+// What export_gltf builds before the document is written: the binary buffer, the
+// materials and images, and the meshes and nodes (each one JSON object, in order).
+struct GltfDocument {
   BufferBuilder buffer;
-  std::vector<std::string> meshes, nodes;  // each one JSON object, written in order below
+  MaterialTable table;
+  std::vector<std::string> meshes, nodes;
   bool any_instancing = false;
-  for (const PlantGroup& group : groups) {
-    const GltfPlant& plant = plants[group.plants.front()];
-    const Skeleton& sk = plant.skeleton;
-    const SkinnedSkeleton skinned = skin_skeleton(sk);
+};
 
-    // The skeleton as LINES: vertex i is joint i; one (parent joint, child joint) pair
-    // per segment, a branch's first segment starting at the joint it grows from.
-    JsonWriter primitives;
-    size_t primitive_count = 0;
-    primitives.begin_array();
-    if (sk.segment_count() > 0) {
-      std::vector<float> positions, radii;
-      positions.reserve(sk.joints.size() * 3);
-      for (const Joint& j : sk.joints) {
-        for (double x : j.position_m) positions.push_back(static_cast<float>(x));
-        radii.push_back(static_cast<float>(j.radius_m));
-      }
-      std::vector<uint32_t> pairs;
-      pairs.reserve(sk.segment_count() * 2);
-      for (const Chain& c : sk.chains) {
-        for (uint32_t j = 1; j < c.joint_count; ++j) {
-          uint32_t lower = c.first_joint + j - 1;
-          if (j == 1 && c.parent) lower = sk.chains[c.parent->chain].first_joint + c.parent->joint;
-          pairs.push_back(lower);
-          pairs.push_back(c.first_joint + j);
-        }
-      }
-      const size_t pos = buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer);
-      const size_t rad = buffer.add_floats(radii, 1, "SCALAR", kTargetArrayBuffer);
-      const size_t idx = buffer.add_indices(pairs);
-      primitives.begin_object();
-      primitives.key("attributes").begin_object().key("POSITION").integer(pos).key("_RADIUS").integer(rad).end_object();
-      primitives.key("indices").integer(idx);
-      primitives.key("mode").integer(kModeLines);
-      primitives.end_object();
-      ++primitive_count;
-    }
-    if (options.mesh && !skinned.frusta.empty()) {
-      TessellateOptions to;
-      to.segments_around = options.segments_around;
-      const TriangleMesh tm = tessellate(skinned, to);
-      if (!tm.indices.empty()) {
-        // One primitive per material index, in increasing order.
-        std::map<uint32_t, std::vector<uint32_t>> triangles_of;
-        for (size_t t = 0; t < tm.triangle_count(); ++t) {
-          std::vector<uint32_t>& list = triangles_of[skinned.frusta[tm.triangle_frustum[t]].material];
-          list.insert(list.end(), tm.indices.begin() + static_cast<std::ptrdiff_t>(3 * t),
-                      tm.indices.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
-        }
-        // The bark's textures are the wood's (material 0, materials.h): a plant without
-        // wood embeds none.
-        const bool has_wood = triangles_of.count(0) > 0;
-        const Bark& bark = plant.bark;
-        const double r_ref_m = median_segment_radius(skinned);
-        Expected<std::optional<size_t>> normal_map =
-            has_wood ? table.normal_texture(bark, r_ref_m) : Expected<std::optional<size_t>>(std::optional<size_t>());
-        if (!normal_map) return std::move(normal_map.error());
-        const std::optional<size_t> normal_texture = *normal_map;
-
-        std::vector<float> positions, normals, texcoords;
-        positions.reserve(tm.positions.size() * 3);
-        normals.reserve(tm.normals.size() * 3);
-        texcoords.reserve(tm.uvs.size() * 2);
-        for (const glm::dvec3& p : tm.positions)
-          positions.insert(positions.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
-        for (const glm::dvec3& n : tm.normals) {
-          // Renormalised in float so the validator's unit-length check holds exactly.
-          float f[3] = {static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z)};
-          const float len = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-          normals.insert(normals.end(), {f[0] / len, f[1] / len, f[2] / len});
-        }
-        // (u · u_repeat, v_m · v_per_metre) of every vertex.
-        auto scaled_uvs = [&](double u_repeat, double v_per_metre) {
-          std::vector<float> st;
-          st.reserve(tm.uvs.size() * 2);
-          for (const glm::dvec2& uv : tm.uvs)
-            st.insert(st.end(), {static_cast<float>(uv.x * u_repeat), static_cast<float>(uv.y * v_per_metre)});
-          return st;
-        };
-        texcoords = scaled_uvs(bark.u_repeat, bark.v_per_metre);
-        // Accessor order NORMAL, POSITION, TANGENT, TEXCOORD_0: the order files written so
-        // far have (it came from GCC's right-to-left evaluation of a string concatenation),
-        // now fixed in code so that every compiler writes the same bytes.
-        const size_t normal_accessor = buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer);
-        const size_t position_accessor = buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer);
-        JsonWriter attributes;
-        attributes.begin_object();
-        attributes.key("POSITION").integer(position_accessor);
-        attributes.key("NORMAL").integer(normal_accessor);
-        if (normal_texture)
-          attributes.key("TANGENT").integer(buffer.add_floats(vertex_tangents(tm, skinned), 4, "VEC4", kTargetArrayBuffer));
-        attributes.key("TEXCOORD_0").integer(buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer));
-        const std::string shared_attributes = attributes.text() + "}";
-        // A table image repeating otherwise than the bark reads TEXCOORD_1, its own
-        // (u · u_repeat, v_m · v_per_metre); one accessor per distinct pair of repeats.
-        std::map<std::pair<double, double>, std::string> attributes_with_texcoord_1;
-        for (const auto& [material, indices] : triangles_of) {
-          const bool wood = material == 0;  // the bark's textures are the wood's (materials.h)
-          const std::optional<SegmentTexture> segment = segment_texture(options.materials, &bark, material);
-          int texcoord = 0;
-          const std::string* primitive_attributes = &shared_attributes;
-          if (segment && (segment->u_repeat != bark.u_repeat || segment->v_per_metre != bark.v_per_metre)) {
-            texcoord = 1;
-            const std::pair<double, double> repeat{segment->u_repeat, segment->v_per_metre};
-            auto it = attributes_with_texcoord_1.find(repeat);
-            if (it == attributes_with_texcoord_1.end()) {
-              const size_t accessor =
-                  buffer.add_floats(scaled_uvs(repeat.first, repeat.second), 2, "VEC2", kTargetArrayBuffer);
-              it = attributes_with_texcoord_1
-                       .emplace(repeat, attributes.text() + ",\"TEXCOORD_1\":" + std::to_string(accessor) + "}")
-                       .first;
-            }
-            primitive_attributes = &it->second;
-          }
-          const size_t m = table.material(material_json(
-              material, bark, options.materials,
-              segment ? std::optional<size_t>(table.albedo_texture(segment->path)) : std::nullopt, texcoord,
-              wood ? normal_texture : std::nullopt, r_ref_m, table.leaf_images()));
-          primitives.begin_object();
-          primitives.key("attributes").raw(*primitive_attributes);
-          primitives.key("indices").integer(buffer.add_indices(indices));
-          primitives.key("material").integer(m);
-          primitives.key("mode").integer(kModeTriangles);
-          primitives.end_object();
-          ++primitive_count;
-        }
-      }
-    }
-    if (options.mesh && !sk.leaves.empty()) {
-      // The leaves (leaf_mesh.h): flat triangles with their leaf's normal at each vertex,
-      // one primitive per material index in increasing order, double-sided materials;
-      // TEXCOORD_0 = (u, 1 − v) of leaf_uvs (glTF's t runs down the image: an image drawn
-      // upright, petiole at its bottom row, covers the leaf as the renderers map it).
-      LeafMesh leaves;
-      append_leaves(leaves, sk, 0);
-      std::map<uint32_t, std::vector<uint32_t>> triangles_of;
-      std::vector<float> positions, normals, texcoords;
-      for (const glm::dvec2& t : leaves.uvs)
-        texcoords.insert(texcoords.end(), {static_cast<float>(t.x), static_cast<float>(1 - t.y)});
-      for (const glm::dvec3& q : leaves.positions)
-        positions.insert(positions.end(), {static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z)});
-      for (uint32_t l : leaves.vertex_leaf) {
-        // Renormalised in float so the validator's unit-length check holds exactly.
-        const glm::dvec3& n = leaves.leaves[l].normal;
-        const float f[3] = {static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z)};
-        const float len = std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-        normals.insert(normals.end(), {f[0] / len, f[1] / len, f[2] / len});
-      }
-      for (size_t t = 0; t < leaves.triangle_count(); ++t) {
-        std::vector<uint32_t>& list = triangles_of[leaves.leaves[leaves.triangle_leaf[t]].material];
-        list.insert(list.end(), leaves.indices.begin() + static_cast<std::ptrdiff_t>(3 * t),
-                    leaves.indices.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
-      }
-      if (!triangles_of.empty()) {
-        JsonWriter attributes;
-        attributes.begin_object();
-        attributes.key("POSITION").integer(buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer));
-        attributes.key("NORMAL").integer(buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer));
-        attributes.key("TEXCOORD_0").integer(buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer));
-        attributes.end_object();
-        for (const auto& [material, indices] : triangles_of) {
-          primitives.begin_object();
-          primitives.key("attributes").raw(attributes.text());
-          primitives.key("indices").integer(buffer.add_indices(indices));
-          Expected<std::optional<size_t>> texture = table.leaf_texture(material);
-          if (!texture) return std::move(texture.error());
-          primitives.key("material").integer(
-              table.material(leaf_material_json(material, options.materials, table.leaf_images(), *texture)));
-          primitives.key("mode").integer(kModeTriangles);
-          primitives.end_object();
-          ++primitive_count;
-        }
-      }
-    }
-    primitives.end_array();
-
-    JsonWriter node;
-    node.begin_object();
-    node.key("name").string(plant.name);
-    if (primitive_count > 0) {
-      JsonWriter mesh;
-      mesh.begin_object();
-      mesh.key("name").string(plant.name);
-      mesh.key("primitives").raw(primitives.text());
-      mesh.end_object();
-      meshes.push_back(mesh.take());
-      node.key("mesh").integer(meshes.size() - 1);
-    }
-    const bool instanced = group.plants.size() > 1;
-    if (instanced) {
-      // EXT_mesh_gpu_instancing: the node keeps the identity transform; each instance's
-      // TRS is in the attributes (float), exact values in extras.sylva.instances.
-      std::vector<float> translation, rotation, scale;
-      for (size_t i : group.plants) {
-        const GltfPlant& p = plants[i];
-        for (double x : p.position_m) translation.push_back(static_cast<float>(x));
-        for (double q : quaternion_about_y(p.rotate_y_deg)) rotation.push_back(static_cast<float>(q));
-        for (int k = 0; k < 3; ++k) scale.push_back(static_cast<float>(p.scale));
-      }
-      const size_t t = buffer.add_floats(translation, 3, "VEC3", 0);
-      const size_t r = buffer.add_floats(rotation, 4, "VEC4", 0);
-      const size_t s = buffer.add_floats(scale, 3, "VEC3", 0);
-      node.key("extensions").begin_object().key("EXT_mesh_gpu_instancing").begin_object();
-      node.key("attributes").begin_object().key("TRANSLATION").integer(t).key("ROTATION").integer(r);
-      node.key("SCALE").integer(s).end_object();
-      node.end_object().end_object();
-      any_instancing = true;
-    } else {
-      if (plant.position_m[0] != 0 || plant.position_m[1] != 0 || plant.position_m[2] != 0)
-        node.key("translation").numbers(plant.position_m, 3);
-      if (plant.rotate_y_deg != 0) node.key("rotation").numbers(quaternion_about_y(plant.rotate_y_deg).data(), 4);
-      if (plant.scale != 1) {
-        const double s[3] = {plant.scale, plant.scale, plant.scale};
-        node.key("scale").numbers(s, 3);
-      }
-    }
-    // The skeleton document of docs/spec/skeleton.md, the seed as a string (JSON consumers read
-    // numbers as doubles, which cannot hold every 64-bit seed).
-    // "compact": the same document with its large arrays in bufferViews (gltf_export.h).
-    if (options.extras == GltfExtras::full) {
-      node.key("extras").begin_object().key("sylva").begin_object();
-      write_skeleton_members(node, sk, {.compact = true, .seed_as_string = true});
-      write_skinning(node, skinned, nullptr);
-      node.key("instances").begin_array();
-      for (size_t i : group.plants) write_instance(node, plants[i]);
-      node.end_array();
-      node.end_object().end_object();
-    } else if (options.extras == GltfExtras::compact) {
-      node.key("extras").begin_object().key("sylva").begin_object();
-      write_compact_skeleton(node, sk, buffer);
-      write_skinning(node, skinned, &buffer);
-      std::vector<double> placement;
-      node.key("instances").begin_object().key("count").integer(group.plants.size());
-      node.key("names").begin_array();
-      for (size_t i : group.plants) {
-        const GltfPlant& p = plants[i];
-        node.string(p.name);
-        placement.insert(placement.end(), {p.position_m[0], p.position_m[1], p.position_m[2], p.rotate_y_deg, p.scale});
-      }
-      node.end_array();
-      write_view(node, "placement", placement, buffer);
-      node.end_object();
-      node.end_object().end_object();
-    }
-    node.end_object();
-    nodes.push_back(node.take());
-  }
-
-  // The document. Arrays that would be empty are left out (glTF forbids empty arrays).
+// The primitives of one plant's mesh: a JSON array, open while they are added, and how
+// many it holds.
+struct MeshPrimitives {
   JsonWriter json;
-  json.begin_object();
-  json.key("asset").begin_object().key("version").string("2.0").key("generator").string("sylva").end_object();
-  // The instances' placements exist only in the extension (the node has no fallback
-  // transform per instance): a viewer without it would show one plant at the origin, so
-  // the extension is required, not merely used (glTF 2.0 sec. 3.12).
-  if (any_instancing) {
-    json.key("extensionsUsed").begin_array().string("EXT_mesh_gpu_instancing").end_array();
-    json.key("extensionsRequired").begin_array().string("EXT_mesh_gpu_instancing").end_array();
+  size_t count = 0;
+};
+
+// The skeleton as LINES: vertex i is joint i; one (parent joint, child joint) pair per
+// segment, a branch's first segment starting at the joint it grows from.
+void add_skeleton_lines(const Skeleton& sk, BufferBuilder& buffer, MeshPrimitives& primitives) {
+  std::vector<float> positions, radii;
+  positions.reserve(sk.joints.size() * 3);
+  for (const Joint& j : sk.joints) {
+    for (double x : j.position_m) positions.push_back(static_cast<float>(x));
+    radii.push_back(static_cast<float>(j.radius_m));
   }
-  json.key("scene").integer(0);
-  json.key("scenes").begin_array().begin_object().key("nodes").begin_array();
-  for (size_t i = 0; i < nodes.size(); ++i) json.integer(i);
-  json.end_array().end_object().end_array();
-  json.key("nodes").begin_array();
-  for (const std::string& node : nodes) json.raw(node);
-  json.end_array();
-  if (!meshes.empty()) {
-    json.key("meshes").begin_array();
-    for (const std::string& mesh : meshes) json.raw(mesh);
-    json.end_array();
-  }
-  if (!table.materials().empty()) {
-    json.key("materials").begin_array();
-    for (const std::string& material : table.materials()) json.raw(material);
-    json.end_array();
-  }
-  if (!table.images().empty()) {
-    // Texture i shows image i; one sampler: linear, mipmapped, repeating (the bark tiles).
-    json.key("samplers").begin_array().begin_object();
-    json.key("magFilter").integer(kFilterLinear).key("minFilter").integer(kFilterLinearMipmapLinear);
-    json.key("wrapS").integer(kWrapRepeat).key("wrapT").integer(kWrapRepeat);
-    json.end_object().end_array();
-    json.key("textures").begin_array();
-    for (size_t i = 0; i < table.images().size(); ++i)
-      json.begin_object().key("sampler").integer(0).key("source").integer(i).end_object();
-    json.end_array();
-    json.key("images").begin_array();
-    for (const EmbeddedImage& image : table.images()) {
-      json.begin_object();
-      if (glb)
-        json.key("bufferView").integer(buffer.add_bytes(image.bytes)).key("mimeType").string(image.mime);
-      else
-        json.key("uri").string("data:" + std::string(image.mime) + ";base64," + base64(image.bytes));
-      json.end_object();
+  std::vector<uint32_t> pairs;
+  pairs.reserve(sk.segment_count() * 2);
+  for (const Chain& c : sk.chains) {
+    for (uint32_t j = 1; j < c.joint_count; ++j) {
+      uint32_t lower = c.first_joint + j - 1;
+      if (j == 1 && c.parent) lower = sk.chains[c.parent->chain].first_joint + c.parent->joint;
+      pairs.push_back(lower);
+      pairs.push_back(c.first_joint + j);
     }
-    json.end_array();
   }
+  const size_t pos = buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer);
+  const size_t rad = buffer.add_floats(radii, 1, "SCALAR", kTargetArrayBuffer);
+  const size_t idx = buffer.add_indices(pairs);
+  JsonWriter& json = primitives.json;
+  json.begin_object();
+  json.key("attributes").begin_object().key("POSITION").integer(pos).key("_RADIUS").integer(rad).end_object();
+  json.key("indices").integer(idx);
+  json.key("mode").integer(kModeLines);
+  json.end_object();
+  ++primitives.count;
+}
+
+// (u · u_repeat, v_m · v_per_metre) of every vertex of `tm`.
+std::vector<float> scaled_uvs(const TriangleMesh& tm, double u_repeat, double v_per_metre) {
+  std::vector<float> st;
+  st.reserve(tm.uvs.size() * 2);
+  for (const glm::dvec2& uv : tm.uvs)
+    st.insert(st.end(), {static_cast<float>(uv.x * u_repeat), static_cast<float>(uv.y * v_per_metre)});
+  return st;
+}
+
+// The vertex attributes all primitives of the segments share, as the text of a JSON
+// object left open (a primitive may add its TEXCOORD_1): POSITION, NORMAL, TANGENT with
+// a normal map (`tangents`), TEXCOORD_0 in the bark's repeats.
+std::string open_segment_attributes(const TriangleMesh& tm, const SkinnedSkeleton& skinned, const Bark& bark,
+                                    bool tangents, BufferBuilder& buffer) {
+  std::vector<float> positions, normals;
+  positions.reserve(tm.positions.size() * 3);
+  normals.reserve(tm.normals.size() * 3);
+  for (const glm::dvec3& p : tm.positions) append_float3(positions, p);
+  for (const glm::dvec3& n : tm.normals) append_unit_float3(normals, n);
+  const std::vector<float> texcoords = scaled_uvs(tm, bark.u_repeat, bark.v_per_metre);
+  // Accessor order NORMAL, POSITION, TANGENT, TEXCOORD_0: the order files written so
+  // far have (it came from GCC's right-to-left evaluation of a string concatenation),
+  // now fixed in code so that every compiler writes the same bytes.
+  const size_t normal_accessor = buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer);
+  const size_t position_accessor = buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer);
+  JsonWriter attributes;
+  attributes.begin_object();
+  attributes.key("POSITION").integer(position_accessor);
+  attributes.key("NORMAL").integer(normal_accessor);
+  if (tangents)
+    attributes.key("TANGENT").integer(buffer.add_floats(vertex_tangents(tm, skinned), 4, "VEC4", kTargetArrayBuffer));
+  attributes.key("TEXCOORD_0").integer(buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer));
+  return attributes.take();
+}
+
+// The segments of `skinned` tessellated (tessellate.h), one primitive per material index
+// in increasing order, with the bark's textures on the wood.
+Status add_segment_mesh(const SkinnedSkeleton& skinned, const Bark& bark, const GltfExportOptions& options,
+                        GltfDocument& doc, MeshPrimitives& primitives) {
+  TessellateOptions to;
+  to.segments_around = options.segments_around;
+  const TriangleMesh tm = tessellate(skinned, to);
+  if (tm.indices.empty()) return {};
+  const std::map<uint32_t, std::vector<uint32_t>> triangles_of = triangles_by_material(
+      tm.indices, tm.triangle_count(), [&](size_t t) { return skinned.frusta[tm.triangle_frustum[t]].material; });
+  // The bark's textures are the wood's (material 0, materials.h): a plant without
+  // wood embeds none.
+  const bool has_wood = triangles_of.count(0) > 0;
+  const double r_ref_m = median_segment_radius(skinned);
+  Expected<std::optional<size_t>> normal_map =
+      has_wood ? doc.table.normal_texture(bark, r_ref_m) : Expected<std::optional<size_t>>(std::optional<size_t>());
+  if (!normal_map) return std::move(normal_map.error());
+  const std::optional<size_t> normal_texture = *normal_map;
+
+  const std::string open_attributes =
+      open_segment_attributes(tm, skinned, bark, normal_texture.has_value(), doc.buffer);
+  const std::string shared_attributes = open_attributes + "}";
+  // A table image repeating otherwise than the bark reads TEXCOORD_1, its own
+  // (u · u_repeat, v_m · v_per_metre); one accessor per distinct pair of repeats.
+  std::map<std::pair<double, double>, std::string> attributes_with_texcoord_1;
+  for (const auto& [material, indices] : triangles_of) {
+    const bool wood = material == 0;  // the bark's textures are the wood's (materials.h)
+    const std::optional<SegmentTexture> segment = segment_texture(options.materials, &bark, material);
+    int texcoord = 0;
+    const std::string* primitive_attributes = &shared_attributes;
+    if (segment && (segment->u_repeat != bark.u_repeat || segment->v_per_metre != bark.v_per_metre)) {
+      texcoord = 1;
+      const std::pair<double, double> repeat{segment->u_repeat, segment->v_per_metre};
+      auto it = attributes_with_texcoord_1.find(repeat);
+      if (it == attributes_with_texcoord_1.end()) {
+        const size_t accessor =
+            doc.buffer.add_floats(scaled_uvs(tm, repeat.first, repeat.second), 2, "VEC2", kTargetArrayBuffer);
+        it = attributes_with_texcoord_1
+                 .emplace(repeat, open_attributes + ",\"TEXCOORD_1\":" + std::to_string(accessor) + "}")
+                 .first;
+      }
+      primitive_attributes = &it->second;
+    }
+    const size_t m = doc.table.material(material_json(
+        material, bark, options.materials,
+        segment ? std::optional<size_t>(doc.table.albedo_texture(segment->path)) : std::nullopt, texcoord,
+        wood ? normal_texture : std::nullopt, r_ref_m, doc.table.leaf_images()));
+    JsonWriter& json = primitives.json;
+    json.begin_object();
+    json.key("attributes").raw(*primitive_attributes);
+    json.key("indices").integer(doc.buffer.add_indices(indices));
+    json.key("material").integer(m);
+    json.key("mode").integer(kModeTriangles);
+    json.end_object();
+    ++primitives.count;
+  }
+  return {};
+}
+
+// The leaves (leaf_mesh.h): flat triangles with their leaf's normal at each vertex, one
+// primitive per material index in increasing order, double-sided materials;
+// TEXCOORD_0 = (u, 1 − v) of leaf_uvs (glTF's t runs down the image: an image drawn
+// upright, petiole at its bottom row, covers the leaf as the renderers map it).
+Status add_leaf_mesh(const Skeleton& sk, const GltfExportOptions& options, GltfDocument& doc,
+                     MeshPrimitives& primitives) {
+  LeafMesh leaves;
+  append_leaves(leaves, sk, 0);
+  std::vector<float> positions, normals, texcoords;
+  for (const glm::dvec2& t : leaves.uvs)
+    texcoords.insert(texcoords.end(), {static_cast<float>(t.x), static_cast<float>(1 - t.y)});
+  for (const glm::dvec3& q : leaves.positions) append_float3(positions, q);
+  for (uint32_t l : leaves.vertex_leaf) append_unit_float3(normals, leaves.leaves[l].normal);
+  const std::map<uint32_t, std::vector<uint32_t>> triangles_of = triangles_by_material(
+      leaves.indices, leaves.triangle_count(), [&](size_t t) { return leaves.leaves[leaves.triangle_leaf[t]].material; });
+  if (triangles_of.empty()) return {};
+  JsonWriter attributes;
+  attributes.begin_object();
+  attributes.key("POSITION").integer(doc.buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer));
+  attributes.key("NORMAL").integer(doc.buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer));
+  attributes.key("TEXCOORD_0").integer(doc.buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer));
+  attributes.end_object();
+  for (const auto& [material, indices] : triangles_of) {
+    JsonWriter& json = primitives.json;
+    json.begin_object();
+    json.key("attributes").raw(attributes.text());
+    json.key("indices").integer(doc.buffer.add_indices(indices));
+    Expected<std::optional<size_t>> texture = doc.table.leaf_texture(material);
+    if (!texture) return std::move(texture.error());
+    json.key("material").integer(
+        doc.table.material(leaf_material_json(material, options.materials, doc.table.leaf_images(), *texture)));
+    json.key("mode").integer(kModeTriangles);
+    json.end_object();
+    ++primitives.count;
+  }
+  return {};
+}
+
+// EXT_mesh_gpu_instancing: the node keeps the identity transform; each instance's TRS is
+// in the attributes (float), exact values in extras.sylva.instances.
+void write_instancing(JsonWriter& node, const std::vector<GltfPlant>& plants, const PlantGroup& group,
+                      BufferBuilder& buffer) {
+  std::vector<float> translation, rotation, scale;
+  for (size_t i : group.plants) {
+    const GltfPlant& p = plants[i];
+    for (double x : p.position_m) translation.push_back(static_cast<float>(x));
+    for (double q : quaternion_about_y(p.rotate_y_deg)) rotation.push_back(static_cast<float>(q));
+    for (int k = 0; k < 3; ++k) scale.push_back(static_cast<float>(p.scale));
+  }
+  const size_t t = buffer.add_floats(translation, 3, "VEC3", 0);
+  const size_t r = buffer.add_floats(rotation, 4, "VEC4", 0);
+  const size_t s = buffer.add_floats(scale, 3, "VEC3", 0);
+  node.key("extensions").begin_object().key("EXT_mesh_gpu_instancing").begin_object();
+  node.key("attributes").begin_object().key("TRANSLATION").integer(t).key("ROTATION").integer(r);
+  node.key("SCALE").integer(s).end_object();
+  node.end_object().end_object();
+}
+
+// A single plant's transform, each part only where it is not the identity's.
+void write_placement(JsonWriter& node, const GltfPlant& plant) {
+  if (plant.position_m[0] != 0 || plant.position_m[1] != 0 || plant.position_m[2] != 0)
+    node.key("translation").numbers(plant.position_m, 3);
+  if (plant.rotate_y_deg != 0) node.key("rotation").numbers(quaternion_about_y(plant.rotate_y_deg).data(), 4);
+  if (plant.scale != 1) {
+    const double s[3] = {plant.scale, plant.scale, plant.scale};
+    node.key("scale").numbers(s, 3);
+  }
+}
+
+// The skeleton document of docs/spec/skeleton.md, the seed as a string (JSON consumers read
+// numbers as doubles, which cannot hold every 64-bit seed).
+// "compact": the same document with its large arrays in bufferViews (gltf_export.h).
+void write_node_extras(JsonWriter& node, const std::vector<GltfPlant>& plants, const PlantGroup& group,
+                       const SkinnedSkeleton& skinned, GltfExtras extras, BufferBuilder& buffer) {
+  const Skeleton& sk = plants[group.plants.front()].skeleton;
+  if (extras == GltfExtras::full) {
+    node.key("extras").begin_object().key("sylva").begin_object();
+    write_skeleton_members(node, sk, {.compact = true, .seed_as_string = true});
+    write_skinning(node, skinned, nullptr);
+    node.key("instances").begin_array();
+    for (size_t i : group.plants) write_instance(node, plants[i]);
+    node.end_array();
+    node.end_object().end_object();
+  } else if (extras == GltfExtras::compact) {
+    node.key("extras").begin_object().key("sylva").begin_object();
+    write_compact_skeleton(node, sk, buffer);
+    write_skinning(node, skinned, &buffer);
+    std::vector<double> placement;
+    node.key("instances").begin_object().key("count").integer(group.plants.size());
+    node.key("names").begin_array();
+    for (size_t i : group.plants) {
+      const GltfPlant& p = plants[i];
+      node.string(p.name);
+      placement.insert(placement.end(), {p.position_m[0], p.position_m[1], p.position_m[2], p.rotate_y_deg, p.scale});
+    }
+    node.end_array();
+    write_view(node, "placement", placement, buffer);
+    node.end_object();
+    node.end_object().end_object();
+  }
+}
+
+// The mesh (where it has primitives) and the node of one group of plants, added to `doc`.
+Status add_plant_group(GltfDocument& doc, const std::vector<GltfPlant>& plants, const PlantGroup& group,
+                       const GltfExportOptions& options) {
+  const GltfPlant& plant = plants[group.plants.front()];
+  const Skeleton& sk = plant.skeleton;
+  const SkinnedSkeleton skinned = skin_skeleton(sk);
+
+  MeshPrimitives primitives;
+  primitives.json.begin_array();
+  if (sk.segment_count() > 0) add_skeleton_lines(sk, doc.buffer, primitives);
+  if (options.mesh && !skinned.frusta.empty())
+    if (Status added = add_segment_mesh(skinned, plant.bark, options, doc, primitives); !added) return added;
+  if (options.mesh && !sk.leaves.empty())
+    if (Status added = add_leaf_mesh(sk, options, doc, primitives); !added) return added;
+  primitives.json.end_array();
+
+  JsonWriter node;
+  node.begin_object();
+  node.key("name").string(plant.name);
+  if (primitives.count > 0) {
+    JsonWriter mesh;
+    mesh.begin_object();
+    mesh.key("name").string(plant.name);
+    mesh.key("primitives").raw(primitives.json.text());
+    mesh.end_object();
+    doc.meshes.push_back(mesh.take());
+    node.key("mesh").integer(doc.meshes.size() - 1);
+  }
+  if (group.plants.size() > 1) {
+    write_instancing(node, plants, group, doc.buffer);
+    doc.any_instancing = true;
+  } else {
+    write_placement(node, plant);
+  }
+  write_node_extras(node, plants, group, skinned, options.extras, doc.buffer);
+  node.end_object();
+  doc.nodes.push_back(node.take());
+  return {};
+}
+
+// Samplers, textures and images: texture i shows image i; one sampler: linear,
+// mipmapped, repeating (the bark tiles). Images go into the buffer in a .glb, into data
+// URIs in a .gltf.
+void write_textures(JsonWriter& json, const MaterialTable& table, bool glb, BufferBuilder& buffer) {
+  json.key("samplers").begin_array().begin_object();
+  json.key("magFilter").integer(kFilterLinear).key("minFilter").integer(kFilterLinearMipmapLinear);
+  json.key("wrapS").integer(kWrapRepeat).key("wrapT").integer(kWrapRepeat);
+  json.end_object().end_array();
+  json.key("textures").begin_array();
+  for (size_t i = 0; i < table.images().size(); ++i)
+    json.begin_object().key("sampler").integer(0).key("source").integer(i).end_object();
+  json.end_array();
+  json.key("images").begin_array();
+  for (const EmbeddedImage& image : table.images()) {
+    json.begin_object();
+    if (glb)
+      json.key("bufferView").integer(buffer.add_bytes(image.bytes)).key("mimeType").string(image.mime);
+    else
+      json.key("uri").string("data:" + std::string(image.mime) + ";base64," + base64(image.bytes));
+    json.end_object();
+  }
+  json.end_array();
+}
+
+// The buffer layout (see the top of this file): accessors, bufferViews and the one
+// buffer, in a .gltf as a data URI.
+void write_buffer_layout(JsonWriter& json, const BufferBuilder& buffer, bool glb) {
   const std::string& bin = buffer.bytes();
   if (!buffer.accessors().empty()) {
     json.key("accessors").begin_array();
@@ -937,34 +943,105 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
     if (!glb) json.key("uri").string("data:application/octet-stream;base64," + base64(bin));
     json.end_object().end_array();
   }
-  json.end_object();
-  const std::string text = json.take() + "\n";
+}
 
-  std::string file;
-  if (glb) {
-    std::string json_chunk = text;
-    while (json_chunk.size() % 4 != 0) json_chunk += ' ';
-    std::string bin_chunk = bin;
-    while (bin_chunk.size() % 4 != 0) bin_chunk += '\0';
-    const size_t total = 12 + 8 + json_chunk.size() + (bin_chunk.empty() ? 0 : 8 + bin_chunk.size());
-    if (total > std::numeric_limits<uint32_t>::max())
-      return file_diagnostic(path, "the model exceeds the 4 GiB of a GLB file");
-    file.reserve(total);
-    append_u32(file, kGlbMagic);
-    append_u32(file, 2);
-    append_u32(file, static_cast<uint32_t>(total));
-    append_u32(file, static_cast<uint32_t>(json_chunk.size()));
-    append_u32(file, kGlbChunkJson);
-    file += json_chunk;
-    if (!bin_chunk.empty()) {
-      append_u32(file, static_cast<uint32_t>(bin_chunk.size()));
-      append_u32(file, kGlbChunkBin);
-      file += bin_chunk;
-    }
-  } else {
-    file = text;
+// The glTF JSON document of `doc`, with its newline. Arrays that would be empty are left
+// out (glTF forbids empty arrays). In a .glb the images are appended to the buffer here.
+std::string document_json(GltfDocument& doc, bool glb) {
+  JsonWriter json;
+  json.begin_object();
+  json.key("asset").begin_object().key("version").string("2.0").key("generator").string("sylva").end_object();
+  // The instances' placements exist only in the extension (the node has no fallback
+  // transform per instance): a viewer without it would show one plant at the origin, so
+  // the extension is required, not merely used (glTF 2.0 sec. 3.12).
+  if (doc.any_instancing) {
+    json.key("extensionsUsed").begin_array().string("EXT_mesh_gpu_instancing").end_array();
+    json.key("extensionsRequired").begin_array().string("EXT_mesh_gpu_instancing").end_array();
   }
-  return write_file_atomically(path, file);
+  json.key("scene").integer(0);
+  json.key("scenes").begin_array().begin_object().key("nodes").begin_array();
+  for (size_t i = 0; i < doc.nodes.size(); ++i) json.integer(i);
+  json.end_array().end_object().end_array();
+  json.key("nodes").begin_array();
+  for (const std::string& node : doc.nodes) json.raw(node);
+  json.end_array();
+  if (!doc.meshes.empty()) {
+    json.key("meshes").begin_array();
+    for (const std::string& mesh : doc.meshes) json.raw(mesh);
+    json.end_array();
+  }
+  if (!doc.table.materials().empty()) {
+    json.key("materials").begin_array();
+    for (const std::string& material : doc.table.materials()) json.raw(material);
+    json.end_array();
+  }
+  if (!doc.table.images().empty()) write_textures(json, doc.table, glb, doc.buffer);
+  write_buffer_layout(json, doc.buffer, glb);
+  json.end_object();
+  return json.take() + "\n";
+}
+
+// The GLB container (glTF 2.0 sec. 4.4): header, the JSON chunk padded with spaces, the
+// binary chunk (if any) padded with zeros.
+Expected<std::string> glb_file(const std::string& text, const std::string& bin, const std::string& path) {
+  std::string json_chunk = text;
+  while (json_chunk.size() % 4 != 0) json_chunk += ' ';
+  std::string bin_chunk = bin;
+  while (bin_chunk.size() % 4 != 0) bin_chunk += '\0';
+  const size_t total = 12 + 8 + json_chunk.size() + (bin_chunk.empty() ? 0 : 8 + bin_chunk.size());
+  if (total > std::numeric_limits<uint32_t>::max())
+    return file_diagnostic(path, "the model exceeds the 4 GiB of a GLB file");
+  std::string file;
+  file.reserve(total);
+  append_u32(file, kGlbMagic);
+  append_u32(file, 2);
+  append_u32(file, static_cast<uint32_t>(total));
+  append_u32(file, static_cast<uint32_t>(json_chunk.size()));
+  append_u32(file, kGlbChunkJson);
+  file += json_chunk;
+  if (!bin_chunk.empty()) {
+    append_u32(file, static_cast<uint32_t>(bin_chunk.size()));
+    append_u32(file, kGlbChunkBin);
+    file += bin_chunk;
+  }
+  return file;
+}
+
+}  // namespace
+
+Status check_bark_textures(const Bark& bark) {
+  if (bark.albedo_texture) {
+    Expected<EmbeddedImage> image = read_albedo_image(*bark.albedo_texture);
+    if (!image) return std::move(image.error());
+  }
+  if (bark.height_texture) {
+    Expected<HeightMap> map = read_height_map(*bark.height_texture);
+    if (!map) return std::move(map.error());
+  }
+  return {};
+}
+
+double bark_reference_radius_m(const Skeleton& skeleton) { return median_segment_radius(skin_skeleton(skeleton)); }
+
+Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path, const GltfExportOptions& options) {
+  const std::string ext = lower_case(path);
+  const bool glb = ext.ends_with(".glb");
+  if (!glb && !ext.ends_with(".gltf")) return file_diagnostic(path, "the output must end in .gltf or .glb");
+  if (plants.empty()) return file_diagnostic(path, "no plants to export");
+  if (options.segments_around < 3 || options.segments_around > 4096)
+    return file_diagnostic(path, "segments around must be an integer from 3 to 4096");
+  for (size_t i = 0; i < plants.size(); ++i)
+    if (auto problem = plant_problem(plants[i], i)) return file_diagnostic(path, *problem);
+  GltfDocument doc;
+  if (options.mesh)
+    if (Status loaded = doc.table.load(plants, options.materials); !loaded) return loaded;
+  for (const PlantGroup& group : group_plants(plants, options))
+    if (Status added = add_plant_group(doc, plants, group, options); !added) return added;
+  const std::string text = document_json(doc, glb);
+  if (!glb) return write_file_atomically(path, text);
+  Expected<std::string> file = glb_file(text, doc.buffer.bytes(), path);
+  if (!file) return std::move(file.error());
+  return write_file_atomically(path, *file);
 }
 
 }  // namespace sylva

@@ -76,9 +76,10 @@ using solid_bounds::Bounds;
 // by a subtraction exact to half an ulp of its result, is re-centred on the midpoint in
 // plain double (measured on one core: 160 ns a test against the general function's 270,
 // whose compensated re-centring and plane offsets the cone's own frame makes
-// unnecessary; cone tests are most of a camera ray's cone query). Same regrouped
-// discriminant, same root choice, same answers to rounding (the stiff matrix, and the
-// tests against frustum_solid_interval).
+// unnecessary; cone tests are most of a camera ray's cone query). The same quadric and
+// Bounds::inside_cone, whose root choice it takes by the quick test first (nearly every
+// ray); same answers to rounding (the stiff matrix, and the tests against
+// frustum_solid_interval).
 SolidInterval ShadowConeGeometry::interval(const Ray& ray, double t_min, double t_max) const {
   SolidInterval out;
   const glm::dvec3& d = ray.direction;
@@ -94,41 +95,7 @@ SolidInterval ShadowConeGeometry::interval(const Ray& ray, double t_min, double 
   const double rho = radius0 + slope * oy, slope_dir_y = slope * dy;
   if (!b.linear_at_least(slope_dir_y, -rho, SolidBoundary::side)) return out;  // r(s) >= 0
   const glm::dvec3 origin_perp = o - oy * axis, dir_perp = d - dy * axis;
-  const double A = glm::dot(dir_perp, dir_perp) - slope_dir_y * slope_dir_y;
-  const double half_b = glm::dot(origin_perp, dir_perp) - rho * slope_dir_y;
-  const double C = glm::dot(origin_perp, origin_perp) - rho * rho;
-  const glm::dvec3 radial_term = rho * dir_perp - slope_dir_y * origin_perp;
-  const glm::dvec3 moment = glm::cross(origin_perp, dir_perp);
-  const double discriminant = glm::dot(radial_term, radial_term) - glm::dot(moment, moment);
-  if (A == 0) {
-    if (!b.linear_at_least(-2 * half_b, C, SolidBoundary::side)) return out;
-  } else if (!(discriminant >= 0)) {
-    if (A > 0 || std::isnan(discriminant)) return out;  // A < 0: the whole line (near the apex)
-  } else {
-    const double sign_b = half_b >= 0 ? 1.0 : -1.0;
-    const double root = std::sqrt(discriminant);
-    const double q = -(half_b + sign_b * root);
-    double r0 = q / A;
-    // The other root: C/q or the textbook form, the one with the smaller error bound
-    // (relief.cpp says why: a tangent ray re-centred at the tangent point). The textbook
-    // bound is at least ε·|q|/|A| (|q| = |half_b| + √D'), so where ε·(|w⊥|² + ρ²)/|q|
-    // is below that, C/q wins without the rest of the bounds (nearly every ray).
-    const double op2 = glm::dot(origin_perp, origin_perp);
-    bool pair = (op2 + rho * rho) * std::abs(A) <= q * q;
-    if (!pair && q != 0) {
-      constexpr double eps = std::numeric_limits<double>::epsilon();
-      const double dp2 = glm::dot(dir_perp, dir_perp);
-      const double c_error = eps * (op2 + rho * rho);
-      const double half_b_error = eps * (std::sqrt(op2 * dp2) + std::abs(rho * slope_dir_y));
-      const double d_error = eps * (glm::dot(radial_term, radial_term) + glm::dot(moment, moment));
-      const double root_error = d_error / (root + std::sqrt(d_error) + std::numeric_limits<double>::min());
-      const double direct_bound = (eps * (std::abs(half_b) + root) + half_b_error + root_error) / std::abs(A);
-      pair = c_error / std::abs(q) <= direct_bound;
-    }
-    double r1 = pair ? C / q : (-half_b + sign_b * root) / A;
-    if (r1 < r0) std::swap(r0, r1);
-    if (!b.inside_quadric(A, r0, r1)) return out;
-  }
+  if (!b.inside_cone(origin_perp, dir_perp, rho, slope_dir_y, solid_bounds::SecondRoot::quick_then_bounds)) return out;
   if (!std::isfinite(b.lo) || !std::isfinite(b.hi)) return out;
   out.t_enter = shift + b.lo, out.enter = b.lo_by;
   out.t_exit = shift + b.hi, out.exit = b.hi_by;
