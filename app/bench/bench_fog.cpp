@@ -36,7 +36,6 @@
 #include <set>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "app/bench/bench_metrics.h"
@@ -52,6 +51,7 @@
 #include "core/util/file_io.h"
 #include "core/util/random.h"
 #include "core/util/clock.h"
+#include "core/util/parallel.h"
 
 namespace sylva::cli {
 
@@ -688,7 +688,7 @@ int run_bench_fog(const std::vector<std::string>& args) {
                  "its photons and cones alone\n";
     return kInputError;
   }
-  const unsigned threads = a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = worker_count(a.threads);
   const std::string header = run_header(a, scene, threads);
   // Read before the run: a bad file fails in a second, not after an hour.
   Expected<std::vector<Row>> merged = read_merge_files(a.merge, header);

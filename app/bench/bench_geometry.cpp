@@ -25,7 +25,6 @@
 #include <iostream>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "app/bench/bench_metrics.h"
@@ -34,6 +33,7 @@
 #include "core/util/file_io.h"
 #include "app/bench/plot.h"
 #include "core/cpu/render_cpu.h"
+#include "core/util/parallel.h"
 
 namespace sylva::cli {
 
@@ -185,7 +185,7 @@ int run_bench_geometry(const std::vector<std::string>& args) {
   auto loaded = load_render_input(a.grammar, a.width.value_or(512), a.height.value_or(384), passes);
   if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
   const Scene scene = std::move(std::get<Scene>(loaded));
-  const unsigned threads = a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = worker_count(a.threads);
   const bool relief = scene_has_relief(scene);
   std::cerr << "sylva bench geometry: " << a.grammar.grammar << ", " << scene.width << "x" << scene.height << ", "
             << threads << " threads; reference " << describe_reference(relief, a.reference_steps, a.reference_bisection)

@@ -46,7 +46,6 @@
 #include <optional>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <unistd.h>
@@ -63,6 +62,7 @@
 #include "core/scene/render_common.h"
 #include "core/gl/render_gl.h"
 #include "core/util/clock.h"
+#include "core/util/parallel.h"
 
 namespace sylva::cli {
 
@@ -263,7 +263,7 @@ class LazyReference {
   const RenderImage& image() {
     if (!image_) {
       const bool relief = scene_has_relief(scene_);
-      const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+      const unsigned threads = worker_count(0);
       std::cerr << "sylva bench gpu: CPU reference " << describe() << ", " << scene_.width << "x" << scene_.height
                 << ", " << threads << " threads\n";
       image_ = render_cpu_timed(scene_, reference_geometry(relief, args_.reference_steps, args_.reference_bisection),
@@ -336,7 +336,7 @@ void run_method(const Scene& scene, uint32_t frames, uint32_t warmup, LazyRefere
       // The moving plants have no converged reference: the CPU draws the last pose the
       // same way, which checks that update_plants uploaded it.
       row.reference = "RC at the same pose (CPU)";
-      const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+      const unsigned threads = worker_count(0);
       row.errors = compare_images(render_cpu_timed(posed, m.geometry, threads).result.image, image);
     } else {
       row.reference = reference.describe();

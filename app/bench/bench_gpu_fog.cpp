@@ -8,7 +8,6 @@
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <thread>
 #include <variant>
 
 #include <unistd.h>
@@ -22,6 +21,7 @@
 #include "core/cpu/photons.h"
 #include "core/cpu/render_cpu.h"
 #include "core/gl/render_gl.h"
+#include "core/util/parallel.h"
 
 namespace sylva::cli {
 
@@ -100,7 +100,7 @@ int run_gpu_fog_rows(const GpuFogArgs& a, const std::string& device, const GlCon
   }
   std::printf("%-34s %-11s %10s %10s %10s %8s %10s %9s\n", "input", "method", "fog_ms", "cones_ms", "frame_ms", "cones",
               "rmse_rel", "bias_rel");
-  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = worker_count(0);
   std::vector<PlotPanel> panels;
   int failed = 0;
   for (const std::string& input : a.inputs) {

@@ -30,7 +30,6 @@
 #include <iostream>
 #include <limits>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "app/bench/bench_metrics.h"
@@ -43,6 +42,7 @@
 #include "core/geometry/tessellate.h"
 #include "core/grow/turtle.h"
 #include "core/grow/grow.h"
+#include "core/util/parallel.h"
 
 namespace sylva::cli {
 
@@ -66,19 +66,10 @@ double time_trace(size_t rays, unsigned threads, int repeats,
   double best = std::numeric_limits<double>::infinity();
   for (int r = 0; r < repeats; ++r) {
     auto t0 = std::chrono::steady_clock::now();
-    constexpr size_t kChunk = 4096;
-    std::atomic<size_t> next{0};
-    auto worker = [&] {
-      for (;;) {
-        size_t begin = next.fetch_add(kChunk);
-        if (begin >= rays) return;
-        trace(begin, std::min(rays, begin + kChunk));
-      }
-    };
-    std::vector<std::thread> pool;
-    for (unsigned k = 1; k < threads; ++k) pool.emplace_back(worker);
-    worker();
-    for (std::thread& t : pool) t.join();
+    constexpr size_t kChunk = 4096;  // rays per work item
+    parallel_for((rays + kChunk - 1) / kChunk, threads, nullptr, [&](size_t chunk, unsigned) {
+      trace(chunk * kChunk, std::min(rays, (chunk + 1) * kChunk));
+    });
     best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
   return best;
@@ -176,7 +167,7 @@ int run_bench_raycast(const std::vector<std::string>& args) {
   rays.reserve(static_cast<size_t>(width) * height);
   for (uint32_t y = 0; y < height; ++y)
     for (uint32_t x = 0; x < width; ++x) rays.push_back(camera_ray(scene, x + 0.5, y + 0.5));
-  const unsigned all = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned all = worker_count(0);
   double scale = 0;
   {
     Aabb box{glm::dvec3(std::numeric_limits<double>::infinity()), glm::dvec3(-std::numeric_limits<double>::infinity())};

@@ -29,7 +29,6 @@
 #include <optional>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "app/bench/bench_metrics.h"
@@ -42,6 +41,7 @@
 #include "core/gl/render_gl.h"
 #include "core/util/color.h"
 #include "core/util/file_io.h"
+#include "core/util/parallel.h"
 
 namespace sylva::cli {
 
@@ -226,7 +226,7 @@ int run_bench_spp(const std::vector<std::string>& args) {
     return kOk;
   }
   const uint32_t width = a.width.value_or(a.quick ? 160 : 800), height = a.height.value_or(a.quick ? 120 : 600);
-  const unsigned threads = a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = worker_count(a.threads);
 
   std::vector<std::string> backends;
   if (a.cpu) backends.push_back("cpu");

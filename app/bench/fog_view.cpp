@@ -2,14 +2,13 @@
 #include "app/bench/fog_view.h"
 
 #include <algorithm>
-#include <atomic>
 #include <limits>
-#include <thread>
 
 #include "core/scene/render_common.h"
 #include "core/light/shading.h"
 #include "core/util/random.h"
 #include "core/util/clock.h"
+#include "core/util/parallel.h"
 
 namespace sylva::cli {
 
@@ -49,24 +48,16 @@ std::vector<float> fog_image(const View& v, const FogIntegrator& integrator, uin
                              double* seconds, double* cpu_seconds) {
   const size_t n = v.origin.size();
   std::vector<float> out(n * 3);
-  std::atomic<size_t> next{0};
+  constexpr size_t kChunk = 256;  // pixels per work item
   const auto start = Clock::now();
   const double cpu_start = process_cpu_seconds();
-  auto worker = [&] {
-    for (;;) {
-      const size_t begin = next.fetch_add(256);
-      if (begin >= n) return;
-      for (size_t i = begin; i < std::min(n, begin + 256); ++i) {
-        render_common::SampleRng rng(mix_pair(seed, i));
-        const FogRayResult r = integrator.integrate(v.origin[i], v.direction[i], v.t_end[i], rng);
-        for (int c = 0; c < 3; ++c) out[i * 3 + c] = static_cast<float>(r.inscatter[c]);
-      }
+  parallel_for((n + kChunk - 1) / kChunk, threads, nullptr, [&](size_t chunk, unsigned) {
+    for (size_t i = chunk * kChunk; i < std::min(n, (chunk + 1) * kChunk); ++i) {
+      render_common::SampleRng rng(mix_pair(seed, i));
+      const FogRayResult r = integrator.integrate(v.origin[i], v.direction[i], v.t_end[i], rng);
+      for (int c = 0; c < 3; ++c) out[i * 3 + c] = static_cast<float>(r.inscatter[c]);
     }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
+  });
   *seconds = seconds_since(start);
   if (cpu_seconds) *cpu_seconds = process_cpu_seconds() - cpu_start;
   return out;

@@ -36,9 +36,9 @@ View pixel_rays(const Scene& scene, const SceneTracer& tracer);
 View strided(const View& v, uint32_t stride, std::vector<size_t>* pixels);
 
 // The in-scatter of every ray of `v` (RGB, in the view's order) by `integrator` on
-// `threads` threads; ray i's random numbers from (seed, i) only, so the image does not
-// depend on the thread count. *seconds: wall time; *cpu_seconds (when given): the
-// process's CPU time meanwhile (core-seconds).
+// `threads` threads (0: every core); ray i's random numbers from (seed, i) only, so the
+// image does not depend on the thread count. *seconds: wall time; *cpu_seconds (when
+// given): the process's CPU time meanwhile (core-seconds).
 std::vector<float> fog_image(const View& v, const FogIntegrator& integrator, uint64_t seed, unsigned threads,
                              double* seconds, double* cpu_seconds = nullptr);
 

@@ -1,14 +1,14 @@
-// batch.cpp — seed ranges, output patterns and the thread pool of batch.h.
+// batch.cpp — seed ranges, output patterns and the seed tasks of batch.h on parallel_for.
 #include "app/front/batch.h"
 
 #include <algorithm>
-#include <atomic>
 #include <exception>
 #include <filesystem>
 #include <iostream>
 #include <mutex>
 #include <new>
-#include <thread>
+
+#include "core/util/parallel.h"
 
 namespace sylva::cli {
 
@@ -147,36 +147,25 @@ std::vector<uint64_t> run_seed_tasks(const SeedRange& range, unsigned threads,
                                                               uint64_t done, uint64_t total)>& on_done,
                                      const Progress& progress) {
   const uint64_t total = range.count();
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  const unsigned workers = static_cast<unsigned>(std::min<uint64_t>(threads ? threads : cores, total));
-  std::atomic<uint64_t> next{0};
   std::mutex done_mutex;
   uint64_t done = 0;
   std::vector<uint64_t> failed;
-
-  auto work = [&] {
-    for (uint64_t k; !progress.cancelled() && (k = next.fetch_add(1)) < total;) {
-      const uint64_t seed = range.first + k;
-      SeedTaskResult r;
-      try {
-        r = task(seed);
-      } catch (const std::bad_alloc&) {
-        r.error = file_diagnostic("", "out of memory");
-      } catch (const std::exception& e) {
-        r.error = file_diagnostic("", std::string("internal error: ") + e.what());
-      }
-      std::lock_guard<std::mutex> lock(done_mutex);
-      ++done;
-      if (r.error) failed.push_back(seed);
-      on_done(seed, r, done, total);
-      progress.report(static_cast<double>(done) / static_cast<double>(total), "batch");
+  parallel_for(total, threads, progress.cancel_flag(), [&](size_t k, unsigned) {
+    const uint64_t seed = range.first + k;
+    SeedTaskResult r;
+    try {
+      r = task(seed);
+    } catch (const std::bad_alloc&) {
+      r.error = file_diagnostic("", "out of memory");
+    } catch (const std::exception& e) {
+      r.error = file_diagnostic("", std::string("internal error: ") + e.what());
     }
-  };
-  std::vector<std::thread> pool;
-  pool.reserve(workers);
-  for (unsigned i = 1; i < workers; ++i) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
+    std::lock_guard<std::mutex> lock(done_mutex);
+    ++done;
+    if (r.error) failed.push_back(seed);
+    on_done(seed, r, done, total);
+    progress.report(static_cast<double>(done) / static_cast<double>(total), "batch");
+  });
   std::sort(failed.begin(), failed.end());
   return failed;
 }

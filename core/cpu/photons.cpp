@@ -13,7 +13,6 @@
 #include <map>
 #include <mutex>
 #include <stdexcept>
-#include <thread>
 #include <sys/mman.h>
 #include <time.h>
 
@@ -25,6 +24,7 @@
 #include "core/scene/render_common.h"
 #include "core/geometry/relief.h"
 #include "core/util/math.h"
+#include "core/util/parallel.h"
 #include "core/util/random.h"
 #include "core/util/clock.h"
 
@@ -82,32 +82,6 @@ glm::dvec3 photon_direction(const glm::dvec3& to_sun, const AxisFrame& f, double
   const double h = (x * x + y * y) * one_minus_cos_alpha;
   const double lateral = std::sqrt(one_minus_cos_alpha * (2 - h));
   return -((1 - h) * to_sun + lateral * (x * f.e0 + y * f.e1));
-}
-
-unsigned thread_count(unsigned requested) {
-  return requested ? requested : std::max(1u, std::thread::hardware_concurrency());
-}
-
-// Runs work(chunk) for chunks [0, chunks) on `threads` threads; stops handing out chunks
-// once `cancel` is set. Returns whether every chunk ran.
-template <class Work>
-bool parallel_chunks(uint64_t chunks, unsigned threads, const std::atomic<bool>* cancel, Work&& work) {
-  std::atomic<uint64_t> next{0}, done{0};
-  auto worker = [&] {
-    for (;;) {
-      if (cancel && cancel->load(std::memory_order_relaxed)) return;
-      const uint64_t c = next.fetch_add(1, std::memory_order_relaxed);
-      if (c >= chunks) return;
-      work(c);
-      done.fetch_add(1, std::memory_order_relaxed);
-    }
-  };
-  threads = static_cast<unsigned>(std::min<uint64_t>(threads, std::max<uint64_t>(1, chunks)));
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
-  return done.load() == chunks;
 }
 
 // A prototype's frustum placed by `x` (instances.h): the same solid in the world. A plane
@@ -266,11 +240,7 @@ class SunMask {
       for (const Capsule& c : capsules) draw(c);
       for_each_placed(draw);
     };
-    std::vector<std::thread> pool;
-    for (unsigned b = 1; b < bands; ++b)
-      pool.emplace_back(rasterise, band_row(b), band_row(b + 1));
-    rasterise(0, band_row(1));
-    for (std::thread& t : pool) t.join();
+    run_on_workers(bands, [&](unsigned b) { rasterise(band_row(b), band_row(b + 1)); });
     // The coarse bitmap, keyed by the position at the middle depth: grown by the drift
     // from there to either end of the depth range, in coarse cells, and one more.
     z_mid_ = 0.5 * (z_lo + z_hi);
@@ -453,7 +423,7 @@ SunPhotons trace_photons(const SunMask& mask, const SunEmitter& e, const SunPhot
   std::vector<std::vector<ShadowVector>> per_chunk(chunks);
   std::vector<uint8_t> ran(chunks, 0);
 
-  auto trace_chunk = [&](uint64_t c) {
+  auto trace_chunk = [&](uint64_t c, unsigned) {
     std::vector<ShadowVector>& local = per_chunk[c];
     const uint64_t end = std::min(options.photons, (c + 1) * kChunk);
     for (uint64_t i = c * kChunk; i < end; ++i) {
@@ -467,7 +437,7 @@ SunPhotons trace_photons(const SunMask& mask, const SunEmitter& e, const SunPhot
     }
     ran[c] = 1;
   };
-  out.cancelled = !parallel_chunks(chunks, thread_count(options.threads), options.cancel, trace_chunk);
+  out.cancelled = !parallel_for(chunks, options.threads, options.cancel, trace_chunk);
   size_t total = 0;
   for (const auto& v : per_chunk) total += v.size();
   out.vectors.vectors.reserve(total);
@@ -588,7 +558,7 @@ SunPhotonTracer::SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun
   impl_->emitter = sun_emitter(frusta, sun, leaf_mesh ? leaf_mesh->bounds() : empty_box());
   if (!frusta.empty()) {
     impl_->accel.emplace(frusta);
-    impl_->mask.emplace(frusta, leaf_mesh, impl_->emitter, thread_count(threads));
+    impl_->mask.emplace(frusta, leaf_mesh, impl_->emitter, worker_count(threads));
   }
   impl_->build_seconds = seconds_since(start);
 }
@@ -654,7 +624,7 @@ SunPhotonTracer::SunPhotonTracer(const SceneGeometry& geometry, const Sun& sun, 
   if (any_frusta && leaf_lo.x <= leaf_hi.x) lo = glm::min(lo, leaf_lo), hi = glm::max(hi, leaf_hi);
   m.any_frusta = any_frusta;
   m.emitter = sun_emitter_of_box(lo, hi, any_frusta, sun);
-  if (any_frusta) m.mask.emplace(geometry.frusta, world_leaves, m.emitter, thread_count(threads), &placed);
+  if (any_frusta) m.mask.emplace(geometry.frusta, world_leaves, m.emitter, worker_count(threads), &placed);
   m.build_seconds += seconds_since(start);
 }
 
@@ -950,7 +920,7 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
   char detail[160];
   std::snprintf(detail, sizeof detail, "%llu photons, %zu shadow vectors, %s",
                 static_cast<unsigned long long>(out->photons), out->vectors.vectors.size(),
-                (std::to_string(thread_count(options.photons.threads)) + " threads").c_str());
+                (std::to_string(worker_count(options.photons.threads)) + " threads").c_str());
   out->passes.push_back({"photons", out->photon_seconds, detail});
   if (out->cancelled) return out;
 

@@ -16,6 +16,7 @@
 #include "core/light/shading.h"
 #include "core/cpu/texture.h"
 #include "core/util/math.h"
+#include "core/util/parallel.h"
 #include "core/util/clock.h"
 
 #include <algorithm>
@@ -23,11 +24,9 @@
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <limits>
-#include <mutex>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
-#include <thread>
 
 namespace sylva {
 
@@ -689,39 +688,33 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   const uint32_t tiles_x = (scene.width + kTile - 1) / kTile;
   const uint32_t tiles_y = (scene.height + kTile - 1) / kTile;
   const uint32_t tiles = tiles_x * tiles_y;
-  unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-  threads = std::min<unsigned>(threads, tiles);
+  const unsigned threads = std::min<unsigned>(worker_count(options.threads), tiles);
 
   Renderer renderer(scene, geometry, options, textures.get(), fog ? &*fog : nullptr);
-  std::atomic<uint32_t> next_tile{0}, done_tiles{0};
-  std::mutex totals_mutex;
-  TileCost total;
-  auto worker = [&] {
-    TileCost mine;
-    for (;;) {
-      if (options.progress.cancelled()) break;
-      const uint32_t tile = next_tile.fetch_add(1, std::memory_order_relaxed);
-      if (tile >= tiles) break;
-      renderer.render_tile(tile, image, &mine);
-      const uint32_t done = done_tiles.fetch_add(1, std::memory_order_acq_rel) + 1;
-      if (done < tiles) tile_progress.report(static_cast<double>(done) / tiles, "render");
-    }
-    std::lock_guard lock(totals_mutex);
-    total.trace_s += mine.trace_s;
-    total.shade_s += mine.shade_s;
-    total.fog_s += mine.fog_s;
-    total.shadow_rays += mine.shadow_rays;
-    total.fog_rays += mine.fog_rays;
-    total.fog_shadow_rays += mine.fog_shadow_rays;
-    total.fog_stopped += mine.fog_stopped;
+  std::atomic<uint32_t> done_tiles{0};
+  // A worker's costs, a cache line of its own: render_tile adds to them for every pixel.
+  struct alignas(64) WorkerCost {
+    TileCost cost;
   };
+  std::vector<WorkerCost> worker_costs(threads);
 
   const Clock::time_point start = Clock::now();
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
+  parallel_for(tiles, threads, options.progress.cancel_flag(), [&](size_t tile, unsigned worker) {
+    renderer.render_tile(static_cast<uint32_t>(tile), image, &worker_costs[worker].cost);
+    const uint32_t done = done_tiles.fetch_add(1, std::memory_order_acq_rel) + 1;
+    if (done < tiles) tile_progress.report(static_cast<double>(done) / tiles, "render");
+  });
   const double wall = seconds_since(start);
+  TileCost total;
+  for (const WorkerCost& w : worker_costs) {
+    total.trace_s += w.cost.trace_s;
+    total.shade_s += w.cost.shade_s;
+    total.fog_s += w.cost.fog_s;
+    total.shadow_rays += w.cost.shadow_rays;
+    total.fog_rays += w.cost.fog_rays;
+    total.fog_shadow_rays += w.cost.fog_shadow_rays;
+    total.fog_stopped += w.cost.fog_stopped;
+  }
   result.cancelled = done_tiles.load() < tiles;
   if (!result.cancelled) tile_progress.report(1, "render");
   result.primary_rays = pixels * std::max(1u, options.spp);

@@ -7,10 +7,11 @@
 #include <chrono>
 #include <mutex>
 #include <optional>
-#include <thread>
 #include <tuple>
 #include <utility>
 #include <vector>
+
+#include "core/util/parallel.h"
 
 namespace sylva {
 
@@ -88,35 +89,26 @@ Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& pro
     plant_recipe[i] = it->second;
   }
   std::vector<std::optional<Expected<GrowResult>>> grown(first_plant.size());
-  std::atomic<size_t> next{0}, done{0};
+  std::atomic<size_t> done{0};
   std::mutex report;
   const double total = static_cast<double>(std::max<size_t>(1, first_plant.size()));
-  auto work = [&] {
-    for (size_t r; (r = next.fetch_add(1)) < first_plant.size();) {
-      if (progress.cancelled()) return;
-      const ScenePlant& p = scene.plants[first_plant[r]];
-      const Expected<lsys::Grammar>& g = grammars.at(Source{p.grammar, p.defines});
-      if (!g) continue;  // reported below, at its first plant
-      lsys::DeriveOptions derive;
-      derive.steps = p.steps;
-      derive.seed = p.seed;
-      derive.max_modules = max_modules;
-      // One plant: its derivation's own progress; many: each polls the flag, reports once done.
-      derive.progress = first_plant.size() == 1 ? progress : Progress(progress.cancel_flag());
-      grown[r] = grow(*g, derive, p.grammar, p.defines);
-      const size_t finished = done.fetch_add(1) + 1;
-      if (first_plant.size() > 1) {
-        std::lock_guard<std::mutex> lock(report);
-        progress.report(static_cast<double>(finished) / total, "grow");
-      }
+  parallel_for(first_plant.size(), 0, progress.cancel_flag(), [&](size_t r, unsigned) {
+    const ScenePlant& p = scene.plants[first_plant[r]];
+    const Expected<lsys::Grammar>& g = grammars.at(Source{p.grammar, p.defines});
+    if (!g) return;  // reported below, at its first plant
+    lsys::DeriveOptions derive;
+    derive.steps = p.steps;
+    derive.seed = p.seed;
+    derive.max_modules = max_modules;
+    // One plant: its derivation's own progress; many: each polls the flag, reports once done.
+    derive.progress = first_plant.size() == 1 ? progress : Progress(progress.cancel_flag());
+    grown[r] = grow(*g, derive, p.grammar, p.defines);
+    const size_t finished = done.fetch_add(1) + 1;
+    if (first_plant.size() > 1) {
+      std::lock_guard<std::mutex> lock(report);
+      progress.report(static_cast<double>(finished) / total, "grow");
     }
-  };
-  const unsigned threads = static_cast<unsigned>(
-      std::min<size_t>(first_plant.size(), std::max(1u, std::thread::hardware_concurrency())));
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
-  if (threads > 0) work();
-  for (std::thread& t : pool) t.join();
+  });
   // Every plant whose recipe grew keeps its skeleton, also when another failed or the
   // work was cancelled.
   for (size_t i = 0; i < scene.plants.size(); ++i) {

@@ -11,12 +11,12 @@
 #include <glm/geometric.hpp>
 #include <memory>
 #include <nanoflann.hpp>
-#include <thread>
 
 #include "core/geometry/relief.h"
 #include "core/geometry/skin.h"
 #include "core/geometry/solid_bounds.h"
 #include "core/util/math.h"
+#include "core/util/parallel.h"
 
 namespace sylva {
 namespace {
@@ -522,19 +522,13 @@ struct ShadowVectorIndex::Plant {
 
 namespace {
 
-// Runs body(thread, begin, end) over [0, n) split into `threads` contiguous ranges.
+// Runs body(thread, begin, end) over [0, n) split into `threads` (>= 1) contiguous
+// ranges, fewer for a small n (at most n/64 + 1): a thread is worth its start-up only
+// for a few dozen items.
 template <class Body>
 void parallel_ranges(size_t n, unsigned threads, Body&& body) {
   threads = static_cast<unsigned>(std::max<size_t>(1, std::min<size_t>(threads, n / 64 + 1)));
-  if (threads == 1) return body(0u, size_t(0), n);
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < threads; ++t)
-    pool.emplace_back([&, t] { body(t, n * t / threads, n * (t + 1) / threads); });
-  for (std::thread& th : pool) th.join();
-}
-
-unsigned thread_count(unsigned requested) {
-  return requested ? requested : std::max(1u, std::thread::hardware_concurrency());
+  run_on_workers(threads, [&](unsigned t) { body(t, n * t / threads, n * (t + 1) / threads); });
 }
 
 // atan2 within 1e-5 rad (a minimax polynomial on one octant): the angular sector of a
@@ -759,7 +753,7 @@ ShadowVectorIndex::ShadowVectorIndex(const ShadowVectors& vectors, std::span<con
       pl.table.resize(n * neighbours_p1);
       pl.table_dist.resize(n * neighbours_p1);
       pl.table_count.resize(n);
-      parallel_ranges(n, thread_count(threads), [&](unsigned, size_t b, size_t e) {
+      parallel_ranges(n, worker_count(threads), [&](unsigned, size_t b, size_t e) {
         for (size_t i = b; i < e; ++i) {
           const std::array<float, 3>& q = pl.cloud.points[i];
           pl.table_count[i] = static_cast<uint32_t>(
@@ -785,7 +779,7 @@ std::vector<ShadowCone> ShadowVectorIndex::cluster(const ConeParams& params, con
   rep.vectors = vectors_.vectors.size();
   if (cone_of_vector) cone_of_vector->assign(vectors_.vectors.size(), kNoCone);
   std::vector<ShadowCone> cones;
-  const unsigned workers = thread_count(threads);
+  const unsigned workers = worker_count(threads);
   std::vector<Scratch> scratch(workers);
   std::vector<Proposal> proposals;
   std::vector<uint32_t> seeds;
