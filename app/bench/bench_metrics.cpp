@@ -113,7 +113,7 @@ uint32_t parse_count(const std::string& flag, const std::string& value, uint64_t
 std::string input_stem(const std::string& path) {
   std::string name = path.substr(path.find_last_of('/') + 1);
   for (const std::string e : {".scene.json", ".skel.json", ".lsys", ".glb", ".gltf"}) {
-    if (name.size() > e.size() && name.compare(name.size() - e.size(), e.size(), e) == 0)
+    if (name.size() > e.size() && name.ends_with(e))
       return name.substr(0, name.size() - e.size());
   }
   return name;

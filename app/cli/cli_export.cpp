@@ -12,6 +12,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "app/front/batch.h"
@@ -74,16 +75,12 @@ void print_export_help() {
                "  -h, --help               show this help\n";
 }
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // The node name of a plant: the file name without folder and extension(s).
 std::string plant_name(const std::string& path) {
   std::string name = std::filesystem::path(path).filename().string();
-  for (const char* ext : {".lsys", ".skel.json", ".json"})
-    if (ends_with(name, ext) && name.size() > std::string(ext).size()) {
-      name.resize(name.size() - std::string(ext).size());
+  for (std::string_view ext : {".lsys", ".skel.json", ".json"})
+    if (name.ends_with(ext) && name.size() > ext.size()) {
+      name.resize(name.size() - ext.size());
       break;
     }
   return name;
@@ -203,11 +200,11 @@ int run_export(const std::vector<std::string>& raw_args) {
   const auto start = std::chrono::steady_clock::now();
   const std::string& input = a.grammar;
   InputKind kind;
-  if (ends_with(input, ".skel.json")) kind = InputKind::skeleton;
-  else if (ends_with(input, ".scene.json")) kind = InputKind::scene;
-  else if (ends_with(input, ".lsys")) kind = InputKind::grammar;
+  if (input.ends_with(".skel.json")) kind = InputKind::skeleton;
+  else if (input.ends_with(".scene.json")) kind = InputKind::scene;
+  else if (input.ends_with(".lsys")) kind = InputKind::grammar;
   else throw UsageError{"INPUT '" + input + "' must be a .lsys grammar, a .skel.json skeleton or a .scene.json scene"};
-  if (!ends_with(a.output, ".gltf") && !ends_with(a.output, ".glb"))
+  if (!a.output.ends_with(".gltf") && !a.output.ends_with(".glb"))
     throw UsageError{"-o " + a.output + ": the output must end in .gltf or .glb"};
   if (kind != InputKind::grammar && (a.steps || a.seed || range || !a.defines.empty()))
     throw UsageError{"-n, --seed and -D apply to a .lsys INPUT only"};

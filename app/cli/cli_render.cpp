@@ -328,10 +328,6 @@ FrameRange parse_frames(const std::string& v) {
   return {*first, *last, false};
 }
 
-bool ends_with(const std::string& s, std::string_view suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 std::string seconds_text(double s) {
   char buf[32];
   std::snprintf(buf, sizeof buf, s < 10 ? "%.2f s" : "%.0f s", s);
@@ -348,7 +344,7 @@ int run_render_frames(const RenderArgs& a) {
   const std::string& input = a.grammar.grammar;
   const std::string& pattern = a.grammar.output;
   const bool growth = is_grammar_input(input);
-  if (!growth && !ends_with(input, ".scene.json"))
+  if (!growth && !input.ends_with(".scene.json"))
     throw UsageError{"--frames applies to a .scene.json scene with an animation key (its plants move) or a .lsys "
                      "grammar (frame k is k derivation steps)"};
   if (growth && a.grammar.steps) throw UsageError{"--frames on a grammar sets the derivation steps: leave out -n"};
@@ -357,7 +353,7 @@ int run_render_frames(const RenderArgs& a) {
   FrameRange range = parse_frames(*a.frames);
   std::optional<std::string> ffmpeg;
   if (a.video) {
-    if (!ends_with(pattern, ".png")) throw UsageError{"--video encodes PNG frames: -o must end in .png"};
+    if (!pattern.ends_with(".png")) throw UsageError{"--video encodes PNG frames: -o must end in .png"};
     if (!video_container_for(*a.video))
       throw UsageError{"--video " + *a.video + ": expected a .mp4, .mkv, .webm, .mov or .gif file"};
     ffmpeg = find_ffmpeg();
