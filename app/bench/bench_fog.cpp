@@ -216,7 +216,7 @@ Args parse_args(const std::vector<std::string>& args) {
       rest.push_back(a);
     }
   }
-  out.grammar = parse_grammar_args(rest, false);
+  out.grammar = parse_grammar_args(rest);
   if (out.grammar.help) return out;
   if (!is_render_input(out.grammar.grammar))
     throw UsageError{"SCENE '" + out.grammar.grammar + "' must end in .lsys, .skel.json, .scene.json, .glb or .gltf"};

@@ -88,7 +88,7 @@ Args parse_args(const std::vector<std::string>& args) {
     else if (a == "--reference-bisection") out.reference_bisection = static_cast<int>(parse_count(a, value(), 60));
     else rest.push_back(a);
   }
-  out.grammar = parse_grammar_args(rest, false);
+  out.grammar = parse_grammar_args(rest);
   if (out.grammar.help) return out;
   if (!is_render_input(out.grammar.grammar))
     throw UsageError{"INPUT '" + out.grammar.grammar + "' must end in .lsys, .skel.json, .scene.json, .glb or .gltf"};

@@ -186,7 +186,7 @@ int run_export(const std::vector<std::string>& raw_args) {
   const std::optional<SeedRange> range = take_seed_range(args, grammar_value_flags());
   GrammarArgs a;
   try {
-    a = parse_grammar_args(args, true);
+    a = parse_grammar_args(args, {.wants_output = true});
   } catch (const UsageError& e) {
     if (e.message.rfind("missing GRAMMAR", 0) == 0)
       throw UsageError{"missing INPUT (a .lsys grammar, a .skel.json skeleton or a .scene.json scene)"};

@@ -275,7 +275,7 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
     }
   }
   try {
-    out.grammar = parse_grammar_args(rest, true);
+    out.grammar = parse_grammar_args(rest, {.wants_output = true});
   } catch (const UsageError& e) {
     if (e.message.rfind("missing GRAMMAR", 0) == 0)
       throw UsageError{"missing INPUT (a .lsys grammar, .skel.json skeleton or .scene.json scene)"};
