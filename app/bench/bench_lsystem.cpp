@@ -84,6 +84,16 @@ class CapturingReporter : public benchmark::ConsoleReporter {
   std::map<std::string, double> seconds_;
 };
 
+void print_lsystem_help() {
+  std::cout << "usage: sylva bench lsystem [--quick] [--presets DIR] [Google Benchmark flags]\n\n"
+               "Derivation throughput (modules produced per second, one thread) for ABOP 1.24a,\n"
+               "Honda's tree (ABOP 2.6) and ABOP 1.31a from DIR (default: the presets); turtle\n"
+               "segments per second; peak bytes per module; memcpy bandwidth in the same run;\n"
+               "scaling/* rows: the work bounds of docs/limits.md at doubling sizes (time per\n"
+               "item, complexity fit). --quick uses small sizes (a smoke test, not a measurement). --benchmark_* flags\n"
+               "(e.g. --benchmark_filter=REGEX) go to Google Benchmark.\n";
+}
+
 }  // namespace
 
 int run_bench(const std::vector<std::string>& args) {
@@ -134,13 +144,7 @@ int run_bench(const std::vector<std::string>& args) {
   };
   parse_flags(std::span(args).subspan(1), table);  // args[0] is "lsystem"
   if (help) {
-    std::cout << "usage: sylva bench lsystem [--quick] [--presets DIR] [Google Benchmark flags]\n\n"
-                 "Derivation throughput (modules produced per second, one thread) for ABOP 1.24a,\n"
-                 "Honda's tree (ABOP 2.6) and ABOP 1.31a from DIR (default: the presets); turtle\n"
-                 "segments per second; peak bytes per module; memcpy bandwidth in the same run;\n"
-                 "scaling/* rows: the work bounds of docs/limits.md at doubling sizes (time per\n"
-                 "item, complexity fit). --quick uses small sizes (a smoke test, not a measurement). --benchmark_* flags\n"
-                 "(e.g. --benchmark_filter=REGEX) go to Google Benchmark.\n";
+    print_lsystem_help();
     return kOk;
   }
   auto load = [&](const std::string& file) -> std::optional<lsys::Grammar> {

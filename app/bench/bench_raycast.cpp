@@ -129,6 +129,15 @@ void compare(const std::vector<double>& ref, const std::vector<double>& got, dou
   r.depth_rms_rel = both ? std::sqrt(sum_sq / static_cast<double>(both)) / scale : 0;
 }
 
+void print_raycast_help() {
+  std::cout << "usage: sylva bench raycast [PRESET] [--width W --height H] [--csv FILE] [--quick]\n\n"
+               "Primary rays per second on a preset (default pine, 1024x768): sylva's BVH and\n"
+               "analytic frusta against Embree user geometry, round curves and tessellated\n"
+               "meshes, on one thread and all threads, with depth error and bytes per segment.\n"
+               "--csv FILE writes the rows; --quick uses 256x192 and one repeat (a smoke test,\n"
+               "not a measurement).\n";
+}
+
 }  // namespace
 
 int run_bench_raycast(const std::vector<std::string>& args) {
@@ -148,12 +157,7 @@ int run_bench_raycast(const std::vector<std::string>& args) {
   flag_table.positional = [&preset](const std::string& name) { preset = name; };
   parse_flags(std::span(args).subspan(1), flag_table);  // args[0] is "raycast"
   if (help) {
-    std::cout << "usage: sylva bench raycast [PRESET] [--width W --height H] [--csv FILE] [--quick]\n\n"
-                 "Primary rays per second on a preset (default pine, 1024x768): sylva's BVH and\n"
-                 "analytic frusta against Embree user geometry, round curves and tessellated\n"
-                 "meshes, on one thread and all threads, with depth error and bytes per segment.\n"
-                 "--csv FILE writes the rows; --quick uses 256x192 and one repeat (a smoke test,\n"
-                 "not a measurement).\n";
+    print_raycast_help();
     return kOk;
   }
   const std::string path = std::string(SYLVA_PRESETS_DIR) + "/" + preset + ".lsys";
