@@ -150,73 +150,63 @@ std::vector<uint32_t> parse_counts(const std::string& flag, const std::string& t
 
 Args parse_args(const std::vector<std::string>& args) {
   Args out;
-  std::vector<std::string> rest;
   bool photons_given = false, seeds_given = false, brute_given = false, cone_given = false, size_given = false,
        reference_given = false;
-  for (size_t i = 1; i < args.size(); ++i) {  // args[0] is "fog"
-    const std::string& a = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw UsageError{a + " needs a value"};
-      return args[++i];
-    };
-    if (a == "--photons") {
-      out.photons.clear();
-      for (const std::string& n : split(value(), ',')) {
-        const std::optional<uint64_t> v = parse_u64(n);
-        if (!v || *v == 0 || *v > 1'000'000'000) throw UsageError{"--photons: '" + n + "' is not a count from 1 to 1e9"};
-        out.photons.push_back(*v);
-      }
-      photons_given = true;
-    } else if (a == "--modes") {
-      out.modes = split(value(), ',');
-      for (const std::string& m : out.modes)
-        if (m != "brute" && m != "medium" && m != "fast" && m != "refined")
-          throw UsageError{"--modes: '" + m + "' is not one of brute, medium, fast, refined"};
-    } else if (a == "--brute-steps") {
-      out.brute_steps = parse_counts(a, value(), 65536);
-      brute_given = true;
-    } else if (a == "--cone-steps") {
-      out.cone_steps = parse_counts(a, value(), 65536);
-      cone_given = true;
-    } else if (a == "--seeds") {
-      out.seeds = parse_count(a, value(), 1000);
-      seeds_given = true;
-    } else if (a == "--width") {
-      out.width = parse_count(a, value(), 16384);
-      size_given = true;
-    } else if (a == "--height") {
-      out.height = parse_count(a, value(), 16384);
-      size_given = true;
-    } else if (a == "--reference-steps") {
-      out.reference_steps = parse_count(a, value(), 65536);
-      reference_given = true;
-    } else if (a == "--reference-stride") {
-      out.reference_stride = parse_count(a, value(), 1024);
-    } else if (a == "--fixed-params" || a == "--cone-params") {
-      out.fixed_params = parse_cone_params(a, value());
-    } else if (a == "--threads") {
-      out.threads = parse_count(a, value(), 4096);
-    } else if (a == "--per-core-photons") {
-      out.per_core_photons = parse_count(a, value(), 1'000'000'000);
-    } else if (a == "--cones-only") {
-      out.cones_only = true;
-    } else if (a == "--csv") {
-      out.csv = value();
-    } else if (a == "--plot") {
-      out.plot = value();
-    } else if (a == "--quick") {
-      out.quick = true;
-    } else if (a == "--clock") {
-      const std::string v = value();
-      if (v != "wall" && v != "cpu") throw UsageError{"--clock: '" + v + "' is not wall or cpu"};
-      out.cpu_clock = v == "cpu";
-    } else if (a == "--merge") {
-      out.merge.push_back(value());
-    } else {
-      rest.push_back(a);
-    }
-  }
-  out.grammar = parse_grammar_args(rest, false);
+  FlagTable table;
+  table.leaves_others = true;  // SCENE and the grammar flags: parse_grammar_args's
+  table.flags = {
+      noting_given(value_flag({"--photons"},
+                              [&out](const std::string&, const std::string& list) {
+                                out.photons.clear();
+                                for (const std::string& n : split(list, ',')) {
+                                  const std::optional<uint64_t> v = parse_u64(n);
+                                  if (!v || *v == 0 || *v > 1'000'000'000)
+                                    throw UsageError{"--photons: '" + n + "' is not a count from 1 to 1e9"};
+                                  out.photons.push_back(*v);
+                                }
+                              }),
+                   photons_given),
+      value_flag({"--modes"},
+                 [&out](const std::string&, const std::string& list) {
+                   out.modes = split(list, ',');
+                   for (const std::string& m : out.modes)
+                     if (m != "brute" && m != "medium" && m != "fast" && m != "refined")
+                       throw UsageError{"--modes: '" + m + "' is not one of brute, medium, fast, refined"};
+                 }),
+      noting_given(value_flag({"--brute-steps"},
+                              [&out](const std::string& spelled, const std::string& v) {
+                                out.brute_steps = parse_counts(spelled, v, 65536);
+                              }),
+                   brute_given),
+      noting_given(value_flag({"--cone-steps"},
+                              [&out](const std::string& spelled, const std::string& v) {
+                                out.cone_steps = parse_counts(spelled, v, 65536);
+                              }),
+                   cone_given),
+      noting_given(count_flag({"--seeds"}, out.seeds, 1000), seeds_given),
+      noting_given(count_flag({"--width"}, out.width, 16384), size_given),
+      noting_given(count_flag({"--height"}, out.height, 16384), size_given),
+      noting_given(count_flag({"--reference-steps"}, out.reference_steps, 65536), reference_given),
+      count_flag({"--reference-stride"}, out.reference_stride, 1024),
+      value_flag({"--fixed-params", "--cone-params"},
+                 [&out](const std::string& spelled, const std::string& v) {
+                   out.fixed_params = parse_cone_params(spelled, v);
+                 }),
+      count_flag({"--threads"}, out.threads, 4096),
+      count_flag({"--per-core-photons"}, out.per_core_photons, 1'000'000'000),
+      set_flag({"--cones-only"}, out.cones_only),
+      text_flag({"--csv"}, out.csv),
+      text_flag({"--plot"}, out.plot),
+      set_flag({"--quick"}, out.quick),
+      value_flag({"--clock"},
+                 [&out](const std::string&, const std::string& v) {
+                   if (v != "wall" && v != "cpu") throw UsageError{"--clock: '" + v + "' is not wall or cpu"};
+                   out.cpu_clock = v == "cpu";
+                 }),
+      value_flag({"--merge"}, [&out](const std::string&, const std::string& v) { out.merge.push_back(v); }),
+  };
+  const std::vector<std::string> rest = parse_flags(std::span(args).subspan(1), table);  // args[0] is "fog"
+  out.grammar = parse_grammar_args(rest);
   if (out.grammar.help) return out;
   if (!is_render_input(out.grammar.grammar))
     throw UsageError{"SCENE '" + out.grammar.grammar + "' must end in .lsys, .skel.json, .scene.json, .glb or .gltf"};

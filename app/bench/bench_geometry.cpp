@@ -71,24 +71,20 @@ struct Args {
 
 Args parse_args(const std::vector<std::string>& args) {
   Args out;
-  std::vector<std::string> rest;
-  for (size_t i = 1; i < args.size(); ++i) {  // args[0] is "geometry"
-    const std::string& a = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw UsageError{a + " needs a value"};
-      return args[++i];
-    };
-    if (a == "--width") out.width = parse_count(a, value(), 16384);
-    else if (a == "--height") out.height = parse_count(a, value(), 16384);
-    else if (a == "--threads") out.threads = parse_count(a, value(), 4096);
-    else if (a == "--quick") out.quick = true;
-    else if (a == "--csv") out.csv = value();
-    else if (a == "--plot") out.plot = value();
-    else if (a == "--reference-steps") out.reference_steps = static_cast<int>(parse_count(a, value(), 1 << 20));
-    else if (a == "--reference-bisection") out.reference_bisection = static_cast<int>(parse_count(a, value(), 60));
-    else rest.push_back(a);
-  }
-  out.grammar = parse_grammar_args(rest, false);
+  FlagTable table;
+  table.leaves_others = true;  // INPUT and the grammar flags: parse_grammar_args's
+  table.flags = {
+      count_flag({"--width"}, out.width, 16384),
+      count_flag({"--height"}, out.height, 16384),
+      count_flag({"--threads"}, out.threads, 4096),
+      set_flag({"--quick"}, out.quick),
+      text_flag({"--csv"}, out.csv),
+      text_flag({"--plot"}, out.plot),
+      count_flag({"--reference-steps"}, out.reference_steps, 1 << 20),
+      count_flag({"--reference-bisection"}, out.reference_bisection, 60),
+  };
+  const std::vector<std::string> rest = parse_flags(std::span(args).subspan(1), table);  // args[0] is "geometry"
+  out.grammar = parse_grammar_args(rest);
   if (out.grammar.help) return out;
   if (!is_render_input(out.grammar.grammar))
     throw UsageError{"INPUT '" + out.grammar.grammar + "' must end in .lsys, .skel.json, .scene.json, .glb or .gltf"};

@@ -146,33 +146,31 @@ std::string family_named(const std::string& name) {
 
 Args parse_args(const std::vector<std::string>& args) {
   Args out;
-  for (size_t i = 1; i < args.size(); ++i) {  // args[0] is "gpu"
-    const std::string& a = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw UsageError{a + " needs a value"};
-      return args[++i];
-    };
-    if (a == "-h" || a == "--help") out.help = true;
-    else if (a == "--width") out.width = parse_count(a, value(), 16384);
-    else if (a == "--height") out.height = parse_count(a, value(), 16384);
-    else if (a == "--frames") out.frames = parse_count(a, value(), 1'000'000);
-    else if (a == "--warmup") out.warmup = static_cast<uint32_t>(parse_count(a, value(), 1'000'000));
-    else if (a == "--quick") out.quick = true;
-    else if (a == "--full") out.full = true;
-    else if (a == "--fog") out.fog = true;
-    else if (a == "--csv") out.csv = value(), out.csv_given = true;
-    else if (a == "--plot") out.plot = value(), out.plot_given = true;
-    else if (a == "--reference-steps") out.reference_steps = static_cast<int>(parse_count(a, value(), 1 << 20));
-    else if (a == "--reference-stride") out.reference_stride = parse_count(a, value(), 1024);
-    else if (a == "--reference-bisection") out.reference_bisection = static_cast<int>(parse_count(a, value(), 60));
-    else if (a == "--methods") {
-      std::stringstream list(value());
-      for (std::string name; std::getline(list, name, ',');)
-        if (!name.empty()) out.families.push_back(family_named(name));
-      if (out.families.empty()) throw UsageError{"--methods needs at least one method family"};
-    } else if (!a.empty() && a[0] == '-') throw UsageError{"unknown option '" + a + "'"};
-    else out.inputs.push_back(a);
-  }
+  FlagTable table;
+  table.flags = {
+      help_flag(out.help),
+      count_flag({"--width"}, out.width, 16384),
+      count_flag({"--height"}, out.height, 16384),
+      count_flag({"--frames"}, out.frames, 1'000'000),
+      count_flag({"--warmup"}, out.warmup, 1'000'000),
+      set_flag({"--quick"}, out.quick),
+      set_flag({"--full"}, out.full),
+      set_flag({"--fog"}, out.fog),
+      noting_given(text_flag({"--csv"}, out.csv), out.csv_given),
+      noting_given(text_flag({"--plot"}, out.plot), out.plot_given),
+      count_flag({"--reference-steps"}, out.reference_steps, 1 << 20),
+      count_flag({"--reference-stride"}, out.reference_stride, 1024),
+      count_flag({"--reference-bisection"}, out.reference_bisection, 60),
+      value_flag({"--methods"},
+                 [&out](const std::string&, const std::string& names) {
+                   std::stringstream list(names);
+                   for (std::string name; std::getline(list, name, ',');)
+                     if (!name.empty()) out.families.push_back(family_named(name));
+                   if (out.families.empty()) throw UsageError{"--methods needs at least one method family"};
+                 }),
+  };
+  table.positional = [&out](const std::string& input) { out.inputs.push_back(input); };
+  parse_flags(std::span(args).subspan(1), table);  // args[0] is "gpu"
   if (out.help) return out;
   if (out.width.has_value() != out.height.has_value()) throw UsageError{"give --width and --height together"};
   if (out.full && out.quick) throw UsageError{"--full and --quick exclude each other"};

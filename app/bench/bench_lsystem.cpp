@@ -84,6 +84,16 @@ class CapturingReporter : public benchmark::ConsoleReporter {
   std::map<std::string, double> seconds_;
 };
 
+void print_lsystem_help() {
+  std::cout << "usage: sylva bench lsystem [--quick] [--presets DIR] [Google Benchmark flags]\n\n"
+               "Derivation throughput (modules produced per second, one thread) for ABOP 1.24a,\n"
+               "Honda's tree (ABOP 2.6) and ABOP 1.31a from DIR (default: the presets); turtle\n"
+               "segments per second; peak bytes per module; memcpy bandwidth in the same run;\n"
+               "scaling/* rows: the work bounds of docs/limits.md at doubling sizes (time per\n"
+               "item, complexity fit). --quick uses small sizes (a smoke test, not a measurement). --benchmark_* flags\n"
+               "(e.g. --benchmark_filter=REGEX) go to Google Benchmark.\n";
+}
+
 }  // namespace
 
 int run_bench(const std::vector<std::string>& args) {
@@ -123,21 +133,19 @@ int run_bench(const std::vector<std::string>& args) {
   bool quick = false;
   std::string presets = SYLVA_PRESETS_DIR;
   std::vector<std::string> gb_args = {"sylva-bench"};
-  for (size_t i = 1; i < args.size(); ++i) {
-    if (args[i] == "-h" || args[i] == "--help") {
-      std::cout << "usage: sylva bench lsystem [--quick] [--presets DIR] [Google Benchmark flags]\n\n"
-                   "Derivation throughput (modules produced per second, one thread) for ABOP 1.24a,\n"
-                   "Honda's tree (ABOP 2.6) and ABOP 1.31a from DIR (default: the presets); turtle\n"
-                   "segments per second; peak bytes per module; memcpy bandwidth in the same run;\n"
-                   "scaling/* rows: the work bounds of docs/limits.md at doubling sizes (time per\n"
-                   "item, complexity fit). --quick uses small sizes (a smoke test, not a measurement). --benchmark_* flags\n"
-                   "(e.g. --benchmark_filter=REGEX) go to Google Benchmark.\n";
-      return kOk;
-    }
-    if (args[i] == "--quick") quick = true;
-    else if (args[i] == "--presets" && i + 1 < args.size()) presets = args[++i];
-    else if (args[i].rfind("--benchmark_", 0) == 0) gb_args.push_back(args[i]);
-    else throw UsageError{"unknown option '" + args[i] + "'"};
+  bool help = false;
+  FlagTable table;
+  Flag presets_dir = text_flag({"--presets"}, presets);
+  presets_dir.claims = [](const std::string&) { return true; };  // given last: an unknown option
+  table.flags = {help_at_once(help), set_flag({"--quick"}, quick), presets_dir};
+  table.unknown = [&gb_args](const std::string& arg) {
+    if (!arg.starts_with("--benchmark_")) throw UsageError{"unknown option '" + arg + "'"};
+    gb_args.push_back(arg);
+  };
+  parse_flags(std::span(args).subspan(1), table);  // args[0] is "lsystem"
+  if (help) {
+    print_lsystem_help();
+    return kOk;
   }
   auto load = [&](const std::string& file) -> std::optional<lsys::Grammar> {
     auto g = lsys::load_grammar(presets + "/" + file);

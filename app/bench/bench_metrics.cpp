@@ -103,17 +103,10 @@ ImageErrors compare_images(const RenderImage& reference, const RenderImage& imag
   return e;
 }
 
-uint32_t parse_count(const std::string& flag, const std::string& value, uint64_t max) {
-  auto n = parse_u64(value);
-  if (!n || *n == 0 || *n > max)
-    throw UsageError{flag + " " + value + ": expected an integer from 1 to " + std::to_string(max)};
-  return static_cast<uint32_t>(*n);
-}
-
 std::string input_stem(const std::string& path) {
   std::string name = path.substr(path.find_last_of('/') + 1);
   for (const std::string e : {".scene.json", ".skel.json", ".lsys", ".glb", ".gltf"}) {
-    if (name.size() > e.size() && name.compare(name.size() - e.size(), e.size(), e) == 0)
+    if (name.size() > e.size() && name.ends_with(e))
       return name.substr(0, name.size() - e.size());
   }
   return name;

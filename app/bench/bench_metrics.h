@@ -52,9 +52,6 @@ struct ImageErrors {
 };
 ImageErrors compare_images(const RenderImage& reference, const RenderImage& image);
 
-// Parses a count flag's value: an integer from 1 to `max`, else UsageError naming `flag`.
-uint32_t parse_count(const std::string& flag, const std::string& value, uint64_t max);
-
 // INPUT as given when it is a render input (is_render_input), else a preset's scene or
 // grammar by name: presets/scenes/NAME.scene.json, then presets/NAME.lsys. UsageError when
 // it is neither.

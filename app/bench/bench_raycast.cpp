@@ -120,6 +120,15 @@ void compare(const std::vector<double>& ref, const std::vector<double>& got, dou
   r.depth_rms_rel = both ? std::sqrt(sum_sq / static_cast<double>(both)) / scale : 0;
 }
 
+void print_raycast_help() {
+  std::cout << "usage: sylva bench raycast [PRESET] [--width W --height H] [--csv FILE] [--quick]\n\n"
+               "Primary rays per second on a preset (default pine, 1024x768): sylva's BVH and\n"
+               "analytic frusta against Embree user geometry, round curves and tessellated\n"
+               "meshes, on one thread and all threads, with depth error and bytes per segment.\n"
+               "--csv FILE writes the rows; --quick uses 256x192 and one repeat (a smoke test,\n"
+               "not a measurement).\n";
+}
+
 }  // namespace
 
 int run_bench_raycast(const std::vector<std::string>& args) {
@@ -127,26 +136,20 @@ int run_bench_raycast(const std::vector<std::string>& args) {
   uint32_t width = 1024, height = 768;
   int max_level = 3, repeats = 3;
   std::string csv;
-  for (size_t i = 1; i < args.size(); ++i) {
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw UsageError{args[i] + " needs a value"};
-      return args[++i];
-    };
-    if (args[i] == "-h" || args[i] == "--help") {
-      std::cout << "usage: sylva bench raycast [PRESET] [--width W --height H] [--csv FILE] [--quick]\n\n"
-                   "Primary rays per second on a preset (default pine, 1024x768): sylva's BVH and\n"
-                   "analytic frusta against Embree user geometry, round curves and tessellated\n"
-                   "meshes, on one thread and all threads, with depth error and bytes per segment.\n"
-                   "--csv FILE writes the rows; --quick uses 256x192 and one repeat (a smoke test,\n"
-                   "not a measurement).\n";
-      return kOk;
-    }
-    if (args[i] == "--quick") width = 256, height = 192, max_level = 1, repeats = 1;
-    else if (const std::string flag = args[i]; flag == "--width") width = parse_count(flag, value(), 16384);
-    else if (flag == "--height") height = parse_count(flag, value(), 16384);
-    else if (args[i] == "--csv") csv = value();
-    else if (!args[i].empty() && args[i][0] == '-') throw UsageError{"unknown option '" + args[i] + "'"};
-    else preset = args[i];
+  bool help = false;
+  FlagTable flag_table;
+  flag_table.flags = {
+      help_at_once(help),
+      switch_flag({"--quick"}, [&] { width = 256, height = 192, max_level = 1, repeats = 1; }),
+      count_flag({"--width"}, width, 16384),
+      count_flag({"--height"}, height, 16384),
+      text_flag({"--csv"}, csv),
+  };
+  flag_table.positional = [&preset](const std::string& name) { preset = name; };
+  parse_flags(std::span(args).subspan(1), flag_table);  // args[0] is "raycast"
+  if (help) {
+    print_raycast_help();
+    return kOk;
   }
   const std::string path = std::string(SYLVA_PRESETS_DIR) + "/" + preset + ".lsys";
   auto g = lsys::load_grammar(path);

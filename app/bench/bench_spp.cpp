@@ -104,35 +104,40 @@ double parse_fraction(const std::string& flag, const std::string& text) {
 
 Args parse_args(const std::vector<std::string>& args) {
   Args out;
-  for (size_t i = 1; i < args.size(); ++i) {  // args[0] is "spp"
-    const std::string& a = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw UsageError{a + " needs a value"};
-      return args[++i];
-    };
-    if (a == "-h" || a == "--help") out.help = true;
-    else if (a == "--width") out.width = parse_count(a, value(), 16384);
-    else if (a == "--height") out.height = parse_count(a, value(), 16384);
-    else if (a == "--spp") out.spp = parse_spp_list(a, value());
-    else if (a == "--reference-spp") out.reference_spp = parse_count(a, value(), 4096);
-    else if (a == "--threads") out.threads = parse_count(a, value(), 4096);
-    else if (a == "--speckle-step") out.speckle_step = parse_count(a, value(), 255);
-    else if (a == "--max-speckle") out.max_speckle = parse_fraction(a, value());
-    else if (a == "--quick") out.quick = true;
-    else if (a == "--csv") out.csv = value();
-    else if (a == "--plot") out.plot = value();
-    else if (a == "--backends") {
-      out.cpu = out.gl = false;
-      std::stringstream in(value());
-      for (std::string item; std::getline(in, item, ',');) {
-        if (item == "cpu") out.cpu = true;
-        else if (item == "gl") out.gl = true;
-        else throw UsageError{"--backends: unknown backend '" + item + "' (available: cpu, gl)"};
-      }
-      if (!out.cpu && !out.gl) throw UsageError{"--backends needs cpu, gl or both"};
-    } else if (!a.empty() && a[0] == '-') throw UsageError{"unknown option " + a + " (see sylva bench spp --help)"};
-    else out.inputs.push_back(resolve_bench_input(a));
-  }
+  FlagTable table;
+  table.flags = {
+      help_flag(out.help),
+      count_flag({"--width"}, out.width, 16384),
+      count_flag({"--height"}, out.height, 16384),
+      value_flag({"--spp"},
+                 [&out](const std::string& spelled, const std::string& v) { out.spp = parse_spp_list(spelled, v); }),
+      count_flag({"--reference-spp"}, out.reference_spp, 4096),
+      count_flag({"--threads"}, out.threads, 4096),
+      count_flag({"--speckle-step"}, out.speckle_step, 255),
+      value_flag({"--max-speckle"},
+                 [&out](const std::string& spelled, const std::string& v) {
+                   out.max_speckle = parse_fraction(spelled, v);
+                 }),
+      set_flag({"--quick"}, out.quick),
+      text_flag({"--csv"}, out.csv),
+      text_flag({"--plot"}, out.plot),
+      value_flag({"--backends"},
+                 [&out](const std::string&, const std::string& names) {
+                   out.cpu = out.gl = false;
+                   std::stringstream in(names);
+                   for (std::string item; std::getline(in, item, ',');) {
+                     if (item == "cpu") out.cpu = true;
+                     else if (item == "gl") out.gl = true;
+                     else throw UsageError{"--backends: unknown backend '" + item + "' (available: cpu, gl)"};
+                   }
+                   if (!out.cpu && !out.gl) throw UsageError{"--backends needs cpu, gl or both"};
+                 }),
+  };
+  table.positional = [&out](const std::string& input) { out.inputs.push_back(resolve_bench_input(input)); };
+  table.unknown = [](const std::string& arg) {
+    throw UsageError{"unknown option " + arg + " (see sylva bench spp --help)"};
+  };
+  parse_flags(std::span(args).subspan(1), table);  // args[0] is "spp"
   if (out.width.has_value() != out.height.has_value()) throw UsageError{"--width and --height go together"};
   if (out.help) return out;
   if (out.inputs.empty()) out.inputs = {std::string(SYLVA_PRESETS_DIR) + "/pine.lsys", std::string(SYLVA_PRESETS_DIR) + "/elm.lsys"};

@@ -9,9 +9,11 @@
 #include <cstdio>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "app/front/batch.h"
@@ -74,30 +76,18 @@ void print_export_help() {
                "  -h, --help               show this help\n";
 }
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // The node name of a plant: the file name without folder and extension(s).
 std::string plant_name(const std::string& path) {
   std::string name = std::filesystem::path(path).filename().string();
-  for (const char* ext : {".lsys", ".skel.json", ".json"})
-    if (ends_with(name, ext) && name.size() > std::string(ext).size()) {
-      name.resize(name.size() - std::string(ext).size());
+  for (std::string_view ext : {".lsys", ".skel.json", ".json"})
+    if (name.ends_with(ext) && name.size() > ext.size()) {
+      name.resize(name.size() - ext.size());
       break;
     }
   return name;
 }
 
 enum class InputKind { grammar, skeleton, scene };
-
-// The value of flag `name` at raw_args[*i] ("--name V" or "--name=V"); advances *i.
-std::string flag_value(const std::vector<std::string>& raw_args, size_t* i, const std::string& name) {
-  const std::string& a = raw_args[*i];
-  if (a.size() > name.size()) return a.substr(name.size() + 1);
-  if (*i + 1 >= raw_args.size()) throw UsageError{name + " needs a value"};
-  return raw_args[++*i];
-}
 
 // A finite number from `text`, in (lo, hi] or [lo, hi] (`open_low`); a usage error naming `name`.
 double number_flag(const std::string& name, const std::string& text, double lo, bool open_low) {
@@ -110,8 +100,6 @@ double number_flag(const std::string& name, const std::string& text, double lo, 
                      (lo == 0 ? "0" : std::to_string(lo)) + " and <= 1e6"};
   return v;
 }
-
-bool is_flag(const std::string& a, const std::string& name) { return a == name || a.rfind(name + "=", 0) == 0; }
 
 // The one summary line export prints on stdout, like grow's: what was read, what was
 // written, its plants, chains and segments (and leaves, where there are any), the file's
@@ -140,62 +128,48 @@ int run_export(const std::vector<std::string>& raw_args) {
   options.extras = GltfExtras::compact;  // the CLI's default (the library's is full)
   Bark bark;                 // from the --bark-* flags
   bool bark_flags = false;
-  std::vector<std::string> args;
-  for (size_t i = 0; i < raw_args.size(); ++i) {
-    const std::string& a = raw_args[i];
-    if (is_flag(a, "--bark-albedo")) {
-      bark.albedo_texture = flag_value(raw_args, &i, "--bark-albedo");
-      bark_flags = true;
-    } else if (is_flag(a, "--bark-height")) {
-      bark.height_texture = flag_value(raw_args, &i, "--bark-height");
-      bark_flags = true;
-    } else if (is_flag(a, "--relief-depth")) {
-      bark.relief_depth_m = number_flag("--relief-depth", flag_value(raw_args, &i, "--relief-depth"), 0, false);
-      bark_flags = true;
-    } else if (is_flag(a, "--u-repeat")) {
-      bark.u_repeat = number_flag("--u-repeat", flag_value(raw_args, &i, "--u-repeat"), 0, true);
-      bark_flags = true;
-    } else if (is_flag(a, "--v-per-metre")) {
-      bark.v_per_metre = number_flag("--v-per-metre", flag_value(raw_args, &i, "--v-per-metre"), 0, true);
-      bark_flags = true;
-    } else if (a == "--mesh") {
-      options.mesh = true;
-    } else if (a == "--instancing") {
-      options.instancing = true;
-    } else if (is_flag(a, "--extras")) {
-      const std::string mode = flag_value(raw_args, &i, "--extras");
-      if (mode == "compact") options.extras = GltfExtras::compact;
-      else if (mode == "full") options.extras = GltfExtras::full;
-      else if (mode == "none") options.extras = GltfExtras::none;
-      else throw UsageError{"--extras " + mode + ": expected compact, full or none"};
-    } else if (a == "--segments-around" || a.rfind("--segments-around=", 0) == 0) {
-      std::string v;
-      if (a.size() > std::string("--segments-around").size()) {
-        v = a.substr(std::string("--segments-around=").size());
-      } else {
-        if (i + 1 >= raw_args.size()) throw UsageError{"--segments-around needs a value"};
-        v = raw_args[++i];
-      }
-      const auto n = parse_u64(v);
-      if (!n || *n < 3 || *n > 4096) throw UsageError{"--segments-around " + v + ": expected an integer from 3 to 4096"};
-      options.segments_around = static_cast<int>(*n);
-    } else {
-      args.push_back(a);
-      // Keep a value that follows a value-taking flag with it, whatever it looks like.
-      for (const std::string& f : grammar_value_flags())
-        if (a == f && i + 1 < raw_args.size()) args.push_back(raw_args[++i]);
-    }
-  }
+  FlagTable table;
+  table.inline_values = InlineValues::value_flags;
+  table.leaves_others = true;  // INPUT, -o and the grammar flags: parse_grammar_args's
+  table.later_value_flags = grammar_value_flags();
+  // A --bark-* flag: `set` stores its value in `bark`; bark_flags says one was given.
+  auto bark_flag = [&bark_flags](const std::string& name, std::function<void(const std::string& value)> set) {
+    return noting_given(value_flag({name}, [set = std::move(set)](const std::string&, const std::string& value) {
+                          set(value);
+                        }),
+                        bark_flags);
+  };
+  table.flags = {
+      bark_flag("--bark-albedo", [&bark](const std::string& v) { bark.albedo_texture = v; }),
+      bark_flag("--bark-height", [&bark](const std::string& v) { bark.height_texture = v; }),
+      bark_flag("--relief-depth",
+                [&bark](const std::string& v) { bark.relief_depth_m = number_flag("--relief-depth", v, 0, false); }),
+      bark_flag("--u-repeat", [&bark](const std::string& v) { bark.u_repeat = number_flag("--u-repeat", v, 0, true); }),
+      bark_flag("--v-per-metre",
+                [&bark](const std::string& v) { bark.v_per_metre = number_flag("--v-per-metre", v, 0, true); }),
+      set_flag({"--mesh"}, options.mesh),
+      set_flag({"--instancing"}, options.instancing),
+      value_flag({"--extras"},
+                 [&options](const std::string&, const std::string& mode) {
+                   if (mode == "compact") options.extras = GltfExtras::compact;
+                   else if (mode == "full") options.extras = GltfExtras::full;
+                   else if (mode == "none") options.extras = GltfExtras::none;
+                   else throw UsageError{"--extras " + mode + ": expected compact, full or none"};
+                 }),
+      value_flag({"--segments-around"},
+                 [&options](const std::string&, const std::string& v) {
+                   const auto n = parse_u64(v);
+                   if (!n || *n < 3 || *n > 4096)
+                     throw UsageError{"--segments-around " + v + ": expected an integer from 3 to 4096"};
+                   options.segments_around = static_cast<int>(*n);
+                 }),
+  };
+  std::vector<std::string> args = parse_flags(raw_args, table);
   const std::optional<SeedRange> range = take_seed_range(args, grammar_value_flags());
-  GrammarArgs a;
-  try {
-    a = parse_grammar_args(args, true);
-  } catch (const UsageError& e) {
-    if (e.message.rfind("missing GRAMMAR", 0) == 0)
-      throw UsageError{"missing INPUT (a .lsys grammar, a .skel.json skeleton or a .scene.json scene)"};
-    if (e.message.rfind("missing -o", 0) == 0) throw UsageError{"missing -o FILE.gltf|FILE.glb"};
-    throw;
-  }
+  const GrammarArgs a = parse_grammar_args(
+      args, {.wants_output = true,
+             .missing_input = "missing INPUT (a .lsys grammar, a .skel.json skeleton or a .scene.json scene)",
+             .missing_output = "missing -o FILE.gltf|FILE.glb"});
   if (a.help) {
     print_export_help();
     return kOk;
@@ -203,11 +177,11 @@ int run_export(const std::vector<std::string>& raw_args) {
   const auto start = std::chrono::steady_clock::now();
   const std::string& input = a.grammar;
   InputKind kind;
-  if (ends_with(input, ".skel.json")) kind = InputKind::skeleton;
-  else if (ends_with(input, ".scene.json")) kind = InputKind::scene;
-  else if (ends_with(input, ".lsys")) kind = InputKind::grammar;
+  if (input.ends_with(".skel.json")) kind = InputKind::skeleton;
+  else if (input.ends_with(".scene.json")) kind = InputKind::scene;
+  else if (input.ends_with(".lsys")) kind = InputKind::grammar;
   else throw UsageError{"INPUT '" + input + "' must be a .lsys grammar, a .skel.json skeleton or a .scene.json scene"};
-  if (!ends_with(a.output, ".gltf") && !ends_with(a.output, ".glb"))
+  if (!a.output.ends_with(".gltf") && !a.output.ends_with(".glb"))
     throw UsageError{"-o " + a.output + ": the output must end in .gltf or .glb"};
   if (kind != InputKind::grammar && (a.steps || a.seed || range || !a.defines.empty()))
     throw UsageError{"-n, --seed and -D apply to a .lsys INPUT only"};

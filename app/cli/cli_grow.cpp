@@ -55,7 +55,7 @@ std::string format_number(double v) {
 }  // namespace
 
 int run_derive(const std::vector<std::string>& args) {
-  GrammarArgs a = parse_grammar_args(args, false);
+  GrammarArgs a = parse_grammar_args(args);
   if (a.help) {
     print_derive_help();
     return kOk;
@@ -119,7 +119,7 @@ GrowOutcome grow_to_file(const lsys::Grammar& g, const GrammarArgs& a, const std
 int run_grow(const std::vector<std::string>& raw_args) {
   std::vector<std::string> args = raw_args;
   const std::optional<SeedRange> range = take_seed_range(args, grammar_value_flags());
-  GrammarArgs a = parse_grammar_args(args, true);
+  GrammarArgs a = parse_grammar_args(args, {.wants_output = true});
   if (a.help) {
     print_grow_help();
     return kOk;

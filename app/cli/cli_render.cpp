@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cctype>
@@ -150,13 +151,6 @@ struct RenderArgs {
   std::optional<std::string> video;   // --video
 };
 
-uint32_t parse_size(const std::string& flag, const std::string& v, uint32_t max) {
-  auto n = parse_u64(v);
-  if (!n || *n == 0 || *n > max)
-    throw UsageError{flag + " " + v + ": expected an integer from 1 to " + std::to_string(max)};
-  return static_cast<uint32_t>(*n);
-}
-
 // --cone-params p1,p2,p3,p4 (Hougs and Day 2001 sec. 3.2.1) or auto (nullopt): four integers with
 // p1 >= p3 + 1 (a ring needs its seed and p3 neighbours), p2 >= 2, p3 >= 1, p4 >= 1.
 std::optional<std::array<uint32_t, 4>> parse_cone_params(const std::string& v) {
@@ -178,112 +172,111 @@ std::optional<std::array<uint32_t, 4>> parse_cone_params(const std::string& v) {
   return p;
 }
 
+// An argument left for the grammar flags that is -n, --seed, -D or --max-modules, in any
+// spelling ("-n5", "--seed=3"): those shape a grammar only.
+bool is_derive_flag(const std::string& arg) {
+  const std::string name = arg.starts_with("--") ? arg.substr(0, arg.find('=')) : arg;
+  return name == "-n" || name == "--steps" || name == "--seed" || name == "-D" || name == "--define" ||
+         name == "--max-modules" || (name.size() > 2 && (name.starts_with("-D") || name.starts_with("-n")));
+}
+
 RenderArgs parse_render_args(const std::vector<std::string>& args) {
   RenderArgs out;
-  std::vector<std::string> rest;
-  for (size_t i = 0; i < args.size(); ++i) {
-    std::string a = args[i], inline_value;
-    bool has_inline = false;
-    if (a.rfind("--", 0) == 0 && a.find('=') != std::string::npos) {
-      inline_value = a.substr(a.find('=') + 1);
-      a = a.substr(0, a.find('='));
-      has_inline = true;
-    }
-    auto value = [&]() -> std::string {
-      if (has_inline) return inline_value;
-      if (i + 1 >= args.size()) throw UsageError{a + " needs a value"};
-      return args[++i];
-    };
-    if (a == "--backend") {
-      out.backend = value();
-      if (out.backend != "auto" && out.backend != "gl" && out.backend != "cpu")
-        throw UsageError{"--backend " + out.backend + ": expected auto, gl or cpu"};
-    } else if (a == "--width") {
-      out.width = parse_size(a, value(), 65536);
-    } else if (a == "--height") {
-      out.height = parse_size(a, value(), 65536);
-    } else if (a == "--spp") {
-      out.spp = parse_size(a, value(), 65536);
-    } else if (a == "--aov") {
-      std::string list = value();
-      size_t start = 0;
-      for (;;) {
-        size_t comma = list.find(',', start);
-        std::string name = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-        if (name == "depth") out.aovs |= kAovDepth;
-        else if (name == "normal") out.aovs |= kAovNormal;
-        else if (name == "uv") out.aovs |= kAovUv;
-        else if (name == "id") out.aovs |= kAovId;
-        else if (name == "fog") out.aovs |= kAovFog;
-        else throw UsageError{"--aov: unknown AOV '" + name + "' (expected depth, normal, uv, id or fog)"};
-        if (comma == std::string::npos) break;
-        start = comma + 1;
-      }
-    } else if (a == "--geometry") {
-      const std::string g = value();
-      if (g == "frusta") out.geometry.kind = GeometryKind::frusta;
-      else if (g == "mesh") out.geometry.kind = GeometryKind::mesh;
-      else throw UsageError{"--geometry " + g + ": expected frusta or mesh"};
-    } else if (a == "--mesh-level") {
-      const std::string v = value();
-      auto n = parse_u64(v);
-      if (!n || *n > 6) throw UsageError{"--mesh-level " + v + ": expected an integer from 0 to 6"};
-      out.geometry.mesh_level = static_cast<int>(*n);
-    } else if (a == "--fog-mode") {
-      const std::string v = value();
-      const std::optional<FogMode> mode = fog_mode_from_name(v);
-      if (!mode) throw UsageError{"--fog-mode " + v + ": expected auto, brute, medium, fast, refined or reference"};
-      out.fog.mode = *mode;
-      out.fog_flags = true;
-    } else if (a == "--fog-steps") {
-      out.fog.steps = parse_size(a, value(), kFogMaxSteps);
-      out.fog_flags = true;
-    } else if (a == "--photons") {
-      const std::string v = value();
-      auto n = parse_u64(v);
-      if (!n || *n == 0 || *n > kFogMaxPhotons)
-        throw UsageError{"--photons " + v + ": expected an integer from 1 to " + std::to_string(kFogMaxPhotons)};
-      out.fog.photons = *n;
-      out.fog_flags = true;
-    } else if (a == "--cone-params") {
-      out.fog.cone_params = parse_cone_params(value());
-      out.fog_flags = true;
-    } else if (a == "--frames") {
-      out.frames = value();
-    } else if (a == "--fps") {
-      const std::string v = value();
-      char* end = nullptr;
-      const double fps = std::strtod(v.c_str(), &end);
-      if (v.empty() || *end != '\0' || !(fps > 0 && fps <= 1000))
-        throw UsageError{"--fps " + v + ": expected a number of frames per second in (0, 1000]"};
-      out.fps = fps;
-    } else if (a == "--video") {
-      out.video = value();
-    } else if (a == "--eye") {
-      out.camera.eye = parse_point_flag(a, value());
-    } else if (a == "--target") {
-      out.camera.target = parse_point_flag(a, value());
-    } else if (a == "--fov") {
-      out.camera.fov_y_deg = parse_fov_flag(value());
-    } else if (a == "--verbose" || a == "-v") {
-      out.verbose = true;
-    } else {
-      if (a == "-n" || a == "--steps" || a == "--seed" || a == "-D" || a == "--define" ||
-          a == "--max-modules" || (a.size() > 2 && (a.rfind("-D", 0) == 0 || a.rfind("-n", 0) == 0)))
-        out.grammar_flags = true;
-      rest.push_back(args[i]);
-    }
-  }
-  try {
-    out.grammar = parse_grammar_args(rest, true);
-  } catch (const UsageError& e) {
-    if (e.message.rfind("missing GRAMMAR", 0) == 0)
-      throw UsageError{"missing INPUT (a .lsys grammar, .skel.json skeleton or .scene.json scene)"};
-    if (e.message.rfind("missing -o", 0) == 0) throw UsageError{"missing -o IMAGE"};
-    if (e.message.rfind("unexpected argument", 0) == 0)
-      throw UsageError{e.message.substr(0, e.message.find(" (one GRAMMAR")) + " (one INPUT only)"};
-    throw;
-  }
+  FlagTable table;
+  table.inline_values = InlineValues::all_flags;
+  table.leaves_others = true;  // INPUT, -o and the grammar flags: parse_grammar_args's
+  table.flags = {
+      value_flag({"--backend"},
+                 [&out](const std::string&, const std::string& v) {
+                   out.backend = v;
+                   if (out.backend != "auto" && out.backend != "gl" && out.backend != "cpu")
+                     throw UsageError{"--backend " + out.backend + ": expected auto, gl or cpu"};
+                 }),
+      count_flag({"--width"}, out.width, 65536),
+      count_flag({"--height"}, out.height, 65536),
+      count_flag({"--spp"}, out.spp, 65536),
+      value_flag({"--aov"},
+                 [&out](const std::string&, const std::string& list) {
+                   size_t start = 0;
+                   for (;;) {
+                     size_t comma = list.find(',', start);
+                     std::string name =
+                         list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+                     if (name == "depth") out.aovs |= kAovDepth;
+                     else if (name == "normal") out.aovs |= kAovNormal;
+                     else if (name == "uv") out.aovs |= kAovUv;
+                     else if (name == "id") out.aovs |= kAovId;
+                     else if (name == "fog") out.aovs |= kAovFog;
+                     else throw UsageError{"--aov: unknown AOV '" + name + "' (expected depth, normal, uv, id or fog)"};
+                     if (comma == std::string::npos) break;
+                     start = comma + 1;
+                   }
+                 }),
+      value_flag({"--geometry"},
+                 [&out](const std::string&, const std::string& g) {
+                   if (g == "frusta") out.geometry.kind = GeometryKind::frusta;
+                   else if (g == "mesh") out.geometry.kind = GeometryKind::mesh;
+                   else throw UsageError{"--geometry " + g + ": expected frusta or mesh"};
+                 }),
+      value_flag({"--mesh-level"},
+                 [&out](const std::string&, const std::string& v) {
+                   auto n = parse_u64(v);
+                   if (!n || *n > 6) throw UsageError{"--mesh-level " + v + ": expected an integer from 0 to 6"};
+                   out.geometry.mesh_level = static_cast<int>(*n);
+                 }),
+      noting_given(value_flag({"--fog-mode"},
+                              [&out](const std::string&, const std::string& v) {
+                                const std::optional<FogMode> mode = fog_mode_from_name(v);
+                                if (!mode)
+                                  throw UsageError{"--fog-mode " + v +
+                                                   ": expected auto, brute, medium, fast, refined or reference"};
+                                out.fog.mode = *mode;
+                              }),
+                   out.fog_flags),
+      noting_given(count_flag({"--fog-steps"}, out.fog.steps, kFogMaxSteps), out.fog_flags),
+      noting_given(value_flag({"--photons"},
+                              [&out](const std::string&, const std::string& v) {
+                                auto n = parse_u64(v);
+                                if (!n || *n == 0 || *n > kFogMaxPhotons)
+                                  throw UsageError{"--photons " + v + ": expected an integer from 1 to " +
+                                                   std::to_string(kFogMaxPhotons)};
+                                out.fog.photons = *n;
+                              }),
+                   out.fog_flags),
+      noting_given(value_flag({"--cone-params"},
+                              [&out](const std::string&, const std::string& v) {
+                                out.fog.cone_params = parse_cone_params(v);
+                              }),
+                   out.fog_flags),
+      value_flag({"--frames"}, [&out](const std::string&, const std::string& v) { out.frames = v; }),
+      value_flag({"--fps"},
+                 [&out](const std::string&, const std::string& v) {
+                   char* end = nullptr;
+                   const double fps = std::strtod(v.c_str(), &end);
+                   if (v.empty() || *end != '\0' || !(fps > 0 && fps <= 1000))
+                     throw UsageError{"--fps " + v + ": expected a number of frames per second in (0, 1000]"};
+                   out.fps = fps;
+                 }),
+      value_flag({"--video"}, [&out](const std::string&, const std::string& v) { out.video = v; }),
+      value_flag({"--eye"},
+                 [&out](const std::string& spelled, const std::string& v) {
+                   out.camera.eye = parse_point_flag(spelled, v);
+                 }),
+      value_flag({"--target"},
+                 [&out](const std::string& spelled, const std::string& v) {
+                   out.camera.target = parse_point_flag(spelled, v);
+                 }),
+      value_flag({"--fov"},
+                 [&out](const std::string&, const std::string& v) { out.camera.fov_y_deg = parse_fov_flag(v); }),
+      set_flag({"--verbose", "-v"}, out.verbose),
+  };
+  const std::vector<std::string> rest = parse_flags(args, table);
+  out.grammar_flags = std::ranges::any_of(rest, is_derive_flag);
+  out.grammar = parse_grammar_args(
+      rest, {.wants_output = true,
+             .missing_input = "missing INPUT (a .lsys grammar, .skel.json skeleton or .scene.json scene)",
+             .missing_output = "missing -o IMAGE",
+             .input_name = "INPUT"});
   return out;
 }
 
@@ -328,10 +321,6 @@ FrameRange parse_frames(const std::string& v) {
   return {*first, *last, false};
 }
 
-bool ends_with(const std::string& s, std::string_view suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 std::string seconds_text(double s) {
   char buf[32];
   std::snprintf(buf, sizeof buf, s < 10 ? "%.2f s" : "%.0f s", s);
@@ -348,7 +337,7 @@ int run_render_frames(const RenderArgs& a) {
   const std::string& input = a.grammar.grammar;
   const std::string& pattern = a.grammar.output;
   const bool growth = is_grammar_input(input);
-  if (!growth && !ends_with(input, ".scene.json"))
+  if (!growth && !input.ends_with(".scene.json"))
     throw UsageError{"--frames applies to a .scene.json scene with an animation key (its plants move) or a .lsys "
                      "grammar (frame k is k derivation steps)"};
   if (growth && a.grammar.steps) throw UsageError{"--frames on a grammar sets the derivation steps: leave out -n"};
@@ -357,7 +346,7 @@ int run_render_frames(const RenderArgs& a) {
   FrameRange range = parse_frames(*a.frames);
   std::optional<std::string> ffmpeg;
   if (a.video) {
-    if (!ends_with(pattern, ".png")) throw UsageError{"--video encodes PNG frames: -o must end in .png"};
+    if (!pattern.ends_with(".png")) throw UsageError{"--video encodes PNG frames: -o must end in .png"};
     if (!video_container_for(*a.video))
       throw UsageError{"--video " + *a.video + ": expected a .mp4, .mkv, .webm, .mov or .gif file"};
     ffmpeg = find_ffmpeg();

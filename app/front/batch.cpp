@@ -30,34 +30,25 @@ SeedRange parse_seed_range(const std::string& text) {
 
 }  // namespace
 
-const std::vector<std::string>& grammar_value_flags() {
-  static const std::vector<std::string> flags = {"-n", "--steps", "--seed", "-D", "--define", "--max-modules",
-                                                 "-o", "--output"};
-  return flags;
-}
-
 std::optional<SeedRange> take_seed_range(std::vector<std::string>& args, const std::vector<std::string>& value_flags) {
   std::optional<SeedRange> range;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--seed" && i + 1 < args.size() && args[i + 1].find("..") != std::string::npos) {
-      if (range) throw UsageError{"--seed given twice"};
-      range = parse_seed_range(args[i + 1]);
-      args.erase(args.begin() + static_cast<std::ptrdiff_t>(i), args.begin() + static_cast<std::ptrdiff_t>(i) + 2);
-      --i;
-    } else if (a.rfind("--seed=", 0) == 0 && a.find("..") != std::string::npos) {
-      if (range) throw UsageError{"--seed given twice"};
-      range = parse_seed_range(a.substr(7));
-      args.erase(args.begin() + static_cast<std::ptrdiff_t>(i));
-      --i;
-    } else if (std::find(value_flags.begin(), value_flags.end(), a) != value_flags.end()) {
-      ++i;  // its value, whatever it looks like
-    }
-  }
+  // --seed is this pass's only flag, and only with a range for its value; every other
+  // argument, a single seed's --seed included, stays for parse_grammar_args.
+  Flag seed_range = value_flag({"--seed"}, [&range](const std::string&, const std::string& value) {
+    if (range) throw UsageError{"--seed given twice"};
+    range = parse_seed_range(value);
+  });
+  seed_range.claims = [](const std::string& value) { return value.find("..") != std::string::npos; };
+  FlagTable table;
+  table.flags = {seed_range};
+  table.inline_values = InlineValues::value_flags;
+  table.leaves_others = true;
+  table.later_value_flags = value_flags;
+  args = parse_flags(args, table);
   // A single --seed besides the range is a contradiction parse_grammar_args cannot see.
   if (range)
     for (const std::string& a : args)
-      if (a == "--seed" || a.rfind("--seed=", 0) == 0) throw UsageError{"--seed given twice"};
+      if (a == "--seed" || a.starts_with("--seed=")) throw UsageError{"--seed given twice"};
   return range;
 }
 

@@ -35,9 +35,6 @@ inline constexpr uint64_t kMaxBatchSeeds = 1'000'000;
 std::optional<SeedRange> take_seed_range(std::vector<std::string>& args,
                                          const std::vector<std::string>& value_flags);
 
-// The flags of parse_grammar_args that take a value.
-const std::vector<std::string>& grammar_value_flags();
-
 // True when `pattern` holds "{seed}".
 bool has_seed_placeholder(const std::string& pattern);
 

@@ -16,28 +16,19 @@
 
 namespace sylva::cli {
 
-namespace {
-
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-
-}  // namespace
-
-bool is_grammar_input(const std::string& path) { return ends_with(path, ".lsys"); }
+bool is_grammar_input(const std::string& path) { return path.ends_with(".lsys"); }
 
 bool is_render_input(const std::string& path) {
-  return ends_with(path, ".scene.json") || ends_with(path, ".skel.json") || is_grammar_input(path) ||
-         ends_with(path, ".glb") || ends_with(path, ".gltf");
+  return path.ends_with(".scene.json") || path.ends_with(".skel.json") || is_grammar_input(path) ||
+         path.ends_with(".glb") || path.ends_with(".gltf");
 }
 
 std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std::optional<uint32_t> width,
                                                 std::optional<uint32_t> height,
                                                 std::vector<RenderPass>& passes) {
   const std::string& input = grammar.grammar;
-  const bool is_scene = ends_with(input, ".scene.json"), is_skeleton = ends_with(input, ".skel.json"),
-             is_gltf = ends_with(input, ".glb") || ends_with(input, ".gltf");
+  const bool is_scene = input.ends_with(".scene.json"), is_skeleton = input.ends_with(".skel.json"),
+             is_gltf = input.ends_with(".glb") || input.ends_with(".gltf");
   auto start = std::chrono::steady_clock::now();
   Scene scene;
   if (is_scene) {

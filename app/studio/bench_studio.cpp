@@ -123,22 +123,25 @@ bool latency(Ui& ui, GlViewport& viewport, const std::string& presets, const std
   return true;
 }
 
+void print_help() {
+  std::cout << "usage: sylva bench studio [--quick]\n\n"
+               "The studio's speed on this machine, without a window (EGL; llvmpipe without a GPU):\n"
+               "edit-to-picture latency for elm and pine (a define moved until the viewport shows the\n"
+               "regrown plant), UI frame times while a ~15 M-module derivation runs, and resident\n"
+               "memory over 1,000 regrows (--quick: fewer runs, 100 regrows).\n";
+}
+
 }  // namespace
 
 int run_bench_studio(const std::vector<std::string>& args) {
-  bool quick = false;
-  for (size_t i = 1; i < args.size(); ++i) {
-    if (args[i] == "--quick") quick = true;
-    else if (args[i] == "-h" || args[i] == "--help") {
-      std::cout << "usage: sylva bench studio [--quick]\n\n"
-                   "The studio's speed on this machine, without a window (EGL; llvmpipe without a GPU):\n"
-                   "edit-to-picture latency for elm and pine (a define moved until the viewport shows the\n"
-                   "regrown plant), UI frame times while a ~15 M-module derivation runs, and resident\n"
-                   "memory over 1,000 regrows (--quick: fewer runs, 100 regrows).\n";
-      return cli::kOk;
-    } else {
-      throw cli::UsageError{"unknown argument '" + args[i] + "'"};
-    }
+  bool quick = false, help = false;
+  cli::FlagTable table;
+  table.flags = {cli::set_flag({"--quick"}, quick), cli::help_at_once(help)};
+  table.unknown = [](const std::string& arg) { throw cli::UsageError{"unknown argument '" + arg + "'"}; };
+  cli::parse_flags(std::span(args).subspan(1), table);  // args[0] is "studio"
+  if (help) {
+    print_help();
+    return cli::kOk;
   }
   GlContextResult gl = create_headless_gl_context();
   if (!gl.context) {

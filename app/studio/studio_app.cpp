@@ -31,14 +31,10 @@ std::string one_line(const Diagnostic& d) {
 
 using Clock = std::chrono::steady_clock;
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // The node name of a plant in glTF: the grammar's file name without its extension.
 std::string stem(const std::string& path) {
   std::string name = base_name(path);
-  if (ends_with(name, ".lsys")) name.resize(name.size() - 5);
+  if (name.ends_with(".lsys")) name.resize(name.size() - 5);
   return name.empty() ? "plant" : name;
 }
 
@@ -103,7 +99,7 @@ void StudioApp::keep(const std::string& name) { rects_[name] = WidgetRect{ImGui:
 // ---- documents --------------------------------------------------------------------
 
 std::optional<std::string> StudioApp::open(const std::string& path) {
-  if (ends_with(path, ".scene.json")) {
+  if (path.ends_with(".scene.json")) {
     Expected<Scene> read = read_scene_file(path);
     if (!read) return one_line(read.error());
     Scene scene = std::move(*read);
@@ -993,7 +989,7 @@ void StudioApp::draw_presets() {
     const std::filesystem::path dir = std::filesystem::path(options_.presets_dir) / sub;
     for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
       const std::string p = e.path().string();
-      if (ends_with(p, ".lsys") || ends_with(p, ".scene.json")) files.push_back(p);
+      if (p.ends_with(".lsys") || p.ends_with(".scene.json")) files.push_back(p);
     }
   }
   std::sort(files.begin(), files.end());

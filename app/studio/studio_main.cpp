@@ -58,38 +58,33 @@ struct StudioArgs {
 
 StudioArgs parse_args(const std::vector<std::string>& args) {
   StudioArgs a;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& s = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw cli::UsageError{s + " needs a value"};
-      return args[++i];
-    };
-    if (s == "-h" || s == "--help") {
-      a.help = true;
-    } else if (s == "--screenshot") {
-      a.screenshot = value();
-    } else if (s == "--frames") {
-      const std::string v = value();
-      auto n = cli::parse_u64(v);
-      if (!n || *n > 10000) throw cli::UsageError{"--frames " + v + ": expected an integer from 0 to 10000"};
-      a.frames = static_cast<int>(*n);
-    } else if (s == "--size") {
-      const std::string v = value();
-      const size_t x = v.find('x');
-      auto w = x == std::string::npos ? std::nullopt : cli::parse_u64(v.substr(0, x));
-      auto h = x == std::string::npos ? std::nullopt : cli::parse_u64(v.substr(x + 1));
-      if (!w || !h || *w < 64 || *h < 64 || *w > 16384 || *h > 16384)
-        throw cli::UsageError{"--size " + v + ": expected WxH, each from 64 to 16384"};
-      a.width = static_cast<int>(*w);
-      a.height = static_cast<int>(*h);
-    } else if (!s.empty() && s[0] == '-') {
-      throw cli::UsageError{"unknown option '" + s + "'"};
-    } else if (a.input.empty()) {
-      a.input = s;
-    } else {
-      throw cli::UsageError{"unexpected argument '" + s + "' (one INPUT only)"};
-    }
-  }
+  cli::FlagTable table;
+  table.flags = {
+      cli::help_flag(a.help),
+      cli::text_flag({"--screenshot"}, a.screenshot),
+      cli::value_flag({"--frames"},
+                      [&a](const std::string&, const std::string& v) {
+                        auto n = cli::parse_u64(v);
+                        if (!n || *n > 10000)
+                          throw cli::UsageError{"--frames " + v + ": expected an integer from 0 to 10000"};
+                        a.frames = static_cast<int>(*n);
+                      }),
+      cli::value_flag({"--size"},
+                      [&a](const std::string&, const std::string& v) {
+                        const size_t x = v.find('x');
+                        auto w = x == std::string::npos ? std::nullopt : cli::parse_u64(v.substr(0, x));
+                        auto h = x == std::string::npos ? std::nullopt : cli::parse_u64(v.substr(x + 1));
+                        if (!w || !h || *w < 64 || *h < 64 || *w > 16384 || *h > 16384)
+                          throw cli::UsageError{"--size " + v + ": expected WxH, each from 64 to 16384"};
+                        a.width = static_cast<int>(*w);
+                        a.height = static_cast<int>(*h);
+                      }),
+  };
+  table.positional = [&a](const std::string& input) {
+    if (!a.input.empty()) throw cli::UsageError{"unexpected argument '" + input + "' (one INPUT only)"};
+    a.input = input;
+  };
+  cli::parse_flags(args, table);
   if (!a.screenshot.empty() && a.input.empty()) throw cli::UsageError{"--screenshot needs an INPUT"};
   if (!a.screenshot.empty() && !can_write_image_format(a.screenshot))
     throw cli::UsageError{"--screenshot " + a.screenshot + ": OpenImageIO cannot write this format"};
