@@ -194,6 +194,7 @@ int run_export(const std::vector<std::string>& raw_args) {
   if (range && !has_seed_placeholder(a.output))
     throw UsageError{"--seed " + std::to_string(range->first) + ".." + std::to_string(range->last) +
                      " writes one file per seed: -o must hold {seed}, e.g. -o out/plant_{seed}.glb"};
+  if (range) check_pattern_separates(a.output, "{seed}");
 
   // The textures are checked once, before any plant grows or any file is written.
   if (Status textures = check_bark_textures(bark); !textures) {

@@ -127,6 +127,7 @@ int run_grow(const std::vector<std::string>& raw_args) {
   if (range && !has_seed_placeholder(a.output))
     throw UsageError{"--seed " + std::to_string(range->first) + ".." + std::to_string(range->last) +
                      " writes one file per seed: -o must hold {seed}, e.g. -o out/plant_{seed}.skel.json"};
+  if (range) check_pattern_separates(a.output, "{seed}");
   int code = kOk;
   auto g = load_grammar_for(a, &code);
   if (!g) return code;

@@ -343,6 +343,7 @@ int run_render_frames(const RenderArgs& a) {
   if (growth && a.grammar.steps) throw UsageError{"--frames on a grammar sets the derivation steps: leave out -n"};
   if (!has_frame_placeholder(pattern))
     throw UsageError{"-o " + pattern + ": with --frames the output must hold {frame}, e.g. -o frames/f_{frame}.png"};
+  check_pattern_separates(pattern, "{frame}");
   FrameRange range = parse_frames(*a.frames);
   std::optional<std::string> ffmpeg;
   if (a.video) {
@@ -384,6 +385,10 @@ int run_render_frames(const RenderArgs& a) {
   const double fps = a.fps.value_or(growth ? 4.0 : base.animation->fps);
   if (auto problem = image_size_problem(base.width, base.height, a.spp)) {
     std::cerr << "sylva render: error: " << *problem << "\n";
+    return kInputError;
+  }
+  if (auto problem = image_format_size_problem(pattern, base.width, base.height)) {
+    std::cerr << file_diagnostic(pattern, *problem).format();
     return kInputError;
   }
   if (!base.fog && (a.fog_flags || (a.aovs & kAovFog)))
@@ -550,6 +555,10 @@ int run_render(const std::vector<std::string>& args) {
   apply_camera_flags(a.camera, scene.camera);
   if (auto problem = image_size_problem(scene.width, scene.height, a.spp)) {
     std::cerr << "sylva render: error: " << *problem << "\n";
+    return kInputError;
+  }
+  if (auto problem = image_format_size_problem(output, scene.width, scene.height)) {
+    std::cerr << file_diagnostic(output, *problem).format();
     return kInputError;
   }
   // Every output is checked now, with the inputs read, rather than after the render.

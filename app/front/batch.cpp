@@ -70,6 +70,15 @@ constexpr std::string_view kFramePlaceholder = "{frame}";
 
 bool has_seed_placeholder(const std::string& pattern) { return pattern.find(kPlaceholder) != std::string::npos; }
 
+void check_pattern_separates(const std::string& pattern, std::string_view placeholder) {
+  // Each value gives its own file only if the placeholder outlives '..' and '.': in
+  // out/{seed}/../a.skel.json it names a folder that '..' leaves at once.
+  const std::string normal = std::filesystem::path(pattern).lexically_normal().string();
+  if (normal.find(placeholder) == std::string::npos)
+    throw UsageError{"-o " + pattern + ": '..' undoes the folder " + std::string(placeholder) +
+                     " names, so every one would write the same file " + normal};
+}
+
 std::string expand_seed_pattern(const std::string& pattern, uint64_t seed) {
   return expand_placeholder(pattern, kPlaceholder, std::to_string(seed));
 }

@@ -38,6 +38,10 @@ std::optional<SeedRange> take_seed_range(std::vector<std::string>& args,
 // True when `pattern` holds "{seed}".
 bool has_seed_placeholder(const std::string& pattern);
 
+// Throws UsageError when `placeholder` ("{seed}", "{frame}") in `pattern` does not give
+// each value its own file: '..' undoes the folder it names (out/{seed}/../a.skel.json).
+void check_pattern_separates(const std::string& pattern, std::string_view placeholder);
+
 // `pattern` with every "{seed}" replaced by the seed in decimal.
 std::string expand_seed_pattern(const std::string& pattern, uint64_t seed);
 

@@ -51,6 +51,9 @@ def output_path(pattern, seed):
     """The file of one seed: ``{seed}`` in ``pattern`` replaced by the decimal seed (docs/spec/cli.md)."""
     if "{seed}" not in pattern:
         raise ValueError(f"the output pattern {pattern!r} has no {{seed}}: every seed would write the same file")
+    if "{seed}" not in os.path.normpath(pattern):
+        raise ValueError(f"the output pattern {pattern!r}: '..' undoes the folder {{seed}} names, "
+                         f"so every seed would write {os.path.normpath(pattern)!r}")
     return pattern.replace("{seed}", str(seed))
 
 

@@ -372,12 +372,22 @@ Skeleton skeleton_from_file(const std::filesystem::path& path_in) {
   return skeleton_from_json(*read, path);
 }
 
+// The files a plant is made from, which nothing made from it may overwrite
+// (docs/limits.md, "Outputs"): the grammar it grew from. (The CLI refuses every file its
+// command read; a Python session lives too long for that, so each call names its own.)
+std::vector<std::string> plant_inputs(const Skeleton& sk) {
+  if (sk.source.grammar.empty() || sk.source.grammar.front() == '<') return {};
+  return {sk.source.grammar};
+}
+
 void skeleton_save(const Skeleton& sk, const std::filesystem::path& path) {
+  const std::string target = path_string(path);
+  if (Status allowed = check_not_an_input(target, plant_inputs(sk)); !allowed) throw_file_error(allowed.error());
   const std::string json = write_skeleton_json(sk);
   Status written;
   {
     py::gil_scoped_release release;
-    written = write_file_atomically(path_string(path), json);
+    written = write_file_atomically(target, json);
   }
   if (!written) throw_file_error(written.error());
 }
@@ -495,6 +505,13 @@ void python_export_gltf(const py::object& plants, const std::filesystem::path& p
     const Bark b = bark_from_dict(bark);
     for (GltfPlant& p : gltf_plants) p.bark = b;
   }
+  std::vector<std::string> inputs;
+  for (const GltfPlant& p : gltf_plants) {
+    for (std::string& input : plant_inputs(p.skeleton)) inputs.push_back(std::move(input));
+    for (const auto* image : {&p.bark.albedo_texture, &p.bark.height_texture})
+      if (*image) inputs.push_back(**image);
+  }
+  if (Status allowed = check_not_an_input(path_string(path), inputs); !allowed) throw_file_error(allowed.error());
   GltfExportOptions options;
   options.mesh = mesh;
   options.segments_around = segments_around;

@@ -143,6 +143,18 @@ void note_input_file(const std::string& path) {
   if (inputs.enabled && ::stat(path.c_str(), &info) == 0) inputs.files.insert({info.st_dev, info.st_ino});
 }
 
+Status check_not_an_input(const std::string& output, const std::vector<std::string>& inputs) {
+  struct stat out {};
+  if (output.empty() || ::lstat(output.c_str(), &out) != 0) return {};  // a new file is nobody's input
+  for (const std::string& input : inputs) {
+    struct stat in {};
+    if (!input.empty() && ::stat(input.c_str(), &in) == 0 && in.st_dev == out.st_dev && in.st_ino == out.st_ino)
+      return file_diagnostic(output, "cannot write: it is " + (input == output ? std::string("an input") : "'" + input + "'") +
+                                         " of this call, which writing would destroy");
+  }
+  return {};
+}
+
 Status check_output_path(const std::string& path) {
   if (path.empty()) return file_diagnostic(path, "cannot write: the path is empty");
   if (path.back() == '/') return errno_error(path, "cannot write", EISDIR);

@@ -36,6 +36,13 @@ Expected<std::string> read_text_file(const std::string& path, size_t max_bytes =
 void refuse_outputs_onto_inputs();
 void note_input_file(const std::string& path);
 
+// The same rule for a front end that keeps no process-wide list (Python: a session reads
+// and writes many files over its life): a Diagnostic when `output` is the same file as one
+// of `inputs` — the files the output is made from, compared by device and inode, whatever
+// their names — else success. A symbolic link at `output` is replaced, never written
+// through, so it is compared itself.
+Status check_not_an_input(const std::string& output, const std::vector<std::string>& inputs);
+
 // Whether `path` may be written as an output (docs/limits.md, "Outputs"): a missing file, a
 // regular file that is writable (not `chmod a-w`, and writable to this user), or a
 // symbolic link (replaced, see below) — and never a file noted as an input. A FIFO, a

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,7 +30,11 @@ Status write_image_atomically(const std::string& path, uint32_t width, uint32_t 
                               const std::vector<ChannelFormat>& formats, bool srgb);
 
 // The first half of write_image_atomically: the complete image in a temporary next to
-// `path`, to be renamed with others by commit_files (file_io.h), all or nothing.
+// `path`, to be renamed with others by commit_files (file_io.h), all or nothing. The
+// image is encoded in memory and decoded back to its last row before a byte reaches the
+// disk, then written with every write() checked: an encoder that fails without saying so
+// or a full disk is a Diagnostic, never a truncated or empty file. A size past the
+// format's own limit (image_format_size_problem) is refused before the encoder runs.
 Expected<PendingFile> write_pending_image(const std::string& path, uint32_t width, uint32_t height,
                                           const std::vector<std::string>& channel_names,
                                           const std::vector<float>& pixels,
@@ -44,6 +49,9 @@ std::string lower_extension(const std::string& path);
 Status check_image_opens(const std::string& path);
 
 // Whether OpenImageIO has a writer for `path`'s extension (checked before rendering).
+// image_format_size_problem: why an image of width x height cannot be written in
+// `path`'s format (JPEG: at most 65,500 pixels a side; WebP 16,383; TGA 65,535), or none.
 bool can_write_image_format(const std::string& path);
+std::optional<std::string> image_format_size_problem(const std::string& path, uint64_t width, uint64_t height);
 
 }  // namespace sylva

@@ -134,6 +134,11 @@ const std::vector<UsageCase>& usage_cases() {
       {"MaxModulesNegative", {"derive", "{G}", "--max-modules", "-5"}},
       {"MaxModulesNotANumber", {"derive", "{G}", "--max-modules", "abc"}},
       {"GrowMaxModulesZero", {"grow", "{G}", "-o", "{O}", "--max-modules", "0"}},
+      // '..' undoes the folder the placeholder names: three seeds onto one file (issue 32).
+      {"GrowSeedsFoldedOntoOneFile", {"grow", "{G}", "--seed", "1..3", "-o", "out/{seed}/../same.skel.json"}},
+      {"ExportSeedsFoldedOntoOneFile", {"export", "{G}", "--seed", "1..3", "-o", "{seed}/../same.glb"}},
+      {"FramesFoldedOntoOneFile",
+       {"render", "{G}", "--frames", "1..3", "-o", "f/{frame}/../same.png", "--width", "8", "--height", "8"}},
   };
   return cases;
 }

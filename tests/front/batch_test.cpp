@@ -56,5 +56,20 @@ TEST(SeedTasks, CancellingStopsStartingNewSeeds) {
   EXPECT_EQ(ran.load(), 5);
 }
 
+// A placeholder that '..' undoes gives every value one file (issue 32): refused, naming
+// the file they would all write; one that survives normalisation is kept.
+TEST(OutputPatterns, APlaceholderThatDotDotUndoesIsRefused) {
+  EXPECT_THROW(check_pattern_separates("out/{seed}/../same.skel.json", "{seed}"), UsageError);
+  EXPECT_THROW(check_pattern_separates("{frame}/../f.png", "{frame}"), UsageError);
+  try {
+    check_pattern_separates("out/{seed}/../same.skel.json", "{seed}");
+  } catch (const UsageError& e) {
+    EXPECT_NE(e.message.find("out/same.skel.json"), std::string::npos) << e.message;
+  }
+  EXPECT_NO_THROW(check_pattern_separates("out/{seed}/a.skel.json", "{seed}"));
+  EXPECT_NO_THROW(check_pattern_separates("./out/../a_{seed}.skel.json", "{seed}"));
+  EXPECT_NO_THROW(check_pattern_separates("f/{frame}/../{frame}.png", "{frame}"));
+}
+
 }  // namespace
 }  // namespace sylva::cli

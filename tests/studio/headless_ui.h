@@ -131,8 +131,9 @@ class HeadlessUi {
       frame(app);
     }
   }
-  // Frames (with the worker running for real) until `done` or `timeout_s` of wall time.
-  bool until(StudioApp& app, const std::function<bool()>& done, double timeout_s = 20) {
+  // Frames (with the worker running for real) until `done` or `timeout_s` of wall time: a
+  // hang guard, far above the second or two the worker takes on an idle machine.
+  bool until(StudioApp& app, const std::function<bool()>& done, double timeout_s = 300) {
     const auto start = std::chrono::steady_clock::now();
     while (!done()) {
       if (std::chrono::steady_clock::now() - start > std::chrono::duration<double>(timeout_s)) return false;
@@ -156,7 +157,7 @@ class HeadlessUi {
     return true;
   }
   // Until the worker is idle and its result is on screen.
-  bool settle(StudioApp& app, double timeout_s = 20) {
+  bool settle(StudioApp& app, double timeout_s = 300) {
     return until(app, [&] { return !app.worker().busy() && !app.worker().result_waiting(); }, timeout_s) &&
            (frames(app, 3), true);
   }

@@ -322,7 +322,7 @@ TEST_F(Fixture, SixtyRapidEditsPutOnlyTheLastPlantOnScreen) {
 TEST_F(Fixture, OpensAScene) {
   auto app = make_app();
   ASSERT_FALSE(app->open(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes/saguaro.scene.json"));
-  ASSERT_TRUE(ui.until(*app, [&] { return app->plant_drawn(); }, 60));
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plant_drawn(); }));
   EXPECT_NE(app->path().find("saguaro.lsys"), std::string::npos);
   EXPECT_GT(viewport.segments, 0u);
   EXPECT_EQ(app->scene().plants.size(), 1u);
@@ -395,7 +395,7 @@ TEST_F(Fixture, ThePresetBrowserOpensAPreset) {
   EXPECT_TRUE(app->rect("preset:scenes/pine.scene.json"));
   ui.click(*app, elm->centre());
   EXPECT_NE(app->path().find("presets/elm.lsys"), std::string::npos);
-  ASSERT_TRUE(ui.until(*app, [&] { return app->plant_drawn(); }, 60));
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plant_drawn(); }));
   EXPECT_EQ(viewport.segments, 1769u);
   EXPECT_FALSE(app->rect("preset:elm.lsys")) << "the browser closes once a preset is open";
 }

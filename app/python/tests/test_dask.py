@@ -68,6 +68,9 @@ def test_bad_batches_are_refused_before_any_task(tmp_path, client):
     assert e.value.line == 3
     with pytest.raises(ValueError, match="no \\{seed\\}"):
         sylva_dask.batch(client, "grow", "presets/elm.lsys", [1, 2], str(tmp_path / "same.skel.json"))
+    with pytest.raises(ValueError, match="undoes the folder"):
+        sylva_dask.batch(client, "grow", "presets/elm.lsys", [1, 2], str(tmp_path / "{seed}" / ".." / "same.skel.json"))
+    assert list(tmp_path.iterdir()) == [bad]
     with pytest.raises(ValueError, match="repeated"):
         sylva_dask.batch(client, "grow", "presets/elm.lsys", [1, 1], str(tmp_path / "x_{seed}.skel.json"))
     with pytest.raises(ValueError, match="unknown kind"):

@@ -145,3 +145,21 @@ def test_leaves_are_arrays_matching_the_json():
 def test_a_skeleton_without_leaves_has_empty_leaf_arrays(elm):
     assert elm.leaf_count == 0
     assert elm.leaves.shape == (0,) and elm.leaf_vertices.shape == (0, 3)
+
+
+def test_save_never_overwrites_the_grammar_the_plant_grew_from(tmp_path):
+    # Issue 32 item 5: the CLI refuses `grow mine.lsys -o mine.lsys`; so does Python, under
+    # any name for the same file (a hard link here), and the grammar stays as it was.
+    grammar = tmp_path / "mine.lsys"
+    text = open("presets/elm.lsys").read()
+    grammar.write_text(text)
+    (tmp_path / "alias.lsys").hardlink_to(grammar)
+    sk = sylva.Grammar.from_file(str(grammar)).grow(seed=7)
+    for target in (grammar, tmp_path / "alias.lsys"):
+        with pytest.raises(OSError, match="of this call, which writing would destroy"):
+            sk.save(target)
+        with pytest.raises(OSError, match="of this call, which writing would destroy"):
+            sylva.export_gltf(sk, target)
+    assert grammar.read_text() == text
+    sk.save(tmp_path / "mine.skel.json")  # any other file is written
+    assert sylva.Skeleton.from_file(tmp_path / "mine.skel.json").to_json() == sk.to_json()

@@ -1,0 +1,96 @@
+// output_damage_test.cpp — issue 32's damage items: an image output is whole or not
+// written at all (docs/spec/cli.md "outputs are written atomically"), in every format the
+// writer offers, on a full disk, and past a format's own size limit; and no front end
+// writes onto its input (docs/limits.md).
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "tests/support/process.h"
+
+namespace {
+
+const std::string kSaguaro = std::string(SYLVA_SOURCE_DIR) + "/presets/saguaro.lsys";
+
+// `sylva args...` with the files it may write limited to `kib` KiB (RLIMIT_FSIZE, as
+// bash's `ulimit -f`) and SIGXFSZ ignored: a write past the limit fails with EFBIG, as
+// one on a full disk fails with ENOSPC — a disk that fills during the write.
+ProcessResult run_sylva_on_a_full_disk(int kib, const std::vector<std::string>& args) {
+  std::vector<std::string> argv{"bash", "-c", "trap '' XFSZ; ulimit -f " + std::to_string(kib) + "; exec \"$0\" \"$@\"",
+                                SYLVA_BINARY};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return run_process(argv);
+}
+
+// width x height x channels of the image at `path` when it decodes to its last row.
+std::string decoded_size(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) return "cannot open: " + OIIO::geterror();
+  const OIIO::ImageSpec& spec = in->spec();
+  std::vector<float> pixels(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()))
+    return "cannot decode: " + in->geterror();
+  return std::to_string(spec.width) + "x" + std::to_string(spec.height) + "x" + std::to_string(spec.nchannels);
+}
+
+// A disk that fills while the picture is written: exit 1 naming the file, the image that
+// was there before unchanged byte for byte, no temporary left. (Before: OpenImageIO's PNG
+// writer reported no short write, sylva exited 0 and renamed a truncated PNG over the
+// old one.)
+TEST(OutputDamage, AFullDiskIsAnErrorAndTheImageBeforeStays) {
+  for (const char* name : {"s.png", "s.exr", "s.tif"}) {
+    SCOPED_TRACE(name);
+    TempDir dir;
+    const std::string out = dir.file(name);
+    const std::vector<std::string> args{"render", kSaguaro, "-o", out, "--width", "320", "--height", "240",
+                                        "--spp", "1", "--backend", "cpu"};
+    ProcessResult first = run_sylva(args);
+    ASSERT_EQ(first.exit_code, 0) << describe(first);
+    const std::string before = read_file(out);
+    ASSERT_GT(before.size(), 4u << 10) << "the picture must be larger than the disk's room";
+
+    ProcessResult full = run_sylva_on_a_full_disk(2, args);
+    EXPECT_EQ(full.exit_code, 1) << describe(full);
+    EXPECT_NE(full.err.find(out + ": error:"), std::string::npos) << describe(full);
+    EXPECT_EQ(read_file(out), before) << "the image before was damaged";
+    EXPECT_EQ(list_dir(dir.path()), std::vector<std::string>{name}) << "a temporary was left behind";
+  }
+}
+
+// Every format the help names writes a whole image of the size asked. (Before: .jp2 and
+// .j2k renders exited 0 and left an empty file: the plugin names its codec by the file
+// name's extension, which the temporary lacked.)
+TEST(OutputDamage, EveryFormatWritesAnImageThatDecodesToItsLastRow) {
+  TempDir dir;
+  for (const char* ext : {"png", "exr", "jpg", "jp2", "j2k", "tif", "hdr", "bmp", "tga", "webp"}) {
+    SCOPED_TRACE(ext);
+    const std::string out = dir.file(std::string("s.") + ext);
+    ProcessResult r = run_sylva({"render", kSaguaro, "-o", out, "--width", "64", "--height", "48", "--spp", "1",
+                                 "--backend", "cpu"});
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    const std::string size = decoded_size(out);
+    EXPECT_TRUE(size == "64x48x4" || size == "64x48x3") << size;
+  }
+}
+
+// A JPEG wider than libjpeg's 65,500 pixels: refused before the render with a
+// `file: error:` line and nothing written. (Before: libjpeg's default error handler
+// printed its own text and called exit(), leaving the temporary behind.)
+TEST(OutputDamage, AnImageBeyondItsFormatsSideLimitIsRefusedBeforeTheRender) {
+  for (const char* name : {"wide.jpg", "wide.webp"}) {
+    SCOPED_TRACE(name);
+    TempDir dir;
+    const std::string out = dir.file(name);
+    ProcessResult r = run_sylva({"render", kSaguaro, "-o", out, "--width", "65536", "--height", "1", "--spp", "1",
+                                 "--backend", "cpu"});
+    EXPECT_EQ(r.exit_code, 1) << describe(r);
+    EXPECT_NE(r.err.find(out + ": error: a "), std::string::npos) << describe(r);
+    EXPECT_NE(r.err.find("pixels a side"), std::string::npos) << describe(r);
+    EXPECT_TRUE(list_dir(dir.path()).empty()) << "something was written";
+  }
+}
+
+}  // namespace
