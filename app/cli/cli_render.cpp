@@ -516,9 +516,10 @@ int run_render_frames(const RenderArgs& a) {
   }
   std::cerr << "\n";
   if (a.video) {
-    if (Status encoded = encode_video(*ffmpeg, pattern, range.first, range.count(), fps, *a.video); !encoded) {
+    if (Status encoded = encode_video(*ffmpeg, pattern, range.first, range.count(), fps, *a.video, &g_interrupted);
+        !encoded) {
       std::cerr << encoded.error().format();
-      return kInputError;
+      return g_interrupted.load() ? kInterrupted : kInputError;
     }
     std::cerr << "sylva render: wrote " << *a.video << " (" << done << " frames at " << fps << " fps)\n";
   }

@@ -51,17 +51,17 @@ void apply_camera_flags(const CameraFlags& flags, Camera& camera) {
   if (flags.eye) camera.eye = *flags.eye;
   if (flags.target) camera.target = *flags.target;
   if (flags.fov_y_deg) camera.fov_y_deg = *flags.fov_y_deg;
-  glm::dvec3 forward = camera.target - camera.eye;
-  const double longest = std::max({std::abs(forward.x), std::abs(forward.y), std::abs(forward.z)});
-  if (!(longest > 0)) throw UsageError{"--eye and --target: the camera's eye and target must differ"};
-  if (!std::isfinite(longest)) throw UsageError{"--eye and --target: the camera's eye and target are too far apart"};
-  // The same test as a scene file's camera (scene.cpp read_camera), on unit vectors;
-  // rescaled first, so that an eye at 1e300 m does not overflow to a NaN direction.
-  forward /= longest;
-  const glm::dvec3 side = glm::cross(glm::normalize(forward), glm::normalize(camera.up));
-  if (!(glm::length(side) > 1e-9))
+  // The one camera check (scene.h camera_problem), as a scene file's camera has it.
+  const std::optional<std::string> problem = camera_problem(camera);
+  if (!problem) return;
+  if (problem->starts_with("eye coordinates")) throw UsageError{"--eye: the " + *problem};
+  if (problem->starts_with("target coordinates")) throw UsageError{"--target: the " + *problem};
+  if (problem->starts_with("eye and target"))
+    throw UsageError{"--eye and --target: the camera's eye and target must differ"};
+  if (problem->starts_with("up must not be parallel"))
     throw UsageError{"--eye and --target: the view must not be straight along the camera's up (a scene's "
                      "camera.up, else +Y): move the eye or the target sideways a little"};
+  throw UsageError{"--eye, --target, --fov: the camera's " + *problem};
 }
 
 }  // namespace sylva::cli

@@ -2,10 +2,12 @@
 #include "app/front/video.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -72,7 +74,10 @@ std::string number_text(double x) {
 
 // Runs argv[0] with `argv`, stdin from /dev/null, stdout discarded, stderr captured into
 // *err. Returns the exit status (128 + signal when killed, -1 when it could not start).
-int run_child(const std::vector<std::string>& argv, std::string* err) {
+// The child is stopped (SIGTERM) when `cancel` becomes true while it runs — sylva's SIGINT
+// handler sets it, and interrupts the read below — and by a SIGTERM or SIGHUP to sylva
+// (remember_child): it never outlives sylva.
+int run_child(const std::vector<std::string>& argv, std::string* err, const std::atomic<bool>* cancel) {
   int pipe_fds[2];
   if (::pipe(pipe_fds) != 0) return -1;
   posix_spawn_file_actions_t actions;
@@ -94,8 +99,16 @@ int run_child(const std::vector<std::string>& argv, std::string* err) {
     *err = std::strerror(spawned);
     return -1;
   }
+  const int child_slot = remember_child(pid);
+  bool stopped = false;
+  auto stop_when_cancelled = [&] {
+    if (stopped || !cancel || !cancel->load()) return;
+    ::kill(pid, SIGTERM);
+    stopped = true;
+  };
   char buf[4096];
   for (ssize_t n; (n = ::read(pipe_fds[0], buf, sizeof buf)) != 0;) {
+    stop_when_cancelled();
     if (n < 0) {
       if (errno == EINTR) continue;
       break;
@@ -105,8 +118,14 @@ int run_child(const std::vector<std::string>& argv, std::string* err) {
   }
   ::close(pipe_fds[0]);
   int status = 0;
-  while (::waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) return -1;
+  while (::waitpid(pid, &status, 0) < 0) {
+    stop_when_cancelled();
+    if (errno != EINTR) {
+      forget_child(child_slot);
+      return -1;
+    }
+  }
+  forget_child(child_slot);
   if (WIFEXITED(status)) return WEXITSTATUS(status);
   return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
 }
@@ -121,7 +140,7 @@ std::string last_line(std::string text) {
 }  // namespace
 
 Status encode_video(const std::string& ffmpeg, const std::string& pattern, uint64_t first, uint64_t count, double fps,
-                    const std::string& video) {
+                    const std::string& video, const std::atomic<bool>* cancel) {
   const std::optional<std::string> container = video_container_for(video);
   if (!container) return file_diagnostic(video, "not a video sylva encodes (.mp4, .mkv, .webm, .mov or .gif)");
   Expected<PendingFile> pending = PendingFile::create(video);
@@ -139,7 +158,8 @@ Status encode_video(const std::string& ffmpeg, const std::string& pattern, uint6
   }
   argv.insert(argv.end(), {"-f", *container, pending->temporary()});
   std::string messages;
-  const int status = run_child(argv, &messages);
+  const int status = run_child(argv, &messages, cancel);
+  if (cancel && cancel->load()) return file_diagnostic(video, "interrupted: the video was not written");
   if (status != 0) {
     const std::string why = status < 0 ? "could not run " + ffmpeg + (messages.empty() ? "" : ": " + messages)
                                        : ffmpeg + " failed (exit " + std::to_string(status) + ")" +

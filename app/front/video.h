@@ -6,6 +6,7 @@
 // leaves OUT as it was.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -29,8 +30,10 @@ std::string ffmpeg_sequence_pattern(const std::string& pattern);
 // at `fps` frames per second into `video` (check_output_path passed; container from
 // video_container_for): H.264 (VP9 for .webm, a palette for .gif) with pixels padded to
 // even sizes. Failure: a Diagnostic for `video` with ffmpeg's exit status and its last
-// message; `video` is untouched then.
+// message; `video` is untouched then. `cancel` (Ctrl-C: render's SIGINT flag) becoming
+// true stops ffmpeg; a SIGTERM or SIGHUP to sylva stops it too (file_io.h remember_child):
+// either way no ffmpeg outlives sylva and no temporary is left.
 Status encode_video(const std::string& ffmpeg, const std::string& pattern, uint64_t first, uint64_t count, double fps,
-                    const std::string& video);
+                    const std::string& video, const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace sylva::cli

@@ -60,3 +60,32 @@ void bind_module(pybind11::module_& m);
 void bind_render(pybind11::module_& m);
 
 }  // namespace sylva::python
+
+namespace pybind11::detail {
+
+// An object made by `Skeleton.__new__(Skeleton)` (or Grammar's) without __init__ holds no
+// C++ value: pybind11 would hand every method a fresh block of uninitialised memory
+// (to_json, grow: a crash; positions: a shape read from garbage). Every method and
+// property takes its object through these casters, which raise TypeError for it instead.
+// (Constructors and pickle's __setstate__ take the bare instance, not through them, so
+// they still fill such an object.)
+template <typename T>
+struct initialised_caster : type_caster_base<T> {
+  bool load(handle src, bool convert) {
+    if (isinstance<T>(src)) {
+      auto* inst = reinterpret_cast<instance*>(src.ptr());
+      if (!inst->get_value_and_holder(get_type_info(typeid(T))).holder_constructed())
+        throw type_error(std::string(Py_TYPE(src.ptr())->tp_name) +
+                         " object was made by __new__ without __init__ and holds nothing: make one with "
+                         "sylva.Grammar(...), Grammar.from_file(), Grammar.grow(), Skeleton.from_file() or "
+                         "Skeleton.from_json()");
+    }
+    return type_caster_base<T>::load(src, convert);
+  }
+};
+template <>
+class type_caster<sylva::Skeleton> : public initialised_caster<sylva::Skeleton> {};
+template <>
+class type_caster<sylva::python::PyGrammar> : public initialised_caster<sylva::python::PyGrammar> {};
+
+}  // namespace pybind11::detail

@@ -26,14 +26,21 @@ FileStamp stamp_of(const std::string& path) {
   return s;
 }
 
-std::optional<std::string> restorable_autosave(const std::string& path, const std::string& file_text) {
+std::optional<Autosave> restorable_autosave(const std::string& path, const std::string& file_text) {
   const std::string a = autosave_path(path);
   const FileStamp as = stamp_of(a), fs = stamp_of(path);
   if (as.size < 0) return std::nullopt;
-  if (fs.size >= 0 && as.mtime_ns < fs.mtime_ns) return std::nullopt;
   Expected<std::string> r = read_text_file(a);
   if (!r || *r == file_text) return std::nullopt;
-  return std::move(*r);
+  return Autosave{std::move(*r), fs.size >= 0 && as.mtime_ns < fs.mtime_ns};
+}
+
+std::string save_target(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::is_symlink(fs::symlink_status(path, error))) return path;
+  const fs::path real = fs::weakly_canonical(fs::absolute(path, error), error);
+  return error ? path : real.string();
 }
 
 void remove_autosave(const std::string& path) { ::unlink(autosave_path(path).c_str()); }

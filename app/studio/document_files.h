@@ -22,10 +22,20 @@ struct FileStamp {
 };
 FileStamp stamp_of(const std::string& path);
 
-// An autosave of `path` that should be offered for restoring: it exists, is newer than
-// the file (or the file is gone), and holds something other than the file's text.
-// Returns its text.
-std::optional<std::string> restorable_autosave(const std::string& path, const std::string& file_text);
+// An autosave of `path` that should be offered for restoring: it exists and holds
+// something other than the file's text — whether newer than the file or older (the file
+// changed since, say by a `git checkout`: the edits are still the user's, and the next
+// autosave would otherwise replace them unseen).
+struct Autosave {
+  std::string text;
+  bool older_than_file = false;
+};
+std::optional<Autosave> restorable_autosave(const std::string& path, const std::string& file_text);
+
+// The file a save of `path` writes: `path` itself, or, when it is a symbolic link, the
+// file it leads to (every link followed), so that saving a document opened through a link
+// changes the real document and keeps the link. A dangling link gives the path it names.
+std::string save_target(const std::string& path);
 
 // Removes the autosave of `path` (after a save, or when the user discards the edits).
 void remove_autosave(const std::string& path);

@@ -161,7 +161,7 @@ void StudioApp::load_text(const std::string& path, std::string text, const std::
       if (scene_.plants[i].grammar == path_) edited_plants_.push_back(i);
   }
   history_.reset(doc_state());
-  restore_text_ = path_.empty() ? std::nullopt : restorable_autosave(path_, saved_text_);
+  restore_ = path_.empty() ? std::nullopt : restorable_autosave(path_, saved_text_);
   show_presets_ = false;
   status_ = "opened " + base_name(scene_path_.empty() ? path_ : scene_path_);
   submit_regrow();
@@ -173,7 +173,8 @@ std::optional<std::string> StudioApp::save() {
     dialog_path_ = "untitled.lsys";
     return std::nullopt;
   }
-  if (Status written = write_file_atomically(path_, text_); !written) {
+  // Through a symbolic link to the real document (the link stays a link).
+  if (Status written = write_file_atomically(save_target(path_), text_); !written) {
     status_ = one_line(written.error());
     return status_;
   }
@@ -421,10 +422,15 @@ void StudioApp::write_parameters_to_text() {
 void StudioApp::autosave(double now) {
   if (now - last_autosave_ < options_.autosave_s) return;
   last_autosave_ = now;
-  if (!dirty() || text_ == autosaved_text_) return;
+  if (auto error = autosave_now()) status_ = "autosave: " + *error;
+}
+
+std::optional<std::string> StudioApp::autosave_now() {
+  if (!dirty() || text_ == autosaved_text_) return std::nullopt;
   const std::string target = autosave_path(path_.empty() ? "untitled.lsys" : path_);
-  if (Status written = write_file_atomically(target, text_); !written) status_ = "autosave: " + one_line(written.error());
-  else autosaved_text_ = text_;
+  if (Status written = write_file_atomically(target, text_); !written) return one_line(written.error());
+  autosaved_text_ = text_;
+  return std::nullopt;
 }
 
 void StudioApp::watch_file(double now) {
@@ -1061,22 +1067,24 @@ void StudioApp::draw_file_dialog() {
 }
 
 void StudioApp::draw_modals() {
-  if (restore_text_) {
+  if (restore_) {
     if (!ImGui::IsPopupOpen("Restore unsaved edits?")) ImGui::OpenPopup("Restore unsaved edits?");
     if (ImGui::BeginPopupModal("Restore unsaved edits?", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
       ImGui::Text("%s has edits that were never saved (%s).", display_name().c_str(), autosave_path(path_).c_str());
+      if (restore_->older_than_file)
+        ImGui::Text("They are older than the file, which changed since they were written.");
       if (ImGui::Button("Restore")) {
-        set_text(*restore_text_);
+        set_text(restore_->text);
         snapshot();
         submit_regrow();
-        restore_text_.reset();
+        restore_.reset();
         ImGui::CloseCurrentPopup();
       }
       keep("button:Restore");
       ImGui::SameLine();
       if (ImGui::Button("Discard")) {
         remove_autosave(path_);
-        restore_text_.reset();
+        restore_.reset();
         ImGui::CloseCurrentPopup();
       }
       keep("button:Discard");

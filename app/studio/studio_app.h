@@ -60,10 +60,13 @@ class StudioApp {
 
   // Opens a .lsys grammar or a .scene.json scene (its plants grow; the editor shows the
   // first plant's grammar). Returns the error text, changing nothing, when it cannot.
-  // An autosave newer than the file is offered for restoring.
+  // An autosave that differs from the file is offered for restoring (document_files.h).
   std::optional<std::string> open(const std::string& path);
   // One frame of widgets at time `now` (seconds, any origin, increasing).
   void frame(double now);
+  // Writes an edited document's autosave now, whatever the timer (SIGTERM, SIGHUP: the
+  // studio keeps the buffer as vim and nano do). Returns the error text when it cannot.
+  std::optional<std::string> autosave_now();
 
   std::string title() const;  // "sylva studio — elm.lsys*"
   bool dirty() const;         // the text differs from the file's
@@ -101,7 +104,7 @@ class StudioApp {
   const std::map<std::string, double>& overrides() const { return overrides_; }
   const Scene& scene() const { return scene_; }
   const OrbitCamera& camera() const { return orbit_; }
-  bool restore_offered() const { return restore_text_.has_value(); }
+  bool restore_offered() const { return restore_.has_value(); }
   bool close_prompt_open() const { return close_prompt_; }
   bool external_change_prompt_open() const { return external_prompt_; }
   const std::string& status() const { return status_; }
@@ -202,7 +205,7 @@ class StudioApp {
   std::string autosaved_text_;
 
   // Prompts and dialogs.
-  std::optional<std::string> restore_text_;
+  std::optional<Autosave> restore_;
   bool close_prompt_ = false;
   std::optional<std::string> open_after_prompt_;  // a file to open once the prompt is answered
   bool external_prompt_ = false;

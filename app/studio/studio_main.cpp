@@ -10,7 +10,11 @@
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
+#include <signal.h>
+
 #include <algorithm>
+#include <array>
+#include <csignal>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -122,6 +126,35 @@ void trace(const char* what, const std::string& detail) {
   std::fflush(stdout);
 }
 
+// SIGTERM, SIGHUP or SIGINT received while the window is open (0: none). The main loop,
+// which wakes at least every 0.25 s, writes the autosave and ends the studio as the
+// signal would (docs/spec/studio.md "never losing work"; vim and nano keep their buffers).
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+void on_stop_signal(int signal) { g_stop_signal = signal; }
+
+// Installs on_stop_signal for the three signals while it lives (replacing the `sylva`
+// command's remove-the-temporaries handlers: the loop finishes any write first), then
+// puts the previous handlers back.
+class StopSignals {
+ public:
+  StopSignals() {
+    struct sigaction action {};
+    action.sa_handler = on_stop_signal;
+    sigemptyset(&action.sa_mask);
+    for (size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &action, &previous_[i]);
+  }
+  ~StopSignals() {
+    for (size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &previous_[i], nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  static constexpr std::array<int, 3> kSignals{SIGTERM, SIGHUP, SIGINT};
+  std::array<struct sigaction, 3> previous_{};
+};
+
 }  // namespace
 
 int run_studio(const std::vector<std::string>& raw_args) {
@@ -186,11 +219,18 @@ int run_studio(const std::vector<std::string>& raw_args) {
     int frames_after_plant = -1;
     uint64_t traced_plants = 0;
     std::string traced_error, title;
+    const StopSignals stop_signals;
     while (code == cli::kOk) {
       // Sleep until input, a worker result (glfwPostEmptyEvent) or a timer tick, unless
       // something is in motion.
       if (!a.screenshot.empty() || app.wants_frames()) glfwPollEvents();
       else glfwWaitEventsTimeout(0.25);
+      if (const int signal = g_stop_signal) {
+        // Killed (SIGTERM, SIGHUP, SIGINT): keep the edits in the autosave first.
+        if (auto err = app.autosave_now()) std::cerr << "sylva studio: error: autosave: " << *err << "\n";
+        code = 128 + signal;
+        break;
+      }
       if (glfwWindowShouldClose(window)) {
         glfwSetWindowShouldClose(window, GLFW_FALSE);
         app.request_close();
@@ -248,6 +288,11 @@ int run_studio(const std::vector<std::string>& raw_args) {
   ImGui::DestroyContext();
   glfwDestroyWindow(window);
   glfwTerminate();
+  if (const int signal = g_stop_signal) {
+    // The buffer is saved: now end as the signal would have (exit status 128 + signal).
+    std::signal(signal, SIG_DFL);
+    std::raise(signal);
+  }
   return code;
 }
 

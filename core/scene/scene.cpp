@@ -52,6 +52,23 @@ SkeletonBounds skeleton_bounds(const Skeleton& skeleton) {
   return b;
 }
 
+std::optional<std::string> camera_problem(const Camera& camera) {
+  for (const auto& [key, p] : {std::pair{"eye", camera.eye}, std::pair{"target", camera.target}})
+    for (int k = 0; k < 3; ++k)
+      if (!(std::abs(p[k]) <= kMaxCoordinateM))
+        return std::string(key) + " coordinates must be within ±1e12 m (docs/limits.md)";
+  // Eye and target within ±1e12 m: their difference is finite.
+  const glm::dvec3 forward = camera.target - camera.eye;
+  if (!(glm::length(forward) > 0)) return std::string("eye and target must differ");
+  const std::optional<glm::dvec3> up = rescaled_direction(camera.up);
+  if (!up) return std::string("up must not be zero");
+  if (!(glm::length(glm::cross(glm::normalize(forward), glm::normalize(*up))) > 1e-9))
+    return std::string("up must not be parallel to the view direction");
+  if (!(camera.fov_y_deg > 0 && camera.fov_y_deg < 180))
+    return std::string("fov_y_deg must be between 0 and 180 degrees");
+  return std::nullopt;
+}
+
 Camera framing_camera(const glm::dvec3& lo, const glm::dvec3& hi, uint32_t width, uint32_t height) {
   Camera c;
   c.fov_y_deg = 35;

@@ -35,6 +35,14 @@ struct Camera {
   bool operator==(const Camera&) const = default;
 };
 
+// Why `camera` cannot be rendered, or nullopt: the one check of every camera, a scene's
+// and the command line's (docs/limits.md): eye and target within ±kMaxCoordinateM and
+// distinct, up not zero and not along the view, fov_y_deg strictly between 0 and 180. The
+// message starts with the camera key it names ("eye", "target", "up" or "fov_y_deg"),
+// e.g. "eye coordinates must be within ±1e12 m (docs/limits.md)"; `up` is compared as a
+// direction, whatever its length.
+std::optional<std::string> camera_problem(const Camera& camera);
+
 // The sun: a disc light. angular_radius_deg 0 is a point sun (hard shadows).
 struct Sun {
   glm::dvec3 direction{0.4, 1.0, 0.2};  // toward the sun, need not be unit (stored unit)

@@ -116,15 +116,12 @@ Camera read_camera(const JsonValue& v) {
   if (auto* x = v.find("target")) c.target = point(*x, "camera.target");
   if (auto* x = v.find("up")) c.up = vec3(*x, "camera.up");
   if (auto* x = v.find("fov_y_deg")) c.fov_y_deg = number_in(*x, "camera.fov_y_deg", 0, 180, true, true);
-  glm::dvec3 forward = c.target - c.eye;
-  if (!(glm::length(forward) > 0)) fail(v, "camera.eye and camera.target must differ");
-  // Compared as unit vectors, so that an up of [0, 1e300, 0] is not taken for parallel.
-  const std::optional<glm::dvec3> up = rescaled_direction(c.up);
-  if (!up) fail(v, "camera.up must not be zero");
-  c.up = *up;
-  glm::dvec3 side = glm::cross(glm::normalize(forward), glm::normalize(*up));
-  if (!(glm::length(side) > 1e-9))
-    fail(v, "camera.up must not be parallel to the view direction");
+  // The keys' own checks above give their places; what concerns them together, here.
+  if (auto problem = camera_problem(c)) {
+    if (problem->starts_with("eye and target")) fail(v, "camera.eye and camera.target must differ");
+    fail(v, "camera." + *problem);
+  }
+  c.up = *rescaled_direction(c.up);
   return c;
 }
 

@@ -7,6 +7,7 @@
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <sys/types.h>
 #include <unistd.h>
 
@@ -102,8 +103,19 @@ void forget_temporary(int slot) {
   if (slot >= 0) g_temporaries[slot].state.store(0);
 }
 
+// Child processes that write a pending temporary (ffmpeg), for the same handler: stopped
+// and reaped before the temporaries are removed, so none outlives sylva to write one again.
+constexpr int kChildSlots = 16;
+std::atomic<pid_t> g_children[kChildSlots];
+
 extern "C" void remove_temporaries_and_reraise(int signal_number) {
   const int saved_errno = errno;
+  for (std::atomic<pid_t>& child : g_children)
+    if (const pid_t pid = child.load(); pid > 0) {
+      ::kill(pid, SIGTERM);  // kill() and waitpid() are async-signal-safe
+      while (::waitpid(pid, nullptr, 0) < 0 && errno == EINTR) {
+      }
+    }
   for (TemporarySlot& slot : g_temporaries)
     if (slot.state.load() == 2) ::unlink(slot.path);
   errno = saved_errno;
@@ -291,6 +303,18 @@ Status commit_files(std::vector<PendingFile>& files) {
   }
   for (const std::string& d : directories) sync_directory(d);
   return {};
+}
+
+int remember_child(pid_t pid) {
+  for (int i = 0; i < kChildSlots; ++i) {
+    pid_t expected = 0;
+    if (g_children[i].compare_exchange_strong(expected, pid)) return i;
+  }
+  return -1;
+}
+
+void forget_child(int slot) {
+  if (slot >= 0) g_children[slot].store(0);
 }
 
 void remove_temporaries_on_signals() {

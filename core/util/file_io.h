@@ -5,6 +5,8 @@
 // and the system's reason ("strerror"), as a Diagnostic (diagnostic.h) with the errno.
 #pragma once
 
+#include <sys/types.h>
+
 #include <cstddef>
 #include <string>
 #include <string_view>
@@ -94,6 +96,12 @@ Status commit_files(std::vector<PendingFile>& files);
 // process and then end it as the signal would have (the `sylva` command calls it first).
 // A handler set later (render's SIGINT, which cancels the render) takes precedence while set.
 void remove_temporaries_on_signals();
+// A child process writing a pending temporary (ffmpeg encoding a video): until
+// forget_child(slot), those handlers first send it SIGTERM and reap it, so it never
+// outlives sylva to write the temporary after it was removed. Returns the slot (-1 when
+// all 16 are taken: the child is then not stopped by a signal).
+int remember_child(pid_t pid);
+void forget_child(int slot);
 
 // Replaces the file at `path` with `bytes` so that readers see either the old file or
 // the complete new one, never a mix or a truncated file:

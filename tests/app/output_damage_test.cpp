@@ -93,4 +93,34 @@ TEST(OutputDamage, AnImageBeyondItsFormatsSideLimitIsRefusedBeforeTheRender) {
   }
 }
 
+// SIGTERM (or SIGINT) to sylva while ffmpeg encodes --video: ffmpeg is stopped and reaped
+// with sylva, the video's temporary is removed, and sylva ends as the signal says (143 or
+// 130). An ffmpeg that takes its time stands in for a long encode: a script on PATH that
+// records its pid and sleeps. (Before: SIGTERM left an orphaned ffmpeg writing the
+// temporary after sylva died; Ctrl-C gave exit 1, "ffmpeg failed (exit 130)".)
+TEST(OutputDamage, ASignalDuringTheVideoStopsFfmpegAndLeavesNoTemporary) {
+  for (const char* signal : {"TERM", "INT"}) {
+    SCOPED_TRACE(signal);
+    TempDir dir;
+    std::filesystem::create_directory(dir.path() / "bin");
+    const std::string fake = dir.write("bin/ffmpeg", "#!/bin/sh\necho $$ > \"$(dirname \"$0\")/pid\"\nexec sleep 120\n");
+    std::filesystem::permissions(fake, std::filesystem::perms::owner_all);
+    // Waits for the fake ffmpeg to start, signals sylva alone (not its process group),
+    // and reports sylva's status and whether the fake ffmpeg outlived it.
+    const std::string script =
+        "PATH=\"$1/bin:$PATH\" \"$0\" render \"$2\" --frames 0..1 -o \"$1/out/f_{frame}.png\" --video \"$1/out/v.mp4\" "
+        "--width 32 --height 24 --spp 1 --backend cpu 2>\"$1/err\" & sylva=$!\n"
+        "for _ in $(seq 600); do [ -s \"$1/bin/pid\" ] && break; sleep 0.1; done\n"
+        "kill -" + std::string(signal) + " $sylva; wait $sylva; echo \"status $?\"\n"
+        "sleep 0.5; if kill -0 \"$(cat \"$1/bin/pid\")\" 2>/dev/null; then echo orphan; kill \"$(cat \"$1/bin/pid\")\"; fi\n";
+    ProcessResult r = run_process({"bash", "-c", script, SYLVA_BINARY, dir.path().string(), kSaguaro});
+    EXPECT_EQ(r.exit_code, 0) << describe(r);
+    EXPECT_NE(r.out.find(std::string("status ") + (std::string(signal) == "TERM" ? "143" : "130")), std::string::npos)
+        << describe(r) << read_file(dir.file("err"));
+    EXPECT_EQ(r.out.find("orphan"), std::string::npos) << "ffmpeg outlived sylva\n" << describe(r);
+    EXPECT_EQ(list_dir(dir.path() / "out"), (std::vector<std::string>{"f_0000.png", "f_0001.png"}))
+        << "the frames stay; no video, no temporary";
+  }
+}
+
 }  // namespace

@@ -233,6 +233,45 @@ TEST_F(Fixture, AutosavesAndOffersToRestore) {
   EXPECT_EQ(read_text_file(path).value(), app->text());
 }
 
+// An autosave older than its document (the file changed since, e.g. by a git checkout)
+// is still offered, saying so; before, it was ignored and the next autosave replaced it.
+TEST_F(Fixture, AnAutosaveOlderThanTheFileIsStillOffered) {
+  const std::string edits = std::string(kTree) + "// edits never saved\n";
+  ASSERT_TRUE(write_file_atomically(autosave_path(path), edits).ok());
+  const auto old = std::filesystem::last_write_time(path) - std::chrono::hours(1);
+  std::filesystem::last_write_time(autosave_path(path), old);
+  auto app = make_app();
+  ASSERT_FALSE(app->open(path));
+  EXPECT_TRUE(app->restore_offered());
+  ui.frames(*app, 3);
+  auto restore = app->rect("button:Restore");
+  ASSERT_TRUE(restore);
+  ui.click(*app, restore->centre());
+  EXPECT_EQ(app->text(), edits);
+  // One the same as the file is nothing to restore.
+  ASSERT_TRUE(write_file_atomically(autosave_path(path), kTree).ok());
+  auto again = make_app();
+  ASSERT_FALSE(again->open(path));
+  EXPECT_FALSE(again->restore_offered());
+}
+
+// Ctrl+S on a document opened through a symbolic link writes the real document and
+// leaves the link a link (before: the link was replaced by a regular file and the real
+// document never changed).
+TEST_F(Fixture, SavingThroughASymbolicLinkWritesTheRealDocument) {
+  const std::string link = dir.file("link.lsys");
+  std::filesystem::create_symlink(path, link);
+  auto app = make_app();
+  ASSERT_FALSE(app->open(link));
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plant_drawn(); }));
+  click_line_end(*app, 8);
+  ui.type(*app, "F");
+  ASSERT_FALSE(app->save());
+  EXPECT_TRUE(std::filesystem::is_symlink(link));
+  EXPECT_EQ(read_text_file(path).value(), app->text());
+  EXPECT_FALSE(app->dirty());
+}
+
 TEST_F(Fixture, ClosingWithUnsavedEditsAsksFirst) {
   auto app = opened();
   EXPECT_TRUE(make_app()->request_close()) << "nothing to lose: closes at once";

@@ -163,4 +163,28 @@ TEST(StudioWindow, XdotoolClicksAndTypesIntoTheRealWindow) {
   EXPECT_NE(saved.find("A -> F[+A][-A][+A]\n"), std::string::npos) << "Ctrl+S saved the typed text:\n" << saved;
 }
 
+// SIGTERM with an edit typed after the last autosave (every 3 s): the studio writes the
+// buffer to the autosave, then ends as SIGTERM would (143); the document is unchanged
+// until the user restores and saves. (Before: the edit was lost, as issue 32 found.)
+TEST(StudioWindow, SigtermKeepsTheUnsavedEditInTheAutosave) {
+  if (!on_path("xvfb-run")) SYLVA_SKIP_WITHOUT_TOOL("xvfb-run not found (Debian: xvfb)");
+  if (!on_path("xdotool")) SYLVA_SKIP_WITHOUT_TOOL("xdotool not found (Debian: xdotool; scripts/setup.sh installs it)");
+  TempDir dir;
+  const std::string text = "#define N 4 /* [1, 8, 1] */\n"
+                           "angle: 30\n"
+                           "derivation length: N\n"
+                           "axiom: A\n"
+                           "productions:\n"
+                           "A -> F[+A][-A]\n";
+  const std::string g = dir.write("tree.lsys", text);
+  ProcessResult r =
+      run_process(xvfb(dir, {"bash", kSource + "/tests/studio/xdotool_smoke.sh", SYLVA_BINARY, g, "term"}), {}, 240);
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  EXPECT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.out.find("studio exit 143"), std::string::npos) << describe(r);
+  EXPECT_EQ(read_file(g), text) << "nothing saves the document but the user";
+  const std::string autosave = read_file(dir.file(".tree.lsys.autosave"));
+  EXPECT_NE(autosave.find("A -> F[+A][-A][+A]\n"), std::string::npos) << "the autosave:\n" << autosave;
+}
+
 }  // namespace

@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# xdotool_smoke.sh SYLVA GRAMMAR — run inside xvfb-run by window_test.cpp: opens GRAMMAR
-# (a binary tree whose production is on line 6) in the studio, clicks at the end of
-# line 6, types '[' (an unbalanced bracket: an error), Backspace and '[+A]' (a third
-# branch: the plant regrows), saves with Ctrl+S, and closes. The studio's trace lines
-# (SYLVA_STUDIO_TRACE=1) go to stdout for the test to read.
+# xdotool_smoke.sh SYLVA GRAMMAR [save|term] — run inside xvfb-run by window_test.cpp:
+# opens GRAMMAR (a binary tree whose production is on line 6) in the studio, clicks at the
+# end of line 6, types '[' (an unbalanced bracket: an error), Backspace and '[+A]' (a
+# third branch: the plant regrows), then `save` (the default): saves with Ctrl+S and
+# closes; `term`: sends SIGTERM with the edit unsaved. Prints the studio's trace lines
+# (SYLVA_STUDIO_TRACE=1) and "studio exit STATUS" for the test to read.
 set -u
 sylva=$1
 grammar=$2
+mode=${3:-save}
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
 SYLVA_STUDIO_TRACE=1 "$sylva" studio "$grammar" --size 1000x700 >"$log" 2>&1 &
@@ -41,9 +43,13 @@ plants=$(grep -c '^studio: plant ' "$log")
 press BackSpace
 xdotool type --delay 50 '[+A]'
 wait_for '^studio: plant ' "$plants"
-press ctrl+s
-sleep 1
-kill "$pid"
+if [ "$mode" = save ]; then
+  press ctrl+s
+  sleep 1
+fi
+kill -TERM "$pid"
 wait "$pid" 2>/dev/null
+status=$?
 cat "$log"
+echo "studio exit $status"
 exit 0

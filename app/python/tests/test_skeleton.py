@@ -163,3 +163,21 @@ def test_save_never_overwrites_the_grammar_the_plant_grew_from(tmp_path):
     assert grammar.read_text() == text
     sk.save(tmp_path / "mine.skel.json")  # any other file is written
     assert sylva.Skeleton.from_file(tmp_path / "mine.skel.json").to_json() == sk.to_json()
+
+
+@pytest.mark.parametrize("make, use", [
+    (lambda: sylva.Skeleton.__new__(sylva.Skeleton), lambda o: o.to_json()),
+    (lambda: sylva.Skeleton.__new__(sylva.Skeleton), lambda o: o.positions),
+    (lambda: sylva.Skeleton.__new__(sylva.Skeleton), lambda o: o.joint_count),
+    (lambda: sylva.Skeleton.__new__(sylva.Skeleton), repr),
+    (lambda: sylva.Skeleton.__new__(sylva.Skeleton), lambda o: sylva.export_gltf([o], "never.glb")),
+    (lambda: sylva.Skeleton.__new__(sylva.Skeleton), lambda o: sylva.render(o, width=8, height=8)),
+    (lambda: sylva.Grammar.__new__(sylva.Grammar), lambda o: o.grow()),
+    (lambda: sylva.Grammar.__new__(sylva.Grammar), lambda o: o.derive()),
+])
+def test_an_object_made_by_new_without_init_raises_type_error(make, use, tmp_path, monkeypatch):
+    # Issue 32 item 8: these crashed the interpreter (uninitialised memory).
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(TypeError, match="made by __new__ without __init__"):
+        use(make())
+    assert list(tmp_path.iterdir()) == []
