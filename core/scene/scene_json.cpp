@@ -103,6 +103,9 @@ uint32_t image_size(const JsonValue& v, std::string_view what) {
 
 std::string path_relative_to(const std::string& base_dir, const JsonValue& v, std::string_view what) {
   if (!v.is_string() || v.text.empty()) fail(v, std::string(what) + " must be a non-empty path string");
+  // The system would read the path only up to the NUL: another file, silently.
+  if (v.text.find('\0') != std::string::npos)
+    fail(v, std::string(what) + " must not hold a NUL character (\\u0000): no file name does");
   std::filesystem::path p(v.text);
   if (p.is_absolute() || base_dir.empty()) return v.text;
   return (std::filesystem::path(base_dir) / p).lexically_normal().string();

@@ -167,8 +167,17 @@ Status check_not_an_input(const std::string& output, const std::vector<std::stri
   return {};
 }
 
+Status check_path_has_no_nul(const std::string& path) {
+  if (path.find('\0') == std::string::npos) return {};
+  std::string shown = path;
+  std::replace(shown.begin(), shown.end(), '\0', '?');
+  return file_diagnostic(shown, "the path holds a NUL character, which no file name does (the system would open "
+                                "the file named by the part before it)");
+}
+
 Status check_output_path(const std::string& path) {
   if (path.empty()) return file_diagnostic(path, "cannot write: the path is empty");
+  if (Status named = check_path_has_no_nul(path); !named) return named;
   if (path.back() == '/') return errno_error(path, "cannot write", EISDIR);
   struct stat info {};
   if (::lstat(path.c_str(), &info) != 0) {
@@ -327,6 +336,7 @@ void remove_temporaries_on_signals() {
 }
 
 Expected<std::string> read_text_file(const std::string& path, size_t max_bytes) {
+  if (Status named = check_path_has_no_nul(path); !named) return std::move(named.error());
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     const int error_number = errno;  // before anything that may allocate

@@ -45,6 +45,11 @@ void note_input_file(const std::string& path);
 // through, so it is compared itself.
 Status check_not_an_input(const std::string& output, const std::vector<std::string>& inputs);
 
+// A path holding a NUL character names no file: the system would take the part before
+// it, another file. A Diagnostic for it (the NULs shown as '?'), else success.
+// read_text_file, check_output_path and check_image_opens refuse such a path with it.
+Status check_path_has_no_nul(const std::string& path);
+
 // Whether `path` may be written as an output (docs/limits.md, "Outputs"): a missing file, a
 // regular file that is writable (not `chmod a-w`, and writable to this user), or a
 // symbolic link (replaced, see below) — and never a file noted as an input. A FIFO, a

@@ -185,6 +185,7 @@ Expected<PendingFile> write_pending_image(const std::string& path, uint32_t widt
 }
 
 Status check_image_opens(const std::string& path) {
+  if (Status named = check_path_has_no_nul(path); !named) return named;
   note_input_file(path);  // a texture of the scene: never an output too
   auto input = OIIO::ImageInput::open(path);
   if (input) {

@@ -134,6 +134,14 @@ TEST(Scene, UnknownNestedKeyIsLocatedAtTheKey) {
   EXPECT_NE(e.message.find("plants[0].bark"), std::string::npos) << e.message;
 }
 
+// "plant.lsys\u0000.missing" would open plant.lsys (issue 32): refused at the key.
+TEST(Scene, APathHoldingANulIsAnErrorAtItsKey) {
+  Diagnostic e = expect_error("{\"plants\": [{\"grammar\":\n  \"plant.lsys\\u0000.missing\"}]}");
+  EXPECT_EQ(e.loc.line, 2u) << e.format();
+  EXPECT_NE(e.message.find("NUL"), std::string::npos) << e.format();
+  EXPECT_NE(e.message.find("grammar"), std::string::npos) << e.format();
+}
+
 TEST(Scene, MissingPlantsIsAnError) {
   Diagnostic e = expect_error("{\"sky\": [1, 1, 1]}");
   EXPECT_NE(e.message.find("plants"), std::string::npos);

@@ -123,6 +123,20 @@ TEST_F(FileIoTest, ADirectoryIsNotReadable) {
   EXPECT_EQ(result.error().format(), directory_ + ": error: cannot read: Is a directory\n");
 }
 
+// A NUL inside a path: the system would open the file named by the part before it
+// (issue 32). Refused for reading and for writing, the file before it untouched.
+TEST_F(FileIoTest, APathHoldingANulIsRefusedNotCutShort) {
+  put(path("plant.lsys"), "axiom: F\n");
+  const std::string with_nul = path("plant.lsys") + std::string(1, '\0') + ".missing";
+  const Expected<std::string> read = read_text_file(with_nul);
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.error().message.find("NUL"), std::string::npos) << read.error().format();
+  EXPECT_EQ(read.error().file, path("plant.lsys") + "?.missing");
+  EXPECT_FALSE(check_output_path(with_nul).ok());
+  EXPECT_FALSE(write_file_atomically(with_nul, "overwritten").ok());
+  EXPECT_EQ(read_text_file(path("plant.lsys")).value(), "axiom: F\n");
+}
+
 // ---- write_file_atomically --------------------------------------------------------
 
 TEST_F(FileIoTest, WritingCreatesAFileWithExactlyTheBytes) {
