@@ -20,9 +20,10 @@ build/release/app/sylva render presets/saguaro.lsys -o out/saguaro.png --width 8
 # The same plant in its scene: bark texture and relief-mapped ribs, marched in the shaders.
 build/release/app/sylva render presets/scenes/saguaro.scene.json -o out/saguaro_ribs.png --width 800 --height 600 \
   --backend gl
-# Crepuscular rays: the fog's shafts between the crowns (Hougs and Day 2001; about half a minute on
-# two cores: one million sun photons, their shadow cones, refined in-scatter; one sample per
-# pixel, where the default 8 would march the fog 8 times: docs/benchmarks.md "Samples per pixel").
+# Crepuscular rays: the fog's shafts between the crowns (the default fog mode, auto, is map on the
+# CPU: sun photons find where the plants are, four sun-space depth maps of them, every camera
+# ray walked through the maps, docs/fog-map.md; one sample per pixel, where the default 8 would
+# walk the fog 8 times: docs/benchmarks.md "Samples per pixel").
 build/release/app/sylva render presets/scenes/pine_stand_low_sun.scene.json -o out/pine_stand_fog.png --width 480 \
   --height 360 --backend cpu --spp 1
 echo "skeletons, out/saguaro.png, out/saguaro_ribs.png and out/pine_stand_fog.png written to out/" \

@@ -45,6 +45,7 @@
 #include "app/front/render_input.h"
 #include "core/cpu/photons.h"
 #include "core/cpu/render_cpu.h"
+#include "core/cpu/sun_maps.h"
 #include "core/scene/fog_integrator.h"
 #include "core/scene/render_common.h"
 #include "core/light/shading.h"
@@ -71,7 +72,7 @@ void print_help() {
                "once per photon count, cone parameters (automatic and fixed) and seed, and reused by\n"
                "every mode. Prints the time each mode needs to reach given RMSEs and fast mode's bias\n"
                "floor; writes the rows as CSV, the cones' coverage as CSV, and a log-log plot.\n\n"
-               "  --modes LIST          of brute,medium,fast,refined (default all four)\n"
+               "  --modes LIST          of brute,medium,fast,refined,map (default all five)\n"
                "  --brute-steps LIST    brute's samples per ray (default 8,16,32,64,128,256,512,1024)\n"
                "  --cone-steps LIST     medium's and refined's (default 16,64,256)\n"
                "  --photons LIST        photon counts (default 10000,100000,1000000,10000000)\n"
@@ -84,6 +85,16 @@ void print_help() {
                "  --threads N           threads (default: every core)\n"
                "  --per-core-photons N  photons of the one-thread photon rate (default 1000000)\n"
                "  --cones-only          photons and cones only, no fog rows\n"
+               "  --map-resolutions L   map mode's texels a side (default 1024,2048,4096); its rows\n"
+               "                        are mapK (K maps over the sun's disc, as the renderer runs\n"
+               "                        it: the photons find the tiles, no cones), steps = the\n"
+               "                        resolution, cone_s = the maps' build\n"
+               "  --map-directions L    map mode's disc directions (default 1,4)\n"
+               "  --map-memory-mib N    the maps' memory limit (default 1024)\n"
+               "  --map-dilate N        tiles of margin around each shadow vector's tile (default 1)\n"
+               "  --map-variants        also the variants docs/fog-map.md measured: maprayK (one map\n"
+               "                        per camera ray) and mapconesK-auto/-fixed (only the cone\n"
+               "                        intervals walked; cone_s = cones + maps)\n"
                "  --csv FILE            rows (default SCENE-stem.fog.csv; the cones' coverage in\n"
                "                        the same name with -cones.csv)\n"
                "  --plot FILE           log-log RMSE against time (default SCENE-stem.fog.png)\n"
@@ -99,7 +110,7 @@ void print_help() {
 
 struct Args {
   GrammarArgs grammar;
-  std::vector<std::string> modes = {"brute", "medium", "fast", "refined"};
+  std::vector<std::string> modes = {"brute", "medium", "fast", "refined", "map"};
   std::vector<uint32_t> brute_steps = {8, 16, 32, 64, 128, 256, 512, 1024};
   std::vector<uint32_t> cone_steps = {16, 64, 256};
   std::vector<uint64_t> photons = {10'000, 100'000, 1'000'000, 10'000'000};
@@ -111,6 +122,11 @@ struct Args {
   unsigned threads = 0;
   uint64_t per_core_photons = 1'000'000;
   bool cones_only = false;
+  std::vector<uint32_t> map_resolutions = {1024, 2048, 4096};
+  std::vector<uint32_t> map_directions = {1, 4};
+  uint64_t map_memory_mib = 1024;
+  uint32_t map_dilate = SunMapOptions{}.dilate_tiles;
+  bool map_variants = false;
   std::string csv, cones_csv, plot;
   bool quick = false;
   bool cpu_clock = false;           // --clock cpu
@@ -151,7 +167,7 @@ std::vector<uint32_t> parse_counts(const std::string& flag, const std::string& t
 Args parse_args(const std::vector<std::string>& args) {
   Args out;
   bool photons_given = false, seeds_given = false, brute_given = false, cone_given = false, size_given = false,
-       reference_given = false;
+       reference_given = false, map_given = false;
   FlagTable table;
   table.leaves_others = true;  // SCENE and the grammar flags: parse_grammar_args's
   table.flags = {
@@ -170,8 +186,8 @@ Args parse_args(const std::vector<std::string>& args) {
                  [&out](const std::string&, const std::string& list) {
                    out.modes = split(list, ',');
                    for (const std::string& m : out.modes)
-                     if (m != "brute" && m != "medium" && m != "fast" && m != "refined")
-                       throw UsageError{"--modes: '" + m + "' is not one of brute, medium, fast, refined"};
+                     if (m != "brute" && m != "medium" && m != "fast" && m != "refined" && m != "map")
+                       throw UsageError{"--modes: '" + m + "' is not one of brute, medium, fast, refined, map"};
                  }),
       noting_given(value_flag({"--brute-steps"},
                               [&out](const std::string& spelled, const std::string& v) {
@@ -195,6 +211,27 @@ Args parse_args(const std::vector<std::string>& args) {
       count_flag({"--threads"}, out.threads, 4096),
       count_flag({"--per-core-photons"}, out.per_core_photons, 1'000'000'000),
       set_flag({"--cones-only"}, out.cones_only),
+      noting_given(value_flag({"--map-resolutions"},
+                 [&out](const std::string& spelled, const std::string& v) {
+                   out.map_resolutions = parse_counts(spelled, v, kFogMaxMapResolution);
+                   for (uint32_t n : out.map_resolutions)
+                     if (n < kFogMinMapResolution || n % 32 != 0)
+                       throw UsageError{spelled + ": " + std::to_string(n) + " is not a multiple of 32 from " +
+                                        std::to_string(kFogMinMapResolution) + " to " +
+                                        std::to_string(kFogMaxMapResolution)};
+                 }), map_given),
+      value_flag({"--map-directions"},
+                 [&out](const std::string& spelled, const std::string& v) {
+                   out.map_directions = parse_counts(spelled, v, kFogMaxMapDirections);
+                 }),
+      count_flag({"--map-memory-mib"}, out.map_memory_mib, 1 << 20),
+      value_flag({"--map-dilate"},
+                 [&out](const std::string& spelled, const std::string& v) {
+                   const std::optional<uint64_t> n = parse_u64(v);
+                   if (!n || *n > 8) throw UsageError{spelled + " " + v + ": expected an integer from 0 to 8"};
+                   out.map_dilate = static_cast<uint32_t>(*n);
+                 }),
+      set_flag({"--map-variants"}, out.map_variants),
       text_flag({"--csv"}, out.csv),
       text_flag({"--plot"}, out.plot),
       set_flag({"--quick"}, out.quick),
@@ -215,6 +252,7 @@ Args parse_args(const std::vector<std::string>& args) {
     if (!seeds_given) out.seeds = 2;
     if (!brute_given) out.brute_steps = {8, 32};
     if (!cone_given) out.cone_steps = {16};
+    if (!map_given) out.map_resolutions = {256};
     if (!size_given) out.width = 64, out.height = 48;
     if (!reference_given) out.reference_steps = 8;
     out.per_core_photons = std::min<uint64_t>(out.per_core_photons, 100'000);
@@ -401,7 +439,7 @@ class FogBench {
     cones_csv_ << "# sylva bench fog " << a_.grammar.grammar << ", " << threads_ << " threads\n";
     cones_csv_ << "photons,seed,params_kind,photon_s,cone_s,params_s,cpu_s,params,vectors,covered,cones,missed_shadow,"
                   "covered_lit,coverage_points,shadowed_points,query_us\n";
-    const bool cone_modes = wants("medium") || wants("fast") || wants("refined");
+    const bool cone_modes = wants("medium") || wants("fast") || wants("refined") || wants("map");
     for (uint64_t photons : a_.photons)
       for (const bool automatic : {true, false})
         for (uint32_t seed = 1; seed <= a_.seeds; ++seed) {
@@ -430,7 +468,52 @@ class FogBench {
             row.mode = "fast" + suffix;
             render_row(row, FogMode::fast, &source);
           }
+          if (wants("map")) run_map_rows(*c, source, base, suffix);
         }
+  }
+
+  // Mode map over the cones `c` (and, with --map-whole, over every ray's whole shadow range):
+  // a row per map resolution and disc directions, the maps' build counted in cone_s.
+  void run_map_rows(const SunCones& c, const ConeSetFogSource& source, const Row& base, const std::string& suffix) {
+    for (uint32_t resolution : a_.map_resolutions)
+      for (uint32_t directions : a_.map_directions) {
+        SunMapOptions mo;
+        mo.resolution = resolution;
+        mo.disc_maps = directions;
+        mo.threads = threads_;
+        mo.memory_limit_bytes = a_.map_memory_mib << 20;
+        mo.dilate_tiles = a_.map_dilate;
+        const double cpu_start = process_cpu_seconds();
+        const Expected<SunMaps> maps = build_sun_maps(tracer_, c.vectors, mo);
+        const double cpu_s = process_cpu_seconds() - cpu_start;
+        if (!maps) {
+          std::printf("map %u² x %u: skipped: %s\n", resolution, directions, maps.error().message.c_str());
+          continue;
+        }
+        std::printf("map %u² x %u: %s, %.3f s wall, %.3f s CPU\n", resolution, directions, maps->describe().c_str(),
+                    maps->seconds, cpu_s);
+        const double map_s = a_.cpu_clock ? cpu_s / threads_ : maps->seconds;
+        const std::string k = std::to_string(maps->maps.size());
+        Row row = base;
+        row.steps = resolution;
+        // As the renderer runs it: the photons find the tiles, no cones (the automatic
+        // and fixed rows are then the same setting on their own seeds' photons).
+        if (suffix == "-auto") {
+          row.cone_s = map_s, row.cones = 0;
+          row.mode = "map" + k;
+          render_row(row, FogMode::map, nullptr, maps->maps);
+        }
+        if (!a_.map_variants) continue;
+        if (maps->maps.size() > 1 && suffix == "-auto") {
+          row.mode = "mapray" + k;  // one map per camera ray, drawn at random
+          render_row(row, FogMode::map, nullptr, maps->maps, true);
+        }
+        row = base;
+        row.steps = resolution;
+        row.cone_s += map_s;
+        row.mode = "mapcones" + k + suffix;  // only the cone intervals walked
+        render_row(row, FogMode::map, &source, maps->maps);
+      }
   }
 
   // Each setting's bias: the mean image of its seeds against the reference.
@@ -450,10 +533,13 @@ class FogBench {
  private:
   // The fog of every pixel by `mode` for `row`'s setting and seed: its time and RMSE, printed
   // and kept.
-  void render_row(Row row, FogMode mode, const FogConeSource* cones) {
+  void render_row(Row row, FogMode mode, const FogConeSource* cones, std::span<const SunDepthMap> maps = {},
+                  bool map_per_ray = false) {
     FogIntegratorOptions o;
     o.mode = mode;
     o.steps = std::max(1u, row.steps);
+    o.maps = maps;
+    o.map_per_ray = map_per_ray;
     const FogIntegrator integrator(*medium_, fog_sun_of(scene_.sun), scene_.sky, *g_.tracer, cones, o);
     double cpu = 0;
     const std::vector<float> image = fog_image(view_, integrator, mix_pair(row.seed, 0x666f67), threads_,
@@ -626,6 +712,23 @@ void print_times_to_reach(const std::vector<Row>& rows, Families& f) {
       }
       std::printf("\n");
     }
+  }
+  // The same as ratios: what each family gains over brute force at brute's own RMSEs.
+  if (!f.curves.count("brute")) return;
+  std::printf("\nspeed-up over brute at equal RMSE (brute's time / the family's, photons, cones and maps "
+              "included):\n%-16s",
+              "family");
+  for (const auto& t : targets) std::printf(" %12s", t.first.c_str());
+  std::printf("\n");
+  for (const auto& [family, points] : f.curves) {
+    if (family == "brute") continue;
+    std::printf("%-16s", family.c_str());
+    for (const auto& t : targets) {
+      const double mine = time_to_reach(points, t.second), brute = time_to_reach(f.curves.at("brute"), t.second);
+      if (mine <= 0 || brute <= 0) std::printf(" %12s", "-");
+      else std::printf(" %11.3gx", brute / mine);
+    }
+    std::printf("\n");
   }
 }
 

@@ -105,8 +105,13 @@ void print_render_help() {
          "                         disc points); medium (shadow rays only inside the shadow\n"
          "                         cones), fast (no sunlight inside them, no shadow rays) and\n"
          "                         refined (their edges bisected to the exact shadow) trace sun\n"
-         "                         photons into shadow cones first (Hougs and Day 2001)\n"
+         "                         photons into shadow cones first (Hougs and Day 2001); map\n"
+         "                         walks each ray through sun-space depth maps of the plants\n"
+         "                         (exact up to their texels, no shadow rays; docs/fog-map.md)\n"
          "      --fog-steps N      samples along each ray, 1 to " << kFogMaxSteps << " (default 64)\n"
+         "      --fog-map-resolution N  map: texels a side of each sun map, a multiple of 32\n"
+         "                         from 32 to 65536 (default 2048)\n"
+         "      --fog-map-directions N  map: maps over the sun's disc, 1 to " << kFogMaxMapDirections << " (default 4)\n"
          "      --photons N        sun photons for the shadow cones, 1 to " << kFogMaxPhotons << "\n"
          "                         (default 1000000)\n"
          "      --cone-params P    the cones' clustering: p1,p2,p3,p4 (neighbours >= p3 + 1,\n"
@@ -229,11 +234,22 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
                                 const std::optional<FogMode> mode = fog_mode_from_name(v);
                                 if (!mode)
                                   throw UsageError{"--fog-mode " + v +
-                                                   ": expected auto, brute, medium, fast, refined or reference"};
+                                                   ": expected auto, brute, medium, fast, refined, reference or map"};
                                 out.fog.mode = *mode;
                               }),
                    out.fog_flags),
       noting_given(count_flag({"--fog-steps"}, out.fog.steps, kFogMaxSteps), out.fog_flags),
+      noting_given(value_flag({"--fog-map-resolution"},
+                              [&out](const std::string&, const std::string& v) {
+                                auto n = parse_u64(v);
+                                if (!n || *n < kFogMinMapResolution || *n > kFogMaxMapResolution || *n % 32 != 0)
+                                  throw UsageError{"--fog-map-resolution " + v + ": expected a multiple of 32 from " +
+                                                   std::to_string(kFogMinMapResolution) + " to " +
+                                                   std::to_string(kFogMaxMapResolution)};
+                                out.fog.map_resolution = static_cast<uint32_t>(*n);
+                              }),
+                   out.fog_flags),
+      noting_given(count_flag({"--fog-map-directions"}, out.fog.map_directions, kFogMaxMapDirections), out.fog_flags),
       noting_given(value_flag({"--photons"},
                               [&out](const std::string&, const std::string& v) {
                                 auto n = parse_u64(v);
@@ -392,7 +408,7 @@ int run_render_frames(const RenderArgs& a) {
     return kInputError;
   }
   if (!base.fog && (a.fog_flags || (a.aovs & kAovFog)))
-    throw UsageError{"--fog-mode, --fog-steps, --photons, --cone-params and --aov fog apply to a scene with fog "
+    throw UsageError{"--fog-mode, --fog-steps, --fog-map-resolution, --fog-map-directions, --photons, --cone-params and --aov fog apply to a scene with fog "
                      "only ('" + input + "' has no fog key)"};
   // Every frame's outputs are checked before the first is rendered.
   for (uint64_t f = range.first; f <= range.last; ++f)
@@ -570,7 +586,7 @@ int run_render(const std::vector<std::string>& args) {
     }
   auto start = std::chrono::steady_clock::now();
   if (!scene.fog && (a.fog_flags || (a.aovs & kAovFog)))
-    throw UsageError{"--fog-mode, --fog-steps, --photons, --cone-params and --aov fog apply to a scene with fog "
+    throw UsageError{"--fog-mode, --fog-steps, --fog-map-resolution, --fog-map-directions, --photons, --cone-params and --aov fog apply to a scene with fog "
                      "only ('" + input + "' has no fog key)"};
 
   RenderOptions options;

@@ -680,6 +680,22 @@ bool SunPhotonTracer::toward_sun_blocked(const glm::dvec3& point) const {
                           (impl_->leaves.tracer && impl_->leaves.tracer->nearest_leaf(ray, 0, kInf).hit()));
 }
 
+double SunPhotonTracer::first_hit(const Ray& ray) const {
+  const Impl& m = *impl_;
+  if (!m.any_frusta || (m.mask && !m.mask->may_hit(ray.origin, ray.direction))) return kInf;
+  if (m.placed) {
+    const SurfaceHit hit = m.placed->nearest(ray, 0, kInf);
+    return hit.hit() ? hit.t : kInf;
+  }
+  const BvhHit hit = m.accel->nearest(ray, 0, kInf);
+  double t = hit.hit_any() ? hit.hit.t : kInf;
+  if (m.leaves.tracer) {
+    const SurfaceHit leaf = m.leaves.tracer->nearest_leaf(ray, 0, t);
+    if (leaf.hit()) t = leaf.t;
+  }
+  return t;
+}
+
 SunPhotons trace_sun_photons(std::span<const Frustum> frusta, const Sun& sun, const SunPhotonOptions& options) {
   const SunPhotonTracer tracer(frusta, sun, options.threads);
   SunPhotons out = tracer.trace(options);
@@ -976,7 +992,7 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
 }
 
 bool fog_mode_needs_cones(FogMode mode) {
-  return mode == FogMode::medium || mode == FogMode::fast || mode == FogMode::refined || mode == FogMode::automatic;
+  return mode == FogMode::medium || mode == FogMode::fast || mode == FogMode::refined;
 }
 
 SunConeOptions sun_cone_options_for(FogMode mode, uint64_t photons, const std::optional<std::array<uint32_t, 4>>& params,

@@ -119,6 +119,11 @@ class SunPhotonTracer {
   SunPhotons trace(const SunPhotonOptions& options) const;
   // Whether a frustum blocks the sun's centre from `point` (an exact shadow ray).
   bool toward_sun_blocked(const glm::dvec3& point) const;
+  // The distance along `ray` (direction unit, pointing away from the sun within its disc,
+  // origin on the sunward side of the emitter's sphere) to the first plant surface a
+  // photon would stop at — frustum or leaf, as trace() sees them — or +inf when it meets
+  // none (the occupancy mask answers most misses without a traversal).
+  double first_hit(const Ray& ray) const;
   const SunEmitter& emitter() const;
   double build_seconds() const;  // the accelerator's and the mask's
   std::span<const Frustum> frusta() const;  // the frusta skinned in the world
@@ -224,7 +229,8 @@ std::unique_ptr<const SunCones> build_sun_cones(const SceneGeometry& geometry, c
                                                 const SunPhotonTracer* tracer = nullptr);
 
 // What the fog needs of photons and cones for a render (docs/spec/fog.md's modes): whether
-// `mode` reads shadow cones (medium, fast, refined; auto is refined on the CPU) and the
+// `mode` reads shadow cones (medium, fast, refined; resolve auto first: cpu_fog_mode, or the
+// GL backend's) and the
 // options of build_sun_cones for it — `photons` sun photons (seeded by `seed`), the
 // clustering parameters p1..p4 given, or automatic (nullopt), the automatic choice
 // weighing a missed shadow 4× a covered lit point for medium and refined (a miss costs them

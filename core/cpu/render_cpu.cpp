@@ -12,6 +12,7 @@
 #include "core/cpu/leaf_tracer.h"
 #include "core/cpu/mesh_accel.h"
 #include "core/cpu/photons.h"
+#include "core/cpu/sun_maps.h"
 #include "core/scene/render_common.h"
 #include "core/light/shading.h"
 #include "core/cpu/texture.h"
@@ -29,6 +30,8 @@
 #include <stdexcept>
 
 namespace sylva {
+
+FogMode cpu_fog_mode(FogMode mode) { return mode == FogMode::automatic ? FogMode::map : mode; }
 
 namespace {
 
@@ -61,6 +64,7 @@ struct TileCost {
   uint64_t shadow_rays = 0;      // the surfaces' shadow rays
   uint64_t fog_rays = 0;         // camera rays integrated through the fog
   uint64_t fog_shadow_rays = 0;  // the fog's shadow rays
+  uint64_t fog_map_texels = 0;   // sun-map texels its walks tested (mode map)
   uint64_t fog_stopped = 0;      // fog rays whose sunlit part stopped at kFogNegligibleDepth
 };
 
@@ -197,6 +201,7 @@ class Renderer {
     const FogRayResult f = fog_->integrate(h.ray.origin, h.ray.direction / length, t_hit * length, rng);
     ++cost->fog_rays;
     cost->fog_shadow_rays += f.shadow_rays;
+    cost->fog_map_texels += f.map_texels;
     cost->fog_stopped += f.terminated_early ? 1 : 0;
     cost->fog_s += seconds_since(start);
     return f;
@@ -663,11 +668,13 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
   std::optional<FogIntegrator> fog;
   std::unique_ptr<const SunCones> sun_cones;
   std::optional<ConeSetFogSource> cone_source;
+  std::optional<Expected<SunMaps>> sun_maps;  // mode map, unless the caller brought maps
   const FogConeSource* cones = options.fog.cones;
   if (scene.fog) {
     FogIntegratorOptions fog_options;
-    fog_options.mode = options.fog.mode.value_or(scene.fog->mode);
+    fog_options.mode = cpu_fog_mode(options.fog.mode.value_or(scene.fog->mode));
     fog_options.steps = options.fog.steps.value_or(scene.fog->steps);
+    fog_options.maps = options.fog.maps;
     if (!cones && fog_mode_needs_cones(fog_options.mode)) {
       sun_cones = build_sun_cones(
           geometry, scene,
@@ -681,6 +688,24 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
       }
       cone_source.emplace(sun_cones->cones);
       cones = &*cone_source;
+    }
+    if (fog_options.mode == FogMode::map) {
+      cones = nullptr;  // the maps' tiles index the shadow (docs/fog-map.md): every ray walks them whole
+      if (fog_options.maps.empty()) {
+        SunMapOptions mo;
+        mo.resolution = options.fog.map_resolution.value_or(scene.fog->map_resolution);
+        mo.disc_maps = options.fog.map_directions.value_or(scene.fog->map_directions);
+        mo.threads = options.threads;
+        mo.cancel = options.progress.cancel_flag();
+        const uint64_t photons = std::min(options.fog.photons.value_or(scene.fog->photons), kSunMapTilePhotons);
+        sun_maps.emplace(build_sun_maps_of(geometry, scene, photons, mo, &result.passes));
+        if (!*sun_maps) throw std::runtime_error(sun_maps->error().message);
+        if ((*sun_maps)->cancelled) {
+          result.cancelled = true;
+          return result;
+        }
+        fog_options.maps = (*sun_maps)->maps;
+      }
     }
     fog.emplace(fog_medium_of(scene), fog_sun_of(scene.sun), scene.sky, *geometry.tracer, cones, fog_options);
   }
@@ -713,6 +738,7 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
     total.shadow_rays += w.cost.shadow_rays;
     total.fog_rays += w.cost.fog_rays;
     total.fog_shadow_rays += w.cost.fog_shadow_rays;
+    total.fog_map_texels += w.cost.fog_map_texels;
     total.fog_stopped += w.cost.fog_stopped;
   }
   result.cancelled = done_tiles.load() < tiles;
@@ -737,6 +763,9 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
       detail += sun_cones ? ", " + std::to_string(sun_cones->cones.size()) + " shadow cones"
                 : cones   ? ", the caller's shadow cones"
                           : ", no shadow cones (every ray searched whole)";
+    if (mode == FogMode::map)
+      detail += ", " + std::to_string(fog->map_count()) + " sun maps, " + std::to_string(total.fog_map_texels) +
+                " map texels walked";
     detail += "; " + std::to_string(total.fog_rays) + " rays, " + std::to_string(total.fog_shadow_rays) +
               " shadow rays, " + std::to_string(total.fog_stopped) + " stopped at T < 4e-18";
     result.passes.push_back({"fog (thread time)", total.fog_s, detail});

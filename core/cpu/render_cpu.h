@@ -135,6 +135,11 @@ SceneGeometry build_instanced_geometry(const Scene& scene, const SkinOptions& sk
                                        std::vector<RenderPass>* passes = nullptr,
                                        const SceneTextures* textures = nullptr, const Progress& progress = {});
 
+// The fog mode the CPU runs for `mode`: auto is map (docs/spec/fog.md: the fastest mode that
+// reaches refined's accuracy, measured by `sylva bench fog` on the bundled canopy scenes;
+// docs/fog-map.md and docs/benchmarks.md "Fog mode map"), every other mode itself.
+FogMode cpu_fog_mode(FogMode mode);
+
 // Renders `scene` (every plant's skeleton set). Deterministic for any thread count.
 // options.progress: "geometry" (the first 5%), then "render", the fraction of tiles done,
 // reported from the worker threads; checked before every tile. Cancelled: the result has

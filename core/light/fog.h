@@ -66,6 +66,12 @@ struct FogMedium {
 FogMedium fog_medium(double sigma_s, double sigma_a, double g, double height_falloff, double ground,
                      double top = kFogInfinity);
 
+// An interval of t (metres along a unit ray direction), t0 < t1: a part of a ray that is lit,
+// or that a shadow cone covers.
+struct FogInterval {
+  double t0 = 0, t1 = 0;
+};
+
 // ---- Phase function -------------------------------------------------------------------
 
 // The largest |g| for which Schlick's k = 1.55g − 0.55g³ stays below 1 in magnitude: the

@@ -36,9 +36,11 @@ FogIntegrator::FogIntegrator(const FogMedium& medium, const FogSun& sun, const g
                              const FogIntegratorOptions& options)
     : medium_(medium), sun_(sun), sky_(sky), tracer_(tracer), cones_(cones),
       mode_(options.mode == FogMode::automatic ? FogMode::refined : options.mode),
-      steps_(std::max(1u, options.steps)) {
+      steps_(std::max(1u, options.steps)), maps_(options.maps), map_per_ray_(options.map_per_ray) {
   if (mode_ == FogMode::fast && !cones_)
     throw std::invalid_argument("fog mode fast needs shadow cones (V = 0 inside them): none were given");
+  if (mode_ == FogMode::map && maps_.empty())
+    throw std::invalid_argument("fog mode map needs sun maps: none were given");
   cos_alpha_ = std::cos(sun_.angular_radius_rad);
   sun_frame_ = axis_frame(sun_.direction);
   const bool radiant = sun_.radiance.x > 0 || sun_.radiance.y > 0 || sun_.radiance.z > 0;
@@ -92,15 +94,6 @@ bool meets_box(const glm::dvec3& origin, const glm::dvec3& direction, const Aabb
     if (!(u0 <= u1)) return false;
   }
   return true;
-}
-
-// Appends [t0, t1] to a sorted list of lit pieces, merging with the last when they touch.
-void append_lit(std::vector<FogInterval>* lit, double t0, double t1) {
-  if (!(t1 > t0)) return;
-  if (!lit->empty() && lit->back().t1 >= t0)
-    lit->back().t1 = std::max(lit->back().t1, t1);
-  else
-    lit->push_back({t0, t1});
 }
 
 }  // namespace
@@ -164,6 +157,31 @@ double FogIntegrator::sun_fast(const CameraRay& ray, double a, double b, const s
   }
   append_lit(&lit, t, b);
   return integrate_lit(medium_, ray.origin, ray.direction, sun_.direction, a, lit);
+}
+
+double FogIntegrator::sun_map(const CameraRay& ray, double a, double b, const std::vector<FogInterval>& cones,
+                              SampleRng& rng, FogRayResult* result) const {
+  thread_local std::vector<FogInterval> lit;
+  SunMapWalkStats stats;
+  double sum = 0;
+  std::span<const SunDepthMap> maps = maps_;
+  if (map_per_ray_ && maps.size() > 1) {
+    const size_t k = std::min(maps.size() - 1, static_cast<size_t>(rng.next_double() * maps.size()));
+    maps = maps.subspan(k, 1);
+  }
+  for (const SunDepthMap& map : maps) {
+    lit.clear();
+    double t = a;
+    for (const FogInterval& c : cones) {
+      append_lit(&lit, t, c.t0);  // outside the cones the sun is visible
+      map.lit_parts(ray.origin, ray.direction, c.t0, c.t1, &lit, &stats);
+      t = c.t1;
+    }
+    append_lit(&lit, t, b);
+    sum += integrate_lit(medium_, ray.origin, ray.direction, sun_.direction, a, lit);
+  }
+  result->map_texels += stats.texels;
+  return sum / maps.size();
 }
 
 double FogIntegrator::sun_refined(const CameraRay& ray, double a, double b, const std::vector<FogInterval>& search,
@@ -249,7 +267,7 @@ FogRayResult FogIntegrator::integrate(const glm::dvec3& origin, const glm::dvec3
   // top, a climbing ray: b = kFogFar), so no probe lies far beyond the plants.
   const FogInterval shade = shadow_range(ray, a, b);
   std::vector<FogInterval> cones;
-  if (mode_ == FogMode::medium || mode_ == FogMode::fast || mode_ == FogMode::refined) {
+  if (mode_ == FogMode::medium || mode_ == FogMode::fast || mode_ == FogMode::refined || mode_ == FogMode::map) {
     if (cones_) {
       cones_->intervals(Ray{origin, direction}, shade.t0, shade.t1, &cones);
       cones = clipped(cones, shade.t0, shade.t1);
@@ -262,6 +280,7 @@ FogRayResult FogIntegrator::integrate(const glm::dvec3& origin, const glm::dvec3
     case FogMode::brute: sun = sun_brute(ray, a, b, nullptr, rng, &r); break;
     case FogMode::medium: sun = sun_brute(ray, a, b, &cones, rng, &r); break;
     case FogMode::fast: sun = sun_fast(ray, a, b, cones); break;
+    case FogMode::map: sun = sun_map(ray, a, b, cones, rng, &r); break;
     case FogMode::automatic:
     case FogMode::refined: {
       const glm::dvec3 toward_sun = disc_direction(rng);

@@ -35,7 +35,13 @@
 //             averaged: converged once the probes resolve the smallest shadow (a shadow
 //             narrower than a probe gap can hide in it; a gap holds 1/(8·steps) of the ray's
 //             unshadowed weight, which bounds what one hidden shadow can cost).
-//  auto       refined.
+//  map        the cone intervals (the whole shadow range without a cone set) walked through
+//             each sun-space depth map (core/light/sun_map.h: one per direction of the sun's
+//             disc), texel by texel: the parts in front of the map are lit, closed form over
+//             them; the maps' results averaged. No shadow rays, no random numbers: exact with
+//             respect to the maps (docs/fog-map.md gives their error).
+//  auto       refined here (the integrator alone has no maps); render_cpu runs auto as map
+//             (cpu_fog_mode, core/cpu/render_cpu.h).
 //
 // Early termination: the sunlit part is integrated only up to where T(0, t) falls below
 // e^{−kFogNegligibleDepth} (no shadow rays beyond; what is left is < 4e-18·E_sun·p). The sky
@@ -47,6 +53,7 @@
 
 #include <cstdint>
 #include <glm/vec3.hpp>
+#include <span>
 #include <vector>
 
 #include "core/light/fog.h"
@@ -56,6 +63,7 @@
 #include "core/geometry/skin.h"
 #include "core/geometry/surface.h"
 #include "core/light/shadow_cones.h"
+#include "core/light/sun_map.h"
 
 namespace sylva {
 
@@ -74,11 +82,6 @@ constexpr int kReferenceBisections = 24;
 constexpr int kReferenceDiscSamples = 16;
 // Probes per ray per disc point in reference mode, per unit of `steps`.
 constexpr uint32_t kReferenceProbesPerStep = 8;
-
-// An interval of t (metres along the unit camera direction), t0 < t1.
-struct FogInterval {
-  double t0 = 0, t1 = 0;
-};
 
 // The shadow cones as the integrator queries them (Hougs and Day 2001 sec. 3.3.1): the sorted,
 // disjoint intervals of t in [t_min, t_max] where origin + t·direction (direction unit) lies
@@ -114,8 +117,15 @@ FogSun fog_sun_of(const Sun& sun);
 FogMedium fog_medium_of(const Scene& scene);
 
 struct FogIntegratorOptions {
-  FogMode mode = FogMode::automatic;
-  uint32_t steps = 64;  // >= 1
+  FogIntegratorOptions(FogMode mode_ = FogMode::automatic, uint32_t steps_ = 64) : mode(mode_), steps(steps_) {}
+  FogMode mode;
+  uint32_t steps;  // >= 1
+  // Mode map: the sun maps (one per disc direction; they must outlive the integrator).
+  // Mode map needs at least one (std::invalid_argument without).
+  std::span<const SunDepthMap> maps;
+  // Mode map with several maps: walk one per camera ray, drawn from the ray's random
+  // numbers (true), or all of them and average (false).
+  bool map_per_ray = false;
 };
 
 // What one camera ray collected.
@@ -123,6 +133,7 @@ struct FogRayResult {
   glm::dvec3 inscatter{0, 0, 0};  // ∫ … dt above, linear RGB (fog.R fog.G fog.B)
   double transmittance = 1;       // T(0, t_end) (fog.T)
   uint64_t shadow_rays = 0;       // rays cast through the tracer
+  uint64_t map_texels = 0;        // texels of the sun maps walked one by one (mode map)
   bool terminated_early = false;  // the sunlit part stopped at kFogNegligibleDepth
 };
 
@@ -142,6 +153,7 @@ class FogIntegrator {
                          render_common::SampleRng& rng) const;
 
   FogMode mode() const { return mode_; }  // the mode run (auto resolved to refined)
+  size_t map_count() const { return maps_.size(); }  // mode map's maps
   const FogMedium& medium() const { return medium_; }
   const FogSun& sun() const { return sun_; }
 
@@ -157,6 +169,8 @@ class FogIntegrator {
   double sun_brute(const CameraRay& ray, double a, double b, const std::vector<FogInterval>* cones,
                    render_common::SampleRng& rng, FogRayResult* result) const;
   double sun_fast(const CameraRay& ray, double a, double b, const std::vector<FogInterval>& cones) const;
+  double sun_map(const CameraRay& ray, double a, double b, const std::vector<FogInterval>& cones,
+                 render_common::SampleRng& rng, FogRayResult* result) const;
   double sun_refined(const CameraRay& ray, double a, double b, const std::vector<FogInterval>& search, uint32_t probes,
                      int bisections, const glm::dvec3& toward_sun, render_common::SampleRng& rng,
                      FogRayResult* result) const;
@@ -168,6 +182,8 @@ class FogIntegrator {
   const FogConeSource* cones_;
   FogMode mode_;
   uint32_t steps_;
+  std::span<const SunDepthMap> maps_;
+  bool map_per_ray_ = false;
   double cos_alpha_ = 1;
   AxisFrame sun_frame_{};
   bool sunlit_ = false;  // the sun lights the fog at all (radiance > 0, above the horizon)

@@ -7,10 +7,12 @@
 #include <atomic>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "core/geometry/relief.h"
+#include "core/light/sun_map.h"
 #include "core/scene/scene.h"
 #include "core/geometry/skin.h"
 #include "core/util/progress.h"
@@ -67,6 +69,11 @@ struct FogRenderOptions {
   // one set serves every camera and frame); null: the renderer has none (fog_integrator.h
   // says what each mode then does).
   const FogConeSource* cones = nullptr;
+  // Mode map (docs/fog-map.md): the maps' texels a side and disc directions (--fog-map-resolution,
+  // --fog-map-directions), and sun maps already built for these plants and sun (with
+  // `cones`; empty: the renderer builds its own).
+  std::optional<uint32_t> map_resolution, map_directions;
+  std::span<const SunDepthMap> maps;
 };
 
 // The samples per pixel of `sylva render` and of the Python module's render() when none

@@ -26,13 +26,14 @@ const char* fog_mode_name(FogMode mode) {
     case FogMode::fast: return "fast";
     case FogMode::refined: return "refined";
     case FogMode::reference: return "reference";
+    case FogMode::map: return "map";
   }
   return "auto";
 }
 
 std::optional<FogMode> fog_mode_from_name(std::string_view name) {
   for (FogMode m : {FogMode::automatic, FogMode::brute, FogMode::medium, FogMode::fast, FogMode::refined,
-                    FogMode::reference})
+                    FogMode::reference, FogMode::map})
     if (name == fog_mode_name(m)) return m;
   return std::nullopt;
 }

@@ -70,6 +70,7 @@ enum class FogMode : uint8_t {
   fast,       // no sunlight inside the cones, closed form outside
   refined,    // the cones' intervals refined to the exact transitions, closed form
   reference,  // converged: every visibility change bisected, many sun-disc samples
+  map,        // the cones' intervals walked through sun-space depth maps, closed form
 };
 const char* fog_mode_name(FogMode mode);                          // "auto", "brute", ...
 std::optional<FogMode> fog_mode_from_name(std::string_view name);  // nullopt: not a mode
@@ -87,6 +88,9 @@ struct Fog {
   FogMode mode = FogMode::automatic;
   uint32_t steps = 64;           // samples along a ray (brute, medium; probes of refined), >= 1
   uint64_t photons = 1'000'000;  // sun photons for the shadow cones, >= 1
+  uint32_t map_resolution = 2048;  // mode map: texels a side of a sun map, a multiple of 32 in
+                                   // [32, 65536] (core/cpu/sun_maps.h; docs/fog-map.md)
+  uint32_t map_directions = 4;     // mode map: maps over the sun's disc, 1 to 64 (a point sun: 1)
   bool operator==(const Fog&) const = default;
 };
 
@@ -94,6 +98,9 @@ struct Fog {
 // (`photons`, --photons) a scene or the command line may ask for.
 constexpr uint32_t kFogMaxSteps = 65536;
 constexpr uint64_t kFogMaxPhotons = 1'000'000'000;
+// The range of a sun map's texels a side (a multiple of 32) and of its disc directions.
+constexpr uint32_t kFogMinMapResolution = 32, kFogMaxMapResolution = 65536;
+constexpr uint32_t kFogMaxMapDirections = 64;
 
 // The `animation` key (docs/animation.md): how the plants move over time, for
 // `sylva render --frames` and the studio. Frame k is at time k / fps seconds; the motion

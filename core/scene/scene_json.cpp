@@ -388,7 +388,8 @@ std::vector<ScenePlant> scatter_plants(const SceneScatter& sc, size_t index, dou
 // and column), so the message points at what to change.
 Fog read_fog(const JsonValue& v, double ground_height) {
   expect_object(v, "fog");
-  check_keys(v, "fog", {"sigma_s", "sigma_a", "g", "height_falloff", "top", "mode", "steps", "photons"});
+  check_keys(v, "fog", {"sigma_s", "sigma_a", "g", "height_falloff", "top", "mode", "steps", "photons", "map_resolution",
+                          "map_directions"});
   Fog f;
   for (const JsonMember& m : v.members) {
     const std::string& key = m.key.name;
@@ -433,7 +434,7 @@ Fog read_fog(const JsonValue& v, double ground_height) {
     } else if (key == "mode") {
       const std::optional<FogMode> mode = value.is_string() ? fog_mode_from_name(value.text) : std::nullopt;
       if (!mode)
-        throw at_key(what + " must be one of \"auto\", \"brute\", \"medium\", \"fast\", \"refined\", \"reference\", not " +
+        throw at_key(what + " must be one of \"auto\", \"brute\", \"medium\", \"fast\", \"refined\", \"reference\", \"map\", not " +
                      shown);
       f.mode = *mode;
     } else if (key == "steps") {
@@ -446,6 +447,17 @@ Fog read_fog(const JsonValue& v, double ground_height) {
       if (!n || *n == 0 || *n > kFogMaxPhotons)
         throw at_key(what + " must be an integer from 1 to " + std::to_string(kFogMaxPhotons) + ", not " + shown);
       f.photons = *n;
+    } else if (key == "map_resolution") {
+      const auto n = value.as_uint64();
+      if (!n || *n < kFogMinMapResolution || *n > kFogMaxMapResolution || *n % 32 != 0)
+        throw at_key(what + " must be a multiple of 32 from " + std::to_string(kFogMinMapResolution) + " to " +
+                     std::to_string(kFogMaxMapResolution) + " (texels a side), not " + shown);
+      f.map_resolution = static_cast<uint32_t>(*n);
+    } else if (key == "map_directions") {
+      const auto n = value.as_uint64();
+      if (!n || *n == 0 || *n > kFogMaxMapDirections)
+        throw at_key(what + " must be an integer from 1 to " + std::to_string(kFogMaxMapDirections) + ", not " + shown);
+      f.map_directions = static_cast<uint32_t>(*n);
     }
   }
   return f;
@@ -642,6 +654,11 @@ void write_fog(JsonWriter& w, const Fog& f) {
   w.key("mode").string(fog_mode_name(f.mode));
   w.key("steps").integer(f.steps);
   w.key("photons").integer(f.photons);
+  // The map's keys only where they differ from the defaults (scenes written before them
+  // stay byte-identical).
+  const Fog defaults;
+  if (f.map_resolution != defaults.map_resolution) w.key("map_resolution").integer(f.map_resolution);
+  if (f.map_directions != defaults.map_directions) w.key("map_directions").integer(f.map_directions);
   w.end_object();
 }
 

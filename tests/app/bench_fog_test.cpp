@@ -32,7 +32,7 @@ TEST(BenchFog, QuickRunWritesEveryModesRowsTheTimeTableAndThePlot) {
   EXPECT_NE(rows.find("mode,steps,photons,seed,photon_s,cone_s,render_s,total_s,rmse,bias,cones\n"), std::string::npos)
       << rows;
   // --quick: 2 seeds of brute 8 and 32, cones of 1e4 and 1e5 photons with automatic
-  // and fixed parameters, medium and refined at 16 steps and fast on each.
+  // and fixed parameters, medium and refined at 16 steps and fast on each, map on each.
   EXPECT_EQ(count_lines_starting(rows, "brute,8,0,"), 2u) << rows;
   EXPECT_EQ(count_lines_starting(rows, "brute,32,0,"), 2u) << rows;
   for (const char* kind : {"auto", "fixed"}) {
@@ -42,6 +42,15 @@ TEST(BenchFog, QuickRunWritesEveryModesRowsTheTimeTableAndThePlot) {
     EXPECT_EQ(count_lines_starting(rows, "refined-" + k + ",16,100000,"), 2u) << rows;
     EXPECT_EQ(count_lines_starting(rows, "fast-" + k + ",0,10000,"), 2u) << rows;
   }
+  // Mode map at 256² texels: one map, and four over the grove's sun disc, on each photon
+  // count's tiles (no cones: one row per seed, not per cone parameters).
+  for (const char* photons : {"10000", "100000"}) {
+    EXPECT_EQ(count_lines_starting(rows, std::string("map1,256,") + photons + ","), 2u) << rows;
+    EXPECT_EQ(count_lines_starting(rows, std::string("map4,256,") + photons + ","), 2u) << rows;
+  }
+  EXPECT_EQ(rows.find("mapcones"), std::string::npos) << rows;  // only with --map-variants
+  EXPECT_NE(r.out.find("4 maps of 256²"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("speed-up over brute at equal RMSE"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("time (s, mean over seeds, photons and cones included) to reach the RMSE of"), std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("fast-auto bias floor"), std::string::npos) << r.out;

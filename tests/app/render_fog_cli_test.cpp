@@ -139,7 +139,10 @@ TEST(RenderFogCli, BadFogFlagsAreUsageErrors) {
       {{"--fog-steps", "0"}, "--fog-steps 0: expected an integer from 1 to 65536"},
       {{"--fog-steps", "1000000"}, "--fog-steps 1000000"},
       {{"--fog-steps", "1.5"}, "--fog-steps 1.5"},
-      {{"--fog-mode", "warp"}, "--fog-mode warp: expected auto, brute, medium, fast, refined or reference"},
+      {{"--fog-mode", "warp"}, "--fog-mode warp: expected auto, brute, medium, fast, refined, reference or map"},
+      {{"--fog-map-resolution", "1000"}, "--fog-map-resolution 1000: expected a multiple of 32 from 32 to 65536"},
+      {{"--fog-map-resolution", "0"}, "--fog-map-resolution 0: expected a multiple of 32"},
+      {{"--fog-map-directions", "65"}, "--fog-map-directions"},
       {{"--cone-params", "96,8,24"}, "--cone-params 96,8,24: expected auto or p1,p2,p3,p4"},
       {{"--cone-params", "96,8,24,16,2"}, "expected auto or p1,p2,p3,p4"},
       {{"--cone-params", "0,0,0,0"}, "expected auto or p1,p2,p3,p4"},
@@ -190,29 +193,32 @@ TEST(RenderFogCli, FogFlagsOnASceneWithoutFogAreUsageErrors) {
   EXPECT_EQ(r.err.find("fog"), std::string::npos) << describe(r);
 }
 
-TEST(RenderFogCli, OnlyTheConeModesTraceSunPhotons) {
+TEST(RenderFogCli, OnlyTheConeAndMapModesTraceSunPhotons) {
   TempDir dir;
   const std::string scene = write_scene(dir, R"({"mode": "fast", "top": 20, "steps": 2, "photons": 20000})");
-  // The scene's own mode, then each mode from the flag: the cone modes (auto is refined on
-  // the CPU) list the photon and cone passes; brute and reference trace no photons.
+  // The scene's own mode, then each mode from the flag: the cone modes list the photon and
+  // cone passes, map (and auto, which is map on the CPU) the photons and its sun maps;
+  // brute and reference trace no photons.
   struct Case {
     std::vector<std::string> flags;
-    bool photons;
+    bool photons, cones;
     const char* mode;
   };
-  const Case cases[] = {{{}, true, "fast"},
-                        {{"--fog-mode", "medium"}, true, "medium"},
-                        {{"--fog-mode", "refined"}, true, "refined"},
-                        {{"--fog-mode", "auto"}, true, "refined (auto)"},
-                        {{"--fog-mode", "brute"}, false, "brute"},
-                        {{"--fog-mode", "reference"}, false, "reference"}};
+  const Case cases[] = {{{}, true, true, "fast"},
+                        {{"--fog-mode", "medium"}, true, true, "medium"},
+                        {{"--fog-mode", "refined"}, true, true, "refined"},
+                        {{"--fog-mode", "map"}, true, false, "map"},
+                        {{"--fog-mode", "auto"}, true, false, "map (auto)"},
+                        {{"--fog-mode", "brute"}, false, false, "brute"},
+                        {{"--fog-mode", "reference"}, false, false, "reference"}};
   for (const Case& c : cases) {
     std::vector<std::string> args = {"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose"};
     args.insert(args.end(), c.flags.begin(), c.flags.end());
     ProcessResult r = run_sylva(args);
     ASSERT_EQ(r.exit_code, 0) << c.mode << ": " << describe(r);
     EXPECT_EQ(r.err.find("  photons ") != std::string::npos, c.photons) << c.mode << ": " << describe(r);
-    EXPECT_EQ(r.err.find("shadow cones") != std::string::npos, c.photons) << c.mode << ": " << describe(r);
+    EXPECT_EQ(r.err.find("shadow cones") != std::string::npos, c.cones) << c.mode << ": " << describe(r);
+    EXPECT_EQ(r.err.find("  sun maps ") != std::string::npos, c.photons && !c.cones) << c.mode << ": " << describe(r);
     EXPECT_NE(r.err.find(std::string("fog (thread time)")), std::string::npos) << describe(r);
     EXPECT_NE(r.err.find(std::string(c.mode) + ", 2 steps"), std::string::npos) << c.mode << ": " << describe(r);
   }
@@ -227,7 +233,7 @@ TEST(RenderFogCli, TheConeParametersAreTheFlagsOrTheAutomaticChoiceWithItsReport
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_NE(r.err.find("20000 photons"), std::string::npos) << describe(r);
   EXPECT_NE(r.err.find("cone parameters (automatic)"), std::string::npos) << describe(r);
-  for (const char* mode : {"medium", "refined", "auto"}) {
+  for (const char* mode : {"medium", "refined", "fast"}) {
     r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "cpu", "--verbose", "--fog-mode", mode,
                    "--cone-params", "41,8,8,8"});
     ASSERT_EQ(r.exit_code, 0) << mode << ": " << describe(r);
@@ -236,9 +242,9 @@ TEST(RenderFogCli, TheConeParametersAreTheFlagsOrTheAutomaticChoiceWithItsReport
   }
 }
 
-TEST(RenderFogCli, EveryBundledFogSceneRendersOnTheCpuWithItsCones) {
+TEST(RenderFogCli, EveryBundledFogSceneRendersOnTheCpuWithItsSunMaps) {
   // presets/scenes/'s fog scenes (crepuscular rays, height fog), small and quick: the
-  // default mode (auto: refined with the shadow cones of sun photons) and the fog AOV.
+  // default mode (auto: map, sun maps built from sun photons) and the fog AOV.
   int scenes = 0;
   for (const auto& entry : std::filesystem::directory_iterator(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes")) {
     const std::string path = entry.path().string();
@@ -249,8 +255,8 @@ TEST(RenderFogCli, EveryBundledFogSceneRendersOnTheCpuWithItsCones) {
                                  "--height", "36", "--photons", "20000", "--fog-steps", "4", "--aov", "fog",
                                  "--verbose"});
     ASSERT_EQ(r.exit_code, 0) << path << ": " << describe(r);
-    EXPECT_NE(r.err.find("  cones "), std::string::npos) << path << ": " << describe(r);
-    EXPECT_NE(r.err.find("refined (auto)"), std::string::npos) << path << ": " << describe(r);
+    EXPECT_NE(r.err.find("  sun maps "), std::string::npos) << path << ": " << describe(r);
+    EXPECT_NE(r.err.find("map (auto)"), std::string::npos) << path << ": " << describe(r);
     const std::vector<std::string> channels = channel_names(dir.file("f.exr"));
     EXPECT_NE(std::find(channels.begin(), channels.end(), "fog.T"), channels.end()) << path;
   }

@@ -40,7 +40,11 @@ TEST(RenderFog, ASceneWithoutFogRunsNoneOfIt) {
   EXPECT_FALSE(has_pass(r, "fog"));
   EXPECT_FALSE(has_pass(r, "photons"));
   EXPECT_FALSE(has_pass(r, "cones"));
+  EXPECT_FALSE(has_pass(r, "sun maps"));
   EXPECT_TRUE(r.image.fog.empty());  // no fog, no fog AOV
+  // Nor does mode map build its maps without fog.
+  o.fog.mode = FogMode::map;
+  EXPECT_FALSE(has_pass(render_cpu(s, o), "sun maps"));
 }
 
 TEST(RenderFog, AFoggySceneListsTheFogPassAndBruteAndReferenceTraceNoPhotons) {
@@ -157,13 +161,15 @@ TEST(RenderFog, HeightFogWithoutATopRendersInEveryModeAndAgreesWithTheReference)
     return std::sqrt(err / n) / (mean / n);
   };
   EXPECT_LT(relative_rmse(high), 1e-5);
-  for (FogMode mode : {FogMode::brute, FogMode::medium, FogMode::fast, FogMode::refined, FogMode::automatic}) {
+  for (FogMode mode :
+       {FogMode::brute, FogMode::medium, FogMode::fast, FogMode::refined, FogMode::automatic, FogMode::map}) {
     RenderOptions m = o;
     m.fog.mode = mode;
     const RenderResult r = render_cpu(s, m);
     ASSERT_EQ(r.image.fog.size(), ref.image.fog.size()) << fog_mode_name(mode);
     // Brute and medium sample 16 points a ray, fast darkens every cone whole: looser.
-    const double tolerance = mode == FogMode::refined || mode == FogMode::automatic ? 0.01 : 0.05;
+    const double tolerance =
+        mode == FogMode::refined || mode == FogMode::automatic || mode == FogMode::map ? 0.01 : 0.05;
     EXPECT_LT(relative_rmse(r), tolerance) << fog_mode_name(mode);
   }
 }
@@ -225,6 +231,35 @@ TEST(RenderFog, SurfacesReceiveSunlightAttenuatedByTheFog) {
   const double sunlit_clear = a.image.beauty[p * 4] - ambient;
   EXPECT_GT(sunlit_clear, 0.1);
   EXPECT_NEAR(b.image.beauty[p * 4], T * (ambient + t_sun * sunlit_clear), 1e-6);
+}
+
+TEST(RenderFog, MapModeBuildsItsMapsFromPhotonsAndCastsNoShadowRays) {
+  Scene s = foggy_cylinder(FogMode::map);
+  s.sun.angular_radius_deg = 0.27;  // a disc: one map per direction (a point sun has one)
+  RenderOptions o;
+  o.fog.map_resolution = 512;
+  o.fog.map_directions = 3;
+  const RenderResult r = render_cpu(s, o);
+  EXPECT_TRUE(has_pass(r, "photons"));
+  EXPECT_FALSE(has_pass(r, "cones"));  // the maps' tiles are the index (docs/fog-map.md)
+  const auto maps = std::find_if(r.passes.begin(), r.passes.end(), [](const RenderPass& p) { return p.name == "sun maps"; });
+  ASSERT_NE(maps, r.passes.end());
+  EXPECT_EQ(maps->detail.rfind("3 maps of 512²", 0), 0u) << maps->detail;
+  const auto fog = std::find_if(r.passes.begin(), r.passes.end(),
+                                [](const RenderPass& p) { return p.name.rfind("fog", 0) == 0; });
+  ASSERT_NE(fog, r.passes.end());
+  EXPECT_EQ(fog->detail.rfind("map, ", 0), 0u) << fog->detail;
+  EXPECT_NE(fog->detail.find(" 0 shadow rays"), std::string::npos) << fog->detail;
+  EXPECT_EQ(fog->detail.find(" 0 map texels"), std::string::npos) << fog->detail;
+  // Maps over the memory bound are refused with what they would need.
+  o.fog.map_resolution = 65536;
+  o.fog.map_directions = 64;
+  try {
+    (void)render_cpu(s, o);
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("more than the limit of 64.0 MiB"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

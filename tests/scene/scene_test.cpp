@@ -199,12 +199,34 @@ TEST(SceneFog, AbsentKeysDefault) {
   EXPECT_EQ(f.steps, 64u);
   EXPECT_EQ(f.photons, 1000000u);
   EXPECT_EQ(f.sigma_s, 0.05);
+  EXPECT_EQ(f.map_resolution, 2048u);
+  EXPECT_EQ(f.map_directions, 4u);
+}
+
+TEST(SceneFog, MapKeysAreReadAndWrittenOnlyWhereTheyDifferFromTheDefaults) {
+  Expected<Scene> r = parse_scene_json(
+      R"({"plants": [], "fog": {"mode": "map", "map_resolution": 4096, "map_directions": 9}})", "s", "");
+  ASSERT_TRUE(r.ok()) << r.error().format();
+  EXPECT_EQ(r->fog->mode, FogMode::map);
+  EXPECT_EQ(r->fog->map_resolution, 4096u);
+  EXPECT_EQ(r->fog->map_directions, 9u);
+  const Expected<std::string> text = write_scene_json(*r);
+  ASSERT_TRUE(text.ok()) << text.error().format();
+  const std::string& written = *text;
+  EXPECT_NE(written.find("\"map_resolution\": 4096"), std::string::npos) << written;
+  EXPECT_NE(written.find("\"map_directions\": 9"), std::string::npos) << written;
+  Scene plain = *r;
+  plain.fog = Fog{};
+  const Expected<std::string> plain_text = write_scene_json(plain);
+  ASSERT_TRUE(plain_text.ok()) << plain_text.error().format();
+  EXPECT_EQ(plain_text->find("map_"), std::string::npos);
 }
 
 TEST(SceneFog, ModeNamesRoundTrip) {
   for (FogMode m : {FogMode::automatic, FogMode::brute, FogMode::medium, FogMode::fast, FogMode::refined,
-                    FogMode::reference})
+                    FogMode::reference, FogMode::map})
     EXPECT_EQ(fog_mode_from_name(fog_mode_name(m)), m);
+  EXPECT_EQ(fog_mode_name(FogMode::map), std::string("map"));
   EXPECT_EQ(fog_mode_name(FogMode::automatic), std::string("auto"));
   EXPECT_FALSE(fog_mode_from_name("automatic"));
   EXPECT_FALSE(fog_mode_from_name("Brute"));
@@ -229,7 +251,7 @@ TEST(SceneFog, EveryKeyOutOfRangeIsAnErrorAtTheKey) {
       {R"("top": -3)", "fog.top -3 must be above the ground (ground.height 0)"},
       {R"("top": 0)", "must be above the ground"},
       {R"("top": "high")", "fog.top must be a number"},
-      {R"("mode": "fastest")", R"(fog.mode must be one of "auto", "brute", "medium", "fast", "refined", "reference", not "fastest")"},
+      {R"("mode": "fastest")", R"(fog.mode must be one of "auto", "brute", "medium", "fast", "refined", "reference", "map", not "fastest")"},
       {R"("mode": 3)", "fog.mode must be one of"},
       {R"("steps": 0)", "fog.steps must be an integer from 1 to 65536, not 0"},
       {R"("steps": 1.5)", "fog.steps must be an integer from 1 to 65536, not 1.5"},
@@ -239,6 +261,12 @@ TEST(SceneFog, EveryKeyOutOfRangeIsAnErrorAtTheKey) {
       {R"("photons": 0)", "fog.photons must be an integer from 1 to 1000000000, not 0"},
       {R"("photons": 2e9)", "not 2e9"},
       {R"("photons": true)", "not a boolean"},
+      {R"("map_resolution": 1000)", "fog.map_resolution must be a multiple of 32 from 32 to 65536 (texels a side), not 1000"},
+      {R"("map_resolution": 0)", "not 0"},
+      {R"("map_resolution": 131072)", "not 131072"},
+      {R"("map_resolution": 2048.5)", "not 2048.5"},
+      {R"("map_directions": 0)", "fog.map_directions must be an integer from 1 to 64, not 0"},
+      {R"("map_directions": 65)", "not 65"},
       {R"("densty": 1)", "unknown key \"densty\" in fog"},
   };
   for (const Bad& b : bad) {
