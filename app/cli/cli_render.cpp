@@ -397,6 +397,18 @@ int run_render_frames(const RenderArgs& a) {
   apply_camera_flags(a.camera, base.camera);
   if (!growth && !base.animation)
     throw UsageError{"--frames: " + input + " has no animation key, so its plants stand still (docs/animation.md)"};
+  // --fps is a scene's time step too (docs/animation.md): frame k at k / fps seconds, and
+  // `all` the frames of its duration at that rate.
+  if (!growth && a.fps) {
+    if (!(base.animation->duration_s * *a.fps <= static_cast<double>(kMaxAnimationFrames)))
+    {
+      char text[160];
+      std::snprintf(text, sizeof text, "--fps %g: %g frames a second over the scene's %g s ask for more than %llu frames",
+                    *a.fps, *a.fps, base.animation->duration_s, static_cast<unsigned long long>(kMaxAnimationFrames));
+      throw UsageError{text};
+    }
+    base.animation->fps = *a.fps;
+  }
   if (range.all) range = {0, animation_frame_count(*base.animation) - 1, false};
   const double fps = a.fps.value_or(growth ? 4.0 : base.animation->fps);
   if (auto problem = image_size_problem(base.width, base.height, a.spp)) {

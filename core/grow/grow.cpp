@@ -47,6 +47,13 @@ Expected<GrowResult> grow(const lsys::Grammar& g, const lsys::DeriveOptions& opt
   return r;
 }
 
+namespace {
+
+// Whether a scene's grammar path names a grammar file: `.lsys` (docs/spec/scene.md).
+bool looks_like_grammar(const std::string& path) { return path.ends_with(".lsys"); }
+
+}  // namespace
+
 Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& progress) {
   // Where the scene names plant i's grammar: its own entry or its scatter entry.
   auto named_by = [&](size_t i) {
@@ -123,9 +130,31 @@ Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& pro
   for (size_t r = 0; r < first_plant.size(); ++r) {
     const size_t i = first_plant[r];
     const ScenePlant& p = scene.plants[i];
-    // The grammar's own diagnostic, and where the scene named the grammar.
     auto located = [&](Diagnostic d) {
       if (d.cancelled) return d;
+      // A file that is not a grammar (/etc/passwd, a picture): the error is the scene's key,
+      // and nothing of the file is quoted — not its line, not the parser's message, which
+      // may name a word of it (docs/limits.md "Inputs").
+      if (!looks_like_grammar(p.grammar)) {
+        Diagnostic top = diagnostic_at(
+            scene.file, p.grammar_loc,
+            named_by(i) + ".grammar names '" + p.grammar + "', which is not a grammar (a .lsys file)" +
+                (d.loc.line ? ": its line " + std::to_string(d.loc.line) + " is not L-system text"
+                            : ": " + d.message));
+        top.error_number = d.error_number;
+        return top;
+      }
+      // No place in the grammar (it cannot be read, or the scene's defines name a define
+      // it lacks): what to change is the scene's key — the error there, the grammar's as a note.
+      if (d.loc.line == 0) {
+        std::string what = d.message;
+        if (what.starts_with("-D ")) what = "its defines name " + what.substr(3);  // "-D X: the grammar has no …"
+        Diagnostic top = diagnostic_at(scene.file, p.grammar_loc, named_by(i) + ".grammar '" + p.grammar + "': " + what);
+        top.error_number = d.error_number;
+        d.notes.clear();
+        return std::move(top).with_note(std::move(d));
+      }
+      // An error in the grammar: the grammar's own diagnostic, and where the scene named it.
       Diagnostic note = diagnostic_at(scene.file, p.grammar_loc, named_by(i) + ".grammar names this grammar");
       return std::move(d).with_note(std::move(note));
     };

@@ -38,9 +38,11 @@ Expected<GrowResult> grow(const lsys::Grammar& grammar, const lsys::DeriveOption
 
 // Grows every plant of `scene` that has no skeleton yet from its grammar (with its seed,
 // steps and defines) and stores the skeleton in the plant, untransformed. The first
-// error is the grammar's own Diagnostic (its file, line, column and source line) with a
-// note at the scene key that named the grammar (scene.file at plants[i].grammar_loc:
-// "plants[i].grammar names this grammar"). Progress: one equal share per plant to grow;
+// error, for an error with a place in the grammar, is the grammar's own Diagnostic (its
+// file, line, column and source line) with a note at the scene key that named the grammar
+// (scene.file at plants[i].grammar_loc: "plants[i].grammar names this grammar"); for one
+// without (an unreadable grammar, a define it lacks) the error is at that key with the
+// grammar's as a note; a path not ending in .lsys is never quoted (docs/design.md). Progress: one equal share per plant to grow;
 // cancelled: cancelled_diagnostic(), the plants grown so far keep their skeletons.
 Status grow_scene_plants(Scene& scene, uint64_t max_modules = 50'000'000, const Progress& progress = {});
 

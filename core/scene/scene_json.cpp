@@ -154,8 +154,20 @@ void check_texture(const JsonValue& object, std::string_view key, const std::str
   const uint32_t line = member ? member->key.line : object.line;
   const uint32_t column = member ? member->key.column : object.column;
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw Located{line, column, what + ": no such image file '" + path + "'"};
+  const std::filesystem::file_type type = std::filesystem::status(path, ec).type();
+  if (type != std::filesystem::file_type::regular) {
+    // Say what is there instead: a directory or /dev/zero is not a missing file.
+    using T = std::filesystem::file_type;
+    const char* is = type == T::directory ? "a directory"
+                     : type == T::character ? "a character device"
+                     : type == T::block ? "a block device"
+                     : type == T::fifo ? "a pipe"
+                     : type == T::socket ? "a socket"
+                     : nullptr;
+    throw Located{line, column,
+                  is ? what + ": '" + path + "' is " + is + ", not an image file"
+                     : what + ": no such image file '" + path + "'"};
+  }
   if (Status opens = check_image_opens(path); !opens)
     throw Located{line, column, what + ": cannot open image '" + path + "': " + opens.error().message};
 }

@@ -78,6 +78,33 @@ TEST(RenderFrames, ASceneWritesOneImagePerFrameAndItsPlantsMove) {
   EXPECT_GT(mean_abs_difference(pixels(dir.file("out/f_0002.png")), rest), 1e-3);
 }
 
+TEST(RenderFrames, FpsIsTheScenesTimeStepToo) {
+  // docs/animation.md: --fps sets the time step of a scene's frames (frame k at k / fps s)
+  // and `all` covers the scene's duration at that rate.
+  TempDir dir;
+  const std::string scene = write_scene(dir, kDance);  // 10 fps, 0.4 s
+  ProcessResult ten = run_sylva({"render", "--spp", "1", scene, "--frames", "1", "-o", dir.file("ten_{frame}.png"),
+                                 "--backend", "cpu", "--width", "64", "--height", "48"});
+  ASSERT_EQ(ten.exit_code, 0) << describe(ten);
+  ProcessResult twenty = run_sylva({"render", "--spp", "1", scene, "--frames", "all", "-o", dir.file("tw_{frame}.png"),
+                                    "--fps", "20", "--backend", "cpu", "--width", "64", "--height", "48"});
+  ASSERT_EQ(twenty.exit_code, 0) << describe(twenty);
+  EXPECT_NE(twenty.err.find("8 frames in"), std::string::npos) << describe(twenty);  // ceil(0.4 × 20)
+  EXPECT_TRUE(fs::exists(dir.file("tw_0007.png")));
+  EXPECT_FALSE(fs::exists(dir.file("tw_0008.png")));
+  // Frame 2 at 20 fps is t = 0.1 s: frame 1 at 10 fps, pixel for pixel; frame 1 is not.
+  EXPECT_EQ(mean_abs_difference(pixels(dir.file("tw_0002.png")), pixels(dir.file("ten_0001.png"))), 0.0);
+  EXPECT_GT(mean_abs_difference(pixels(dir.file("tw_0001.png")), pixels(dir.file("ten_0001.png"))), 1e-4);
+  // A rate that asks for more frames than a scene may have is a usage error, before any
+  // frame is rendered (200 s × 1000 fps = 200,000 frames > 100,000).
+  const std::string long_scene = write_scene(dir, R"({"motion": "dance", "fps": 10, "duration_s": 200})");
+  ProcessResult many = run_sylva({"render", "--spp", "1", long_scene, "--frames", "0..1", "-o",
+                                  dir.file("m_{frame}.png"), "--fps", "1000", "--backend", "cpu"});
+  EXPECT_EQ(many.exit_code, 2) << describe(many);
+  EXPECT_NE(many.err.find("ask for more than 100000 frames"), std::string::npos) << describe(many);
+  EXPECT_FALSE(fs::exists(dir.file("m_0000.png")));
+}
+
 TEST(RenderFrames, OnOpenGlTheRendererReuploadsEachPoseAndMatchesTheCpu) {
   TempDir dir;
   const std::string scene = write_scene(dir, kDance);

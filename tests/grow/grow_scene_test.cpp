@@ -56,16 +56,55 @@ TEST(SceneGrow, AGrammarErrorIsTheGrammarsDiagnosticWithANoteAtTheSceneKey) {
   EXPECT_TRUE(scene->plants[0].skeleton.has_value());  // the plant before it grew
 }
 
-TEST(SceneGrow, AnUnreadableGrammarIsNamedWithTheSceneKeyToo) {
+TEST(SceneGrow, AnUnreadableGrammarIsAnErrorAtTheSceneKeyWithTheFilesAsANote) {
   Expected<Scene> scene = parse_scene_json(R"({"plants": [{"grammar": "no/such.lsys"}]})", "s.scene.json", "");
   ASSERT_TRUE(scene.ok());
   const Status grown = grow_scene_plants(*scene);
   ASSERT_FALSE(grown.ok());
-  EXPECT_EQ(grown.error().file, "no/such.lsys");
-  EXPECT_EQ(grown.error().loc, SourceLoc{});
+  // What to change is the scene's key: the error there, the file's own as a note.
+  EXPECT_EQ(grown.error().file, "s.scene.json");
+  EXPECT_EQ(grown.error().loc, (SourceLoc{1, 25}));
+  EXPECT_EQ(grown.error().message.rfind("plants[0].grammar 'no/such.lsys': ", 0), 0u) << grown.error().message;
   EXPECT_EQ(grown.error().error_number, ENOENT);
   ASSERT_EQ(grown.error().notes.size(), 1u);
-  EXPECT_EQ(grown.error().notes[0].loc, (SourceLoc{1, 25}));
+  EXPECT_EQ(grown.error().notes[0].file, "no/such.lsys");
+  EXPECT_EQ(grown.error().notes[0].loc, SourceLoc{});
+}
+
+TEST(SceneGrow, ADefineTheGrammarLacksIsAnErrorAtTheSceneKey) {
+  const std::string saguaro = std::string(SYLVA_SOURCE_DIR) + "/presets/saguaro.lsys";
+  Expected<Scene> scene =
+      parse_scene_json(R"({"plants": [{"grammar": ")" + saguaro + R"(", "defines": {"NO_SUCH": 2}}]})", "s.scene.json", "");
+  ASSERT_TRUE(scene.ok());
+  const Status grown = grow_scene_plants(*scene);
+  ASSERT_FALSE(grown.ok());
+  EXPECT_EQ(grown.error().file, "s.scene.json");
+  EXPECT_EQ(grown.error().loc, (SourceLoc{1, 25}));
+  EXPECT_NE(grown.error().message.find("its defines name NO_SUCH: the grammar has no '#define NO_SUCH'"),
+            std::string::npos)
+      << grown.error().format();
+  ASSERT_EQ(grown.error().notes.size(), 1u);
+  EXPECT_EQ(grown.error().notes[0].file, saguaro);
+}
+
+TEST(SceneGrow, AFileThatIsNotAGrammarIsNeverQuoted) {
+  // A scene naming any readable file (/etc/passwd) as its grammar: the error names the
+  // file and says it is not a grammar, and prints nothing of what it holds.
+  test::TempFolder dir;
+  std::ofstream(dir.file("secrets.txt")) << "root:x:0:0:root:/root:/bin/bash\ndaemon:x:1:1\n";
+  Expected<Scene> scene = parse_scene_json(R"({"plants": [{"grammar": "secrets.txt"}]})",
+                                           dir.file("s.scene.json"), dir.path());
+  ASSERT_TRUE(scene.ok()) << scene.error().format();
+  const Status grown = grow_scene_plants(*scene);
+  ASSERT_FALSE(grown.ok());
+  const std::string text = grown.error().format();
+  EXPECT_EQ(text.find("root"), std::string::npos) << text;
+  EXPECT_EQ(text.find("daemon"), std::string::npos) << text;
+  EXPECT_NE(text.find("which is not a grammar (a .lsys file): its line 1 is not L-system text"), std::string::npos)
+      << text;
+  EXPECT_EQ(grown.error().file, dir.file("s.scene.json"));
+  EXPECT_TRUE(grown.error().notes.empty());
+  EXPECT_FALSE(grown.error().source_line.has_value());
 }
 
 TEST(SceneGrow, ReportsProgressPerPlantAndStopsWhenCancelled) {

@@ -330,6 +330,9 @@ TEST(SceneMaterials, EveryBadEntryIsAnErrorAtItsKey) {
       {R"({"index": 1, "albedo": [1, -1, 1]})", "materials[0].albedo components must be >= 0", 43},
       {R"({"index": 1, "albedo": "leaf.png"})", "materials[0].albedo: no such image file", 29},
       {R"({"index": 1, "alpha": "mask.png"})", "materials[0].alpha: no such image file", 29},
+      // Something that is there but is no image is named for what it is.
+      {R"({"index": 1, "albedo": "/dev/zero"})", "materials[0].albedo: '/dev/zero' is a character device, not an image file", 29},
+      {R"({"index": 1, "albedo": "/tmp"})", "materials[0].albedo: '/tmp' is a directory, not an image file", 29},
       {R"({"index": 1, "albedo": 7})", "materials[0].albedo", 39},
       {R"({"index": 1, "two_sided": 1})", "materials[0].two_sided must be true or false", 42},
       {R"({"index": 1, "colour": [1, 1, 1]})", "unknown key \"colour\" in materials[0]", 29},
