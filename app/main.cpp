@@ -8,6 +8,7 @@
 #include "app/bench/bench.h"
 #include "app/cli/cli.h"
 #include "app/studio/studio.h"
+#include "core/cpu/sun_maps.h"
 #include "core/geometry/tessellate.h"
 #include "core/util/file_io.h"
 
@@ -72,6 +73,9 @@ int main(int argc, char** argv) {
     std::cerr << "sylva " << sub << ": error: " << e.message << " (see 'sylva " << sub << " --help')\n";
     return kUsageError;
   } catch (const sylva::MeshTooLarge& e) {  // refused before allocating (docs/limits.md)
+    std::cerr << "sylva " << sub << ": error: " << e.what() << "\n";
+    return kInputError;
+  } catch (const sylva::SunMapsRefused& e) {  // the same for the fog's sun maps (docs/fog-map.md)
     std::cerr << "sylva " << sub << ": error: " << e.what() << "\n";
     return kInputError;
   } catch (const std::bad_alloc&) {

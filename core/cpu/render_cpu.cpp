@@ -699,7 +699,7 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
         mo.cancel = options.progress.cancel_flag();
         const uint64_t photons = std::min(options.fog.photons.value_or(scene.fog->photons), kSunMapTilePhotons);
         sun_maps.emplace(build_sun_maps_of(geometry, scene, photons, mo, &result.passes));
-        if (!*sun_maps) throw std::runtime_error(sun_maps->error().message);
+        if (!*sun_maps) throw SunMapsRefused(sun_maps->error().message);
         if ((*sun_maps)->cancelled) {
           result.cancelled = true;
           return result;

@@ -22,6 +22,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,12 @@ struct SunMapOptions {
   uint64_t memory_limit_bytes = kSunMapDefaultMemoryLimit;
   unsigned threads = 0;     // 0: every core
   const std::atomic<bool>* cancel = nullptr;
+};
+
+// What render_cpu throws when build_sun_maps refuses the scene's or the flags' maps (over
+// the memory bound, before anything was allocated): bad input, not a fault (exit 1).
+struct SunMapsRefused : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 struct SunMaps {

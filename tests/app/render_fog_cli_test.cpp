@@ -224,6 +224,19 @@ TEST(RenderFogCli, OnlyTheConeAndMapModesTraceSunPhotons) {
   }
 }
 
+TEST(RenderFogCli, SunMapsOverTheMemoryBoundAreBadInputAndNothingIsWritten) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, R"({"mode": "map", "top": 20, "photons": 20000})");
+  ProcessResult r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "cpu",
+                               "--fog-map-resolution", "65536", "--fog-map-directions", "64"});
+  EXPECT_EQ(r.exit_code, 1) << describe(r);
+  EXPECT_NE(r.err.find("sylva render: error: the sun maps would need"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("more than the limit of 64.0 MiB: lower the resolution or the disc directions"),
+            std::string::npos)
+      << describe(r);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("f.png")));
+}
+
 TEST(RenderFogCli, TheConeParametersAreTheFlagsOrTheAutomaticChoiceWithItsReport) {
   // --verbose prints the automatic choice's report (what it measured on random points,
   // core/cpu/photons.h AutoConeReport) or the parameters --cone-params gave.
