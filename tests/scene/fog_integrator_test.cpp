@@ -422,11 +422,12 @@ TEST(FogIntegrator, ShadowRaysStartOnlyWhereTheirSunRayMeetsTheCasters) {
 
 // ---- Mode map ----------------------------------------------------------------------------
 
-// The sun maps of the spheres: one per direction, every tile allocated, each texel the
-// height of the first sphere its sun ray meets (exact ray–sphere), over ±half metres
-// around `centre`.
-std::vector<SunDepthMap> sphere_maps(const std::vector<Sphere>& spheres, const std::vector<glm::dvec3>& directions,
-                                     const glm::dvec3& centre, double half, uint32_t size) {
+// Sun maps with every tile allocated, one per direction, over ±half metres around
+// `centre`: each texel the height `first_hit(c, s)` of the first surface met going down the
+// sun ray along s through the texel's centre c (on the plane of height 0), kNoPlant for none.
+template <class FirstHit>
+std::vector<SunDepthMap> exact_maps(const std::vector<glm::dvec3>& directions, const glm::dvec3& centre, double half,
+                                    uint32_t size, FirstHit&& first_hit) {
   std::vector<SunDepthMap> maps;
   for (const glm::dvec3& s : directions) {
     SunMapFrame f;
@@ -439,20 +440,39 @@ std::vector<SunDepthMap> sphere_maps(const std::vector<Sphere>& spheres, const s
       const uint32_t tile = map.tile_of_slot(k), tx = tile % tiles, ty = tile / tiles;
       float* h = map.slot_texels(k);
       for (uint32_t j = 0; j < SunDepthMap::kTile; ++j)
-        for (uint32_t i = 0; i < SunDepthMap::kTile; ++i) {
-          const glm::dvec3 c = map.texel_centre(tx * SunDepthMap::kTile + i, ty * SunDepthMap::kTile + j);
-          float best = SunDepthMap::kNoPlant;
-          for (const Sphere& sp : spheres) {  // the line c + λ·s meets the sphere at its largest λ
-            const glm::dvec3 w = c - sp.centre;
-            const double b = glm::dot(w, s), disc = b * b - (glm::dot(w, w) - sp.radius * sp.radius);
-            if (disc >= 0) best = std::max(best, static_cast<float>(-b + std::sqrt(disc)));
-          }
-          h[j * SunDepthMap::kTile + i] = best;
-        }
+        for (uint32_t i = 0; i < SunDepthMap::kTile; ++i)
+          h[j * SunDepthMap::kTile + i] =
+              first_hit(map.texel_centre(tx * SunDepthMap::kTile + i, ty * SunDepthMap::kTile + j), s);
       map.finish_tile(k);
     }
   }
   return maps;
+}
+
+// The sun maps of the spheres (exact ray–sphere).
+std::vector<SunDepthMap> sphere_maps(const std::vector<Sphere>& spheres, const std::vector<glm::dvec3>& directions,
+                                     const glm::dvec3& centre, double half, uint32_t size) {
+  return exact_maps(directions, centre, half, size, [&](const glm::dvec3& c, const glm::dvec3& s) {
+    float best = SunDepthMap::kNoPlant;
+    for (const Sphere& sp : spheres) {  // the line c + λ·s meets the sphere at its largest λ
+      const glm::dvec3 w = c - sp.centre;
+      const double b = glm::dot(w, s), disc = b * b - (glm::dot(w, w) - sp.radius * sp.radius);
+      if (disc >= 0) best = std::max(best, static_cast<float>(-b + std::sqrt(disc)));
+    }
+    return best;
+  });
+}
+
+// `k` directions spread evenly over a disc of angular radius `alpha` around unit `s` (the
+// Vogel spiral of core/cpu/sun_maps.h).
+std::vector<glm::dvec3> disc_directions(const glm::dvec3& s, double alpha, int k) {
+  const AxisFrame f = axis_frame(s);
+  std::vector<glm::dvec3> out;
+  for (int i = 0; i < k; ++i) {
+    const double theta = alpha * std::sqrt((i + 0.5) / k), phi = i * 2.399963229728653;
+    out.push_back(glm::normalize(std::cos(theta) * s + std::sin(theta) * (std::cos(phi) * f.e0 + std::sin(phi) * f.e1)));
+  }
+  return out;
 }
 
 FogRayResult run_map(const ShaftScene& s, std::span<const SunDepthMap> maps, const FogConeSource* cones = nullptr,
@@ -503,19 +523,9 @@ TEST(FogIntegrator, MapModeFollowsTheSunDiscWithSeveralMaps) {
   const glm::dvec3 centre = s.eye + 27.0 * s.direction + 6.0 * s.sun.direction;
   // The reference: many stratified disc points, each an exact (fine-probed) point-sun answer.
   const Estimate reference = estimate(s, FogMode::reference, 16, nullptr, 6);
-  // Directions spread evenly over the disc (the Vogel spiral of core/cpu/sun_maps.h).
-  auto directions = [&](int k) {
-    const AxisFrame f = axis_frame(s.sun.direction);
-    std::vector<glm::dvec3> out;
-    for (int i = 0; i < k; ++i) {
-      const double theta = 0.05 * std::sqrt((i + 0.5) / k), phi = i * 2.399963229728653;
-      out.push_back(glm::normalize(std::cos(theta) * s.sun.direction +
-                                   std::sin(theta) * (std::cos(phi) * f.e0 + std::sin(phi) * f.e1)));
-    }
-    return out;
-  };
-  const std::vector<SunDepthMap> one = sphere_maps(s.spheres, directions(1), centre, 32, 2048);
-  const std::vector<SunDepthMap> many = sphere_maps(s.spheres, directions(16), centre, 32, 2048);
+  const std::vector<SunDepthMap> one = sphere_maps(s.spheres, disc_directions(s.sun.direction, 0.05, 1), centre, 32, 2048);
+  const std::vector<SunDepthMap> many =
+      sphere_maps(s.spheres, disc_directions(s.sun.direction, 0.05, 16), centre, 32, 2048);
   const double err_one = std::abs(s.sun_of(run_map(s, one)) - reference.mean);
   const double err_many = std::abs(s.sun_of(run_map(s, many)) - reference.mean);
   EXPECT_LT(err_many, 0.01 * reference.mean);
@@ -662,43 +672,20 @@ TEST(FogIntegrator, EveryModeFindsTheShadowDepthOfAPostsPenumbra) {
   EXPECT_NEAR(mean_depth({FogMode::brute, 64}, 64), truth, 0.15 * truth);
   EXPECT_NEAR(mean_depth({FogMode::medium, 64}, 64), truth, 0.15 * truth);
   EXPECT_NEAR(mean_depth({FogMode::reference, 64}, 4), truth, 0.05 * truth);
-  // The map: 4 directions over the disc (Vogel, as core/cpu/sun_maps.h), 1024² over ±4 m.
-  std::vector<glm::dvec3> directions;
-  const AxisFrame f = axis_frame(s.sun.direction);
-  for (int k = 0; k < 4; ++k) {
-    const double theta = s.sun.angular_radius_rad * std::sqrt((k + 0.5) / 4), phi = k * 2.399963229728653;
-    directions.push_back(glm::normalize(std::cos(theta) * s.sun.direction +
-                                        std::sin(theta) * (std::cos(phi) * f.e0 + std::sin(phi) * f.e1)));
-  }
-  std::vector<SunDepthMap> maps;
-  for (const glm::dvec3& d : directions) {
-    SunMapFrame frame;
-    frame.centre = {0, 4, 0}, frame.to_sun = d, frame.half_extent_m = 4, frame.size = 1024;
-    const AxisFrame a = axis_frame(d);
-    frame.e0 = a.e0, frame.e1 = a.e1;
-    SunDepthMap& map = maps.emplace_back(frame, std::vector<uint8_t>(32 * 32, 1));
-    for (size_t k = 0; k < map.allocated_tiles(); ++k) {
-      const uint32_t tile = map.tile_of_slot(k), tx = tile % 32, ty = tile / 32;
-      float* h = map.slot_texels(k);
-      for (uint32_t j = 0; j < 32; ++j)
-        for (uint32_t i = 0; i < 32; ++i) {
-          // The first post surface down the sun ray through the texel, from 100 m up it.
-          const glm::dvec3 c = map.texel_centre(tx * 32 + i, ty * 32 + j);
-          const Ray down{c + 100.0 * d, -d};
-          double lo = 0, hi = 200;
-          if (!s.post.hit(down, lo, hi)) {
-            h[j * 32 + i] = SunDepthMap::kNoPlant;
-            continue;
-          }
-          for (int step = 0; step < 60; ++step) {  // the entry, by bisection on "hit before"
-            const double mid = 0.5 * (lo + hi);
-            (s.post.hit(down, 0, mid) ? hi : lo) = mid;
-          }
-          h[j * 32 + i] = static_cast<float>(100 - hi);
+  // The map: 4 directions over the disc, 1024² over ±4 m; a texel's height is the first
+  // post surface down its sun ray, found by bisection on "hit before" from 100 m up.
+  const std::vector<SunDepthMap> maps = exact_maps(
+      disc_directions(s.sun.direction, s.sun.angular_radius_rad, 4), {0, 4, 0}, 4, 1024,
+      [&](const glm::dvec3& c, const glm::dvec3& d) {
+        const Ray down{c + 100.0 * d, -d};
+        double lo = 0, hi = 200;
+        if (!s.post.hit(down, lo, hi)) return SunDepthMap::kNoPlant;
+        for (int step = 0; step < 60; ++step) {
+          const double mid = 0.5 * (lo + hi);
+          (s.post.hit(down, 0, mid) ? hi : lo) = mid;
         }
-      map.finish_tile(k);
-    }
-  }
+        return static_cast<float>(100 - hi);
+      });
   FogIntegratorOptions o(FogMode::map, 64);
   o.maps = maps;
   EXPECT_NEAR(mean_depth(o, 1), truth, 0.05 * truth);
