@@ -35,7 +35,6 @@ namespace sylva::cli {
 
 namespace {
 
-constexpr int kInterrupted = 130;  // 128 + SIGINT, the shell's convention
 constexpr uint32_t kMaxConeParam = 100000;  // --cone-params: any larger is a typo
 
 // Mesa's software rasterisers, by the GL_RENDERER string they report ("llvmpipe (LLVM
@@ -391,8 +390,11 @@ int run_render_frames(const RenderArgs& a) {
     if (range.all) range = {0, static_cast<uint64_t>(std::max<int64_t>(0, g->steps)), false};
     last_args.steps = static_cast<int64_t>(range.last);
   }
-  auto loaded = load_render_input(last_args, a.width, a.height, passes);
-  if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
+  auto loaded = load_render_input(last_args, a.width, a.height, passes, Progress(&g_interrupted));
+  if (auto* code = std::get_if<ExitCode>(&loaded)) {
+    if (*code == kInterrupted) std::cerr << "sylva render: interrupted while growing; nothing written\n";
+    return *code;
+  }
   Scene base = std::move(std::get<Scene>(loaded));
   apply_camera_flags(a.camera, base.camera);
   if (!growth && !base.animation)
@@ -476,8 +478,11 @@ int run_render_frames(const RenderArgs& a) {
       GrammarArgs step = a.grammar;
       step.steps = static_cast<int64_t>(f);
       std::vector<RenderPass> ignored;
-      auto grown = load_render_input(step, a.width, a.height, ignored);
-      if (auto* code = std::get_if<ExitCode>(&grown)) return *code;
+      auto grown = load_render_input(step, a.width, a.height, ignored, Progress(&g_interrupted));
+      if (auto* code = std::get_if<ExitCode>(&grown)) {
+        if (*code == kInterrupted) break;  // said below, with the frames kept
+        return *code;
+      }
       scene = std::move(std::get<Scene>(grown));
       scene.camera = base.camera;
       scene.ground = base.ground;
@@ -578,8 +583,11 @@ int run_render(const std::vector<std::string>& args) {
   SigintGuard sigint;
   g_interrupted.store(false);
   std::vector<RenderPass> passes;
-  auto loaded = load_render_input(a.grammar, a.width, a.height, passes);
-  if (auto* code = std::get_if<ExitCode>(&loaded)) return *code;
+  auto loaded = load_render_input(a.grammar, a.width, a.height, passes, Progress(&g_interrupted));
+  if (auto* code = std::get_if<ExitCode>(&loaded)) {
+    if (*code == kInterrupted) std::cerr << "sylva render: interrupted while growing; nothing written\n";
+    return *code;
+  }
   Scene scene = std::move(std::get<Scene>(loaded));
   apply_camera_flags(a.camera, scene.camera);
   if (auto problem = image_size_problem(scene.width, scene.height, a.spp)) {

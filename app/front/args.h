@@ -17,7 +17,8 @@
 
 namespace sylva::cli {
 
-enum ExitCode : int { kOk = 0, kInputError = 1, kUsageError = 2, kInternalError = 3 };
+// kInterrupted: 128 + SIGINT, the shell's convention for work stopped by Ctrl-C.
+enum ExitCode : int { kOk = 0, kInputError = 1, kUsageError = 2, kInternalError = 3, kInterrupted = 130 };
 
 // Thrown for usage errors; main() prints "sylva SUBCOMMAND: error: message" and exits 2.
 struct UsageError {

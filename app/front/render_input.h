@@ -22,8 +22,10 @@ bool is_grammar_input(const std::string& path);  // .lsys
 // Loads INPUT (grammar.grammar; -n/--seed/-D/--max-modules apply to a grammar) and grows
 // every plant; `width`/`height` override the scene's image size. Appends what it did to
 // `passes`. On failure prints the located error to stderr and returns the exit code.
+// `progress` reaches the derivation, interpretation and turtle (grow.h): cancelled (render's
+// SIGINT), it returns kInterrupted without a message — the caller says what was kept.
 std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std::optional<uint32_t> width,
                                                 std::optional<uint32_t> height,
-                                                std::vector<RenderPass>& passes);
+                                                std::vector<RenderPass>& passes, const Progress& progress = {});
 
 }  // namespace sylva::cli

@@ -11,6 +11,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -20,6 +21,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -161,6 +163,39 @@ std::shared_ptr<const lsys::Grammar> PyGrammar::with_defines(const std::map<std:
 
 namespace {
 
+// Ctrl-C during long work with the GIL released (issue 32): the work's Progress reports
+// (each derivation step, every 64 Ki modules, each turtle chunk: core/util/progress.h) take
+// the GIL and run Python's signal handlers; the first exception one raises (KeyboardInterrupt)
+// cancels the work and is raised again once it has stopped, so Ctrl-C lands within a step.
+class PythonInterrupt {
+ public:
+  PythonInterrupt() = default;
+  PythonInterrupt(const PythonInterrupt&) = delete;
+  PythonInterrupt& operator=(const PythonInterrupt&) = delete;
+
+  // A Progress for the work; this object must outlive it.
+  Progress progress() {
+    return Progress([this](double, std::string_view) { check(); }, &cancel_);
+  }
+  // With the GIL held: raises what a signal handler raised, if one did.
+  void raise_if_interrupted() {
+    if (error_) throw std::move(*error_);
+  }
+
+ private:
+  void check() {
+    if (cancel_.load(std::memory_order_relaxed)) return;
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) {
+      error_.emplace();  // takes the pending exception
+      cancel_.store(true);
+    }
+  }
+
+  std::atomic<bool> cancel_{false};
+  std::optional<py::error_already_set> error_;
+};
+
 lsys::DeriveOptions derive_options(const py::object& steps, const py::object& seed, uint64_t max_modules) {
   lsys::DeriveOptions options;
   options.steps = steps_from_python(steps);
@@ -172,8 +207,10 @@ lsys::DeriveOptions derive_options(const py::object& steps, const py::object& se
 
 Skeleton grammar_grow(const PyGrammar& self, const py::object& steps, const py::object& seed,
                       const py::object& defines_object, uint64_t max_modules) {
-  const lsys::DeriveOptions options = derive_options(steps, seed, max_modules);
+  lsys::DeriveOptions options = derive_options(steps, seed, max_modules);
   const std::map<std::string, double> defines = defines_from_python(defines_object);
+  PythonInterrupt interrupt;
+  options.progress = interrupt.progress();
   std::optional<sylva::Diagnostic> failure;
   std::optional<GrowResult> result;
   uint64_t still_expandable = 0;
@@ -194,6 +231,7 @@ Skeleton grammar_grow(const PyGrammar& self, const py::object& steps, const py::
       failure = e.diagnostic;
     }
   }
+  interrupt.raise_if_interrupted();
   if (failure) throw GrammarFailure(*failure);
   if (still_expandable != 0) {
     const std::string message = self.file + ": the interpretation stopped at maximum depth " +
@@ -206,8 +244,10 @@ Skeleton grammar_grow(const PyGrammar& self, const py::object& steps, const py::
 
 std::string grammar_derive(const PyGrammar& self, const py::object& steps, const py::object& seed,
                            const py::object& defines_object, uint64_t max_modules) {
-  const lsys::DeriveOptions options = derive_options(steps, seed, max_modules);
+  lsys::DeriveOptions options = derive_options(steps, seed, max_modules);
   const std::map<std::string, double> defines = defines_from_python(defines_object);
+  PythonInterrupt interrupt;
+  options.progress = interrupt.progress();
   std::optional<sylva::Diagnostic> failure;
   std::string text;
   {
@@ -223,6 +263,7 @@ std::string grammar_derive(const PyGrammar& self, const py::object& steps, const
       failure = e.diagnostic;
     }
   }
+  interrupt.raise_if_interrupted();
   if (failure) throw GrammarFailure(*failure);
   return text;
 }

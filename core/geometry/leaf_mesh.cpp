@@ -1,5 +1,6 @@
 // leaf_mesh.cpp — see leaf_mesh.h. Ear clipping: D. Eberly, "Triangulation by Ear
-// Clipping" (Geometric Tools, 2002), O(n²) per polygon, ample for a turtle's leaves.
+// Clipping" (Geometric Tools, 2002), with the reflex vertices in a k-d tree (as mapbox's
+// earcut keeps them on a z-order curve) so that an ear asks only its neighbourhood.
 #include "core/geometry/leaf_mesh.h"
 
 #include <algorithm>
@@ -40,7 +41,107 @@ bool in_triangle(const Point2& p, const Point2& a, const Point2& b, const Point2
 
 }  // namespace
 
-std::vector<uint32_t> triangulate_polygon(std::span<const std::array<double, 3>> vertices) {
+namespace {
+
+// The polygon's reflex vertices — bending inward by however little: a vertex too flat to
+// make an ear still blocks one (the only ones that can lie in an ear of a simple polygon:
+// Eberly §2; clipping only ever makes a vertex more convex) in a static 2D k-d tree with a
+// count of the live ones below each node: an ear asks the tree for the live vertices in its
+// box, O(log n + k), and a vertex that is clipped or has turned convex leaves it in O(log n).
+class ReflexTree {
+ public:
+  ReflexTree(const std::vector<Point2>& p, std::vector<uint32_t> members) : p_(p), items_(std::move(members)) {
+    size_t nodes = 1;
+    while (nodes < 2 * std::max<size_t>(items_.size(), 1) / kLeaf + 2) nodes *= 2;
+    nodes_.resize(2 * nodes);
+    slot_.assign(p.size(), kAbsent);
+    if (!items_.empty()) build(0, 0, items_.size(), 0);
+    for (size_t i = 0; i < items_.size(); ++i) slot_[items_[i]] = static_cast<uint32_t>(i);
+  }
+
+  // Calls test(v) for each live member v inside the box [lo, hi] until one returns true; a
+  // member for which live(v) is false is removed as met.
+  template <class Live, class Test>
+  bool any_in(const Point2& lo, const Point2& hi, Live&& live, Test&& test) {
+    return any_in(0, 0, items_.size(), lo, hi, live, test);
+  }
+
+  bool contains(uint32_t v) const { return slot_[v] != kAbsent; }
+
+  void remove(uint32_t v) {
+    if (slot_[v] == kAbsent) return;
+    const size_t at = slot_[v];
+    slot_[v] = kAbsent;
+    size_t node = 0, begin = 0, end = items_.size();
+    for (;;) {
+      --nodes_[node].live;
+      if (end - begin <= kLeaf) return;
+      const size_t mid = (begin + end) / 2;
+      if (at < mid) {
+        end = mid, node = 2 * node + 1;
+      } else {
+        begin = mid, node = 2 * node + 2;
+      }
+    }
+  }
+
+ private:
+  static constexpr size_t kLeaf = 8;
+  static constexpr uint32_t kAbsent = UINT32_MAX;
+  struct Node {
+    Point2 lo{}, hi{};
+    uint32_t live = 0;
+  };
+
+  void build(size_t node, size_t begin, size_t end, int axis) {
+    Node& n = nodes_[node];
+    n.live = static_cast<uint32_t>(end - begin);
+    n.lo = n.hi = p_[items_[begin]];
+    for (size_t i = begin; i < end; ++i) {
+      const Point2& q = p_[items_[i]];
+      n.lo = {std::min(n.lo.x, q.x), std::min(n.lo.y, q.y)};
+      n.hi = {std::max(n.hi.x, q.x), std::max(n.hi.y, q.y)};
+    }
+    if (end - begin <= kLeaf) return;
+    const size_t mid = (begin + end) / 2;
+    auto first = items_.begin();
+    std::nth_element(first + static_cast<std::ptrdiff_t>(begin), first + static_cast<std::ptrdiff_t>(mid),
+                     first + static_cast<std::ptrdiff_t>(end), [&](uint32_t a, uint32_t b) {
+                       return axis == 0 ? p_[a].x < p_[b].x : p_[a].y < p_[b].y;
+                     });
+    build(2 * node + 1, begin, mid, 1 - axis);
+    build(2 * node + 2, mid, end, 1 - axis);
+  }
+
+  template <class Live, class Test>
+  bool any_in(size_t node, size_t begin, size_t end, const Point2& lo, const Point2& hi, Live& live, Test& test) {
+    const Node& n = nodes_[node];
+    if (n.live == 0 || n.hi.x < lo.x || n.lo.x > hi.x || n.hi.y < lo.y || n.lo.y > hi.y) return false;
+    if (end - begin <= kLeaf) {
+      for (size_t i = begin; i < end; ++i) {
+        const uint32_t v = items_[i];
+        if (slot_[v] == kAbsent) continue;
+        if (!live(v)) {
+          remove(v);
+          continue;
+        }
+        if (test(v)) return true;
+      }
+      return false;
+    }
+    const size_t mid = (begin + end) / 2;
+    return any_in(2 * node + 1, begin, mid, lo, hi, live, test) || any_in(2 * node + 2, mid, end, lo, hi, live, test);
+  }
+
+  const std::vector<Point2>& p_;
+  std::vector<uint32_t> items_;  // the members, in k-d order
+  std::vector<Node> nodes_;      // heap order: node k's children are 2k + 1 and 2k + 2
+  std::vector<uint32_t> slot_;   // per vertex: its place in items_, kAbsent when not (or no longer) in
+};
+
+}  // namespace
+
+std::vector<uint32_t> triangulate_polygon(std::span<const std::array<double, 3>> vertices, TriangulationWork* work) {
   std::vector<uint32_t> out;
   const size_t n = vertices.size();
   if (n < 3) return out;
@@ -59,37 +160,84 @@ std::vector<uint32_t> triangulate_polygon(std::span<const std::array<double, 3>>
     extent = std::max({extent, std::abs(p[v].x), std::abs(p[v].y)});
   }
   const double flat = 1e-12 * extent * extent;  // an ear with less (doubled) area has none
-  std::vector<uint32_t> ring(n);
-  for (size_t v = 0; v < n; ++v) ring[v] = static_cast<uint32_t>(v);
-  while (ring.size() > 3) {
-    const size_t m = ring.size();
-    bool clipped = false;
-    for (size_t i = 0; i < m && !clipped; ++i) {
-      const uint32_t a = ring[(i + m - 1) % m], b = ring[i], c = ring[(i + 1) % m];
-      const double area = orient(p[a], p[b], p[c]);
-      if (std::abs(area) <= flat) {  // no area: drop the vertex, emit nothing
-        ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(i));
-        clipped = true;
-        break;
+  // The ring as a doubly linked list; `area` is a vertex's doubled turn with its neighbours.
+  std::vector<uint32_t> prev(n), next(n);
+  for (uint32_t v = 0; v < n; ++v) {
+    prev[v] = static_cast<uint32_t>((v + n - 1) % n);
+    next[v] = static_cast<uint32_t>((v + 1) % n);
+  }
+  std::vector<char> alive(n, 1);
+  auto area = [&](uint32_t v) { return orient(p[prev[v]], p[v], p[next[v]]); };
+  std::vector<uint32_t> reflex;
+  for (uint32_t v = 0; v < n; ++v)
+    if (area(v) < 0) reflex.push_back(v);
+  ReflexTree tree(p, std::move(reflex));
+  // Vertices that turn reflex later: only next to a dropped vertex without area (|turn| ≤
+  // flat) that bent inward, or in a polygon that is not simple; few, so tested one by one.
+  std::vector<uint32_t> late;
+  TriangulationWork count;
+  // No reflex vertex of the ring other than a, b, c in the counter-clockwise triangle abc.
+  auto empty = [&](uint32_t a, uint32_t b, uint32_t c) {
+    const Point2 lo{std::min({p[a].x, p[b].x, p[c].x}), std::min({p[a].y, p[b].y, p[c].y})};
+    const Point2 hi{std::max({p[a].x, p[b].x, p[c].x}), std::max({p[a].y, p[b].y, p[c].y})};
+    auto live = [&](uint32_t q) { return alive[q] && area(q) < 0; };
+    auto inside = [&](uint32_t q) {
+      ++count.point_tests;
+      return q != a && q != b && q != c && in_triangle(p[q], p[a], p[b], p[c]);
+    };
+    for (size_t i = 0; i < late.size();) {
+      if (!live(late[i])) {
+        late[i] = late.back(), late.pop_back();
+        continue;
       }
-      if (area < 0) continue;  // reflex
-      bool empty = true;
-      for (size_t k = 0; k < m && empty; ++k) {
-        const uint32_t q = ring[k];
-        if (q == a || q == b || q == c) continue;
-        empty = !in_triangle(p[q], p[a], p[b], p[c]);
-      }
-      if (!empty) continue;
-      out.insert(out.end(), {a, b, c});
-      ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(i));
-      clipped = true;
+      if (inside(late[i++])) return false;
     }
-    if (!clipped) {  // not simple: finish as a fan
-      for (size_t i = 1; i + 1 < ring.size(); ++i) out.insert(out.end(), {ring[0], ring[i], ring[i + 1]});
+    return !tree.any_in(lo, hi, live, inside);
+  };
+  auto unlink = [&](uint32_t v) {
+    const uint32_t a = prev[v], c = next[v];
+    next[a] = c, prev[c] = a, alive[v] = 0;
+    tree.remove(v);
+    for (uint32_t u : {a, c})
+      if (area(u) < 0 && !tree.contains(u) && std::find(late.begin(), late.end(), u) == late.end())
+        late.push_back(u);
+  };
+  // Walk the ring clipping ears as they come (Eberly's ear list, found lazily); a full turn
+  // without a clip means no ear is left: not simple.
+  constexpr uint32_t kNone = UINT32_MAX;
+  size_t m = n, since = 0;
+  uint32_t v = 0, skipped = kNone;
+  while (m > 3) {
+    if (since >= m) {  // not simple: finish as a fan
+      for (uint32_t w = next[v]; next[w] != v; w = next[w]) out.insert(out.end(), {v, w, next[w]});
+      if (work) *work = count;
       return out;
     }
+    ++count.ear_tests;
+    const uint32_t a = prev[v], c = next[v];
+    const double turn = orient(p[a], p[v], p[c]);
+    if (std::abs(turn) <= flat) {  // no area: drop the vertex, emit nothing
+      unlink(v);
+      v = c, skipped = kNone;
+    } else if (turn > 0 && empty(a, v, c)) {
+      out.insert(out.end(), {a, v, c});
+      unlink(v);
+      // Try past c first (as earcut does): a convex run is then halved pass by pass into
+      // triangles of fair shape, not fanned from one vertex into slivers. Where that is no
+      // ear, c is next (a strip is zipped up from its end, not walked round once per ear).
+      skipped = c, v = next[c];
+    } else if (skipped != kNone) {
+      v = skipped, skipped = kNone;
+      continue;
+    } else {
+      v = c, ++since;
+      continue;
+    }
+    --m, since = 0;
   }
-  if (std::abs(orient(p[ring[0]], p[ring[1]], p[ring[2]])) > flat) out.insert(out.end(), {ring[0], ring[1], ring[2]});
+  const uint32_t a = prev[v], c = next[v];
+  if (std::abs(orient(p[a], p[v], p[c])) > flat) out.insert(out.end(), {a, v, c});
+  if (work) *work = count;
   return out;
 }
 

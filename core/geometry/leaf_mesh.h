@@ -30,7 +30,16 @@ glm::dvec3 polygon_newell_normal(std::span<const std::array<double, 3>> vertices
 // clipping", 2002) in the plane of the Newell normal. Ears without area (repeated or
 // collinear vertices) are clipped without a triangle; a polygon that is not simple (where
 // no ear is left) is finished as a fan. Empty for fewer than 3 vertices or no area.
-std::vector<uint32_t> triangulate_polygon(std::span<const std::array<double, 3>> vertices);
+// Cost: the ring is walked clipping ears as they come, and an ear is tested only against the
+// reflex vertices in its box, found in a k-d tree — O(n log n) for a turtle's leaves, convex
+// or toothed (issue 32: a 524,288-vertex leaf had taken minutes); `work`, when given,
+// receives the counts (tests bound them).
+struct TriangulationWork {
+  uint64_t ear_tests = 0;    // vertices tried as an ear
+  uint64_t point_tests = 0;  // reflex vertices in an ear's box tested against it
+};
+std::vector<uint32_t> triangulate_polygon(std::span<const std::array<double, 3>> vertices,
+                                          TriangulationWork* work = nullptr);
 
 // A leaf's texture coordinates (docs/leaves.md "Texture coordinates"), one (u, v) per
 // vertex: v runs from the petiole (vertex 0, where the turtle stood at `{`) toward the tip

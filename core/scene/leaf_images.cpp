@@ -4,8 +4,11 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
+#include <tuple>
 
 #include "core/util/color.h"
 #include "core/util/limits.h"
@@ -49,32 +52,66 @@ Expected<Image8> read_image8(const std::string& path, const std::string& role) {
   return image;
 }
 
-// Bilinear, clamped (GL_LINEAR + GL_CLAMP_TO_EDGE) sample of channel c of `image` at the
-// continuous texel position (x, y) with texel centres at integers, in [0, 1].
-double bilinear(const Image8& image, int c, double x, double y) {
-  const double fx = std::floor(x), fy = std::floor(y);
-  const double ax = x - fx, ay = y - fy;
-  auto at = [&](double i, double j) {
-    const int64_t xi = std::clamp<int64_t>(static_cast<int64_t>(i), 0, image.width - 1);
-    const int64_t yj = std::clamp<int64_t>(static_cast<int64_t>(j), 0, image.height - 1);
-    return image.texels[(static_cast<size_t>(yj) * image.width + static_cast<size_t>(xi)) * image.channels +
-                        static_cast<size_t>(c)] /
-           255.0;
-  };
-  return (1 - ay) * ((1 - ax) * at(fx, fy) + ax * at(fx + 1, fy)) + ay * ((1 - ax) * at(fx, fy + 1) + ax * at(fx + 1, fy + 1));
-}
+// `image` resampled onto a width × height layer: channel c at layer texel (x, y) is the
+// texel itself at the same size, else bilinear, clamped (GL_LINEAR + GL_CLAMP_TO_EDGE)
+// between the four image texels around the layer texel's centre mapped into the image
+// (texel centres at integers). The weights of each column and row are found once.
+class Resampler {
+ public:
+  Resampler(const Image8& image, uint32_t width, uint32_t height)
+      : image_(image), same_(image.width == width && image.height == height) {
+    if (same_) return;
+    columns_ = axis(image.width, width);
+    rows_ = axis(image.height, height);
+  }
 
-// Channel c of `image` at texel (x, y) of a width × height layer: the texel itself at the
-// same size, else the image resampled bilinearly (its texel centres mapped onto the layer's).
-double resampled(const Image8& image, int c, uint32_t x, uint32_t y, uint32_t width, uint32_t height) {
-  if (image.width == width && image.height == height)
-    return image.texels[(size_t{y} * width + x) * image.channels + static_cast<size_t>(c)] / 255.0;
-  return bilinear(image, c, (x + 0.5) * image.width / width - 0.5, (y + 0.5) * image.height / height - 0.5);
-}
+  double at(int c, uint32_t x, uint32_t y) const {
+    if (same_) return texel(c, x, y) / 255.0;
+    const Tap &u = columns_[x], &v = rows_[y];
+    return ((1 - v.weight) * ((1 - u.weight) * texel(c, u.lo, v.lo) + u.weight * texel(c, u.hi, v.lo)) +
+            v.weight * ((1 - u.weight) * texel(c, u.lo, v.hi) + u.weight * texel(c, u.hi, v.hi))) /
+           255.0;
+  }
+
+ private:
+  struct Tap {
+    uint32_t lo = 0, hi = 0;  // the clamped texels either side
+    double weight = 0;        // of `hi`
+  };
+  // Layer texel i's centre (i + ½) · source / layer − ½ in the image, for i < layer.
+  static std::vector<Tap> axis(uint32_t source, uint32_t layer) {
+    std::vector<Tap> taps(layer);
+    for (uint32_t i = 0; i < layer; ++i) {
+      const double p = (i + 0.5) * source / layer - 0.5, f = std::floor(p);
+      auto clamped = [&](double t) {
+        return static_cast<uint32_t>(std::clamp<int64_t>(static_cast<int64_t>(t), 0, int64_t{source} - 1));
+      };
+      taps[i] = {clamped(f), clamped(f + 1), p - f};
+    }
+    return taps;
+  }
+  double texel(int c, uint32_t x, uint32_t y) const {
+    return image_.texels[(size_t{y} * image_.width + x) * static_cast<size_t>(image_.channels) + static_cast<size_t>(c)];
+  }
+
+  const Image8& image_;
+  bool same_;
+  std::vector<Tap> columns_, rows_;
+};
 
 uint8_t to_byte(double v) { return static_cast<uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255)); }
 
 }  // namespace
+
+std::pair<uint32_t, uint32_t> leaf_layer_size(uint32_t width, uint32_t height, size_t layers) {
+  if (width == 0 || height == 0) return {width, height};
+  const double texels = static_cast<double>(width) * height * static_cast<double>(std::max<size_t>(layers, 1));
+  const double scale = std::min({1.0, static_cast<double>(kMaxLeafLayerSide) / width, static_cast<double>(kMaxLeafLayerSide) / height,
+                                 std::sqrt(static_cast<double>(kMaxLeafLayerTexels) / texels)});
+  if (scale >= 1) return {width, height};
+  auto side = [&](uint32_t s) { return std::max<uint32_t>(1, static_cast<uint32_t>(std::floor(s * scale))); };
+  return {side(width), side(height)};
+}
 
 Expected<std::shared_ptr<const LeafImages>> LeafImages::load(const std::map<uint32_t, SceneMaterial>& table) {
   auto out = std::make_shared<LeafImages>();
@@ -93,10 +130,16 @@ Expected<std::shared_ptr<const LeafImages>> LeafImages::load(const std::map<uint
     if (m.alpha_image)
       if (Status s = read(*m.alpha_image, "alpha"); !s) return std::move(s.error());
   }
+  uint32_t widest = 0, tallest = 0;
   for (const auto& [path, image] : files) {
-    out->width_ = std::max(out->width_, image.width);
-    out->height_ = std::max(out->height_, image.height);
+    widest = std::max(widest, image.width);
+    tallest = std::max(tallest, image.height);
   }
+  const size_t layers = static_cast<size_t>(std::count_if(
+      table.begin(), table.end(), [](const auto& entry) { return entry.second.albedo_image || entry.second.alpha_image; }));
+  std::tie(out->width_, out->height_) = leaf_layer_size(widest, tallest, layers);
+  std::array<double, 256> linear;  // each encoded byte decoded
+  for (size_t b = 0; b < linear.size(); ++b) linear[b] = srgb_to_linear(static_cast<double>(b) / 255.0);
   for (const auto& [index, m] : table) {
     if (!m.albedo_image && !m.alpha_image) continue;
     const Image8* albedo = m.albedo_image ? &files.at(*m.albedo_image) : nullptr;
@@ -109,6 +152,9 @@ Expected<std::shared_ptr<const LeafImages>> LeafImages::load(const std::map<uint
     layer.albedo = albedo != nullptr;
     layer.cutout = a_image != nullptr;
     const uint32_t w = out->width_, h = out->height_;
+    const std::optional<Resampler> albedo_at = albedo ? std::optional<Resampler>(std::in_place, *albedo, w, h) : std::nullopt;
+    const std::optional<Resampler> alpha_at =
+        a_image ? std::optional<Resampler>(std::in_place, *a_image, w, h) : std::nullopt;
     layer.rgba.resize(size_t{w} * h * 4);
     glm::dvec3 sum(0);
     double opaque = 0;
@@ -118,11 +164,11 @@ Expected<std::shared_ptr<const LeafImages>> LeafImages::load(const std::map<uint
         for (int c = 0; c < 3; ++c) {
           // A gray albedo gives gray; a gray + alpha image's colour is its first channel.
           const int channel = !albedo ? 0 : albedo->channels >= 3 ? c : 0;
-          t[c] = albedo ? to_byte(resampled(*albedo, channel, x, y, w, h)) : 255;
+          t[c] = albedo ? to_byte(albedo_at->at(channel, x, y)) : 255;
         }
-        t[3] = a_image ? to_byte(resampled(*a_image, a_channel, x, y, w, h)) : 255;
+        t[3] = a_image ? to_byte(alpha_at->at(a_channel, x, y)) : 255;
         if (t[3] >= 128) {
-          sum += glm::dvec3(srgb_to_linear(t[0] / 255.0), srgb_to_linear(t[1] / 255.0), srgb_to_linear(t[2] / 255.0));
+          sum += glm::dvec3(linear[t[0]], linear[t[1]], linear[t[2]]);
           opaque += 1;
         }
       }

@@ -10,7 +10,10 @@
 // the albedo image's own alpha channel; 255 (opaque) without either. Every layer of a
 // scene has one size, the largest width and the largest height among its images (a smaller
 // image is resampled bilinearly, as sample() reads), so the GL renderer holds them in one
-// 2D array texture.
+// 2D array texture — bounded (docs/limits.md): each side at most kMaxLeafLayerSide and all
+// layers together at most kMaxLeafLayerTexels, both sides scaled down by one factor where
+// the largest sizes would exceed that (a 65536×1 and a 1×65536 image would otherwise merge
+// into 4 G texels), the images then resampled onto the smaller layer.
 //
 // Lookup (sample): (u, v) a leaf's texture coordinates (leaf_mesh.h leaf_uvs: v = 0 at the
 // petiole, the image's bottom row); texel (x, y) with x = u·width − ½, y = (1 − v)·height − ½,
@@ -35,6 +38,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -45,6 +49,16 @@
 namespace sylva {
 
 inline constexpr double kLeafAlphaCutoff = 0.5;
+
+// The merged layers' bounds: a side (OpenGL 4.5's least GL_MAX_TEXTURE_SIZE), and the
+// texels of all layers together (2^26: 256 MiB of RGBA8, eight 2896² layers).
+inline constexpr uint32_t kMaxLeafLayerSide = 16384;
+inline constexpr uint64_t kMaxLeafLayerTexels = uint64_t{1} << 26;
+
+// The size of `layers` merged layers whose images are at most `width` × `height` (the
+// largest width and the largest height): that size, or both sides scaled down by one
+// factor (each at least 1) to keep within the bounds above.
+std::pair<uint32_t, uint32_t> leaf_layer_size(uint32_t width, uint32_t height, size_t layers);
 
 class LeafImages {
  public:

@@ -123,4 +123,24 @@ TEST(OutputDamage, ASignalDuringTheVideoStopsFfmpegAndLeavesNoTemporary) {
   }
 }
 
+// Ctrl-C while a grammar derives (issue 32, item 12): the derivation polls render's SIGINT
+// flag, so render stops within a step, says so and writes nothing, with status 130. The
+// grammar derives ~10^6 modules for 100,000 steps — hours. (Before: the derivation ran
+// to its end before the render saw the flag.) SIGINT is sent until sylva ends: a
+// background job starts with SIGINT ignored until render sets its handler.
+TEST(OutputDamage, CtrlCWhileTheGrammarDerivesStopsTheRenderWithinAStep) {
+  TempDir dir;
+  const std::string grammar = dir.write("long.lsys",
+                                        "derivation length: 100000\naxiom: A(0)\nproductions:\n"
+                                        "p1: A(n) : n < 20 -> A(n+1)A(n+1)\np2: A(n) : n >= 20 -> A(n)\n");
+  const std::string script =
+      "\"$0\" render \"$1/long.lsys\" -o \"$1/x.png\" --width 32 --height 24 --spp 1 --backend cpu 2>\"$1/err\" & "
+      "sylva=$!\nsleep 1\nwhile kill -INT $sylva 2>/dev/null; do sleep 0.5; done\nwait $sylva; echo \"status $?\"\n";
+  ProcessResult r = run_process({"bash", "-c", script, SYLVA_BINARY, dir.path().string()});
+  const std::string err = read_file(dir.file("err"));
+  EXPECT_NE(r.out.find("status 130"), std::string::npos) << describe(r) << err;
+  EXPECT_NE(err.find("sylva render: interrupted while growing; nothing written"), std::string::npos) << err;
+  EXPECT_EQ(list_dir(dir.path()), (std::vector<std::string>{"err", "long.lsys"}));
+}
+
 }  // namespace

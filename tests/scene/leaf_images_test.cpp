@@ -126,5 +126,49 @@ TEST(LeafImages, TheSceneKeysNameTheImagesRelativeToTheSceneAndWriteBackTheSame)
   EXPECT_EQ(again->materials, s->materials);
 }
 
+// Hostile sizes (issue 32, item 9): a 65536×1 and a 1×65536 image — a few hundred bytes each —
+// once merged into a 65536² layer per material (32 GiB). The layers are bounded and the
+// images keep their content, resampled onto the smaller layer.
+TEST(LeafImages, ALongAndATallImageMergeIntoBoundedLayersThatKeepTheirContent) {
+  test::TempFolder dir;
+  // Long: left half red, right half green. Tall: top half blue, bottom half white.
+  test::write_rgba_png(dir.file("long.png"), 65536, 1, [](uint32_t x, uint32_t) -> std::array<float, 4> {
+    return x < 32768 ? std::array<float, 4>{1, 0, 0, 1} : std::array<float, 4>{0, 1, 0, 1};
+  });
+  test::write_rgba_png(dir.file("tall.png"), 1, 65536, [](uint32_t, uint32_t y) -> std::array<float, 4> {
+    return y < 32768 ? std::array<float, 4>{0, 0, 1, 1} : std::array<float, 4>{1, 1, 1, 1};
+  });
+  std::map<uint32_t, SceneMaterial> table;
+  table[1].albedo_image = dir.file("long.png");
+  table[2].albedo_image = dir.file("tall.png");
+  auto loaded = LeafImages::load(table);
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  const LeafImages& images = **loaded;
+  EXPECT_LE(images.width(), kMaxLeafLayerSide);
+  EXPECT_LE(images.height(), kMaxLeafLayerSide);
+  EXPECT_LE(uint64_t{images.width()} * images.height() * images.layer_count(), kMaxLeafLayerTexels);
+  EXPECT_EQ(images.width(), images.height());  // one factor for both sides
+  EXPECT_GE(images.width(), 4096u);
+  EXPECT_NEAR(images.albedo(1, 0.25, 0.5).x, 1, 1e-12);
+  EXPECT_NEAR(images.albedo(1, 0.75, 0.5).y, 1, 1e-12);
+  EXPECT_NEAR(images.albedo(1, 0.75, 0.5).x, 0, 1e-12);
+  EXPECT_NEAR(images.albedo(2, 0.5, 0.75).z, 1, 1e-12);  // v = 0.75: the top half
+  EXPECT_NEAR(images.albedo(2, 0.5, 0.75).x, 0, 1e-12);
+  EXPECT_NEAR(images.albedo(2, 0.5, 0.25).x, 1, 1e-12);
+  EXPECT_NEAR(images.mean_albedo(1).x, 0.5, 1e-3);
+}
+
+TEST(LeafImages, TheLayerSizeIsKeptWithinItsBoundsByOneFactor) {
+  EXPECT_EQ(leaf_layer_size(4, 2, 3), std::make_pair(4u, 2u));
+  EXPECT_EQ(leaf_layer_size(4096, 4096, 4), std::make_pair(4096u, 4096u));  // 2^26 exactly
+  EXPECT_EQ(leaf_layer_size(8192, 8192, 4), std::make_pair(4096u, 4096u));
+  EXPECT_EQ(leaf_layer_size(65536, 1, 1), std::make_pair(16384u, 1u));     // the side bound
+  EXPECT_EQ(leaf_layer_size(1, 65536, 1), std::make_pair(1u, 16384u));
+  const auto [w, h] = leaf_layer_size(12000, 7000, 5);
+  EXPECT_LE(uint64_t{w} * h * 5, kMaxLeafLayerTexels);
+  EXPECT_GT(uint64_t{w + 1} * (h + 1) * 5, kMaxLeafLayerTexels);  // not smaller than it must be
+  EXPECT_NEAR(double(w) / h, 12000.0 / 7000.0, 1e-3);
+}
+
 }  // namespace
 }  // namespace sylva
