@@ -35,11 +35,25 @@ struct ParseFailure {
   throw ParseFailure{loc, std::move(message)};
 }
 
-// One logical line (continuations joined) with the source place of every byte; locs has
-// one extra entry for the position just past the end.
+// One logical line (continuations joined) and where its bytes come from: one piece per
+// physical line (12 bytes each, not a place per byte: issue 32's 128 MB of blank lines).
 struct LogicalLine {
+  struct Piece {
+    size_t offset = 0;  // text[offset, next piece's offset) is from ...
+    uint32_t line = 0;  // ... this physical line, from this column on
+    uint32_t column = 1;
+  };
   std::string text;
-  std::vector<SourceLoc> locs;
+  std::vector<Piece> pieces;  // by offset; at least one
+
+  // The source place of text[p]; text.size() (or more): the place just past the end.
+  SourceLoc loc(size_t p) const {
+    p = std::min(p, text.size());
+    auto after = std::upper_bound(pieces.begin(), pieces.end(), p,
+                                  [](size_t v, const Piece& piece) { return v < piece.offset; });
+    const Piece& piece = *(after - 1);
+    return {piece.line, static_cast<uint32_t>(piece.column + (p - piece.offset))};
+  }
 };
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
@@ -166,18 +180,22 @@ std::vector<LogicalLine> logical_lines(const std::string& text) {
     }
     size_t keep = phys.size();
     while (keep > 0 && is_space(phys[keep - 1])) --keep;
+    if (!continuing && keep == 0) {  // blank: no logical line (every pass skips them)
+      pos = nl + 1;
+      continue;
+    }
     bool continues = keep > 0 && phys[keep - 1] == '\\';
     size_t take = continues ? keep - 1 : phys.size();
-    current.text.reserve(current.text.size() + take);
-    current.locs.reserve(current.locs.size() + take + 1);
-    for (size_t k = 0; k < take; ++k) {
-      current.text += phys[k];
-      current.locs.push_back({line_no, static_cast<uint32_t>(k + 1)});
-    }
+    // Appended with the string's own geometric growth: reserving exactly what each
+    // physical line adds made 200,000 continuations quadratic (issue 32, item 11).
+    current.pieces.push_back({current.text.size(), line_no, 1});
+    const size_t capacity = current.text.capacity();
+    current.text.append(phys.substr(0, take));
+    if (current.text.capacity() != capacity) parse_work().line_bytes_copied += current.text.size() - take;
     if (continues && nl < text.size()) {
       continuing = true;
     } else {
-      current.locs.push_back({line_no, static_cast<uint32_t>(take + 1)});
+      ++parse_work().logical_lines;
       lines.push_back(std::move(current));
       current = LogicalLine{};
       continuing = false;
@@ -193,8 +211,8 @@ struct Cursor {
   size_t pos;
   size_t end;
 
-  SourceLoc loc() const { return line->locs[std::min(pos, line->text.size())]; }
-  SourceLoc loc_at(size_t p) const { return line->locs[std::min(p, line->text.size())]; }
+  SourceLoc loc() const { return line->loc(pos); }
+  SourceLoc loc_at(size_t p) const { return line->loc(p); }
   bool at_end() const { return pos >= end; }
   char peek(size_t ahead = 0) const {
     return pos + ahead < end ? line->text[pos + ahead] : '\0';
@@ -745,8 +763,9 @@ void Parser::parse_define(const LogicalLine& line) {
   Func fn;
   if (name == "pi" || find_func(name, &fn))
     fail(loc, "#define cannot redefine the built-in '" + name + "'");
-  for (const Define& d : g_.defines)
-    if (d.name == name) fail(loc, "'" + name + "' is defined twice (first at line " + std::to_string(d.loc.line) + ")");
+  if (define_values_.count(name))  // a hash look-up: 400,000 defines were quadratic (issue 32)
+    for (const Define& d : g_.defines)
+      if (++parse_work().define_compares, d.name == name) fail(loc, "'" + name + "' is defined twice (first at line " + std::to_string(d.loc.line) + ")");
   Define d{name, 0, loc, false};
   auto ov = options_.define_overrides.find(name);
   c.skip_spaces();
@@ -1151,7 +1170,12 @@ Word Parser::parse_word_line(const LogicalLine& line) {
 
 }  // namespace
 
-std::string Grammar::source_line(uint32_t line) const {
+ParseWork& parse_work() {
+  thread_local ParseWork work;
+  return work;
+}
+
+std::string_view Grammar::source_line(uint32_t line) const {
   if (!text || line == 0) return {};
   size_t pos = 0;
   for (uint32_t l = 1; l < line; ++l) {
@@ -1160,22 +1184,25 @@ std::string Grammar::source_line(uint32_t line) const {
     ++pos;
   }
   size_t end = text->find('\n', pos);
-  std::string s = text->substr(pos, end == std::string::npos ? std::string::npos : end - pos);
+  std::string_view s = std::string_view(*text).substr(pos, end == std::string::npos ? std::string::npos : end - pos);
   // The line ends at its CR too (CRLF, or the lone CR an error points at).
-  if (size_t cr = s.find('\r'); cr != std::string::npos) s.resize(cr);
+  if (size_t cr = s.find('\r'); cr != std::string_view::npos) s = s.substr(0, cr);
   return s;
 }
 
 Diagnostic Grammar::error_at(SourceLoc loc, std::string message) const {
   Diagnostic d = diagnostic_at(file, loc, std::move(message));
-  if (loc.line) d.source_line = source_line(loc.line);
+  if (loc.line) set_source_line(d, source_line(loc.line));
   return d;
 }
 
-Expected<Grammar> parse_grammar(std::string_view text, std::string file, const ParseOptions& options) {
+namespace {
+
+Expected<Grammar> parse_grammar_text(std::shared_ptr<const std::string> text, std::string file,
+                                     const ParseOptions& options) {
   Grammar g;
   g.file = std::move(file);
-  g.text = std::make_shared<const std::string>(text);
+  g.text = std::move(text);
   try {
     Parser parser(g, options);
     parser.parse(*g.text);
@@ -1185,17 +1212,24 @@ Expected<Grammar> parse_grammar(std::string_view text, std::string file, const P
   return g;
 }
 
+}  // namespace
+
+Expected<Grammar> parse_grammar(std::string_view text, std::string file, const ParseOptions& options) {
+  return parse_grammar_text(std::make_shared<const std::string>(text), std::move(file), options);
+}
+
 Expected<Grammar> load_grammar(const std::string& path, const ParseOptions& options) {
   // Bounded, regular files and pipes only (docs/limits.md): a directory is not "no axiom".
   Expected<std::string> text = read_text_file(path);
   if (!text) return std::move(text.error());
-  return parse_grammar(*text, path, options);
+  // The text read is the grammar's own (moved, not copied: a 1 GiB file is held once).
+  return parse_grammar_text(std::make_shared<const std::string>(std::move(*text)), path, options);
 }
 
 Expected<Word> parse_word(std::string_view text, Grammar& grammar) {
   LogicalLine line;
   line.text = std::string(text);
-  for (size_t i = 0; i <= text.size(); ++i) line.locs.push_back({1, static_cast<uint32_t>(i + 1)});
+  line.pieces.push_back({0, 1, 1});
   try {
     if (line.text.find('\n') != std::string::npos) fail({1, static_cast<uint32_t>(line.text.find('\n') + 1)}, "a word is one line");
     validate_text(text);
@@ -1209,7 +1243,7 @@ Expected<Word> parse_word(std::string_view text, Grammar& grammar) {
     return w;
   } catch (const ParseFailure& f) {
     Diagnostic d = diagnostic_at("<word>", f.loc, f.message);
-    if (f.loc.line) d.source_line = std::string(text);
+    if (f.loc.line) set_source_line(d, text);
     return d;
   }
 }

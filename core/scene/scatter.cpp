@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 #include <unordered_map>
 
 #include <glm/common.hpp>
@@ -16,16 +17,70 @@ namespace sylva {
 
 namespace {
 
+// Whether the rightward ray from p crosses edge ab (the even–odd rule's test).
+bool crosses(glm::dvec2 a, glm::dvec2 b, glm::dvec2 p) {
+  return (a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x;
+}
+
+}  // namespace
+
 bool inside_polygon(const std::vector<glm::dvec2>& poly, glm::dvec2 p) {
   bool in = false;
-  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
-    const glm::dvec2 a = poly[i], b = poly[j];
-    if ((a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x) in = !in;
+  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++)
+    if (crosses(poly[i], poly[j], p)) in = !in;
+  return in;
+}
+
+PolygonBands::PolygonBands(const std::vector<glm::dvec2>& polygon) : polygon_(polygon) {
+  const size_t n = polygon.size();
+  if (n == 0) return;
+  lo_ = hi_ = polygon.front().y;
+  for (const glm::dvec2& q : polygon) lo_ = std::min(lo_, q.y), hi_ = std::max(hi_, q.y);
+  double spans = 0;
+  for (size_t i = 0, j = n - 1; i < n; j = i++) spans += std::abs(polygon[i].y - polygon[j].y);
+  const double height = hi_ - lo_;
+  // As many bands as edges, fewer where edges are tall (a comb's teeth cross every band):
+  // the entries, Σ (bands an edge crosses), stay within about 9 per edge.
+  double bands = static_cast<double>(n);
+  if (spans > 0) bands = std::min(bands, 8.0 * static_cast<double>(n) * height / spans);
+  bands_ = height > 0 ? static_cast<uint32_t>(std::clamp(bands, 1.0, static_cast<double>(n))) : 1;
+  scale_ = height > 0 ? bands_ / height : 0;
+  first_.assign(size_t{bands_} + 1, 0);
+  auto each_band = [&](auto&& visit) {
+    for (size_t i = 0, j = n - 1; i < n; j = i++) {
+      const double y0 = polygon[i].y, y1 = polygon[j].y;
+      if (y0 == y1) continue;  // never crossed by a horizontal ray
+      for (uint32_t b = band(std::min(y0, y1)), last = band(std::max(y0, y1)); b <= last; ++b) visit(b, i);
+    }
+  };
+  each_band([&](uint32_t b, size_t) { ++first_[b + 1]; });
+  for (uint32_t b = 0; b < bands_; ++b) first_[b + 1] += first_[b];
+  edges_.resize(first_[bands_]);
+  std::vector<uint32_t> fill(first_.begin(), first_.end() - 1);
+  each_band([&](uint32_t b, size_t i) { edges_[fill[b]++] = static_cast<uint32_t>(i); });
+}
+
+uint32_t PolygonBands::band(double y) const {
+  return static_cast<uint32_t>(std::clamp(std::floor((y - lo_) * scale_), 0.0, double(bands_ - 1)));
+}
+
+bool PolygonBands::inside(glm::dvec2 p) const {
+  if (polygon_.empty() || p.y < lo_ || p.y >= hi_) return false;  // no edge straddles p.y
+  // An edge straddles p.y when its lower end is at or below p.y and its upper end above,
+  // so (band is monotone) it is listed in p.y's band: the same crossings as the full walk.
+  const uint32_t b = band(p.y);
+  const size_t n = polygon_.size();
+  bool in = false;
+  for (uint32_t k = first_[b]; k < first_[b + 1]; ++k) {
+    const size_t i = edges_[k], j = i == 0 ? n - 1 : i - 1;
+    if (crosses(polygon_[i], polygon_[j], p)) in = !in;
   }
   return in;
 }
 
-}  // namespace
+double PolygonBands::mean_band_edges() const {
+  return bands_ > 0 ? static_cast<double>(edges_.size()) / bands_ : 0;
+}
 
 double scatter_area_m2(const SceneScatter& s) {
   if (s.disc_centre) return std::numbers::pi * s.disc_radius * s.disc_radius;
@@ -47,12 +102,25 @@ Expected<std::vector<ScatterPlacement>> place_scatter(const SceneScatter& s) {
       hi = glm::max(hi, p);
     }
   }
+  const std::optional<PolygonBands> bands =
+      s.disc_centre ? std::nullopt : std::optional<PolygonBands>(std::in_place, s.polygon);
+  const uint64_t max_darts = 30 * s.count + 1000;
+  if (bands && static_cast<double>(max_darts) * bands->mean_band_edges() > kMaxScatterEdgeTests) {
+    char why[300];
+    std::snprintf(why, sizeof why,
+                  "the polygon's %zu corners cross each other's height so often (%.0f edges in a band on average) "
+                  "that placing %llu plants would test about %.3g edges, more than the limit of %.3g; simplify "
+                  "the polygon or lower the count",
+                  s.polygon.size(), bands->mean_band_edges(), static_cast<unsigned long long>(s.count),
+                  static_cast<double>(max_darts) * bands->mean_band_edges(), kMaxScatterEdgeTests);
+    return file_diagnostic("", why);
+  }
   auto inside = [&](glm::dvec2 p) {
     if (s.disc_centre) {
       const glm::dvec2 d = p - *s.disc_centre;
       return glm::dot(d, d) <= s.disc_radius * s.disc_radius;
     }
-    return inside_polygon(s.polygon, p);
+    return bands->inside(p);
   };
   Rng darts(s.seed), attributes(s.seed ^ 0x5ca77e5eed5ca77eull);
   std::vector<ScatterPlacement> out;
@@ -65,7 +133,6 @@ Expected<std::vector<ScatterPlacement>> place_scatter(const SceneScatter& s) {
     return std::pair<int64_t, int64_t>{static_cast<int64_t>(std::floor((p.x - lo.x) / cell)),
                                        static_cast<int64_t>(std::floor((p.y - lo.y) / cell))};
   };
-  const uint64_t max_darts = 30 * s.count + 1000;
   for (uint64_t dart = 0; dart < max_darts && out.size() < s.count; ++dart) {
     const glm::dvec2 p(lo.x + darts.next_double() * (hi.x - lo.x), lo.y + darts.next_double() * (hi.y - lo.y));
     if (!inside(p)) continue;

@@ -29,6 +29,34 @@ struct ScatterPlacement {
   uint64_t plant_seed = 0;  // the grammar seed of this plant
 };
 
+// Point in polygon by the even–odd rule (a rightward ray's crossings), the slow exact
+// reference: every edge.
+bool inside_polygon(const std::vector<glm::dvec2>& polygon, glm::dvec2 p);
+
+// The same test in about constant time for an outline of many corners (issue 32: 80,000
+// corners made every dart test every edge): the polygon's height cut into bands, each
+// listing the edges that reach into it, so a point tests only its band's edges — with the
+// same arithmetic, so the answer is inside_polygon's exactly. About one band per edge,
+// fewer where edges are tall, so the lists hold at most about 9 entries per edge.
+class PolygonBands {
+ public:
+  explicit PolygonBands(const std::vector<glm::dvec2>& polygon);  // kept by reference
+  bool inside(glm::dvec2 p) const;
+  double mean_band_edges() const;  // the edges a point tests, on average over the bands
+
+ private:
+  uint32_t band(double y) const;
+  const std::vector<glm::dvec2>& polygon_;
+  double lo_ = 0, hi_ = 0, scale_ = 0;
+  uint32_t bands_ = 0;
+  std::vector<uint32_t> first_;  // per band, its first entry in edges_ (and one past the last)
+  std::vector<uint32_t> edges_;  // edge i joins corners i − 1 and i
+};
+
+// Placement refuses a polygon whose darts would test more edges than this in all (a comb
+// of 80,000 full-height teeth and a million plants), saying so, rather than run for hours.
+inline constexpr double kMaxScatterEdgeTests = 2e10;
+
 // The area of `scatter` in m² (π r², or the polygon's by the shoelace formula).
 double scatter_area_m2(const SceneScatter& scatter);
 

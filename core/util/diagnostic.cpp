@@ -36,7 +36,14 @@ void append_excerpt(std::string& out, const std::string& source_line, uint32_t c
     else if (b < 0x20 || b == 0x7f || (!utf8 && b >= 0x80)) c = '?';
   }
   out += prefix + shown + (begin + kWindow < source_line.size() ? "..." : "") + "\n";
-  out += std::string(prefix.size() + (col - begin), ' ') + "^\n";
+  // The caret under the character: one space per character before it, not per byte (the
+  // column in the header counts bytes, as clang's does; issue 32 found "é" pushing the
+  // caret off). A line that is not UTF-8 is echoed a byte per '?', so bytes are characters.
+  size_t before = 0;
+  for (size_t i = 0; i < std::min(col - begin, shown.size()); ++i)
+    before += (static_cast<unsigned char>(shown[i]) >> 6) != 0x2;
+  before += col - begin > shown.size() ? col - begin - shown.size() : 0;
+  out += std::string(prefix.size() + before, ' ') + "^\n";
 }
 
 void append_formatted(std::string& out, const Diagnostic& d, const char* severity) {
@@ -48,7 +55,10 @@ void append_formatted(std::string& out, const Diagnostic& d, const char* severit
   }
   if (!place.empty()) out += place + ": ";
   out += std::string(severity) + ": " + d.message + "\n";
-  if (d.source_line) append_excerpt(out, *d.source_line, d.loc.column);
+  if (d.source_line) {
+    const size_t column = d.loc.column > d.source_offset ? d.loc.column - d.source_offset : 0;
+    append_excerpt(out, *d.source_line, static_cast<uint32_t>(column));
+  }
   for (const Diagnostic& note : d.notes) append_formatted(out, note, "note");
 }
 }  // namespace
@@ -62,6 +72,19 @@ std::string Diagnostic::format() const {
 Diagnostic Diagnostic::with_note(Diagnostic note) && {
   notes.push_back(std::move(note));
   return std::move(*this);
+}
+
+void set_source_line(Diagnostic& d, std::string_view line) {
+  size_t begin = 0;
+  if (line.size() > kMaxSourceLineBytes) {
+    const size_t column = d.loc.column ? d.loc.column - 1 : 0;
+    begin = std::min(column > kMaxSourceLineBytes / 2 ? column - kMaxSourceLineBytes / 2 : 0,
+                     line.size() - kMaxSourceLineBytes);
+    // Not inside a UTF-8 sequence: back to its lead byte.
+    while (begin > 0 && (static_cast<unsigned char>(line[begin]) >> 6) == 0x2) --begin;
+  }
+  d.source_line = std::string(line.substr(begin, kMaxSourceLineBytes));
+  d.source_offset = begin;
 }
 
 Diagnostic diagnostic_at(std::string file, SourceLoc loc, std::string message) {

@@ -40,7 +40,9 @@ struct Diagnostic {
   SourceLoc loc;                           // where in `file`; {0,0}: the file as a whole
   std::string message;                     // one sentence, without the place
   std::optional<std::string> source_line;  // the physical line at loc, when the reporter
-                                           //   had the text (format() echoes it with a caret)
+                                           //   had the text (format() echoes it with a caret);
+                                           //   a long line only around loc (set_source_line)
+  size_t source_offset = 0;                // bytes of the line left out before source_line
   std::vector<Diagnostic> notes;           // further places that explain this one, in order
   int error_number = 0;                    // errno of the failing system call (file I/O); 0: none
   bool cancelled = false;                  // the work was cancelled, not failed (progress.h)
@@ -59,6 +61,12 @@ struct Diagnostic {
 
 // A Diagnostic at `loc` in `file`, without source line.
 Diagnostic diagnostic_at(std::string file, SourceLoc loc, std::string message);
+
+// Sets d.source_line to `line`, the physical line at d.loc — of a line longer than
+// kMaxSourceLineBytes only the kMaxSourceLineBytes around d.loc.column (d.source_offset
+// the bytes left out before them), so an error in a 1 GiB line does not copy it.
+inline constexpr size_t kMaxSourceLineBytes = 4096;
+void set_source_line(Diagnostic& d, std::string_view line);
 
 // A Diagnostic for `file` as a whole (no place, no source line).
 Diagnostic file_diagnostic(std::string file, std::string message, int error_number = 0);

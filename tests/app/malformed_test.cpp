@@ -186,12 +186,17 @@ void expect_located_error(const ProcessResult& r, const std::string& file_arg, s
   if (echo == Echo::kExact && plain_text(source)) {
     EXPECT_EQ(echoed, source) << "second stderr line must be source line " << reported->line << "\n"
                               << describe(r);
-    size_t column = static_cast<size_t>(reported->column);
+    // The column counts bytes; the caret stands under that byte's character: one blank per
+    // character before it (UTF-8 continuation bytes are not characters).
+    const size_t byte_column = static_cast<size_t>(reported->column);
+    size_t column = 1;
+    for (size_t i = 0; i + 1 < byte_column && i < source.size(); ++i)
+      column += (static_cast<unsigned char>(source[i]) >> 6) != 0x2;
     bool caret_ok = caret.size() >= column && caret[column - 1] == '^' &&
                     std::all_of(caret.begin(), caret.begin() + static_cast<std::ptrdiff_t>(column - 1),
                                 [](char c) { return c == ' ' || c == '\t'; });
-    EXPECT_TRUE(caret_ok) << "third stderr line must put '^' in byte column " << column
-                          << " after blanks, got '" << caret << "'\n" << describe(r);
+    EXPECT_TRUE(caret_ok) << "third stderr line must put '^' under byte column " << byte_column << " (character "
+                          << column << ") after blanks, got '" << caret << "'\n" << describe(r);
   } else {
     size_t hat = caret.find('^');
     bool caret_ok = hat != std::string_view::npos &&

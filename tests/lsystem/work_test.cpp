@@ -9,6 +9,7 @@
 namespace sylva::lsys {
 namespace {
 
+using testing::parse_error;
 using testing::parse_ok;
 
 // `count` declared names N0, N1, ... on `module:` lines of 100 names each.
@@ -146,6 +147,63 @@ TEST(Work, AnInterpretationPastItsBudgetFailsAtItsProduction) {
   EXPECT_EQ(t.error().loc.line, 4u);
   EXPECT_NE(t.error().message.find("budget of 16000 modules written (16 x --max-modules)"), std::string::npos)
       << t.error().message;
+}
+
+// Issue 32, item 11: readers that cost far more than their input.
+TEST(Work, TwoHundredThousandLineContinuationsAreJoinedInLinearTime) {
+  std::string text = "axiom: F\nF -> F";
+  for (int i = 0; i < 200000; ++i) text += "\\\n F";
+  text += "\n";
+  parse_work() = {};
+  Grammar g = parse_ok(text);
+  // Geometric growth: each byte is copied a few times at most. Reserving exactly what each
+  // physical line added copied the joined line once per line: ~6·10^11 bytes here.
+  EXPECT_LE(parse_work().line_bytes_copied, 2 * text.size());
+  EXPECT_EQ(parse_work().logical_lines, 2u);
+  DeriveOptions one;
+  one.steps = 1;
+  auto w = derive(g, one);
+  ASSERT_TRUE(w.ok());
+  EXPECT_EQ(w->size(), 200001u);
+}
+
+TEST(Work, FourHundredThousandDefinesAreCheckedForRepeatsByHash) {
+  std::string text;
+  for (int i = 0; i < 400000; ++i) text += "#define D" + std::to_string(i) + " " + std::to_string(i) + "\n";
+  text += "axiom: A(D399999)\n";
+  parse_work() = {};
+  Grammar g = parse_ok(text);
+  EXPECT_EQ(parse_work().define_compares, 0u);  // each new name against every earlier one: 8·10^10
+  EXPECT_EQ(g.defines.size(), 400000u);
+  // A repeat is still found, and says where the first one is.
+  const Diagnostic twice = parse_error("#define A 1\n#define B 2\n#define A 3\naxiom: F\n");
+  EXPECT_NE(twice.message.find("'A' is defined twice (first at line 1)"), std::string::npos) << twice.message;
+  EXPECT_EQ(twice.loc.line, 3u);
+}
+
+TEST(Work, BlankLinesKeepNothing) {
+  const std::string text = std::string(1000000, '\n') + "   \n\t\naxiom: F\n" + std::string(1000, '\n');
+  parse_work() = {};
+  Grammar g = parse_ok(text);
+  EXPECT_EQ(parse_work().logical_lines, 1u);  // a logical line per blank line: ~100 bytes each
+  const Diagnostic e = parse_error(std::string(100000, '\n') + "axiom: F\nF -> G(\n");
+  EXPECT_EQ(e.loc.line, 100002u);  // places still count every line
+}
+
+TEST(Work, AnErrorInAHugeLineQuotesOnlyItsNeighbourhood) {
+  // The axiom's 600,001st byte is the bad one: the diagnostic keeps 4 KiB around it, not
+  // the 1 MB line (a 1 GiB line of NULs had been copied twice more).
+  std::string line = "axiom: " + std::string(600000, 'F') + ")" + std::string(400000, 'F');
+  const Diagnostic e = parse_error(line + "\n");
+  ASSERT_TRUE(e.source_line);
+  EXPECT_LE(e.source_line->size(), kMaxSourceLineBytes);
+  EXPECT_EQ(e.loc.column, 600008u) << e.message;
+  EXPECT_EQ((*e.source_line)[e.loc.column - 1 - e.source_offset], ')');
+  // The excerpt shows the ')' with the caret under it.
+  const std::string text = e.format();
+  const size_t excerpt = text.find('\n') + 1, caret_line = text.find('\n', excerpt) + 1;
+  const size_t caret = text.find('^', caret_line) - caret_line;
+  EXPECT_EQ(text[excerpt + caret], ')') << text.substr(0, 600);
 }
 
 }  // namespace

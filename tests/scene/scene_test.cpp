@@ -14,6 +14,7 @@
 #include <random>
 #include <set>
 
+#include "core/scene/scatter.h"
 #include "core/scene/scene_json.h"
 #include "tests/support/test_textures.h"
 
@@ -807,6 +808,63 @@ TEST(SceneScatterKey, EntriesThatCannotFitOrSayTooLittleOrTooMuchAreLocatedError
     EXPECT_NE(r.error().message.find(c.message), std::string::npos) << c.entry << " -> " << r.error().format();
     EXPECT_EQ(r.error().loc.line, 1u) << c.entry;
   }
+}
+
+// Issue 32, item 11: a polygon of 80,000 corners made every dart test every edge. The
+// banded test gives inside_polygon's answer exactly, for points anywhere (at corners'
+// heights too), while a point tests a handful of edges.
+TEST(SceneScatterKey, TheBandedPointInPolygonTestAgreesWithTheFullWalkAndTestsFewEdges) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(0, 1);
+  auto star = [&](size_t n, double jag) {  // radii from 100 − jag to 100
+    std::vector<glm::dvec2> p;
+    for (size_t i = 0; i < n; ++i) {
+      const double a = 2 * M_PI * static_cast<double>(i) / static_cast<double>(n), r = 100 - jag * unit(rng);
+      p.push_back({r * std::cos(a), std::round(r * std::sin(a))});  // many corners share a height
+    }
+    return p;
+  };
+  std::vector<glm::dvec2> comb;  // 40 full-height teeth
+  comb.push_back({0, 0});
+  comb.push_back({80, 0});
+  for (int k = 39; k >= 0; --k)
+    for (glm::dvec2 q : {glm::dvec2(2 * k + 1.5, 1), glm::dvec2(2 * k + 1.5, 100), glm::dvec2(2 * k + 0.5, 100),
+                         glm::dvec2(2 * k + 0.5, 1)})
+      comb.push_back(q);
+  for (const std::vector<glm::dvec2>& polygon : {star(7, 50), star(300, 50), star(5000, 50), star(5000, 1), comb}) {
+    const PolygonBands bands(polygon);
+    glm::dvec2 lo = polygon[0], hi = polygon[0];
+    for (const glm::dvec2& q : polygon) lo = glm::min(lo, q), hi = glm::max(hi, q);
+    for (int k = 0; k < 20000; ++k) {
+      glm::dvec2 p(lo.x - 1 + unit(rng) * (hi.x - lo.x + 2), lo.y - 1 + unit(rng) * (hi.y - lo.y + 2));
+      if (k % 4 == 0) p.y = polygon[static_cast<size_t>(k) % polygon.size()].y;  // exactly a corner's height
+      ASSERT_EQ(bands.inside(p), inside_polygon(polygon, p)) << polygon.size() << " corners at " << p.x << ", " << p.y;
+    }
+  }
+  // A wiggly outline (a forest stand's): a horizontal line meets a few of its edges.
+  EXPECT_LT(PolygonBands(star(80000, 0.005)).mean_band_edges(), 12);
+  EXPECT_LT(PolygonBands(comb).mean_band_edges(), 9.5 * static_cast<double>(comb.size()));  // memory bound
+}
+
+TEST(SceneScatterKey, APolygonOfEightyThousandCornersPlacesItsPlantsAndAHopelessCombIsRefused) {
+  std::string corners;
+  for (int i = 0; i < 80000; ++i) {
+    const double a = 2 * M_PI * i / 80000.0, r = 20 + (i % 2);  // a fine star
+    corners += (i ? ", [" : "[") + std::to_string(r * std::cos(a)) + ", " + std::to_string(r * std::sin(a)) + "]";
+  }
+  auto placed = scene_with_scatter(cactus_entry(R"("count": 2000, "polygon": [)" + corners + "]"));
+  ASSERT_TRUE(placed) << placed.error().format();
+  EXPECT_EQ(placed->plants.size(), 2000u);
+  // 40,000 full-height teeth and a million plants: ~10^15 edge tests, refused at the entry.
+  std::string teeth = "[0, 0], [80000, 0]";
+  for (int k = 39999; k >= 0; --k)
+    teeth += ", [" + std::to_string(2 * k + 1.5) + ", 1], [" + std::to_string(2 * k + 1.5) + ", 100], [" +
+             std::to_string(2 * k + 0.5) + ", 100], [" + std::to_string(2 * k + 0.5) + ", 1]";
+  auto refused = scene_with_scatter(cactus_entry(R"("count": 1000000, "polygon": [)" + teeth + "]"));
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("simplify the polygon or lower the count"), std::string::npos)
+      << refused.error().format();
+  EXPECT_EQ(refused.error().loc.line, 1u);
 }
 
 TEST(SceneScatterKey, WritesBackAsItsEntryAndReadsBackEqual) {
