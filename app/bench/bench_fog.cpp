@@ -27,7 +27,8 @@
 // Outputs: the CSV, STEM.fog-cones.csv (the cones' coverage of the exact shadow), a
 // log-log plot of RMSE against total time (the plot module), and on stdout the time each
 // family needs to reach given RMSEs (interpolated on its fastest settings, log-log) and
-// fast mode's bias floor.
+// fast mode's bias floor. On stderr, a progress line per row with an estimate of the time
+// left, and a line every 30 s within a long row (the reference) (bench_rows.h).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -37,8 +38,10 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include <unistd.h>
 
 #include "app/bench/bench_metrics.h"
+#include "app/bench/bench_rows.h"
 #include "app/bench/fog_view.h"
 #include "app/bench/plot.h"
 #include "app/bench/bench.h"
@@ -396,8 +399,33 @@ void print_per_core_photon_rate(const SunPhotonTracer& tracer, uint64_t photons)
 // seeds (for the bias).
 class FogBench {
  public:
-  FogBench(const Args& a, const Scene& scene, const SceneGeometry& g, const SunPhotonTracer& tracer, unsigned threads)
-      : a_(a), scene_(scene), g_(g), tracer_(tracer), threads_(threads) {}
+  FogBench(const Args& a, const Scene& scene, const SceneGeometry& g, const SunPhotonTracer& tracer, unsigned threads,
+           bool fog_rows)
+      : a_(a), scene_(scene), g_(g), tracer_(tracer), threads_(threads),
+        progress_("sylva bench fog", planned_rows(fog_rows), isatty(STDERR_FILENO) != 0) {}
+
+  // The rows this run will measure: the reference, the brute rows, and per photon count,
+  // parameter kind and seed the cones row and the rows of the modes reading them.
+  size_t planned_rows(bool fog_rows) const {
+    const size_t seeds = a_.seeds;
+    size_t n = fog_rows ? 1 : 0;
+    if (fog_rows && wants("brute")) n += a_.brute_steps.size() * seeds;
+    size_t automatic = 1, fixed = 1;  // the cones rows
+    if (fog_rows) {
+      for (const char* m : {"medium", "refined"})
+        if (wants(m)) automatic += a_.cone_steps.size(), fixed += a_.cone_steps.size();
+      if (wants("fast")) ++automatic, ++fixed;
+      if (wants("map")) {
+        const bool disc = scene_.sun.angular_radius_deg > 0;
+        for (uint32_t directions : a_.map_directions) {
+          const size_t settings = a_.map_resolutions.size();
+          automatic += settings;
+          if (a_.map_variants) automatic += settings * ((disc && directions > 1) ? 2 : 1), fixed += settings;
+        }
+      }
+    }
+    return n + a_.photons.size() * seeds * (automatic + fixed);
+  }
 
   bool wants(const std::string& m) const { return std::find(a_.modes.begin(), a_.modes.end(), m) != a_.modes.end(); }
 
@@ -411,7 +439,9 @@ class FogBench {
     const FogIntegrator ref(*medium_, fog_sun_of(scene_.sun), scene_.sky, *g_.tracer, nullptr, ro);
     double seconds = 0;
     const View sparse = strided(view_, a_.reference_stride, &reference_pixels_);
-    const std::vector<float> image = fog_image(sparse, ref, 0, threads_, &seconds);
+    const std::string what = "reference, " + std::to_string(a_.reference_steps) + " steps";
+    const Progress within([&](double f, std::string_view) { progress_.within(f, what); });
+    const std::vector<float> image = fog_image(sparse, ref, 0, threads_, &seconds, nullptr, within);
     reference_.assign(image.begin(), image.end());
     double mean = 0;
     for (double v : reference_) mean += v;
@@ -421,6 +451,7 @@ class FogBench {
                 a_.reference_steps, a_.reference_steps * kReferenceProbesPerStep, reference_pixels_.size(),
                 a_.reference_stride, seconds, mean);
     std::fflush(stdout);
+    progress_.done(what);
   }
 
   // brute at each --brute-steps, each seed.
@@ -488,6 +519,7 @@ class FogBench {
         const double cpu_s = process_cpu_seconds() - cpu_start;
         if (!maps) {
           std::printf("map %u² x %u: skipped: %s\n", resolution, directions, maps.error().message.c_str());
+          std::fflush(stdout);
           continue;
         }
         std::printf("map %u² x %u: %s, %.3f s wall, %.3f s CPU\n", resolution, directions, maps->describe().c_str(),
@@ -542,8 +574,12 @@ class FogBench {
     o.map_per_ray = map_per_ray;
     const FogIntegrator integrator(*medium_, fog_sun_of(scene_.sun), scene_.sky, *g_.tracer, cones, o);
     double cpu = 0;
+    const std::string what = row.mode + ", " + std::to_string(row.steps) + " steps, " +
+                             (row.photons ? std::to_string(row.photons) + " photons, " : "") + "seed " +
+                             std::to_string(row.seed);
+    const Progress within([&](double f, std::string_view) { progress_.within(f, what); });
     const std::vector<float> image = fog_image(view_, integrator, mix_pair(row.seed, 0x666f67), threads_,
-                                               &row.render_s, &cpu);
+                                               &row.render_s, &cpu, within);
     if (a_.cpu_clock) row.render_s = cpu / threads_;
     row.total_s = row.photon_s + row.cone_s + row.render_s;
     row.rmse = rmse(image, reference_, reference_pixels_);
@@ -556,6 +592,7 @@ class FogBench {
                 row.total_s, row.rmse, row.cones);
     std::fflush(stdout);
     rows_.push_back(row);
+    progress_.done(what);
   }
 
   // The cones `c` built from `photons` photons of `seed`: the line of the cones' CSV, the
@@ -590,7 +627,9 @@ class FogBench {
                 row.mode.c_str(), "-", static_cast<unsigned long long>(photons), seed, row.photon_s, row.cone_s, "-",
                 row.total_s, "-", row.cones, cov.missed_shadow, cov.covered_lit, params_text(c.params).c_str(),
                 query_us, cpu_s);
+    std::fflush(stdout);
     rows_.push_back(row);
+    progress_.done(row.mode + ", " + std::to_string(photons) + " photons, seed " + std::to_string(seed));
     return base;
   }
 
@@ -611,6 +650,7 @@ class FogBench {
   const SceneGeometry& g_;
   const SunPhotonTracer& tracer_;
   const unsigned threads_;
+  BenchProgress progress_;  // after a_ and scene_, which planned_rows() reads
   View view_;
   std::vector<double> reference_;
   std::vector<size_t> reference_pixels_;  // of the view, in the reference's order
@@ -801,8 +841,8 @@ int run_bench_fog(const std::vector<std::string>& args) {
   std::printf("photon tracer: accelerator and occupancy mask built in %.3f s\n", tracer.build_seconds());
   print_per_core_photon_rate(tracer, a.per_core_photons);
 
-  FogBench bench(a, scene, g, tracer, threads);
   const bool fog_rows = !a.cones_only;
+  FogBench bench(a, scene, g, tracer, threads, fog_rows);
   if (fog_rows) bench.render_reference();
   std::printf("%-14s %5s %9s %4s %9s %9s %9s %9s %11s %6s\n", "mode", "steps", "photons", "seed", "photon_s", "cone_s",
               "render_s", "total_s", "rmse", "cones");

@@ -1,6 +1,7 @@
 // bench_rows.cpp — progress and incremental CSV of a benchmark's rows (bench_rows.h).
 #include "app/bench/bench_rows.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -44,33 +45,66 @@ std::string bench_progress_line(const std::string& label, size_t done, size_t pl
   return line;
 }
 
+std::string bench_within_row_line(const std::string& label, size_t row, size_t planned, const std::string& what,
+                                  double fraction, double row_s, double elapsed_s) {
+  char percent[16];
+  std::snprintf(percent, sizeof percent, "%.0f %%", 100 * std::clamp(fraction, 0.0, 1.0));
+  std::string line = label + ": row " + std::to_string(row) + "/" + std::to_string(planned) + " (" + what + ") " +
+                     percent + " in " + describe_duration(row_s);
+  if (fraction > 0 && fraction < 1) line += ", about " + describe_duration(row_s / fraction * (1 - fraction)) + " left in it";
+  return line + "; " + describe_duration(elapsed_s) + " elapsed";
+}
+
+namespace {
+double seconds_between(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+}  // namespace
+
+BenchProgress::BenchProgress(std::string label, size_t planned, bool decorated, double within_every_s)
+    : label_(std::move(label)), planned_(planned), decorated_(decorated), within_every_s_(within_every_s) {}
+
+void BenchProgress::start() { start_ = last_ = said_ = std::chrono::steady_clock::now(); }
+
+double BenchProgress::done(const std::string& what) {
+  ++done_;
+  const auto now = std::chrono::steady_clock::now();
+  const double row_s = seconds_between(last_, now);
+  std::cerr << bench_progress_line(label_, done_, planned_, what, row_s, seconds_between(start_, now), decorated_)
+            << std::endl;
+  last_ = said_ = now;
+  return row_s;
+}
+
+void BenchProgress::within(double fraction, const std::string& what) {
+  const auto now = std::chrono::steady_clock::now();
+  if (seconds_between(said_, now) < within_every_s_) return;
+  said_ = now;
+  std::cerr << bench_within_row_line(label_, done_ + 1, planned_, what, fraction, seconds_between(last_, now),
+                                     seconds_between(start_, now))
+            << std::endl;
+}
+
 BenchRows::BenchRows(std::string label, std::string csv_path, std::string head, size_t planned, bool decorated)
-    : label_(std::move(label)), path_(std::move(csv_path)), head_(std::move(head)), planned_(planned),
-      decorated_(decorated) {}
+    : path_(std::move(csv_path)), head_(std::move(head)), progress_(std::move(label), planned, decorated) {}
 
 std::string BenchRows::text(bool finished) const {
   std::string t = head_ + rows_;
   if (!finished)
-    t += "# partial run: " + std::to_string(done_) + " of " + std::to_string(planned_) +
+    t += "# partial run: " + std::to_string(progress_.rows_done()) + " of " + std::to_string(progress_.planned()) +
          " rows (the run was stopped, or is still running)\n";
   return t;
 }
 
 Status BenchRows::start() {
-  start_ = last_ = std::chrono::steady_clock::now();
+  progress_.start();
   return write_file_atomically(path_, text(false));
 }
 
 Status BenchRows::add(const std::string& csv_line, const std::string& what) {
   rows_ += csv_line;
-  ++done_;
-  const auto now = std::chrono::steady_clock::now();
-  const double row_s = std::chrono::duration<double>(now - last_).count();
-  const double elapsed_s = std::chrono::duration<double>(now - start_).count();
-  last_ = now;
-  Status written = write_file_atomically(path_, text(false));
-  std::cerr << bench_progress_line(label_, done_, planned_, what, row_s, elapsed_s, decorated_) << "\n";
-  return written;
+  progress_.done(what);
+  return write_file_atomically(path_, text(false));
 }
 
 Status BenchRows::finish() { return write_file_atomically(path_, text(true)); }

@@ -33,6 +33,35 @@ std::string describe_duration(double seconds);
 std::string bench_progress_line(const std::string& label, size_t done, size_t planned, const std::string& what,
                                 double row_s, double elapsed_s, bool decorated);
 
+// A line within a long row, at most every few seconds (bench_progress_line's form):
+//   LABEL: row K/N (WHAT) 37 % in 4 min 10 s, about 7 min 5 s left in it; 5 min 2 s elapsed
+std::string bench_within_row_line(const std::string& label, size_t row, size_t planned, const std::string& what,
+                                  double fraction, double row_s, double elapsed_s);
+
+// The progress of a benchmark's rows on stderr: a line per row done (bench_progress_line)
+// and, for a row that reports its own fraction, a line within it at most every
+// `within_every_s` seconds, so that no run is silent for long (`sylva bench gpu`, `bench
+// fog`). Not thread-safe: one thread calls it (within() from a Progress callback, which
+// serialises its calls).
+class BenchProgress {
+ public:
+  BenchProgress(std::string label, size_t planned, bool decorated, double within_every_s = 30);
+  void start();  // the clock starts (also at construction)
+  // Row done: prints its line; returns its time in seconds.
+  double done(const std::string& what);
+  // `fraction` of the row now running (row done()+1), named `what`.
+  void within(double fraction, const std::string& what);
+  size_t rows_done() const { return done_; }
+  size_t planned() const { return planned_; }
+
+ private:
+  std::string label_;
+  size_t planned_ = 0, done_ = 0;
+  bool decorated_ = false;
+  double within_every_s_ = 30;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_ = start_, said_ = start_;
+};
+
 class BenchRows {
  public:
   // `label`: "sylva bench gpu"; `head`: the CSV's comment and column lines, each ending
@@ -51,10 +80,8 @@ class BenchRows {
  private:
   std::string text(bool finished) const;
 
-  std::string label_, path_, head_, rows_;
-  size_t planned_ = 0, done_ = 0;
-  bool decorated_ = false;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_ = start_;
+  std::string path_, head_, rows_;
+  BenchProgress progress_;
 };
 
 }  // namespace sylva::cli

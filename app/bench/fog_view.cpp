@@ -2,6 +2,7 @@
 #include "app/bench/fog_view.h"
 
 #include <algorithm>
+#include <atomic>
 #include <limits>
 
 #include "core/scene/render_common.h"
@@ -45,19 +46,24 @@ View strided(const View& v, uint32_t stride, std::vector<size_t>* pixels) {
 }
 
 std::vector<float> fog_image(const View& v, const FogIntegrator& integrator, uint64_t seed, unsigned threads,
-                             double* seconds, double* cpu_seconds) {
+                             double* seconds, double* cpu_seconds, const Progress& progress) {
   const size_t n = v.origin.size();
   std::vector<float> out(n * 3);
   constexpr size_t kChunk = 256;  // pixels per work item
+  const size_t chunks = (n + kChunk - 1) / kChunk;
+  std::atomic<size_t> chunks_done{0};
   const auto start = Clock::now();
   const double cpu_start = process_cpu_seconds();
-  parallel_for((n + kChunk - 1) / kChunk, threads, nullptr, [&](size_t chunk, unsigned) {
+  parallel_for(chunks, threads, nullptr, [&](size_t chunk, unsigned) {
     for (size_t i = chunk * kChunk; i < std::min(n, (chunk + 1) * kChunk); ++i) {
       render_common::SampleRng rng(mix_pair(seed, i));
       const FogRayResult r = integrator.integrate(v.origin[i], v.direction[i], v.t_end[i], rng);
       for (int c = 0; c < 3; ++c) out[i * 3 + c] = static_cast<float>(r.inscatter[c]);
     }
+    const size_t done = chunks_done.fetch_add(1, std::memory_order_relaxed) + 1;
+    if (progress.reporting() && done % 16 == 0) progress.report(double(done) / double(chunks), "fog");
   });
+  progress.report(1, "fog");
   *seconds = seconds_since(start);
   if (cpu_seconds) *cpu_seconds = process_cpu_seconds() - cpu_start;
   return out;

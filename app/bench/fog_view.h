@@ -18,6 +18,7 @@
 #include "core/scene/fog_integrator.h"
 #include "core/scene/scene.h"
 #include "core/geometry/surface.h"
+#include "core/util/progress.h"
 
 namespace sylva::cli {
 
@@ -38,9 +39,10 @@ View strided(const View& v, uint32_t stride, std::vector<size_t>* pixels);
 // The in-scatter of every ray of `v` (RGB, in the view's order) by `integrator` on
 // `threads` threads (0: every core); ray i's random numbers from (seed, i) only, so the
 // image does not depend on the thread count. *seconds: wall time; *cpu_seconds (when
-// given): the process's CPU time meanwhile (core-seconds).
+// given): the process's CPU time meanwhile (core-seconds). `progress` is told the fraction
+// of the rays done, every 16 chunks of 256.
 std::vector<float> fog_image(const View& v, const FogIntegrator& integrator, uint64_t seed, unsigned threads,
-                             double* seconds, double* cpu_seconds = nullptr);
+                             double* seconds, double* cpu_seconds = nullptr, const Progress& progress = {});
 
 // RMSE over `pixels` (indices into `image`, RGB per pixel with `stride` floats) and the
 // channels R, G, B against `reference` (RGB, one per pixel in `pixels`' order).

@@ -93,7 +93,10 @@ std::optional<uint64_t> seed_from_python(const py::object& value) {
                          std::string(Py_TYPE(value.ptr())->tp_name));
   // __index__ accepts int and numpy integers, rejects floats and strings (TypeError).
   py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
-  if (!index) throw py::error_already_set();
+  if (!index) {
+    PyErr_Clear();
+    throw py::type_error("seed must be an int in [0, 2**64 - 1], not " + std::string(Py_TYPE(value.ptr())->tp_name));
+  }
   const unsigned long long seed = PyLong_AsUnsignedLongLong(index.ptr());
   if (seed == static_cast<unsigned long long>(-1) && PyErr_Occurred()) {
     PyErr_Clear();
@@ -109,7 +112,10 @@ std::optional<int64_t> steps_from_python(const py::object& value) {
   if (PyBool_Check(value.ptr()) || PyFloat_Check(value.ptr()))
     throw py::type_error("steps must be an int >= 0, not " + std::string(Py_TYPE(value.ptr())->tp_name));
   py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
-  if (!index) throw py::error_already_set();
+  if (!index) {
+    PyErr_Clear();
+    throw py::type_error("steps must be an int >= 0, not " + std::string(Py_TYPE(value.ptr())->tp_name));
+  }
   int overflow = 0;
   const long long steps = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
   if (steps == -1 && PyErr_Occurred()) throw py::error_already_set();
@@ -449,6 +455,19 @@ std::string plant_name(const Skeleton& sk) {
   return stem;
 }
 
+// `value` as a T for the argument `name`: a TypeError that names the argument, what it
+// expects and the type it got, never pybind11's "Unable to cast Python instance to C++
+// type" (issue 32).
+template <class T>
+T cast_argument(const py::handle& value, const std::string& name, const char* expected) {
+  try {
+    return value.cast<T>();
+  } catch (const py::cast_error&) {
+    throw py::type_error(name + " must be " + expected + ", got " +
+                         std::string(py::str(py::type::handle_of(value).attr("__name__"))));
+  }
+}
+
 // A Skeleton or a sequence of Skeletons.
 std::vector<const Skeleton*> skeleton_list(const py::object& plants) {
   std::vector<const Skeleton*> list;
@@ -486,20 +505,21 @@ Bark bark_from_dict(const py::object& value) {
     const py::object v = py::reinterpret_borrow<py::object>(item);
     if (key == "albedo") {
       if (py::isinstance<py::str>(v) || py::hasattr(v, "__fspath__")) {
-        bark.albedo_texture = path_string(v.cast<std::filesystem::path>());
+        bark.albedo_texture = path_string(cast_argument<std::filesystem::path>(v, "bark['albedo']", "a path"));
       } else {
-        const auto rgb = v.cast<std::vector<double>>();
+        const auto rgb =
+            cast_argument<std::vector<double>>(v, "bark['albedo']", "a path or an (r, g, b) linear colour");
         if (rgb.size() != 3) throw py::value_error("bark['albedo'] must be a path or an (r, g, b) linear colour");
         bark.albedo_rgb = glm::dvec3(rgb[0], rgb[1], rgb[2]);
       }
     } else if (key == "height") {
-      bark.height_texture = path_string(v.cast<std::filesystem::path>());
+      bark.height_texture = path_string(cast_argument<std::filesystem::path>(v, "bark['height']", "a path"));
     } else if (key == "relief_depth") {
-      bark.relief_depth_m = v.cast<double>();
+      bark.relief_depth_m = cast_argument<double>(v, "bark['relief_depth']", "a number (metres)");
       if (!std::isfinite(bark.relief_depth_m) || bark.relief_depth_m < 0)
         throw py::value_error("bark['relief_depth'] must be a finite number >= 0 (metres)");
     } else if (key == "u_repeat" || key == "v_per_metre") {
-      const double x = v.cast<double>();
+      const double x = cast_argument<double>(v, "bark['" + key + "']", "a number");
       if (!std::isfinite(x) || x <= 0) throw py::value_error("bark['" + key + "'] must be a finite number > 0");
       (key == "u_repeat" ? bark.u_repeat : bark.v_per_metre) = x;
     } else {
@@ -523,23 +543,28 @@ void python_export_gltf(const py::object& plants, const std::filesystem::path& p
   }
   if (!names.is_none()) {
     py::sequence seq = per_plant(names, skeletons.size(), "names");
-    for (size_t i = 0; i < skeletons.size(); ++i) gltf_plants[i].name = seq[i].cast<std::string>();
+    for (size_t i = 0; i < skeletons.size(); ++i)
+      gltf_plants[i].name = cast_argument<std::string>(seq[i], "names[" + std::to_string(i) + "]", "a str");
   }
   if (!positions.is_none()) {
     py::sequence seq = per_plant(positions, skeletons.size(), "positions");
     for (size_t i = 0; i < skeletons.size(); ++i) {
-      auto p = seq[i].cast<std::vector<double>>();
+      auto p = cast_argument<std::vector<double>>(seq[i], "positions[" + std::to_string(i) + "]",
+                                                  "an (x, y, z) sequence of numbers");
       if (p.size() != 3) throw py::value_error("positions: every entry must be (x, y, z) in metres");
       for (int k = 0; k < 3; ++k) gltf_plants[i].position_m[k] = p[static_cast<size_t>(k)];
     }
   }
   if (!rotate_y_deg.is_none()) {
     py::sequence seq = per_plant(rotate_y_deg, skeletons.size(), "rotate_y_deg");
-    for (size_t i = 0; i < skeletons.size(); ++i) gltf_plants[i].rotate_y_deg = seq[i].cast<double>();
+    for (size_t i = 0; i < skeletons.size(); ++i)
+      gltf_plants[i].rotate_y_deg =
+          cast_argument<double>(seq[i], "rotate_y_deg[" + std::to_string(i) + "]", "a number (degrees)");
   }
   if (!scales.is_none()) {
     py::sequence seq = per_plant(scales, skeletons.size(), "scales");
-    for (size_t i = 0; i < skeletons.size(); ++i) gltf_plants[i].scale = seq[i].cast<double>();
+    for (size_t i = 0; i < skeletons.size(); ++i)
+      gltf_plants[i].scale = cast_argument<double>(seq[i], "scales[" + std::to_string(i) + "]", "a number");
   }
   if (!bark.is_none()) {
     if (!mesh) throw py::value_error("bark shapes the mesh: pass mesh=True too");
@@ -625,6 +650,9 @@ void bind_module(py::module_& m) {
       if (p) std::rethrow_exception(p);
     } catch (const MeshTooLarge& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const py::cast_error& e) {
+      // A conversion cast_argument does not cover: still a TypeError, not a RuntimeError.
+      PyErr_SetString(PyExc_TypeError, (std::string("an argument has the wrong type: ") + e.what()).c_str());
     }
   });
   for (PyObject* type : {g_grammar_error, g_skeleton_error}) {

@@ -228,13 +228,15 @@ Expected<uint32_t> compact_count(const std::string& path, const JsonValue& objec
   return static_cast<uint32_t>(*n);
 }
 
-// The bufferView `key` of `object` (a "compact" array of `elements` values); none when
-// `elements` is 0.
+// The bufferView `key` of `object` (a "compact" array of `elements` values). With
+// `elements` 0 the key may be left out (what the writer does); a key that is there must
+// name a view of exactly that size, so that data the counts leave out (a count of 0 over
+// full views) is an error rather than a silently empty plant.
 template <class T>
 Expected<std::vector<T>> compact_array(BinaryViews& views, const std::string& path, const JsonValue& object,
                                        const char* key, uint64_t elements, const std::string& where) {
-  if (elements == 0) return std::vector<T>();
   const JsonValue* index = object.find(key);
+  if (!index && elements == 0) return std::vector<T>();
   if (!index) return error_at(path, object, where + ": missing key \"" + key + "\" (a bufferView index)");
   return views.read<T>(*index, elements, where + "." + key);
 }

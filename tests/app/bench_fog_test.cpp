@@ -28,6 +28,15 @@ TEST(BenchFog, QuickRunWritesEveryModesRowsTheTimeTableAndThePlot) {
   EXPECT_NE(r.out.find("M photons/s per core"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("us/ray"), std::string::npos) << r.out;  // the cone query
   EXPECT_NE(r.err.find("cone parameters (automatic)"), std::string::npos) << r.err;
+  // Issue 32: a progress line per row; the plan counts every row the run measures. The
+  // CSV's rows (cones, brute, medium, refined, fast and map rows) plus the reference.
+  const std::string csv_text = read_file(csv);
+  const size_t csv_rows = count_lines_starting(csv_text, "") - count_lines_starting(csv_text, "#") - 1;  // less the columns
+  const std::string last = "sylva bench fog: row " + std::to_string(csv_rows + 1) + "/" + std::to_string(csv_rows + 1) + " done";
+  EXPECT_NE(r.err.find("sylva bench fog: row 1/" + std::to_string(csv_rows + 1) + " done in "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(reference, 8 steps)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(last), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("/" + std::to_string(csv_rows + 2) + " done"), std::string::npos) << r.err;
   const std::string rows = read_file(csv);
   EXPECT_NE(rows.find("mode,steps,photons,seed,photon_s,cone_s,render_s,total_s,rmse,bias,cones\n"), std::string::npos)
       << rows;

@@ -12,6 +12,7 @@
 namespace {
 
 using sylva::cli::bench_progress_line;
+using sylva::cli::bench_within_row_line;
 using sylva::cli::BenchRows;
 using sylva::cli::describe_duration;
 
@@ -30,6 +31,14 @@ TEST(BenchRows, TheLineEstimatesTheTimeLeftFromTheMeanRowAndIsDecoratedOnlyOnReq
   EXPECT_EQ(bench_progress_line("x", 10, 10, "last", 1, 100, false), "x: row 10/10 done in 1.0 s (last); 1 min 40 s elapsed");
   const std::string decorated = bench_progress_line("x", 5, 10, "w", 1, 10, true);
   EXPECT_EQ(decorated, "x: \x1b[1mrow 5/10\x1b[0m [##########..........] done in 1.0 s (w); 10 s elapsed, about 10 s left");
+}
+
+TEST(BenchRows, TheLineWithinALongRowEstimatesWhatIsLeftOfIt) {
+  // 25 % of the reference in 2 min: about 6 min left in it.
+  EXPECT_EQ(bench_within_row_line("sylva bench fog", 1, 45, "reference, 64 steps", 0.25, 120, 130),
+            "sylva bench fog: row 1/45 (reference, 64 steps) 25 % in 2 min 0 s, about 6 min 0 s left in it; "
+            "2 min 10 s elapsed");
+  EXPECT_EQ(bench_within_row_line("x", 3, 4, "w", 0, 5, 9), "x: row 3/4 (w) 0 % in 5.0 s; 9.0 s elapsed");
 }
 
 TEST(BenchRows, TheCsvHoldsTheRowsDoneAndSaysItIsPartialUntilFinished) {

@@ -1346,6 +1346,9 @@ TEST(GltfExtras, MalformedCompactExtrasGiveLocatedErrorsNeverACrash) {
   add("view_key_missing", "missing key \"joints\"", [](CompactCase& c) { c.chains = R"({"count":1,"joint_count":0,"parent":1,"material":3})"; });
   add("count_missing", "count must be", [](CompactCase& c) { c.chains = R"({"joint_count":0,"parent":1,"joints":2,"material":3})"; });
   add("count_huge", "count must be", [](CompactCase& c) { c.chains = R"({"count":1e30,"joint_count":0,"parent":1,"joints":2,"material":3})"; });
+  // Issue 32: a count of 0 over full views used to read as an empty plant (exit 0).
+  add("count_zero_over_full_views", "expected 0 values", [](CompactCase& c) { c.chains = R"({"count":0,"joint_count":0,"parent":1,"joints":2,"material":3})"; });
+  add("leaf_count_zero_over_a_full_view", "expected 0 values", [](CompactCase& c) { c.version = "2"; c.more = R"(,"leaves":{"count":0,"vertex_count":0})"; });
   add("count_mismatch", "expected 4 values", [](CompactCase& c) { c.chains = R"({"count":4,"joint_count":0,"parent":1,"joints":2,"material":3})"; });
   add("joint_counts_lie", "expected", [](CompactCase& c) { std::memcpy(c.bin.data(), "\xff\xff\xff\x7f", 4); });
   add("offset_past_end", "runs past the end of buffer 0", [](CompactCase& c) {

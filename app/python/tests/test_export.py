@@ -74,6 +74,27 @@ def test_bad_arguments_raise_before_writing(saguaro, tmp_path):
     assert not path.exists()
 
 
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"names": [3]}, r"names\[0\] must be a str, got int"),
+        ({"positions": ["abc"]}, r"positions\[0\] must be an \(x, y, z\) sequence of numbers, got str"),
+        ({"rotate_y_deg": ["a"]}, r"rotate_y_deg\[0\] must be a number \(degrees\), got str"),
+        ({"scales": [None]}, r"scales\[0\] must be a number, got NoneType"),
+        ({"mesh": True, "bark": {"albedo": 3}}, r"bark\['albedo'\] must be a path or an \(r, g, b\) linear colour, got int"),
+        ({"mesh": True, "bark": {"height": 2.5}}, r"bark\['height'\] must be a path, got float"),
+        ({"mesh": True, "bark": {"relief_depth": "x"}}, r"bark\['relief_depth'\] must be a number \(metres\), got str"),
+        ({"mesh": True, "bark": {"u_repeat": [1]}}, r"bark\['u_repeat'\] must be a number, got list"),
+    ],
+)
+def test_a_value_of_the_wrong_type_is_a_type_error_naming_the_argument(saguaro, tmp_path, kwargs, message):
+    # Issue 32: these were RuntimeError "Unable to cast Python instance to C++ type".
+    path = tmp_path / "x.glb"
+    with pytest.raises(TypeError, match=message):
+        sylva.export_gltf([saguaro], path, **kwargs)
+    assert not path.exists()
+
+
 def test_export_failure_raises_with_the_reason(saguaro, tmp_path):
     # The README's promise: OSError for files, ValueError for values, never RuntimeError.
     with pytest.raises(FileNotFoundError):

@@ -62,8 +62,15 @@ def test_out_of_range_seeds_raise_overflow_error(seed):
 @pytest.mark.parametrize("seed", [7.0, "7", True])
 def test_non_integer_seeds_raise_type_error(seed):
     g = sylva.Grammar.from_file("presets/elm.lsys")
-    with pytest.raises(TypeError):
+    with pytest.raises(TypeError, match="seed must be an int"):
         g.grow(seed=seed)
+
+
+@pytest.mark.parametrize("steps", [7.0, "7", None.__class__])
+def test_non_integer_steps_raise_type_error_naming_steps(steps):
+    g = sylva.Grammar.from_file("presets/elm.lsys")
+    with pytest.raises(TypeError, match="steps must be an int"):
+        g.grow(steps=steps)
 
 
 def test_negative_steps_raise_value_error():
