@@ -31,7 +31,7 @@ namespace {
 
 void print_export_help() {
   std::cout << "usage: sylva export INPUT -o FILE.gltf|FILE.glb [--mesh] [--segments-around N] [--instancing]\n"
-               "                    [--extras compact|full|none]\n"
+               "                    [--extras compact|full|none] [--skin smooth|paper]\n"
                "                    [--bark-albedo FILE] [--bark-height FILE] [--relief-depth M]\n"
                "                    [--u-repeat N] [--v-per-metre N]\n"
                "                    [-n STEPS] [--seed S|A..B] [-D NAME=VALUE]... [--max-modules N]\n\n"
@@ -48,6 +48,9 @@ void print_export_help() {
                "      --segments-around N  columns around each frustum of the mesh, 3 to 4096 (default 8)\n"
                "      --instancing         repeated identical plants of a scene as one node with\n"
                "                           EXT_mesh_gpu_instancing\n"
+               "      --skin S             how chains meet in the mesh and extras' skinning, for every\n"
+               "                           plant (over a scene's skin keys): smooth (the default) or\n"
+               "                           paper (Bhagvat et al. 2009's mitred chains)\n"
                "      --extras MODE        how each node's extras.sylva holds the skeleton (docs/gltf.md):\n"
                "                           compact (default) the large arrays (joints, chains, leaves,\n"
                "                             skinning, instance placements) as raw little-endian float64/\n"
@@ -127,6 +130,7 @@ int run_export(const std::vector<std::string>& raw_args) {
   GltfExportOptions options;
   options.extras = GltfExtras::compact;  // the CLI's default (the library's is full)
   Bark bark;                 // from the --bark-* flags
+  std::optional<SkinStyle> skin;  // --skin
   bool bark_flags = false;
   FlagTable table;
   table.inline_values = InlineValues::value_flags;
@@ -148,6 +152,7 @@ int run_export(const std::vector<std::string>& raw_args) {
       bark_flag("--v-per-metre",
                 [&bark](const std::string& v) { bark.v_per_metre = number_flag("--v-per-metre", v, 0, true); }),
       set_flag({"--mesh"}, options.mesh),
+      skin_flag(skin),
       set_flag({"--instancing"}, options.instancing),
       value_flag({"--extras"},
                  [&options](const std::string&, const std::string& mode) {
@@ -212,6 +217,7 @@ int run_export(const std::vector<std::string>& raw_args) {
     plant.name = plant_name(input);
     plant.skeleton = std::move(*read);
     plant.bark = bark;
+    plant.skin = skin.value_or(SkinStyle::smooth);
     if (Status exported = export_gltf({plant}, a.output, options); !exported) {
       std::cerr << exported.error().format();
       return kInputError;
@@ -226,6 +232,7 @@ int run_export(const std::vector<std::string>& raw_args) {
       return kInputError;
     }
     Scene& scene = *read;
+    if (skin) override_skin(scene, *skin);
     options.materials = scene.materials;  // one glTF material per entry (docs/materials.md)
     // A plant's grammar error: the grammar's place, and a note at the scene key naming it.
     if (Status grown = grow_scene_plants(scene, a.max_modules); !grown) {
@@ -241,6 +248,7 @@ int run_export(const std::vector<std::string>& raw_args) {
       p.rotate_y_deg = sp.rotate_y_deg;
       p.scale = sp.scale;
       p.bark = sp.bark;
+      p.skin = sp.skin;
       plants.push_back(std::move(p));
     }
     if (Status exported = export_gltf(plants, a.output, options); !exported) {
@@ -264,6 +272,7 @@ int run_export(const std::vector<std::string>& raw_args) {
     plant.name = plant_name(input);
     plant.skeleton = std::move(grown->skeleton);
     plant.bark = bark;
+    plant.skin = skin.value_or(SkinStyle::smooth);
     if (Status exported = export_gltf({plant}, output, options); !exported) return std::move(exported.error());
     return export_summary(input, output, {plant}, one_start);
   };

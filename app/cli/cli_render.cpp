@@ -57,7 +57,7 @@ void print_render_help() {
       << "usage: sylva render INPUT -o IMAGE [--backend auto|gl|cpu] [--width W --height H]\n"
          "                    [--aov depth,normal,uv,id,fog] [--spp N] [--verbose]\n"
          "                    [--eye X,Y,Z] [--target X,Y,Z] [--fov DEG]\n"
-         "                    [--geometry frusta|mesh] [--mesh-level M]\n"
+         "                    [--geometry frusta|mesh] [--mesh-level M] [--skin smooth|paper]\n"
          "                    [--fog-mode MODE] [--fog-steps N] [--photons N] [--cone-params P]\n"
          "                    [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n"
          "                    [--frames all|A..B [--fps F] [--video VIDEO]]\n\n"
@@ -96,6 +96,10 @@ void print_render_help() {
          "                         gives them)\n"
          "      --mesh-level M     the mesh's subdivision level, 0 to 6: 16·4^M triangles per\n"
          "                         segment (default 2)\n"
+         "      --skin S           how chains meet, for every plant (over the scene's and the\n"
+         "                         plants' skin keys): smooth (collars, domes, rounded bends;\n"
+         "                         the default) or paper (Bhagvat et al. 2009's mitred chains,\n"
+         "                         plain capped laterals, flat ends)\n"
          "a scene with fog only (each overrides the scene's fog key of the same name):\n"
          "      --fog-mode MODE    how the light the fog scatters is computed: auto (default:\n"
          "                         refined on the CPU, fast with OpenGL), brute (ray marching,\n"
@@ -153,7 +157,13 @@ struct RenderArgs {
   std::optional<std::string> frames;  // --frames, as given
   std::optional<double> fps;          // --fps
   std::optional<std::string> video;   // --video
+  std::optional<SkinStyle> skin;      // --skin: every plant's, over the scene's keys
 };
+
+// The scene as --skin asks (nothing without it).
+void apply_skin_flag(const RenderArgs& a, Scene& scene) {
+  if (a.skin) override_skin(scene, *a.skin);
+}
 
 // --cone-params p1,p2,p3,p4 (Hougs and Day 2001 sec. 3.2.1) or auto (nullopt): four integers with
 // p1 >= p3 + 1 (a ring needs its seed and p3 neighbours), p2 >= 2, p3 >= 1, p4 >= 1.
@@ -196,6 +206,7 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
                    if (out.backend != "auto" && out.backend != "gl" && out.backend != "cpu")
                      throw UsageError{"--backend " + out.backend + ": expected auto, gl or cpu"};
                  }),
+      skin_flag(out.skin),
       count_flag({"--width"}, out.width, 65536),
       count_flag({"--height"}, out.height, 65536),
       count_flag({"--spp"}, out.spp, 65536),
@@ -396,6 +407,7 @@ int run_render_frames(const RenderArgs& a) {
     return *code;
   }
   Scene base = std::move(std::get<Scene>(loaded));
+  apply_skin_flag(a, base);
   apply_camera_flags(a.camera, base.camera);
   if (!growth && !base.animation)
     throw UsageError{"--frames: " + input + " has no animation key, so its plants stand still (docs/animation.md)"};
@@ -484,6 +496,7 @@ int run_render_frames(const RenderArgs& a) {
         return *code;
       }
       scene = std::move(std::get<Scene>(grown));
+      apply_skin_flag(a, scene);
       scene.camera = base.camera;
       scene.ground = base.ground;
     } else {
@@ -589,6 +602,7 @@ int run_render(const std::vector<std::string>& args) {
     return *code;
   }
   Scene scene = std::move(std::get<Scene>(loaded));
+  apply_skin_flag(a, scene);
   apply_camera_flags(a.camera, scene.camera);
   if (auto problem = image_size_problem(scene.width, scene.height, a.spp)) {
     std::cerr << "sylva render: error: " << *problem << "\n";

@@ -55,6 +55,13 @@ Flag text_flag(std::vector<std::string> names, std::string& text) {
   return value_flag(std::move(names), [&text](const std::string&, const std::string& value) { text = value; });
 }
 
+Flag skin_flag(std::optional<SkinStyle>& style) {
+  return value_flag({"--skin"}, [&style](const std::string& spelled, const std::string& value) {
+    style = parse_skin_style(value);
+    if (!style) throw UsageError{spelled + " " + value + ": expected smooth or paper"};
+  });
+}
+
 Flag noting_given(Flag flag, bool& given) {
   flag.apply = [&given, apply = std::move(flag.apply)](const std::string& spelled, const std::string& value) {
     apply(spelled, value);

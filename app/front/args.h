@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "core/geometry/skin.h"
+
 namespace sylva::cli {
 
 // kInterrupted: 128 + SIGINT, the shell's convention for work stopped by Ctrl-C.
@@ -81,6 +83,8 @@ Flag count_flag(std::vector<std::string> names, Count& count, uint64_t max) {
     count = parse_count(spelled, value, max);
   });
 }
+// --skin smooth|paper (render, export, studio; docs/spec/scene.md "Skin"), into `style`.
+Flag skin_flag(std::optional<SkinStyle>& style);
 // `flag`, which also sets `given` where it is given (a default that depends on it, a
 // check that it applies).
 Flag noting_given(Flag flag, bool& given);

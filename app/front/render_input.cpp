@@ -71,6 +71,7 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
       plant.position = {p.position_m[0], p.position_m[1], p.position_m[2]};
       plant.rotate_y_deg = p.rotate_y_deg;
       plant.scale = p.scale;
+      plant.skin = p.skin;
       const Skeleton placed = place_plant(plant);
       const SkeletonBounds b = skeleton_bounds(placed);
       lo = glm::min(lo, b.lo);

@@ -20,7 +20,8 @@ namespace sylva::python {
 namespace {
 
 py::array_t<float> python_render(const Skeleton& skeleton, uint32_t width, uint32_t height, const std::string& backend,
-                                 uint32_t spp, unsigned threads) {
+                                 uint32_t spp, unsigned threads, const std::string& skin) {
+  const SkinStyle style = skin_style_argument(skin);
   if (backend != "auto" && backend != "cpu") {
     if (backend == "gpu") throw py::value_error("backend 'gpu': the GPU renderer is not available from Python yet; use 'cpu'");
     throw py::value_error("backend must be 'auto' or 'cpu', got '" + backend + "'");
@@ -34,6 +35,7 @@ py::array_t<float> python_render(const Skeleton& skeleton, uint32_t width, uint3
   {
     py::gil_scoped_release release;
     Scene scene = default_scene_for(skeleton, width, height);
+    override_skin(scene, style);
     RenderOptions options;
     options.spp = spp;
     options.threads = threads;
@@ -51,14 +53,15 @@ py::array_t<float> python_render(const Skeleton& skeleton, uint32_t width, uint3
 
 void bind_render(py::module_& m) {
   m.def("render", &python_render, "skeleton"_a, py::kw_only(), "width"_a = 640u, "height"_a = 480u,
-        "backend"_a = "auto", "spp"_a = kDefaultRenderSpp, "threads"_a = 0u,
+        "backend"_a = "auto", "spp"_a = kDefaultRenderSpp, "threads"_a = 0u, "skin"_a = "smooth",
         R"doc(Renders a Skeleton with the CPU ray caster and returns an (H, W, 4) float32 array.
 
 The plant stands in its default scene (as `sylva render plant.skel.json`): sun, sky,
 ground at its lowest point and a camera framing it. Pixels are linear RGBA, row 0 at
 the top, alpha 1 (the sky is part of the picture); convert to sRGB for display.
 Keyword-only: width, height (pixels), backend ('auto' or 'cpu'; the GPU renderer is
-not exposed yet), spp (stratified samples per pixel; default 8, as `sylva render`), threads (0: every core). The GIL
+not exposed yet), spp (stratified samples per pixel; default 8, as `sylva render`), threads (0: every core),
+skin ("smooth", or "paper": Bhagvat et al. 2009's mitred chains, as `--skin`). The GIL
 is released while rendering; the image is the same for every thread count.)doc");
 }
 

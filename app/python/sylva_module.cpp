@@ -124,6 +124,12 @@ std::optional<int64_t> steps_from_python(const py::object& value) {
   return static_cast<int64_t>(steps);
 }
 
+SkinStyle skin_style_argument(const std::string& skin) {
+  const std::optional<SkinStyle> style = parse_skin_style(skin);
+  if (!style) throw py::value_error("skin must be \"smooth\" or \"paper\", got \"" + skin + "\"");
+  return *style;
+}
+
 std::map<std::string, double> defines_from_python(const py::object& value) {
   std::map<std::string, double> defines;
   if (value.is_none()) return defines;
@@ -532,7 +538,8 @@ Bark bark_from_dict(const py::object& value) {
 void python_export_gltf(const py::object& plants, const std::filesystem::path& path, bool mesh, int segments_around,
                         bool instancing, const py::object& names, const py::object& positions,
                         const py::object& rotate_y_deg, const py::object& scales, const py::object& bark,
-                        const std::string& extras) {
+                        const std::string& extras, const std::string& skin) {
+  const SkinStyle style = skin_style_argument(skin);
   const std::vector<const Skeleton*> skeletons = skeleton_list(plants);
   if (skeletons.empty()) throw py::value_error("export_gltf needs at least one plant");
   if (segments_around < 3) throw py::value_error("segments_around must be >= 3");
@@ -540,6 +547,7 @@ void python_export_gltf(const py::object& plants, const std::filesystem::path& p
   for (size_t i = 0; i < skeletons.size(); ++i) {
     gltf_plants[i].skeleton = *skeletons[i];
     gltf_plants[i].name = plant_name(*skeletons[i]);
+    gltf_plants[i].skin = style;
   }
   if (!names.is_none()) {
     py::sequence seq = per_plant(names, skeletons.size(), "names");
@@ -814,7 +822,8 @@ released while growing. A RuntimeWarning reports an interpretation cut at max de
   m.def("export_gltf", &python_export_gltf, "plants"_a, "path"_a, py::kw_only(), "mesh"_a = false,
         "segments_around"_a = 8, "instancing"_a = false, "names"_a = py::none(), "positions"_a = py::none(),
         "rotate_y_deg"_a = py::none(), "scales"_a = py::none(), "bark"_a = py::none(), "extras"_a = "full",
-        R"doc(export_gltf(plants: Skeleton | Sequence[Skeleton], path: str | os.PathLike, *, mesh: bool = False, segments_around: int = 8, instancing: bool = False, names: Sequence[str] | None = None, positions: Sequence[tuple[float, float, float]] | None = None, rotate_y_deg: Sequence[float] | None = None, scales: Sequence[float] | None = None, bark: dict | None = None, extras: str = "full") -> None
+        "skin"_a = "smooth",
+        R"doc(export_gltf(plants: Skeleton | Sequence[Skeleton], path: str | os.PathLike, *, mesh: bool = False, segments_around: int = 8, instancing: bool = False, names: Sequence[str] | None = None, positions: Sequence[tuple[float, float, float]] | None = None, rotate_y_deg: Sequence[float] | None = None, scales: Sequence[float] | None = None, bark: dict | None = None, extras: str = "full", skin: str = "smooth") -> None
 
 Writes plants to a glTF 2.0 file, binary (.glb) or JSON (.gltf) by extension.
 
@@ -841,6 +850,8 @@ Keyword-only:
                    here: every number as JSON, for readers of the JSON), "compact" (the
                    large arrays as bufferViews of raw float64/uint32, bit-exact and a few
                    times smaller: `sylva export`'s default) or "none" (a plain mesh)
+  skin             how chains meet in the mesh and extras' skinning: "smooth" (collars,
+                   domes, rounded bends) or "paper" (Bhagvat et al. 2009's mitred chains)
 The mesh has one material per material index the plants use. The file is written
 atomically; a file that cannot be read or written (a missing texture, a missing folder,
 a FIFO or read-only target) raises OSError, plants beyond the limits (docs/limits.md)

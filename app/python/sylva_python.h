@@ -15,6 +15,7 @@
 #include <string>
 
 #include "core/geometry/skeleton.h"
+#include "core/geometry/skin.h"
 #include "core/util/diagnostic.h"
 #include "core/grow/grow.h"
 
@@ -54,6 +55,8 @@ std::optional<uint64_t> seed_from_python(const pybind11::object& value);
 std::optional<int64_t> steps_from_python(const pybind11::object& value);
 // None → {}; a dict {str: number} → the override map (non-finite values: ValueError).
 std::map<std::string, double> defines_from_python(const pybind11::object& value);
+// "smooth" or "paper" → its SkinStyle; anything else → ValueError naming `skin`.
+SkinStyle skin_style_argument(const std::string& skin);
 
 // Adds everything to the module (sylva_module.cpp) and sylva.render (python_render.cpp).
 void bind_module(pybind11::module_& m);

@@ -64,6 +64,7 @@ StudioApp::StudioApp(StudioOptions options, Viewport* viewport)
       viewport_(viewport),
       worker_(std::make_unique<GrowWorker>()),
       cones_(std::make_unique<ConeWorker>()) {
+  if (options_.skin) skin_choice_ = *options_.skin == SkinStyle::paper ? 2 : 1;
   show_presets_ = true;  // until a document is opened
   scene_ = Scene{};
   scene_.plants.assign(1, ScenePlant{});  // an untitled grammar: typing grows it
@@ -298,6 +299,7 @@ Scene StudioApp::view_scene() const {
   Scene s = scene_;
   if (!bark_)
     for (ScenePlant& p : s.plants) p.bark = Bark{};
+  if (skin_choice_ != 0) override_skin(s, skin_choice_ == 2 ? SkinStyle::paper : SkinStyle::smooth);
   return s;
 }
 
@@ -456,7 +458,7 @@ void StudioApp::watch_file(double now) {
 std::optional<std::string> StudioApp::export_gltf_file(const std::string& path, bool mesh) {
   if (!plant_) return std::string("no plant to export yet");
   std::vector<GltfPlant> plants;
-  for (const ScenePlant& sp : scene_.plants) {
+  for (const ScenePlant& sp : view_scene().plants) {
     if (!sp.skeleton) continue;
     GltfPlant p;
     p.name = stem(sp.grammar.empty() ? path_ : sp.grammar);
@@ -465,6 +467,7 @@ std::optional<std::string> StudioApp::export_gltf_file(const std::string& path, 
     p.rotate_y_deg = sp.rotate_y_deg;
     p.scale = sp.scale;
     p.bark = sp.bark;
+    p.skin = sp.skin;
     plants.push_back(std::move(p));
   }
   GltfExportOptions o;
@@ -956,6 +959,10 @@ void StudioApp::draw_view() {
   skin |= ImGui::Checkbox("bark", &bark_);
   ImGui::SameLine();
   skin |= ImGui::Checkbox("relief", &render_options_.geometry.relief);
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(110);
+  skin |= ImGui::Combo("skin", &skin_choice_, "scene's\0smooth\0paper\0");
+  keep("skin");
   ImGui::SameLine();
   ImGui::SetNextItemWidth(100);
   int knuckles = render_options_.skin.knuckle_frusta;

@@ -43,6 +43,8 @@ struct StudioOptions {
   double autosave_s = 3;          // how often an edited document is autosaved
   double watch_s = 0.5;           // how often the file on disk is checked for changes
   uint64_t max_modules = 50'000'000;
+  std::optional<SkinStyle> skin;  // --skin: every plant's, over the scene's keys (the view's
+                                  //   skin control starts here; none: the scene's)
 };
 
 // Where the tests click: screen rectangles of named widgets from the last frame.
@@ -155,7 +157,7 @@ class StudioApp {
   void draw_modals();
   void draw_file_dialog();
   void keep(const std::string& name);  // records the last item's rect under `name`
-  Scene view_scene() const;            // scene_ with the view's bark toggle applied
+  Scene view_scene() const;            // scene_ with the view's bark and skin controls applied
   void plants_changed();               // skin/bark/relief options or new plants → set_plants
   std::string display_name() const;
 
@@ -194,6 +196,7 @@ class StudioApp {
   OrbitCamera orbit_;
   RenderOptions render_options_;
   bool bark_ = true;
+  int skin_choice_ = 0;              // the view's skin control: 0 the scene's, 1 smooth, 2 paper
   float sun_azimuth_deg_ = 0, sun_elevation_deg_ = 45;
   bool view_half_res_ = false;
 

@@ -37,11 +37,14 @@ namespace sylva::studio {
 namespace {
 
 void print_help() {
-  std::cout << "usage: sylva studio [INPUT] [--size WxH] [--screenshot OUT.png [--frames N]]\n\n"
+  std::cout << "usage: sylva studio [INPUT] [--size WxH] [--skin smooth|paper] [--screenshot OUT.png [--frames N]]\n\n"
                "Opens the studio: edit a grammar and watch the plant regrow. INPUT is a .lsys grammar\n"
                "or a .scene.json scene (the editor shows its first plant's grammar); without one, the\n"
                "preset browser opens. Needs a display (on a machine without one: xvfb-run -a sylva studio ...).\n\n"
                "  --size WxH          window size in pixels (default 1280x800)\n"
+               "  --skin S            how chains meet, for every plant (over the scene's skin keys):\n"
+               "                      smooth or paper (Bhagvat et al. 2009's mitred chains); the view's\n"
+               "                      skin control starts there\n"
                "  --screenshot FILE   grow the plant, draw N frames after it is on screen, write the\n"
                "                      window's pixels to FILE (PNG, atomically) and exit 0; exit 1 with\n"
                "                      the located error, writing nothing, if INPUT does not parse\n"
@@ -58,6 +61,7 @@ struct StudioArgs {
   int frames = 3;
   int width = 1280, height = 800;
   bool help = false;
+  std::optional<SkinStyle> skin;
 };
 
 StudioArgs parse_args(const std::vector<std::string>& args) {
@@ -66,6 +70,7 @@ StudioArgs parse_args(const std::vector<std::string>& args) {
   table.flags = {
       cli::help_flag(a.help),
       cli::text_flag({"--screenshot"}, a.screenshot),
+      cli::skin_flag(a.skin),
       cli::value_flag({"--frames"},
                       [&a](const std::string&, const std::string& v) {
                         auto n = cli::parse_u64(v);
@@ -208,6 +213,7 @@ int run_studio(const std::vector<std::string>& raw_args) {
     StudioOptions options;
     const char* presets = std::getenv("SYLVA_PRESETS");
     options.presets_dir = presets ? presets : SYLVA_PRESETS_DIR;
+    options.skin = a.skin;
     StudioApp app(options, viewport_ptr.get());
     app.worker().on_result([] { glfwPostEmptyEvent(); });
     if (code == cli::kOk && !a.input.empty())

@@ -376,6 +376,7 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     progress.report(static_cast<double>(p) / static_cast<double>(scene.plants.size()), "geometry");
     if (only && !(*only)[p]) continue;
     const ScenePlant& plant = scene.plants[p];
+    const SkinOptions plant_skin = skin.styled(plant.skin);
     Clock::time_point start = Clock::now();
     Skeleton placed = place_plant(plant);
     skin_s += seconds_since(start);
@@ -383,7 +384,7 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
       start = Clock::now();
       // A relief or displacement reaches out to relief_depth_m beyond the frusta.
       const double relief_m = plant.bark.height_texture ? std::max(0.0, plant.bark.relief_depth_m) : 0.0;
-      const bool out = plant_is_culled(scene, view, plant_box(placed, skin, relief_m));
+      const bool out = plant_is_culled(scene, view, plant_box(placed, plant_skin, relief_m));
       cull_s += seconds_since(start);
       if (out) {
         ++culled;
@@ -393,7 +394,7 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     start = Clock::now();
     const double plant_count = static_cast<double>(scene.plants.size());
     Expected<SkinnedSkeleton> skinned_or =
-        skin_skeleton(placed, skin, progress.part(p / plant_count, (p + 1) / plant_count));
+        skin_skeleton(placed, plant_skin, progress.part(p / plant_count, (p + 1) / plant_count));
     if (!skinned_or) {  // cancelled
       g.cancelled = true;
       return g;
@@ -549,7 +550,10 @@ SceneGeometry build_instanced_geometry(const Scene& scene, const SkinOptions& sk
     const PlantTransform transform = PlantTransform::of(plant);
     if (options.cull) {
       const Clock::time_point cull_start = Clock::now();
-      if (!boxed[k]) local_box[k] = plant_box(*scene.plants[groups.prototypes[k]].skeleton, skin), boxed[k] = 1;
+      if (!boxed[k]) {
+        const ScenePlant& prototype = scene.plants[groups.prototypes[k]];
+        local_box[k] = plant_box(*prototype.skeleton, skin.styled(prototype.skin)), boxed[k] = 1;
+      }
       const bool out = plant_is_culled(scene, view, transform.world_box(local_box[k]));
       cull_s += seconds_since(cull_start);
       if (out) {

@@ -16,6 +16,12 @@
 
 namespace sylva {
 
+std::optional<SkinStyle> parse_skin_style(std::string_view text) {
+  if (text == "smooth") return SkinStyle::smooth;
+  if (text == "paper") return SkinStyle::paper;
+  return std::nullopt;
+}
+
 namespace {
 
 // Cancellation is checked, and progress reported, once per 1024 chains.

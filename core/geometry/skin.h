@@ -53,6 +53,8 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
+#include <string_view>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <vector>
@@ -80,6 +82,16 @@ enum class FrustumKind : uint8_t {
   knuckle,  // part of the ball closing a split (sharp) joint
 };
 
+// How chains meet (docs/spec/scene.md "Skin"): the scene's and each plant's `skin` key and
+// `--skin` on render, export and studio.
+enum class SkinStyle : uint8_t {
+  smooth,  // collars where laterals leave, domes on chain ends that carry children, rounded bends
+  paper,   // Bhagvat et al. 2009, sec. 2, as published: mitres, plain capped laterals, flat ends
+};
+inline constexpr const char* skin_style_name(SkinStyle s) { return s == SkinStyle::paper ? "paper" : "smooth"; }
+// "smooth" or "paper" (exactly); none for anything else.
+std::optional<SkinStyle> parse_skin_style(std::string_view text);
+
 // Options of skin_skeleton.
 struct SkinOptions {
   bool fit_minor_axis = false;    // sec. 2.2 iterative fit of the new cone's base radius
@@ -100,15 +112,20 @@ struct SkinOptions {
   double round_bends_over_deg = 20; // bends sharper than this are rounded by an arc ...
   double round_piece_deg = 10;      // ... of pieces that each turn at most this much
 
-  // Sec. 2 as published: laterals start with a plain capped cylinder, chain ends are flat
-  // caps and every bend is a mitre (or a split joint): what the paper's figures show.
-  static SkinOptions paper() {
-    SkinOptions o;
-    o.collars = false;
-    o.round_bends_over_deg = 180;
-    o.round_piece_deg = 180;
+  // These options with the joints of `style`: smooth keeps them; paper (sec. 2 as
+  // published: laterals start with a plain capped cylinder, chain ends are flat caps and
+  // every bend is a mitre or a split joint, what the paper's figures show) turns collars,
+  // domes and rounded bends off. The other knobs (tilt, knuckles, twist, fit) are kept.
+  SkinOptions styled(SkinStyle style) const {
+    SkinOptions o = *this;
+    if (style == SkinStyle::paper) {
+      o.collars = false;
+      o.round_bends_over_deg = 180;
+      o.round_piece_deg = 180;
+    }
     return o;
   }
+  static SkinOptions paper() { return SkinOptions{}.styled(SkinStyle::paper); }
 };
 
 // One skinned frustum: the shared shape plus what renderers and texturing need.

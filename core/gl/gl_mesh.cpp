@@ -265,7 +265,7 @@ struct GlMesh::State {
     const auto append = [&](uint32_t p, const Skeleton& skeleton, std::vector<GlMeshSphere>* out) -> size_t {
       const ScenePlant& plant = scene.plants[p];
       Clock::time_point start = Clock::now();
-      const SkinnedSkeleton skinned = skin_skeleton(skeleton, options.skin);
+      const SkinnedSkeleton skinned = skin_skeleton(skeleton, options.skin.styled(plant.skin));
       skinned_frusta += skinned.frusta.size();
       skin_s += seconds_since(start);
       // build_scene_geometry's mesh path: the same plant_mesh, within the same limit.

@@ -248,9 +248,9 @@ struct GlRenderer::State {
 
   // Skins one skeleton (placed: in the world) into records and id quadruples (plant, chain,
   // segment, 0), and its frusta's bounding spheres into *out.
-  void skin_one(const Skeleton& skeleton, uint32_t plant, const Progress& progress, std::vector<GpuSegment>* records,
-                std::vector<uint32_t>* ids, std::vector<Sphere>* out) const {
-    Expected<SkinnedSkeleton> skinned_or = skin_skeleton(skeleton, options.skin, progress);
+  void skin_one(const Skeleton& skeleton, uint32_t plant, SkinStyle style, const Progress& progress,
+                std::vector<GpuSegment>* records, std::vector<uint32_t>* ids, std::vector<Sphere>* out) const {
+    Expected<SkinnedSkeleton> skinned_or = skin_skeleton(skeleton, options.skin.styled(style), progress);
     if (!skinned_or) throw GlCancelled();  // the only error skin_skeleton returns
     const SkinnedSkeleton& skinned = *skinned_or;
     for (const Frustum& f : skinned.frusta) {
@@ -301,7 +301,8 @@ struct GlRenderer::State {
     const double share = 1.0 / std::max(1u, n);
     for (uint32_t p : split.world) {
       if (options.progress.cancelled()) throw GlCancelled();  // between plants
-      skin_one(place_plant(scene.plants[p]), p, options.progress.part(p * share, (p + 1) * share), records, ids, &fresh);
+      skin_one(place_plant(scene.plants[p]), p, scene.plants[p].skin, options.progress.part(p * share, (p + 1) * share),
+               records, ids, &fresh);
     }
     const uint32_t world_records = static_cast<uint32_t>(records->size());
     uint64_t drawn = world_records;
@@ -321,7 +322,7 @@ struct GlRenderer::State {
         // plant may be one skinned in the world, with a relief none of these has).
         const uint32_t prototype = group.front();
         std::vector<Sphere> local;
-        skin_one(*scene.plants[prototype].skeleton, prototype, {}, records, ids, &local);
+        skin_one(*scene.plants[prototype].skeleton, prototype, scene.plants[prototype].skin, {}, records, ids, &local);
         const Sphere bound = enclosing_sphere(local);
         const uint32_t draw_index = static_cast<uint32_t>(fresh_draws.size());
         InstancedDraw draw{first, static_cast<uint32_t>(records->size()) - first,

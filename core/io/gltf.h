@@ -73,7 +73,8 @@
 //   "chains" — exactly docs/spec/skeleton.md's document;
 //   "skinning": {"max_tilt_deg", "columns": [...], "frusta": [[chain, segment, knuckle,
 //     lower_normal[3], lower_offset_m, upper_normal[3], upper_offset_m, u_offset], ...]}
-//     — skin_skeleton's frusta with default SkinOptions, in its order;
+//     — skin_skeleton's frusta with default SkinOptions styled by the plant's skin, in
+//     its order, and "skin": "smooth" or "paper" (which of the two);
 //   "instances": [{"name", "position_m"[3], "rotate_y_deg", "scale"}, ...] — the exact
 //     placement of every plant this node draws (one, or several when instanced).
 // Extras "compact" (GltfExtras::compact, `sylva export`'s default): "format", "version"
@@ -87,7 +88,7 @@
 //   "leaves"    {"count" L, "vertex_count" u32[L], "joint" u32[2L] (as "parent"),
 //                "material" u32[L], "vertices" f64[3V]}, V = the sum of vertex_count;
 //                left out without leaves;
-//   "skinning"  {"max_tilt_deg", "columns", "frusta": {"count" F, "ids" u32[3F] (chain,
+//   "skinning"  {"max_tilt_deg", "skin", "columns", "frusta": {"count" F, "ids" u32[3F] (chain,
 //                segment, knuckle 0/1), "planes" f64[9F] (the other columns in order)}};
 //   "instances" {"count" K, "names" [K strings], "placement" f64[5K] (position_m[3],
 //                rotate_y_deg, scale)}.
@@ -121,6 +122,8 @@ struct GltfPlant {
   double rotate_y_deg = 0;      // node rotation about +Y
   double scale = 1;             // node uniform scale
   Bark bark = {};               // textures and relief of the mesh (used with `mesh` only)
+  SkinStyle skin = SkinStyle::smooth;  // how its chains meet (the frusta of the mesh and of
+                                       //   extras' "skinning"; docs/spec/scene.md "Skin")
 };
 
 // How a node's extras.sylva holds the skeleton (docs/gltf.md "Skeleton in extras").
@@ -153,7 +156,7 @@ Status check_bark_textures(const Bark& bark);
 // r_ref of the baked normal map: the median over the skinned segments (knuckles left
 // out) of the mean of their two end radii, segments of radius 0 at both ends left out;
 // 0 when there is none.
-double bark_reference_radius_m(const Skeleton& skeleton);
+double bark_reference_radius_m(const Skeleton& skeleton, SkinStyle skin = SkinStyle::smooth);
 
 // Reads the sylva skeletons back from a glTF file's node extras (for `sylva render
 // plant.glb`), "full" or "compact": one plant per node and instance, in node order. A

@@ -393,6 +393,15 @@ Status read_sylva_extras(const std::string& path, const JsonValue& node, size_t 
     if (Status valid = validate_skeleton(*read); !valid) return error_at(path, sylva, where + ": " + valid.error().message);
   }
 
+  // The skin its frusta were written with (files from before the key: smooth, the only one).
+  SkinStyle skin = SkinStyle::smooth;
+  if (const JsonValue* skinning = sylva.find("skinning"); skinning && skinning->is_object())
+    if (const JsonValue* style = skinning->find("skin")) {
+      const std::optional<SkinStyle> parsed = style->is_string() ? parse_skin_style(style->text) : std::nullopt;
+      if (!parsed) return error_at(path, *style, where + ".skinning.skin must be \"smooth\" or \"paper\"");
+      skin = *parsed;
+    }
+
   const JsonValue* instances = sylva.find("instances");
   std::vector<Placement> placements;
   if (!instances) {
@@ -448,6 +457,7 @@ Status read_sylva_extras(const std::string& path, const JsonValue& node, size_t 
     std::copy(placement.position_m, placement.position_m + 3, p.position_m);
     p.rotate_y_deg = placement.rotate_y_deg;
     p.scale = placement.scale;
+    p.skin = skin;
     plants->push_back(std::move(p));
   }
   return {};

@@ -190,10 +190,11 @@ void write_compact_skeleton(JsonWriter& w, const Skeleton& sk, BufferBuilder& bu
 // Per frustum of skin_skeleton (default options): what a renderer needs beyond the
 // skeleton to reproduce the surface parametrization. With `binary` (extras "compact")
 // the frusta go to bufferViews.
-void write_skinning(JsonWriter& w, const SkinnedSkeleton& skinned, BufferBuilder* binary) {
+void write_skinning(JsonWriter& w, const SkinnedSkeleton& skinned, SkinStyle skin, BufferBuilder* binary) {
   const SkinOptions defaults;
   w.key("skinning").begin_object();
   w.key("max_tilt_deg").number(defaults.max_tilt_deg);
+  w.key("skin").string(skin_style_name(skin));
   w.key("columns").begin_array();
   for (const char* column : {"chain", "segment", "knuckle", "lower_normal", "lower_offset_m", "upper_normal",
                              "upper_offset_m", "u_offset"})
@@ -595,7 +596,7 @@ std::vector<PlantGroup> group_plants(const std::vector<GltfPlant>& plants, const
   if (options.instancing) {
     std::map<std::string, size_t> group_of;
     for (size_t i = 0; i < plants.size(); ++i) {
-      std::string key = write_skeleton_json(plants[i].skeleton);
+      std::string key = write_skeleton_json(plants[i].skeleton) + skin_style_name(plants[i].skin);
       if (options.mesh) key += bark_key(plants[i].bark);
       auto [it, inserted] = group_of.emplace(std::move(key), groups.size());
       if (inserted) groups.emplace_back();
@@ -826,7 +827,7 @@ void write_node_extras(JsonWriter& node, const std::vector<GltfPlant>& plants, c
   if (extras == GltfExtras::full) {
     node.key("extras").begin_object().key("sylva").begin_object();
     write_skeleton_members(node, sk, {.compact = true, .seed_as_string = true});
-    write_skinning(node, skinned, nullptr);
+    write_skinning(node, skinned, plants[group.plants.front()].skin, nullptr);
     node.key("instances").begin_array();
     for (size_t i : group.plants) write_instance(node, plants[i]);
     node.end_array();
@@ -834,7 +835,7 @@ void write_node_extras(JsonWriter& node, const std::vector<GltfPlant>& plants, c
   } else if (extras == GltfExtras::compact) {
     node.key("extras").begin_object().key("sylva").begin_object();
     write_compact_skeleton(node, sk, buffer);
-    write_skinning(node, skinned, &buffer);
+    write_skinning(node, skinned, plants[group.plants.front()].skin, &buffer);
     std::vector<double> placement;
     node.key("instances").begin_object().key("count").integer(group.plants.size());
     node.key("names").begin_array();
@@ -855,7 +856,7 @@ Status add_plant_group(GltfDocument& doc, const std::vector<GltfPlant>& plants, 
                        const GltfExportOptions& options) {
   const GltfPlant& plant = plants[group.plants.front()];
   const Skeleton& sk = plant.skeleton;
-  const SkinnedSkeleton skinned = skin_skeleton(sk);
+  const SkinnedSkeleton skinned = skin_skeleton(sk, SkinOptions{}.styled(plant.skin));
 
   MeshPrimitives primitives;
   primitives.json.begin_array();
@@ -1021,7 +1022,9 @@ Status check_bark_textures(const Bark& bark) {
   return {};
 }
 
-double bark_reference_radius_m(const Skeleton& skeleton) { return median_segment_radius(skin_skeleton(skeleton)); }
+double bark_reference_radius_m(const Skeleton& skeleton, SkinStyle skin) {
+  return median_segment_radius(skin_skeleton(skeleton, SkinOptions{}.styled(skin)));
+}
 
 Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path, const GltfExportOptions& options) {
   const std::string ext = lower_case(path);

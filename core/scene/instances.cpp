@@ -56,15 +56,16 @@ bool same_shape(const Skeleton& a, const Skeleton& b) {
 }  // namespace
 
 PlantInstances plant_instances(const Scene& scene) {
-  // Candidates: the same grammar, steps and defines, and as many joints and leaves.
-  using Key = std::tuple<std::string, std::optional<int64_t>, std::map<std::string, double>, size_t, size_t>;
+  // Candidates: the same grammar, steps, defines and skin, and as many joints and leaves.
+  using Key =
+      std::tuple<std::string, std::optional<int64_t>, std::map<std::string, double>, SkinStyle, size_t, size_t>;
   std::map<Key, std::vector<uint32_t>> prototypes_of_key;  // prototype indices
   PlantInstances out;
   out.prototype_of_plant.resize(scene.plants.size());
   for (uint32_t p = 0; p < scene.plants.size(); ++p) {
     const ScenePlant& plant = scene.plants[p];
     if (!plant.skeleton) throw std::logic_error("plant_instances: a plant has no skeleton (call grow_scene_plants)");
-    std::vector<uint32_t>& candidates = prototypes_of_key[Key{plant.grammar, plant.steps, plant.defines,
+    std::vector<uint32_t>& candidates = prototypes_of_key[Key{plant.grammar, plant.steps, plant.defines, plant.skin,
                                                               plant.skeleton->joints.size(),
                                                               plant.skeleton->leaves.size()}];
     uint32_t found = UINT32_MAX;

@@ -178,6 +178,12 @@ MaterialLook material_look(const std::map<uint32_t, SceneMaterial>& table, const
   return look;
 }
 
+void override_skin(Scene& scene, SkinStyle style) {
+  scene.skin = style;
+  for (ScenePlant& p : scene.plants) p.skin = style;
+  for (SceneScatter& sc : scene.scatter) sc.skin.reset();
+}
+
 Skeleton place_plant(const ScenePlant& plant) {
   Skeleton sk = *plant.skeleton;
   const double angle = plant.rotate_y_deg * std::numbers::pi / 180;

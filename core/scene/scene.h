@@ -20,6 +20,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/geometry/skeleton.h"
+#include "core/geometry/skin.h"
 #include "core/util/bounds.h"
 #include "core/util/diagnostic.h"
 #include "core/util/progress.h"
@@ -212,6 +213,8 @@ struct ScenePlant {
                                            //   not read from a file); grow_scene_plants' note
   uint32_t scatter = 0;                    // k + 1: placed by scatter[k] (written as that
                                            //   entry, not as a plant); 0: one of `plants`
+  SkinStyle skin = SkinStyle::smooth;      // its own `skin` key, else its scatter entry's,
+                                           //   else the scene's (docs/spec/scene.md "Skin")
   bool operator==(const ScenePlant&) const = default;
 };
 
@@ -238,6 +241,7 @@ struct SceneScatter {
   double rotate_min_deg = 0, rotate_max_deg = 360;
   double scale_min = 1, scale_max = 1;
   double min_spacing = 0;                  // metres between any two plants' positions
+  std::optional<SkinStyle> skin;           // its `skin` key; none: the scene's
   SourceLoc grammar_loc = {};
   bool operator==(const SceneScatter&) const = default;
 };
@@ -256,6 +260,7 @@ struct Scene {
   std::map<uint32_t, SceneMaterial> materials;  // by material index (< kMaterialSlots)
   std::vector<ScenePlant> plants;  // the scene's own, then every scatter entry's, in order
   std::vector<SceneScatter> scatter;
+  SkinStyle skin = SkinStyle::smooth;  // the `skin` key: every plant's that names none
   std::string file = {};           // the file it was read from, for messages ("" if made
                                    //   in code); like ScenePlant::grammar_loc, a place, not
                                    //   part of what the scene describes (not written)
@@ -267,6 +272,10 @@ struct Scene {
 // set in code (the studio's sun control) should go through this for the scene to write
 // and read back exactly (write_scene_json). Precondition: toward_sun is not zero.
 glm::dvec3 unit_sun_direction(const glm::dvec3& toward_sun);
+
+// `--skin` (render, export, studio): every plant, scatter entry and the scene itself
+// skinned by `style`, whatever their keys say.
+void override_skin(Scene& scene, SkinStyle style);
 
 // The skeleton of `plant` placed in the world: p' = position + R_y(rotate_y_deg)·(scale·p),
 // radii scaled. Precondition: plant.skeleton is set.

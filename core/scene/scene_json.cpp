@@ -262,10 +262,18 @@ void read_recipe(const JsonValue& v, const std::string& base_dir, const std::str
   }
 }
 
-ScenePlant read_plant(const JsonValue& v, const std::string& base_dir, size_t index) {
+// The `skin` key `v` (docs/spec/scene.md "Skin"), `otherwise` where there is none.
+SkinStyle skin_style(const JsonValue* v, const std::string& what, SkinStyle otherwise) {
+  if (!v) return otherwise;
+  const std::optional<SkinStyle> style = v->is_string() ? parse_skin_style(v->text) : std::nullopt;
+  if (!style) fail(*v, what + " must be \"smooth\" or \"paper\"");
+  return *style;
+}
+
+ScenePlant read_plant(const JsonValue& v, const std::string& base_dir, size_t index, SkinStyle scene_skin) {
   const std::string what = "plants[" + std::to_string(index) + "]";
   expect_object(v, what);
-  check_keys(v, what, {"grammar", "seed", "steps", "defines", "position", "rotate_y_deg", "scale", "bark"});
+  check_keys(v, what, {"grammar", "seed", "steps", "defines", "position", "rotate_y_deg", "scale", "bark", "skin"});
   ScenePlant p;
   read_recipe(v, base_dir, what, &p.grammar, &p.grammar_loc, &p.steps, &p.defines);
   if (auto* x = v.find("seed")) {
@@ -277,6 +285,7 @@ ScenePlant read_plant(const JsonValue& v, const std::string& base_dir, size_t in
   if (auto* x = v.find("rotate_y_deg")) p.rotate_y_deg = number(*x, what + ".rotate_y_deg");
   if (auto* x = v.find("scale")) p.scale = number_in(*x, what + ".scale", 0, 1e9, true, false);
   if (auto* x = v.find("bark")) p.bark = read_bark(*x, base_dir, what + ".bark");
+  p.skin = skin_style(v.find("skin"), what + ".skin", scene_skin);
   return p;
 }
 
@@ -300,10 +309,11 @@ SceneScatter read_scatter(const JsonValue& v, const std::string& base_dir, size_
   expect_object(v, what);
   check_keys(v, what,
              {"grammar", "steps", "defines", "bark", "count", "density", "disc", "polygon", "seed", "plant_seeds",
-              "rotate_y_deg", "scale", "min_spacing"});
+              "rotate_y_deg", "scale", "min_spacing", "skin"});
   SceneScatter sc;
   read_recipe(v, base_dir, what, &sc.grammar, &sc.grammar_loc, &sc.steps, &sc.defines);
   if (auto* x = v.find("bark")) sc.bark = read_bark(*x, base_dir, what + ".bark");
+  if (auto* x = v.find("skin")) sc.skin = skin_style(x, what + ".skin", SkinStyle::smooth);
   const JsonValue* disc = v.find("disc");
   const JsonValue* polygon = v.find("polygon");
   if ((disc != nullptr) == (polygon != nullptr)) fail(v, what + " needs exactly one area: \"disc\" or \"polygon\"");
@@ -518,7 +528,7 @@ Scene read_scene(const JsonValue& root, const std::string& base_dir) {
   expect_object(root, "a scene");
   check_keys(root, "the scene",
              {"format", "version", "camera", "image", "sun", "sky", "ground", "fog", "animation", "materials",
-              "plants", "scatter"});
+              "plants", "scatter", "skin"});
   Scene s;
   if (auto* x = root.find("format"); x && !(x->is_string() && x->text == "sylva-scene"))
     fail(*x, "format must be \"sylva-scene\"");
@@ -544,16 +554,18 @@ Scene read_scene(const JsonValue& root, const std::string& base_dir) {
   if (auto* x = root.find("fog")) s.fog = read_fog(*x, s.ground.height);
   if (auto* x = root.find("animation")) s.animation = read_animation(*x);
   if (auto* x = root.find("materials")) s.materials = read_materials(*x, base_dir);
+  s.skin = skin_style(root.find("skin"), "skin", SkinStyle::smooth);
   const JsonValue* plants = root.find("plants");
   if (!plants) fail(root, "a scene needs \"plants\" (an array of plants)");
   if (!plants->is_array()) fail(*plants, std::string("plants must be an array, not ") + plants->kind_name());
   for (size_t i = 0; i < plants->elements.size(); ++i)
-    s.plants.push_back(read_plant(plants->elements[i], base_dir, i));
+    s.plants.push_back(read_plant(plants->elements[i], base_dir, i, s.skin));
   if (auto* x = root.find("scatter")) {
     if (!x->is_array()) fail(*x, std::string("scatter must be an array, not ") + x->kind_name());
     for (size_t k = 0; k < x->elements.size(); ++k) {
       s.scatter.push_back(read_scatter(x->elements[k], base_dir, k));
       std::vector<ScenePlant> placed = scatter_plants(s.scatter.back(), k, s.ground.height, x->elements[k]);
+      for (ScenePlant& p : placed) p.skin = s.scatter.back().skin.value_or(s.skin);
       if (s.plants.size() + placed.size() > kMaxScatterPlants)
         fail(x->elements[k], "the scene has more than " + std::to_string(kMaxScatterPlants) + " plants");
       s.plants.insert(s.plants.end(), std::make_move_iterator(placed.begin()), std::make_move_iterator(placed.end()));
@@ -760,16 +772,18 @@ void write_scatter(JsonWriter& w, const SceneScatter& sc, const std::string& bas
   w.key("scale").numbers(scale, 2);
   w.key("min_spacing").number(sc.min_spacing);
   write_bark(w, sc.bark, base_dir);
+  if (sc.skin) w.key("skin").string(skin_style_name(*sc.skin));
   w.end_object();
 }
 
-void write_plant(JsonWriter& w, const ScenePlant& p, const std::string& base_dir) {
+void write_plant(JsonWriter& w, const ScenePlant& p, const std::string& base_dir, SkinStyle scene_skin) {
   w.begin_object(Layout::spaced);
   write_recipe(w, p.grammar, p.seed, p.steps, p.defines, base_dir);
   write_vec3(w.key("position"), p.position);
   w.key("rotate_y_deg").number(p.rotate_y_deg);
   w.key("scale").number(p.scale);
   write_bark(w, p.bark, base_dir);
+  if (p.skin != scene_skin) w.key("skin").string(skin_style_name(p.skin));
   w.end_object();
 }
 
@@ -795,9 +809,10 @@ Expected<std::string> write_scene_json(const Scene& scene, const std::string& ba
   if (scene.fog) write_fog(w, *scene.fog);
   if (scene.animation) write_animation(w, *scene.animation);
   if (!scene.materials.empty()) write_materials(w, scene.materials, base_dir);
+  if (scene.skin != SkinStyle::smooth) w.key("skin").string(skin_style_name(scene.skin));
   w.key("plants").begin_array(Layout::lines);
   for (const ScenePlant& plant : scene.plants)
-    if (plant.scatter == 0) write_plant(w, plant, base_dir);  // scattered ones: their entry
+    if (plant.scatter == 0) write_plant(w, plant, base_dir, scene.skin);  // scattered ones: their entry
   w.end_array();
   if (!scene.scatter.empty()) {
     w.key("scatter").begin_array(Layout::lines);

@@ -321,6 +321,55 @@ TEST(ExportCli, RenderingTheExportedFileGivesTheSameDepthImageAsTheGrammar) {
   EXPECT_TRUE(from_glb == read_file(dir.path() / "from_lsys.exr"));
 }
 
+// docs/spec/scene.md "Skin": --skin on render and export over the scene's key, the
+// paper's skin in the export's mesh and extras, and the exported file rendering as the
+// grammar does under the same skin.
+TEST(ExportCli, TheSkinFlagAndTheScenesSkinKeyGiveThePapersSkinEverywhere) {
+  TempDir dir;
+  const std::string saguaro = kSource + "/presets/saguaro.lsys";
+  const std::string scene = dir.write("paper.scene.json", R"({"skin": "paper", "image": {"width": 96, "height": 72},
+    "plants": [{"grammar": ")" + saguaro + R"(", "seed": 3}]})");
+  const std::string smooth_scene = dir.write("smooth.scene.json", R"({"image": {"width": 96, "height": 72},
+    "plants": [{"grammar": ")" + saguaro + R"(", "seed": 3}]})");
+  auto depth = [&](const std::string& input, const std::string& out, std::vector<std::string> more = {}) {
+    std::vector<std::string> argv = {"render", input, "--backend", "cpu", "-o", dir.file(out), "--aov", "depth",
+                                     "--spp", "1"};
+    argv.insert(argv.end(), more.begin(), more.end());
+    expect_ok(run_sylva(argv));
+    return read_file(dir.path() / out);
+  };
+  const std::string by_key = depth(scene, "key.exr");
+  EXPECT_FALSE(by_key.empty());
+  EXPECT_EQ(by_key, depth(smooth_scene, "flag.exr", {"--skin", "paper"})) << "--skin paper = the scene's key";
+  EXPECT_NE(by_key, depth(smooth_scene, "smooth.exr")) << "the paper's skin changed nothing";
+  EXPECT_EQ(depth(scene, "over.exr", {"--skin", "smooth"}), read_file(dir.path() / "smooth.exr"))
+      << "--skin smooth overrides the scene's paper";
+  // Export: the scene's key and the flag give the same file; extras say which skin.
+  expect_ok(run_sylva({"export", scene, "-o", dir.file("key.gltf"), "--mesh", "--extras", "full"}));
+  expect_ok(run_sylva({"export", smooth_scene, "-o", dir.file("flag.gltf"), "--mesh", "--extras", "full", "--skin",
+                       "paper"}));
+  expect_ok(run_sylva({"export", smooth_scene, "-o", dir.file("smooth.gltf"), "--mesh", "--extras", "full"}));
+  const std::string key_gltf = read_file(dir.path() / "key.gltf");
+  EXPECT_EQ(key_gltf, read_file(dir.path() / "flag.gltf"));
+  EXPECT_NE(key_gltf.find("\"skin\":\"paper\""), std::string::npos);
+  EXPECT_NE(read_file(dir.path() / "smooth.gltf").find("\"skin\":\"smooth\""), std::string::npos);
+  expect_valid({dir.file("key.gltf")});
+  // A paper export renders back with the paper's skin (extras' skinning.skin).
+  expect_ok(run_sylva({"export", saguaro, "-o", dir.file("paper.glb"), "--skin", "paper", "--seed", "3"}));
+  const std::vector<std::string> size = {"--width", "96", "--height", "72"};
+  std::vector<std::string> paper_grammar = {"--skin", "paper", "--seed", "3", "--width", "96", "--height", "72"};
+  EXPECT_EQ(depth(dir.file("paper.glb"), "glb.exr", size), depth(saguaro, "grammar.exr", paper_grammar));
+  EXPECT_NE(read_file(dir.path() / "glb.exr"), depth(saguaro, "grammar_smooth.exr", {"--seed", "3", "--width", "96",
+                                                                                       "--height", "72"}));
+  ProcessResult bad = run_sylva({"export", saguaro, "-o", dir.file("x.glb"), "--skin", "mitred"});
+  EXPECT_EQ(bad.exit_code, 2) << describe(bad);
+  EXPECT_NE(bad.err.find("--skin mitred: expected smooth or paper"), std::string::npos) << bad.err;
+  bad = run_sylva({"render", saguaro, "-o", dir.file("x.png"), "--skin"});
+  EXPECT_EQ(bad.exit_code, 2) << describe(bad);
+  EXPECT_FALSE(fs::exists(dir.path() / "x.glb"));
+  EXPECT_FALSE(fs::exists(dir.path() / "x.png"));
+}
+
 TEST(ExportCli, RenderingAGltfWithoutSylvaExtrasIsAClearError) {
   TempDir dir;
   const std::string plain = dir.write("plain.gltf", R"({"asset":{"version":"2.0"},"nodes":[{"name":"x"}]})");

@@ -48,5 +48,25 @@ TEST(RenderCpuJoints, ThePapersPlainSkinningShowsTheRimTheStepAndTheFacet) {
   }
 }
 
+TEST(RenderCpuJoints, TheScenesPaperSkinIsThePapersSkinningPlantByPlant) {
+  // docs/spec/scene.md "Skin": a plant's `skin` reaches the renderer with the default
+  // options: its depth is exactly that of SkinOptions::paper(); a smooth plant beside it
+  // keeps the joints.
+  for (const test::JointCloseUp& c : test::joint_close_ups()) {
+    Scene paper = c.scene;
+    override_skin(paper, SkinStyle::paper);
+    RenderOptions o;
+    o.aovs = kAovDepth;
+    o.spp = 1;
+    const RenderResult by_key = render_cpu(paper, o);
+    o.skin = SkinOptions::paper();
+    const RenderResult by_options = render_cpu(c.scene, o);
+    EXPECT_EQ(by_key.image.depth, by_options.image.depth) << c.name;
+    if (c.name == "fork") continue;  // its paper and smooth silhouettes may agree
+    o.skin = SkinOptions{};
+    EXPECT_NE(render_cpu(c.scene, o).image.depth, by_key.image.depth) << c.name << ": the key changed nothing";
+  }
+}
+
 }  // namespace
 }  // namespace sylva

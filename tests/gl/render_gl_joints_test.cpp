@@ -34,5 +34,25 @@ TEST(RenderGlJoints, CloseUpsOfJointsAndElbowsMatchTheCpuAndShowNoConvexCrease) 
   }
 }
 
+TEST(RenderGlJoints, ThePapersSkinByTheScenesKeyMatchesTheCpu) {
+  // The `skin` key reaches the GL skinning too (render_gl.cpp skin_one): the paper's
+  // mitred close-ups agree with the CPU's, and differ from the smooth ones.
+  SYLVA_REQUIRE_GL();
+  RenderOptions o;
+  o.aovs = kAovDepth;
+  for (const test::JointCloseUp& c : test::joint_close_ups()) {
+    if (c.name == "fork") continue;
+    Scene paper = c.scene;
+    override_skin(paper, SkinStyle::paper);
+    const RenderResult gl = gl_test::gl_render(paper, o), cpu = gl_test::cpu_render(paper, o);
+    const gl_test::Agreement a = gl_test::compare(gl.image, cpu.image);
+    EXPECT_GE(a.hit_miss, 0.995) << c.name << ": " << a.describe();
+    EXPECT_LE(a.depth_median_rel, 1e-4) << c.name << ": " << a.describe();
+    const gl_test::Agreement smooth = gl_test::compare(gl.image, gl_test::gl_render(c.scene, o).image);
+    EXPECT_TRUE(smooth.hit_miss < 1 || smooth.depth_max_rel > 1e-3)
+        << c.name << ": paper and smooth drew the same: " << smooth.describe();
+  }
+}
+
 }  // namespace
 }  // namespace sylva

@@ -33,6 +33,15 @@ TEST(PlantInstances, AnAnimatedPlantOfTheSameRecipeIsNotMerged) {
   EXPECT_NE(g.prototype_of_plant[0], g.prototype_of_plant[2]);
 }
 
+TEST(PlantInstances, APlantOfAnotherSkinIsNotMerged) {
+  // The same skeleton skinned paper and smooth gives other frusta: not one prototype.
+  Scene s = test::instanced_grove();
+  s.plants[2].skin = SkinStyle::paper;
+  const PlantInstances g = plant_instances(s);
+  EXPECT_EQ(g.distinct(), 4u);
+  EXPECT_NE(g.prototype_of_plant[0], g.prototype_of_plant[2]);
+}
+
 TEST(PlantTransform, TakesASkeletonsPointWherePlacePlantPutsItAndBack) {
   ScenePlant plant;
   plant.skeleton = test::cylinder(0.1, 0, 2);

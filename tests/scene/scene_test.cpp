@@ -889,3 +889,56 @@ TEST(SceneScatterKey, WritesBackAsItsEntryAndReadsBackEqual) {
 }
 
 }  // namespace sylva
+
+namespace sylva {
+namespace {
+
+// docs/spec/scene.md "Skin": the scene's key is every plant's that names none; a plant's
+// and a scatter entry's own win; --skin (override_skin) wins over all; writes back.
+TEST(SceneSkinKey, APlantsOwnSkinWinsOverTheScenesAndTheFlagOverBoth) {
+  const std::string g = kCactusGrammar;
+  auto s = parse_scene_json(R"({"skin": "paper", "plants": [{"grammar": ")" + g + R"("},
+    {"grammar": ")" + g + R"(", "skin": "smooth"}], "scatter": [)" +
+                                cactus_entry(R"("count": 2, "disc": {"centre": [0, 0], "radius": 5})") + "," +
+                                cactus_entry(R"("count": 2, "disc": {"centre": [9, 0], "radius": 5}, "skin": "smooth")") +
+                                "]}",
+                            "k.scene.json", "");
+  ASSERT_TRUE(s) << s.error().format();
+  EXPECT_EQ(s->skin, SkinStyle::paper);
+  ASSERT_EQ(s->plants.size(), 6u);
+  const std::vector<SkinStyle> expected = {SkinStyle::paper, SkinStyle::smooth, SkinStyle::paper,
+                                           SkinStyle::paper, SkinStyle::smooth, SkinStyle::smooth};
+  for (size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(s->plants[i].skin, expected[i]) << "plant " << i;
+  // Written back: the scene's key, the plant that differs, the entry that names one.
+  Expected<std::string> text = write_scene_json(*s);
+  ASSERT_TRUE(text) << text.error().format();
+  EXPECT_NE(text->find("\"skin\": \"paper\""), std::string::npos) << *text;
+  auto back = parse_scene_json(*text, "k.scene.json", "");
+  ASSERT_TRUE(back) << back.error().format() << *text;
+  for (size_t i = 0; i < back->plants.size(); ++i) EXPECT_EQ(back->plants[i].skin, s->plants[i].skin) << i;
+  EXPECT_EQ(back->scatter[1].skin, SkinStyle::smooth);
+  EXPECT_FALSE(back->scatter[0].skin);
+  // --skin smooth: every plant, whatever its key.
+  Scene flagged = *s;
+  override_skin(flagged, SkinStyle::smooth);
+  for (const ScenePlant& p : flagged.plants) EXPECT_EQ(p.skin, SkinStyle::smooth);
+  // Without any key nothing is written (scenes from before the key keep their bytes).
+  auto plain = parse_scene_json(R"({"plants": [{"grammar": ")" + g + R"("}]})", "p.scene.json", "");
+  ASSERT_TRUE(plain);
+  EXPECT_EQ(plain->plants[0].skin, SkinStyle::smooth);
+  EXPECT_EQ(write_scene_json(*plain)->find("skin"), std::string::npos);
+}
+
+TEST(SceneSkinKey, AnythingButSmoothOrPaperIsAnErrorAtTheKey) {
+  Diagnostic e = expect_error("{\"plants\": [],\n \"skin\": \"mitred\"}");
+  EXPECT_EQ(e.loc.line, 2u);
+  EXPECT_EQ(e.loc.column, 10u);
+  EXPECT_NE(e.message.find("skin must be \"smooth\" or \"paper\""), std::string::npos) << e.message;
+  e = expect_error("{\"plants\": [{\"grammar\": \"g.lsys\", \"skin\": 1}]}");
+  EXPECT_NE(e.message.find("plants[0].skin must be"), std::string::npos) << e.message;
+  e = expect_error("{\"plants\": [], \"scatter\": [{\"grammar\": \"g.lsys\", \"count\": 1, \"skin\": \"Paper\"}]}");
+  EXPECT_NE(e.message.find("scatter[0].skin must be"), std::string::npos) << e.message;
+}
+
+}  // namespace
+}  // namespace sylva

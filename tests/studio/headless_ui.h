@@ -26,8 +26,11 @@ class FakeViewport : public Viewport {
   void set_plants(const Scene& scene, const RenderOptions&) override {
     ++set_plants_calls;
     segments = 0;
-    for (const ScenePlant& p : scene.plants)
+    skins.clear();
+    for (const ScenePlant& p : scene.plants) {
       if (p.skeleton) segments += p.skeleton->segment_count();
+      skins.push_back(p.skin);
+    }
   }
   ViewImage image(const Scene& scene) override {
     const std::vector<double> key = {scene.camera.eye.x, scene.camera.eye.y, scene.camera.eye.z,
@@ -48,6 +51,7 @@ class FakeViewport : public Viewport {
   int set_plants_calls = 0, renders = 0, last_plants = -1, fog_cones_calls = 0;
   std::shared_ptr<const ConeSet> last_cones;
   uint64_t segments = 0;
+  std::vector<SkinStyle> skins;  // each plant's, as the last set_plants saw them
   std::vector<double> last_key;
   ViewStats stats_;
 };

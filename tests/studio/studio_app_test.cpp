@@ -321,6 +321,37 @@ TEST_F(Fixture, CameraAndSunReRenderWithoutRegrowing) {
   EXPECT_EQ(app->worker().counts().submitted, 1u) << "nor derives";
 }
 
+// docs/spec/scene.md "Skin": --skin starts the view's skin control; the control re-skins
+// every plant without regrowing, and the studio's export writes what the view shows.
+TEST_F(Fixture, TheSkinControlReSkinsThePlantsAndStartsAtSkinFlag) {
+  StudioOptions o;
+  o.skin = SkinStyle::paper;
+  auto app = opened(o);
+  EXPECT_EQ(viewport.skins, std::vector<SkinStyle>{SkinStyle::paper}) << "--skin paper reaches the view";
+  // The control: scene's, smooth, paper. Pick "smooth" from its list.
+  auto combo = app->rect("skin");
+  ASSERT_TRUE(combo);
+  const int plants = viewport.set_plants_calls;
+  ui.click(*app, combo->centre());
+  const ImGuiStyle& style = ImGui::GetStyle();
+  const float row = ImGui::GetFontSize() + style.ItemSpacing.y;
+  ui.click(*app, ImVec2(combo->min.x + 10, combo->max.y + style.WindowPadding.y + 1.5f * row));
+  ui.frames(*app, 2);
+  EXPECT_GT(viewport.set_plants_calls, plants);
+  EXPECT_EQ(viewport.skins, std::vector<SkinStyle>{SkinStyle::smooth});
+  EXPECT_EQ(app->worker().counts().submitted, 1u) << "re-skinning never derives";
+  // Back to paper: the export carries it in extras' skinning.
+  ui.click(*app, combo->centre());
+  ui.click(*app, ImVec2(combo->min.x + 10, combo->max.y + style.WindowPadding.y + 2.5f * row));
+  ui.frames(*app, 2);
+  EXPECT_EQ(viewport.skins, std::vector<SkinStyle>{SkinStyle::paper});
+  const std::string out = dir.file("tree.gltf");
+  ASSERT_FALSE(app->export_gltf_file(out, false));
+  const Expected<std::string> written = read_text_file(out);
+  ASSERT_TRUE(written.ok());
+  EXPECT_NE(written->find("\"skin\":\"paper\""), std::string::npos);
+}
+
 TEST_F(Fixture, StepRewindAndAnimateUseTheStepCache) {
   auto app = opened();
   app->rewind();

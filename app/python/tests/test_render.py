@@ -45,3 +45,19 @@ def test_render_refuses_sizes_and_samples_beyond_the_limits_before_allocating(sa
         sylva.render(saguaro, width=65537, height=1)
     with pytest.raises(ValueError, match="samples per pixel"):
         sylva.render(saguaro, width=4, height=4, spp=4_000_000_000)
+
+
+def test_render_and_export_take_the_papers_skin(saguaro, tmp_path):
+    # docs/spec/scene.md "Skin": skin="paper" is `--skin paper`; the default is smooth.
+    smooth = sylva.render(saguaro, width=64, height=48, spp=1)
+    np.testing.assert_array_equal(smooth, sylva.render(saguaro, width=64, height=48, spp=1, skin="smooth"))
+    paper = sylva.render(saguaro, width=64, height=48, spp=1, skin="paper")
+    assert not np.array_equal(smooth, paper)
+    with pytest.raises(ValueError, match='skin must be "smooth" or "paper"'):
+        sylva.render(saguaro, width=8, height=8, skin="mitred")
+    out = tmp_path / "paper.gltf"
+    sylva.export_gltf(saguaro, out, mesh=True, skin="paper")
+    assert '"skin":"paper"' in out.read_text()
+    with pytest.raises(ValueError, match="skin must be"):
+        sylva.export_gltf(saguaro, tmp_path / "x.glb", skin="Paper")
+    assert not (tmp_path / "x.glb").exists()
