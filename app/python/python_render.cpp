@@ -4,7 +4,11 @@
 #include <pybind11/pybind11.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cstring>
+#include <future>
+#include <optional>
 #include <string>
 
 #include "app/python/sylva_python.h"
@@ -31,16 +35,34 @@ py::array_t<float> python_render(const Skeleton& skeleton, uint32_t width, uint3
   // The documented limits (docs/limits.md), checked before anything is allocated.
   if (auto problem = image_size_problem(width, height, spp)) throw py::value_error(*problem);
   if (auto problem = plant_extent_problem(skeleton)) throw py::value_error("render: " + *problem);
-  RenderResult result;
+  // The render runs on its own thread while this one, the GIL released, runs Python's
+  // signal handlers every 50 ms (only the main thread can, and the render's progress comes
+  // from its workers): Ctrl-C cancels the render between tiles and raises KeyboardInterrupt.
+  std::atomic<bool> cancel{false};
+  std::optional<py::error_already_set> interrupted;
+  std::future<RenderResult> rendering;
   {
     py::gil_scoped_release release;
-    Scene scene = default_scene_for(skeleton, width, height);
-    override_skin(scene, style);
-    RenderOptions options;
-    options.spp = spp;
-    options.threads = threads;
-    result = render_cpu(scene, options);
+    rendering = std::async(std::launch::async, [&] {
+      Scene scene = default_scene_for(skeleton, width, height);
+      override_skin(scene, style);
+      RenderOptions options;
+      options.spp = spp;
+      options.threads = threads;
+      options.progress = Progress(&cancel);
+      return render_cpu(scene, options);
+    });
+    while (rendering.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+      if (interrupted) continue;  // cancelled: waiting for the tiles in flight
+      py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() != 0) {
+        interrupted.emplace();  // takes the pending exception
+        cancel.store(true);
+      }
+    }
   }
+  RenderResult result = rendering.get();  // rethrows what the render threw
+  if (interrupted) throw std::move(*interrupted);
   const RenderImage& image = result.image;
   if (image.beauty.size() != static_cast<size_t>(width) * height * 4)
     throw std::runtime_error("render: the renderer returned an image of the wrong size");

@@ -61,3 +61,34 @@ def test_render_and_export_take_the_papers_skin(saguaro, tmp_path):
     with pytest.raises(ValueError, match="skin must be"):
         sylva.export_gltf(saguaro, tmp_path / "x.glb", skin="Paper")
     assert not (tmp_path / "x.glb").exists()
+
+
+def test_ctrl_c_stops_a_long_render_with_keyboard_interrupt(tmp_path):
+    """render() runs Python's signal handlers while its workers render: Ctrl-C cancels the
+    render between tiles and raises KeyboardInterrupt (before: only once it finished)."""
+    import signal
+    import subprocess
+    import sys
+    import time
+    script = tmp_path / "long_render.py"
+    script.write_text(
+        "import sys, sylva\n"
+        "sk = sylva.Grammar.from_file('presets/saguaro.lsys').grow(seed=5)\n"
+        "print('started', flush=True)\n"
+        "try:\n"
+        "    sylva.render(sk, width=4096, height=4096, spp=4096)\n"  # hours
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True)\n"
+        "    sys.exit(7)\n")
+    child = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True)
+    try:
+        assert child.stdout.readline().strip() == "started"
+        time.sleep(1.0)
+        child.send_signal(signal.SIGINT)
+        out, _ = child.communicate(timeout=600)  # a hang guard, not a time budget
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+    assert child.returncode == 7, out
+    assert "interrupted" in out
