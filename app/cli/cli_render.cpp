@@ -37,15 +37,13 @@ namespace {
 
 constexpr uint32_t kMaxConeParam = 100000;  // --cone-params: any larger is a typo
 
-// Mesa's software rasterisers, by the GL_RENDERER string they report ("llvmpipe (LLVM
-// 15.0.6, 256 bits)", "softpipe", "swrast"): auto still renders with them (docs/spec/cli.md), and
-// says so, since the CPU ray caster may be the faster choice on such a machine.
-bool is_software_renderer(const std::string& renderer) {
-  std::string lower = renderer;
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  for (const char* name : {"llvmpipe", "softpipe", "swrast"})
-    if (lower.find(name) != std::string::npos) return true;
-  return false;
+// --backend auto's rule (docs/spec/cli.md): OpenGL on a GPU; where the only GL is a software
+// rasteriser (llvmpipe, softpipe) the CPU ray caster, which is several times faster there.
+// Why auto declines `context`, or none where it takes it.
+std::optional<std::string> auto_declines(const std::string& backend, const GlContext& context) {
+  if (backend != "auto" || !context.info().software) return std::nullopt;
+  return "--backend auto: " + context.info().renderer +
+         " is a software rasteriser, slower than the CPU ray caster; --backend gl forces it";
 }
 
 std::atomic<bool> g_interrupted{false};
@@ -69,10 +67,12 @@ void print_render_help() {
          "format OpenImageIO writes. For a non-EXR IMAGE each AOV goes to its own EXR next to\n"
          "it: IMAGE without its extension + .depth.exr, .normal.exr, .uv.exr, .id.exr, .fog.exr.\n\n"
          "  -o, --output IMAGE     the image to write\n"
-         "      --backend B        auto (default): OpenGL on a window-less EGL context (the GPU,\n"
-         "                         or Mesa's llvmpipe without one), else the CPU ray caster,\n"
-         "                         saying why; gl: OpenGL or exit 1 saying why; cpu: the CPU\n"
-         "                         reference (fog's refined and reference: CPU only)\n"
+         "      --backend B        auto (default): OpenGL on a GPU (a window-less EGL context);\n"
+         "                         the CPU ray caster where the only GL is a software\n"
+         "                         rasteriser (Mesa's llvmpipe: the CPU is several times\n"
+         "                         faster; --verbose says so) or none opens (saying why);\n"
+         "                         gl: OpenGL, llvmpipe included, or exit 1 saying why; cpu:\n"
+         "                         the CPU reference (fog's refined and reference: CPU only)\n"
          "      --width W          image width in pixels (default: the scene's, else 1024)\n"
          "      --height H         image height in pixels (default: the scene's, else 768)\n"
          "      --aov LIST         extra outputs, comma-separated: depth (channel Z, distance\n"
@@ -452,6 +452,7 @@ int run_render_frames(const RenderArgs& a) {
   options.progress = Progress(&g_interrupted);
   // The backend, chosen once for every frame as a single render chooses it.
   std::unique_ptr<GlContext> context;
+  std::string backend_note;  // why auto took the CPU where a GL context opened
   if (a.backend != "cpu") {
     std::string why_not;
     if (auto unsupported = gl_unsupported(base, options)) {
@@ -461,7 +462,12 @@ int run_render_frames(const RenderArgs& a) {
       if (made.context) context = std::move(made.context);
       else why_not = made.error;
     }
-    if (!context) {
+    if (context) {
+      if (auto declined = auto_declines(a.backend, *context)) {
+        context.reset();
+        backend_note = " (" + *declined + ")";
+      }
+    } else {
       if (a.backend == "gl") {
         std::cerr << "sylva render: --backend gl: " << why_not << "\n";
         return kInputError;
@@ -471,7 +477,7 @@ int run_render_frames(const RenderArgs& a) {
   }
   std::cerr << "sylva render: " << range.count() << (range.count() == 1 ? " frame" : " frames") << " (" << range.first
             << ".." << range.last << ") of " << base.width << "x" << base.height << ", "
-            << (context ? "OpenGL ray caster (" + context->info().renderer + ")" : std::string("CPU ray caster"))
+            << (context ? "OpenGL ray caster (" + context->info().renderer + ")" : "CPU ray caster" + backend_note)
             << "\n";
 
   std::vector<Skeleton> rest;
@@ -635,6 +641,7 @@ int run_render(const std::vector<std::string>& args) {
   std::string backend_name = "CPU ray caster";
   std::optional<RenderResult> gl_result;
   GlFrameStats gl_stats;
+  bool software_gl = false;  // auto found only a software rasteriser: the CPU, by choice
   if (a.backend != "cpu") {
     std::string why_not;
     const char* fallback = "OpenGL unavailable";
@@ -646,6 +653,12 @@ int run_render(const std::vector<std::string>& args) {
       GlContextResult context = create_headless_gl_context();
       if (!context.context) {
         why_not = context.error;
+      } else if (auto declined = auto_declines(a.backend, *context.context)) {
+        // The CPU, quietly; --verbose says why.
+        backend_name = "CPU ray caster (" + *declined + ")";
+        passes.push_back({"gl context", seconds_since(context_start),
+                          context.context->info().describe() + ": not used"});
+        software_gl = true;
       } else {
         passes.push_back({"gl context", seconds_since(context_start), context.context->info().describe()});
         try {
@@ -655,20 +668,13 @@ int run_render(const std::vector<std::string>& args) {
           backend_name = options.geometry.kind == GeometryKind::mesh ? "OpenGL rasteriser (meshes, " + renderer + ")"
                                                                      : "OpenGL ray caster (" + renderer + ")";
           // auto names what it chose (the fallback below names the CPU and why).
-          // auto keeps OpenGL even in software (docs/spec/cli.md; docs/limits.md "--backend auto"),
-          // and says that the CPU ray caster is the faster choice there.
-          if (a.backend == "auto") {
-            std::cerr << "sylva render: --backend auto: " << backend_name << "\n";
-            if (is_software_renderer(renderer))
-              std::cerr << "sylva render: " << renderer << " is a software renderer: --backend cpu (the CPU ray "
-                        << "caster) is usually 2-4x faster on this machine\n";
-          }
+          if (a.backend == "auto") std::cerr << "sylva render: --backend auto: " << backend_name << "\n";
         } catch (const GlError& e) {
           why_not = e.what();
         }
       }
     }
-    if (!gl_result) {
+    if (!gl_result && !software_gl) {
       if (a.backend == "gl") {
         std::cerr << "sylva render: --backend gl: " << why_not << "\n";
         return kInputError;
