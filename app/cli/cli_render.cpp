@@ -54,7 +54,7 @@ void print_render_help() {
   std::cout
       << "usage: sylva render INPUT -o IMAGE [--backend auto|gl|cpu] [--width W --height H]\n"
          "                    [--aov depth,normal,uv,id,fog] [--spp N] [--verbose]\n"
-         "                    [--eye X,Y,Z] [--target X,Y,Z] [--fov DEG]\n"
+         "                    [--eye X,Y,Z] [--target X,Y,Z] [--fov DEG] [--sun X,Y,Z]\n"
          "                    [--geometry frusta|mesh] [--mesh-level M] [--skin smooth|paper]\n"
          "                    [--fog-mode MODE] [--fog-steps N] [--photons N] [--cone-params P]\n"
          "                    [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n"
@@ -88,6 +88,9 @@ void print_render_help() {
          "      --eye X,Y,Z        the camera's eye in metres (Y up), e.g. --eye 6,3,6\n"
          "      --target X,Y,Z     the point it looks at, in metres\n"
          "      --fov DEG          its full vertical field of view in degrees, in (0, 180)\n"
+         "      --sun X,Y,Z        the direction toward the sun (need not be unit; Y up), e.g.\n"
+         "                         --sun 1,0.3,0 for a low sun from +X; overrides a scene's\n"
+         "                         sun.direction (default scene: 0.5,1,0.3)\n"
          "                         (each overrides a scene's camera key; for a grammar or\n"
          "                         skeleton the default camera frames the plant, fov 35)\n"
          "      --geometry G       what stands for the plants: frusta (default: the exact\n"
@@ -158,11 +161,13 @@ struct RenderArgs {
   std::optional<double> fps;          // --fps
   std::optional<std::string> video;   // --video
   std::optional<SkinStyle> skin;      // --skin: every plant's, over the scene's keys
+  std::optional<glm::dvec3> sun;      // --sun: toward the sun, over the scene's sun.direction
 };
 
-// The scene as --skin asks (nothing without it).
-void apply_skin_flag(const RenderArgs& a, Scene& scene) {
+// The scene as --skin and --sun ask (nothing without them).
+void apply_scene_flags(const RenderArgs& a, Scene& scene) {
   if (a.skin) override_skin(scene, *a.skin);
+  if (a.sun) scene.sun.direction = unit_sun_direction(*a.sun);
 }
 
 // --cone-params p1,p2,p3,p4 (Hougs and Day 2001 sec. 3.2.1) or auto (nullopt): four integers with
@@ -292,6 +297,12 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
                  [&out](const std::string& spelled, const std::string& v) {
                    out.camera.target = parse_point_flag(spelled, v);
                  }),
+      value_flag({"--sun"},
+                 [&out](const std::string& spelled, const std::string& v) {
+                   const glm::dvec3 d = parse_point_flag(spelled, v);
+                   if (d == glm::dvec3(0)) throw UsageError{spelled + " " + v + ": the direction toward the sun must not be zero"};
+                   out.sun = d;
+                 }),
       value_flag({"--fov"},
                  [&out](const std::string&, const std::string& v) { out.camera.fov_y_deg = parse_fov_flag(v); }),
       set_flag({"--verbose", "-v"}, out.verbose),
@@ -407,7 +418,8 @@ int run_render_frames(const RenderArgs& a) {
     return *code;
   }
   Scene base = std::move(std::get<Scene>(loaded));
-  apply_skin_flag(a, base);
+  if (auto warning = empty_plants_warning(base, a.grammar.grammar)) std::cerr << *warning << "\n";
+  apply_scene_flags(a, base);
   apply_camera_flags(a.camera, base.camera);
   if (!growth && !base.animation)
     throw UsageError{"--frames: " + input + " has no animation key, so its plants stand still (docs/animation.md)"};
@@ -502,7 +514,7 @@ int run_render_frames(const RenderArgs& a) {
         return *code;
       }
       scene = std::move(std::get<Scene>(grown));
-      apply_skin_flag(a, scene);
+      apply_scene_flags(a, scene);
       scene.camera = base.camera;
       scene.ground = base.ground;
     } else {
@@ -608,7 +620,8 @@ int run_render(const std::vector<std::string>& args) {
     return *code;
   }
   Scene scene = std::move(std::get<Scene>(loaded));
-  apply_skin_flag(a, scene);
+  if (auto warning = empty_plants_warning(scene, a.grammar.grammar)) std::cerr << *warning << "\n";
+  apply_scene_flags(a, scene);
   apply_camera_flags(a.camera, scene.camera);
   if (auto problem = image_size_problem(scene.width, scene.height, a.spp)) {
     std::cerr << "sylva render: error: " << *problem << "\n";

@@ -2,6 +2,7 @@
 #include "app/front/render_input.h"
 
 #include <chrono>
+#include <filesystem>
 #include <glm/common.hpp>
 #include <iostream>
 #include <limits>
@@ -128,6 +129,24 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
   if (width) scene.width = *width;
   if (height) scene.height = *height;
   return scene;
+}
+
+std::optional<std::string> empty_plants_warning(const Scene& scene, const std::string& input) {
+  size_t empty = 0, first = 0;
+  for (size_t i = scene.plants.size(); i-- > 0;) {
+    const ScenePlant& p = scene.plants[i];
+    if (p.skeleton && p.skeleton->segment_count() == 0 && p.skeleton->leaves.empty()) ++empty, first = i;
+  }
+  if (empty == 0) return std::nullopt;
+  const std::string nothing = ": nothing of " + std::string(empty == 1 ? "it" : "them") + " is drawn";
+  if (scene.plants.size() == 1) return input + ": warning: the plant has no segments and no leaves" + nothing;
+  const ScenePlant& p = scene.plants[first];
+  const std::string key = p.scatter ? "scatter[" + std::to_string(p.scatter - 1) + "]"
+                                    : "plants[" + std::to_string(first) + "]";  // the file's come first
+  const std::string name = p.grammar.empty() ? "" : ", " + std::filesystem::path(p.grammar).filename().string();
+  return input + ": warning: " + std::to_string(empty) + " of " + std::to_string(scene.plants.size()) +
+         (empty == 1 ? " plants has" : " plants have") + " no segments and no leaves (the first: " + key + name + ")" +
+         nothing;
 }
 
 }  // namespace sylva::cli

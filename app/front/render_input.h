@@ -28,4 +28,11 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
                                                 std::optional<uint32_t> height,
                                                 std::vector<RenderPass>& passes, const Progress& progress = {});
 
+// The warning for plants of `scene` (loaded from `input`) that grew nothing to draw — no
+// segment and no leaf — or none where every plant has something (an empty plant is no
+// error, but a picture of bare ground should not pass unremarked):
+//   INPUT: warning: the plant has no segments and no leaves: nothing of it is drawn
+//   INPUT: warning: 3 of 12 plants have no segments and no leaves (the first: plants[4], cactus.lsys): ...
+std::optional<std::string> empty_plants_warning(const Scene& scene, const std::string& input);
+
 }  // namespace sylva::cli

@@ -863,4 +863,16 @@ ValueError, each with the reason naming the file, and nothing is written. The GI
 
 }  // namespace sylva::python
 
-PYBIND11_MODULE(sylva, m) { sylva::python::bind_module(m); }
+PYBIND11_MODULE(sylva, m) {
+  // The skeleton's arrays are numpy arrays: without numpy pybind11 would fail with a bare
+  // "ImportError: initialization failed". Say what is missing and where to get it.
+  try {
+    py::module_::import("numpy.core.multiarray");
+  } catch (py::error_already_set& e) {
+    if (!e.matches(PyExc_ImportError)) throw;
+    const std::string python = py::str(py::module_::import("sys").attr("executable"));
+    throw py::import_error("sylva needs numpy, which " + python + " cannot import (" + e.what() +
+                           "); on Debian: apt-get install python3-numpy, and run /usr/bin/python3");
+  }
+  sylva::python::bind_module(m);
+}

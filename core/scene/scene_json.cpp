@@ -556,7 +556,10 @@ Scene read_scene(const JsonValue& root, const std::string& base_dir) {
   if (auto* x = root.find("materials")) s.materials = read_materials(*x, base_dir);
   s.skin = skin_style(root.find("skin"), "skin", SkinStyle::smooth);
   const JsonValue* plants = root.find("plants");
-  if (!plants) fail(root, "a scene needs \"plants\" (an array of plants)");
+  if (!plants)
+    fail(root, root.find("scatter") ? "a scene needs \"plants\" (docs/spec/scene.md), even where \"scatter\" places "
+                                      "them all: add \"plants\": []"
+                                    : "a scene needs \"plants\" (an array of plants)");
   if (!plants->is_array()) fail(*plants, std::string("plants must be an array, not ") + plants->kind_name());
   for (size_t i = 0; i < plants->elements.size(); ++i)
     s.plants.push_back(read_plant(plants->elements[i], base_dir, i, s.skin));

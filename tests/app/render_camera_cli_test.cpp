@@ -118,6 +118,30 @@ TEST(RenderCamera, FlagsOverrideASceneCamera) {
   EXPECT_EQ(d.hit_fraction(), 1.0);
 }
 
+// --sun (issue 31 §6): the direction toward the sun over the scene's; the default scene's
+// own direction gives the same image, a low sun another; zero or malformed: exit 2.
+TEST(RenderCamera, SunSetsTheDirectionTowardTheSun) {
+  TempDir dir;
+  auto render = [&](const std::string& name, std::vector<std::string> flags) {
+    std::vector<std::string> args = {"render", kSaguaro, "-o", dir.file(name), "--width", "48", "--height", "36",
+                                     "--backend", "cpu", "--spp", "1"};
+    args.insert(args.end(), flags.begin(), flags.end());
+    ProcessResult r = run_sylva(args);
+    EXPECT_EQ(r.exit_code, 0) << describe(r);
+    return read_file(dir.file(name));
+  };
+  const std::string plain = render("plain.png", {});
+  EXPECT_FALSE(plain.empty());
+  EXPECT_EQ(render("same.png", {"--sun", "0.5,1,0.3"}), plain);
+  EXPECT_NE(render("low.png", {"--sun", "1,0.2,0"}), plain);
+  for (const char* bad : {"0,0,0", "1,2", "nan,1,0"}) {
+    ProcessResult r = run_sylva({"render", kSaguaro, "-o", dir.file("bad.png"), "--sun", bad});
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << describe(r);
+    EXPECT_NE(r.err.find("--sun"), std::string::npos) << describe(r);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("bad.png")));
+}
+
 // Bad values are usage errors (exit 2) that name the flag, and nothing is written.
 TEST(RenderCamera, BadValuesAreUsageErrorsNamingTheFlag) {
   TempDir dir;

@@ -164,6 +164,31 @@ TEST(RenderCli, WhatTheGlBackendCannotDrawGoesToTheCpuUnderAutoAndFailsUnderGl) 
   EXPECT_FALSE(std::filesystem::exists(dir.file("g.png")));
 }
 
+// Issue 31 §6: a plant that grew nothing to draw renders (exit 0) but is named on stderr.
+TEST(RenderCli, APlantThatGrewNothingIsAWarningNotASilentPicture) {
+  TempDir dir;
+  const std::string bare = dir.write("bare.lsys", "derivation length: 2\naxiom: A\nA -> +A\n");
+  ProcessResult r = run_sylva({"render", bare, "-o", dir.file("b.png"), "--width", "32", "--height", "24",
+                               "--backend", "cpu", "--spp", "1"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.err.find(bare + ": warning: the plant has no segments and no leaves: nothing of it is drawn\n"),
+            std::string::npos)
+      << describe(r);
+  EXPECT_TRUE(std::filesystem::exists(dir.file("b.png")));
+  const std::string scene = dir.write("two.scene.json", R"({"plants": [{"grammar": ")" + kSaguaro +
+                                                            R"("}, {"grammar": "bare.lsys"}]})");
+  r = run_sylva({"render", scene, "-o", dir.file("s.png"), "--width", "32", "--height", "24", "--backend", "cpu",
+                 "--spp", "1"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.err.find(scene + ": warning: 1 of 2 plants has no segments and no leaves (the first: plants[1], "
+                               "bare.lsys): nothing of it is drawn\n"),
+            std::string::npos)
+      << describe(r);
+  ProcessResult plant = run_sylva({"render", kSaguaro, "-o", dir.file("p.png"), "--width", "32", "--height", "24",
+                                   "--backend", "cpu", "--spp", "1"});
+  EXPECT_EQ(plant.err.find("warning"), std::string::npos) << describe(plant);
+}
+
 TEST(RenderCli, GlBackendDrawsTheMeshBaseline) {
   TempDir dir;
   ProcessResult r = run_sylva({"render", kSaguaro, "-o", dir.file("m.png"), "--width", "32", "--height", "24",

@@ -146,6 +146,10 @@ TEST(Scene, APathHoldingANulIsAnErrorAtItsKey) {
 TEST(Scene, MissingPlantsIsAnError) {
   Diagnostic e = expect_error("{\"sky\": [1, 1, 1]}");
   EXPECT_NE(e.message.find("plants"), std::string::npos);
+  // Only scatter: the contract still wants the key, and the message says what to write.
+  e = expect_error("{\"scatter\": []}");
+  EXPECT_NE(e.message.find("even where \"scatter\" places them all: add \"plants\": []"), std::string::npos)
+      << e.message;
 }
 
 TEST(Scene, WrongTypesAndRangesAreLocated) {

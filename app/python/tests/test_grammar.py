@@ -107,3 +107,19 @@ def test_derive_equals_cli_derive(sylva_binary):
     cli = subprocess.run([sylva_binary, "derive", "presets/abop_1_24a.lsys", "-n", "3"],
                          capture_output=True, check=True).stdout.decode()
     assert g.derive(steps=3) + "\n" == cli
+
+
+def test_importing_sylva_without_numpy_says_numpy_is_missing(tmp_path):
+    """Issue 31 §6: a Python without numpy got "ImportError: initialization failed"."""
+    import os
+    import subprocess
+    import sys
+    fake = tmp_path / "numpy"
+    fake.mkdir()
+    (fake / "__init__.py").write_text("raise ImportError('No module named numpy (hidden by the test)')\n")
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(tmp_path), env.get("PYTHONPATH", "")])
+    r = subprocess.run([sys.executable, "-c", "import sylva"], env=env, capture_output=True, text=True, timeout=600)
+    assert r.returncode != 0
+    assert "ImportError: sylva needs numpy" in r.stderr, r.stderr
+    assert "python3-numpy" in r.stderr, r.stderr
