@@ -1,8 +1,11 @@
 // define_controls.cpp — see define_controls.h.
 #include "app/studio/define_controls.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 #include "core/grow/grow.h"
@@ -60,6 +63,22 @@ std::string shortest(double value) {
   std::string out;
   lsys::append_shortest_double(out, value);
   return out;
+}
+
+double slider_value(double value, double resolution) {
+  if (!std::isfinite(value) || !(resolution > 0) || !std::isfinite(resolution)) return value;
+  const double tolerance = resolution / 2;
+  // Decimal places from the coarsest that can matter to the finest a double holds.
+  const int coarsest = -static_cast<int>(std::floor(std::log10(std::max(std::abs(value), tolerance)))) - 1;
+  for (int places = std::max(coarsest, -15); places <= 17; ++places) {
+    char text[64];
+    const double scale = std::pow(10.0, places);
+    // Rounded as text (exact decimal), read back: the double the text stands for.
+    std::snprintf(text, sizeof text, "%.*f", std::max(places, 0), std::round(value * scale) / scale);
+    const double candidate = std::strtod(text, nullptr);
+    if (std::abs(candidate - value) <= tolerance) return candidate;
+  }
+  return value;
 }
 
 std::vector<DefineLine> scan_defines(std::string_view text) {

@@ -38,6 +38,13 @@ std::string with_define_value(std::string_view text, const DefineLine& line, dou
 // The shortest decimal that reads back as exactly `value` ("0.1", "3", "1e-07").
 std::string shortest(double value);
 
+// The value a slider stands for at `value`: among the numbers within `resolution / 2` of it
+// (a slider's resolution: its range over its width in pixels, or its step), the one with
+// the fewest decimals, nearest to `value` — so that "Write to text" writes 6.14, not
+// 6.1363638043403625, and a step of 0.1 gives 0.3, not 0.30000000000000004. `value` itself
+// where resolution is not a positive finite number.
+double slider_value(double value, double resolution);
+
 // Parses a number typed in a field exactly (the whole text, no trailing junk); nullopt
 // when it is not a finite number.
 std::optional<double> parse_exact(std::string_view text);

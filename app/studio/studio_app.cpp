@@ -348,7 +348,8 @@ void StudioApp::poll_worker() {
   if (animating_ && !worker_->busy() && plant_ && !error_) {
     if (plant_->shown_step >= plant_->steps) {
       animating_ = false;
-    } else {
+    } else if (now_ - animate_stepped_at_ >= 1.0 / animate_steps_per_s_) {
+      animate_stepped_at_ = now_;
       show_step_ = plant_->shown_step + 1;
       submit_regrow();
     }
@@ -379,6 +380,7 @@ void StudioApp::rewind() {
 void StudioApp::animate() {
   show_step_ = 0;
   animating_ = true;
+  animate_stepped_at_ = now_;
   submit_regrow();
 }
 
@@ -761,11 +763,14 @@ void StudioApp::draw_parameters() {
     if (!known) value = parse_exact(d.value_text).value_or(0);
     bool changed = false, released = false;
     if (d.has_range()) {
-      ImGui::SetNextItemWidth(std::max(80.0f, ImGui::GetContentRegionAvail().x - field_w - 130));
+      const float slider_w = std::max(80.0f, ImGui::GetContentRegionAvail().x - field_w - 130);
+      ImGui::SetNextItemWidth(slider_w);
       double v = value;
       if (ImGui::SliderScalar("##slider", ImGuiDataType_Double, &v, &*d.min, &*d.max, "%.4g",
                               ImGuiSliderFlags_NoRoundToFormat)) {
         if (d.step) v = *d.min + std::round((v - *d.min) / *d.step) * *d.step;
+        // What the slider can tell apart: its step, or its range over its pixels.
+        v = slider_value(v, d.step ? *d.step : (*d.max - *d.min) / static_cast<double>(slider_w));
         v = std::clamp(v, *d.min, *d.max);
         if (v != value) value = v, changed = true;
       }
@@ -844,6 +849,10 @@ void StudioApp::draw_derivation() {
   ImGui::SameLine();
   if (ImGui::Button(animating_ ? "Stop" : "Animate")) animating_ ? (void)(animating_ = false) : animate();
   keep("button:Animate");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(90);
+  ImGui::SliderFloat("##speed", &animate_steps_per_s_, 0.25f, 60, "%.2g steps/s", ImGuiSliderFlags_Logarithmic);
+  keep("slider:animate_speed");
   ImGui::SameLine();
   if (worker_->busy()) {
     if (ImGui::Button("Cancel")) worker_->cancel(), animating_ = false;

@@ -13,6 +13,7 @@
 // A parse or derivation error leaves the last good plant on screen and marks the text.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -124,7 +125,9 @@ class StudioApp {
   void step();     // one more derivation step
   void run();      // to the derivation length
   void rewind();   // back to the axiom
-  void animate();  // from the axiom, one step per frame
+  void animate();  // from the axiom, animate_speed() steps a second (as fast as they grow, at most)
+  double animate_speed() const { return animate_steps_per_s_; }
+  void set_animate_speed(double steps_per_s) { animate_steps_per_s_ = std::clamp(steps_per_s, 0.25, 60.0); }
   void frame_plant();
   std::optional<std::string> export_gltf_file(const std::string& path, bool mesh);
   std::optional<std::string> export_skeleton_file(const std::string& path);
@@ -192,6 +195,8 @@ class StudioApp {
   std::optional<std::chrono::steady_clock::time_point> latency_start_;
   std::vector<double> latencies_;
   bool animating_ = false;
+  float animate_steps_per_s_ = 4;    // the Animate speed control
+  double animate_stepped_at_ = 0;    // now_ when the animation last took a step
   bool camera_set_ = false;
   OrbitCamera orbit_;
   RenderOptions render_options_;

@@ -148,6 +148,14 @@ TEST_F(Fixture, OneSliderDragIsOneUndoStepAndTheTextIsUntouched) {
   EXPECT_FALSE(app->overrides().count("ANGLE"));
   app->redo();
   EXPECT_EQ(app->overrides().at("ANGLE"), dragged);
+  // The dragged value is what the slider can tell apart (issue 31 §5): over [0, 90] on a
+  // few hundred pixels, at most one decimal, and that is what "Write to text" writes.
+  const std::string written = shortest(dragged);
+  EXPECT_LE(written.size() - std::min(written.size(), written.find('.')), 2u) << written;
+  auto write = app->rect("write_to_text");
+  ASSERT_TRUE(write);
+  ui.click(*app, write->centre());
+  EXPECT_NE(app->text().find("#define ANGLE " + written + " /* [0, 90] */"), std::string::npos) << app->text();
 }
 
 TEST_F(Fixture, ATypedValueIsExactAndWritesToTheText) {
@@ -371,6 +379,24 @@ TEST_F(Fixture, StepRewindAndAnimateUseTheStepCache) {
   ASSERT_TRUE(ui.settle(*app));
   EXPECT_EQ(app->plant()->shown_step, 5);
   EXPECT_EQ(viewport.segments, 31u);
+}
+
+// Issue 31 §5: Animate has a speed: at 2 steps a second the four steps take two seconds of
+// the UI's clock (120 frames at 60 Hz), however fast the worker grows them.
+TEST_F(Fixture, AnimateTakesItsStepsAtTheChosenSpeed) {
+  auto app = opened();
+  ASSERT_TRUE(app->rect("slider:animate_speed"));
+  app->set_animate_speed(2);
+  app->animate();
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plant()->shown_step == 0; }));
+  int frames = 0;
+  ASSERT_TRUE(ui.until(*app, [&] {
+    ++frames;
+    return app->plant()->shown_step == 4 && !app->worker().busy();
+  }));
+  EXPECT_GE(frames, 4 * 30 - 4) << "4 steps at 2 a second, 60 frames a second";
+  app->set_animate_speed(1000);
+  EXPECT_EQ(app->animate_speed(), 60) << "clamped";
 }
 
 TEST_F(Fixture, SixtyRapidEditsPutOnlyTheLastPlantOnScreen) {

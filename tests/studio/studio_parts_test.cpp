@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <thread>
 
 #include <glm/geometric.hpp>
@@ -44,6 +45,22 @@ TEST(DefineControls, WritingAValueChangesOnlyTheValue) {
   const std::vector<DefineLine> d = scan_defines(text);
   EXPECT_EQ(with_define_value(text, d[0], 0.1), "#define ANGLE 0.1 /* [0, 90] */\n#define N 3\n");
   EXPECT_EQ(with_define_value(text, d[1], 12), "#define ANGLE 22.5 /* [0, 90] */\n#define N 12\n");
+}
+
+TEST(DefineControls, ASliderValueIsTheShortestDecimalItsResolutionTellsApart) {
+  // Issue 31 §5: "Write to text" wrote 6.1363638043403625 from a slider 300 px wide over [0, 10].
+  EXPECT_EQ(shortest(slider_value(6.1363638043403625, 10.0 / 300)), "6.14");
+  EXPECT_EQ(shortest(slider_value(6.1363638043403625, 1.0)), "6");
+  EXPECT_EQ(shortest(slider_value(0.1 * 3, 0.1)), "0.3");          // a step of 0.1
+  EXPECT_EQ(shortest(slider_value(1234.5678, 100)), "1200");
+  EXPECT_EQ(shortest(slider_value(-0.0123456, 1e-4)), "-0.0123");
+  EXPECT_EQ(shortest(slider_value(2.5e-7, 1e-9)), "2.5e-07");
+  // Never farther than half the resolution; the value itself without one.
+  for (double v : {0.123456789, 98.7654321, -3.33333333, 1e-5 * 7.77}) {
+    for (double r : {1e-6, 1e-3, 0.05, 0.7}) EXPECT_LE(std::abs(slider_value(v, r) - v), r / 2) << v << " " << r;
+  }
+  EXPECT_EQ(slider_value(6.13636, 0), 6.13636);
+  EXPECT_EQ(slider_value(6.13636, std::nan("")), 6.13636);
 }
 
 TEST(DefineControls, TypedNumbersAreExact) {
