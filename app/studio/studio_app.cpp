@@ -543,7 +543,7 @@ void StudioApp::frame(double now) {
 
   ImGui::BeginChild("left", ImVec2(left, avail.y - status_h), false);
   {
-    const float message_h = ImGui::GetTextLineHeightWithSpacing() * 2 + 4;
+    const float message_h = message_bar_height(ImGui::GetContentRegionAvail().x);
     draw_editor(ImVec2(ImGui::GetContentRegionAvail().x, ImGui::GetContentRegionAvail().y - message_h));
     draw_message_bar();
   }
@@ -640,13 +640,38 @@ void StudioApp::draw_editor(ImVec2 size) {
   if (editor_.deactivated() && doc_state() != history_.current()) snapshot();
 }
 
+std::string StudioApp::message_text() const {
+  if (!error_) return "";
+  const std::string text = error_->format();
+  return text.substr(0, text.find('\n'));
+}
+
+float StudioApp::message_bar_height(float width) const {
+  const float line = ImGui::GetTextLineHeightWithSpacing();
+  if (!error_) return line * 2 + 4;
+  // The whole message, wrapped to the pane (issue 31 §5: it was cut at the pane's edge),
+  // but never more than a third of the pane's height.
+  const float wrapped = ImGui::CalcTextSize(message_text().c_str(), nullptr, false, width).y;
+  return std::min(wrapped + ImGui::GetStyle().ItemSpacing.y, ImGui::GetContentRegionAvail().y / 3) + line + 4;
+}
+
 void StudioApp::draw_message_bar() {
   if (error_) {
-    const std::string first = error_->format().substr(0, error_->format().find('\n'));
-    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.5f, 0.45f, 1));
-    const bool clicked = ImGui::Selectable(first.c_str(), false);
-    ImGui::PopStyleColor();
+    const std::string first = message_text();
+    // A selectable as tall as the wrapped message, the message drawn over it.
+    const ImVec2 at = ImGui::GetCursorPos();
+    const float width = ImGui::GetContentRegionAvail().x;
+    const float height = ImGui::CalcTextSize(first.c_str(), nullptr, false, width).y;
+    const bool clicked = ImGui::Selectable("##message", false, 0, ImVec2(width, height));
     keep("message");
+    const ImVec2 after = ImGui::GetCursorPos();
+    ImGui::SetCursorPos(at);
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.5f, 0.45f, 1));
+    ImGui::PushTextWrapPos(at.x + width);
+    ImGui::TextUnformatted(first.c_str());
+    ImGui::PopTextWrapPos();
+    ImGui::PopStyleColor();
+    ImGui::SetCursorPos(after);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("click to go to the error\n%s", error_->format().c_str());
     if (clicked && error_->loc.line > 0) editor_.jump_to(error_->loc.line, std::max(1u, error_->loc.column));
     ImGui::TextDisabled("the viewport keeps the last good plant");

@@ -153,6 +153,8 @@ class StudioApp {
   void draw_viewport(ImVec2 size);
   void draw_parameters();
   void draw_derivation();
+  std::string message_text() const;             // the error's first line, or ""
+  float message_bar_height(float width) const;  // the bar below the editor, wrapped to `width`
   void draw_view();
   void draw_fog();
   void update_cones();  // the fog's cones for the plants and sun on screen (cone_worker.h)

@@ -105,6 +105,24 @@ TEST_F(Fixture, TypingAnErrorMarksItsLineAndKeepsThePlantThenTheFixRegrows) {
   EXPECT_EQ(viewport.segments, 40u);
 }
 
+// Issue 31 §5: a message longer than the pane is wrapped, never cut; the bar grows for it.
+TEST_F(Fixture, ALongErrorMessageIsWrappedWhole) {
+  auto app = opened();
+  click_line_end(*app, 8);
+  ui.key(*app, kKeyEnter);
+  ui.type(*app, std::string(150, 'q') + ": 3");  // unknown directive 'qqq...q'
+  ASSERT_TRUE(ui.until(*app, [&] { return app->error().has_value(); }));
+  ui.frames(*app, 2);
+  auto message = app->rect("message");
+  ASSERT_TRUE(message);
+  auto editor = app->rect("editor");
+  ASSERT_TRUE(editor);
+  const float line = ImGui::GetTextLineHeight();
+  EXPECT_GE(message->max.y - message->min.y, 2 * line) << "wrapped onto more lines";
+  EXPECT_LE(message->max.x, editor->max.x + ImGui::GetStyle().ItemSpacing.x) << "within the pane";
+  EXPECT_LE(editor->max.y, message->min.y + 1) << "the editor makes room";
+}
+
 TEST_F(Fixture, ClickingTheMessageJumpsToTheError) {
   auto app = opened();
   click_line_end(*app, 6);
