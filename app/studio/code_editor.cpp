@@ -17,7 +17,9 @@ constexpr ImU32 kCurrentLine = IM_COL32(255, 255, 255, 18);
 constexpr ImU32 kErrorRed = IM_COL32(235, 70, 60, 255);
 constexpr ImU32 kEditorBg = IM_COL32(22, 24, 28, 255);
 
-// Line (1-based) and column (1-based, bytes) of byte `offset`.
+
+}  // namespace
+
 void line_column(const char* text, size_t length, size_t offset, uint32_t* line, uint32_t* column) {
   uint32_t l = 1;
   size_t line_start = 0;
@@ -28,7 +30,14 @@ void line_column(const char* text, size_t length, size_t offset, uint32_t* line,
   *column = static_cast<uint32_t>(offset - line_start + 1);
 }
 
-}  // namespace
+size_t changed_until(std::string_view before, std::string_view after) {
+  const size_t n = std::min(before.size(), after.size());
+  size_t prefix = 0;
+  while (prefix < n && before[prefix] == after[prefix]) ++prefix;
+  size_t suffix = 0;
+  while (suffix < n - prefix && before[before.size() - 1 - suffix] == after[after.size() - 1 - suffix]) ++suffix;
+  return after.size() - suffix;
+}
 
 size_t offset_of(const std::string& text, uint32_t line, uint32_t column) {
   size_t pos = 0;

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include <imgui.h>
 
@@ -32,6 +33,13 @@ struct EditorMark {
   uint32_t length = 1;   // bytes underlined
   std::string message;   // tooltip
 };
+
+// Line (1-based) and column (1-based, bytes) of byte `offset` of `text`.
+void line_column(const char* text, size_t length, size_t offset, uint32_t* line, uint32_t* column);
+
+// Where an edit that turned `before` into `after` ends in `after` (bytes): after their
+// common prefix and before their common suffix. An undo puts the cursor there.
+size_t changed_until(std::string_view before, std::string_view after);
 
 class CodeEditor {
  public:

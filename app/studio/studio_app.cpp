@@ -242,6 +242,12 @@ void StudioApp::snapshot() {
 }
 
 void StudioApp::apply_state(const DocState& s) {
+  // The cursor goes to the edit undone or redone (issue 31 §5: it went to the file's end).
+  if (s.text != text_) {
+    uint32_t line = 1, column = 1;
+    line_column(s.text.data(), s.text.size(), changed_until(text_, s.text), &line, &column);
+    editor_.jump_to(line, column);
+  }
   set_text(s.text);
   overrides_ = s.defines;
   seed_ = s.seed;

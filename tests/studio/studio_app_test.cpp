@@ -208,6 +208,10 @@ TEST_F(Fixture, UndoRestoresWholeEditsNotKeystrokes) {
   ui.type(*app, "G");
   ui.key(*app, 'Z', /*ctrl=*/true);
   EXPECT_NE(app->text().find("[-A]FFF\n"), std::string::npos) << app->text();
+  // The cursor stands where the undone "G" was, at the end of line 8 (not the file's end).
+  ui.frames(*app, 3);
+  EXPECT_EQ(app->editor().cursor_line(), 8u);
+  EXPECT_EQ(app->editor().cursor_column(), std::string("A -> F(LEN)[+A][-A]FFF").size() + 1);
   ui.key(*app, 'Z', true);
   EXPECT_EQ(app->text(), kTree);
   ui.key(*app, 'Z', true, /*shift=*/true);

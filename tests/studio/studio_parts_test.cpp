@@ -8,6 +8,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "app/studio/code_editor.h"
 #include "app/studio/define_controls.h"
 #include "app/studio/grow_worker.h"
 #include "app/studio/orbit_camera.h"
@@ -61,6 +62,17 @@ TEST(DefineControls, ASliderValueIsTheShortestDecimalItsResolutionTellsApart) {
   }
   EXPECT_EQ(slider_value(6.13636, 0), 6.13636);
   EXPECT_EQ(slider_value(6.13636, std::nan("")), 6.13636);
+}
+
+TEST(CodeEditorPlaces, AnEditEndsAfterTheCommonPrefixAndBeforeTheCommonSuffix) {
+  EXPECT_EQ(changed_until("abcXdef", "abcdef"), 3u);    // a deletion: where it was
+  EXPECT_EQ(changed_until("abcdef", "abcXYdef"), 5u);   // an insertion: after it
+  EXPECT_EQ(changed_until("aaa", "aaaa"), 4u);          // repeats: the end of the longest prefix
+  EXPECT_EQ(changed_until("x", "x"), 1u);
+  uint32_t line = 0, column = 0;
+  line_column("ab\ncd\n", 6, 4, &line, &column);
+  EXPECT_EQ(line, 2u);
+  EXPECT_EQ(column, 2u);
 }
 
 TEST(DefineControls, TypedNumbersAreExact) {
