@@ -507,18 +507,33 @@ std::optional<std::string> StudioApp::export_png_file(const std::string& path, u
 
 // ---- the frame --------------------------------------------------------------------
 
+void StudioApp::handle_chord(int key, bool shift) {
+  switch (key) {
+    case 'Z': shift ? redo() : undo(); break;
+    case 'Y': redo(); break;
+    case 'F': editor_.open_find(); break;
+    case 'G': editor_.open_goto(); break;
+    case 'S':
+      if (shift) dialog_ = FileDialog::save_as, dialog_path_ = path_.empty() ? "untitled.lsys" : path_;
+      else save();
+      break;
+    case 'O': dialog_ = FileDialog::open, dialog_path_ = path_; break;
+    default: break;
+  }
+}
+
 void StudioApp::handle_shortcuts() {
+  if (chords_from_callbacks_) {
+    std::vector<Chord> chords;
+    chords.swap(chords_);
+    for (const Chord& c : chords) handle_chord(c.key, c.shift);
+    return;
+  }
+  // No key callback (the headless tests): ImGui's polled keys.
   const ImGuiIO& io = ImGui::GetIO();
   if (!io.KeyCtrl) return;
-  if (key_pressed('Z')) io.KeyShift ? redo() : undo();
-  if (key_pressed('Y')) redo();
-  if (key_pressed('F')) editor_.open_find();
-  if (key_pressed('G')) editor_.open_goto();
-  if (key_pressed('S')) {
-    if (io.KeyShift) dialog_ = FileDialog::save_as, dialog_path_ = path_.empty() ? "untitled.lsys" : path_;
-    else save();
-  }
-  if (key_pressed('O')) dialog_ = FileDialog::open, dialog_path_ = path_;
+  for (char key : {'Z', 'Y', 'F', 'G', 'S', 'O'})
+    if (key_pressed(key)) handle_chord(key, io.KeyShift);
 }
 
 void StudioApp::frame(double now) {

@@ -125,6 +125,11 @@ class StudioApp {
   void step();     // one more derivation step
   void run();      // to the derivation length
   void rewind();   // back to the axiom
+  // A Ctrl chord (`key`: 'Z', 'Y', 'F', 'G', 'S', 'O') from the window's key callback,
+  // handled at the next frame. Once one has come this way, chords are taken only from
+  // here: a press and release between two frames (a short chord at a low frame rate)
+  // never reaches ImGui's polled key state, and was lost (issue 31 §5).
+  void queue_chord(int key, bool shift) { chords_.push_back({key, shift}), chords_from_callbacks_ = true; }
   void animate();  // from the axiom, animate_speed() steps a second (as fast as they grow, at most)
   double animate_speed() const { return animate_steps_per_s_; }
   void set_animate_speed(double steps_per_s) { animate_steps_per_s_ = std::clamp(steps_per_s, 0.25, 60.0); }
@@ -153,6 +158,7 @@ class StudioApp {
   void draw_viewport(ImVec2 size);
   void draw_parameters();
   void draw_derivation();
+  void handle_chord(int key, bool shift);  // a Ctrl chord: undo, redo, find, go to, save, open
   std::string message_text() const;             // the error's first line, or ""
   float message_bar_height(float width) const;  // the bar below the editor, wrapped to `width`
   void draw_view();
@@ -197,6 +203,12 @@ class StudioApp {
   std::optional<std::chrono::steady_clock::time_point> latency_start_;
   std::vector<double> latencies_;
   bool animating_ = false;
+  struct Chord {
+    int key;
+    bool shift;
+  };
+  std::vector<Chord> chords_;          // queue_chord's, not yet handled
+  bool chords_from_callbacks_ = false;
   float animate_steps_per_s_ = 4;    // the Animate speed control
   double animate_stepped_at_ = 0;    // now_ when the animation last took a step
   bool camera_set_ = false;

@@ -136,6 +136,17 @@ void trace(const char* what, const std::string& detail) {
 // signal would (docs/spec/studio.md "never losing work"; vim and nano keep their buffers).
 volatile std::sig_atomic_t g_stop_signal = 0;
 
+// Ctrl chords from GLFW's key callback (StudioApp::queue_chord): a chord pressed and
+// released between two frames is kept. ImGui's callback, installed first, is chained.
+StudioApp* g_chord_app = nullptr;
+GLFWkeyfun g_imgui_key_callback = nullptr;
+
+void on_key(GLFWwindow* window, int key, int scancode, int action, int mods) {
+  if (g_imgui_key_callback) g_imgui_key_callback(window, key, scancode, action, mods);
+  if (g_chord_app && action == GLFW_PRESS && (mods & GLFW_MOD_CONTROL) && key >= 'A' && key <= 'Z')
+    g_chord_app->queue_chord(key, (mods & GLFW_MOD_SHIFT) != 0);
+}
+
 void on_stop_signal(int signal) { g_stop_signal = signal; }
 
 // Installs on_stop_signal for the three signals while it lives (replacing the `sylva`
@@ -216,6 +227,8 @@ int run_studio(const std::vector<std::string>& raw_args) {
     options.skin = a.skin;
     StudioApp app(options, viewport_ptr.get());
     app.worker().on_result([] { glfwPostEmptyEvent(); });
+    g_chord_app = &app;
+    g_imgui_key_callback = glfwSetKeyCallback(window, on_key);
     if (code == cli::kOk && !a.input.empty())
       if (auto err = app.open(a.input)) {
         std::cerr << *err << (err->empty() || err->back() != '\n' ? "\n" : "");
@@ -288,6 +301,8 @@ int run_studio(const std::vector<std::string>& raw_args) {
       }
       glfwSwapBuffers(window);
     }
+    glfwSetKeyCallback(window, g_imgui_key_callback);  // the app goes; ImGui's stays
+    g_chord_app = nullptr;
   }
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
