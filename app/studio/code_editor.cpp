@@ -201,23 +201,35 @@ bool CodeEditor::draw(const char* id, std::string& text, const std::optional<Edi
     const float y = text_origin_.y + static_cast<float>(cursor_line_ - 1) * lh;
     dl->AddRectFilled(ImVec2(window_left, y), ImVec2(window_right, y + lh), kCurrentLine);
   }
-  // Gutter: line numbers, right-aligned.
+  // Gutter: line numbers, right-aligned, at the editor's left edge whatever the sideways
+  // scroll (issue 31 §5: it scrolled away with long lines). Where the text has scrolled
+  // under it, it is drawn over the text — which draws in its own child window, after this
+  // one — on the foreground list clipped to the editor (in place while a popup is open,
+  // which that list would cover).
   const float clip_top = ImGui::GetWindowPos().y, clip_bottom = clip_top + ImGui::GetWindowHeight();
+  scroll_x_ = ImGui::GetScrollX();
+  left_edge_ = window_left;
+  gutter_left_ = start.x + scroll_x_;
+  ImDrawList* gutter_dl = dl;
+  if (scroll_x_ > 0 && !ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId)) {
+    gutter_dl = ImGui::GetForegroundDrawList();
+    gutter_dl->PushClipRect(ImVec2(window_left, clip_top), ImVec2(window_right, clip_bottom), true);
+    gutter_dl->AddRectFilled(ImVec2(gutter_left_, clip_top), ImVec2(gutter_left_ + gutter, clip_bottom), kEditorBg);
+  }
   for (uint32_t l = 1; l <= lines; ++l) {
     const float y = text_origin_.y + static_cast<float>(l - 1) * lh;
     if (y + lh < clip_top || y > clip_bottom) continue;
     char number[16];
     std::snprintf(number, sizeof number, "%u", l);
     const float w = ImGui::CalcTextSize(number).x;
-    dl->AddText(ImVec2(start.x + gutter - lh * 0.6f - w, y), active_ && l == cursor_line_ ? IM_COL32(220, 220, 225, 255)
-                                                                                         : kGutterText,
-                number);
+    gutter_dl->AddText(ImVec2(gutter_left_ + gutter - lh * 0.6f - w, y),
+                       active_ && l == cursor_line_ ? IM_COL32(220, 220, 225, 255) : kGutterText, number);
   }
   // The error: a dot in the gutter and a squiggle under its columns.
   if (mark && mark->line >= 1 && mark->line <= lines) {
     const float y = text_origin_.y + static_cast<float>(mark->line - 1) * lh;
     const float r = lh * 0.28f;
-    dl->AddCircleFilled(ImVec2(start.x + r + 2, y + lh * 0.5f), r, kErrorRed);
+    gutter_dl->AddCircleFilled(ImVec2(gutter_left_ + r + 2, y + lh * 0.5f), r, kErrorRed);
     marker_drawn_ = true;
     marker_line_ = mark->line;
     const size_t line_begin = offset_of(text, mark->line, 1);
@@ -238,9 +250,11 @@ bool CodeEditor::draw(const char* id, std::string& text, const std::optional<Edi
       dl->AddLine(ImVec2(x, up ? base : base - amp), ImVec2(xn, up ? base - amp : base), kErrorRed, 1.2f);
     }
     if (!mark->message.empty() && (ImGui::IsMouseHoveringRect(ImVec2(x0, y), ImVec2(x1, y + lh)) ||
-                                   ImGui::IsMouseHoveringRect(ImVec2(start.x, y), ImVec2(start.x + gutter, y + lh))))
+                                   ImGui::IsMouseHoveringRect(ImVec2(gutter_left_, y),
+                                                              ImVec2(gutter_left_ + gutter, y + lh))))
       ImGui::SetTooltip("%s", mark->message.c_str());
   }
+  if (gutter_dl != dl) gutter_dl->PopClipRect();
   // Keep the cursor's line in view when it moved (keys, jumps), not when the user scrolls.
   if (scroll_to_cursor_) {
     scroll_to_cursor_ = false;
@@ -249,6 +263,14 @@ bool CodeEditor::draw(const char* id, std::string& text, const std::optional<Edi
     const float view = ImGui::GetWindowHeight() - style.ScrollbarSize;
     if (cy < ImGui::GetScrollY()) ImGui::SetScrollY(std::max(0.0f, cy - lh));
     else if (cy + lh > ImGui::GetScrollY() + view) ImGui::SetScrollY(cy + 2 * lh - view);
+    // Sideways too: the cursor's column stays right of the gutter and inside the view.
+    const size_t line_begin = offset_of(text, cursor_line_, 1);
+    const float cx = gutter + style.FramePadding.x +
+                     ImGui::CalcTextSize(text.data() + line_begin,
+                                         text.data() + std::min(text.size(), line_begin + cursor_column_ - 1)).x;
+    const float window_w = ImGui::GetWindowWidth();
+    if (cx < ImGui::GetScrollX() + gutter) ImGui::SetScrollX(std::max(0.0f, cx - gutter - lh));
+    else if (cx > ImGui::GetScrollX() + window_w - lh) ImGui::SetScrollX(cx - window_w + 2 * lh);
   }
   ImGui::EndChild();
   ImGui::PopStyleColor();

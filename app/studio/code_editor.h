@@ -68,6 +68,11 @@ class CodeEditor {
   ImVec2 text_origin() const { return text_origin_; }
   float line_height() const { return line_height_; }
   bool marker_drawn() const { return marker_drawn_; }      // the error marker was drawn last frame
+  // Where the gutter (line numbers, error dot) was drawn last frame, on screen, and how far
+  // the text was scrolled sideways: the gutter stays at the editor's left edge.
+  float gutter_left() const { return gutter_left_; }
+  float scroll_x() const { return scroll_x_; }
+  float left_edge() const { return left_edge_; }  // the editor's left edge on screen
   uint32_t marker_line() const { return marker_line_; }
 
  private:
@@ -93,6 +98,7 @@ class CodeEditor {
   ImVec2 text_origin_{0, 0};
   float line_height_ = 13;
   bool marker_drawn_ = false;
+  float gutter_left_ = 0, scroll_x_ = 0, left_edge_ = 0;
   uint32_t marker_line_ = 0;
   const std::string* text_ = nullptr;  // during draw, for the callback
 };

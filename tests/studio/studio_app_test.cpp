@@ -248,6 +248,22 @@ TEST_F(Fixture, AChordFromTheKeyCallbackIsHandledEvenIfReleasedBeforeTheFrame) {
   EXPECT_NE(app->text(), kTree);
 }
 
+// Issue 31 §5: typing past the editor's right edge scrolls the text sideways to the cursor,
+// and the gutter (line numbers, the error dot) stays at the editor's left edge.
+TEST_F(Fixture, TheGutterStaysWhileALongLineScrollsSideways) {
+  auto app = opened();
+  click_line_end(*app, 8);
+  ui.type(*app, std::string(300, 'F'));
+  ui.frames(*app, 3);
+  EXPECT_GT(app->editor().scroll_x(), 0) << "the cursor's column is in view";
+  EXPECT_EQ(app->editor().gutter_left(), app->editor().left_edge());
+  for (int i = 0; i < 7; ++i) ui.key(*app, kKeyUp);  // back to line 1's start: scrolled back
+  ui.key(*app, kKeyHome);
+  ui.frames(*app, 3);
+  EXPECT_EQ(app->editor().scroll_x(), 0);
+  EXPECT_EQ(app->editor().gutter_left(), app->editor().left_edge());
+}
+
 TEST_F(Fixture, GoToLineAndFind) {
   auto app = opened();
   ui.key(*app, 'G', true);
