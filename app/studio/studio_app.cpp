@@ -48,6 +48,19 @@ uint32_t token_length(const std::string& text, uint32_t line, uint32_t column) {
   return static_cast<uint32_t>(std::max<size_t>(1, end - at));
 }
 
+}  // namespace
+
+Fog fog_for_view(const Camera& camera) {
+  Fog f;
+  const double d = std::max(glm::length(camera.eye - camera.target), 0.1);
+  const double sigma_t = kAddedFogOpticalDepth / d;
+  f.sigma_s = std::clamp(sigma_t * 10 / 11, 1e-4, 0.5);  // the defaults' ratio: sigma_a = sigma_s / 10
+  f.sigma_a = f.sigma_s / 10;
+  return f;
+}
+
+namespace {
+
 bool key_pressed(char key) { return ImGui::IsKeyPressed(static_cast<int>(key), false); }
 
 std::optional<uint64_t> parse_u64_exact(const std::string& s) {
@@ -940,7 +953,7 @@ void StudioApp::update_cones() {
 void StudioApp::draw_fog() {
   if (!ImGui::CollapsingHeader("Fog", ImGuiTreeNodeFlags_DefaultOpen)) return;
   if (!scene_.fog) {
-    if (ImGui::Button("add fog")) scene_.fog = Fog{};
+    if (ImGui::Button("add fog")) scene_.fog = fog_for_view(scene_.camera);
     keep("fog:add");
     return;
   }

@@ -48,6 +48,12 @@ struct StudioOptions {
                                   //   skin control starts here; none: the scene's)
 };
 
+// The fog "add fog" makes (issue 31 §5: Fog{}'s 0.05 /m washed out a single tree seen from
+// 20 m): Fog{}'s, with its extinction scaled so that the light from the camera's target
+// keeps exp(-kAddedFogOpticalDepth) of itself (0.78): shafts show, the plant stays.
+constexpr double kAddedFogOpticalDepth = 0.25;
+Fog fog_for_view(const Camera& camera);
+
 // Where the tests click: screen rectangles of named widgets from the last frame.
 struct WidgetRect {
   ImVec2 min{0, 0}, max{0, 0};

@@ -4,6 +4,9 @@
 // never for a camera move, and the fog is saved with the scene.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <glm/geometric.hpp>
+
 #include <string>
 
 #include "core/scene/scene.h"
@@ -142,6 +145,23 @@ TEST_F(FogFixture, FogSettingsAreSavedIntoTheScene) {
   read = read_scene_file(saved);
   ASSERT_TRUE(read) << read.error().format();
   EXPECT_FALSE(read->fog);
+}
+
+// Issue 31 §5: "add fog" scales the medium to the view, so a single tree is not washed out.
+TEST(StudioAddFog, TheAddedFogLetsThePlantKeepThreeQuartersOfItsLight) {
+  Camera near, far;
+  near.eye = {0, 2, 10}, near.target = {0, 2, 0};
+  far.eye = {0, 20, 400}, far.target = {0, 20, 0};
+  for (const Camera& c : {near, far}) {
+    const Fog f = fog_for_view(c);
+    const double d = glm::length(c.eye - c.target);
+    EXPECT_NEAR(std::exp(-(f.sigma_s + f.sigma_a) * d), std::exp(-kAddedFogOpticalDepth), 1e-9) << d;
+    EXPECT_NEAR(f.sigma_a, f.sigma_s / 10, 1e-15);
+  }
+  EXPECT_LT(fog_for_view(far).sigma_s, fog_for_view(near).sigma_s);
+  Camera degenerate;
+  degenerate.eye = degenerate.target = {1, 1, 1};
+  EXPECT_LE(fog_for_view(degenerate).sigma_s, 0.5);  // finite, within the panel's range
 }
 
 }  // namespace
