@@ -57,6 +57,8 @@ void set_located_error(PyObject* type, const std::string& text, const std::strin
   PyErr_SetObject(type, exc.ptr());
 }
 
+}  // namespace
+
 // Strips the trailing newline of a formatted diagnostic (str(e) should not end in one).
 std::string chomp(std::string text) {
   while (!text.empty() && text.back() == '\n') text.pop_back();
@@ -77,8 +79,6 @@ std::string chomp(std::string text) {
 
 // `os.fspath(path)` as the caller wrote it (kept verbatim: it is recorded in files).
 std::string path_string(const std::filesystem::path& path) { return path.string(); }
-
-}  // namespace
 
 GrammarFailure::GrammarFailure(sylva::Diagnostic d)
     : std::runtime_error(d.message), diagnostic(std::move(d)) {}
@@ -459,19 +459,6 @@ std::string plant_name(const Skeleton& sk) {
   std::string stem = std::filesystem::path(sk.source.grammar).stem().string();
   if (stem.empty() || stem.front() == '<') stem = "plant";
   return stem;
-}
-
-// `value` as a T for the argument `name`: a TypeError that names the argument, what it
-// expects and the type it got, never pybind11's "Unable to cast Python instance to C++
-// type" (issue 32).
-template <class T>
-T cast_argument(const py::handle& value, const std::string& name, const char* expected) {
-  try {
-    return value.cast<T>();
-  } catch (const py::cast_error&) {
-    throw py::type_error(name + " must be " + expected + ", got " +
-                         std::string(py::str(py::type::handle_of(value).attr("__name__"))));
-  }
 }
 
 // A Skeleton or a sequence of Skeletons.

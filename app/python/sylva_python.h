@@ -8,6 +8,7 @@
 #include <pybind11/pybind11.h>
 
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
@@ -55,6 +56,26 @@ std::optional<uint64_t> seed_from_python(const pybind11::object& value);
 std::optional<int64_t> steps_from_python(const pybind11::object& value);
 // None → {}; a dict {str: number} → the override map (non-finite values: ValueError).
 std::map<std::string, double> defines_from_python(const pybind11::object& value);
+// A formatted diagnostic without its final newline (str(e) should not end in one).
+std::string chomp(std::string text);
+// Raises OSError from a file's Diagnostic (FileNotFoundError etc. by errno, as open() would).
+[[noreturn]] void throw_file_error(const Diagnostic& error);
+// `os.fspath(path)` as the caller wrote it (kept verbatim: it is recorded in files).
+std::string path_string(const std::filesystem::path& path);
+
+// `value` as a T for the argument `name`: a TypeError that names the argument, what it
+// expects and the type it got, never pybind11's "Unable to cast Python instance to C++
+// type" (issue 32).
+template <class T>
+T cast_argument(const pybind11::handle& value, const std::string& name, const char* expected) {
+  try {
+    return value.cast<T>();
+  } catch (const pybind11::cast_error&) {
+    throw pybind11::type_error(name + " must be " + expected + ", got " +
+                         std::string(pybind11::str(pybind11::type::handle_of(value).attr("__name__"))));
+  }
+}
+
 // "smooth" or "paper" → its SkinStyle; anything else → ValueError naming `skin`.
 SkinStyle skin_style_argument(const std::string& skin);
 

@@ -1,4 +1,7 @@
-"""sylva.render: the CPU ray caster on a skeleton's default scene, as numpy."""
+"""sylva.render: the CPU ray caster on a skeleton or a scene, as numpy (and a file)."""
+import os
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -92,3 +95,40 @@ def test_ctrl_c_stops_a_long_render_with_keyboard_interrupt(tmp_path):
             child.wait()
     assert child.returncode == 7, out
     assert "interrupted" in out
+
+
+def test_render_takes_a_scene_a_camera_a_sun_and_writes_the_image(tmp_path):
+    """Issue 31 §6: render took only a skeleton, with a fixed camera, and wrote nothing."""
+    scene = "presets/scenes/saguaro.scene.json"
+    img = sylva.render(scene, width=48, height=36, spp=1)
+    assert img.shape == (36, 48, 4) and np.isfinite(img).all()
+    # The CLI's flags, the same picture byte for byte.
+    out = tmp_path / "s.png"
+    again = sylva.render(scene, width=48, height=36, spp=1, eye=(0, 3, 15), target=(0, 3, 0), fov_y_deg=30,
+                         sun=(1, 0.3, 0), output=out)
+    assert not np.array_equal(img, again)
+    cli = tmp_path / "cli.png"
+    r = subprocess.run([os.environ.get("SYLVA_BINARY", "build/release/app/sylva"), "render", scene, "-o", str(cli),
+                        "--width", "48", "--height", "36", "--spp", "1", "--backend", "cpu", "--eye", "0,3,15",
+                        "--target", "0,3,0", "--fov", "30", "--sun", "1,0.3,0"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert out.read_bytes() == cli.read_bytes()
+    # Bad arguments name themselves; nothing is written; never onto the scene.
+    with pytest.raises(ValueError, match="camera"):
+        sylva.render(scene, width=8, height=8, eye=(0, 3, 0), target=(0, 3, 0))
+    with pytest.raises(TypeError, match="eye must be an"):
+        sylva.render(scene, width=8, height=8, eye="above")
+    with pytest.raises(ValueError, match="sun"):
+        sylva.render(scene, width=8, height=8, sun=(0, 0, 0))
+    with pytest.raises(ValueError, match="not a .scene.json"):
+        sylva.render("presets/elm.lsys", width=8, height=8)
+    with pytest.raises(TypeError, match="render takes a sylva.Skeleton or the path"):
+        sylva.render(42)
+    with pytest.raises(FileNotFoundError):
+        sylva.render(str(tmp_path / "missing.scene.json"))
+    copy = tmp_path / "copy.scene.json"
+    copy.write_text(open(scene).read().replace('"../', '"' + os.path.abspath("presets") + '/'))
+    before = copy.read_bytes()
+    with pytest.raises(OSError):
+        sylva.render(copy, width=8, height=8, spp=1, output=copy)
+    assert copy.read_bytes() == before
