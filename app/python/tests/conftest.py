@@ -7,7 +7,10 @@ Run by hand:  PYTHONPATH=build-py/python /usr/bin/python3 -m pytest -q app/pytho
 import os
 import pathlib
 import shutil
+import signal
 import subprocess
+import sys
+import time
 
 import pytest
 
@@ -47,5 +50,31 @@ def validate_gltf(repo):
     def run(path):
         done = subprocess.run([node, str(script), str(path)], capture_output=True, text=True)
         assert done.returncode == 0, done.stdout + done.stderr
+
+    return run
+
+
+@pytest.fixture
+def interrupted(tmp_path):
+    """A function that runs `setup` then `call` (Python source) in a child interpreter,
+    sends it SIGINT `after_s` seconds into `call`, and asserts that `call` raised
+    KeyboardInterrupt (the child exits 7 saying so) rather than finishing or crashing."""
+
+    def run(setup, call, after_s):
+        script = tmp_path / "interrupted.py"
+        script.write_text(f"import sys, sylva\n{setup}\nprint('started', flush=True)\ntry:\n    {call}\n"
+                          "except KeyboardInterrupt:\n    print('interrupted', flush=True)\n    sys.exit(7)\n")
+        child = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True)
+        try:
+            assert child.stdout.readline().strip() == "started"
+            time.sleep(after_s)
+            child.send_signal(signal.SIGINT)
+            out, _ = child.communicate(timeout=600)  # a hang guard, not a time budget
+        finally:
+            if child.poll() is None:
+                child.kill()
+                child.wait()
+        assert child.returncode == 7, out
+        assert "interrupted" in out
 
     return run
