@@ -318,8 +318,13 @@ Scene StudioApp::view_scene() const {
   Scene s = scene_;
   if (!bark_)
     for (ScenePlant& p : s.plants) p.bark = Bark{};
-  if (skin_choice_ != 0) override_skin(s, skin_choice_ == 2 ? SkinStyle::paper : SkinStyle::smooth);
+  if (auto style = skin_override()) override_skin(s, *style);
   return s;
+}
+
+std::optional<SkinStyle> StudioApp::skin_override() const {
+  if (skin_choice_ == 0) return std::nullopt;
+  return skin_choice_ == 2 ? SkinStyle::paper : SkinStyle::smooth;
 }
 
 void StudioApp::plants_changed() {
@@ -479,7 +484,8 @@ void StudioApp::watch_file(double now) {
 std::optional<std::string> StudioApp::export_gltf_file(const std::string& path, bool mesh) {
   if (!plant_) return std::string("no plant to export yet");
   std::vector<GltfPlant> plants;
-  for (const ScenePlant& sp : view_scene().plants) {
+  const std::optional<SkinStyle> skin = skin_override();
+  for (const ScenePlant& sp : scene_.plants) {  // the bark whatever the view shows; its skin
     if (!sp.skeleton) continue;
     GltfPlant p;
     p.name = stem(sp.grammar.empty() ? path_ : sp.grammar);
@@ -488,7 +494,7 @@ std::optional<std::string> StudioApp::export_gltf_file(const std::string& path, 
     p.rotate_y_deg = sp.rotate_y_deg;
     p.scale = sp.scale;
     p.bark = sp.bark;
-    p.skin = sp.skin;
+    p.skin = skin.value_or(sp.skin);
     plants.push_back(std::move(p));
   }
   GltfExportOptions o;

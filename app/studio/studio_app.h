@@ -175,6 +175,7 @@ class StudioApp {
   void draw_file_dialog();
   void keep(const std::string& name);  // records the last item's rect under `name`
   Scene view_scene() const;            // scene_ with the view's bark and skin controls applied
+  std::optional<SkinStyle> skin_override() const;  // the skin control's, none for "scene's"
   void plants_changed();               // skin/bark/relief options or new plants → set_plants
   std::string display_name() const;
 
