@@ -415,16 +415,19 @@ class FogBench {
       for (const char* m : {"medium", "refined"})
         if (wants(m)) automatic += a_.cone_steps.size(), fixed += a_.cone_steps.size();
       if (wants("fast")) ++automatic, ++fixed;
-      if (wants("map")) {
-        const bool disc = scene_.sun.angular_radius_deg > 0;
-        for (uint32_t directions : a_.map_directions) {
-          const size_t settings = a_.map_resolutions.size();
-          automatic += settings;
-          if (a_.map_variants) automatic += settings * ((disc && directions > 1) ? 2 : 1), fixed += settings;
-        }
-      }
+      if (wants("map"))
+        for (uint32_t directions : a_.map_directions)
+          for (const bool a : {true, false}) (a ? automatic : fixed) += a_.map_resolutions.size() * map_rows(directions, a);
     }
     return n + a_.photons.size() * seeds * (automatic + fixed);
+  }
+
+  // The rows run_map_rows measures for one resolution and disc directions, over cones of
+  // automatic or fixed parameters.
+  size_t map_rows(uint32_t directions, bool automatic) const {
+    const bool several = scene_.sun.angular_radius_deg > 0 && directions > 1;  // sun_map_directions' rule
+    if (!automatic) return a_.map_variants ? 1 : 0;
+    return 1 + (a_.map_variants ? (several ? 2 : 1) : 0);
   }
 
   bool wants(const std::string& m) const { return std::find(a_.modes.begin(), a_.modes.end(), m) != a_.modes.end(); }
@@ -520,6 +523,7 @@ class FogBench {
         if (!maps) {
           std::printf("map %u² x %u: skipped: %s\n", resolution, directions, maps.error().message.c_str());
           std::fflush(stdout);
+          for (size_t k = map_rows(directions, suffix == "-auto"); k > 0; --k) progress_.done("map, skipped");
           continue;
         }
         std::printf("map %u² x %u: %s, %.3f s wall, %.3f s CPU\n", resolution, directions, maps->describe().c_str(),

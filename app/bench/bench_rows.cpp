@@ -66,14 +66,13 @@ BenchProgress::BenchProgress(std::string label, size_t planned, bool decorated, 
 
 void BenchProgress::start() { start_ = last_ = said_ = std::chrono::steady_clock::now(); }
 
-double BenchProgress::done(const std::string& what) {
+void BenchProgress::done(const std::string& what) {
   ++done_;
   const auto now = std::chrono::steady_clock::now();
   const double row_s = seconds_between(last_, now);
   std::cerr << bench_progress_line(label_, done_, planned_, what, row_s, seconds_between(start_, now), decorated_)
             << std::endl;
   last_ = said_ = now;
-  return row_s;
 }
 
 void BenchProgress::within(double fraction, const std::string& what) {

@@ -47,8 +47,8 @@ class BenchProgress {
  public:
   BenchProgress(std::string label, size_t planned, bool decorated, double within_every_s = 30);
   void start();  // the clock starts (also at construction)
-  // Row done: prints its line; returns its time in seconds.
-  double done(const std::string& what);
+  // Row done: prints its line.
+  void done(const std::string& what);
   // `fraction` of the row now running (row done()+1), named `what`.
   void within(double fraction, const std::string& what);
   size_t rows_done() const { return done_; }
