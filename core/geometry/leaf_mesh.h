@@ -42,7 +42,7 @@ std::vector<uint32_t> triangulate_polygon(std::span<const std::array<double, 3>>
                                           TriangulationWork* work = nullptr);
 
 // A leaf's texture coordinates (docs/leaves.md "Texture coordinates"), one (u, v) per
-// vertex: v runs from the petiole (vertex 0, where the turtle stood at `{`) toward the tip
+// vertex: v runs from the petiole (vertex 0, the one nearest to where the turtle stood at `{`) toward the tip
 // (the vertex farthest from it), u across, left to right seen from the front (the side
 // `normal` points to); both scaled to [0, 1] over the leaf's bounding rectangle in that
 // frame, so an image drawn upright (petiole at its bottom row) covers the leaf. `normal`:

@@ -32,13 +32,52 @@ struct TurtleState {
   bool branch_pending = false; // set by '[': the next F starts a new chain
 };
 
-// A polygon between `{` and `}` (docs/spec/grammar.md, ABOP 1.10 and 5.1): the joint the turtle
-// stood on at `{` and the positions `.` recorded.
+// A polygon between `{` and `}` (docs/spec/grammar.md, ABOP 1.10 and 5.1; cpfg): the joint the
+// turtle stood on at `{`, where it stood, and the vertices `.`, `F` and `f` recorded.
 struct OpenPolygon {
   size_t module;                          // the `{`'s index in the word, for messages
   std::optional<ChainParent> joint;
+  dvec3 opened;                           // the turtle's position at `{`
   std::vector<std::array<double, 3>> vertices;
 };
+
+// Two recorded vertices are "equal" (docs/spec/grammar.md: a repeat is recorded once) when
+// they differ by rounding only: 1e-9 of their magnitude, or 1e-12 m near the origin. A turtle
+// that walks a polygon's outline back to its start (`{.-f+f+f-|-f+f+f}`) lands there up to
+// rounding, never bit for bit.
+bool same_vertex(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  double scale = 0, gap = 0;
+  for (int k = 0; k < 3; ++k) {
+    scale = std::max({scale, std::abs(a[k]), std::abs(b[k])});
+    gap = std::max(gap, std::abs(a[k] - b[k]));
+  }
+  return gap <= 1e-12 + 1e-9 * scale;
+}
+
+void record_vertex(OpenPolygon& polygon, const dvec3& p) {
+  const std::array<double, 3> v{p.x, p.y, p.z};
+  if (polygon.vertices.empty() || !same_vertex(polygon.vertices.back(), v)) polygon.vertices.push_back(v);
+}
+
+// Closes a polygon's vertex list as cpfg draws it: a last vertex equal to the first is
+// dropped, and the list is turned (its cyclic order kept) so that the vertex nearest to where
+// `{` opened comes first: the petiole (leaf_mesh.h). Of vertices equally near (within 1e-9),
+// the first recorded is taken, so a symmetric blade keeps its order.
+std::vector<std::array<double, 3>> closed_polygon(OpenPolygon& polygon) {
+  std::vector<std::array<double, 3>> v = std::move(polygon.vertices);
+  if (v.size() > 1 && same_vertex(v.front(), v.back())) v.pop_back();
+  if (v.empty()) return v;
+  std::vector<double> distance(v.size());
+  double nearest = INFINITY;
+  for (size_t k = 0; k < v.size(); ++k) {
+    distance[k] = glm::length(dvec3(v[k][0], v[k][1], v[k][2]) - polygon.opened);
+    nearest = std::min(nearest, distance[k]);
+  }
+  size_t first = 0;
+  while (distance[first] > nearest + 1e-9 * std::max(nearest, glm::length(polygon.opened))) ++first;
+  std::rotate(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(first), v.end());
+  return v;
+}
 
 struct PendingJoint {
   uint32_t chain;
@@ -165,25 +204,36 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
       if (m.symbol == sym_open) {
         std::optional<ChainParent> joint;
         if (t.chain >= 0) joint = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
-        polygons.push_back({i, joint, {}});
+        polygons.push_back({i, joint, t.position, {}});
         continue;
       }
       if (m.symbol == sym_vertex) {  // outside a polygon a '.' records nothing (as in cpfg)
-        if (!polygons.empty()) polygons.back().vertices.push_back({t.position.x, t.position.y, t.position.z});
+        if (!polygons.empty()) record_vertex(polygons.back(), t.position);
         continue;
       }
       if (m.symbol == sym_close) {
         if (polygons.empty()) throw TurtleFailure{"'}' without matching '{'"};
         OpenPolygon& polygon = polygons.back();
-        if (auto problem = leaf_polygon_problem(polygon.vertices)) throw TurtleFailure{"bad leaf: " + *problem};
+        std::vector<std::array<double, 3>> vertices = closed_polygon(polygon);
+        if (auto problem = leaf_polygon_problem(vertices)) throw TurtleFailure{"bad leaf: " + *problem};
         if (leaves.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
-        leaves.push_back(Leaf{polygon.joint, t.material, std::move(polygon.vertices)});
+        leaves.push_back(Leaf{polygon.joint, t.material, std::move(vertices)});
         polygons.pop_back();
         continue;
       }
       if (m.symbol == sym_move) {  // G: move without drawing and without ending the chain
         t.position += t.heading * (has ? p[0] : d.step);
         check_position(t.position);
+        continue;
+      }
+      if ((m.symbol == kSymF || m.symbol == kSymf) && !polygons.empty()) {
+        // Inside a polygon F and f move without drawing, keep the chain, and record the
+        // turtle's new position as the polygon's next vertex (cpfg; docs/spec/grammar.md).
+        const double len = has ? p[0] : d.step;
+        if (len == 0) ++zero_moves;
+        t.position += t.heading * len;
+        check_position(t.position);
+        record_vertex(polygons.back(), t.position);
         continue;
       }
       switch (m.symbol) {
@@ -233,7 +283,6 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           if (len == 0) ++zero_moves;
           t.position += t.heading * len;
           check_position(t.position);
-          if (!polygons.empty()) break;  // inside a polygon f does not end the chain (docs/spec/grammar.md)
           t.chain = -1;
           t.joint = -1;
           t.branch_pending = false;

@@ -744,13 +744,60 @@ TEST(TurtleLeaves, GrammarMdsPolygonIsOneLeafOnTheJointTheTurtleStoodOnAndfDoesN
   const Leaf& leaf = sk.leaves[0];
   EXPECT_EQ(leaf.joint, parent(0, 1));
   EXPECT_EQ(leaf.material, 0u);
-  ASSERT_EQ(leaf.vertices_m.size(), 7u);  // one per '.'
+  // One per '.', a '.' right after an f records nothing new, and the last vertex, back at the
+  // first up to rounding, is dropped: six.
+  ASSERT_EQ(leaf.vertices_m.size(), 6u);
   EXPECT_TRUE(near(leaf.vertices_m[0], {0, 1, 0}));  // '.' right after F: the joint's position
   for (const auto& v : leaf.vertices_m) EXPECT_NEAR(v[2], 0, kTolerance);  // turns about U: the XY plane
   EXPECT_FALSE(leaf_polygon_problem(leaf.vertices_m).has_value());
   // The f moves inside the polygon did not end chain 0: the last F continues it.
   ASSERT_EQ(sk.chains.size(), 1u);
   EXPECT_EQ(sk.chains[0].joint_count, 3u);
+}
+
+// ABOP Fig 1.25's leaf as the book types it: as in cpfg, an f inside a polygon records the
+// turtle's new position. It is the dotted form's polygon, the same vertices in the same order.
+TEST(TurtleLeaves, TheBooksUndottedLeafIsTheDottedFormsPolygon) {
+  const Skeleton book = skeleton_of("angle: 22.5\naxiom: F{-f+f+f-|-f+f+f}F\n");
+  const Skeleton dotted = skeleton_of("angle: 22.5\naxiom: F{.-f.+f.+f.-|-f.+f.+f.}F\n");
+  ASSERT_EQ(book.leaves.size(), 1u);
+  ASSERT_EQ(dotted.leaves.size(), 1u);
+  const auto& a = book.leaves[0].vertices_m;
+  const auto& b = dotted.leaves[0].vertices_m;
+  ASSERT_EQ(a.size(), 6u);
+  ASSERT_EQ(b.size(), 6u);
+  for (size_t k = 0; k < a.size(); ++k) EXPECT_TRUE(near(a[k], b[k])) << "vertex " << k;
+  // The petiole is the vertex nearest to where '{' opened: the joint at (0, 1, 0).
+  EXPECT_TRUE(near(a[0], {0, 1, 0}));
+  EXPECT_FALSE(leaf_polygon_problem(a).has_value());
+  ASSERT_EQ(book.chains.size(), 1u);
+  EXPECT_EQ(book.chains[0].joint_count, 3u);  // no f inside ended the chain
+}
+
+TEST(TurtleLeaves, InsideAPolygonFRecordsAVertexDrawsNoSegmentAndGRecordsNone) {
+  const Skeleton sk = skeleton_of("angle: 90\naxiom: F{F+F+G(0.5)F}F\n");
+  ASSERT_EQ(sk.leaves.size(), 1u);
+  const auto& v = sk.leaves[0].vertices_m;
+  ASSERT_EQ(v.size(), 3u);  // after each F; not after G
+  // (0,2,0), (-1,2,0), (-1,0.5,0); the nearest to (0,1,0), where '{' opened, is the first.
+  EXPECT_TRUE(near(v[0], {0, 2, 0}));
+  EXPECT_TRUE(near(v[1], {-1, 2, 0}));
+  EXPECT_TRUE(near(v[2], {-1, 0.5, 0}));
+  ASSERT_EQ(sk.chains.size(), 1u);
+  EXPECT_EQ(sk.segment_count(), 2u);  // the F before '{' and the one after '}'
+}
+
+TEST(TurtleLeaves, ThePetioleIsTheVertexNearestToWhereTheBraceOpenedInTheRecordedCyclicOrder) {
+  // A unit square walked from the origin: f records (0,1,0), (-1,1,0), (-1,0,0), (0,0,0).
+  // The last is where '{' opened, so it becomes the first; the cycle is kept.
+  const Skeleton sk = skeleton_of("angle: 90\naxiom: {f+f+f+f}\n");
+  ASSERT_EQ(sk.leaves.size(), 1u);
+  const auto& v = sk.leaves[0].vertices_m;
+  ASSERT_EQ(v.size(), 4u);
+  EXPECT_TRUE(near(v[0], {0, 0, 0}));
+  EXPECT_TRUE(near(v[1], {0, 1, 0}));
+  EXPECT_TRUE(near(v[2], {-1, 1, 0}));
+  EXPECT_TRUE(near(v[3], {-1, 0, 0}));
 }
 
 TEST(TurtleLeaves, TheMaterialIsTheOneInForceAtTheClosingBrace) {
