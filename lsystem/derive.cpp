@@ -107,6 +107,13 @@ class Rewriter {
     }
   }
 
+  // True if some production of m's symbol takes m's parameter count (only those could apply).
+  bool has_rule_of_arity(const Module& m) const {
+    for (uint32_t k : by_symbol_[m.symbol])
+      if (productions_[k].predecessor.arity == m.param_count) return true;
+    return false;
+  }
+
   // Interpretation without context (docs/spec/grammar.md "Interpretation rules"), depth first: each
   // module of `in` is expanded completely, its successors in turn up to `max_depth`, before
   // the next one, so a module without a production is copied once rather than once per
@@ -154,7 +161,7 @@ class Rewriter {
           }
         }
         if (!chosen) {
-          if (has_rules && d > max_depth) ++*left_expandable;
+          if (has_rules && d > max_depth && g_.depth_warnings && has_rule_of_arity(m)) ++*left_expandable;
           copy_module(stack_, t, out);
           pop(t);
           continue;

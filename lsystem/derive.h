@@ -58,7 +58,8 @@ Expected<Word> derive(const Grammar& grammar, const DeriveOptions& options = {},
 
 struct InterpretStats {
   int depth = 0;                 // homomorphism passes performed
-  uint64_t still_expandable = 0; // modules left unexpanded at the depth limit
+  uint64_t still_expandable = 0; // modules left unexpanded at the depth limit that a production
+                                 //   of their arity could rewrite (Grammar::depth_warnings)
   // Modules written: to the result and, without context, to the pending stack of the
   // depth-first expansion (a work counter for tests; docs/limits.md "Work"). At most
   // 16 x max_modules: beyond that interpretation fails naming its budget.

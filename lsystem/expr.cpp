@@ -16,7 +16,35 @@ const FuncInfo kFuncs[] = {
     {"exp", 1, false},   {"log", 1, false},   {"pow", 2, false},   {"abs", 1, false},
     {"floor", 1, false}, {"ceil", 1, false},  {"min", 2, false},   {"max", 2, false},
     {"clamp", 3, false}, {"rand", 0, true},   {"uniform", 2, true}, {"gauss", 2, true},
+    {"fabs", 1, false},  {"trunc", 1, false}, {"sign", 1, false},  {"ran", 1, true},
+    {"nran", 2, true},   {"bran", 2, true},   {"biran", 2, true},
 };
+
+// The largest n biran(n, p) draws for (n uniform draws: bounded time, docs/cpfg.md).
+constexpr double kMaxBiranTrials = 1e6;
+
+// A Gamma(k, 1) variate, k > 0 (Marsaglia and Tsang 2000; k < 1 by Gamma(k + 1)·U^(1/k)).
+// The rejection loop accepts with probability above 0.95 per try; it is bounded, and after
+// the bound returns the mean (a run of 64 rejections has probability below 1e-80).
+double gamma_variate(double k, Rng* rng) {
+  double boost = 1;
+  if (k < 1) {
+    boost = std::pow(1.0 - rng->next_double(), 1 / k);
+    k += 1;
+  }
+  const double d = k - 1.0 / 3.0, c = 1 / std::sqrt(9 * d);
+  for (int tries = 0; tries < 64; ++tries) {
+    double x, v;
+    do {
+      x = rng->next_gauss();
+      v = 1 + c * x;
+    } while (v <= 0);
+    v = v * v * v;
+    const double u = 1.0 - rng->next_double();
+    if (std::log(u) < 0.5 * x * x + d - d * v + d * std::log(v)) return d * v * boost;
+  }
+  return d * boost;
+}
 
 // Reduces degrees to a quadrant q (0..3) and a remainder in [-45, 45] degrees.
 void reduce_degrees(double degrees, int* quadrant, double* rem_rad) {
@@ -149,6 +177,27 @@ double Program::run(const Expr& e, const double* slots, Rng* rng) const {
           case Func::kRand: r = rng->next_double(); break;
           case Func::kUniform: r = a[0] + (a[1] - a[0]) * rng->next_double(); break;
           case Func::kGauss: r = a[0] + a[1] * rng->next_gauss(); break;
+          case Func::kFabs: r = std::fabs(a[0]); break;
+          case Func::kTrunc: r = std::trunc(a[0]); break;
+          case Func::kSign: r = a[0] > 0 ? 1.0 : (a[0] < 0 ? -1.0 : 0.0); break;
+          case Func::kRan: r = a[0] * rng->next_double(); break;
+          case Func::kNran: r = a[0] + a[1] * rng->next_gauss(); break;
+          case Func::kBran: {
+            if (!(a[0] > 0) || !(a[1] > 0)) fail(locs[pc], "bran(a, b) needs a > 0 and b > 0");
+            const double x = gamma_variate(a[0], rng), y = gamma_variate(a[1], rng);
+            r = x + y > 0 ? x / (x + y) : 0.5;
+            break;
+          }
+          case Func::kBiran: {
+            if (!(a[0] >= 0) || a[0] != std::floor(a[0]) || a[0] > kMaxBiranTrials)
+              fail(locs[pc], "biran(n, p) needs an integer n from 0 to 1000000");
+            if (!(a[1] >= 0 && a[1] <= 1)) fail(locs[pc], "biran(n, p) needs p from 0 to 1");
+            const auto n = static_cast<int64_t>(a[0]);
+            int64_t hits = 0;
+            for (int64_t k = 0; k < n; ++k) hits += rng->next_double() < a[1];
+            r = static_cast<double>(hits);
+            break;
+          }
         }
         stack[sp++] = check(r);
         break;

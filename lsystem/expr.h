@@ -30,7 +30,9 @@ enum class Op : uint8_t {
 
 enum class Func : uint8_t {
   kSin, kCos, kTan, kAsin, kAcos, kAtan, kAtan2, kSqrt, kExp, kLog, kPow, kAbs,
-  kFloor, kCeil, kMin, kMax, kClamp, kRand, kUniform, kGauss
+  kFloor, kCeil, kMin, kMax, kClamp, kRand, kUniform, kGauss,
+  // The CPFG manual's chapter 5 (docs/cpfg.md): available in every grammar.
+  kFabs, kTrunc, kSign, kRan, kNran, kBran, kBiran
 };
 
 struct Instr {

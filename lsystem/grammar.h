@@ -66,6 +66,19 @@ struct TurtleDefaults {
   bool has_tropism = false;
   double tropism[3] = {0, 0, 0};
   double tropism_e = 0;
+  // cpfg's view-file settings (docs/cpfg.md), read only for a cpfg file: a line width w
+  // becomes a radius of w * width_scale; `#` and `!` add and take width_increment (in line
+  // widths), `;` and `,` add and take color_increment.
+  double width_scale = 0.05;
+  double width_increment = 0;
+  uint32_t color_increment = 1;
+};
+
+// A file a cpfg grammar read with #include (lsystem/cpfg_preprocessor.h).
+struct IncludedFile {
+  std::string path;                          // as opened, for messages
+  std::shared_ptr<const std::string> text;   // for caret lines
+  SourceLoc included_at;                     // the #include line that read it
 };
 
 // A #define after overrides.
@@ -79,12 +92,18 @@ struct Define {
 struct Grammar {
   std::string file;                          // as given, for messages
   std::shared_ptr<const std::string> text;   // the source, for caret lines
+  // A cpfg model file (is_cpfg_text; docs/cpfg.md): the turtle reads cpfg's symbols.
+  bool cpfg = false;
+  std::vector<IncludedFile> includes;        // SourceLoc::file k > 0 is includes[k - 1]
   SymbolTable symbols;
   std::vector<Define> defines;
   TurtleDefaults turtle;
   uint64_t seed = 1;
   int64_t steps = 1;
   int max_depth = 16;        // homomorphism recursion limit
+  // Whether interpret() counts the modules left expandable at max_depth (the front ends warn):
+  // always in sylva's format; in a cpfg file only after 'homomorphism: warnings' (manual 4.3.1).
+  bool depth_warnings = true;
   Word axiom;                 // the start word (random arguments: drawn with `seed`)
   SourceLoc axiom_loc;
   // Set when the axiom draws random numbers (`axiom: F(uniform(1,2))`): derive() then
@@ -101,9 +120,10 @@ struct Grammar {
   bool uses_context = false;  // any production with left or right context
   bool uses_cut = false;      // % appears in a successor or the axiom
 
-  // The physical source line `line` (1-based) without its newline, for messages.
-  std::string_view source_line(uint32_t line) const;
-  // A Diagnostic at `loc` in this grammar's file.
+  // The physical source line at `loc` (in its file) without its newline, for messages.
+  std::string_view source_line(SourceLoc loc) const;
+  // A Diagnostic at `loc` in this grammar's file, or in the included file it names, then
+  // with a note at each #include that led there.
   Diagnostic error_at(SourceLoc loc, std::string message) const;
 };
 
@@ -127,7 +147,12 @@ struct ParseWork {
 };
 ParseWork& parse_work();
 
-// Parses and compiles grammar text. `file` names the grammar in messages.
+// True if `text` is a cpfg model file (docs/spec/grammar.md): its first line that is not
+// blank, a comment or a preprocessor line is `Lsystem: ...`, in any case.
+bool is_cpfg_text(std::string_view text);
+
+// Parses and compiles grammar text. `file` names the grammar in messages (and, for a cpfg
+// file, its folder is where #include looks).
 Expected<Grammar> parse_grammar(std::string_view text, std::string file,
                                 const ParseOptions& options = {});
 

@@ -15,66 +15,18 @@
 #include <unordered_map>
 
 #include "core/util/file_io.h"
+#include "lsystem/cpfg_preprocessor.h"
 #include "lsystem/expr.h"
 #include "lsystem/grammar.h"
+#include "lsystem/source_text.h"
 
 namespace sylva::lsys {
 
-namespace {
+namespace detail {
 
-constexpr int kMaxNesting = 128;     // parentheses / unary operators / calls
-constexpr int64_t kMaxSteps = 1000000;
-constexpr int kMaxDepthLimit = 1000;
-
-struct ParseFailure {
-  SourceLoc loc;
-  std::string message;
-};
-
-[[noreturn]] void fail(SourceLoc loc, std::string message) {
-  throw ParseFailure{loc, std::move(message)};
-}
-
-// One logical line (continuations joined) and where its bytes come from: one piece per
-// physical line (12 bytes each, not a place per byte: issue 32's 128 MB of blank lines).
-struct LogicalLine {
-  struct Piece {
-    size_t offset = 0;  // text[offset, next piece's offset) is from ...
-    uint32_t line = 0;  // ... this physical line, from this column on
-    uint32_t column = 1;
-  };
-  std::string text;
-  std::vector<Piece> pieces;  // by offset; at least one
-
-  // The source place of text[p]; text.size() (or more): the place just past the end.
-  SourceLoc loc(size_t p) const {
-    p = std::min(p, text.size());
-    auto after = std::upper_bound(pieces.begin(), pieces.end(), p,
-                                  [](size_t v, const Piece& piece) { return v < piece.offset; });
-    const Piece& piece = *(after - 1);
-    return {piece.line, static_cast<uint32_t>(piece.column + (p - piece.offset))};
-  }
-};
-
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-bool is_ident_start(char c) {
-  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
-}
-bool is_ident_char(char c) { return is_ident_start(c) || (c >= '0' && c <= '9'); }
-bool is_digit(char c) { return c >= '0' && c <= '9'; }
-
-std::string quote_char(char c) {
-  if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-    char buf[8];
-    std::snprintf(buf, sizeof buf, "0x%02x", static_cast<unsigned char>(c));
-    return buf;
-  }
-  return std::string("'") + c + "'";
-}
-
-// Checks UTF-8 and NUL bytes; returns the place of the first problem.
-void validate_text(std::string_view text) {
+void validate_text(std::string_view text, uint32_t file) {
   uint32_t line = 1, col = 1;
+  auto fail = [file](SourceLoc loc, std::string message) { detail::fail({loc.line, loc.column, file}, std::move(message)); };
   size_t i = 0;
   while (i < text.size()) {
     unsigned char c = static_cast<unsigned char>(text[i]);
@@ -115,6 +67,25 @@ void validate_text(std::string_view text) {
     }
     i += len;
   }
+}
+
+}  // namespace detail
+
+namespace {
+
+using namespace detail;  // NOLINT: the parser is the detail's main user
+
+constexpr int kMaxNesting = 128;     // parentheses / unary operators / calls
+constexpr int64_t kMaxSteps = 1000000;
+constexpr int kMaxDepthLimit = 1000;
+
+std::string quote_char(char c) {
+  if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+    char buf[8];
+    std::snprintf(buf, sizeof buf, "0x%02x", static_cast<unsigned char>(c));
+    return buf;
+  }
+  return std::string("'") + c + "'";
 }
 
 // Replaces /* ... */ comments by spaces, keeping newlines (so places do not move).
@@ -164,26 +135,13 @@ bool is_comment_line(std::string_view s) {
 
 std::vector<LogicalLine> logical_lines(const std::string& text) {
   std::vector<LogicalLine> lines;
-  size_t pos = 0;
-  uint32_t line_no = 0;
   LogicalLine current;
   bool continuing = false;
-  while (pos <= text.size()) {
-    size_t nl = text.find('\n', pos);
-    if (nl == std::string::npos) nl = text.size();
-    ++line_no;
-    std::string_view phys(text.data() + pos, nl - pos);
-    if (!phys.empty() && phys.back() == '\r') phys.remove_suffix(1);
-    if (!continuing && is_comment_line(phys)) {
-      pos = nl + 1;
-      continue;
-    }
+  for_each_physical_line(text, [&](uint32_t line_no, std::string_view phys, bool last) {
+    if (!continuing && is_comment_line(phys)) return;
     size_t keep = phys.size();
     while (keep > 0 && is_space(phys[keep - 1])) --keep;
-    if (!continuing && keep == 0) {  // blank: no logical line (every pass skips them)
-      pos = nl + 1;
-      continue;
-    }
+    if (!continuing && keep == 0) return;  // blank: no logical line (every pass skips them)
     bool continues = keep > 0 && phys[keep - 1] == '\\';
     size_t take = continues ? keep - 1 : phys.size();
     // Appended with the string's own geometric growth: reserving exactly what each
@@ -192,7 +150,7 @@ std::vector<LogicalLine> logical_lines(const std::string& text) {
     const size_t capacity = current.text.capacity();
     current.text.append(phys.substr(0, take));
     if (current.text.capacity() != capacity) parse_work().line_bytes_copied += current.text.size() - take;
-    if (continues && nl < text.size()) {
+    if (continues && !last) {
       continuing = true;
     } else {
       ++parse_work().logical_lines;
@@ -200,8 +158,7 @@ std::vector<LogicalLine> logical_lines(const std::string& text) {
       current = LogicalLine{};
       continuing = false;
     }
-    pos = nl + 1;
-  }
+  });
   return lines;
 }
 
@@ -295,10 +252,18 @@ class Parser {
   void declare_modules(Cursor c);
   void set_ignore(Cursor c);
 
+  // ---- cpfg model files (docs/cpfg.md) ----
+  bool cpfg_line(const LogicalLine& line, std::string_view rest, bool* homomorphism);
+  void set_consider(Cursor c);
+
   Grammar& g_;
   const ParseOptions& options_;
   std::unordered_map<std::string, double> define_values_;
   bool have_axiom_ = false;
+  bool seen_lsystem_ = false;  // cpfg: the 'Lsystem:' line was read
+  bool seen_end_ = false;      // cpfg: the 'endlsystem' line was read
+  bool consider_ = false;      // cpfg: a 'consider:' list names the modules context sees
+  std::vector<uint8_t> considered_;  // by symbol id
 };
 
 // ---------------------------------------------------------------- expressions
@@ -619,7 +584,7 @@ std::vector<Parser::ParsedModule> Parser::parse_modules(Cursor c, const char* wh
         fail(loc, "unexpected '(' (no space is allowed between a module name and its arguments)");
       fail(loc, std::string("unexpected '(' in ") + what);
     }
-    if (ch == ')' || ch == ',' || ch == ':')
+    if (ch == ')' || (ch == ',' && !g_.cpfg) || ch == ':')  // ',' is a module in cpfg (colour)
       fail(loc, "unexpected " + quote_char(ch) + " in " + what);
     std::string_view name = module_name_at(c);
     bool ok = true;
@@ -802,6 +767,7 @@ void Parser::declare_modules(Cursor c) {
 
 void Parser::set_ignore(Cursor c) {
   std::vector<ParsedModule> ms = parse_modules(c, "the ignore list");
+  if (consider_) fail(c.loc(), "'consider:' and 'ignore:' cannot both be given");
   for (const ParsedModule& m : ms) {
     if (!m.args.empty()) fail(m.loc, "the ignore list takes module names without parameters");
     if (m.symbol == kSymPush || m.symbol == kSymPop)
@@ -819,9 +785,10 @@ bool Parser::try_directive(const LogicalLine& line) {
   Cursor c{&line, 0, line.text.size()};
   c.skip_spaces();
   std::string_view rest = c.rest();
+  const std::string folded = g_.cpfg ? lower_ascii(rest.substr(0, 24)) : std::string();
   for (const char* name : kNames) {
     size_t n = std::strlen(name);
-    if (rest.substr(0, n) != name) continue;
+    if ((g_.cpfg ? std::string_view(folded).substr(0, n) : rest.substr(0, n)) != name) continue;
     size_t p = n;
     while (p < rest.size() && is_space(rest[p])) ++p;
     if (p >= rest.size() || rest[p] != ':') continue;
@@ -982,6 +949,10 @@ void Parser::parse_production(const LogicalLine& line, bool homomorphism) {
     std::string_view ct = cond_text.rest();
     while (!ct.empty() && is_space(ct.back())) ct.remove_suffix(1);
     has_condition = ct != "*";
+    if (g_.cpfg)
+      if (size_t brace = find_top_level(cond_text, "{"); brace != std::string::npos)
+        fail(cond_text.loc_at(brace), "statements in a production ('{ ... }', CPFG manual 3.2) are not supported yet "
+                                      "(docs/cpfg.md)");
   }
   // Context split at top-level '<' and '>'.
   size_t lt = find_top_level(context, "<");
@@ -1048,10 +1019,92 @@ void Parser::parse_production(const LogicalLine& line, bool homomorphism) {
       fail(p.probability.loc, "a probability must not be negative");
     g_.uses_random = true;
   }
+  {
+    Cursor t = succ;
+    t.skip_spaces();
+    std::string_view st = t.rest();
+    while (!st.empty() && is_space(st.back())) st.remove_suffix(1);
+    if (g_.cpfg && st == "*") succ.end = succ.pos;  // cpfg's empty successor (manual 3)
+    else if (g_.cpfg && t.at_end()) fail(t.loc(), "expected a successor after '-->' (cpfg writes '*' for none)");
+  }
   p.successor = compile_successor(succ, scope, "the successor");
   for (const Expr& e : p.successor.args)
     if (e.uses_random) g_.uses_random = true;
   (homomorphism ? g_.homomorphism : g_.productions).push_back(std::move(p));
+}
+
+// A line of a cpfg file that only cpfg has; true when it was one. Productions and the
+// directives both formats share go on to the common code.
+bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest, bool* homomorphism) {
+  Cursor c{&line, 0, line.text.size()};
+  c.skip_spaces();
+  const std::string folded = lower_ascii(rest);
+  // `word` then spaces then ':' (or the end, where `colon_optional`); *value the rest.
+  auto keyword = [&](std::string_view word, bool colon_optional, Cursor* value) {
+    if (folded.compare(0, word.size(), word) != 0) return false;
+    size_t k = word.size();
+    if (k < folded.size() && is_ident_char(folded[k])) return false;
+    while (k < folded.size() && is_space(folded[k])) ++k;
+    if (k < folded.size() && folded[k] == ':') ++k;
+    else if (!(colon_optional && k == folded.size())) return false;
+    if (value) *value = c.sub(c.pos + k, line.text.size());
+    return true;
+  };
+  auto unsupported = [&](const std::string& what) {
+    fail(c.loc(), what + " is not supported yet (docs/cpfg.md)");
+  };
+  Cursor value = c;
+  if (keyword("lsystem", false, &value)) {
+    if (seen_lsystem_) unsupported("a second L-system (sub-L-systems, CPFG manual 7.2)");
+    seen_lsystem_ = true;
+    return true;  // its label names the L-system for sub-L-systems only
+  }
+  if (seen_end_) unsupported("text after 'endlsystem' (sub-L-systems, CPFG manual 7.2)");
+  if (folded == "endlsystem") {
+    seen_end_ = true;
+    return true;
+  }
+  if (keyword("homomorphism", true, &value)) {
+    const std::string option = lower_ascii(value.rest());
+    std::string_view o = option;
+    while (!o.empty() && is_space(o.front())) o.remove_prefix(1);
+    if (!o.empty() && o != "warnings" && o != "no warnings")
+      fail(value.loc(), "expected 'warnings' or 'no warnings' after 'homomorphism:'");
+    g_.depth_warnings = o == "warnings";
+    *homomorphism = true;
+    return true;
+  }
+  // The homomorphism's own generator (manual 4.3.3): sylva's homomorphism draws from streams
+  // keyed by module and depth already, so a redraw never changes it; the value is read only.
+  if (*homomorphism && keyword("seed", false, &value)) {
+    constant_expression(value, "the homomorphism's seed");
+    return true;
+  }
+  if (keyword("decomposition", true, nullptr)) unsupported("decomposition (CPFG manual 4.4)");
+  if (folded.compare(0, 4, "ring") == 0 && lower_ascii(rest).find("lsystem") != std::string::npos)
+    unsupported("a ring L-system (CPFG manual 3.1.1)");
+  if (keyword("consider", false, &value)) {
+    set_consider(value);
+    return true;
+  }
+  if (keyword("define", false, nullptr)) unsupported("'define:' arrays (CPFG manual 2.2.2)");
+  for (const char* block : {"start", "starteach", "endeach", "end"})
+    if (keyword(block, false, nullptr))
+      unsupported("the '" + std::string(rest.substr(0, std::strlen(block))) + ":' block (CPFG manual 4.1)");
+  return false;
+}
+
+void Parser::set_consider(Cursor c) {
+  std::vector<ParsedModule> ms = parse_modules(c, "the consider list");
+  if (consider_) fail(c.loc(), "'consider:' is given twice");
+  for (uint8_t ignored : g_.ignored)
+    if (ignored) fail(c.loc(), "'consider:' and 'ignore:' cannot both be given");
+  consider_ = true;
+  for (const ParsedModule& m : ms) {
+    if (!m.args.empty()) fail(m.loc, "the consider list takes module names without parameters");
+    if (considered_.size() <= m.symbol) considered_.resize(m.symbol + 1u, 0);
+    considered_[m.symbol] = 1;
+  }
 }
 
 enum class LineKind { kBlank, kDefine, kModule, kSection, kOther };
@@ -1074,12 +1127,38 @@ LineKind classify(const LogicalLine& line) {
   return LineKind::kOther;
 }
 
+// The module names of the CPFG manual's chapter 6 that are longer than one character: a
+// cpfg file reads `@Gs` as one module, as cpfg does.
+constexpr const char* kCpfgModuleNames[] = {
+    "@Gc", "@Ge", "@Gr", "@Gs", "@Gt", "@L",  "@O",  "@PC", "@PD", "@PS", "@T",  "@Td", "@Tf", "@Tp", "@Ts",
+    "@Tx", "@bc", "@bo", "@c",  "@o",  "@v",  "@M",  "@m",  "@R",  "@D",  "@Di", "@Dd", "@;",  "@,",  "?P",
+    "?H",  "?L",  "?U",  "?E"};
+
 void Parser::parse(const std::string& text) {
   validate_text(text);
-  std::string clean = blank_comments(text);
-  size_t bom = clean.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
-  if (bom) clean.replace(0, 3, "   ");
-  std::vector<LogicalLine> lines = logical_lines(clean);
+  std::vector<LogicalLine> lines;
+  if (is_cpfg_text(text)) {
+    // A cpfg model file (docs/cpfg.md): the C preprocessor first, cpfg's defaults.
+    g_.cpfg = true;
+    g_.turtle.angle_deg = 45;  // the view file's default angle increment (CPFG manual 8.1.1)
+    g_.max_depth = 1;          // a homomorphism is applied once unless 'maximum depth:' says more
+    g_.depth_warnings = false; // ... and says nothing of what is left unless asked (manual 4.3.1)
+    g_.turtle.width = 1 * g_.turtle.width_scale;  // the initial line width, 1 (manual 8.1.1)
+    std::string body = text;
+    if (body.compare(0, 3, "\xEF\xBB\xBF") == 0) body.replace(0, 3, "   ");
+    detail::CpfgSource source = detail::preprocess_cpfg(body, g_.file, options_, g_.includes);
+    lines = std::move(source.lines);
+    g_.defines = std::move(source.defines);
+    for (const char* name : kCpfgModuleNames) {
+      g_.symbols.declare_multichar(name);
+      g_.symbols.intern(name);
+    }
+  } else {
+    std::string clean = blank_comments(text);
+    size_t bom = clean.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+    if (bom) clean.replace(0, 3, "   ");
+    lines = logical_lines(clean);
+  }
 
   // Pass 1: module declarations (they change how every module string is tokenised).
   for (const LogicalLine& line : lines) {
@@ -1092,7 +1171,7 @@ void Parser::parse(const std::string& text) {
   for (const LogicalLine& line : lines)
     if (classify(line) == LineKind::kDefine) parse_define(line);
   for (const auto& [name, value] : options_.define_overrides) {
-    if (!define_values_.count(name))
+    if (!g_.cpfg && !define_values_.count(name))
       fail({0, 0}, "-D " + name + ": the grammar has no '#define " + name + "'");
   }
   // Pass 3: directives, sections and productions.
@@ -1104,6 +1183,7 @@ void Parser::parse(const std::string& text) {
     c.skip_spaces();
     std::string_view rest = c.rest();
     while (!rest.empty() && is_space(rest.back())) rest.remove_suffix(1);
+    if (g_.cpfg && cpfg_line(line, rest, &homomorphism)) continue;
     if (rest.substr(0, 7) == "#ignore") {
       Cursor v = c.sub(c.pos + 7, line.text.size());
       v.skip_spaces();
@@ -1148,11 +1228,19 @@ void Parser::parse(const std::string& text) {
       fail(c.loc(), "unknown directive '" + std::string(rest.substr(0, rest.find_first_of(" \t:"))) + "'");
     fail(c.loc(), "expected a production 'predecessor -> successor' or a directive 'name: value'");
   }
-  if (!have_axiom_) fail({1, 1}, "no axiom: the grammar needs a line 'axiom: <modules>'");
+  if (g_.cpfg && !seen_end_)
+    fail(lines.empty() ? SourceLoc{1, 1} : lines.back().loc(lines.back().text.size()),
+         "the L-system has no 'endlsystem' line (CPFG manual 2)");
+  if (!have_axiom_) fail({1, 1}, g_.cpfg ? "no axiom: the L-system needs a line 'Axiom: <modules>'"
+                                         : "no axiom: the grammar needs a line 'axiom: <modules>'");
 
   // Index productions by predecessor symbol; size per-symbol tables.
   const size_t nsym = g_.symbols.size();
   g_.ignored.resize(nsym, 0);
+  if (consider_) {  // every module that 'consider:' does not name is ignored; brackets never are
+    considered_.resize(nsym, 0);
+    for (size_t k = 0; k < nsym; ++k) g_.ignored[k] = k != kSymPush && k != kSymPop && !considered_[k];
+  }
   g_.productions_by_symbol.assign(nsym, {});
   g_.homomorphism_by_symbol.assign(nsym, {});
   for (uint32_t i = 0; i < g_.productions.size(); ++i)
@@ -1175,7 +1263,10 @@ ParseWork& parse_work() {
   return work;
 }
 
-std::string_view Grammar::source_line(uint32_t line) const {
+namespace {
+
+// Line `line` (1-based) of `text` without its newline.
+std::string_view line_of(const std::string* text, uint32_t line) {
   if (!text || line == 0) return {};
   size_t pos = 0;
   for (uint32_t l = 1; l < line; ++l) {
@@ -1190,9 +1281,28 @@ std::string_view Grammar::source_line(uint32_t line) const {
   return s;
 }
 
+}  // namespace
+
+std::string_view Grammar::source_line(SourceLoc loc) const {
+  if (loc.file > includes.size()) return {};
+  return line_of(loc.file == 0 ? text.get() : includes[loc.file - 1].text.get(), loc.line);
+}
+
 Diagnostic Grammar::error_at(SourceLoc loc, std::string message) const {
-  Diagnostic d = diagnostic_at(file, loc, std::move(message));
-  if (loc.line) set_source_line(d, source_line(loc.line));
+  // One place, in the file `at` names, with its source line.
+  auto located = [this](SourceLoc at, std::string text) {
+    const bool included = at.file > 0 && at.file <= includes.size();
+    Diagnostic d = diagnostic_at(included ? includes[at.file - 1].path : file, {at.line, at.column}, std::move(text));
+    if (at.line) set_source_line(d, source_line(at));
+    return d;
+  };
+  Diagnostic d = located(loc, std::move(message));
+  // The include chain, innermost first: an includer comes before what it includes in
+  // `includes`, so the walk ends.
+  for (SourceLoc at = loc; at.file > 0 && at.file <= includes.size();) {
+    at = includes[at.file - 1].included_at;
+    d = std::move(d).with_note(located(at, "included from here"));
+  }
   return d;
 }
 

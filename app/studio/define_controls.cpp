@@ -99,13 +99,17 @@ std::vector<DefineLine> scan_defines(std::string_view text) {
       DefineLine d;
       d.name = std::string(l.substr(name_begin, i - name_begin));
       d.line = line;
+      // A function-like macro of a cpfg file (docs/cpfg.md) has no value to set.
+      const bool function_like = i < l.size() && l[i] == '(';
       while (i < l.size() && is_space(l[i])) ++i;
       size_t value_begin = i;
       size_t comment = l.find("/*", i);
       size_t value_end = comment == std::string_view::npos ? l.size() : comment;
+      // A cpfg file's `//` comment ends the value too (in sylva's format a value never holds '//').
+      if (size_t slashes = l.substr(0, value_end).find("//", i); slashes != std::string_view::npos) value_end = slashes;
       if (value_end > value_begin && l[value_end - 1] == '\r') --value_end;
       while (value_end > value_begin && is_space(l[value_end - 1])) --value_end;
-      if (!d.name.empty() && value_end > value_begin) {
+      if (!d.name.empty() && !function_like && value_end > value_begin) {
         d.value_begin = pos + value_begin;
         d.value_end = pos + value_end;
         d.value_text = std::string(l.substr(value_begin, value_end - value_begin));

@@ -146,6 +146,52 @@ std::vector<SourceLoc> places_writing(const lsys::Grammar& g, lsys::SymbolId sym
   return places;
 }
 
+// What the turtle makes of a cpfg file's own symbols (CPFG manual 6; docs/cpfg.md).
+enum class CpfgKind : uint8_t {
+  kNone, kDraw, kMove, kColorUp, kColorDown, kWidthUp, kWidthDown, kLevel, kSetPosition, kUnsupported
+};
+
+struct CpfgSymbols {
+  std::vector<CpfgKind> kind;  // by symbol id; empty for sylva's own format
+};
+
+CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
+  CpfgSymbols out;
+  if (!g.cpfg) return out;
+  out.kind.assign(g.symbols.size(), CpfgKind::kNone);
+  auto set = [&](const char* name, CpfgKind kind) {
+    lsys::SymbolId id = 0;
+    if (g.symbols.find(name, &id)) out.kind[id] = kind;
+  };
+  set("G", CpfgKind::kDraw);
+  set("g", CpfgKind::kMove);
+  set(";", CpfgKind::kColorUp);
+  set(",", CpfgKind::kColorDown);
+  set("#", CpfgKind::kWidthUp);
+  set("!", CpfgKind::kWidthDown);
+  set("@v", CpfgKind::kLevel);
+  set("@M", CpfgKind::kSetPosition);
+  for (const char* name : {"~", "@o", "@c", "@O", "@Gs", "@Gc", "@Ge", "@Gr", "@Gt", "@T", "@Ts", "@Td", "@Tf",
+                           "@D", "@Di", "@Dd", "@R", "@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc", "?P", "?H", "?L",
+                           "?U", "?E"})
+    set(name, CpfgKind::kUnsupported);
+  return out;
+}
+
+// The feature a cpfg symbol sylva does not draw yet belongs to, for its error.
+std::string cpfg_feature(const std::string& name) {
+  if (name == "~") return "a predefined surface, CPFG manual 6.7.1";
+  if (name == "@o" || name == "@c" || name == "@O") return "a sphere or circle, CPFG manual 6.6";
+  if (name.rfind("@G", 0) == 0) return "a generalized cylinder, CPFG manual 6.7.3";
+  if (name.rfind("@T", 0) == 0) return "a view-file tropism, CPFG manual 6.8";
+  if (name.rfind("@D", 0) == 0) return "the turtle's scale, CPFG manual 6.3";
+  if (name == "@R") return "setting the heading, CPFG manual 6.2";
+  if (name == "@;" || name == "@,") return "a back-side colour, CPFG manual 6.3";
+  if (name.rfind("@P", 0) == 0 || name.rfind("@b", 0) == 0) return "a B-spline surface patch, CPFG manual 6.7.2";
+  if (name == "?E") return "an environmental query, CPFG manual 6.9";
+  return "a turtle query, CPFG manual 6.9";
+}
+
 }  // namespace
 
 Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g, TurtleStats* stats,
@@ -169,7 +215,9 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
     return g.symbols.find(name, &id) ? std::optional<SymbolId>(id) : std::nullopt;
   };
   const std::optional<SymbolId> sym_open = id_of("{"), sym_vertex = id_of("."), sym_close = id_of("}"),
-                                sym_move = id_of("G");
+                                sym_move = g.cpfg ? std::nullopt : id_of("G");
+  // A cpfg file's own symbols (docs/cpfg.md), by symbol id; none for sylva's format.
+  const CpfgSymbols cpfg = cpfg_symbols(g);
   std::vector<OpenPolygon> polygons;  // a stack: polygons nest
   std::vector<Leaf> leaves;
   const size_t n = word.size();
@@ -226,7 +274,45 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
         check_position(t.position);
         continue;
       }
-      if ((m.symbol == kSymF || m.symbol == kSymf) && !polygons.empty()) {
+      SymbolId symbol = m.symbol;
+      if (symbol < cpfg.kind.size() && cpfg.kind[symbol] != CpfgKind::kNone) {
+        switch (cpfg.kind[symbol]) {
+          case CpfgKind::kDraw: symbol = kSymF; break;   // G: move and draw, no polygon vertex
+          case CpfgKind::kMove: symbol = kSymf; break;   // g: move without drawing, no vertex
+          case CpfgKind::kColorUp:
+          case CpfgKind::kColorDown: {
+            double next = has ? p[0] : static_cast<double>(t.material) +
+                                           (cpfg.kind[symbol] == CpfgKind::kColorUp ? 1.0 : -1.0) * d.color_increment;
+            if (!(next >= 0) || next != std::floor(next) || next > 4294967295.0)
+              throw TurtleFailure{"a colour index must be an integer from 0 to 4294967295"};
+            t.material = static_cast<uint32_t>(next);
+            continue;
+          }
+          case CpfgKind::kWidthUp:
+          case CpfgKind::kWidthDown: {
+            const double sign = cpfg.kind[symbol] == CpfgKind::kWidthUp ? 1.0 : -1.0;
+            t.radius = has ? p[0] * d.width_scale : t.radius + sign * d.width_increment * d.width_scale;
+            if (!(t.radius >= 0) || !std::isfinite(t.radius)) throw TurtleFailure{"the line width must be finite and not negative"};
+            if (t.radius > kMaxCoordinateM) throw TurtleFailure{"the radius exceeds the limit of 1e12 m (docs/limits.md)"};
+            continue;
+          }
+          case CpfgKind::kLevel: symbol = kSymLevel; break;  // @v: U as close to up as H allows
+          case CpfgKind::kSetPosition: {
+            if (m.param_count < 3) throw TurtleFailure{"@M needs the position: @M(x, y, z)"};
+            t.position = dvec3(p[0], p[1], p[2]);
+            check_position(t.position);
+            t.chain = -1;  // as after f: the next F starts a new chain
+            t.joint = -1;
+            t.branch_pending = false;
+            continue;
+          }
+          case CpfgKind::kUnsupported:
+            throw TurtleFailure{"'" + g.symbols.name(m.symbol) + "' (" + cpfg_feature(g.symbols.name(m.symbol)) +
+                                ") is not supported yet (docs/cpfg.md)"};
+          case CpfgKind::kNone: break;
+        }
+      }
+      if ((symbol == kSymF || symbol == kSymf) && !polygons.empty() && symbol == m.symbol) {
         // Inside a polygon F and f move without drawing, keep the chain, and record the
         // turtle's new position as the polygon's next vertex (cpfg; docs/spec/grammar.md).
         const double len = has ? p[0] : d.step;
@@ -236,7 +322,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
         record_vertex(polygons.back(), t.position);
         continue;
       }
-      switch (m.symbol) {
+      switch (symbol) {
         case kSymF: {
           const double len = has ? p[0] : d.step;
           if (len == 0) {

@@ -27,9 +27,12 @@ namespace sylva {
 // A place in a text file: 1-based line and column. {0,0} means "no place" (a file that
 // cannot be read, an error about the whole file). Columns count bytes in grammar text
 // (docs/spec/grammar.md) and code points in JSON files (json.h); the two agree on ASCII lines.
+// `file` tells the files of a set apart (a cpfg grammar and the files it #includes:
+// lsystem/grammar.h); 0 is the main one, the only one elsewhere.
 struct SourceLoc {
   uint32_t line = 0;
   uint32_t column = 0;
+  uint32_t file = 0;
   bool operator==(const SourceLoc&) const = default;
 };
 

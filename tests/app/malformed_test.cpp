@@ -5,11 +5,13 @@
 //   <a caret under the column>
 // with exit status 1 and nothing on stdout; never a crash, a hang or a partial word.
 //
-// The corpus is tests/grammars/malformed/NN_name.lsys; the first line of each file says
-// what to expect:
+// The corpus is tests/grammars/malformed/NN_name.lsys (and NN_name.l, cpfg model files,
+// docs/cpfg.md); the first line of each file says what to expect:
 //   # expect: LINE:COLUMN KEYWORD[|KEYWORD...]   (any one keyword, case-insensitive)
 //   # also: TEXT                                 (optional, repeatable: TEXT appears in
 //                                                 the message, e.g. the module "A(0)")
+// A cpfg file writes them as C comments, "// expect: ..." and "// also: ...": there '#'
+// starts a preprocessor directive.
 // Cases too big to check in (10 MB lines, nesting a million deep) are generated here.
 #include <gtest/gtest.h>
 
@@ -59,7 +61,8 @@ std::vector<std::string_view> split_lines(std::string_view text, size_t max_line
 // Parses "# expect: L:C kw|kw" and following "# also: text" lines. nullopt if malformed.
 std::optional<Expectation> parse_expectation(std::string_view content) {
   std::vector<std::string_view> lines = split_lines(content, 8);
-  constexpr std::string_view kExpect = "# expect: ", kAlso = "# also: ";
+  const bool cpfg = !lines.empty() && lines[0].substr(0, 3) == "// ";
+  const std::string_view kExpect = cpfg ? "// expect: " : "# expect: ", kAlso = cpfg ? "// also: " : "# also: ";
   if (lines.empty() || lines[0].substr(0, kExpect.size()) != kExpect) return std::nullopt;
   std::string_view rest = lines[0].substr(kExpect.size());
   Expectation e;
@@ -221,7 +224,7 @@ std::vector<CorpusCase> corpus_cases() {
   std::vector<CorpusCase> cases;
   std::error_code error;
   for (const auto& entry : fs::directory_iterator(kCorpusDir, error)) {
-    if (!entry.is_regular_file() || entry.path().extension() != ".lsys") continue;
+    if (!entry.is_regular_file() || (entry.path().extension() != ".lsys" && entry.path().extension() != ".l")) continue;
     CorpusCase c{entry.path().filename().string(), entry.path().stem().string()};
     for (char& ch : c.test_name)
       if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
@@ -256,7 +259,7 @@ TEST(MalformedCorpus, HoldsAtLeast45SmallCasesEachWithAnExpectation) {
     EXPECT_LT(content.size(), 4096u) << c.file_name << ": corpus cases should be small";
     bool numbered = c.file_name.size() > 3 && std::isdigit(static_cast<unsigned char>(c.file_name[0])) &&
                     std::isdigit(static_cast<unsigned char>(c.file_name[1])) && c.file_name[2] == '_';
-    EXPECT_TRUE(numbered) << c.file_name << ": name must be NN_short_name.lsys";
+    EXPECT_TRUE(numbered) << c.file_name << ": name must be NN_short_name.lsys (or .l)";
   }
 }
 

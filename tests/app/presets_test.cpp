@@ -157,6 +157,34 @@ INSTANTIATE_TEST_SUITE_P(Bundled, PresetTest, ::testing::ValuesIn(kPresets),
                            return std::string(info.param.name);
                          });
 
+// presets/cpfg/*.l: the book's grammars typed as cpfg model files (docs/cpfg.md). Each grows
+// the skeleton of its .lsys twin joint for joint: an independent check of the cpfg path
+// (preprocessor, '-->', homomorphism depth 1, '!' widths) against sylva's own format.
+TEST(CpfgPresets, EachGrowsTheSkeletonOfItsLsysTwinExactly) {
+  const std::vector<std::string> names = list_dir(presets_dir() / "cpfg");
+  ASSERT_FALSE(names.empty());
+  for (const std::string& name : names) {
+    if (fs::path(name).extension() != ".l") continue;
+    const std::string stem = fs::path(name).stem().string();
+    TempDir dir;
+    std::optional<sylva::Skeleton> grown[2];
+    const std::string sources[2] = {"presets/cpfg/" + name, "presets/" + stem + ".lsys"};
+    for (int k = 0; k < 2; ++k) {
+      const std::string output = dir.file(std::to_string(k) + ".skel.json");
+      ProcessResult r = run_sylva({"grow", sources[k], "-o", output}, SYLVA_SOURCE_DIR, 120);
+      ASSERT_EQ(r.exit_code, 0) << describe(r);
+      EXPECT_EQ(r.err.find("warning"), std::string::npos) << describe(r);
+      sylva::Expected<sylva::Skeleton> sk = sylva::read_skeleton_file(output);
+      ASSERT_TRUE(sk.ok()) << sk.error().format();
+      grown[k] = std::move(*sk);
+    }
+    ASSERT_EQ(grown[0]->chains.size(), grown[1]->chains.size()) << name;
+    EXPECT_GT(grown[0]->joints.size(), 1000u) << name;
+    EXPECT_TRUE(grown[0]->chains == grown[1]->chains) << name;
+    EXPECT_TRUE(grown[0]->joints == grown[1]->joints) << name << ": positions, radii and materials";
+  }
+}
+
 // A preset added to presets/ without a pinned count would go untested.
 TEST(Presets, EveryPresetFileIsPinned) {
   std::vector<std::string> pinned;

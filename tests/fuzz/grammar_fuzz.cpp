@@ -1,4 +1,4 @@
-// grammar_fuzz.cpp — libFuzzer target: any bytes as a `.lsys` grammar, parsed, derived
+// grammar_fuzz.cpp — libFuzzer target: any bytes as a `.lsys` grammar or a cpfg model file, parsed, derived
 // (at most kMaxSteps steps and kMaxModules modules, so one input stays milliseconds),
 // interpreted and read by the turtle, as `sylva grow` does. Properties beyond "no crash,
 // no sanitizer finding": every error formats to a message naming the file, and a grown
@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <string_view>
 
 #include "core/geometry/skeleton.h"
@@ -23,21 +24,33 @@ constexpr uint64_t kMaxModules = 4096;
 
 [[noreturn]] void fail(const char* what, const std::string& detail) { sylva::fuzz::fail("grammar_fuzz", what, detail); }
 
+// The grammar's name: a file in an empty folder of its own, so that a cpfg input's
+// #include finds nothing but itself (docs/cpfg.md) whatever folder the fuzzer runs in.
+const std::string& grammar_path() {
+  static const std::string path = [] {
+    char folder[] = "/tmp/sylva_grammar_fuzz_XXXXXX";
+    if (!mkdtemp(folder)) fail("cannot make a folder", folder);
+    return std::string(folder) + "/fuzz.lsys";
+  }();
+  return path;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
-  sylva::Expected<sylva::lsys::Grammar> grammar = sylva::lsys::parse_grammar(text, "fuzz.lsys");
+  const std::string& path = grammar_path();
+  sylva::Expected<sylva::lsys::Grammar> grammar = sylva::lsys::parse_grammar(text, path);
   if (!grammar) {
-    sylva::fuzz::check_error("grammar_fuzz", grammar.error(), "fuzz.lsys");
+    sylva::fuzz::check_error("grammar_fuzz", grammar.error(), path);
     return 0;
   }
   sylva::lsys::DeriveOptions options;
   options.steps = std::min(grammar->steps, kMaxSteps);
   options.max_modules = kMaxModules;
-  sylva::Expected<sylva::GrowResult> grown = sylva::grow(*grammar, options, "fuzz.lsys", {});
+  sylva::Expected<sylva::GrowResult> grown = sylva::grow(*grammar, options, path, {});
   if (!grown) {
-    sylva::fuzz::check_error("grammar_fuzz", grown.error(), "fuzz.lsys");
+    sylva::fuzz::check_error("grammar_fuzz", grown.error(), path);
     return 0;
   }
   if (sylva::Status valid = sylva::validate_skeleton(grown->skeleton); !valid)

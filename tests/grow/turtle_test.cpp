@@ -859,5 +859,74 @@ TEST(TurtleLeaves, PolygonsThatCannotBeLeavesAreErrorsNamingTheClosingModule) {
   }
 }
 
+// ---- cpfg files (docs/cpfg.md): the symbols of the CPFG manual's chapter 6 -------------
+
+std::string cpfg(std::string_view axiom) { return "Lsystem: 1\nAxiom: " + std::string(axiom) + "\nendlsystem\n"; }
+
+TEST(TurtleCpfg, TheDefaultAngleIsTheViewFilesFortyFiveDegrees) {
+  const Skeleton sk = skeleton_of(cpfg("+F"));
+  ASSERT_EQ(sk.joints.size(), 2u);
+  const double h = std::sqrt(0.5);
+  EXPECT_TRUE(near(position(sk.joints[1]), {-h, h, 0}));  // + turns H toward L = -X
+}
+
+TEST(TurtleCpfg, GDrawsLikeFAndgMovesLikef) {
+  // In sylva's format G moves without drawing; in cpfg it draws (manual 6.1).
+  const Skeleton sk = skeleton_of(cpfg("FGgF"));
+  ASSERT_EQ(sk.chains.size(), 2u);  // g ends the chain as f does
+  EXPECT_EQ(sk.chains[0].joint_count, 3u);
+  EXPECT_TRUE(near(position_at(sk, 0, 2), {0, 2, 0}));
+  EXPECT_TRUE(near(position_at(sk, 1, 0), {0, 3, 0}));
+  // Inside a polygon, G and g record no vertex; F and f do.
+  const Skeleton leaf = skeleton_of("Lsystem: 1\nAxiom: {.f+(90)g+(90)f+(90)f}\nendlsystem\n");
+  ASSERT_EQ(leaf.leaves.size(), 1u);
+  // The start, after the first f, after the second; the third lands back on the start (dropped).
+  EXPECT_EQ(leaf.leaves[0].vertices_m.size(), 3u);
+}
+
+TEST(TurtleCpfg, SemicolonAndCommaStepTheColourIndexOrSetIt) {
+  const Skeleton sk = skeleton_of(cpfg("F;F;;F,F;(7)F,(2)F"));
+  ASSERT_EQ(sk.joints.size(), 7u);
+  const uint32_t expected[] = {0, 0, 1, 3, 2, 7, 2};  // a joint has the material of the segment ending at it
+  for (size_t k = 0; k < 7; ++k) EXPECT_EQ(sk.joints[k].material, expected[k]) << k;
+  EXPECT_NE(grow_error(cpfg(",F")).find("colour index"), std::string::npos);
+}
+
+TEST(TurtleCpfg, HashAndBangStepTheLineWidthOrSetItAndARadiusIsWidthTimesTheScale) {
+  // The initial line width is 1: a radius of width_scale (0.05 m). !(4) sets the width to 4:
+  // 0.2 m. Without a parameter they add and take the line width increment, 0 by default.
+  const Skeleton sk = skeleton_of(cpfg("F!(4)F#F#(0.5)F!F"));
+  ASSERT_EQ(sk.joints.size(), 6u);
+  EXPECT_DOUBLE_EQ(sk.joints[0].radius_m, 0.05);
+  EXPECT_DOUBLE_EQ(sk.joints[2].radius_m, 0.2);
+  EXPECT_DOUBLE_EQ(sk.joints[3].radius_m, 0.2);
+  EXPECT_DOUBLE_EQ(sk.joints[4].radius_m, 0.025);
+  EXPECT_DOUBLE_EQ(sk.joints[5].radius_m, 0.025);
+  EXPECT_NE(grow_error(cpfg("!(-1)F")).find("line width"), std::string::npos);
+}
+
+TEST(TurtleCpfg, AtMSetsThePositionAndAtVLevelsTheTurtle) {
+  const Skeleton sk = skeleton_of(cpfg("F@M(3,0,0)F"));
+  ASSERT_EQ(sk.chains.size(), 2u);
+  EXPECT_TRUE(near(position_at(sk, 1, 0), {3, 0, 0}));
+  EXPECT_TRUE(near(position_at(sk, 1, 1), {3, 1, 0}));
+  // @v as $: after a roll and a pitch, L is horizontal again.
+  const Skeleton level = skeleton_of(cpfg("&(30)/(40)@v+(90)F"));
+  ASSERT_EQ(level.joints.size(), 2u);
+  EXPECT_NEAR(level.joints[1].position_m[1], 0, kTolerance);  // + turned H within the horizontal
+}
+
+TEST(TurtleCpfg, SymbolsSylvaDoesNotDrawYetAreErrorsNamingTheFeature) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"F@o(2)", "sphere"}, {"F~l(1)", "surface"}, {"@Gs F @Ge", "generalized cylinder"},
+      {"F@T(1,0.2)F", "tropism"}, {"F?P(0,0,0)", "turtle query"}, {"F?E(1)", "environmental query"}};
+  for (const auto& [axiom, feature] : cases) {
+    const std::string message = grow_error(cpfg(axiom));
+    EXPECT_NE(message.find(feature), std::string::npos) << axiom << ": " << message;
+    EXPECT_NE(message.find("not supported yet"), std::string::npos) << axiom << ": " << message;
+    EXPECT_NE(message.find("test.lsys:2:1"), std::string::npos) << axiom << ": " << message;  // at the axiom
+  }
+}
+
 }  // namespace
 }  // namespace sylva

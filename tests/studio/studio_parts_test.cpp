@@ -41,6 +41,18 @@ TEST(DefineControls, FindsValuesAndRangeAnnotations) {
   EXPECT_FALSE(d[3].has_range()) << "min >= max is no range: a typed field";
 }
 
+TEST(DefineControls, ACpfgFilesCommentEndsAValueAndAFunctionLikeMacroHasNone) {
+  // docs/cpfg.md: cpfg files take C's comments; a macro with parameters is no value to set.
+  const std::string text = "#define N 7 // steps\n#define BR(a) [+(a)F]\n#define LEN 2 /* [1, 4] */ // metres\n";
+  const std::vector<DefineLine> d = scan_defines(text);
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d[0].name, "N");
+  EXPECT_EQ(d[0].value_text, "7");
+  EXPECT_EQ(with_define_value(text, d[0], 9), "#define N 9 // steps\n#define BR(a) [+(a)F]\n#define LEN 2 /* [1, 4] */ // metres\n");
+  EXPECT_EQ(d[1].name, "LEN");
+  EXPECT_TRUE(d[1].has_range());
+}
+
 TEST(DefineControls, WritingAValueChangesOnlyTheValue) {
   const std::string text = "#define ANGLE 22.5 /* [0, 90] */\n#define N 3\n";
   const std::vector<DefineLine> d = scan_defines(text);

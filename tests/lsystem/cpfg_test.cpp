@@ -1,0 +1,351 @@
+// cpfg model files (docs/spec/grammar.md "cpfg model files and vlab objects", docs/cpfg.md):
+// recognising one, the C preprocessor (macros, conditionals, includes and their errors),
+// the model's own lines, and the CPFG manual's chapter 5 functions. Expected words are
+// derived by hand in the comments.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "tests/lsystem/lsystem_test_util.h"
+
+namespace sylva::lsys {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::derive_text;
+using testing::parse_error;
+using testing::parse_ok;
+
+// A fresh folder for files that #include each other; removed at the end of the test.
+class ModelFolder {
+ public:
+  explicit ModelFolder(const std::string& suffix = "") {
+    dir_ = fs::temp_directory_path() / ("sylva_cpfg_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+                                        "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name() + suffix);
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  ~ModelFolder() { fs::remove_all(dir_); }
+  std::string write(const std::string& name, const std::string& text) const {
+    fs::create_directories((dir_ / name).parent_path());
+    std::ofstream(dir_ / name, std::ios::binary) << text;
+    return (dir_ / name).string();
+  }
+  const fs::path& dir() const { return dir_; }
+
+ private:
+  fs::path dir_;
+};
+
+std::string derive_file(const std::string& path, const ParseOptions& options = {}) {
+  auto g = load_grammar(path, options);
+  if (!g.ok()) return "<parse error: " + g.error().format() + ">";
+  auto w = derive(*g);
+  if (!w.ok()) return "<error: " + g->error_at(w.error().loc, w.error().message).format() + ">";
+  return print_word(*w, g->symbols);
+}
+
+// A text that must fail to parse, where and with what.
+struct LocatedError {
+  const char* text;
+  uint32_t line, column;
+  const char* says;
+};
+
+void expect_located(const LocatedError& c) {
+  Diagnostic d = parse_error(c.text);
+  EXPECT_EQ(d.loc.line, c.line) << c.text << "\n" << d.format();
+  EXPECT_EQ(d.loc.column, c.column) << c.text << "\n" << d.format();
+  EXPECT_NE(d.message.find(c.says), std::string::npos) << c.text << "\n" << d.format();
+}
+
+// ---- recognising a cpfg file ----
+
+TEST(CpfgFile, IsTheFirstLineThatIsNoCommentOrDirectiveSayingLsystemInAnyCase) {
+  EXPECT_TRUE(is_cpfg_text("Lsystem: 1\naxiom: F\nendlsystem\n"));
+  EXPECT_TRUE(is_cpfg_text("/* a model\n   of a plant */\n#define N 3\n\n  lsystem : tree\n"));
+  EXPECT_TRUE(is_cpfg_text("// cpp comment\nLSYSTEM:1\n"));
+  EXPECT_TRUE(is_cpfg_text("\xEF\xBB\xBFLsystem: 1\n"));
+  EXPECT_FALSE(is_cpfg_text("axiom: F\nLsystem: 1\n"));  // not the first line
+  EXPECT_FALSE(is_cpfg_text("# a sylva comment\naxiom: F\n"));
+  EXPECT_FALSE(is_cpfg_text("Lsystems: 1\n"));
+  EXPECT_FALSE(is_cpfg_text("Lsystem 1\n"));
+  EXPECT_FALSE(is_cpfg_text(""));
+  EXPECT_TRUE(parse_ok("Lsystem: 1\nAxiom: F\nendlsystem\n").cpfg);
+  EXPECT_FALSE(parse_ok("axiom: F\n").cpfg);
+}
+
+TEST(CpfgFile, SlashSlashIsACommentInACpfgFileAndTwoRollsInSylvasOwn) {
+  EXPECT_EQ(derive_text("Lsystem: 1\nAxiom: F//F\nendlsystem\n"), "F");
+  EXPECT_EQ(derive_text("axiom: F//F\n"), "F//F");
+  // Inside a string (cpfg's printf arguments) '//' is no comment; nothing else changes.
+  EXPECT_EQ(derive_text("Lsystem: 1\nAxiom: F /* block\n comment */ F\nendlsystem\n"), "FF");
+}
+
+// ---- the preprocessor ----
+
+TEST(CpfgPreprocessor, ObjectAndFunctionLikeMacrosExpandAsCppDoes) {
+  // BR(25) -> [+(25)F][-(25)F]; STEP -> 2 inside it through ARM; a macro is not expanded in
+  // its own expansion (SELF stays SELF).
+  const std::string model =
+      "#define STEP 2\n#define ARM(a) +(a)F(STEP)\n#define BR(a) [ARM(a)][ARM(-a)]\n#define SELF SELF G\n"
+      "Lsystem: 1\nderivation length: 1\nAxiom: A\nA --> F BR(25) SELF\nendlsystem\n";
+  EXPECT_EQ(derive_text(model), "F[+(25)F(2)][+(-25)F(2)]SELFG");
+}
+
+TEST(CpfgPreprocessor, ConditionalsChooseLinesAndSkipTheRest) {
+  const std::string model =
+      "#define BUSHY 1\n#define LEVEL 3\n"
+      "#if BUSHY && LEVEL > 2\n#define SHAPE FF\n#elif LEVEL == 2\n#define SHAPE F\n#else\n#define SHAPE G\n#endif\n"
+      "#ifdef NOT_DEFINED\n#error this branch is skipped\n#endif\n"
+      "#ifndef NOT_DEFINED\n#define TAIL X\n#endif\n"
+      "#if defined(TAIL) && !defined NOT_DEFINED\n#define HEAD Y\n#endif\n"
+      "#undef BUSHY\n#ifdef BUSHY\n#define HEAD Z\n#endif\n"
+      "Lsystem: 1\nAxiom: HEAD SHAPE TAIL\nendlsystem\n";
+  EXPECT_EQ(derive_text(model), "YFFX");
+  EXPECT_NE(parse_error("#if 1\n#error stop here\n#endif\nLsystem: 1\nAxiom: F\nendlsystem\n").message.find("stop here"),
+            std::string::npos);
+}
+
+TEST(CpfgPreprocessor, ANumberDefineIsADefineThatMinusDReplaces) {
+  const std::string model = "#define N 2\n#define ANGLE 30\n#define SHAPE F\nLsystem: 1\nderivation length: N\n"
+                            "Axiom: A\nA --> +(ANGLE)A\nendlsystem\n";
+  Grammar g = parse_ok(model);
+  ASSERT_EQ(g.defines.size(), 2u);  // SHAPE is text, not a number
+  EXPECT_EQ(g.defines[0].name, "N");
+  EXPECT_EQ(g.defines[1].value, 30);
+  EXPECT_EQ(derive_text(model), "+(30)+(30)A");
+  ParseOptions options;
+  options.define_overrides["N"] = 1;
+  options.define_overrides["ANGLE"] = -12.5;
+  Grammar over = parse_ok(model, options);
+  EXPECT_TRUE(over.defines[0].overridden);
+  EXPECT_EQ(over.steps, 1);
+  auto w = derive(over);
+  ASSERT_TRUE(w.ok());
+  EXPECT_EQ(print_word(*w, over.symbols), "+(-12.5)A");
+  ParseOptions text_define;
+  text_define.define_overrides["SHAPE"] = 1;
+  EXPECT_NE(parse_error(model, text_define).message.find("no '#define SHAPE <number>'"), std::string::npos);
+}
+
+TEST(CpfgPreprocessor, MalformedDirectivesAreLocatedErrors) {
+  const LocatedError cases[] = {
+      {"#if 1\nLsystem: 1\nAxiom: F\nendlsystem\n", 1, 2, "no '#endif'"},
+      {"#endif\nLsystem: 1\n", 1, 2, "without '#if'"},
+      {"#else\nLsystem: 1\n", 1, 2, "without '#if'"},
+      {"#if 1\n#else\n#else\n#endif\nLsystem: 1\n", 3, 2, "after '#else'"},
+      {"#frobnicate\nLsystem: 1\n", 1, 2, "unknown preprocessor directive '#frobnicate'"},
+      {"#define\nLsystem: 1\n", 1, 2, "needs a name"},
+      {"#define F(a b) a\nLsystem: 1\n", 1, 13, "expected ',' or ')'"},
+      {"#define A 1\n#define A 2\nLsystem: 1\n", 2, 9, "defined twice"},
+      {"#define M(a) a\nLsystem: 1\nAxiom: M(1, 2)\nendlsystem\n", 3, 8, "takes 1 arguments, got 2"},
+      {"#define M(a) a\nLsystem: 1\nAxiom: M(F\nendlsystem\n", 3, 8, "not closed"},
+      {"#if 1 +\n#endif\nLsystem: 1\n", 1, 2, "ends too early"},
+      {"#if 1 / 0\n#endif\nLsystem: 1\n", 1, 2, "division by zero"},
+      {"Lsystem: 1\nAxiom: F\n/* never closed\nendlsystem\n", 3, 1, "unterminated comment"},
+  };
+  for (const LocatedError& c : cases) expect_located(c);
+}
+
+TEST(CpfgPreprocessor, RunawayMacrosStopWithAnErrorInBoundedTime) {
+  // Each level doubles: 2^40 bytes if nothing stopped it.
+  std::string model = "#define M0 FF\n";
+  for (int k = 1; k <= 40; ++k)
+    model += "#define M" + std::to_string(k) + " M" + std::to_string(k - 1) + " M" + std::to_string(k - 1) + "\n";
+  model += "Lsystem: 1\nAxiom: M40\nendlsystem\n";
+  Diagnostic d = parse_error(model);
+  EXPECT_NE(d.message.find("macro expansion too large"), std::string::npos) << d.format();
+  EXPECT_EQ(d.loc.line, 43u);
+}
+
+TEST(CpfgPreprocessor, IncludeReadsAFileOfTheModelsFolderAndErrorsThereShowTheChain) {
+  ModelFolder folder;
+  folder.write("params.h", "#define LEN 2\n#include \"sub/more.h\"\n");
+  folder.write("sub/more.h", "#define KNOT K\n");
+  const std::string model = folder.write("plant.l", "#include \"params.h\"\nLsystem: 1\nAxiom: F(LEN) KNOT\nendlsystem\n");
+  EXPECT_EQ(derive_file(model), "F(2)K");
+
+  // An error in an included file: at its place there, then a note at each #include.
+  folder.write("bad.h", "#define OK 1\n#if OK +\n#endif\n");
+  folder.write("middle.h", "\n#include \"bad.h\"\n");
+  const std::string bad = folder.write("bad.l", "#include \"middle.h\"\nLsystem: 1\nAxiom: F\nendlsystem\n");
+  auto g = load_grammar(bad);
+  ASSERT_FALSE(g.ok());
+  const Diagnostic& d = g.error();
+  EXPECT_EQ(d.file, (folder.dir() / "bad.h").string());
+  EXPECT_EQ(d.loc.line, 2u);
+  ASSERT_EQ(d.notes.size(), 2u) << d.format();
+  EXPECT_EQ(d.notes[0].file, (folder.dir() / "middle.h").string());
+  EXPECT_EQ(d.notes[0].loc.line, 2u);
+  EXPECT_EQ(d.notes[1].file, bad);
+  EXPECT_EQ(d.notes[1].loc.line, 1u);
+  EXPECT_NE(d.format().find("included from here"), std::string::npos);
+  EXPECT_EQ(*d.source_line, "#if OK +");
+
+  // A derivation error in a production that an included file holds points into it.
+  folder.write("rules.h", "A --> F(1/0)\n");
+  const std::string rules = folder.write("rules.l", "Lsystem: 1\nAxiom: A\n#include \"rules.h\"\nendlsystem\n");
+  const std::string message = derive_file(rules);
+  EXPECT_NE(message.find((folder.dir() / "rules.h").string() + ":1:10: error: division by zero"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find(rules + ":3:10: note: included from here"), std::string::npos) << message;
+}
+
+TEST(CpfgPreprocessor, IncludeStaysInsideTheModelsFolderAndNeverRecurses) {
+  ModelFolder folder;
+  folder.write("loop_a.h", "#include \"loop_b.h\"\n");
+  folder.write("loop_b.h", "#include \"loop_a.h\"\n");
+  folder.write("outside.h", "#define X 1\n");
+  struct Case {
+    const char* line;
+    const char* says;
+  };
+  const Case cases[] = {
+      {"#include \"loop_a.h\"", "includes itself"},
+      {"#include \"self.l\"", "includes itself"},
+      {"#include \"../outside.h\"", "only a file in the model's folder"},
+      {"#include \"/etc/hostname\"", "only a file in the model's folder"},
+      {"#include \"missing.h\"", "missing.h"},
+      {"#include missing.h", "in quotes"},
+  };
+  for (const Case& c : cases) {
+    const std::string model = folder.write("self.l", std::string(c.line) + "\nLsystem: 1\nAxiom: F\nendlsystem\n");
+    auto g = load_grammar(model);
+    ASSERT_FALSE(g.ok()) << c.line;
+    EXPECT_NE(g.error().message.find(c.says), std::string::npos) << c.line << "\n" << g.error().format();
+  }
+  // A link that leads out of the folder is refused too.
+  ModelFolder other("_other");
+  const std::string target = other.write("secret.h", "#define S 1\n");
+  fs::create_symlink(target, folder.dir() / "link.h");
+  const std::string linked = folder.write("linked.l", "#include \"link.h\"\nLsystem: 1\nAxiom: F\nendlsystem\n");
+  auto g = load_grammar(linked);
+  ASSERT_FALSE(g.ok());
+  EXPECT_NE(g.error().message.find("outside the model's folder"), std::string::npos) << g.error().format();
+}
+
+// ---- the model ----
+
+TEST(CpfgModel, HeaderWordsInAnyCaseAnEmptySuccessorAndEndlsystem) {
+  // A -> B*: A(1) grows to B with the '*' production deleting C.
+  EXPECT_EQ(derive_text("lsystem: plant\nDerivation Length: 2\nAXIOM: A C\nA --> B A\nC --> *\nendlsystem\n"), "BBA");
+  Diagnostic missing_end = parse_error("Lsystem: 1\nAxiom: F\nF --> FF\n");
+  EXPECT_NE(missing_end.message.find("no 'endlsystem'"), std::string::npos);
+  Diagnostic after = parse_error("Lsystem: 1\nAxiom: F\nendlsystem\nF --> FF\n");
+  EXPECT_EQ(after.loc.line, 4u);
+  EXPECT_NE(after.message.find("after 'endlsystem'"), std::string::npos);
+  EXPECT_NE(parse_error("Lsystem: 1\nAxiom: F\nF -->\nendlsystem\n").message.find("'*' for none"), std::string::npos);
+  // '*' is a module of sylva's own format, never an empty successor there.
+  EXPECT_EQ(derive_text("axiom: A\nA -> *\n"), "*");
+}
+
+TEST(CpfgModel, ConsiderMakesContextSeeOnlyTheNamedModules) {
+  // consider: A B — the + between them is not seen, so A > B matches.
+  EXPECT_EQ(derive_text("Lsystem: 1\nAxiom: A+B\nconsider: A B\nA > B --> X\nendlsystem\n"), "X+B");
+  // Without it the + is seen and the production does not apply.
+  EXPECT_EQ(derive_text("Lsystem: 1\nAxiom: A+B\nA > B --> X\nendlsystem\n"), "A+B");
+  EXPECT_NE(parse_error("Lsystem: 1\nAxiom: F\nignore: +\nconsider: F\nendlsystem\n").message.find("cannot both"),
+            std::string::npos);
+}
+
+TEST(CpfgModel, AHomomorphismIsAppliedOnceUnlessMaximumDepthSaysMore) {
+  Grammar once = parse_ok("Lsystem: 1\nAxiom: X\nhomomorphism\nX --> Y\nY --> F\nendlsystem\n");
+  EXPECT_EQ(once.max_depth, 1);
+  auto w = derive(once);
+  ASSERT_TRUE(w.ok());
+  auto drawn = interpret(once, *w);
+  ASSERT_TRUE(drawn.ok());
+  EXPECT_EQ(print_word(*drawn, once.symbols), "Y");
+  // A seed after 'homomorphism' is the homomorphism's (manual 4.3.3), never the derivation's.
+  Grammar twice = parse_ok(
+      "Lsystem: 1\nseed: 5\nAxiom: X\nhomomorphism: warnings\nseed: 9\nmaximum depth: 2\nX --> Y\nY --> F\nendlsystem\n");
+  EXPECT_EQ(twice.seed, 5u);
+  auto w2 = derive(twice);
+  ASSERT_TRUE(w2.ok());
+  auto drawn2 = interpret(twice, *w2);
+  ASSERT_TRUE(drawn2.ok());
+  EXPECT_EQ(print_word(*drawn2, twice.symbols), "F");
+}
+
+TEST(CpfgModel, TheChapterSixModuleNamesAreOneModuleEach) {
+  EXPECT_EQ(derive_text("Lsystem: 1\nAxiom: @Gs@o(2)?P(0,0)@v;(3),#!\nendlsystem\n"), "@Gs@o(2)?P(0,0)@v;(3),#!");
+  Grammar g = parse_ok("Lsystem: 1\nAxiom: @Gs\nendlsystem\n");
+  auto w = derive(g);
+  ASSERT_TRUE(w.ok());
+  EXPECT_EQ(w->size(), 1u);
+}
+
+TEST(CpfgModel, WhatSylvaCannotReadYetIsAnErrorAtItsPlaceNamingTheFeature) {
+  const LocatedError cases[] = {
+      {"Lsystem: 1\nAxiom: F\nStart: {i=0;}\nendlsystem\n", 3, 1, "'Start:' block"},
+      {"Lsystem: 1\nAxiom: F\nEndEach: {i=i+1;}\nendlsystem\n", 3, 1, "'EndEach:' block"},
+      {"Lsystem: 1\nAxiom: F\ndefine: { array a[3]; }\nendlsystem\n", 3, 1, "arrays"},
+      {"Lsystem: 1\nring lsystem\nAxiom: F\nendlsystem\n", 2, 1, "ring L-system"},
+      {"Lsystem: 1\nAxiom: F\ndecomposition\nendlsystem\n", 3, 1, "decomposition"},
+      {"Lsystem: 1\nAxiom: F\nF : { x = 1; } x > 0 --> FF\nendlsystem\n", 3, 5, "statements in a production"},
+      {"Lsystem: 1\nAxiom: F\nendlsystem\nLsystem: 2\nAxiom: G\nendlsystem\n", 4, 1, "sub-L-systems"},
+  };
+  for (const LocatedError& c : cases) {
+    expect_located(c);
+    EXPECT_NE(parse_error(c.text).message.find("not supported yet"), std::string::npos) << c.text;
+  }
+}
+
+// ---- chapter 5 functions ----
+
+TEST(CpfgFunctions, RoundingAndSignAreExact) {
+  EXPECT_EQ(derive_text("axiom: F(fabs(-2.5)) F(trunc(-2.7)) F(trunc(2.7)) F(sign(-3)) F(sign(0)) F(sign(4))\n"),
+            "F(2.5)F(-2)F(2)F(-1)F(0)F(1)");
+}
+
+// Draws n values of `expr` through the axiom of a one-step grammar with `seed`.
+std::vector<double> draws(const std::string& expr, int n, uint64_t seed = 7) {
+  std::string axiom;
+  for (int k = 0; k < n; ++k) axiom += "A(" + expr + ")";
+  Grammar g = parse_ok("seed: " + std::to_string(seed) + "\nderivation length: 0\naxiom: " + axiom + "\n");
+  auto w = derive(g);
+  EXPECT_TRUE(w.ok());
+  return w.ok() ? w->params : std::vector<double>{};
+}
+
+double mean_of(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return s / static_cast<double>(v.size());
+}
+
+TEST(CpfgFunctions, RandomFunctionsDrawFromTheirDistributionsAndTheSeed) {
+  constexpr int n = 4000;
+  // ran(x): uniform on [0, x]; mean x/2, standard error x/sqrt(12 n) = 0.0091 for x = 2.
+  const std::vector<double> ran = draws("ran(2)", n);
+  for (double x : ran) EXPECT_TRUE(x >= 0 && x <= 2) << x;
+  EXPECT_NEAR(mean_of(ran), 1.0, 5 * 0.0091);
+  // nran(m, s): mean m, standard error s/sqrt(n) = 0.047 for s = 3.
+  EXPECT_NEAR(mean_of(draws("nran(10, 3)", n)), 10.0, 5 * 0.047);
+  // bran(a, b): Beta(a, b), mean a/(a+b) = 0.25 for (2, 6), variance ab/((a+b)^2 (a+b+1)) = 0.0208,
+  // standard error 0.0023; and for a < 1 too (Beta(0.5, 0.5): mean 0.5, sd 0.354, se 0.0056).
+  const std::vector<double> beta = draws("bran(2, 6)", n);
+  for (double x : beta) EXPECT_TRUE(x > 0 && x < 1) << x;
+  EXPECT_NEAR(mean_of(beta), 0.25, 5 * 0.0023);
+  EXPECT_NEAR(mean_of(draws("bran(0.5, 0.5)", n)), 0.5, 5 * 0.0056);
+  // biran(n, p): Binomial(20, 0.3): integers in [0, 20], mean 6, standard error sqrt(4.2/n) = 0.032.
+  const std::vector<double> binomial = draws("biran(20, 0.3)", n);
+  for (double x : binomial) EXPECT_TRUE(x >= 0 && x <= 20 && x == std::floor(x)) << x;
+  EXPECT_NEAR(mean_of(binomial), 6.0, 5 * 0.032);
+  // The seed decides every draw.
+  EXPECT_EQ(draws("bran(2, 6)", 5, 3), draws("bran(2, 6)", 5, 3));
+  EXPECT_NE(draws("bran(2, 6)", 5, 3), draws("bran(2, 6)", 5, 4));
+}
+
+TEST(CpfgFunctions, ArgumentsOutsideTheirDomainAreLocatedErrors) {
+  EXPECT_NE(derive_text("axiom: A\nA -> B(bran(0, 1))\n").find("bran(a, b) needs a > 0"), std::string::npos);
+  EXPECT_NE(derive_text("axiom: A\nA -> B(biran(2.5, 0.5))\n").find("integer n"), std::string::npos);
+  EXPECT_NE(derive_text("axiom: A\nA -> B(biran(1e7, 0.5))\n").find("integer n"), std::string::npos);
+  EXPECT_NE(derive_text("axiom: A\nA -> B(biran(3, 1.5))\n").find("p from 0 to 1"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sylva::lsys
