@@ -18,6 +18,7 @@ namespace {
 
 constexpr uint64_t kAxiomKeyBase = 0xA7104D5EEDULL;
 constexpr uint64_t kHomomorphismStreamBase = 0x40000000ULL;
+constexpr uint64_t kBlockStreamBase = 0xB10C0000ULL;  // + 4 * step + which block
 constexpr uint32_t kNoMatch = 0xFFFFFFFFu;
 constexpr size_t kMaxParams = 0xFFFFFFF0u;
 // Interpretation writes at most this many times --max-modules modules over all its passes
@@ -49,8 +50,10 @@ std::string module_text(const Word& w, size_t i, const SymbolTable& symbols) {
 class Rewriter {
  public:
   Rewriter(const Grammar& g, const std::vector<Production>& productions,
-           const std::vector<std::vector<uint32_t>>& by_symbol, uint64_t seed, uint64_t max_modules)
-      : g_(g), productions_(productions), by_symbol_(by_symbol), seed_(seed), max_modules_(max_modules) {
+           const std::vector<std::vector<uint32_t>>& by_symbol, uint64_t seed, uint64_t max_modules,
+           EvalContext* context)
+      : g_(g), productions_(productions), by_symbol_(by_symbol), seed_(seed), max_modules_(max_modules),
+        context_(context) {
     uint32_t slots = 0;
     for (const Production& p : productions_) slots = std::max(slots, p.slot_count);
     slots_.assign(slots + 1, 0.0);
@@ -58,7 +61,7 @@ class Rewriter {
     for (size_t s = 0; s < by_symbol_.size(); ++s) {
       if (by_symbol_[s].empty()) continue;
       const Production& p = productions_[by_symbol_[s][0]];
-      if (!p.has_context() && p.condition.kind == Expr::Kind::kNone &&
+      if (!p.has_context() && p.condition.kind == Expr::Kind::kNone && !p.has_statements() &&
           p.probability.kind == Expr::Kind::kNone && p.successor.all_constant)
         direct_[s] = &p;
     }
@@ -190,6 +193,7 @@ class Rewriter {
   // Modules written (to the result, and by expand() to its stack): interpretation's work.
   uint64_t work() const { return work_; }
   void set_work_budget(uint64_t budget) { work_budget_ = budget; }
+  void set_seed(uint64_t seed) { seed_ = seed; }
 
   // Index of the module whose production failed, for messages.
   size_t current = 0;
@@ -387,14 +391,21 @@ class Rewriter {
       arity_seen = true;
       if (!matches(p, i, m)) continue;
       current_production = &p;
-      if (p.condition.kind != Expr::Kind::kNone && g_.program.eval(p.condition, slots_.data(), &rng) == 0.0)
+      // cpfg's statements before the condition run on every match (CPFG manual 3.2).
+      if (p.before.kind != Expr::Kind::kNone) g_.program.eval(p.before, slots_.data(), &rng, context_);
+      if (p.condition.kind != Expr::Kind::kNone && g_.program.eval(p.condition, slots_.data(), &rng, context_) == 0.0)
         continue;
       if (p.probability.kind == Expr::Kind::kNone) {
         if (candidates_.empty()) return &p;  // first candidate is deterministic: apply it
         continue;                            // deterministic ones after stochastic: ignored
       }
-      double w = g_.program.eval(p.probability, slots_.data(), &rng);
+      double w = g_.program.eval(p.probability, slots_.data(), &rng, context_);
       if (w < 0) throw DeriveFailure{p.probability.loc, "a probability must not be negative (it is " + std::to_string(w) + ")"};
+      // A candidate with statements keeps its slots (its locals): rebinding could not redo them.
+      if (p.has_statements()) {
+        if (candidate_slots_.size() <= candidates_.size()) candidate_slots_.resize(candidates_.size() + 1);
+        candidate_slots_[candidates_.size()].assign(slots_.begin(), slots_.end());
+      }
       candidates_.push_back({&p, w});
       total += w;
     }
@@ -423,16 +434,18 @@ class Rewriter {
       for (auto& c : candidates_) total += c.second /= largest;
     }
     double u = rng.next_double() * total;
-    const Production* pick = candidates_.back().first;
-    for (const auto& [prod, w] : candidates_) {
-      if (u < w) {
-        pick = prod;
+    size_t picked = candidates_.size() - 1;
+    for (size_t k = 0; k < candidates_.size(); ++k) {
+      if (u < candidates_[k].second) {
+        picked = k;
         break;
       }
-      u -= w;
+      u -= candidates_[k].second;
     }
+    const Production* pick = candidates_[picked].first;
     // Rebind the chosen production's parameters (later candidates overwrote the slots).
-    matches(*pick, i, m);
+    if (pick->has_statements()) slots_ = candidate_slots_[picked];
+    else matches(*pick, i, m);
     return pick;
   }
 
@@ -443,6 +456,11 @@ class Rewriter {
     if ((work_ += s.modules.size()) > work_budget_) over_budget();
     if (out.params.size() > kMaxParams) too_many_params();
     const size_t first_new = out.modules.size();
+    if (p.after.kind != Expr::Kind::kNone) {  // cpfg's statements after the condition
+      current = i;
+      current_production = &p;
+      g_.program.eval(p.after, slots_.data(), &rng, context_);
+    }
     if (s.all_constant) {
       const uint32_t base = static_cast<uint32_t>(out.params.size());
       for (const Module& pm : s.prebuilt.modules)
@@ -455,7 +473,7 @@ class Rewriter {
       for (const SuccessorModule& sm : s.modules) {
         out.modules.push_back(Module{sm.symbol, sm.arg_count, static_cast<uint32_t>(out.params.size())});
         for (uint16_t k = 0; k < sm.arg_count; ++k)
-          out.params.push_back(g_.program.eval(s.args[sm.first_arg + k], slots_.data(), &rng));
+          out.params.push_back(g_.program.eval(s.args[sm.first_arg + k], slots_.data(), &rng, context_));
       }
     }
     if (keyed) {
@@ -470,6 +488,7 @@ class Rewriter {
   const std::vector<std::vector<uint32_t>>& by_symbol_;
   uint64_t seed_;
   uint64_t max_modules_;
+  EvalContext* context_;  // the L-system's global variables (cpfg); null-free: never null
   bool uses_context_ = false;
   const Word* in_ = nullptr;
   Word* out_ = nullptr;
@@ -486,6 +505,7 @@ class Rewriter {
   Word stack_, successor_;
   std::vector<int> stack_depth_;
   std::vector<std::pair<const Production*, double>> candidates_;
+  std::vector<std::vector<double>> candidate_slots_;  // by candidate, for those with statements
 };
 
 // Removes, for each %, the rest of its branch up to (not including) the closing ']'.
@@ -540,15 +560,38 @@ void reserve_for_growth(Word& out, size_t in_size, double growth, uint64_t max_m
   if (out.modules.capacity() < cap) out.modules.reserve(cap);
 }
 
+// The blocks of a cpfg file (CPFG manual 4.1), in the order derive() runs them.
+enum class Block : uint64_t { kStart, kStartEach, kEndEach, kEnd };
+
+// Runs one block over the globals, its random stream keyed by (seed, block, step); a
+// srand() in it sets the derivation's seed from then on (*seed).
+void run_block(const Grammar& g, Block block, int64_t step, uint64_t* seed, EvalContext& context) {
+  const Expr* const exprs[] = {&g.start_block, &g.start_each_block, &g.end_each_block, &g.end_block};
+  const Expr& e = *exprs[static_cast<size_t>(block)];
+  if (e.kind == Expr::Kind::kNone) return;
+  Rng rng(mix_pair(*seed, kBlockStreamBase + 4 * static_cast<uint64_t>(step) + static_cast<uint64_t>(block)));
+  context.reseeded = false;
+  g.program.eval(e, nullptr, &rng, &context);
+  if (context.reseeded) *seed = context.reseed;
+}
+
 }  // namespace
 
 Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStats* stats) {
   auto t0 = std::chrono::steady_clock::now();
   const int64_t steps = options.steps.value_or(g.steps);
-  const uint64_t seed = options.seed.value_or(g.seed);
+  uint64_t seed = options.seed.value_or(g.seed);
   if (g.axiom.size() + g.axiom.params.size() > options.max_modules)
     return g.error_at(g.axiom_loc, "the axiom exceeds --max-modules (" + std::to_string(options.max_modules) +
                                        " modules), each parameter counting as a module");
+  // A cpfg file's global variables, 0 until a block or a production assigns them.
+  std::vector<double> globals(g.global_names.size(), 0.0);
+  EvalContext context{globals.data()};
+  try {
+    run_block(g, Block::kStart, 0, &seed, context);
+  } catch (const EvalError& e) {
+    return g.error_at(e.loc, e.message + " (in the Start block)");
+  }
   Word cur = g.axiom;
   if (g.axiom_successor) {
     // The axiom draws random numbers: evaluate its arguments from this seed's stream.
@@ -568,7 +611,7 @@ Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStat
   }
   if (g.uses_cut) apply_cut(cur);
   Word next;
-  Rewriter rewriter(g, g.productions, g.productions_by_symbol, seed, options.max_modules);
+  Rewriter rewriter(g, g.productions, g.productions_by_symbol, seed, options.max_modules, &context);
   uint64_t peak = cur.capacity_bytes();
   double growth = 2.0;
   int64_t step = 0;
@@ -586,6 +629,8 @@ Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStat
       reserve_for_growth(next, cur.size(), growth, options.max_modules);
       if (g.uses_random) next.lineage.reserve(next.modules.capacity());
       rewriter.current_production = nullptr;
+      run_block(g, Block::kStartEach, step, &seed, context);
+      rewriter.set_seed(seed);
       // Step k is the k-th equal share of the whole (the last steps are the longest, so
       // the bar slows down; it never goes back).
       const Progress step_progress = options.progress.part(static_cast<double>(step - 1) / static_cast<double>(steps),
@@ -596,8 +641,12 @@ Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStat
       peak = std::max<uint64_t>(peak, cur.capacity_bytes() + next.capacity_bytes());
       growth = cur.size() ? std::max(1.0, static_cast<double>(next.size()) / static_cast<double>(cur.size())) : 2.0;
       std::swap(cur, next);
+      rewriter.current_production = nullptr;
+      run_block(g, Block::kEndEach, step, &seed, context);
       if (options.on_step && !options.on_step(step, cur)) return stopped_at(step);
     }
+    rewriter.current_production = nullptr;
+    run_block(g, Block::kEnd, steps, &seed, context);
   } catch (const DeriveCancelled&) {
     return cancelled_diagnostic();
   } catch (const DeriveFailure& f) {
@@ -615,6 +664,7 @@ Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStat
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   options.progress.report(1, "derive");
+  cur.globals = std::move(globals);
   return cur;
 }
 
@@ -627,7 +677,11 @@ Expected<Word> interpret(const Grammar& g, const Word& word, const DeriveOptions
     for (size_t i = 0; i < cur.size(); ++i) cur.lineage[i] = mix_pair(kAxiomKeyBase, i);
   }
   Word next;
-  Rewriter rewriter(g, g.homomorphism, g.homomorphism_by_symbol, seed, options.max_modules);
+  // The globals as the derivation left them (a word from elsewhere: all 0).
+  std::vector<double> globals = word.globals;
+  globals.resize(g.global_names.size(), 0.0);
+  EvalContext eval_context{globals.data()};
+  Rewriter rewriter(g, g.homomorphism, g.homomorphism_by_symbol, seed, options.max_modules, &eval_context);
   const uint64_t budget = options.max_modules > UINT64_MAX / kInterpretBudgetFactor
                               ? UINT64_MAX
                               : options.max_modules * kInterpretBudgetFactor;
@@ -665,7 +719,7 @@ Expected<Word> interpret(const Grammar& g, const Word& word, const DeriveOptions
         if (!changed) break;
       }
       // Modules produced by the last pass that still have a production: left unexpanded.
-      if (depth > g.max_depth)
+      if (depth > g.max_depth && g.depth_warnings)
         for (size_t i = 0; i < cur.size(); ++i)
           if (active[i] && !g.homomorphism_by_symbol[cur.modules[i].symbol].empty()) ++left;
       depth = std::min(depth, g.max_depth);

@@ -17,7 +17,7 @@ const FuncInfo kFuncs[] = {
     {"floor", 1, false}, {"ceil", 1, false},  {"min", 2, false},   {"max", 2, false},
     {"clamp", 3, false}, {"rand", 0, true},   {"uniform", 2, true}, {"gauss", 2, true},
     {"fabs", 1, false},  {"trunc", 1, false}, {"sign", 1, false},  {"ran", 1, true},
-    {"nran", 2, true},   {"bran", 2, true},   {"biran", 2, true},
+    {"nran", 2, true},   {"bran", 2, true},   {"biran", 2, true},  {"srand", 1, true},
 };
 
 // The largest n biran(n, p) draws for (n uniform draws: bounded time, docs/cpfg.md).
@@ -97,11 +97,13 @@ bool find_func(const std::string& name, Func* f) {
   return false;
 }
 
-double Program::run(const Expr& e, const double* slots, Rng* rng) const {
+double Program::run(const Expr& e, const double* slots, Rng* rng, EvalContext* context) const {
   // Expressions are shallow (the parser bounds nesting), so a fixed stack suffices; the
   // compiler checks the depth it needs against kMaxEvalStack.
   double stack[kMaxEvalStack];
   int sp = 0;
+  uint64_t loops = 0;
+  double* writable = const_cast<double*>(slots);  // statements are compiled only over writable slots
   const Instr* code_ptr = code.data();
   for (uint32_t pc = e.begin; pc < e.end; ++pc) {
     const Instr& in = code_ptr[pc];
@@ -142,6 +144,19 @@ double Program::run(const Expr& e, const double* slots, Rng* rng) const {
         }
         break;
       case Op::kBool: stack[sp - 1] = stack[sp - 1] != 0.0 ? 1.0 : 0.0; break;
+      case Op::kStore: writable[in.arg] = stack[--sp]; break;
+      case Op::kGlobal: stack[sp++] = context->globals[in.arg]; break;
+      case Op::kStoreGlobal: context->globals[in.arg] = stack[--sp]; break;
+      case Op::kJump: pc = in.arg - 1; break;
+      case Op::kJumpIfZero:
+        if (stack[--sp] == 0.0) pc = in.arg - 1;
+        break;
+      case Op::kLoop:
+        if (++loops > kMaxLoopIterations)
+          fail(locs[pc], "a loop ran more than " + std::to_string(kMaxLoopIterations) + " times (a runaway loop?)");
+        pc = in.arg - 1;
+        break;
+      case Op::kPop: --sp; break;
       case Op::kCall: {
         double r = 0;
         double* a = nullptr;
@@ -186,6 +201,15 @@ double Program::run(const Expr& e, const double* slots, Rng* rng) const {
             if (!(a[0] > 0) || !(a[1] > 0)) fail(locs[pc], "bran(a, b) needs a > 0 and b > 0");
             const double x = gamma_variate(a[0], rng), y = gamma_variate(a[1], rng);
             r = x + y > 0 ? x / (x + y) : 0.5;
+            break;
+          }
+          case Func::kSrand: {
+            if (!(a[0] >= 0) || a[0] != std::floor(a[0]) || a[0] > 9007199254740992.0)
+              fail(locs[pc], "srand(s) needs a non-negative integer s");
+            const auto seed = static_cast<uint64_t>(a[0]);
+            *rng = Rng(mix_pair(seed, 0x5EEDULL));
+            if (context) context->reseeded = true, context->reseed = seed;
+            r = 0;
             break;
           }
           case Func::kBiran: {

@@ -26,13 +26,22 @@ enum class Op : uint8_t {
   kOrJump,      // pop a; if a != 0 { push 1; pc = arg } (short-circuit ||)
   kBool,        // replace top by (top != 0)
   kCall,        // call function `fn` (arity known per function)
+  // Statements (cpfg files, docs/cpfg.md):
+  kStore,       // slots[arg] = pop (a local variable)
+  kGlobal,      // push globals[arg]
+  kStoreGlobal, // globals[arg] = pop
+  kJump,        // pc = arg
+  kJumpIfZero,  // pop a; if a == 0 { pc = arg }
+  kLoop,        // pc = arg (a loop's backward jump: counted against kMaxLoopIterations)
+  kPop,         // drop the top (an expression used as a statement)
 };
 
 enum class Func : uint8_t {
   kSin, kCos, kTan, kAsin, kAcos, kAtan, kAtan2, kSqrt, kExp, kLog, kPow, kAbs,
   kFloor, kCeil, kMin, kMax, kClamp, kRand, kUniform, kGauss,
   // The CPFG manual's chapter 5 (docs/cpfg.md): available in every grammar.
-  kFabs, kTrunc, kSign, kRan, kNran, kBran, kBiran
+  kFabs, kTrunc, kSign, kRan, kNran, kBran, kBiran,
+  kSrand  // srand(s): restarts the random stream from s (EvalContext::reseed); returns 0
 };
 
 struct Instr {
@@ -60,6 +69,19 @@ struct EvalError {
   std::string message;
 };
 
+// The most backward jumps one evaluation of a statement block may take: a loop that runs
+// longer stops with an error at the loop (docs/cpfg.md, bounded time).
+inline constexpr uint64_t kMaxLoopIterations = 10000000;
+
+// What statements read and write besides their own slots: the L-system's global variables,
+// and the seed a srand() asked for (the derivation's, when a Start/StartEach/EndEach block
+// calls it).
+struct EvalContext {
+  double* globals = nullptr;
+  bool reseeded = false;
+  uint64_t reseed = 0;
+};
+
 // The evaluation stack's size in values: Program::run's fixed stack, and the depth the
 // parser lets a compiled expression need ("expression nested too deeply" beyond).
 inline constexpr int kMaxEvalStack = 512;
@@ -72,16 +94,18 @@ struct Program {
 
   // Evaluates `e` with formal parameters `slots` and random stream `rng` (only touched
   // by rand/uniform/gauss). Throws EvalError on division by zero or a non-finite result.
-  double eval(const Expr& e, const double* slots, Rng* rng) const {
+  // Statements (kStore, kGlobal, kStoreGlobal, srand) write `slots` and `context`: they are
+  // only compiled where the caller passes writable slots and a context with globals.
+  double eval(const Expr& e, const double* slots, Rng* rng, EvalContext* context = nullptr) const {
     switch (e.kind) {
       case Expr::Kind::kConst: return e.value;
       case Expr::Kind::kSlot: return slots[e.slot];
-      default: return run(e, slots, rng);
+      default: return run(e, slots, rng, context);
     }
   }
 
  private:
-  double run(const Expr& e, const double* slots, Rng* rng) const;
+  double run(const Expr& e, const double* slots, Rng* rng, EvalContext* context) const;
 };
 
 // Trigonometry in degrees, exact at multiples of 90° (sin_deg(180) == 0, not 1.2e-16),

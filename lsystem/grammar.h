@@ -50,11 +50,14 @@ struct Production {
   PatternModule predecessor;
   std::vector<PatternModule> left_context;   // in reading order
   std::vector<PatternModule> right_context;  // may contain [ and ]
-  uint32_t slot_count = 0;                   // formal parameters in all patterns
+  uint32_t slot_count = 0;                   // formal parameters in all patterns, then locals
+  Expr before;                               // cpfg statements run on a match, before the condition
   Expr condition;                            // kind kNone: always
+  Expr after;                                // cpfg statements run when the production applies
   Expr probability;                          // kind kNone: not stochastic
   Successor successor;
   bool has_context() const { return !left_context.empty() || !right_context.empty(); }
+  bool has_statements() const { return before.kind != Expr::Kind::kNone || after.kind != Expr::Kind::kNone; }
 };
 
 // Turtle settings from the header (docs/spec/grammar.md "Header directives").
@@ -95,6 +98,10 @@ struct Grammar {
   // A cpfg model file (is_cpfg_text; docs/cpfg.md): the turtle reads cpfg's symbols.
   bool cpfg = false;
   std::vector<IncludedFile> includes;        // SourceLoc::file k > 0 is includes[k - 1]
+  // A cpfg file's global variables (assigned in its blocks) and its blocks (CPFG manual 4.1):
+  // Start before the axiom, StartEach and EndEach around every step, End after the last.
+  std::vector<std::string> global_names;     // a global's index is its place here
+  Expr start_block, start_each_block, end_each_block, end_block;  // kind kNone: none
   SymbolTable symbols;
   std::vector<Define> defines;
   TurtleDefaults turtle;

@@ -255,6 +255,16 @@ class Parser {
   // ---- cpfg model files (docs/cpfg.md) ----
   bool cpfg_line(const LogicalLine& line, std::string_view rest, bool* homomorphism);
   void set_consider(Cursor c);
+  // Statements (CPFG manual 3.2, 4.1): `{ ... }` at c, compiled into one program that leaves
+  // 0 on the stack. With `scope` (a production) a new name assigned is a local slot there;
+  // without (a block) it must be a global (collect_globals registered every block's).
+  Expr compile_statements(Cursor& c, Scope* scope);
+  void parse_block(Cursor& c, ExprBuild& b, Scope* scope);
+  void parse_statement(Cursor& c, ExprBuild& b, Scope* scope);
+  void parse_condition_in_parens(Cursor& c, ExprBuild& b, Scope* scope, const char* what);
+  bool word_at(Cursor& c, std::string_view word);
+  void collect_globals(const std::vector<LogicalLine>& lines);
+  std::vector<LogicalLine> join_statement_lines(std::vector<LogicalLine> lines);
 
   Grammar& g_;
   const ParseOptions& options_;
@@ -264,6 +274,8 @@ class Parser {
   bool seen_end_ = false;      // cpfg: the 'endlsystem' line was read
   bool consider_ = false;      // cpfg: a 'consider:' list names the modules context sees
   std::vector<uint8_t> considered_;  // by symbol id
+  std::unordered_map<std::string, uint32_t> global_index_;  // cpfg: global variables by name
+  bool globals_visible_ = false;  // compiling a production or a block: globals may be read
 };
 
 // ---------------------------------------------------------------- expressions
@@ -525,6 +537,14 @@ void Parser::parse_primary(Cursor& c, ExprBuild& b, const Scope* scope) {
       if (it != scope->end()) {
         b.uses_slot = true;
         emit(b, Op::kSlot, it->second, loc, +1);
+        return;
+      }
+    }
+    if (globals_visible_) {
+      auto it = global_index_.find(name);
+      if (it != global_index_.end()) {
+        b.uses_slot = true;  // not a constant: read when evaluated
+        emit(b, Op::kGlobal, it->second, loc, +1);
         return;
       }
     }
@@ -949,10 +969,6 @@ void Parser::parse_production(const LogicalLine& line, bool homomorphism) {
     std::string_view ct = cond_text.rest();
     while (!ct.empty() && is_space(ct.back())) ct.remove_suffix(1);
     has_condition = ct != "*";
-    if (g_.cpfg)
-      if (size_t brace = find_top_level(cond_text, "{"); brace != std::string::npos)
-        fail(cond_text.loc_at(brace), "statements in a production ('{ ... }', CPFG manual 3.2) are not supported yet "
-                                      "(docs/cpfg.md)");
   }
   // Context split at top-level '<' and '>'.
   size_t lt = find_top_level(context, "<");
@@ -995,9 +1011,28 @@ void Parser::parse_production(const LogicalLine& line, bool homomorphism) {
   p.slot_count = static_cast<uint32_t>(scope.size());
   if (p.has_context()) g_.uses_context = true;
 
-  // Condition.
+  // Condition, and in a cpfg file the statements around it (CPFG manual 3.2):
+  //   pred : {before} condition {after} --> successor
+  globals_visible_ = g_.cpfg;
+  Cursor cond = cond_text;
+  if (g_.cpfg && has_condition) {
+    cond.skip_spaces();
+    if (cond.peek() == '{') p.before = compile_statements(cond, &scope);
+    const size_t brace = find_top_level(cond, "{");
+    if (brace != std::string::npos) {
+      Cursor after = cond.sub(brace, cond.end);
+      p.after = compile_statements(after, &scope);
+      after.skip_spaces();
+      if (!after.at_end()) fail(after.loc(), "unexpected " + quote_char(after.peek()) + " after the statements");
+      cond.end = brace;
+    }
+    std::string_view ct = cond.rest();
+    while (!ct.empty() && is_space(ct.back())) ct.remove_suffix(1);
+    while (!ct.empty() && is_space(ct.front())) ct.remove_prefix(1);
+    has_condition = !ct.empty() && ct != "*";
+  }
   if (has_condition) {
-    Cursor c = cond_text;
+    Cursor c = cond;
     p.condition = compile_expression(c, &scope);
     c.skip_spaces();
     if (!c.at_end()) fail(c.loc(), "unexpected " + quote_char(c.peek()) + " in the condition");
@@ -1028,6 +1063,8 @@ void Parser::parse_production(const LogicalLine& line, bool homomorphism) {
     else if (g_.cpfg && t.at_end()) fail(t.loc(), "expected a successor after '-->' (cpfg writes '*' for none)");
   }
   p.successor = compile_successor(succ, scope, "the successor");
+  globals_visible_ = false;
+  p.slot_count = static_cast<uint32_t>(scope.size());  // the formal parameters, then the locals
   for (const Expr& e : p.successor.args)
     if (e.uses_random) g_.uses_random = true;
   (homomorphism ? g_.homomorphism : g_.productions).push_back(std::move(p));
@@ -1088,9 +1125,19 @@ bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest, bool* hom
     return true;
   }
   if (keyword("define", false, nullptr)) unsupported("'define:' arrays (CPFG manual 2.2.2)");
-  for (const char* block : {"start", "starteach", "endeach", "end"})
-    if (keyword(block, false, nullptr))
-      unsupported("the '" + std::string(rest.substr(0, std::strlen(block))) + ":' block (CPFG manual 4.1)");
+  const std::pair<const char*, Expr*> blocks[] = {{"start", &g_.start_block}, {"starteach", &g_.start_each_block},
+                                                  {"endeach", &g_.end_each_block}, {"end", &g_.end_block}};
+  for (const auto& [block, expr] : blocks) {
+    if (!keyword(block, false, &value)) continue;
+    const std::string name(rest.substr(0, std::strlen(block)));
+    if (expr->kind != Expr::Kind::kNone) fail(c.loc(), "the '" + name + ":' block is given twice");
+    *expr = compile_statements(value, nullptr);
+    value.skip_spaces();
+    if (value.peek() == ';') ++value.pos;  // cpfg writes "Start: { ... };"
+    value.skip_spaces();
+    if (!value.at_end()) fail(value.loc(), "unexpected " + quote_char(value.peek()) + " after the '" + name + ":' block");
+    return true;
+  }
   return false;
 }
 
@@ -1105,6 +1152,247 @@ void Parser::set_consider(Cursor c) {
     if (considered_.size() <= m.symbol) considered_.resize(m.symbol + 1u, 0);
     considered_[m.symbol] = 1;
   }
+}
+
+// ---------------------------------------------------------------- cpfg statements
+
+bool Parser::word_at(Cursor& c, std::string_view word) {
+  c.skip_spaces();
+  if (c.rest().substr(0, word.size()) != word) return false;
+  if (c.pos + word.size() < c.end && is_ident_char(c.line->text[c.pos + word.size()])) return false;
+  c.pos += word.size();
+  return true;
+}
+
+Expr Parser::compile_statements(Cursor& c, Scope* scope) {
+  c.skip_spaces();
+  const SourceLoc start = c.loc();
+  ExprBuild b;
+  b.begin = static_cast<uint32_t>(g_.program.code.size());
+  const bool visible = globals_visible_;
+  globals_visible_ = true;
+  parse_block(c, b, scope);
+  globals_visible_ = visible;
+  g_.program.consts.push_back(0.0);  // what the program leaves: evaluation returns a value
+  emit(b, Op::kConst, static_cast<uint32_t>(g_.program.consts.size() - 1), start, +1);
+  if (b.max_depth > kMaxEvalStack) fail(start, "statements nested too deeply");
+  Expr e;
+  e.kind = Expr::Kind::kProgram;
+  e.loc = start;
+  e.uses_random = b.uses_random;
+  e.begin = b.begin;
+  e.end = static_cast<uint32_t>(g_.program.code.size());
+  if (e.uses_random) g_.uses_random = true;
+  return e;
+}
+
+void Parser::parse_block(Cursor& c, ExprBuild& b, Scope* scope) {
+  c.skip_spaces();
+  const SourceLoc open = c.loc();
+  if (c.peek() != '{') fail(open, "expected '{' (cpfg statements are blocks in braces, CPFG manual 3.2)");
+  if (++b.nesting > kMaxNesting) fail(open, "statements nested too deeply");
+  ++c.pos;
+  for (;;) {
+    c.skip_spaces();
+    if (c.at_end()) fail(open, "'{' is never closed: expected '}'");
+    if (c.peek() == '}') break;
+    parse_statement(c, b, scope);
+  }
+  ++c.pos;
+  --b.nesting;
+}
+
+void Parser::parse_condition_in_parens(Cursor& c, ExprBuild& b, Scope* scope, const char* what) {
+  c.skip_spaces();
+  if (c.peek() != '(') fail(c.loc(), std::string("expected '(' after '") + what + "'");
+  ++c.pos;
+  parse_or(c, b, scope);
+  c.skip_spaces();
+  if (c.peek() != ')') fail(c.loc(), std::string("expected ')' to close the condition of '") + what + "'");
+  ++c.pos;
+}
+
+void Parser::parse_statement(Cursor& c, ExprBuild& b, Scope* scope) {
+  c.skip_spaces();
+  const SourceLoc loc = c.loc();
+  auto here = [&] { return static_cast<uint32_t>(g_.program.code.size()); };
+  auto patch = [&](uint32_t at, uint32_t target) { g_.program.code[at].arg = target; };
+  if (word_at(c, "if")) {
+    parse_condition_in_parens(c, b, scope, "if");
+    const uint32_t skip = here();
+    emit(b, Op::kJumpIfZero, 0, loc, -1);
+    parse_block(c, b, scope);
+    Cursor peek = c;
+    if (word_at(peek, "else")) {
+      c = peek;
+      const uint32_t over = here();
+      emit(b, Op::kJump, 0, loc, 0);
+      patch(skip, here());
+      Cursor next = c;
+      if (word_at(next, "if")) parse_statement(c, b, scope);  // else if
+      else parse_block(c, b, scope);
+      patch(over, here());
+    } else {
+      patch(skip, here());
+    }
+    return;
+  }
+  if (word_at(c, "while")) {
+    const uint32_t top = here();
+    parse_condition_in_parens(c, b, scope, "while");
+    const uint32_t exit = here();
+    emit(b, Op::kJumpIfZero, 0, loc, -1);
+    parse_block(c, b, scope);
+    emit(b, Op::kLoop, top, loc, 0);
+    patch(exit, here());
+    return;
+  }
+  if (word_at(c, "do")) {
+    const uint32_t top = here();
+    parse_block(c, b, scope);
+    if (!word_at(c, "while")) fail(c.loc(), "expected 'while (condition)' after the block of 'do'");
+    parse_condition_in_parens(c, b, scope, "while");
+    const uint32_t exit = here();
+    emit(b, Op::kJumpIfZero, 0, loc, -1);
+    emit(b, Op::kLoop, top, loc, 0);
+    patch(exit, here());
+    c.skip_spaces();
+    if (c.peek() == ';') ++c.pos;
+    return;
+  }
+  // An assignment "name = expr;" (or += -= *= /=), else an expression used as a statement.
+  Cursor probe = c;
+  if (is_ident_start(probe.peek())) {
+    const size_t name_start = probe.pos;
+    while (is_ident_char(probe.peek())) ++probe.pos;
+    const std::string name = c.line->text.substr(name_start, probe.pos - name_start);
+    probe.skip_spaces();
+    if (probe.peek() == '[') fail(probe.loc(), "arrays (CPFG manual 2.2.2) are not supported yet (docs/cpfg.md)");
+    char compound = 0;
+    if ((probe.peek() == '+' || probe.peek() == '-' || probe.peek() == '*' || probe.peek() == '/') && probe.peek(1) == '=')
+      compound = probe.peek(), ++probe.pos;
+    if (probe.peek() == '=' && probe.peek(1) != '=') {
+      const SourceLoc op_loc = probe.loc();
+      ++probe.pos;
+      c = probe;
+      // Where the value goes: a local or formal parameter, else a global, else a new one.
+      bool global = false;
+      uint32_t index = 0;
+      if (scope && scope->count(name)) {
+        index = scope->at(name);
+      } else if (global_index_.count(name)) {
+        global = true;
+        index = global_index_.at(name);
+      } else if (scope) {
+        if (define_values_.count(name) || name == "pi") fail(loc, "'" + name + "' is a constant: it cannot be assigned");
+        index = static_cast<uint32_t>(scope->size());
+        scope->emplace(name, index);
+      } else {
+        fail(loc, "'" + name + "' is not a global variable");  // collect_globals found every one
+      }
+      if (compound) emit(b, global ? Op::kGlobal : Op::kSlot, index, loc, +1);
+      parse_or(c, b, scope);
+      if (compound) {
+        const Op op = compound == '+' ? Op::kAdd : compound == '-' ? Op::kSub : compound == '*' ? Op::kMul : Op::kDiv;
+        emit(b, op, 0, op_loc, -1);
+      }
+      emit(b, global ? Op::kStoreGlobal : Op::kStore, index, loc, -1);
+      c.skip_spaces();
+      if (c.peek() != ';') fail(c.loc(), "expected ';' after the assignment to '" + name + "' (cpfg ends every one with ';')");
+      ++c.pos;
+      return;
+    }
+  }
+  if (c.peek() == ';') {  // an empty statement
+    ++c.pos;
+    return;
+  }
+  parse_or(c, b, scope);
+  emit(b, Op::kPop, 0, loc, -1);
+  c.skip_spaces();
+  if (c.peek() != ';') fail(c.loc(), "expected ';' after the statement");
+  ++c.pos;
+}
+
+// Registers every name a Start/StartEach/EndEach/End block assigns as a global variable
+// (CPFG manual 4.1), before anything is compiled, so a block may read a global another block
+// (or a later line) assigns.
+void Parser::collect_globals(const std::vector<LogicalLine>& lines) {
+  for (const LogicalLine& line : lines) {
+    const std::string folded = lower_ascii(line.text.substr(0, 16));
+    size_t k = 0;
+    while (k < folded.size() && is_space(folded[k])) ++k;
+    bool block = false;
+    for (const char* name : {"starteach", "start", "endeach", "end"}) {
+      const size_t n = std::strlen(name);
+      if (folded.compare(k, n, name) != 0) continue;
+      size_t p = k + n;
+      while (p < folded.size() && is_space(folded[p])) ++p;
+      if (p < folded.size() && folded[p] == ':') block = true;
+      break;
+    }
+    if (!block) continue;
+    const std::string& t = line.text;
+    for (size_t i = 0; i < t.size(); ++i) {
+      if (!is_ident_start(t[i]) || (i > 0 && (is_ident_char(t[i - 1]) || t[i - 1] == '.'))) continue;
+      size_t e = i;
+      while (e < t.size() && is_ident_char(t[e])) ++e;
+      size_t p = e;
+      while (p < t.size() && is_space(t[p])) ++p;
+      if (p < t.size() && (t[p] == '+' || t[p] == '-' || t[p] == '*' || t[p] == '/') && p + 1 < t.size() && t[p + 1] == '=') ++p;
+      if (p < t.size() && t[p] == '=' && (p + 1 >= t.size() || t[p + 1] != '=')) {
+        const std::string name = t.substr(i, e - i);
+        if (!define_values_.count(name) && !global_index_.count(name)) {
+          global_index_.emplace(name, static_cast<uint32_t>(g_.global_names.size()));
+          g_.global_names.push_back(name);
+        }
+      }
+      i = e - 1;
+    }
+  }
+}
+
+// Joins a cpfg line whose statement braces are still open to the lines after it, as cpfg
+// reads blocks and statements over several lines. Braces count before a production's
+// arrow only (after it, `{` and `}` are polygons, which may open in one production and close
+// in another).
+std::vector<LogicalLine> Parser::join_statement_lines(std::vector<LogicalLine> lines) {
+  std::vector<LogicalLine> out;
+  int depth = 0;
+  for (LogicalLine& line : lines) {
+    const bool continuing = depth > 0;
+    size_t end = line.text.size();
+    if (size_t arrow = line.text.find("->"); arrow != std::string::npos) end = arrow;
+    // Where statement braces may stand: a block's, or a production's after its ':' (an
+    // axiom's braces are polygons).
+    size_t from = 0;
+    if (!continuing) {
+      const std::string folded = lower_ascii(line.text.substr(0, 24));
+      size_t k = 0;
+      while (k < folded.size() && is_space(folded[k])) ++k;
+      const size_t colon = line.text.find(':');
+      from = colon == std::string::npos || colon >= end ? end : colon + 1;
+      for (const char* header : {"axiom", "seed", "derivation", "ignore", "consider", "maximum", "lsystem", "define"})
+        if (folded.compare(k, std::strlen(header), header) == 0) from = end;
+    }
+    for (size_t i = from; i < end; ++i) {
+      if (line.text[i] == '{') ++depth;
+      else if (line.text[i] == '}' && depth > 0) --depth;
+    }
+    if (!continuing) {
+      // A line that opens no statement braces stays as it is.
+      out.push_back(std::move(line));
+      continue;
+    }
+    LogicalLine& into = out.back();
+    into.text += ' ';
+    for (LogicalLine::Piece piece : line.pieces) {
+      piece.offset += into.text.size();
+      into.pieces.push_back(piece);
+    }
+    into.text += line.text;
+  }
+  return out;
 }
 
 enum class LineKind { kBlank, kDefine, kModule, kSection, kOther };
@@ -1147,7 +1435,8 @@ void Parser::parse(const std::string& text) {
     std::string body = text;
     if (body.compare(0, 3, "\xEF\xBB\xBF") == 0) body.replace(0, 3, "   ");
     detail::CpfgSource source = detail::preprocess_cpfg(body, g_.file, options_, g_.includes);
-    lines = std::move(source.lines);
+    lines = join_statement_lines(std::move(source.lines));
+    collect_globals(lines);
     g_.defines = std::move(source.defines);
     for (const char* name : kCpfgModuleNames) {
       g_.symbols.declare_multichar(name);

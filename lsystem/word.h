@@ -102,6 +102,9 @@ struct Word {
   // Lineage key of each module (parallel to modules), or empty when the grammar draws
   // no random numbers. See derive.cpp for how keys are made.
   std::vector<uint64_t> lineage;
+  // A cpfg file's global variables (Grammar::global_names) after the derivation that made
+  // this word: interpret() reads them. Empty without globals.
+  std::vector<double> globals;
 
   size_t size() const { return modules.size(); }
   const double* params_of(const Module& m) const { return params.data() + m.param_begin; }

@@ -176,6 +176,14 @@ int run_bench(const std::vector<std::string>& args) {
     int64_t n = steps_to_reach(*g, target_b, 400);
     cases.push_back({"derive/c_abop_1_31a", "abop_1_31a_context.lsys", n, std::move(*g)});
   }
+  {
+    // Honda's tree written as a cpfg model file, its productions with statements (docs/cpfg.md):
+    // beside derive/b_honda_2_6, what the statements and the globals cost.
+    auto g = load("cpfg/abop_2_6_honda.l");
+    if (!g) return kInputError;
+    int64_t n = steps_to_reach(*g, target_b, 60);
+    cases.push_back({"derive/d_honda_cpfg_statements", "cpfg/abop_2_6_honda.l", n, std::move(*g)});
+  }
   for (Case& c : cases) {
     c.produced = modules_produced(c.grammar, c.steps);
     lsys::DeriveOptions o;

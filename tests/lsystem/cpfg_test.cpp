@@ -280,18 +280,109 @@ TEST(CpfgModel, TheChapterSixModuleNamesAreOneModuleEach) {
 
 TEST(CpfgModel, WhatSylvaCannotReadYetIsAnErrorAtItsPlaceNamingTheFeature) {
   const LocatedError cases[] = {
-      {"Lsystem: 1\nAxiom: F\nStart: {i=0;}\nendlsystem\n", 3, 1, "'Start:' block"},
-      {"Lsystem: 1\nAxiom: F\nEndEach: {i=i+1;}\nendlsystem\n", 3, 1, "'EndEach:' block"},
       {"Lsystem: 1\nAxiom: F\ndefine: { array a[3]; }\nendlsystem\n", 3, 1, "arrays"},
+      {"Lsystem: 1\nAxiom: F\nF : {a[1] = 2;} * --> F\nendlsystem\n", 3, 7, "arrays"},
       {"Lsystem: 1\nring lsystem\nAxiom: F\nendlsystem\n", 2, 1, "ring L-system"},
       {"Lsystem: 1\nAxiom: F\ndecomposition\nendlsystem\n", 3, 1, "decomposition"},
-      {"Lsystem: 1\nAxiom: F\nF : { x = 1; } x > 0 --> FF\nendlsystem\n", 3, 5, "statements in a production"},
       {"Lsystem: 1\nAxiom: F\nendlsystem\nLsystem: 2\nAxiom: G\nendlsystem\n", 4, 1, "sub-L-systems"},
   };
   for (const LocatedError& c : cases) {
     expect_located(c);
     EXPECT_NE(parse_error(c.text).message.find("not supported yet"), std::string::npos) << c.text;
   }
+}
+
+// ---- statements (CPFG manual 3.2, 4.1) ----
+
+TEST(CpfgStatements, BeforeAndAfterAProductionsConditionWithLocalsIfAndLoops) {
+  // Step 1: A(1): m = 2, not > 3, so m = 1.5; k counts to 3: B(0) A(1.5) C(3); EndEach: i = 1.
+  // Step 2: A(1.5): m = 3 -> 2.5: B(1) A(2.5) C(3); i = 2. Step 3: A(2.5): m = 5 > 3 -> 105.
+  const std::string model =
+      "Lsystem: 1\nderivation length: 3\nStart: { i = 0; };\nEndEach: {\n  i = i + 1;\n}\nAxiom: A(1)\n"
+      "A(n) : { m = n * 2; if (m > 3) { m = m + 100; } else { m = m - 0.5; } } * { k = 0; while (k < 3) { k += 1; } }"
+      " --> B(i) A(m) C(k)\nendlsystem\n";
+  EXPECT_EQ(derive_text(model), "B(0)B(1)B(2)A(105)C(3)C(3)C(3)");
+  Grammar g = parse_ok(model);
+  EXPECT_EQ(g.global_names, std::vector<std::string>{"i"});
+}
+
+TEST(CpfgStatements, DoWhileElseIfCompoundAssignmentAndBlocksOverSeveralLines) {
+  // x: 0 -> do x += 2 while x < 7 -> 8; y: x > 10? no; x > 5? yes -> 2; z: 8 * 3 / 4 - 1 = 5.
+  const std::string model =
+      "Lsystem: 1\nAxiom: A\n"
+      "A : {\n  x = 0;\n  do { x += 2; } while (x < 7);\n"
+      "  if (x > 10) { y = 1; } else if (x > 5) { y = 2; } else { y = 3; }\n"
+      "  z = x; z *= 3; z /= 4; z -= 1;\n} * --> B(x, y, z)\nendlsystem\n";
+  EXPECT_EQ(derive_text(model), "B(8,2,5)");
+}
+
+TEST(CpfgStatements, GlobalsPassFromBlocksToProductionsAndProductionsWriteThemInWordOrder) {
+  // Start sets count = 10; each A, left to right, takes the count and increments it; End
+  // doubles it, which the homomorphism (run after the derivation) reads.
+  const std::string model =
+      "Lsystem: 1\nStart: {count = 10;}\nEnd: {count = count * 2;}\nAxiom: A A A\n"
+      "A : * {count = count + 1;} --> B(count)\nhomomorphism\nB(n) --> C(n, count)\nendlsystem\n";
+  EXPECT_EQ(derive_text(model), "B(11)B(12)B(13)");
+  Grammar g = parse_ok(model);
+  auto w = derive(g);
+  ASSERT_TRUE(w.ok());
+  ASSERT_EQ(w->globals.size(), 1u);
+  EXPECT_EQ(w->globals[0], 26);
+  auto drawn = interpret(g, *w);
+  ASSERT_TRUE(drawn.ok());
+  EXPECT_EQ(print_word(*drawn, g.symbols), "C(11,26)C(12,26)C(13,26)");
+}
+
+TEST(CpfgStatements, TheConditionReadsWhatTheBeforeStatementsComputed) {
+  // The manual's own example (3.2): A(y) : { x=y/2; s=x*x; } s<10 --> B(x).
+  const std::string model = "Lsystem: 1\nAxiom: A(4) A(8)\nA(y) : { x=y/2; s=x*x; } s<10 --> B(x)\nendlsystem\n";
+  EXPECT_EQ(derive_text(model), "B(2)A(8)");
+}
+
+TEST(CpfgStatements, SrandInStartFixesTheDerivationsRandomNumbersWhateverTheSeed) {
+  // The model: ran/bran after the condition, the seed from srand(SEED).
+  const std::string model =
+      "#define SEED 3\nLsystem: 1\nStart: {srand(SEED);}\nderivation length: 4\nAxiom: A(20)\n"
+      "A(n) : n>1 {nl=floor(n*bran(5,16)); nr=n-nl-1;} --> F[+A(nl)][-A(nr)]\nA(n) : n<=1 --> F\nendlsystem\n";
+  Grammar g = parse_ok(model);
+  DeriveOptions seed_a, seed_b;
+  seed_a.seed = 1;
+  seed_b.seed = 99;
+  auto a = derive(g, seed_a), b = derive(g, seed_b);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(print_word(*a, g.symbols), print_word(*b, g.symbols));  // srand wins over --seed, as in cpfg
+  ParseOptions other;
+  other.define_overrides["SEED"] = 4;
+  Grammar h = parse_ok(model, other);
+  auto c = derive(h);
+  ASSERT_TRUE(c.ok());
+  EXPECT_NE(print_word(*a, g.symbols), print_word(*c, h.symbols));
+  // Every A(n) split into nl + nr + 1 = n: the word's A parameters and F count add up.
+  for (const Module& m : c->modules) ASSERT_LE(m.param_count, 1);
+}
+
+TEST(CpfgStatements, ARunawayLoopStopsWithAnErrorAtTheLoopInBoundedTime) {
+  const std::string model = "Lsystem: 1\nAxiom: A\nA : {x = 0; while (1) { x = x + 1; }} * --> B\nendlsystem\n";
+  const std::string message = derive_text(model);
+  EXPECT_NE(message.find("a loop ran more than 10000000 times"), std::string::npos) << message;
+  Grammar g = parse_ok(model);
+  auto w = derive(g);
+  ASSERT_FALSE(w.ok());
+  EXPECT_EQ(w.error().loc.line, 3u);
+  EXPECT_EQ(w.error().loc.column, 13u);  // at the 'while'
+}
+
+TEST(CpfgStatements, MistakesInStatementsAreLocatedErrors) {
+  const LocatedError cases[] = {
+      {"Lsystem: 1\nAxiom: A\nA : {x = y;} * --> B\nendlsystem\n", 3, 10, "unknown name 'y'"},
+      {"Lsystem: 1\nAxiom: A\nA : {x = 1} * --> B\nendlsystem\n", 3, 11, "expected ';'"},
+      {"Lsystem: 1\nAxiom: A\nA : {if x > 1 { x = 1; }} * --> B\nendlsystem\n", 3, 9, "expected '('"},
+      {"Lsystem: 1\nAxiom: A\nA : {x = 1; * --> B\nendlsystem\n", 3, 13, "expected an expression"},
+      {"Lsystem: 1\nAxiom: A\nA : {do { x = 1; } (x < 2);} * --> B\nendlsystem\n", 3, 20, "expected 'while"},
+      {"Lsystem: 1\nStart: {i = 0;} extra\nAxiom: A\nendlsystem\n", 2, 17, "after the 'Start:' block"},
+      {"Lsystem: 1\nStart: {i = 0;}\nStart: {i = 1;}\nAxiom: A\nendlsystem\n", 3, 1, "given twice"},
+  };
+  for (const LocatedError& c : cases) expect_located(c);
 }
 
 // ---- chapter 5 functions ----
