@@ -75,6 +75,7 @@ struct TurtleDefaults {
   double width_scale = 0.05;
   double width_increment = 0;
   uint32_t color_increment = 1;
+  uint32_t initial_color = 0;  // the material index the turtle starts with (a view file's)
 };
 
 // A file a cpfg grammar read with #include (lsystem/cpfg_preprocessor.h).
@@ -154,6 +155,10 @@ struct ParseWork {
 };
 ParseWork& parse_work();
 
+// True if `path` names a grammar by its form: a `.lsys` file, a cpfg model file (`.l`), or a
+// folder (a vlab object, vlab_object.h). What every front end takes as a grammar input.
+bool is_grammar_path(const std::string& path);
+
 // True if `text` is a cpfg model file (docs/spec/grammar.md): its first line that is not
 // blank, a comment or a preprocessor line is `Lsystem: ...`, in any case.
 bool is_cpfg_text(std::string_view text);
@@ -163,7 +168,8 @@ bool is_cpfg_text(std::string_view text);
 Expected<Grammar> parse_grammar(std::string_view text, std::string file,
                                 const ParseOptions& options = {});
 
-// Reads and parses a grammar file; an unreadable file is an error naming the path.
+// Reads and parses a grammar file; an unreadable file is an error naming the path. A folder
+// is read as a vlab object (vlab_object.h).
 Expected<Grammar> load_grammar(const std::string& path, const ParseOptions& options = {});
 
 // Parses a word as `sylva derive` prints it (constant arguments only), with the

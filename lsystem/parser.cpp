@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <unordered_map>
 
 #include "core/util/file_io.h"
@@ -19,6 +20,7 @@
 #include "lsystem/expr.h"
 #include "lsystem/grammar.h"
 #include "lsystem/source_text.h"
+#include "lsystem/vlab_object.h"
 
 namespace sylva::lsys {
 
@@ -1618,6 +1620,8 @@ Expected<Grammar> parse_grammar(std::string_view text, std::string file, const P
 }
 
 Expected<Grammar> load_grammar(const std::string& path, const ParseOptions& options) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return load_vlab_object(path, options);
   // Bounded, regular files and pipes only (docs/limits.md): a directory is not "no axiom".
   Expected<std::string> text = read_text_file(path);
   if (!text) return std::move(text.error());

@@ -184,8 +184,8 @@ int run_export(const std::vector<std::string>& raw_args) {
   InputKind kind;
   if (input.ends_with(".skel.json")) kind = InputKind::skeleton;
   else if (input.ends_with(".scene.json")) kind = InputKind::scene;
-  else if (input.ends_with(".lsys")) kind = InputKind::grammar;
-  else throw UsageError{"INPUT '" + input + "' must be a .lsys grammar, a .skel.json skeleton or a .scene.json scene"};
+  else if (lsys::is_grammar_path(input)) kind = InputKind::grammar;
+  else throw UsageError{"INPUT '" + input + "' must be a grammar (.lsys, a cpfg .l or a vlab object), a .skel.json skeleton or a .scene.json scene"};
   if (!a.output.ends_with(".gltf") && !a.output.ends_with(".glb"))
     throw UsageError{"-o " + a.output + ": the output must end in .gltf or .glb"};
   if (kind != InputKind::grammar && (a.steps || a.seed || range || !a.defines.empty()))

@@ -601,9 +601,9 @@ int run_render(const std::vector<std::string>& args) {
   const std::string& input = a.grammar.grammar;
   const std::string& output = a.grammar.output;
   if (!is_render_input(input))
-    throw UsageError{"INPUT '" + input + "' must end in .lsys, .skel.json, .scene.json, .glb or .gltf"};
+    throw UsageError{"INPUT '" + input + "' must be a grammar (.lsys, a cpfg .l or a vlab object), .skel.json, .scene.json, .glb or .gltf"};
   if (a.grammar_flags && !is_grammar_input(input))
-    throw UsageError{"-n, --seed, -D and --max-modules apply to a .lsys grammar only"};
+    throw UsageError{"-n, --seed, -D and --max-modules apply to a grammar only"};
   if (!can_write_image_format(output))
     throw UsageError{"-o " + output + ": OpenImageIO cannot write this format (use .png, .exr, ...)"};
   if (a.frames) return run_render_frames(a);

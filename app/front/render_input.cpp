@@ -17,7 +17,7 @@
 
 namespace sylva::cli {
 
-bool is_grammar_input(const std::string& path) { return path.ends_with(".lsys"); }
+bool is_grammar_input(const std::string& path) { return lsys::is_grammar_path(path); }
 
 bool is_render_input(const std::string& path) {
   return path.ends_with(".scene.json") || path.ends_with(".skel.json") || is_grammar_input(path) ||

@@ -17,7 +17,7 @@ namespace sylva::cli {
 
 // Whether `path` names an input render understands (by its extension).
 bool is_render_input(const std::string& path);
-bool is_grammar_input(const std::string& path);  // .lsys
+bool is_grammar_input(const std::string& path);  // .lsys, a cpfg .l, a vlab object folder
 
 // Loads INPUT (grammar.grammar; -n/--seed/-D/--max-modules apply to a grammar) and grows
 // every plant; `width`/`height` override the scene's image size. Appends what it did to

@@ -159,6 +159,16 @@ PyGrammar::PyGrammar(std::string grammar_text, std::string grammar_file)
 }
 
 PyGrammar PyGrammar::from_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {  // a vlab object (docs/cpfg.md)
+    auto loaded = lsys::load_grammar(path);
+    if (!loaded) throw GrammarFailure(loaded.error());
+    PyGrammar g(*loaded->text, loaded->file);
+    g.file = path;
+    g.vlab_object = true;
+    g.parsed = std::make_shared<const lsys::Grammar>(std::move(*loaded));
+    return g;
+  }
   Expected<std::string> read = read_text_file(path);
   if (!read) throw_file_error(read.error());
   return PyGrammar(std::move(*read), path);
@@ -168,7 +178,7 @@ std::shared_ptr<const lsys::Grammar> PyGrammar::with_defines(const std::map<std:
   if (defines.empty()) return parsed;
   lsys::ParseOptions options;
   options.define_overrides = defines;
-  auto reparsed = lsys::parse_grammar(text, file, options);
+  auto reparsed = vlab_object ? lsys::load_grammar(file, options) : lsys::parse_grammar(text, file, options);
   if (!reparsed) throw GrammarFailure(reparsed.error());
   return std::make_shared<const lsys::Grammar>(std::move(*reparsed));
 }

@@ -46,6 +46,7 @@ struct PyGrammar {
 
   std::string text;
   std::string file;
+  bool vlab_object = false;  // `file` is a vlab object folder: parsed through load_grammar (text: the model's)
   std::shared_ptr<const lsys::Grammar> parsed;
 };
 

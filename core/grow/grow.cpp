@@ -49,8 +49,9 @@ Expected<GrowResult> grow(const lsys::Grammar& g, const lsys::DeriveOptions& opt
 
 namespace {
 
-// Whether a scene's grammar path names a grammar file: `.lsys` (docs/spec/scene.md).
-bool looks_like_grammar(const std::string& path) { return path.ends_with(".lsys"); }
+// Whether a scene's grammar path names a grammar: `.lsys` (docs/spec/scene.md), a cpfg `.l`
+// or a vlab object (docs/cpfg.md).
+bool looks_like_grammar(const std::string& path) { return lsys::is_grammar_path(path); }
 
 }  // namespace
 

@@ -202,6 +202,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   const dvec3 tropism(d.tropism[0], d.tropism[1], d.tropism[2]);
   TurtleState t;
   t.radius = d.width;
+  t.material = d.initial_color;
   t.tropism_e = d.has_tropism ? d.tropism_e : 0.0;
   std::vector<TurtleState> stack;
   std::vector<PendingJoint> joints;

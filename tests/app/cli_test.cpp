@@ -194,8 +194,10 @@ TEST_F(CliTest, FolderGivenAsGrammarExitsOne) {
   ProcessResult r = run_sylva({"derive", dir_.path().string()});
   ASSERT_FALSE(crashed(r)) << describe(r);
   EXPECT_EQ(r.exit_code, 1) << describe(r);
-  // Said as what it is, not as a grammar without an axiom (docs/limits.md "Inputs").
-  EXPECT_NE(r.err.find("Is a directory"), std::string::npos) << describe(r);
+  // A folder is read as a vlab object (docs/cpfg.md); one without 'specifications' is said
+  // to be no vlab object, not a grammar without an axiom (docs/limits.md "Inputs").
+  EXPECT_NE(r.err.find("not a vlab object"), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("specifications"), std::string::npos) << describe(r);
   EXPECT_EQ(r.err.find("axiom"), std::string::npos) << describe(r);
 }
 

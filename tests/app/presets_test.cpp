@@ -157,7 +157,8 @@ INSTANTIATE_TEST_SUITE_P(Bundled, PresetTest, ::testing::ValuesIn(kPresets),
                            return std::string(info.param.name);
                          });
 
-// presets/cpfg/*.l: the book's grammars typed as cpfg model files (docs/cpfg.md). Each grows
+// presets/cpfg/*.l and *_object/: the book's grammars typed as cpfg model files and a vlab
+// object (docs/cpfg.md). Each grows
 // the skeleton of its .lsys twin joint for joint: an independent check of the cpfg path
 // (preprocessor, '-->', statements, homomorphism depth 1, '!' widths) against sylva's own
 // format. Positions and materials are equal; a radius may differ in its last bit (a cpfg
@@ -165,9 +166,13 @@ INSTANTIATE_TEST_SUITE_P(Bundled, PresetTest, ::testing::ValuesIn(kPresets),
 TEST(CpfgPresets, EachGrowsTheSkeletonOfItsLsysTwinExactly) {
   const std::vector<std::string> names = list_dir(presets_dir() / "cpfg");
   ASSERT_FALSE(names.empty());
+  size_t checked = 0;
   for (const std::string& name : names) {
-    if (fs::path(name).extension() != ".l") continue;
-    const std::string stem = fs::path(name).stem().string();
+    // NAME.l, or a vlab object folder NAME_object: the twin is presets/NAME.lsys.
+    const bool object = fs::is_directory(presets_dir() / "cpfg" / name) && name.ends_with("_object");
+    if (fs::path(name).extension() != ".l" && !object) continue;
+    const std::string stem = object ? name.substr(0, name.size() - 7) : fs::path(name).stem().string();
+    ++checked;
     TempDir dir;
     std::optional<sylva::Skeleton> grown[2];
     const std::string sources[2] = {"presets/cpfg/" + name, "presets/" + stem + ".lsys"};
@@ -191,6 +196,22 @@ TEST(CpfgPresets, EachGrowsTheSkeletonOfItsLsysTwinExactly) {
       ASSERT_NEAR(a.radius_m, b.radius_m, 1e-15 * b.radius_m) << name << " joint " << j;
     }
   }
+  EXPECT_GE(checked, 3u);  // two model files and a vlab object
+}
+
+// A cpfg model file is a grammar for every command: render and export take it as they take
+// a .lsys (lsys::is_grammar_path), -D included.
+TEST(CpfgPresets, RenderAndExportTakeACpfgModelFile) {
+  TempDir dir;
+  const std::string png = dir.file("fig.png"), glb = dir.file("fig.glb");
+  ProcessResult render = run_sylva({"render", "presets/cpfg/abop_1_24d.l", "-D", "N=3", "--width", "48", "--height",
+                                    "32", "--backend", "cpu", "-o", png},
+                                   SYLVA_SOURCE_DIR, 120);
+  EXPECT_EQ(render.exit_code, 0) << describe(render);
+  EXPECT_TRUE(fs::exists(png) && fs::file_size(png) > 0);
+  ProcessResult exported = run_sylva({"export", "presets/cpfg/abop_1_24d.l", "-D", "N=3", "-o", glb}, SYLVA_SOURCE_DIR, 120);
+  EXPECT_EQ(exported.exit_code, 0) << describe(exported);
+  EXPECT_NE(exported.out.find("1 plant"), std::string::npos) << describe(exported);
 }
 
 // A preset added to presets/ without a pinned count would go untested.

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "lsystem/vlab_object.h"
 #include "tests/lsystem/lsystem_test_util.h"
 
 namespace sylva::lsys {
@@ -383,6 +384,83 @@ TEST(CpfgStatements, MistakesInStatementsAreLocatedErrors) {
       {"Lsystem: 1\nStart: {i = 0;}\nStart: {i = 1;}\nAxiom: A\nendlsystem\n", 3, 1, "given twice"},
   };
   for (const LocatedError& c : cases) expect_located(c);
+}
+
+// ---- vlab objects and view files ----
+
+const char* const kVlabModel = "Lsystem: 1\nderivation length: 1\nAxiom: ;A\nA --> F+#F\nendlsystem\n";
+
+TEST(VlabObject, AFolderIsReadThroughItsSpecificationsCpfgCommandAndItsViewFile) {
+  ModelFolder folder;
+  folder.write("plant.l", kVlabModel);
+  folder.write("plant.v",
+               "/* a view file */\nangle factor: 8\ninitial line width: 3 pixels\nline width increment: 0.5\n"
+               "initial color: 3\ncolor increment: 2\nviewpoint: 0,0,1\nprojection: parallel\n"
+               "tropism: T: 0 -1 0 I: 2 E: 0.1\n");
+  folder.write("specifications", "plant.l\nplant.v\nplant.map\nignore:\n*\nMenu:\n\tEDIT plant.l\n"
+                                 "generate:\n\tcpfg -w 400 300 -m plant.map -wt Plant plant.l plant.v\n");
+  EXPECT_TRUE(is_grammar_path(folder.dir().string()));
+  EXPECT_TRUE(is_grammar_path("tree.l"));
+  EXPECT_TRUE(is_grammar_path("tree.lsys"));
+  EXPECT_FALSE(is_grammar_path("tree.skel.json"));
+  auto g = load_grammar(folder.dir().string());
+  ASSERT_TRUE(g.ok()) << g.error().format();
+  EXPECT_TRUE(g->cpfg);
+  EXPECT_EQ(g->file, (folder.dir() / "plant.l").string());
+  EXPECT_EQ(g->turtle.angle_deg, 45);            // 360 / 8
+  EXPECT_DOUBLE_EQ(g->turtle.width, 3 * 0.05);   // pixels: 0.05 m of radius each
+  EXPECT_EQ(g->turtle.width_increment, 0.5);
+  EXPECT_EQ(g->turtle.initial_color, 3u);
+  EXPECT_EQ(g->turtle.color_increment, 2u);
+  EXPECT_TRUE(g->turtle.has_tropism);
+  EXPECT_EQ(g->turtle.tropism[1], -2);           // T scaled by the intensity
+  EXPECT_EQ(g->turtle.tropism_e, 0.1);
+  // A world-unit style makes a width a diameter.
+  folder.write("plant.v", "angle increment: 30\ninitial line width: 0.2 shaded\n");
+  auto shaded = load_grammar(folder.dir().string());
+  ASSERT_TRUE(shaded.ok()) << shaded.error().format();
+  EXPECT_EQ(shaded->turtle.angle_deg, 30);
+  EXPECT_DOUBLE_EQ(shaded->turtle.width, 0.1);
+}
+
+TEST(VlabObject, WhatSylvaCannotFollowIsAnErrorAtItsPlace) {
+  ModelFolder folder;
+  folder.write("plant.l", kVlabModel);
+  folder.write("plant.v", "angle factor: 8\n");
+  struct Case {
+    const char* specifications;
+    const char* view;
+    const char* file;  // the file the error is in
+    uint32_t line, column;
+    const char* says;
+  };
+  const Case cases[] = {
+      {"run:\n\tcpfg -e field.e plant.l plant.v\n", "angle factor: 8\n", "specifications", 2, 7, "environmental program"},
+      {"run:\n\tcpfg -Q plant.l plant.v\n", "angle factor: 8\n", "specifications", 2, 7, "unknown cpfg option '-Q'"},
+      {"run:\n\tcpfg plant.l\n", "angle factor: 8\n", "specifications", 2, 2, "the model and the view file"},
+      {"run:\n\tcpfg -w 400\n", "angle factor: 8\n", "specifications", 2, 7, "needs 2 argument"},
+      {"run:\n\tlpfg plant.l plant.v\n", "angle factor: 8\n", "specifications", 0, 0, "no cpfg command"},
+      {"run:\n\tcpfg plant.l plant.v\n", "angle factor: 0\n", "plant.v", 1, 15, "must not be 0"},
+      {"run:\n\tcpfg plant.l plant.v\n", "initial line width: wide\n", "plant.v", 1, 21, "needs a number"},
+      {"run:\n\tcpfg plant.l plant.v\n", "tropism: T: 0 -1 0 A: 90 E: 0.2\n", "plant.v", 1, 9, "toward an angle"},
+      {"run:\n\tcpfg plant.l plant.v\n", "initial scale: 2\n", "plant.v", 1, 16, "turtle's scale"},
+      {"run:\n\tcpfg plant.l missing.v\n", "", "missing.v", 0, 0, "cannot open"},
+  };
+  for (const Case& c : cases) {
+    folder.write("specifications", c.specifications);
+    folder.write("plant.v", c.view);
+    auto g = load_grammar(folder.dir().string());
+    ASSERT_FALSE(g.ok()) << c.specifications << c.view;
+    const Diagnostic& d = g.error();
+    EXPECT_NE(d.file.find(c.file), std::string::npos) << d.format();
+    EXPECT_EQ(d.loc.line, c.line) << d.format();
+    EXPECT_EQ(d.loc.column, c.column) << d.format();
+    EXPECT_NE(d.message.find(c.says), std::string::npos) << d.format();
+  }
+  ModelFolder empty("_empty");
+  auto none = load_grammar(empty.dir().string());
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.error().message.find("not a vlab object"), std::string::npos) << none.error().format();
 }
 
 // ---- chapter 5 functions ----

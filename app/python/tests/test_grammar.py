@@ -37,6 +37,24 @@ def test_grammar_from_file_accepts_str_and_pathlike():
     assert "LIMBS" in a.defines
 
 
+def test_grammar_from_file_takes_a_cpfg_model_and_a_vlab_object_folder():
+    # docs/cpfg.md: both grow the plant of their .lsys twin, and -D works on both.
+    twin = sylva.Grammar.from_file("presets/abop_1_24d.lsys").grow(defines={"N": 3})
+    model = sylva.Grammar.from_file("presets/cpfg/abop_1_24d.l")
+    folder = sylva.Grammar.from_file("presets/cpfg/abop_1_24d_object")
+    assert folder.file == "presets/cpfg/abop_1_24d_object"
+    assert "Lsystem: 1" in folder.text  # the object's model
+    assert model.defines["N"] == 7.0 and folder.defines["N"] == 7.0
+    for g in (model, folder):
+        grown = g.grow(defines={"N": 3})
+        assert grown.positions.shape == twin.positions.shape
+        assert (grown.positions == twin.positions).all()
+        assert abs(grown.radii - twin.radii).max() < 1e-15
+    with pytest.raises(sylva.GrammarError) as info:
+        sylva.Grammar.from_file("presets/cpfg")  # a folder without specifications
+    assert "not a vlab object" in str(info.value)
+
+
 def test_grammar_from_missing_file_raises_file_not_found():
     with pytest.raises(FileNotFoundError) as info:
         sylva.Grammar.from_file("presets/no_such_plant.lsys")
