@@ -97,13 +97,12 @@ bool find_func(const std::string& name, Func* f) {
   return false;
 }
 
-double Program::run(const Expr& e, const double* slots, Rng* rng, EvalContext* context) const {
+double Program::run(const Expr& e, double* slots, Rng* rng, EvalContext* context) const {
   // Expressions are shallow (the parser bounds nesting), so a fixed stack suffices; the
   // compiler checks the depth it needs against kMaxEvalStack.
   double stack[kMaxEvalStack];
   int sp = 0;
   uint64_t loops = 0;
-  double* writable = const_cast<double*>(slots);  // statements are compiled only over writable slots
   const Instr* code_ptr = code.data();
   for (uint32_t pc = e.begin; pc < e.end; ++pc) {
     const Instr& in = code_ptr[pc];
@@ -144,7 +143,7 @@ double Program::run(const Expr& e, const double* slots, Rng* rng, EvalContext* c
         }
         break;
       case Op::kBool: stack[sp - 1] = stack[sp - 1] != 0.0 ? 1.0 : 0.0; break;
-      case Op::kStore: writable[in.arg] = stack[--sp]; break;
+      case Op::kStore: slots[in.arg] = stack[--sp]; break;
       case Op::kGlobal: stack[sp++] = context->globals[in.arg]; break;
       case Op::kStoreGlobal: context->globals[in.arg] = stack[--sp]; break;
       case Op::kJump: pc = in.arg - 1; break;

@@ -95,8 +95,8 @@ struct Program {
   // Evaluates `e` with formal parameters `slots` and random stream `rng` (only touched
   // by rand/uniform/gauss). Throws EvalError on division by zero or a non-finite result.
   // Statements (kStore, kGlobal, kStoreGlobal, srand) write `slots` and `context`: they are
-  // only compiled where the caller passes writable slots and a context with globals.
-  double eval(const Expr& e, const double* slots, Rng* rng, EvalContext* context = nullptr) const {
+  // only compiled where the caller passes slots and a context with globals.
+  double eval(const Expr& e, double* slots, Rng* rng, EvalContext* context = nullptr) const {
     switch (e.kind) {
       case Expr::Kind::kConst: return e.value;
       case Expr::Kind::kSlot: return slots[e.slot];
@@ -105,7 +105,7 @@ struct Program {
   }
 
  private:
-  double run(const Expr& e, const double* slots, Rng* rng, EvalContext* context) const;
+  double run(const Expr& e, double* slots, Rng* rng, EvalContext* context) const;
 };
 
 // Trigonometry in degrees, exact at multiples of 90° (sin_deg(180) == 0, not 1.2e-16),

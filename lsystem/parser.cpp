@@ -1120,7 +1120,7 @@ bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest, bool* hom
     return true;
   }
   if (keyword("decomposition", true, nullptr)) unsupported("decomposition (CPFG manual 4.4)");
-  if (folded.compare(0, 4, "ring") == 0 && lower_ascii(rest).find("lsystem") != std::string::npos)
+  if (folded.compare(0, 4, "ring") == 0 && folded.find("lsystem") != std::string::npos)
     unsupported("a ring L-system (CPFG manual 3.1.1)");
   if (keyword("consider", false, &value)) {
     set_consider(value);
