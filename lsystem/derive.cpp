@@ -9,6 +9,7 @@
 #include "lsystem/derive.h"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 
@@ -577,95 +578,159 @@ void run_block(const Grammar& g, Block block, int64_t step, uint64_t* seed, Eval
 
 }  // namespace
 
-Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStats* stats) {
-  auto t0 = std::chrono::steady_clock::now();
-  const int64_t steps = options.steps.value_or(g.steps);
-  uint64_t seed = options.seed.value_or(g.seed);
-  if (g.axiom.size() + g.axiom.params.size() > options.max_modules)
-    return g.error_at(g.axiom_loc, "the axiom exceeds --max-modules (" + std::to_string(options.max_modules) +
-                                       " modules), each parameter counting as a module");
+struct Derivation::Impl {
+  Impl(const Grammar& grammar, const DeriveOptions& o)
+      : g(grammar),
+        options(o),
+        steps(o.steps.value_or(grammar.steps)),
+        seed(o.seed.value_or(grammar.seed)),
+        globals(grammar.global_names.size(), 0.0),
+        context{globals.data()},
+        rewriter(grammar, grammar.productions, grammar.productions_by_symbol, seed, o.max_modules, &context) {}
+
+  // on_step's "no" is a cancellation too: its Diagnostic has `cancelled` set.
+  Diagnostic stopped_at(int64_t at) const {
+    Diagnostic d = g.error_at({}, "cancelled at step " + std::to_string(at));
+    d.cancelled = true;
+    return d;
+  }
+
+  const Grammar& g;
+  const DeriveOptions& options;
+  const int64_t steps;
+  uint64_t seed;
   // A cpfg file's global variables, 0 until a block or a production assigns them.
-  std::vector<double> globals(g.global_names.size(), 0.0);
-  EvalContext context{globals.data()};
+  std::vector<double> globals;
+  EvalContext context;
+  Rewriter rewriter;
+  std::chrono::steady_clock::time_point t0 = std::chrono::steady_clock::now();
+  Word cur, next;
+  uint64_t peak = 0;
+  double growth = 2.0;
+  int64_t step = 0;
+  bool started = false, failed = false;
+};
+
+Derivation::Derivation(const Grammar& grammar, const DeriveOptions& options)
+    : impl_(std::make_unique<Impl>(grammar, options)) {}
+Derivation::~Derivation() = default;
+
+int64_t Derivation::step() const { return impl_->step; }
+int64_t Derivation::steps() const { return impl_->steps; }
+Word& Derivation::word() { return impl_->cur; }
+
+Status Derivation::start() {
+  Impl& m = *impl_;
+  const Grammar& g = m.g;
+  assert(!m.started);
+  m.started = true;
+  m.failed = true;  // until it succeeds
+  if (g.axiom.size() + g.axiom.params.size() > m.options.max_modules)
+    return g.error_at(g.axiom_loc, "the axiom exceeds --max-modules (" + std::to_string(m.options.max_modules) +
+                                       " modules), each parameter counting as a module");
   try {
-    run_block(g, Block::kStart, 0, &seed, context);
+    run_block(g, Block::kStart, 0, &m.seed, m.context);
   } catch (const EvalError& e) {
     return g.error_at(e.loc, e.message + " (in the Start block)");
   }
-  Word cur = g.axiom;
+  m.cur = g.axiom;
   if (g.axiom_successor) {
     // The axiom draws random numbers: evaluate its arguments from this seed's stream.
-    Rng rng = axiom_rng(seed);
+    Rng rng = axiom_rng(m.seed);
     size_t k = 0;
     try {
       for (const SuccessorModule& sm : g.axiom_successor->modules)
         for (uint16_t a = 0; a < sm.arg_count; ++a)
-          cur.params[k++] = g.program.eval(g.axiom_successor->args[sm.first_arg + a], nullptr, &rng);
+          m.cur.params[k++] = g.program.eval(g.axiom_successor->args[sm.first_arg + a], nullptr, &rng);
     } catch (const EvalError& e) {
       return g.error_at(e.loc, e.message + " (in the axiom)");
     }
   }
   if (g.uses_random) {
-    cur.lineage.resize(cur.size());
-    for (size_t i = 0; i < cur.size(); ++i) cur.lineage[i] = mix_pair(kAxiomKeyBase, i);
+    m.cur.lineage.resize(m.cur.size());
+    for (size_t i = 0; i < m.cur.size(); ++i) m.cur.lineage[i] = mix_pair(kAxiomKeyBase, i);
   }
-  if (g.uses_cut) apply_cut(cur);
-  Word next;
-  Rewriter rewriter(g, g.productions, g.productions_by_symbol, seed, options.max_modules, &context);
-  uint64_t peak = cur.capacity_bytes();
-  double growth = 2.0;
-  int64_t step = 0;
-  // on_step's "no" is a cancellation too: its Diagnostic has `cancelled` set.
-  auto stopped_at = [&](int64_t at) {
-    Diagnostic d = g.error_at({}, "cancelled at step " + std::to_string(at));
-    d.cancelled = true;
-    return d;
-  };
-  if (options.on_step && !options.on_step(0, cur)) return stopped_at(0);
+  if (g.uses_cut) apply_cut(m.cur);
+  m.rewriter.set_seed(m.seed);
+  m.peak = m.cur.capacity_bytes();
+  if (m.options.on_step && !m.options.on_step(0, m.cur)) return m.stopped_at(0);
+  m.failed = false;
+  return {};
+}
+
+Status Derivation::advance() {
+  Impl& m = *impl_;
+  const Grammar& g = m.g;
+  assert(m.started && !m.failed && m.step < m.steps);
+  m.failed = true;  // until it succeeds
+  const int64_t step = ++m.step;
   try {
-    for (step = 1; step <= steps; ++step) {
-      if (options.progress.cancelled()) return cancelled_diagnostic();
-      next.clear();
-      reserve_for_growth(next, cur.size(), growth, options.max_modules);
-      if (g.uses_random) next.lineage.reserve(next.modules.capacity());
-      rewriter.current_production = nullptr;
-      run_block(g, Block::kStartEach, step, &seed, context);
-      rewriter.set_seed(seed);
-      // Step k is the k-th equal share of the whole (the last steps are the longest, so
-      // the bar slows down; it never goes back).
-      const Progress step_progress = options.progress.part(static_cast<double>(step - 1) / static_cast<double>(steps),
-                                                           static_cast<double>(step) / static_cast<double>(steps));
-      rewriter.rewrite(cur, next, static_cast<uint64_t>(step), nullptr, nullptr, step_progress, "derive");
-      if (g.uses_cut) apply_cut(next);
-      if (step < steps) step_progress.report(1, "derive");  // the last step's 1 is the whole's
-      peak = std::max<uint64_t>(peak, cur.capacity_bytes() + next.capacity_bytes());
-      growth = cur.size() ? std::max(1.0, static_cast<double>(next.size()) / static_cast<double>(cur.size())) : 2.0;
-      std::swap(cur, next);
-      rewriter.current_production = nullptr;
-      run_block(g, Block::kEndEach, step, &seed, context);
-      if (options.on_step && !options.on_step(step, cur)) return stopped_at(step);
-    }
-    rewriter.current_production = nullptr;
-    run_block(g, Block::kEnd, steps, &seed, context);
+    if (m.options.progress.cancelled()) return cancelled_diagnostic();
+    m.next.clear();
+    reserve_for_growth(m.next, m.cur.size(), m.growth, m.options.max_modules);
+    if (g.uses_random) m.next.lineage.reserve(m.next.modules.capacity());
+    m.rewriter.current_production = nullptr;
+    run_block(g, Block::kStartEach, step, &m.seed, m.context);
+    m.rewriter.set_seed(m.seed);
+    // Step k is the k-th equal share of the whole (the last steps are the longest, so
+    // the bar slows down; it never goes back).
+    const Progress step_progress =
+        m.options.progress.part(static_cast<double>(step - 1) / static_cast<double>(m.steps),
+                                static_cast<double>(step) / static_cast<double>(m.steps));
+    m.rewriter.rewrite(m.cur, m.next, static_cast<uint64_t>(step), nullptr, nullptr, step_progress, "derive");
+    if (g.uses_cut) apply_cut(m.next);
+    if (step < m.steps) step_progress.report(1, "derive");  // the last step's 1 is the whole's
+    m.peak = std::max<uint64_t>(m.peak, m.cur.capacity_bytes() + m.next.capacity_bytes());
+    m.growth = m.cur.size() ? std::max(1.0, static_cast<double>(m.next.size()) / static_cast<double>(m.cur.size()))
+                            : 2.0;
+    std::swap(m.cur, m.next);
+    m.rewriter.current_production = nullptr;
+    run_block(g, Block::kEndEach, step, &m.seed, m.context);
+    if (m.options.on_step && !m.options.on_step(step, m.cur)) return m.stopped_at(step);
   } catch (const DeriveCancelled&) {
     return cancelled_diagnostic();
   } catch (const DeriveFailure& f) {
-    return failure_diagnostic(g, rewriter, f.message, f.loc, "step", step);
+    return failure_diagnostic(g, m.rewriter, f.message, f.loc, "step", step);
   } catch (const EvalError& e) {
-    return failure_diagnostic(g, rewriter, e.message, e.loc, "step", step);
+    return failure_diagnostic(g, m.rewriter, e.message, e.loc, "step", step);
   } catch (const std::bad_alloc&) {
-    return g.error_at({}, "out of memory at step " + std::to_string(step) + "; lower --max-modules or the derivation length");
+    return g.error_at({}, "out of memory at step " + std::to_string(step) +
+                              "; lower --max-modules or the derivation length");
+  }
+  m.failed = false;
+  return {};
+}
+
+Expected<Word> Derivation::finish(DeriveStats* stats) {
+  Impl& m = *impl_;
+  const Grammar& g = m.g;
+  assert(m.started && !m.failed);
+  try {
+    m.rewriter.current_production = nullptr;
+    run_block(g, Block::kEnd, m.steps, &m.seed, m.context);
+  } catch (const DeriveFailure& f) {
+    return failure_diagnostic(g, m.rewriter, f.message, f.loc, "step", m.steps + 1);
+  } catch (const EvalError& e) {
+    return failure_diagnostic(g, m.rewriter, e.message, e.loc, "step", m.steps + 1);
   }
   if (stats) {
-    stats->steps = steps;
-    stats->modules = cur.size();
-    stats->peak_bytes = peak;
-    stats->context_steps = rewriter.context_steps();
-    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    stats->steps = m.step;
+    stats->modules = m.cur.size();
+    stats->peak_bytes = m.peak;
+    stats->context_steps = m.rewriter.context_steps();
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - m.t0).count();
   }
-  options.progress.report(1, "derive");
-  cur.globals = std::move(globals);
-  return cur;
+  m.options.progress.report(1, "derive");
+  m.cur.globals = m.globals;
+  return std::move(m.cur);
+}
+
+Expected<Word> derive(const Grammar& g, const DeriveOptions& options, DeriveStats* stats) {
+  Derivation d(g, options);
+  if (Status s = d.start(); !s) return s.error();
+  while (!d.done())
+    if (Status s = d.advance(); !s) return s.error();
+  return d.finish(stats);
 }
 
 Expected<Word> interpret(const Grammar& g, const Word& word, const DeriveOptions& options, InterpretStats* stats) {

@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 
 #include "core/util/progress.h"
@@ -55,6 +56,35 @@ struct DeriveStats {
 // Derives the grammar's word. `stats` (optional) receives counts and the time taken.
 Expected<Word> derive(const Grammar& grammar, const DeriveOptions& options = {},
                       DeriveStats* stats = nullptr);
+
+// The same derivation one step at a time, so that a caller can act between steps: grow
+// several plants in lockstep and answer their light queries after each step, writing the
+// answers into the word's parameters (docs/spec/light.md). derive() is start(), advance()
+// until done(), finish(). `grammar` and `options` must outlive it. After a call that
+// fails, only destruction is allowed.
+class Derivation {
+ public:
+  Derivation(const Grammar& grammar, const DeriveOptions& options);
+  ~Derivation();
+  Derivation(const Derivation&) = delete;
+  Derivation& operator=(const Derivation&) = delete;
+
+  // The Start block and the axiom (step 0; on_step(0) is called). Once, first.
+  Status start();
+  // One step: StartEach, the rewriting, the cut, EndEach, on_step. Only while !done().
+  Status advance();
+  int64_t step() const;   // steps done
+  int64_t steps() const;  // the derivation length
+  bool done() const { return step() >= steps(); }
+  // The current word. A caller may overwrite its parameters between steps.
+  Word& word();
+  // The End block; the word, with the globals the derivation left. Once, last.
+  Expected<Word> finish(DeriveStats* stats = nullptr);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 struct InterpretStats {
   int depth = 0;                 // homomorphism passes performed

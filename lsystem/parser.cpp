@@ -242,6 +242,7 @@ class Parser {
   };
   std::vector<ParsedModule> parse_modules(Cursor c, const char* what);
   std::string_view module_name_at(Cursor& c);
+  void check_builtin_arity(const ParsedModule& m);
   void check_brackets(const std::vector<ParsedModule>& ms, const char* what);
   Successor compile_successor(Cursor c, const Scope& scope, const char* what);
   Word evaluate_constant_word(const Successor& s);
@@ -660,6 +661,16 @@ void Parser::check_brackets(const std::vector<ParsedModule>& ms, const char* wha
     fail(open.back(), std::string("unbalanced brackets in ") + what + ": '[' is never closed");
 }
 
+// The modules whose parameter count is part of their meaning (light.md): a light query
+// has 1 or 4 parameters, a tropism vector 3.
+void Parser::check_builtin_arity(const ParsedModule& m) {
+  if (m.symbol == kSymLightQuery && m.args.size() != 1 && m.args.size() != 4)
+    fail(m.loc, "?E takes 1 parameter, ?E(q), or 4, ?E(q, x, y, z), not " + std::to_string(m.args.size()) +
+                    " (light.md)");
+  if (m.symbol == kSymTropismVector && m.args.size() != 3)
+    fail(m.loc, "@Tp takes 3 parameters, @Tp(x, y, z), not " + std::to_string(m.args.size()));
+}
+
 Successor Parser::compile_successor(Cursor c, const Scope& scope, const char* what) {
   std::vector<ParsedModule> ms = parse_modules(c, what);
   check_brackets(ms, what);
@@ -667,6 +678,7 @@ Successor Parser::compile_successor(Cursor c, const Scope& scope, const char* wh
   for (ParsedModule& m : ms) {
     if ((m.symbol == kSymPush || m.symbol == kSymPop) && !m.args.empty())
       fail(m.loc, "brackets take no arguments");
+    check_builtin_arity(m);
     SuccessorModule sm{m.symbol, static_cast<uint16_t>(m.args.size()),
                        static_cast<uint32_t>(s.args.size())};
     for (Cursor& a : m.args) {
@@ -712,6 +724,7 @@ std::vector<PatternModule> Parser::compile_pattern(Cursor c, Scope& scope, const
   for (ParsedModule& m : ms) {
     if ((m.symbol == kSymPush || m.symbol == kSymPop) && !m.args.empty())
       fail(m.loc, "brackets take no arguments");
+    check_builtin_arity(m);
     PatternModule pm{m.symbol, static_cast<uint16_t>(m.args.size()), 0};
     pm.first_slot = static_cast<uint32_t>(scope.size());
     for (Cursor& a : m.args) {

@@ -9,7 +9,7 @@ namespace sylva::lsys {
 
 namespace {
 constexpr const char* kBuiltinNames[kBuiltinSymbolCount] = {
-    "F", "f", "+", "-", "&", "^", "\\", "/", "|", "$", "[", "]", "!", "'", "%", "@T"};
+    "F", "f", "+", "-", "&", "^", "\\", "/", "|", "$", "[", "]", "!", "'", "%", "@T", "@Tp", "?E"};
 
 // Bytes in the UTF-8 sequence that starts with `lead` (1 for anything malformed; the
 // parser validates UTF-8 before tokenising).
@@ -26,6 +26,8 @@ SymbolTable::SymbolTable() {
   std::fill(std::begin(ascii_ids_), std::end(ascii_ids_), -1);
   for (const char* name : kBuiltinNames) intern(name);
   declare_multichar("@T");
+  declare_multichar("@Tp");
+  declare_multichar("?E");
 }
 
 SymbolId SymbolTable::intern(std::string_view name, bool* ok) {

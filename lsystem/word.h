@@ -35,6 +35,8 @@ enum BuiltinSymbol : SymbolId {
   kSymMaterial,     // '
   kSymCut,          // %
   kSymTropism,      // @T
+  kSymTropismVector,// @Tp  set the tropism vector (light.md)
+  kSymLightQuery,   // ?E   a light query, answered after every step (light.md)
   kBuiltinSymbolCount
 };
 

@@ -16,6 +16,7 @@
 #include <string_view>
 #include <vector>
 
+#include "app/front/light.h"
 #include "app/front/batch.h"
 #include "app/cli/cli.h"
 #include "core/grow/grow.h"
@@ -235,7 +236,7 @@ int run_export(const std::vector<std::string>& raw_args) {
     if (skin) override_skin(scene, *skin);
     options.materials = scene.materials;  // one glTF material per entry (docs/materials.md)
     // A plant's grammar error: the grammar's place, and a note at the scene key naming it.
-    if (Status grown = grow_scene_plants(scene, a.max_modules); !grown) {
+    if (Status grown = grow_scene_plants(scene, a.max_modules, {}, &cpu_light_oracle()); !grown) {
       std::cerr << grown.error().format();
       return kInputError;
     }
@@ -266,7 +267,7 @@ int run_export(const std::vector<std::string>& raw_args) {
   // Grows with `one`'s seed and exports to `output`; the summary line on success.
   auto export_one = [&](const GrammarArgs& one, const std::string& output) -> Expected<std::string> {
     const auto one_start = std::chrono::steady_clock::now();
-    auto grown = grow(*g, derive_options_for(one), one.grammar, one.defines);
+    auto grown = grow(*g, derive_options_for(one), one.grammar, one.defines, {&cpu_light_oracle()});
     if (!grown) return std::move(grown.error());
     GltfPlant plant;
     plant.name = plant_name(input);

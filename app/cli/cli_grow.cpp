@@ -12,6 +12,7 @@
 #include "core/util/file_io.h"
 #include "core/grow/turtle.h"
 #include "core/grow/grow.h"
+#include "app/front/light.h"
 
 namespace sylva::cli {
 
@@ -63,7 +64,7 @@ int run_derive(const std::vector<std::string>& args) {
   int code = kOk;
   auto g = load_grammar_for(a, &code);
   if (!g) return code;
-  auto word = lsys::derive(*g, derive_options_for(a));
+  auto word = derive_word(*g, derive_options_for(a), {&cpu_light_oracle()});
   if (!word) {
     std::cerr << word.error().format();
     return kInputError;
@@ -87,7 +88,7 @@ struct GrowOutcome {
 
 GrowOutcome grow_to_file(const lsys::Grammar& g, const GrammarArgs& a, const std::string& output) {
   GrowOutcome out;
-  auto result = grow(g, derive_options_for(a), a.grammar, a.defines);
+  auto result = grow(g, derive_options_for(a), a.grammar, a.defines, {&cpu_light_oracle()});
   if (!result) {
     out.error = std::move(result.error());
     return out;

@@ -14,6 +14,7 @@
 #include "core/util/json.h"
 #include "core/grow/grow.h"
 #include "core/util/clock.h"
+#include "app/front/light.h"
 
 namespace sylva::cli {
 
@@ -42,7 +43,7 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
     passes.push_back({"read scene", seconds_since(start), ""});
     start = std::chrono::steady_clock::now();
     // A plant's grammar error: the grammar's place, and a note at the scene key naming it.
-    if (Status grown = grow_scene_plants(scene, grammar.max_modules, progress); !grown) {
+    if (Status grown = grow_scene_plants(scene, grammar.max_modules, progress, &cpu_light_oracle()); !grown) {
       if (grown.cancelled()) return kInterrupted;
       std::cerr << grown.error().format();
       return kInputError;
@@ -111,7 +112,7 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
       o.seed = grammar.seed;
       o.max_modules = grammar.max_modules;
       o.progress = progress;
-      auto grown = grow(*g, o, input, grammar.defines);
+      auto grown = grow(*g, o, input, grammar.defines, {&cpu_light_oracle()});
       if (!grown) {
         if (grown.cancelled()) return kInterrupted;
         std::cerr << grown.error().format();

@@ -16,6 +16,7 @@
 #include <pybind11/stl/filesystem.h>
 #include <glm/vec3.hpp>
 
+#include "app/front/light.h"
 #include "app/python/sylva_python.h"
 #include "core/cpu/render_cpu.h"
 #include "core/util/limits.h"
@@ -68,7 +69,7 @@ Scene scene_of(const py::object& plant, std::optional<uint32_t> width, std::opti
   Status grown;
   {
     py::gil_scoped_release release;
-    grown = grow_scene_plants(*read, 50'000'000);
+    grown = grow_scene_plants(*read, 50'000'000, {}, &cpu_light_oracle());
   }
   if (!grown) throw py::value_error(chomp(grown.error().format()));
   inputs->push_back(path);

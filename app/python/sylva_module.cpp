@@ -25,6 +25,7 @@
 #include <utility>
 #include <vector>
 
+#include "app/front/light.h"
 #include "app/python/sylva_python.h"
 #include "core/util/file_io.h"
 #include "core/io/gltf.h"
@@ -241,7 +242,7 @@ Skeleton grammar_grow(const PyGrammar& self, const py::object& steps, const py::
     py::gil_scoped_release release;
     try {
       std::shared_ptr<const lsys::Grammar> grammar = self.with_defines(defines);
-      auto grown = grow(*grammar, options, self.file, defines);
+      auto grown = grow(*grammar, options, self.file, defines, {&cpu_light_oracle()});
       if (grown) {
         still_expandable = grown->interpret.still_expandable;
         max_depth = grammar->max_depth;
@@ -276,7 +277,7 @@ std::string grammar_derive(const PyGrammar& self, const py::object& steps, const
     py::gil_scoped_release release;
     try {
       std::shared_ptr<const lsys::Grammar> grammar = self.with_defines(defines);
-      auto word = lsys::derive(*grammar, options);
+      auto word = derive_word(*grammar, options, {&cpu_light_oracle()});
       if (word)
         text = lsys::print_word(*word, grammar->symbols);
       else

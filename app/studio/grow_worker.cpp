@@ -5,6 +5,7 @@
 
 #include "core/grow/turtle.h"
 #include "core/grow/grow.h"
+#include "app/front/light.h"
 
 namespace sylva::studio {
 
@@ -200,7 +201,7 @@ GrowOutcome GrowWorker::grow(const GrowRequest& request, uint64_t gen, bool* can
       }
       return true;
     };
-    auto result = lsys::derive(g, options);
+    auto result = derive_word(g, options, {&cpu_light_oracle()});
     options.on_step = nullptr;
     if (stale(gen)) {
       cache.grammar.reset();  // the cache may be incomplete: derive again next time
@@ -253,7 +254,7 @@ GrowOutcome GrowWorker::grow(const GrowRequest& request, uint64_t gen, bool* can
     o.steps = v.steps;
     o.max_modules = request.max_modules;
     o.on_step = [&](int64_t, const lsys::Word&) { return !stale(gen); };
-    auto w = lsys::derive(*parsed, o);
+    auto w = derive_word(*parsed, o, {&cpu_light_oracle()});
     if (stale(gen)) return *cancelled = true, out;
     if (!w) return fail(w.error());
     auto sk = build(*parsed, *w);

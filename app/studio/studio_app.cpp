@@ -16,6 +16,7 @@
 #include "core/scene/scene_json.h"
 #include "core/util/file_io.h"
 #include "core/util/math.h"
+#include "app/front/light.h"
 
 namespace sylva::studio {
 
@@ -130,7 +131,7 @@ std::optional<std::string> StudioApp::open(const std::string& path) {
     for (ScenePlant& p : others.plants)
       if (p.grammar == grammar) p.skeleton = Skeleton{};  // not grown here
     // A plant's grammar error: the grammar's place, and a note at the scene key naming it.
-    if (Status grown = grow_scene_plants(others, options_.max_modules); !grown) return grown.error().format();
+    if (Status grown = grow_scene_plants(others, options_.max_modules, {}, &cpu_light_oracle()); !grown) return grown.error().format();
     for (size_t i = 0; i < scene.plants.size(); ++i)
       if (scene.plants[i].grammar != grammar) scene.plants[i].skeleton = std::move(others.plants[i].skeleton);
     Expected<std::string> r = read_text_file(grammar);

@@ -11,28 +11,39 @@
 #include <utility>
 #include <vector>
 
+#include "core/util/clock.h"
 #include "core/util/parallel.h"
 
 namespace sylva {
 
-Expected<GrowResult> grow(const lsys::Grammar& g, const lsys::DeriveOptions& options,
-                                const std::string& grammar_path, const std::map<std::string, double>& defines) {
-  auto t0 = std::chrono::steady_clock::now();
-  GrowResult r;
-  // Shares of the whole for the progress bar: the derivation's last step usually
-  // dominates, the turtle reads every module once.
-  const bool interprets = !g.homomorphism.empty();
-  const double derive_end = interprets ? 0.6 : 0.7, interpret_end = 0.7;
-  lsys::DeriveOptions part = options;
-  part.progress = options.progress.part(0, derive_end);
-  auto word = lsys::derive(g, part, &r.derive);
-  if (!word) return word.error();
-  r.modules = word->size();
-  const lsys::Word* turtle_word = &*word;
+bool grammar_queries_light(const lsys::Grammar& g) {
+  auto in = [](const lsys::Successor& s) {
+    return std::any_of(s.modules.begin(), s.modules.end(),
+                       [](const lsys::SuccessorModule& m) { return m.symbol == lsys::kSymLightQuery; });
+  };
+  if (std::any_of(g.axiom.modules.begin(), g.axiom.modules.end(),
+                  [](const lsys::Module& m) { return m.symbol == lsys::kSymLightQuery; }))
+    return true;
+  for (const auto* list : {&g.productions, &g.homomorphism})
+    for (const lsys::Production& p : *list)
+      if (in(p.successor)) return true;
+  return false;
+}
+
+namespace {
+
+// The derived word grown into a skeleton: interpretation, turtle, the source recorded.
+Status finish_growth(const lsys::Grammar& g, const lsys::Word& word, const lsys::DeriveOptions& options,
+                     const std::string& grammar_path, const std::map<std::string, double>& defines, double derive_end,
+                     GrowResult& r) {
+  const double interpret_end = 0.7;
+  r.modules = word.size();
+  const lsys::Word* turtle_word = &word;
   Expected<lsys::Word> interpreted = lsys::Word{};
-  if (interprets) {
+  if (!g.homomorphism.empty()) {
+    lsys::DeriveOptions part = options;
     part.progress = options.progress.part(derive_end, interpret_end);
-    interpreted = lsys::interpret(g, *word, part, &r.interpret);
+    interpreted = lsys::interpret(g, word, part, &r.interpret);
     if (!interpreted) return interpreted.error();
     turtle_word = &*interpreted;
   }
@@ -43,6 +54,169 @@ Expected<GrowResult> grow(const lsys::Grammar& g, const lsys::DeriveOptions& opt
   r.skeleton.source.seed = options.seed.value_or(g.seed);
   r.skeleton.source.steps = options.steps.value_or(g.steps);
   r.skeleton.source.defines = defines;
+  return {};
+}
+
+// ---- Growing in light (docs/spec/light.md) -------------------------------------------
+
+// One plant growing in the light: its grammar, its derivation and where it stands.
+struct LightJob {
+  const lsys::Grammar* grammar = nullptr;
+  lsys::DeriveOptions options;
+  ScenePlant placement;  // position, rotation and scale (no skeleton)
+  std::unique_ptr<lsys::Derivation> derivation;
+};
+
+size_t count_queries(const lsys::Word& word) {
+  return static_cast<size_t>(std::count_if(word.modules.begin(), word.modules.end(),
+                                           [](const lsys::Module& m) { return m.symbol == lsys::kSymLightQuery; }));
+}
+
+// The job's current word as a skeleton placed in the world, its queries' positions
+// appended to `sensors` (world), in word order.
+Expected<Skeleton> placed_now(LightJob& job, std::vector<glm::dvec3>& sensors) {
+  const lsys::Grammar& g = *job.grammar;
+  const lsys::Word& word = job.derivation->word();
+  lsys::DeriveOptions quiet = job.options;
+  quiet.progress = Progress(job.options.progress.cancel_flag());
+  const lsys::Word* turtle_word = &word;
+  Expected<lsys::Word> interpreted = lsys::Word{};
+  if (!g.homomorphism.empty()) {
+    interpreted = lsys::interpret(g, word, quiet);
+    if (!interpreted) return interpreted.error();
+    turtle_word = &*interpreted;
+  }
+  std::vector<glm::dvec3> local;
+  auto sk = build_skeleton(*turtle_word, g, nullptr, quiet.progress, &local);
+  if (!sk) return sk.error();
+  const size_t queries = count_queries(word);
+  if (local.size() != queries)
+    return g.error_at({}, "the homomorphism changes the number of ?E queries (" + std::to_string(queries) +
+                              " in the derived word, " + std::to_string(local.size()) +
+                              " drawn); sylva answers them in word order, so it must keep each one (docs/light.md)");
+  ScenePlant p = job.placement;
+  p.skeleton = std::move(*sk);
+  for (const glm::dvec3& q : local) sensors.push_back(place_point(p, q));
+  return place_plant(p);
+}
+
+struct JobFailure {
+  size_t job = 0;
+  Diagnostic error;
+};
+
+// Answers every query of every job's current word at once, writing q (clamped to
+// [0, 1]) and the direction into each `?E`'s parameters. Nothing is traced without queries.
+std::optional<JobFailure> answer_queries(std::vector<LightJob>& jobs, std::span<const Skeleton> fixed,
+                                         const Scene& scene, const LightOracle& oracle, int64_t step,
+                                         LightGrowthStats* stats) {
+  size_t total = 0;
+  for (LightJob& j : jobs) total += count_queries(j.derivation->word());
+  if (total == 0) return std::nullopt;
+  const Clock::time_point t0 = Clock::now();
+  std::vector<Skeleton> plants(fixed.begin(), fixed.end());
+  std::vector<glm::dvec3> sensors;
+  for (size_t k = 0; k < jobs.size(); ++k) {
+    auto sk = placed_now(jobs[k], sensors);
+    if (!sk) return JobFailure{k, sk.error()};
+    plants.push_back(std::move(*sk));
+  }
+  LightAnswerStats answer_stats;
+  auto answers = oracle.answer(plants, sensors, scene, step, &answer_stats);
+  if (!answers) return JobFailure{0, answers.error()};
+  size_t next = 0;
+  for (LightJob& j : jobs) {
+    lsys::Word& word = j.derivation->word();
+    for (const lsys::Module& m : word.modules) {
+      if (m.symbol != lsys::kSymLightQuery) continue;
+      const LightAnswer& a = (*answers)[next++];
+      double* p = word.params.data() + m.param_begin;
+      p[0] = std::clamp(a.q, 0.0, 1.0);
+      if (m.param_count == 4) p[1] = a.toward.x, p[2] = a.toward.y, p[3] = a.toward.z;
+    }
+  }
+  if (stats) {
+    ++stats->answers;
+    stats->queries += total;
+    stats->photons += answer_stats.photons;
+    stats->cpu_seconds += answer_stats.cpu_seconds;
+    stats->seconds += seconds_since(t0);
+    stats->mean_relative_error = answer_stats.mean_relative_error;
+  }
+  return std::nullopt;
+}
+
+// Derives every job in lockstep (light.md): after the axiom and after every `every`-th
+// step, all queries of all jobs are answered at once. On success every derivation is done.
+std::optional<JobFailure> derive_in_light(std::vector<LightJob>& jobs, std::span<const Skeleton> fixed,
+                                          const Scene& scene, const LightOracle& oracle, LightGrowthStats* stats) {
+  const uint32_t every = scene.environment.value_or(LightEnvironment{}).every;
+  for (size_t k = 0; k < jobs.size(); ++k) {
+    jobs[k].derivation = std::make_unique<lsys::Derivation>(*jobs[k].grammar, jobs[k].options);
+    if (Status s = jobs[k].derivation->start(); !s) return JobFailure{k, s.error()};
+  }
+  if (auto f = answer_queries(jobs, fixed, scene, oracle, 0, stats)) return f;
+  for (int64_t step = 1;; ++step) {
+    bool advanced = false;
+    for (size_t k = 0; k < jobs.size(); ++k) {
+      if (jobs[k].derivation->done()) continue;
+      if (Status s = jobs[k].derivation->advance(); !s) return JobFailure{k, s.error()};
+      advanced = true;
+    }
+    if (!advanced) return std::nullopt;
+    if (step % every == 0)
+      if (auto f = answer_queries(jobs, fixed, scene, oracle, step, stats)) return f;
+  }
+}
+
+// The scene a grammar grows in without one: the default scene's sun over the ground y = 0.
+Scene default_light_scene() {
+  Scene s;
+  s.sun.direction = unit_sun_direction({0.5, 1.0, 0.3});
+  s.ground.height = 0;
+  return s;
+}
+
+// The placed skeletons of a scene's plants that have one (they shade the growing plants).
+std::vector<Skeleton> grown_plants(const Scene& scene) {
+  std::vector<Skeleton> out;
+  for (const ScenePlant& p : scene.plants)
+    if (p.skeleton) out.push_back(place_plant(p));
+  return out;
+}
+
+Diagnostic no_oracle(const lsys::Grammar& g) {
+  return g.error_at({}, "this grammar asks for light (?E) but was grown without a light environment (docs/light.md)");
+}
+
+}  // namespace
+
+Expected<lsys::Word> derive_word(const lsys::Grammar& g, const lsys::DeriveOptions& options, const GrowLight& light,
+                                 LightGrowthStats* stats, lsys::DeriveStats* derive_stats) {
+  if (!grammar_queries_light(g)) return lsys::derive(g, options, derive_stats);
+  if (!light.oracle) return no_oracle(g);
+  const Scene scene = light.scene ? *light.scene : default_light_scene();
+  const std::vector<Skeleton> fixed = grown_plants(scene);
+  std::vector<LightJob> jobs(1);
+  jobs[0].grammar = &g;
+  jobs[0].options = options;
+  if (auto f = derive_in_light(jobs, fixed, scene, *light.oracle, stats)) return f->error;
+  return jobs[0].derivation->finish(derive_stats);
+}
+
+Expected<GrowResult> grow(const lsys::Grammar& g, const lsys::DeriveOptions& options,
+                                const std::string& grammar_path, const std::map<std::string, double>& defines,
+                                const GrowLight& light) {
+  auto t0 = std::chrono::steady_clock::now();
+  GrowResult r;
+  // Shares of the whole for the progress bar: the derivation's last step usually
+  // dominates, the turtle reads every module once.
+  const double derive_end = !g.homomorphism.empty() ? 0.6 : 0.7;
+  lsys::DeriveOptions part = options;
+  part.progress = options.progress.part(0, derive_end);
+  Expected<lsys::Word> word = derive_word(g, part, light, &r.light, &r.derive);
+  if (!word) return word.error();
+  if (Status s = finish_growth(g, *word, options, grammar_path, defines, derive_end, r); !s) return s.error();
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
@@ -53,9 +227,58 @@ namespace {
 // or a vlab object (docs/cpfg.md).
 bool looks_like_grammar(const std::string& path) { return lsys::is_grammar_path(path); }
 
+// The plants first_plant names grown in lockstep in the scene's light (light.md), each
+// result in grown[r]; a plant whose grammar did not load is left unset (reported by the
+// caller); on a failure the failing plant gets the error and the others are left unset.
+template <class Grammars>
+void grow_recipes_in_light(const Scene& scene, const Grammars& grammars, const std::vector<size_t>& first_plant,
+                           uint64_t max_modules, const Progress& progress, const LightOracle* light,
+                           std::vector<std::optional<Expected<GrowResult>>>& grown) {
+  std::vector<LightJob> jobs;
+  std::vector<size_t> recipe_of_job;
+  for (size_t r = 0; r < first_plant.size(); ++r) {
+    const ScenePlant& p = scene.plants[first_plant[r]];
+    const auto& g = grammars.at({p.grammar, p.defines});
+    if (!g) continue;
+    if (!light) {
+      grown[r] = no_oracle(*g);
+      return;
+    }
+    LightJob job;
+    job.grammar = &*g;
+    job.options.steps = p.steps;
+    job.options.seed = p.seed;
+    job.options.max_modules = max_modules;
+    job.options.progress = Progress(progress.cancel_flag());
+    job.placement.position = p.position;
+    job.placement.rotate_y_deg = p.rotate_y_deg;
+    job.placement.scale = p.scale;
+    jobs.push_back(std::move(job));
+    recipe_of_job.push_back(r);
+  }
+  if (jobs.empty()) return;
+  // The scene's plants that already have skeletons shade the growing ones.
+  const std::vector<Skeleton> fixed = grown_plants(scene);
+  LightGrowthStats stats;
+  if (auto f = derive_in_light(jobs, fixed, scene, *light, &stats)) {
+    grown[recipe_of_job[f->job]] = std::move(f->error);
+    return;
+  }
+  for (size_t k = 0; k < jobs.size(); ++k) {
+    const ScenePlant& p = scene.plants[first_plant[recipe_of_job[k]]];
+    GrowResult result;
+    result.light = stats;
+    auto word = jobs[k].derivation->finish(&result.derive);
+    Status s = word ? finish_growth(*jobs[k].grammar, *word, jobs[k].options, p.grammar, p.defines, 0.7, result)
+                    : Status(word.error());
+    grown[recipe_of_job[k]] = s ? Expected<GrowResult>(std::move(result)) : Expected<GrowResult>(s.error());
+    progress.report(static_cast<double>(k + 1) / static_cast<double>(jobs.size()), "grow");
+  }
+}
+
 }  // namespace
 
-Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& progress) {
+Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& progress, const LightOracle* light) {
   // Where the scene names plant i's grammar: its own entry or its scatter entry.
   auto named_by = [&](size_t i) {
     const ScenePlant& p = scene.plants[i];
@@ -81,6 +304,9 @@ Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& pro
     const Expected<lsys::Grammar>& g = grammars.at(Source{p.grammar, p.defines});
     return !g || g->uses_random || g->axiom_successor.has_value();
   };
+  // Plants that query light grow in lockstep, each its own recipe: each one's light differs.
+  bool in_light = false;
+  for (const auto& [source, g] : grammars) in_light = in_light || (g && grammar_queries_light(*g));
   // The distinct recipes (grammar, defines, seed, steps) among the plants to grow, each
   // derived once — a scatter entry's instances share a few — in plant order, so the first
   // failing plant is the one reported whatever the threads do.
@@ -91,6 +317,11 @@ Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& pro
   for (size_t i = 0; i < scene.plants.size(); ++i) {
     const ScenePlant& p = scene.plants[i];
     if (p.skeleton) continue;
+    if (in_light) {
+      plant_recipe[i] = first_plant.size();
+      first_plant.push_back(i);
+      continue;
+    }
     const std::optional<uint64_t> seed = seed_matters(p) ? p.seed : std::nullopt;
     auto [it, added] = recipe_of.try_emplace(Recipe{p.grammar, p.defines, seed, p.steps}, first_plant.size());
     if (added) first_plant.push_back(i);
@@ -100,7 +331,8 @@ Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& pro
   std::atomic<size_t> done{0};
   std::mutex report;
   const double total = static_cast<double>(std::max<size_t>(1, first_plant.size()));
-  parallel_for(first_plant.size(), 0, progress.cancel_flag(), [&](size_t r, unsigned) {
+  if (in_light) grow_recipes_in_light(scene, grammars, first_plant, max_modules, progress, light, grown);
+  else parallel_for(first_plant.size(), 0, progress.cancel_flag(), [&](size_t r, unsigned) {
     const ScenePlant& p = scene.plants[first_plant[r]];
     const Expected<lsys::Grammar>& g = grammars.at(Source{p.grammar, p.defines});
     if (!g) return;  // reported below, at its first plant

@@ -10,6 +10,7 @@
 
 #include "core/geometry/skeleton.h"
 #include "core/grow/turtle.h"
+#include "core/scene/light_queries.h"
 #include "core/scene/scene.h"
 #include "core/util/diagnostic.h"
 #include "core/util/progress.h"
@@ -18,6 +19,30 @@
 
 namespace sylva {
 
+// What answering a grammar's light queries cost while it grew (docs/spec/light.md).
+struct LightGrowthStats {
+  uint64_t answers = 0;     // times the queries were answered (steps with queries)
+  uint64_t queries = 0;     // queries answered, over all answers
+  uint64_t photons = 0;     // traced, over all answers
+  double seconds = 0;       // wall time of the answers: interpretation, turtle, tracing
+  double cpu_seconds = 0;   // CPU time of the tracing
+  double mean_relative_error = 0;  // of the last answer (LightAnswerStats)
+};
+
+// The light a grammar's `?E` queries are answered in. A grammar with queries and no oracle
+// is an error; a grammar without queries never calls the oracle.
+struct GrowLight {
+  const LightOracle* oracle = nullptr;
+  // The light's scene: its sun, ground and environment, and its plants that already have
+  // skeletons, which shade the growing plant. Null: the default scene's light (scene.md:
+  // the sun from (0.5, 1, 0.3)) over the ground y = 0, no other plant.
+  const Scene* scene = nullptr;
+};
+
+// Whether any module the grammar writes (axiom, productions, homomorphism) is a light
+// query: only then does growing it trace light.
+bool grammar_queries_light(const lsys::Grammar& grammar);
+
 // Everything `sylva grow` does: derive, interpret, build the skeleton, record the source.
 struct GrowResult {
   Skeleton skeleton;
@@ -25,6 +50,7 @@ struct GrowResult {
   lsys::DeriveStats derive;
   lsys::InterpretStats interpret;
   TurtleStats turtle;
+  LightGrowthStats light;  // zero without light queries
   double seconds = 0;    // total
 };
 
@@ -32,9 +58,17 @@ struct GrowResult {
 // `defines` are recorded in skeleton.source; seed and steps come from options or the
 // grammar. options.progress covers the whole: derivation, interpretation and turtle as
 // its parts ("derive", "interpret", "turtle"); cancelled: cancelled_diagnostic().
+// A grammar with light queries grows at the origin of light.scene (light.md): after the
+// axiom and after every `every`-th step the word is interpreted and every `?E` answered.
 Expected<GrowResult> grow(const lsys::Grammar& grammar, const lsys::DeriveOptions& options,
                                 const std::string& grammar_path,
-                                const std::map<std::string, double>& defines);
+                                const std::map<std::string, double>& defines, const GrowLight& light = {});
+
+// The derived word of `grammar`: lsys::derive(), or for a grammar with light queries the
+// derivation grow() runs in `light` (the word's queries hold the last answers).
+Expected<lsys::Word> derive_word(const lsys::Grammar& grammar, const lsys::DeriveOptions& options,
+                                 const GrowLight& light = {}, LightGrowthStats* stats = nullptr,
+                                 lsys::DeriveStats* derive_stats = nullptr);
 
 // Grows every plant of `scene` that has no skeleton yet from its grammar (with its seed,
 // steps and defines) and stores the skeleton in the plant, untransformed. The first
@@ -44,6 +78,11 @@ Expected<GrowResult> grow(const lsys::Grammar& grammar, const lsys::DeriveOption
 // without (an unreadable grammar, a define it lacks) the error is at that key with the
 // grammar's as a note; a path not ending in .lsys is never quoted (docs/design.md). Progress: one equal share per plant to grow;
 // cancelled: cancelled_diagnostic(), the plants grown so far keep their skeletons.
-Status grow_scene_plants(Scene& scene, uint64_t max_modules = 50'000'000, const Progress& progress = {});
+// When any plant to grow queries light (`?E`), every plant to grow grows in lockstep in
+// the scene's light (light.md): step k of each is interpreted before step k's queries
+// are answered, so neighbours shade each other; plants that already have skeletons shade
+// them too. `light` answers the queries (null with queries: an error).
+Status grow_scene_plants(Scene& scene, uint64_t max_modules = 50'000'000, const Progress& progress = {},
+                         const LightOracle* light = nullptr);
 
 }  // namespace sylva

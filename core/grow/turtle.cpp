@@ -27,6 +27,7 @@ struct TurtleState {
   double radius = 0.05;
   uint32_t material = 0;
   double tropism_e = 0;
+  dvec3 tropism{0, 0, 0};      // T (the header's, or @Tp's for the rest of the branch)
   int64_t chain = -1;          // chain the turtle stands on, or -1
   int64_t joint = -1;          // joint index within that chain
   bool branch_pending = false; // set by '[': the next F starts a new chain
@@ -173,7 +174,7 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
   set("@M", CpfgKind::kSetPosition);
   for (const char* name : {"~", "@o", "@c", "@O", "@Gs", "@Gc", "@Ge", "@Gr", "@Gt", "@T", "@Ts", "@Td", "@Tf",
                            "@D", "@Di", "@Dd", "@R", "@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc", "?P", "?H", "?L",
-                           "?U", "?E"})
+                           "?U"})
     set(name, CpfgKind::kUnsupported);
   return out;
 }
@@ -188,19 +189,18 @@ std::string cpfg_feature(const std::string& name) {
   if (name == "@R") return "setting the heading, CPFG manual 6.2";
   if (name == "@;" || name == "@,") return "a back-side colour, CPFG manual 6.3";
   if (name.rfind("@P", 0) == 0 || name.rfind("@b", 0) == 0) return "a B-spline surface patch, CPFG manual 6.7.2";
-  if (name == "?E") return "an environmental query, CPFG manual 6.9";
   return "a turtle query, CPFG manual 6.9";
 }
 
 }  // namespace
 
 Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g, TurtleStats* stats,
-                                  const Progress& progress) {
+                                  const Progress& progress, std::vector<glm::dvec3>* queries) {
   using namespace lsys;
   auto t0 = std::chrono::steady_clock::now();
   const TurtleDefaults& d = g.turtle;
-  const dvec3 tropism(d.tropism[0], d.tropism[1], d.tropism[2]);
   TurtleState t;
+  t.tropism = dvec3(d.tropism[0], d.tropism[1], d.tropism[2]);
   t.radius = d.width;
   t.material = d.initial_color;
   t.tropism_e = d.has_tropism ? d.tropism_e : 0.0;
@@ -353,7 +353,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           ++t.joint;
           if (t.tropism_e != 0.0) {
             // ABOP 2.2: rotate the frame about H × T by e·|H × T|.
-            const dvec3 axis = glm::cross(t.heading, tropism);
+            const dvec3 axis = glm::cross(t.heading, t.tropism);
             const double len_axis = glm::length(axis);
             if (len_axis > 1e-12) {
               const dvec3 k = axis / len_axis;
@@ -432,6 +432,14 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
         case kSymTropism:
           if (!has) throw TurtleFailure{"@T needs the susceptibility: @T(e)"};
           t.tropism_e = p[0];
+          break;
+        case kSymTropismVector:  // the parser holds its arity at 3
+          t.tropism = dvec3(p[0], p[1], p[2]);
+          if (!std::isfinite(t.tropism.x) || !std::isfinite(t.tropism.y) || !std::isfinite(t.tropism.z))
+            throw TurtleFailure{"the tropism vector must be finite"};
+          break;
+        case kSymLightQuery:
+          if (queries) queries->push_back(t.position);
           break;
         default:
           break;  // carried through, ignored by the turtle

@@ -6,7 +6,8 @@
 // docs/spec/skeleton.md says: the first F (and the first F after f) starts a root chain; the first
 // F after '[' starts a chain attached to the joint the turtle stands on; after ']' the
 // turtle continues its chain if its joint is still that chain's last, else branches.
-// Tropism (ABOP 2.2) bends H toward T by e·|H × T| after every F. Zero-length moves make
+// Tropism (ABOP 2.2) bends H toward T by e·|H × T| after every F; `@T(e)` sets e and
+// `@Tp(x, y, z)` T, for the rest of the branch. Zero-length moves make
 // no joint and are counted.
 // Polygons (docs/spec/grammar.md, ABOP 1.10 and 5.1): `{` opens one (they nest), `.` records the
 // turtle's position as its next vertex (outside a polygon it records nothing), `}` closes
@@ -22,6 +23,8 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/vec3.hpp>
+#include <vector>
 
 #include "core/geometry/skeleton.h"
 #include "core/util/progress.h"
@@ -38,8 +41,11 @@ struct TurtleStats {
 
 // Interprets `word` (the interpreted word: homomorphism already applied) with the turtle
 // settings of `grammar`. `progress` (progress.h) is checked and told the fraction of the
-// word read every 64 Ki modules; cancelled: cancelled_diagnostic().
+// word read every 64 Ki modules; cancelled: cancelled_diagnostic(). `queries`, when
+// given, receives the turtle's position at each light query `?E` of the word, in word
+// order (docs/spec/light.md: where the query's sensor sits).
 Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& grammar,
-                                  TurtleStats* stats = nullptr, const Progress& progress = {});
+                                  TurtleStats* stats = nullptr, const Progress& progress = {},
+                                  std::vector<glm::dvec3>* queries = nullptr);
 
 }  // namespace sylva

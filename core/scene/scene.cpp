@@ -38,6 +38,23 @@ std::optional<FogMode> fog_mode_from_name(std::string_view name) {
   return std::nullopt;
 }
 
+const char* light_sky_name(LightSky sky) {
+  switch (sky) {
+    case LightSky::sun: return "sun";
+    case LightSky::uniform: return "uniform";
+    case LightSky::overcast: return "overcast";
+    case LightSky::sun_uniform: return "sun+uniform";
+    case LightSky::sun_overcast: return "sun+overcast";
+  }
+  return "sun";
+}
+
+std::optional<LightSky> light_sky_from_name(std::string_view name) {
+  for (LightSky s : {LightSky::sun, LightSky::uniform, LightSky::overcast, LightSky::sun_uniform, LightSky::sun_overcast})
+    if (name == light_sky_name(s)) return s;
+  return std::nullopt;
+}
+
 SkeletonBounds skeleton_bounds(const Skeleton& skeleton) {
   SkeletonBounds b;
   if (skeleton.joints.empty() && skeleton.leaves.empty()) return b;
@@ -184,23 +201,25 @@ void override_skin(Scene& scene, SkinStyle style) {
   for (SceneScatter& sc : scene.scatter) sc.skin.reset();
 }
 
-Skeleton place_plant(const ScenePlant& plant) {
-  Skeleton sk = *plant.skeleton;
+glm::dvec3 place_point(const ScenePlant& plant, const glm::dvec3& p) {
   const double angle = plant.rotate_y_deg * std::numbers::pi / 180;
   const double c = std::cos(angle), s = std::sin(angle);
+  const double x = plant.scale * p.x, y = plant.scale * p.y, z = plant.scale * p.z;
+  // R_y: x' = c x + s z, z' = −s x + c z (right-handed, counter-clockwise seen from +Y).
+  return {plant.position.x + c * x + s * z, plant.position.y + y, plant.position.z - s * x + c * z};
+}
+
+Skeleton place_plant(const ScenePlant& plant) {
+  Skeleton sk = *plant.skeleton;
   for (Joint& j : sk.joints) {
-    const double x = plant.scale * j.position_m[0], y = plant.scale * j.position_m[1],
-                 z = plant.scale * j.position_m[2];
-    // R_y: x' = c x + s z, z' = −s x + c z (right-handed, counter-clockwise seen from +Y).
-    j.position_m[0] = plant.position.x + c * x + s * z;
-    j.position_m[1] = plant.position.y + y;
-    j.position_m[2] = plant.position.z - s * x + c * z;
+    const glm::dvec3 q = place_point(plant, {j.position_m[0], j.position_m[1], j.position_m[2]});
+    j.position_m[0] = q.x, j.position_m[1] = q.y, j.position_m[2] = q.z;
     j.radius_m *= plant.scale;
   }
   for (Leaf& leaf : sk.leaves)
     for (auto& v : leaf.vertices_m) {
-      const double x = plant.scale * v[0], y = plant.scale * v[1], z = plant.scale * v[2];
-      v = {plant.position.x + c * x + s * z, plant.position.y + y, plant.position.z - s * x + c * z};
+      const glm::dvec3 q = place_point(plant, {v[0], v[1], v[2]});
+      v = {q.x, q.y, q.z};
     }
   return sk;
 }

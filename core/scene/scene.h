@@ -62,6 +62,31 @@ struct Ground {
   bool operator==(const Ground&) const = default;
 };
 
+// The light that answers a grammar's `?E` queries while it grows (docs/spec/light.md): the
+// scene's sun, a sky, or both, traced with `photons` photons after every `every`-th step.
+enum class LightSky : uint8_t {
+  sun,           // the scene's sun alone
+  uniform,       // a uniform overcast sky (UOC)
+  overcast,      // the CIE standard overcast sky: radiance ∝ (1 + 2 cos θ)/3 (Moon and Spencer 1942)
+  sun_uniform,   // "sun+uniform": sun_fraction of the horizontal irradiance from the sun
+  sun_overcast,  // "sun+overcast"
+};
+const char* light_sky_name(LightSky sky);                            // "sun", "sun+uniform", ...
+std::optional<LightSky> light_sky_from_name(std::string_view name);  // nullopt: not a sky
+
+struct LightEnvironment {
+  LightSky sky = LightSky::sun;
+  double sun_fraction = 1.0;        // [0, 1]; read by the sun+ skies only
+  uint64_t photons = 1'000'000;     // per answer, 1..kLightMaxPhotons
+  double sensor_radius_m = 0.1;     // (0, kLightMaxSensorRadiusM]
+  uint32_t every = 1;               // answer after every n-th step, 1..kLightMaxEvery
+  uint64_t seed = 1;                // the photons' stream, with the step
+  bool operator==(const LightEnvironment&) const = default;
+};
+constexpr uint64_t kLightMaxPhotons = 1'000'000'000;
+constexpr double kLightMaxSensorRadiusM = 1000;
+constexpr uint32_t kLightMaxEvery = 1'000'000;
+
 // How the fog's single scattering is computed (docs/spec/fog.md, "How the integral is computed";
 // core/scene/fog_integrator.h implements each).
 enum class FogMode : uint8_t {
@@ -256,6 +281,7 @@ struct Scene {
   glm::dvec3 sky{0.25, 0.3, 0.4};  // uniform sky radiance, linear RGB
   Ground ground;
   std::optional<Fog> fog;          // none: no fog pass
+  std::optional<LightEnvironment> environment;  // none: the defaults (light.md), for ?E only
   std::optional<SceneAnimation> animation;  // none: the plants stand still
   std::map<uint32_t, SceneMaterial> materials;  // by material index (< kMaterialSlots)
   std::vector<ScenePlant> plants;  // the scene's own, then every scatter entry's, in order
@@ -280,6 +306,8 @@ void override_skin(Scene& scene, SkinStyle style);
 // The skeleton of `plant` placed in the world: p' = position + R_y(rotate_y_deg)·(scale·p),
 // radii scaled. Precondition: plant.skeleton is set.
 Skeleton place_plant(const ScenePlant& plant);
+// One point of the plant's frame placed the same way.
+glm::dvec3 place_point(const ScenePlant& plant, const glm::dvec3& p);
 
 // Axis-aligned bounds of a skeleton's joints grown by their radii, and of its leaves' vertices (metres).
 using SkeletonBounds = Aabb;

@@ -485,6 +485,53 @@ Fog read_fog(const JsonValue& v, double ground_height) {
   return f;
 }
 
+// The `environment` object (docs/spec/light.md), each value out of range reported at its key.
+LightEnvironment read_environment(const JsonValue& v) {
+  expect_object(v, "environment");
+  check_keys(v, "environment", {"sky", "sun_fraction", "photons", "sensor_radius_m", "every", "seed"});
+  LightEnvironment e;
+  for (const JsonMember& m : v.members) {
+    const std::string& key = m.key.name;
+    const JsonValue& value = m.value;
+    const std::string what = "environment." + key;
+    auto at_key = [&](const std::string& message) -> Located { return Located{m.key.line, m.key.column, message}; };
+    const std::string shown = value.is_number()   ? value.text
+                              : value.is_string() ? json_excerpt(value.text)
+                                                  : std::string(value.kind_name());
+    if (key == "sky") {
+      const std::optional<LightSky> sky = value.is_string() ? light_sky_from_name(value.text) : std::nullopt;
+      if (!sky)
+        throw at_key(what + " must be one of \"sun\", \"uniform\", \"overcast\", \"sun+uniform\", \"sun+overcast\", not " +
+                     shown);
+      e.sky = *sky;
+    } else if (key == "sun_fraction") {
+      if (!value.is_number() || !(value.number >= 0 && value.number <= 1))
+        throw at_key(what + " must be a number in [0, 1], not " + shown);
+      e.sun_fraction = value.number;
+    } else if (key == "photons") {
+      const auto n = value.as_uint64();
+      if (!n || *n == 0 || *n > kLightMaxPhotons)
+        throw at_key(what + " must be an integer from 1 to " + std::to_string(kLightMaxPhotons) +
+                     " (docs/limits.md), not " + shown);
+      e.photons = *n;
+    } else if (key == "sensor_radius_m") {
+      if (!value.is_number() || !(value.number > 0 && value.number <= kLightMaxSensorRadiusM))
+        throw at_key(what + " must be a number in (0, 1000] metres, not " + shown);
+      e.sensor_radius_m = value.number;
+    } else if (key == "every") {
+      const auto n = value.as_uint64();
+      if (!n || *n == 0 || *n > kLightMaxEvery)
+        throw at_key(what + " must be an integer from 1 to " + std::to_string(kLightMaxEvery) + ", not " + shown);
+      e.every = static_cast<uint32_t>(*n);
+    } else if (key == "seed") {
+      const auto n = value.as_uint64();
+      if (!n) throw at_key(what + " must be a non-negative integer, not " + shown);
+      e.seed = *n;
+    }
+  }
+  return e;
+}
+
 // The `animation` object (docs/animation.md): `motion` first sets the defaults, then each
 // key present replaces its own; every value out of range is reported at the value.
 SceneAnimation read_animation(const JsonValue& v) {
@@ -527,8 +574,8 @@ SceneAnimation read_animation(const JsonValue& v) {
 Scene read_scene(const JsonValue& root, const std::string& base_dir) {
   expect_object(root, "a scene");
   check_keys(root, "the scene",
-             {"format", "version", "camera", "image", "sun", "sky", "ground", "fog", "animation", "materials",
-              "plants", "scatter", "skin"});
+             {"format", "version", "camera", "image", "sun", "sky", "ground", "fog", "environment", "animation",
+              "materials", "plants", "scatter", "skin"});
   Scene s;
   if (auto* x = root.find("format"); x && !(x->is_string() && x->text == "sylva-scene"))
     fail(*x, "format must be \"sylva-scene\"");
@@ -552,6 +599,7 @@ Scene read_scene(const JsonValue& root, const std::string& base_dir) {
     if (auto* a = x->find("albedo")) s.ground.albedo = colour(*a, "ground.albedo");
   }
   if (auto* x = root.find("fog")) s.fog = read_fog(*x, s.ground.height);
+  if (auto* x = root.find("environment")) s.environment = read_environment(*x);
   if (auto* x = root.find("animation")) s.animation = read_animation(*x);
   if (auto* x = root.find("materials")) s.materials = read_materials(*x, base_dir);
   s.skin = skin_style(root.find("skin"), "skin", SkinStyle::smooth);
@@ -689,6 +737,17 @@ void write_fog(JsonWriter& w, const Fog& f) {
   w.end_object();
 }
 
+void write_environment(JsonWriter& w, const LightEnvironment& e) {
+  w.key("environment").begin_object(Layout::spaced);
+  w.key("sky").string(light_sky_name(e.sky));
+  w.key("sun_fraction").number(e.sun_fraction);
+  w.key("photons").integer(e.photons);
+  w.key("sensor_radius_m").number(e.sensor_radius_m);
+  w.key("every").integer(e.every);
+  w.key("seed").integer(e.seed);
+  w.end_object();
+}
+
 void write_animation(JsonWriter& w, const SceneAnimation& a) {
   w.key("animation").begin_object(Layout::spaced);
   w.key("motion").string(animation_motion_name(a.motion));
@@ -810,6 +869,7 @@ Expected<std::string> write_scene_json(const Scene& scene, const std::string& ba
   write_vec3(w.key("sky"), scene.sky);
   write_ground(w, scene.ground);
   if (scene.fog) write_fog(w, *scene.fog);
+  if (scene.environment) write_environment(w, *scene.environment);
   if (scene.animation) write_animation(w, *scene.animation);
   if (!scene.materials.empty()) write_materials(w, scene.materials, base_dir);
   if (scene.skin != SkinStyle::smooth) w.key("skin").string(skin_style_name(scene.skin));

@@ -1,0 +1,56 @@
+// light_tracer.h — sylva's answer to the grammar's light queries (docs/spec/light.md,
+// core/scene/light_queries.h): sun and sky photons traced through the exact frusta and
+// polygon leaves of every plant, and the light they carry through each sensor sphere.
+//
+// The estimator (docs/light.md): photon i (of N) draws, from a stream keyed by
+// (environment.seed, step, i), whether it comes from the sun (with the sun's share of the
+// open-sky scalar irradiance, sky.h) and its direction ω toward the light — uniform over
+// the sun's disc, or in proportion to the sky's radiance over solid angle — and leaves a
+// disc of radius R perpendicular to ω, tangent to the bounding sphere (centre c, radius R)
+// of the plants and sensors, at a uniform point. Every direction's disc covers the whole
+// sphere, so with no obstacle the photons' track length through a sensor of radius r has
+// the mean N·(4/3)r³/R² whatever the sky; q is the track length the sensor receives over
+// that mean (a track-length estimate of scalar irradiance), its standard error from the
+// photons' spread, and its direction the track-weighted mean of ω.
+//
+// A photon's track ends at the ground plane and, for each sensor, at the first surface it
+// meets that does not cross the sensor's sphere (light.md: a sensor ignores the twig it
+// sits on and its own leaf). "Crosses" is decided conservatively: a frustum whose axis
+// segment passes within r + its larger radius of the centre, a leaf whose polygon passes
+// within r (exact point-triangle distance). Past a surface some sensor ignores, the
+// photon is traced on (at most kMaxLightHitsPerPhoton surfaces), from the far side of a
+// frustum's solid or just past a leaf.
+//
+// Sums are kept in fixed point (integers), so the answers do not depend on how photons
+// are split over threads: the same inputs give the same answers on any thread count.
+// Cost: O(N·(log P + cells crossed)) for P primitives; memory O(P + sensors·threads).
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "core/scene/light_queries.h"
+
+namespace sylva {
+
+inline constexpr int kMaxLightHitsPerPhoton = 64;
+
+class PhotonLightOracle final : public LightOracle {
+ public:
+  explicit PhotonLightOracle(unsigned threads = 0) : threads_(threads) {}
+  Expected<std::vector<LightAnswer>> answer(std::span<const Skeleton> plants, std::span<const glm::dvec3> sensors,
+                                            const Scene& scene, int64_t step,
+                                            LightAnswerStats* stats = nullptr) const override;
+
+ private:
+  unsigned threads_;
+};
+
+// The backward estimate of the same q (tests cross-check the photons with it): from each
+// sensor's centre, `rays` rays toward directions drawn as the photons draw theirs, each
+// counting 1 when it leaves the plants' bounding sphere without meeting a surface the
+// sensor does not ignore, nor the ground. Its std_error is the binomial one.
+Expected<std::vector<LightAnswer>> gather_light(std::span<const Skeleton> plants, std::span<const glm::dvec3> sensors,
+                                                const Scene& scene, int64_t step, uint64_t rays);
+
+}  // namespace sylva

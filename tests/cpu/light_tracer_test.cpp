@@ -1,0 +1,153 @@
+// Tests for core/cpu/light_tracer.h: the light a sensor sphere receives, against closed
+// forms (docs/spec/light.md "Accuracy and cost"): open sky, an opaque disc under a zenith
+// sun and under uniform and overcast skies, a sensor on its own twig, the photons
+// against the backward gather, and the same answers on any thread count.
+#include "core/cpu/light_tracer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/light/sky.h"
+#include "tests/support/test_scenes.h"
+
+namespace sylva {
+namespace {
+
+Scene light_scene(LightSky sky, const glm::dvec3& to_sun = {0, 1, 0}, uint64_t photons = 200'000, double r = 0.1) {
+  Scene s;
+  s.sun.direction = glm::normalize(to_sun);
+  s.sun.angular_radius_deg = 0.01;
+  s.ground.height = 0;
+  LightEnvironment e;
+  e.sky = sky;
+  e.photons = photons;
+  e.sensor_radius_m = r;
+  e.sun_fraction = 0.6;
+  s.environment = e;
+  return s;
+}
+
+// A horizontal opaque disc (a 64-gon leaf) of radius `a` at height y, centred on the y axis.
+Skeleton disc(double a, double y) {
+  Skeleton sk;
+  Leaf leaf;
+  for (int i = 0; i < 64; ++i) {
+    const double phi = 2 * std::numbers::pi * i / 64;
+    leaf.vertices_m.push_back({a * std::cos(phi), y, a * std::sin(phi)});
+  }
+  sk.leaves.push_back(leaf);
+  return sk;
+}
+
+TEST(LightSky, SamplesFollowTheirRadianceAndTheSunShareIsTheScalarOne) {
+  // Fraction of directions within 30° and 45° of the zenith (light.md, light-growth notes
+  // §4.2 give the horizontal ones; over solid angle UOC is 1 − μ0, SOC 1 − (μ0 + μ0²)/2).
+  for (SkyShape shape : {SkyShape::uniform, SkyShape::overcast}) {
+    const int n = 200000;
+    int within30 = 0;
+    for (int i = 0; i < n; ++i) within30 += sky_sample_mu(shape, (i + 0.5) / n) > std::cos(std::numbers::pi / 6);
+    const double mu0 = std::cos(std::numbers::pi / 6);
+    const double expected = shape == SkyShape::uniform ? 1 - mu0 : 1 - (mu0 + mu0 * mu0) / 2;
+    EXPECT_NEAR(within30 / double(n), expected, 1e-4);
+  }
+  EXPECT_DOUBLE_EQ(sun_scalar_share(1, 0.5, SkyShape::uniform), 1);
+  EXPECT_DOUBLE_EQ(sun_scalar_share(0.5, -0.1, SkyShape::uniform), 0);
+  // f = 0.5, μs = 0.5: sun 1, sky 0.5·2 = 1 → a half.
+  EXPECT_NEAR(sun_scalar_share(0.5, 0.5, SkyShape::uniform), 0.5, 1e-15);
+  // SOC: sky 0.5·12/7 → 1/(1 + 6/7) = 7/13.
+  EXPECT_NEAR(sun_scalar_share(0.5, 0.5, SkyShape::overcast), 7.0 / 13.0, 1e-15);
+}
+
+TEST(LightTracer, OpenSkyGivesOneEverywhereAboveTheGround) {
+  const std::vector<glm::dvec3> sensors = {{0, 1, 0}, {3, 2, -1}, {-2, 0.5, 4}, {1, 5, 1}};
+  for (LightSky sky : {LightSky::sun, LightSky::uniform, LightSky::overcast, LightSky::sun_overcast}) {
+    const Scene s = light_scene(sky, {0.3, 1, 0.2}, 200'000, 0.3);
+    LightAnswerStats stats;
+    auto a = PhotonLightOracle(2).answer({}, sensors, s, 0, &stats);
+    ASSERT_TRUE(a) << a.error().format();
+    for (const LightAnswer& x : *a) {
+      EXPECT_GT(x.std_error, 0);
+      EXPECT_NEAR(x.q, 1.0, 3 * x.std_error) << light_sky_name(sky);
+      EXPECT_GT(x.toward.y, 0);
+    }
+    EXPECT_EQ(stats.photons, 200'000u);
+  }
+  // The sun's photons come from the sun: the direction is the sun's.
+  auto a = PhotonLightOracle(2).answer({}, sensors, light_scene(LightSky::sun, {0.3, 1, 0.2}), 0);
+  ASSERT_TRUE(a);
+  EXPECT_NEAR(glm::dot((*a)[0].toward, glm::normalize(glm::dvec3(0.3, 1, 0.2))), 1, 1e-6);
+}
+
+TEST(LightTracer, AnOpaqueDiscShadesBelowItsCentreAndNotOutsideItsShadow) {
+  const std::vector<Skeleton> plants = {disc(1.0, 2.0)};
+  const std::vector<glm::dvec3> sensors = {{0, 1, 0}, {3, 1, 0}, {0, 3, 0}};
+  auto a = PhotonLightOracle(2).answer(plants, sensors, light_scene(LightSky::sun), 0);
+  ASSERT_TRUE(a) << a.error().format();
+  EXPECT_EQ((*a)[0].q, 0);
+  EXPECT_EQ((*a)[0].toward, glm::dvec3(0, 0, 0));
+  EXPECT_NEAR((*a)[1].q, 1, 3 * (*a)[1].std_error);
+  EXPECT_NEAR((*a)[2].q, 1, 3 * (*a)[2].std_error);
+}
+
+TEST(LightTracer, UnderADiscTheSkysClosedFormHoldsForPhotonsAndGather) {
+  // 1 m below a disc of radius 1 the disc hides the sky within 45° of the zenith: q is the
+  // rest of the sky's light over solid angle — UOC μ0 = 0.7071, SOC (μ0 + μ0²)/2 = 0.6036.
+  const std::vector<Skeleton> plants = {disc(1.0, 2.0)};
+  const std::vector<glm::dvec3> sensors = {{0, 1, 0}};
+  const double mu0 = 1 / std::sqrt(2.0);
+  for (LightSky sky : {LightSky::uniform, LightSky::overcast}) {
+    const double expected = sky == LightSky::uniform ? mu0 : (mu0 + mu0 * mu0) / 2;
+    const Scene s = light_scene(sky, {0, 1, 0}, 2'000'000, 0.05);
+    auto photons = PhotonLightOracle(2).answer(plants, sensors, s, 0);
+    auto gather = gather_light(plants, sensors, s, 0, 100'000);
+    ASSERT_TRUE(photons && gather);
+    const LightAnswer& p = (*photons)[0];
+    const LightAnswer& g = (*gather)[0];
+    // The sphere's own extent (r = 0.05 m) moves q by under 0.01.
+    EXPECT_NEAR(p.q, expected, 3 * p.std_error + 0.01) << light_sky_name(sky);
+    EXPECT_NEAR(g.q, expected, 3 * g.std_error) << light_sky_name(sky);
+    EXPECT_NEAR(p.q, g.q, 3 * std::hypot(p.std_error, g.std_error) + 0.01);
+    // The light comes from all around the disc: by symmetry its mean is straight up.
+    EXPECT_NEAR(p.toward.x, 0, 0.15);  // about 5 standard errors at ~2200 crossings
+    EXPECT_NEAR(p.toward.z, 0, 0.15);
+    EXPECT_NEAR(g.toward.y, 1, 0.01);
+  }
+}
+
+TEST(LightTracer, ASensorIgnoresTheTwigItSitsOnButNotAnother) {
+  // A vertical twig from y = 1 to 3 and a sensor on its side; a horizontal branch of
+  // radius 0.3 along x at y = 3.5, whose axis passes 0.5 m above a second sensor.
+  Skeleton sk = test::cylinder(0.05, 1, 3);
+  Skeleton other;
+  other.joints = {{{4, 3.5, 0}, 0.3, 0}, {{6, 3.5, 0}, 0.3, 0}};
+  other.chains = {{0, 2, std::nullopt}};
+  const std::vector<Skeleton> plants = {sk, other};
+  const std::vector<glm::dvec3> sensors = {{0.08, 2, 0}, {5, 3, 0}};
+  const Scene s = light_scene(LightSky::sun, {0.4, 1, 0}, 400'000, 0.1);
+  auto a = PhotonLightOracle(2).answer(plants, sensors, s, 0);
+  ASSERT_TRUE(a);
+  EXPECT_NEAR((*a)[0].q, 1, 3 * (*a)[0].std_error);
+  EXPECT_EQ((*a)[1].q, 0);  // the branch hides the sun's whole disc from the whole sphere
+}
+
+TEST(LightTracer, TheSameAnswersOnOneThreadAndOnTwo) {
+  const std::vector<Skeleton> plants = {disc(0.5, 2.0), test::cylinder(0.1, 0, 2)};
+  const std::vector<glm::dvec3> sensors = {{0.2, 1, 0}, {0.6, 1.5, 0.1}, {0, 2.5, 0}};
+  const Scene s = light_scene(LightSky::sun_overcast, {0.5, 1, 0.3}, 100'000);
+  auto one = PhotonLightOracle(1).answer(plants, sensors, s, 3);
+  auto two = PhotonLightOracle(2).answer(plants, sensors, s, 3);
+  ASSERT_TRUE(one && two);
+  for (size_t i = 0; i < sensors.size(); ++i) {
+    EXPECT_EQ((*one)[i].q, (*two)[i].q);
+    EXPECT_EQ((*one)[i].toward, (*two)[i].toward);
+  }
+  // Another step draws other photons.
+  auto next = PhotonLightOracle(2).answer(plants, sensors, s, 4);
+  ASSERT_TRUE(next);
+  EXPECT_NE((*next)[1].q, (*two)[1].q);
+}
+
+}  // namespace
+}  // namespace sylva
