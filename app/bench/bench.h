@@ -20,5 +20,7 @@ int run_bench_gpu(const std::vector<std::string>& args);
 int run_bench_fog(const std::vector<std::string>& args);
 // `sylva bench spp` (bench_spp.cpp).
 int run_bench_spp(const std::vector<std::string>& args);
+// `sylva bench light` (bench_light.cpp).
+int run_bench_light(const std::vector<std::string>& args);
 
 }  // namespace sylva::cli

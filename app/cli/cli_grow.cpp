@@ -9,6 +9,7 @@
 #include "app/front/batch.h"
 #include "app/cli/cli.h"
 #include "core/scene/scene.h"  // skeleton_bounds
+#include "core/scene/scene_json.h"
 #include "core/util/file_io.h"
 #include "core/grow/turtle.h"
 #include "core/grow/grow.h"
@@ -19,6 +20,9 @@ namespace sylva::cli {
 namespace {
 
 const char* const kGrammarFlags =
+    "      --scene FILE       grow in that scene's light beside its plants, at its origin\n"
+    "                         (a grammar with ?E light queries: docs/spec/light.md)\n"
+    "      --verbose          print what answering ?E cost (photons, time, noise)\n"
     "  -n, --steps N          derivation steps (overrides 'derivation length:')\n"
     "      --seed S           random seed, an integer from 0 to 2^64-1 (overrides 'seed:')\n"
     "  -D NAME=VALUE          override '#define NAME' (repeatable)\n"
@@ -27,7 +31,8 @@ const char* const kGrammarFlags =
     "  -h, --help             show this help\n";
 
 void print_derive_help() {
-  std::cout << "usage: sylva derive GRAMMAR [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n\n"
+  std::cout << "usage: sylva derive GRAMMAR [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n"
+               "                    [--scene FILE] [--verbose]\n\n"
                "Derives the grammar's word and prints it to stdout (modules without spaces,\n"
                "arguments in shortest round-trip decimal form).\n\n"
             << kGrammarFlags;
@@ -35,6 +40,7 @@ void print_derive_help() {
 
 void print_grow_help() {
   std::cout << "usage: sylva grow GRAMMAR [-n STEPS] [--seed S] [-D NAME=VALUE]... [--max-modules N]\n"
+               "                  [--scene FILE] [--verbose]\n"
                "                  -o FILE.skel.json\n\n"
                "Derives the grammar, interprets the word with the turtle and writes the skeleton\n"
                "(sylva-skeleton JSON) atomically; prints one summary line: modules, chains,\n"
@@ -47,6 +53,45 @@ void print_grow_help() {
             << kGrammarFlags;
 }
 
+// --scene and --verbose, taken out before the grammar flags are parsed.
+struct LightArgs {
+  std::string scene_path;
+  bool verbose = false;
+  std::optional<Scene> scene;
+};
+
+LightArgs take_light_args(std::vector<std::string>& args) {
+  LightArgs out;
+  FlagTable table;
+  table.leaves_others = true;
+  table.later_value_flags = grammar_value_flags();
+  table.flags = {text_flag({"--scene"}, out.scene_path), set_flag({"--verbose"}, out.verbose)};
+  args = parse_flags(args, table);
+  return out;
+}
+
+// Reads --scene; false (after printing the error) when it cannot be read.
+bool read_light_scene(LightArgs& l) {
+  if (l.scene_path.empty()) return true;
+  auto scene = read_scene_file(l.scene_path);
+  if (!scene) {
+    std::cerr << scene.error().format();
+    return false;
+  }
+  l.scene = std::move(*scene);
+  return true;
+}
+
+std::string light_summary(const LightGrowthStats& s) {
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "light: %llu answers, %llu queries, %llu photons, %.3f s (%.3f s CPU tracing), mean relative "
+                "standard error %.3g\n",
+                static_cast<unsigned long long>(s.answers), static_cast<unsigned long long>(s.queries),
+                static_cast<unsigned long long>(s.photons), s.seconds, s.cpu_seconds, s.mean_relative_error);
+  return line;
+}
+
 std::string format_number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.4g", v);
@@ -55,7 +100,9 @@ std::string format_number(double v) {
 
 }  // namespace
 
-int run_derive(const std::vector<std::string>& args) {
+int run_derive(const std::vector<std::string>& raw_args) {
+  std::vector<std::string> args = raw_args;
+  LightArgs light = take_light_args(args);
   GrammarArgs a = parse_grammar_args(args);
   if (a.help) {
     print_derive_help();
@@ -64,11 +111,15 @@ int run_derive(const std::vector<std::string>& args) {
   int code = kOk;
   auto g = load_grammar_for(a, &code);
   if (!g) return code;
-  auto word = derive_word(*g, derive_options_for(a), {&cpu_light_oracle()});
+  if (!read_light_scene(light)) return kInputError;
+  LightGrowthStats stats;
+  auto word = derive_word(*g, derive_options_for(a), {&cpu_light_oracle(), light.scene ? &*light.scene : nullptr},
+                          &stats);
   if (!word) {
     std::cerr << word.error().format();
     return kInputError;
   }
+  if (light.verbose) std::cerr << light_summary(stats);
   std::string text = lsys::print_word(*word, g->symbols);
   text += '\n';
   std::fwrite(text.data(), 1, text.size(), stdout);
@@ -84,11 +135,14 @@ struct GrowOutcome {
   std::optional<Diagnostic> error;   // printed on stderr (format())
   std::string warning;               // stderr text, may be empty
   std::string summary;               // the stdout summary line, without newline
+  std::string light;                 // --verbose: what the light cost (stderr, after the summary)
 };
 
-GrowOutcome grow_to_file(const lsys::Grammar& g, const GrammarArgs& a, const std::string& output) {
+GrowOutcome grow_to_file(const lsys::Grammar& g, const GrammarArgs& a, const std::string& output,
+                         const LightArgs& light) {
   GrowOutcome out;
-  auto result = grow(g, derive_options_for(a), a.grammar, a.defines, {&cpu_light_oracle()});
+  auto result = grow(g, derive_options_for(a), a.grammar, a.defines,
+                     {&cpu_light_oracle(), light.scene ? &*light.scene : nullptr});
   if (!result) {
     out.error = std::move(result.error());
     return out;
@@ -112,6 +166,7 @@ GrowOutcome grow_to_file(const lsys::Grammar& g, const GrammarArgs& a, const std
   if (!sk.leaves.empty()) line << ", " << sk.leaves.size() << (sk.leaves.size() == 1 ? " leaf" : " leaves");
   if (result->turtle.zero_length_moves) line << ", " << result->turtle.zero_length_moves << " zero-length moves";
   out.summary = line.str();
+  if (light.verbose) out.light = light_summary(result->light);
   return out;
 }
 
@@ -119,6 +174,7 @@ GrowOutcome grow_to_file(const lsys::Grammar& g, const GrammarArgs& a, const std
 
 int run_grow(const std::vector<std::string>& raw_args) {
   std::vector<std::string> args = raw_args;
+  LightArgs light = take_light_args(args);
   const std::optional<SeedRange> range = take_seed_range(args, grammar_value_flags());
   GrammarArgs a = parse_grammar_args(args, {.wants_output = true});
   if (a.help) {
@@ -132,6 +188,7 @@ int run_grow(const std::vector<std::string>& raw_args) {
   int code = kOk;
   auto g = load_grammar_for(a, &code);
   if (!g) return code;
+  if (!read_light_scene(light)) return kInputError;
   if (range) {
     if (Status folder = create_parent_folder(expand_seed_pattern(a.output, range->first)); !folder) {
       std::cerr << folder.error().format();
@@ -146,10 +203,10 @@ int run_grow(const std::vector<std::string>& raw_args) {
         r.error = std::move(output.error());
         return r;
       }
-      GrowOutcome o = grow_to_file(*g, one, *output);
+      GrowOutcome o = grow_to_file(*g, one, *output, light);
       r.error = o.error;
       r.summary = o.summary;
-      r.warning = o.warning;
+      r.warning = o.warning + o.light;
       return r;
     });
   }
@@ -159,13 +216,14 @@ int run_grow(const std::vector<std::string>& raw_args) {
     std::cerr << output.error().format();
     return kInputError;
   }
-  GrowOutcome o = grow_to_file(*g, a, *output);
+  GrowOutcome o = grow_to_file(*g, a, *output, light);
   std::cerr << o.warning;
   if (o.error) {
     std::cerr << o.error->format();
     return kInputError;
   }
-  std::cout << o.summary << "\n";
+  std::cout << o.summary << "\n" << std::flush;
+  std::cerr << o.light;
   return kOk;
 }
 

@@ -191,41 +191,57 @@ Diagnostic no_oracle(const lsys::Grammar& g) {
 
 }  // namespace
 
-Expected<lsys::Word> derive_word(const lsys::Grammar& g, const lsys::DeriveOptions& options, const GrowLight& light,
-                                 LightGrowthStats* stats, lsys::DeriveStats* derive_stats) {
-  if (!grammar_queries_light(g)) return lsys::derive(g, options, derive_stats);
-  if (!light.oracle) return no_oracle(g);
-  const Scene scene = light.scene ? *light.scene : default_light_scene();
-  const std::vector<Skeleton> fixed = grown_plants(scene);
-  std::vector<LightJob> jobs(1);
-  jobs[0].grammar = &g;
-  jobs[0].options = options;
-  if (auto f = derive_in_light(jobs, fixed, scene, *light.oracle, stats)) return f->error;
-  return jobs[0].derivation->finish(derive_stats);
-}
-
-Expected<GrowResult> grow(const lsys::Grammar& g, const lsys::DeriveOptions& options,
-                                const std::string& grammar_path, const std::map<std::string, double>& defines,
-                                const GrowLight& light) {
-  auto t0 = std::chrono::steady_clock::now();
-  GrowResult r;
-  // Shares of the whole for the progress bar: the derivation's last step usually
-  // dominates, the turtle reads every module once.
-  const double derive_end = !g.homomorphism.empty() ? 0.6 : 0.7;
-  lsys::DeriveOptions part = options;
-  part.progress = options.progress.part(0, derive_end);
-  Expected<lsys::Word> word = derive_word(g, part, light, &r.light, &r.derive);
-  if (!word) return word.error();
-  if (Status s = finish_growth(g, *word, options, grammar_path, defines, derive_end, r); !s) return s.error();
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return r;
-}
-
 namespace {
 
 // Whether a scene's grammar path names a grammar: `.lsys` (docs/spec/scene.md), a cpfg `.l`
 // or a vlab object (docs/cpfg.md).
 bool looks_like_grammar(const std::string& path) { return lsys::is_grammar_path(path); }
+
+// Plant i's grammar error `d` placed where the scene names the grammar (grow.h).
+Diagnostic plant_error(const Scene& scene, size_t i, Diagnostic d) {
+  if (d.cancelled) return d;
+  const ScenePlant& p = scene.plants[i];
+  const std::string named_by =
+      p.scatter ? "scatter[" + std::to_string(p.scatter - 1) + "]" : "plants[" + std::to_string(i) + "]";
+  // A file that is not a grammar (/etc/passwd, a picture): the error is the scene's key,
+  // and nothing of the file is quoted — not its line, not the parser's message, which
+  // may name a word of it (docs/limits.md "Inputs").
+  if (!looks_like_grammar(p.grammar)) {
+    Diagnostic top = diagnostic_at(
+        scene.file, p.grammar_loc,
+        named_by + ".grammar names '" + p.grammar + "', which is not a grammar (a .lsys file)" +
+            (d.loc.line ? ": its line " + std::to_string(d.loc.line) + " is not L-system text" : ": " + d.message));
+    top.error_number = d.error_number;
+    return top;
+  }
+  // No place in the grammar (it cannot be read, or the scene's defines name a define
+  // it lacks): what to change is the scene's key — the error there, the grammar's as a note.
+  if (d.loc.line == 0) {
+    std::string what = d.message;
+    if (what.starts_with("-D ")) what = "its defines name " + what.substr(3);  // "-D X: the grammar has no …"
+    Diagnostic top = diagnostic_at(scene.file, p.grammar_loc, named_by + ".grammar '" + p.grammar + "': " + what);
+    top.error_number = d.error_number;
+    d.notes.clear();
+    return std::move(top).with_note(std::move(d));
+  }
+  // An error in the grammar: the grammar's own diagnostic, and where the scene named it.
+  Diagnostic note = diagnostic_at(scene.file, p.grammar_loc, named_by + ".grammar names this grammar");
+  return std::move(d).with_note(std::move(note));
+}
+
+// The job that grows scene plant `p` in the light (its grammar `g`, its seed, steps, place).
+LightJob job_for_plant(const ScenePlant& p, const lsys::Grammar& g, uint64_t max_modules, const Progress& progress) {
+  LightJob job;
+  job.grammar = &g;
+  job.options.steps = p.steps;
+  job.options.seed = p.seed;
+  job.options.max_modules = max_modules;
+  job.options.progress = Progress(progress.cancel_flag());
+  job.placement.position = p.position;
+  job.placement.rotate_y_deg = p.rotate_y_deg;
+  job.placement.scale = p.scale;
+  return job;
+}
 
 // The plants first_plant names grown in lockstep in the scene's light (light.md), each
 // result in grown[r]; a plant whose grammar did not load is left unset (reported by the
@@ -244,16 +260,7 @@ void grow_recipes_in_light(const Scene& scene, const Grammars& grammars, const s
       grown[r] = no_oracle(*g);
       return;
     }
-    LightJob job;
-    job.grammar = &*g;
-    job.options.steps = p.steps;
-    job.options.seed = p.seed;
-    job.options.max_modules = max_modules;
-    job.options.progress = Progress(progress.cancel_flag());
-    job.placement.position = p.position;
-    job.placement.rotate_y_deg = p.rotate_y_deg;
-    job.placement.scale = p.scale;
-    jobs.push_back(std::move(job));
+    jobs.push_back(job_for_plant(p, *g, max_modules, progress));
     recipe_of_job.push_back(r);
   }
   if (jobs.empty()) return;
@@ -277,6 +284,51 @@ void grow_recipes_in_light(const Scene& scene, const Grammars& grammars, const s
 }
 
 }  // namespace
+
+Expected<lsys::Word> derive_word(const lsys::Grammar& g, const lsys::DeriveOptions& options, const GrowLight& light,
+                                 LightGrowthStats* stats, lsys::DeriveStats* derive_stats) {
+  if (!grammar_queries_light(g)) return lsys::derive(g, options, derive_stats);
+  if (!light.oracle) return no_oracle(g);
+  const Scene scene = light.scene ? *light.scene : default_light_scene();
+  const std::vector<Skeleton> fixed = grown_plants(scene);
+  std::vector<LightJob> jobs(1);
+  jobs[0].grammar = &g;
+  jobs[0].options = options;
+  // The scene's plants without skeletons grow beside it, in lockstep (light.md).
+  std::vector<size_t> plant_of_job = {SIZE_MAX};
+  std::vector<std::unique_ptr<const lsys::Grammar>> neighbours;
+  for (size_t i = 0; i < scene.plants.size(); ++i) {
+    const ScenePlant& p = scene.plants[i];
+    if (p.skeleton) continue;
+    lsys::ParseOptions parse;
+    parse.define_overrides = p.defines;
+    auto loaded = lsys::load_grammar(p.grammar, parse);
+    if (!loaded) return plant_error(scene, i, loaded.error());
+    neighbours.push_back(std::make_unique<const lsys::Grammar>(std::move(*loaded)));
+    jobs.push_back(job_for_plant(p, *neighbours.back(), options.max_modules, options.progress));
+    plant_of_job.push_back(i);
+  }
+  if (auto f = derive_in_light(jobs, fixed, scene, *light.oracle, stats))
+    return f->job == 0 ? f->error : plant_error(scene, plant_of_job[f->job], f->error);
+  return jobs[0].derivation->finish(derive_stats);
+}
+
+Expected<GrowResult> grow(const lsys::Grammar& g, const lsys::DeriveOptions& options,
+                                const std::string& grammar_path, const std::map<std::string, double>& defines,
+                                const GrowLight& light) {
+  auto t0 = std::chrono::steady_clock::now();
+  GrowResult r;
+  // Shares of the whole for the progress bar: the derivation's last step usually
+  // dominates, the turtle reads every module once.
+  const double derive_end = !g.homomorphism.empty() ? 0.6 : 0.7;
+  lsys::DeriveOptions part = options;
+  part.progress = options.progress.part(0, derive_end);
+  Expected<lsys::Word> word = derive_word(g, part, light, &r.light, &r.derive);
+  if (!word) return word.error();
+  if (Status s = finish_growth(g, *word, options, grammar_path, defines, derive_end, r); !s) return s.error();
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
 
 Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& progress, const LightOracle* light) {
   // Where the scene names plant i's grammar: its own entry or its scatter entry.
@@ -363,34 +415,7 @@ Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& pro
   for (size_t r = 0; r < first_plant.size(); ++r) {
     const size_t i = first_plant[r];
     const ScenePlant& p = scene.plants[i];
-    auto located = [&](Diagnostic d) {
-      if (d.cancelled) return d;
-      // A file that is not a grammar (/etc/passwd, a picture): the error is the scene's key,
-      // and nothing of the file is quoted — not its line, not the parser's message, which
-      // may name a word of it (docs/limits.md "Inputs").
-      if (!looks_like_grammar(p.grammar)) {
-        Diagnostic top = diagnostic_at(
-            scene.file, p.grammar_loc,
-            named_by(i) + ".grammar names '" + p.grammar + "', which is not a grammar (a .lsys file)" +
-                (d.loc.line ? ": its line " + std::to_string(d.loc.line) + " is not L-system text"
-                            : ": " + d.message));
-        top.error_number = d.error_number;
-        return top;
-      }
-      // No place in the grammar (it cannot be read, or the scene's defines name a define
-      // it lacks): what to change is the scene's key — the error there, the grammar's as a note.
-      if (d.loc.line == 0) {
-        std::string what = d.message;
-        if (what.starts_with("-D ")) what = "its defines name " + what.substr(3);  // "-D X: the grammar has no …"
-        Diagnostic top = diagnostic_at(scene.file, p.grammar_loc, named_by(i) + ".grammar '" + p.grammar + "': " + what);
-        top.error_number = d.error_number;
-        d.notes.clear();
-        return std::move(top).with_note(std::move(d));
-      }
-      // An error in the grammar: the grammar's own diagnostic, and where the scene named it.
-      Diagnostic note = diagnostic_at(scene.file, p.grammar_loc, named_by(i) + ".grammar names this grammar");
-      return std::move(d).with_note(std::move(note));
-    };
+    auto located = [&](Diagnostic d) { return plant_error(scene, i, std::move(d)); };
     const Expected<lsys::Grammar>& g = grammars.at(Source{p.grammar, p.defines});
     if (!g) return located(g.error());
     if (!grown[r]) return cancelled_diagnostic();

@@ -33,9 +33,11 @@ struct LightGrowthStats {
 // is an error; a grammar without queries never calls the oracle.
 struct GrowLight {
   const LightOracle* oracle = nullptr;
-  // The light's scene: its sun, ground and environment, and its plants that already have
-  // skeletons, which shade the growing plant. Null: the default scene's light (scene.md:
-  // the sun from (0.5, 1, 0.3)) over the ground y = 0, no other plant.
+  // The light's scene: its sun, ground and environment, and its plants: those with
+  // skeletons shade the growing plant, those without grow beside it in lockstep from their
+  // grammars (their errors placed at the scene's keys). The grammar grows at the scene's
+  // origin. Null: the default scene's light (scene.md: the sun from (0.5, 1, 0.3)) over
+  // the ground y = 0, no other plant.
   const Scene* scene = nullptr;
 };
 

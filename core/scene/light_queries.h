@@ -40,6 +40,7 @@ struct LightAnswerStats {
   uint64_t photons = 0;        // traced
   uint64_t sensors = 0;
   double seconds = 0;          // wall, the accelerators' build included
+  double build_seconds = 0;    // of seconds: skinning, accelerators, sensor grid, crossings
   double cpu_seconds = 0;      // CPU time of the process over the answer
   double mean_relative_error = 0;  // mean over sensors with q > 0 of std_error / q
 };

@@ -1,6 +1,6 @@
 // Tests for core/cpu/light_tracer.h: the light a sensor sphere receives, against closed
 // forms (docs/spec/light.md "Accuracy and cost"): open sky, an opaque disc under a zenith
-// sun and under uniform and overcast skies, a sensor on its own twig, the photons
+// sun and under uniform and overcast skies, Beer–Lambert under slabs of random leaves, a sensor on its own twig, the photons
 // against the backward gather, and the same answers on any thread count.
 #include "core/cpu/light_tracer.h"
 
@@ -10,35 +10,14 @@
 #include <numbers>
 
 #include "core/light/sky.h"
+#include "core/scene/light_cases.h"
 #include "tests/support/test_scenes.h"
 
 namespace sylva {
 namespace {
 
 Scene light_scene(LightSky sky, const glm::dvec3& to_sun = {0, 1, 0}, uint64_t photons = 200'000, double r = 0.1) {
-  Scene s;
-  s.sun.direction = glm::normalize(to_sun);
-  s.sun.angular_radius_deg = 0.01;
-  s.ground.height = 0;
-  LightEnvironment e;
-  e.sky = sky;
-  e.photons = photons;
-  e.sensor_radius_m = r;
-  e.sun_fraction = 0.6;
-  s.environment = e;
-  return s;
-}
-
-// A horizontal opaque disc (a 64-gon leaf) of radius `a` at height y, centred on the y axis.
-Skeleton disc(double a, double y) {
-  Skeleton sk;
-  Leaf leaf;
-  for (int i = 0; i < 64; ++i) {
-    const double phi = 2 * std::numbers::pi * i / 64;
-    leaf.vertices_m.push_back({a * std::cos(phi), y, a * std::sin(phi)});
-  }
-  sk.leaves.push_back(leaf);
-  return sk;
+  return light_check_scene(sky, to_sun, 0.01, photons, r);
 }
 
 TEST(LightSky, SamplesFollowTheirRadianceAndTheSunShareIsTheScalarOne) {
@@ -81,7 +60,7 @@ TEST(LightTracer, OpenSkyGivesOneEverywhereAboveTheGround) {
 }
 
 TEST(LightTracer, AnOpaqueDiscShadesBelowItsCentreAndNotOutsideItsShadow) {
-  const std::vector<Skeleton> plants = {disc(1.0, 2.0)};
+  const std::vector<Skeleton> plants = {light_disc(1.0, 2.0)};
   const std::vector<glm::dvec3> sensors = {{0, 1, 0}, {3, 1, 0}, {0, 3, 0}};
   auto a = PhotonLightOracle(2).answer(plants, sensors, light_scene(LightSky::sun), 0);
   ASSERT_TRUE(a) << a.error().format();
@@ -94,11 +73,10 @@ TEST(LightTracer, AnOpaqueDiscShadesBelowItsCentreAndNotOutsideItsShadow) {
 TEST(LightTracer, UnderADiscTheSkysClosedFormHoldsForPhotonsAndGather) {
   // 1 m below a disc of radius 1 the disc hides the sky within 45° of the zenith: q is the
   // rest of the sky's light over solid angle — UOC μ0 = 0.7071, SOC (μ0 + μ0²)/2 = 0.6036.
-  const std::vector<Skeleton> plants = {disc(1.0, 2.0)};
+  const std::vector<Skeleton> plants = {light_disc(1.0, 2.0)};
   const std::vector<glm::dvec3> sensors = {{0, 1, 0}};
-  const double mu0 = 1 / std::sqrt(2.0);
   for (LightSky sky : {LightSky::uniform, LightSky::overcast}) {
-    const double expected = sky == LightSky::uniform ? mu0 : (mu0 + mu0 * mu0) / 2;
+    const double expected = under_disc_q(1, 1, sky == LightSky::overcast);
     const Scene s = light_scene(sky, {0, 1, 0}, 2'000'000, 0.05);
     auto photons = PhotonLightOracle(2).answer(plants, sensors, s, 0);
     auto gather = gather_light(plants, sensors, s, 0, 100'000);
@@ -114,6 +92,31 @@ TEST(LightTracer, UnderADiscTheSkysClosedFormHoldsForPhotonsAndGather) {
     EXPECT_NEAR(p.toward.z, 0, 0.15);
     EXPECT_NEAR(g.toward.y, 1, 0.01);
   }
+}
+
+TEST(LightTracer, UnderASlabOfRandomLeavesBeerLambertHolds) {
+  // light.md: q = exp(−0.5 L / cos θ) — 0.6065 and 0.3679 at θ = 0, 0.5614 and 0.3152 at
+  // θ = 30° for L = 1 and 2. Sensors (r = 0.5 m) on a 5 × 5 grid 0.5 m below the slab's
+  // middle; their mean, within three standard errors of the spread between sensors (the
+  // leaves' randomness and the photons' together).
+  std::vector<glm::dvec3> sensors;
+  for (int i = -2; i <= 2; ++i)
+    for (int k = -2; k <= 2; ++k) sensors.push_back({1.2 * i, 0.5, 1.2 * k});
+  for (double lai : {1.0, 2.0})
+    for (double theta_deg : {0.0, 30.0}) {
+      const double theta = theta_deg * std::numbers::pi / 180;
+      const std::vector<Skeleton> plants = {leaf_slab(lai, 7 + static_cast<uint64_t>(lai))};
+      const Scene s = light_scene(LightSky::sun, {std::sin(theta), std::cos(theta), 0}, 1'000'000, 0.5);
+      auto a = PhotonLightOracle(2).answer(plants, sensors, s, 0);
+      ASSERT_TRUE(a);
+      double sum = 0, sum2 = 0;
+      for (const LightAnswer& x : *a) sum += x.q, sum2 += x.q * x.q;
+      const double n = static_cast<double>(sensors.size());
+      const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / (n - 1));
+      const double expected = beer_lambert_q(lai, theta);
+      EXPECT_NEAR(mean, expected, 3 * se) << "LAI " << lai << ", sun at " << theta_deg << "°, se " << se;
+      EXPECT_LT(se, 0.03);
+    }
 }
 
 TEST(LightTracer, ASensorIgnoresTheTwigItSitsOnButNotAnother) {
@@ -133,7 +136,7 @@ TEST(LightTracer, ASensorIgnoresTheTwigItSitsOnButNotAnother) {
 }
 
 TEST(LightTracer, TheSameAnswersOnOneThreadAndOnTwo) {
-  const std::vector<Skeleton> plants = {disc(0.5, 2.0), test::cylinder(0.1, 0, 2)};
+  const std::vector<Skeleton> plants = {light_disc(0.5, 2.0), test::cylinder(0.1, 0, 2)};
   const std::vector<glm::dvec3> sensors = {{0.2, 1, 0}, {0.6, 1.5, 0.1}, {0, 2.5, 0}};
   const Scene s = light_scene(LightSky::sun_overcast, {0.5, 1, 0.3}, 100'000);
   auto one = PhotonLightOracle(1).answer(plants, sensors, s, 3);
