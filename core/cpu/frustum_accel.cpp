@@ -2,6 +2,7 @@
 #include "core/cpu/frustum_accel.h"
 
 #include "core/cpu/embree_scene.h"
+#include "core/util/parallel.h"
 
 
 #include <atomic>
@@ -110,19 +111,25 @@ FrustumAccel::FrustumAccel(std::span<const Frustum> frusta, CustomFrusta custom)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   // Centre and a padding that covers float rounding of rays far across the scene.
-  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
   const bool has_custom = !custom.shell_m.empty() && custom.intersector;
   if (has_custom && custom.shell_m.size() != frusta.size())
     throw std::invalid_argument("FrustumAccel: custom.shell_m must have one entry per frustum");
-  for (size_t i = 0; i < frusta.size(); ++i) {
-    FrustumShape shape = frusta[i].shape;
-    if (has_custom && custom.shell_m[i] > 0) shape.radius0 += custom.shell_m[i], shape.radius1 += custom.shell_m[i];
-    const Aabb b = frustum_bounds(shape);
-    lo = glm::min(lo, b.lo);
-    hi = glm::max(hi, b.hi);
-  }
+  // The bounds and each frustum's reach, in chunks on every core (min and max are exact
+  // in any order, so the result does not depend on the split).
+  constexpr size_t kChunk = 4096;
+  const size_t chunks = (frusta.size() + kChunk - 1) / kChunk;
+  std::vector<Aabb> chunk_box(chunks, empty_box());
   m.reach.resize(frusta.size());
-  for (size_t i = 0; i < frusta.size(); ++i) m.reach[i] = frustum_radial_reach(frusta[i].shape);
+  parallel_for(chunks, 0, nullptr, [&](size_t c, unsigned) {
+    for (size_t i = c * kChunk; i < std::min(frusta.size(), (c + 1) * kChunk); ++i) {
+      FrustumShape shape = frusta[i].shape;
+      if (has_custom && custom.shell_m[i] > 0) shape.radius0 += custom.shell_m[i], shape.radius1 += custom.shell_m[i];
+      grow(chunk_box[c], frustum_bounds(shape));
+      m.reach[i] = frustum_radial_reach(frusta[i].shape);
+    }
+  });
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+  for (const Aabb& b : chunk_box) lo = glm::min(lo, b.lo), hi = glm::max(hi, b.hi);
   m.data.frusta = frusta.data();
   m.data.reach = m.reach.data();
   m.data.custom_shell = has_custom ? custom.shell_m.data() : nullptr;

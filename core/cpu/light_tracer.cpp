@@ -8,6 +8,8 @@
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <span>
+#include <utility>
 
 #include <glm/geometric.hpp>
 
@@ -58,8 +60,12 @@ std::unique_ptr<LightScene> build_light_scene(std::span<const Skeleton> plants) 
   }
   for (uint32_t& b : s->leaf_base) b += static_cast<uint32_t>(s->frusta.size());
   s->primitives = static_cast<uint32_t>(s->frusta.size() + leaf_count);
+  s->boxes.resize(s->frusta.size());
+  parallel_for((s->frusta.size() + 4095) / 4096, 0, nullptr, [&](size_t c, unsigned) {
+    for (size_t i = c * 4096; i < std::min(s->frusta.size(), (c + 1) * 4096); ++i)
+      s->boxes[i] = frustum_bounds(s->frusta[i].shape);
+  });
   s->boxes.reserve(s->primitives);
-  for (const Frustum& f : s->frusta) s->boxes.push_back(frustum_bounds(f.shape));
   for (const Skeleton& plant : plants)
     for (const Leaf& leaf : plant.leaves) {
       Aabb box = empty_box();
@@ -185,6 +191,62 @@ SensorGrid build_sensor_grid(std::span<const dvec3> sensors, double r) {
   return g;
 }
 
+// The sensors as one batch's parallel photons see them: their centres projected on the
+// plane perpendicular to the batch's direction (coordinates along the frame's e0, e1
+// about the emitter's centre), in a uniform 2D grid of about one sensor per cell, each
+// sensor listed in every cell its disc of radius r overlaps. A photon's cell then holds
+// every sensor it can cross. Rebuilt in place for each batch (its buffers kept).
+struct DirectionMap {
+  double lo[2] = {0, 0};
+  double h = 1;
+  int n[2] = {1, 1};
+  std::vector<uint32_t> start, items;
+  std::vector<glm::dvec2> uv;
+
+  std::span<const uint32_t> at(double u, double v) const {
+    const double x = std::floor((u - lo[0]) / h), y = std::floor((v - lo[1]) / h);
+    if (!(x >= 0 && y >= 0 && x < n[0] && y < n[1])) return {};
+    const size_t c = static_cast<size_t>(y) * static_cast<size_t>(n[0]) + static_cast<size_t>(x);
+    return std::span<const uint32_t>(items).subspan(start[c], start[c + 1] - start[c]);
+  }
+
+  void build(std::span<const dvec3> sensors, const dvec3& centre, const AxisFrame& frame, double reach) {
+    uv.resize(sensors.size());
+    double a[2] = {kInf, kInf}, b[2] = {-kInf, -kInf};
+    for (size_t s = 0; s < sensors.size(); ++s) {
+      const dvec3 o = sensors[s] - centre;
+      uv[s] = {glm::dot(o, frame.e0), glm::dot(o, frame.e1)};
+      for (int k = 0; k < 2; ++k) a[k] = std::min(a[k], uv[s][k] - reach), b[k] = std::max(b[k], uv[s][k] + reach);
+    }
+    const double area = std::max((b[0] - a[0]) * (b[1] - a[1]), 1e-30);
+    h = std::max(reach, std::sqrt(area / static_cast<double>(sensors.size())));
+    for (int k = 0; k < 2; ++k) {
+      lo[k] = a[k];
+      n[k] = std::clamp(static_cast<int>(std::ceil((b[k] - a[k]) / h)), 1, 4096);
+    }
+    h = std::max({h, (b[0] - a[0]) / n[0], (b[1] - a[1]) / n[1]});
+    const size_t cells = static_cast<size_t>(n[0]) * static_cast<size_t>(n[1]);
+    start.assign(cells + 1, 0);
+    auto for_cells = [&](const glm::dvec2& p, auto&& f) {
+      const int x0 = std::clamp(static_cast<int>(std::floor((p.x - reach - lo[0]) / h)), 0, n[0] - 1);
+      const int x1 = std::clamp(static_cast<int>(std::floor((p.x + reach - lo[0]) / h)), 0, n[0] - 1);
+      const int y0 = std::clamp(static_cast<int>(std::floor((p.y - reach - lo[1]) / h)), 0, n[1] - 1);
+      const int y1 = std::clamp(static_cast<int>(std::floor((p.y + reach - lo[1]) / h)), 0, n[1] - 1);
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) f(static_cast<size_t>(y) * static_cast<size_t>(n[0]) + static_cast<size_t>(x));
+    };
+    for (const glm::dvec2& p : uv) for_cells(p, [&](size_t c) { ++start[c + 1]; });
+    for (size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+    items.resize(start[cells]);
+    std::vector<uint32_t>& fill = scratch;
+    fill.assign(start.begin(), start.end() - 1);
+    for (uint32_t s = 0; s < uv.size(); ++s) for_cells(uv[s], [&](size_t c) { items[fill[c]++] = s; });
+  }
+
+ private:
+  std::vector<uint32_t> scratch;
+};
+
 // Per sensor, the primitives that cross its sphere (sorted), as CSR.
 struct Ignored {
   std::vector<uint32_t> start;
@@ -197,21 +259,34 @@ struct Ignored {
 Ignored crossing_primitives(const LightScene& s, std::span<const Skeleton> plants, std::span<const dvec3> sensors,
                             const SensorGrid& grid, double r) {
   std::vector<std::vector<uint32_t>> per(sensors.size());
+  // The frusta in chunks on every core, each chunk's (sensor, frustum) pairs kept apart and
+  // appended in chunk order: the lists come out the same for any thread count.
+  constexpr size_t kFrustumChunk = 8192;
+  const size_t chunks = (s.frusta.size() + kFrustumChunk - 1) / kFrustumChunk;
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> pairs(chunks);
+  const unsigned workers = worker_count(0);
+  std::vector<std::vector<uint32_t>> stamps(workers);
+  parallel_for(chunks, workers, nullptr, [&](size_t chunk, unsigned worker) {
+    std::vector<uint32_t>& stamp = stamps[worker];
+    if (stamp.empty()) stamp.assign(sensors.size(), UINT32_MAX);
+    for (uint32_t f = static_cast<uint32_t>(chunk * kFrustumChunk);
+         f < std::min(s.frusta.size(), (chunk + 1) * kFrustumChunk); ++f) {
+      const FrustumShape& sh = s.frusta[f].shape;
+      const dvec3 a = sh.base, b = sh.base + sh.length * sh.axis;
+      const double reach = r + std::max(sh.radius0, sh.radius1);
+      grid.for_cells_in(glm::min(a, b) - dvec3(reach), glm::max(a, b) + dvec3(reach), [&](size_t c) {
+        for (uint32_t k = grid.start[c]; k < grid.start[c + 1]; ++k) {
+          const uint32_t sensor = grid.items[k];
+          if (stamp[sensor] == f) continue;
+          stamp[sensor] = f;
+          if (point_segment_distance(sensors[sensor], a, b) <= reach) pairs[chunk].push_back({sensor, f});
+        }
+      });
+    }
+  });
+  for (const auto& chunk : pairs)
+    for (const auto& [sensor, f] : chunk) per[sensor].push_back(f);
   std::vector<uint32_t> stamp(sensors.size(), UINT32_MAX);
-  for (uint32_t f = 0; f < s.frusta.size(); ++f) {
-    const FrustumShape& sh = s.frusta[f].shape;
-    const dvec3 a = sh.base, b = sh.base + sh.length * sh.axis;
-    const double reach = r + std::max(sh.radius0, sh.radius1);
-    grid.for_cells_in(glm::min(a, b) - dvec3(reach), glm::max(a, b) + dvec3(reach), [&](size_t c) {
-      for (uint32_t k = grid.start[c]; k < grid.start[c + 1]; ++k) {
-        const uint32_t sensor = grid.items[k];
-        if (stamp[sensor] == f) continue;
-        stamp[sensor] = f;
-        if (point_segment_distance(sensors[sensor], a, b) <= reach) per[sensor].push_back(f);
-      }
-    });
-  }
-  std::fill(stamp.begin(), stamp.end(), UINT32_MAX);
   for (uint32_t p = 0; p < plants.size(); ++p)
     for (uint32_t l = 0; l < plants[p].leaves.size(); ++l) {
       const auto& v = plants[p].leaves[l].vertices_m;
@@ -336,43 +411,58 @@ Expected<std::vector<LightAnswer>> PhotonLightOracle::answer(std::span<const Ske
   const double big_r = 0.5 * glm::length(box.hi - box.lo) * (1 + 1e-9) + 1e-9;
   const SensorGrid grid = build_sensor_grid(sensors, r);
   const Ignored ignored = crossing_primitives(*geometry, plants, sensors, grid, r);
+  const double build_seconds = seconds_since(wall0);
   const double ground = scene.ground.height;
   const double unit = static_cast<double>(1 << 24) / (2 * r);  // fixed-point units per metre
-  const double build_seconds = seconds_since(wall0);
   const unsigned workers = worker_count(threads_);
   std::vector<Accumulator> acc;
   acc.reserve(workers);
   for (unsigned w = 0; w < workers; ++w) acc.emplace_back(sensors.size());
   const uint64_t n = src.sun_share > 0 || env.sky != LightSky::sun ? env.photons : 0;
   const uint64_t stream = mix_pair(mix_pair(env.seed, 0x6c69676874ULL), static_cast<uint64_t>(step));
-  const uint64_t chunks = (n + kChunk - 1) / kChunk;
-  parallel_for(chunks, workers, nullptr, [&](size_t chunk, unsigned worker) {
+  // The directions: K batches of parallel photons (see the header comment), K_sun of them
+  // from the sun's disc (K·s rounded by a uniform draw: unbiased), the rest from the sky;
+  // each set spread by the R2 sequence from a random start.
+  const uint64_t batches = n == 0 ? 0 : std::clamp<uint64_t>(std::llround(std::sqrt(static_cast<double>(n)) / 4), 1, 4096);
+  Rng split(mix_pair(stream, 0x73706c6974ULL));
+  const uint64_t sun_batches = std::min<uint64_t>(
+      batches, static_cast<uint64_t>(std::floor(static_cast<double>(batches) * src.sun_share + split.next_double())));
+  const uint64_t r2_offset0 = split.next_u64(), r2_offset1 = split.next_u64();
+  auto batch_toward = [&](uint64_t b) {
+    const bool sun = b < sun_batches;
+    const uint64_t k = sun ? b : b - sun_batches;
+    const double u = unit_from_fixed(r2_offset0 + k * kR2Step0), v = unit_from_fixed(r2_offset1 + k * kR2Step1);
+    if (!sun) return sky_sample_direction(src.shape, u, v);
+    const double one_minus_cos = u * src.one_minus_cos_alpha;
+    const double sin_t = std::sqrt(std::max(0.0, one_minus_cos * (2 - one_minus_cos)));
+    const double phi = 2 * std::numbers::pi * v;
+    return glm::normalize((1 - one_minus_cos) * src.to_sun +
+                          sin_t * (std::cos(phi) * src.sun_frame.e0 + std::sin(phi) * src.sun_frame.e1));
+  };
+  std::vector<DirectionMap> maps(workers);
+  parallel_for(batches, workers, nullptr, [&](size_t b, unsigned worker) {
     Accumulator& a = acc[worker];
+    DirectionMap& map = maps[worker];
+    const dvec3 toward = batch_toward(b);
+    const AxisFrame f = axis_frame(toward);
+    map.build(sensors, centre, f, r);
     std::vector<PrimitiveHit> hits;
-    const uint64_t end = std::min<uint64_t>(n, (chunk + 1) * kChunk);
-    for (uint64_t i = chunk * kChunk; i < end; ++i) {
+    const uint64_t first = b * (n / batches) + std::min<uint64_t>(b, n % batches);
+    const uint64_t count = n / batches + (b < n % batches ? 1 : 0);
+    for (uint64_t i = first; i < first + count; ++i) {
       Rng rng(mix_pair(stream, i));
-      bool from_sun = false;
-      const dvec3 toward = photon_toward(src, rng, &from_sun);
-      const AxisFrame f = axis_frame(toward);
+      // A uniform point of the disc of radius R perpendicular to the batch's direction.
       const double rad = big_r * std::sqrt(rng.next_double()), phi = 2 * std::numbers::pi * rng.next_double();
+      const double pu = rad * std::cos(phi), pv = rad * std::sin(phi);
+      const std::span<const uint32_t> near = map.at(pu, pv);
+      if (near.empty()) continue;
       Ray ray;
-      ray.origin = centre + big_r * toward + rad * (std::cos(phi) * f.e0 + std::sin(phi) * f.e1);
+      ray.origin = centre + big_r * toward + pu * f.e0 + pv * f.e1;
       ray.direction = -toward;
       // The track ends at the ground (light from below the horizon never arrives).
       double t_end = 2 * big_r;
       if (ray.direction.y < 0) t_end = std::min(t_end, (ground - ray.origin.y) / ray.direction.y);
       if (!(t_end > 0)) continue;
-      // The ray through the grid's box (slabs).
-      double t0 = 0, t1 = t_end;
-      const dvec3 grid_hi = grid.lo + grid.h * dvec3(grid.n[0], grid.n[1], grid.n[2]);
-      for (int k = 0; k < 3 && t0 <= t1; ++k) {
-        const double inv = 1 / ray.direction[k];
-        double ta = (grid.lo[k] - ray.origin[k]) * inv, tb = (grid_hi[k] - ray.origin[k]) * inv;
-        if (ta > tb) std::swap(ta, tb);
-        t0 = std::max(t0, ta), t1 = std::min(t1, tb);
-      }
-      if (!(t0 <= t1)) continue;
       hits.clear();
       auto hit = [&](size_t k) -> const PrimitiveHit& {
         while (hits.size() <= k) {
@@ -382,74 +472,28 @@ Expected<std::vector<LightAnswer>> PhotonLightOracle::answer(std::span<const Ske
         }
         return hits[k];
       };
-      // Past the first surface the photon meets, only sensors that ignore it can still
-      // receive it, and they lie within 2r of its box: once that hit is known, the walk
-      // ends where the ray leaves the grown box.
-      bool cut = false;
-      auto cut_walk = [&]() {
-        cut = true;
-        const PrimitiveHit& first = hits[0];
-        if (!(first.t < t1)) return;
-        const Aabb& b = geometry->boxes[first.primitive];
-        double exit = t1;
-        for (int k = 0; k < 3; ++k) {
-          if (ray.direction[k] == 0) continue;
-          const double inv = 1 / ray.direction[k];
-          const double ta = (b.lo[k] - 2 * r - ray.origin[k]) * inv, tb = (b.hi[k] + 2 * r - ray.origin[k]) * inv;
-          exit = std::min(exit, std::max(ta, tb));
-        }
-        t1 = std::max(t0, exit);
-      };
-      const uint64_t mark = i + 1;
-      // 3D DDA (Amanatides and Woo 1987) over the cells the ray crosses in [t0, t1].
-      const dvec3 p0 = ray.origin + t0 * ray.direction;
-      int c[3], stepc[3];
-      double t_next[3], t_delta[3];
-      for (int k = 0; k < 3; ++k) {
-        c[k] = std::clamp(static_cast<int>(std::floor((p0[k] - grid.lo[k]) / grid.h)), 0, grid.n[k] - 1);
-        const double d = ray.direction[k];
-        stepc[k] = d > 0 ? 1 : -1;
-        if (d == 0) {
-          t_next[k] = kInf, t_delta[k] = kInf;
-        } else {
-          const double edge = grid.lo[k] + grid.h * (c[k] + (d > 0 ? 1 : 0));
-          t_next[k] = (edge - ray.origin[k]) / d;
-          t_delta[k] = grid.h / std::abs(d);
-        }
-      }
-      for (;;) {
-        const size_t cell = grid.cell(c[0], c[1], c[2]);
-        for (uint32_t k = grid.start[cell]; k < grid.start[cell + 1]; ++k) {
-          const uint32_t s = grid.items[k];
-          if (a.stamp[s] == mark) continue;
-          a.stamp[s] = mark;
-          double lo_t, hi_t;
-          if (!sphere_chord(ray, sensors[s], r, &lo_t, &hi_t)) continue;
-          lo_t = std::max(lo_t, 0.0), hi_t = std::min(hi_t, t_end);
-          if (!(hi_t > lo_t)) continue;
-          // The first surface this sensor does not ignore.
-          double stop = hi_t;
-          for (size_t j = 0; j < static_cast<size_t>(kMaxLightHitsPerPhoton); ++j) {
-            const PrimitiveHit& h = hit(j);
-            if (h.t >= hi_t) break;
-            if (!ignored.contains(s, h.primitive)) {
-              stop = h.t;
-              break;
-            }
-            if (j + 1 == static_cast<size_t>(kMaxLightHitsPerPhoton)) stop = h.t;  // give up: treat as blocked
+      for (const uint32_t s : near) {
+        // The track in sensor s: from where the photon enters the sphere to where it leaves
+        // it or meets the first surface s does not ignore.
+        double lo_t, hi_t;
+        if (!sphere_chord(ray, sensors[s], r, &lo_t, &hi_t)) continue;
+        lo_t = std::max(lo_t, 0.0), hi_t = std::min(hi_t, t_end);
+        if (!(hi_t > lo_t)) continue;
+        double stop = hi_t;
+        for (size_t j = 0; j < static_cast<size_t>(kMaxLightHitsPerPhoton); ++j) {
+          const PrimitiveHit& h = hit(j);
+          if (h.t >= hi_t) break;
+          if (!ignored.contains(s, h.primitive)) {
+            stop = h.t;
+            break;
           }
-          if (!(stop > lo_t)) continue;
-          const int64_t q = std::llround((stop - lo_t) * unit);
-          a.track[s] += q;
-          a.square[s] += static_cast<Int128>(q) * q;
-          for (int d = 0; d < 3; ++d) a.dir[3 * s + d] += std::llround(static_cast<double>(q) * toward[d]);
+          if (j + 1 == static_cast<size_t>(kMaxLightHitsPerPhoton)) stop = h.t;  // give up: treat as blocked
         }
-        if (!cut && !hits.empty()) cut_walk();
-        int axis = t_next[0] < t_next[1] ? (t_next[0] < t_next[2] ? 0 : 2) : (t_next[1] < t_next[2] ? 1 : 2);
-        if (t_next[axis] > t1) break;
-        c[axis] += stepc[axis];
-        if (c[axis] < 0 || c[axis] >= grid.n[axis]) break;
-        t_next[axis] += t_delta[axis];
+        if (!(stop > lo_t)) continue;
+        const int64_t q = std::llround((stop - lo_t) * unit);
+        a.track[s] += q;
+        a.square[s] += static_cast<Int128>(q) * q;
+        for (int d = 0; d < 3; ++d) a.dir[3 * s + d] += std::llround(static_cast<double>(q) * toward[d]);
       }
     }
   });

@@ -2,16 +2,21 @@
 // core/scene/light_queries.h): sun and sky photons traced through the exact frusta and
 // polygon leaves of every plant, and the light they carry through each sensor sphere.
 //
-// The estimator (docs/light.md): photon i (of N) draws, from a stream keyed by
-// (environment.seed, step, i), whether it comes from the sun (with the sun's share of the
-// open-sky scalar irradiance, sky.h) and its direction ω toward the light — uniform over
-// the sun's disc, or in proportion to the sky's radiance over solid angle — and leaves a
-// disc of radius R perpendicular to ω, tangent to the bounding sphere (centre c, radius R)
-// of the plants and sensors, at a uniform point. Every direction's disc covers the whole
-// sphere, so with no obstacle the photons' track length through a sensor of radius r has
-// the mean N·(4/3)r³/R² whatever the sky; q is the track length the sensor receives over
-// that mean (a track-length estimate of scalar irradiance), its standard error from the
-// photons' spread, and its direction the track-weighted mean of ω.
+// The estimator (docs/light.md): N photons in K = clamp(√N/4, 1, 4096) batches of
+// parallel photons. A batch's direction ω toward the light is drawn, from a stream keyed
+// by (environment.seed, step), from the sun's disc (uniform) for K_sun = ⌊K·s + u⌋ batches
+// — s the sun's share of the open-sky scalar irradiance (sky.h), u uniform: unbiased — and
+// from the sky (in proportion to its radiance over solid angle) for the rest, each set
+// spread by the R2 sequence. Photon i of a batch leaves a uniform point of the disc of
+// radius R perpendicular to ω, tangent to the bounding sphere (centre c, radius R) of the
+// plants and sensors. Every direction's disc covers the whole sphere, so with no obstacle
+// the photons' track length through a sensor of radius r has the mean N·(4/3)r³/R²
+// whatever the sky; q is the track length the sensor receives over that mean (a
+// track-length estimate of scalar irradiance), its standard error from the photons'
+// spread (as if independent: the shared directions of a batch make it an
+// over-estimate where directions are stratified), and its direction the track-weighted
+// mean of ω. Parallel photons make the search exact and cheap: each batch projects the
+// sensors onto its disc in a 2D grid, and a photon tests only the sensors of its cell.
 //
 // A photon's track ends at the ground plane and, for each sensor, at the first surface it
 // meets that does not cross the sensor's sphere (light.md: a sensor ignores the twig it
@@ -23,7 +28,8 @@
 //
 // Sums are kept in fixed point (integers), so the answers do not depend on how photons
 // are split over threads: the same inputs give the same answers on any thread count.
-// Cost: O(N·(log P + cells crossed)) for P primitives; memory O(P + sensors·threads).
+// Cost: O(N·(sensors per cell + log P per photon that crosses one) + K·sensors) for P
+// primitives; memory O(P + sensors·threads).
 #pragma once
 
 #include <span>

@@ -35,12 +35,6 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr uint64_t kChunk = 1u << 15;  // photons per work item (cancellation granularity)
 
-// R2 (Roberts 2018): x_i = frac(offset + i·(1/g, 1/g²)), g the plastic number, in 64-bit
-// fixed point so that photon 10⁹ is as exact as photon 1.
-constexpr uint64_t kR2Step0 = 0xC13FA9A902A6328FULL;  // 2^64 / g
-constexpr uint64_t kR2Step1 = 0x91E10DA5C79E7B1CULL;  // 2^64 / g²
-
-double unit_from_fixed(uint64_t x) { return static_cast<double>(x >> 11) * 0x1.0p-53; }
 
 // sin and cos of x for |x| <= π/4, by their Taylor series to x¹⁵ and x¹⁶: the first terms
 // left out are below 6e-17·|x| and 2e-18 there, so both are within an ulp or two of libm's and

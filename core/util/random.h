@@ -26,6 +26,13 @@ constexpr uint64_t mix_pair(uint64_t a, uint64_t b) {
   return mix64(a ^ mix64(b + 0x9e3779b97f4a7c15ULL));
 }
 
+// R2 (Roberts 2018): x_i = frac(offset + i·(1/g, 1/g²)), g the plastic number, in 64-bit
+// fixed point so that point 10⁹ is as exact as point 1; unit_from_fixed maps a coordinate
+// to [0, 1) with 53 bits.
+constexpr uint64_t kR2Step0 = 0xC13FA9A902A6328FULL;  // 2^64 / g
+constexpr uint64_t kR2Step1 = 0x91E10DA5C79E7B1CULL;  // 2^64 / g²
+constexpr double unit_from_fixed(uint64_t x) { return static_cast<double>(x >> 11) * 0x1.0p-53; }
+
 class Rng {
  public:
   explicit Rng(uint64_t state = 0) : state_(state) {}
