@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "app/front/light.h"
+#include "core/scene/scene_json.h"
 #include "app/python/sylva_python.h"
 #include "core/util/file_io.h"
 #include "core/io/gltf.h"
@@ -228,10 +229,29 @@ lsys::DeriveOptions derive_options(const py::object& steps, const py::object& se
   return options;
 }
 
-Skeleton grammar_grow(const PyGrammar& self, const py::object& steps, const py::object& seed,
-                      const py::object& defines_object, uint64_t max_modules) {
+// The scene a grammar grows in (light.md): None, or the path of a .scene.json whose
+// plants grow beside it in its light. Raises what render() raises for a bad scene.
+std::optional<Scene> light_scene_from_python(const py::object& scene) {
+  if (scene.is_none()) return std::nullopt;
+  if (!py::isinstance<py::str>(scene) && !py::hasattr(scene, "__fspath__"))
+    throw py::type_error("scene must be None or the path of a .scene.json scene, got " +
+                         std::string(py::str(py::type::handle_of(scene).attr("__name__"))));
+  const std::string path = path_string(scene.cast<std::filesystem::path>());
+  Expected<Scene> read = read_scene_file(path);
+  if (!read) {
+    if (read.error().error_number != 0 || read.error().loc.line == 0) throw_file_error(read.error());
+    throw py::value_error(chomp(read.error().format()));
+  }
+  return std::move(*read);
+}
+
+// Grows as `sylva grow [--scene FILE]` does: the GIL released, interruptible, the
+// interpretation-depth warning raised as a RuntimeWarning.
+GrowResult grow_for_python(const PyGrammar& self, const py::object& steps, const py::object& seed,
+                           const py::object& defines_object, uint64_t max_modules, const py::object& scene_object) {
   lsys::DeriveOptions options = derive_options(steps, seed, max_modules);
   const std::map<std::string, double> defines = defines_from_python(defines_object);
+  const std::optional<Scene> scene = light_scene_from_python(scene_object);
   PythonInterrupt interrupt;
   options.progress = interrupt.progress();
   std::optional<sylva::Diagnostic> failure;
@@ -242,7 +262,7 @@ Skeleton grammar_grow(const PyGrammar& self, const py::object& steps, const py::
     py::gil_scoped_release release;
     try {
       std::shared_ptr<const lsys::Grammar> grammar = self.with_defines(defines);
-      auto grown = grow(*grammar, options, self.file, defines, {&cpu_light_oracle()});
+      auto grown = grow(*grammar, options, self.file, defines, {&cpu_light_oracle(), scene ? &*scene : nullptr});
       if (grown) {
         still_expandable = grown->interpret.still_expandable;
         max_depth = grammar->max_depth;
@@ -262,13 +282,34 @@ Skeleton grammar_grow(const PyGrammar& self, const py::object& steps, const py::
                                 " modules still expandable";
     if (PyErr_WarnEx(PyExc_RuntimeWarning, message.c_str(), 1) != 0) throw py::error_already_set();
   }
-  return std::move(result->skeleton);
+  return std::move(*result);
+}
+
+Skeleton grammar_grow(const PyGrammar& self, const py::object& steps, const py::object& seed,
+                      const py::object& defines_object, uint64_t max_modules, const py::object& scene) {
+  return std::move(grow_for_python(self, steps, seed, defines_object, max_modules, scene).skeleton);
+}
+
+// The skeleton and the light queries of the grown word: an (n, 7) float64 array of
+// [x, y, z, q, dx, dy, dz] per ?E in word order (see the docstring).
+py::tuple grammar_grow_with_queries(const PyGrammar& self, const py::object& steps, const py::object& seed,
+                                    const py::object& defines_object, uint64_t max_modules, const py::object& scene) {
+  GrowResult r = grow_for_python(self, steps, seed, defines_object, max_modules, scene);
+  py::array_t<double> queries({static_cast<py::ssize_t>(r.queries.size()), py::ssize_t{7}});
+  auto q = queries.mutable_unchecked<2>();
+  for (size_t i = 0; i < r.queries.size(); ++i) {
+    const GrowQuery& g = r.queries[i];
+    const double row[7] = {g.position.x, g.position.y, g.position.z, g.q, g.toward.x, g.toward.y, g.toward.z};
+    for (py::ssize_t k = 0; k < 7; ++k) q(static_cast<py::ssize_t>(i), k) = row[k];
+  }
+  return py::make_tuple(py::cast(std::move(r.skeleton)), queries);
 }
 
 std::string grammar_derive(const PyGrammar& self, const py::object& steps, const py::object& seed,
-                           const py::object& defines_object, uint64_t max_modules) {
+                           const py::object& defines_object, uint64_t max_modules, const py::object& scene_object) {
   lsys::DeriveOptions options = derive_options(steps, seed, max_modules);
   const std::map<std::string, double> defines = defines_from_python(defines_object);
+  const std::optional<Scene> scene = light_scene_from_python(scene_object);
   PythonInterrupt interrupt;
   options.progress = interrupt.progress();
   std::optional<sylva::Diagnostic> failure;
@@ -277,7 +318,7 @@ std::string grammar_derive(const PyGrammar& self, const py::object& steps, const
     py::gil_scoped_release release;
     try {
       std::shared_ptr<const lsys::Grammar> grammar = self.with_defines(defines);
-      auto word = derive_word(*grammar, options, {&cpu_light_oracle()});
+      auto word = derive_word(*grammar, options, {&cpu_light_oracle(), scene ? &*scene : nullptr});
       if (word)
         text = lsys::print_word(*word, grammar->symbols);
       else
@@ -740,8 +781,8 @@ Make one with Grammar.grow(), Skeleton.from_file() or Skeleton.from_json().)doc"
     py::options signatures;
     signatures.disable_function_signatures();
     grammar_class.def("grow", &grammar_grow, py::kw_only(), "steps"_a = py::none(), "seed"_a = py::none(),
-           "defines"_a = py::none(), "max_modules"_a = uint64_t{50'000'000},
-           R"doc(grow(self, *, steps: int | None = None, seed: int | None = None, defines: dict[str, float] | None = None, max_modules: int = 50000000) -> sylva.Skeleton
+           "defines"_a = py::none(), "max_modules"_a = uint64_t{50'000'000}, "scene"_a = py::none(),
+           R"doc(grow(self, *, steps: int | None = None, seed: int | None = None, defines: dict[str, float] | None = None, max_modules: int = 50000000, scene: str | os.PathLike | None = None) -> sylva.Skeleton
 
 Derives the grammar and builds its skeleton with the turtle (what `sylva grow` does).
 
@@ -751,12 +792,25 @@ Keyword-only:
   defines      {name: number} overriding #defines; a name the grammar lacks is a
                GrammarError (line and column None)
   max_modules  stop with GrammarError if a word would exceed this many modules
+  scene        a .scene.json: a grammar with light queries (?E) grows at its origin in its
+               light and environment, beside its plants (`sylva grow --scene`); None: the
+               default sun over the ground y = 0 (docs/spec/light.md)
 Returns a Skeleton whose JSON equals `sylva grow` output byte for byte. The GIL is
 released while growing. A RuntimeWarning reports an interpretation cut at max depth.)doc");
+    grammar_class.def("grow_with_queries", &grammar_grow_with_queries, py::kw_only(), "steps"_a = py::none(),
+           "seed"_a = py::none(), "defines"_a = py::none(), "max_modules"_a = uint64_t{50'000'000},
+           "scene"_a = py::none(),
+           R"doc(grow_with_queries(self, *, steps=None, seed=None, defines=None, max_modules=50000000, scene=None) -> tuple[sylva.Skeleton, numpy.ndarray]
+
+grow() and the light queries of the grown word: an (n, 7) float64 array, one row per
+?E module in word order, [x, y, z, q, dx, dy, dz] — where the turtle stood at the query
+(metres, the plant's frame), its last answer q (0..1, the light reaching a small sphere
+there over the open sky's) and the unit direction the light came from (zeros for ?E(q)
+and where no light arrived). A grammar without ?E gives an empty (0, 7) array.)doc");
     grammar_class.def("derive", &grammar_derive, py::kw_only(), "steps"_a = py::none(), "seed"_a = py::none(),
-           "defines"_a = py::none(), "max_modules"_a = uint64_t{50'000'000},
+           "defines"_a = py::none(), "max_modules"_a = uint64_t{50'000'000}, "scene"_a = py::none(),
            "derive(self, *, steps: int | None = None, seed: int | None = None, defines: dict[str, float] | None = None, "
-           "max_modules: int = 50000000) -> str\n\n"
+           "max_modules: int = 50000000, scene: str | os.PathLike | None = None) -> str\n\n"
            "Derives the grammar's word and returns it as `sylva derive` prints it (without the\n"
            "final newline). Same keyword-only knobs as grow(); the GIL is released.");
   }

@@ -47,9 +47,24 @@ Status finish_growth(const lsys::Grammar& g, const lsys::Word& word, const lsys:
     if (!interpreted) return interpreted.error();
     turtle_word = &*interpreted;
   }
-  auto sk = build_skeleton(*turtle_word, g, &r.turtle, options.progress.part(interpret_end, 1));
+  std::vector<glm::dvec3> positions;
+  const bool queries = grammar_queries_light(g);
+  auto sk = build_skeleton(*turtle_word, g, &r.turtle, options.progress.part(interpret_end, 1),
+                           queries ? &positions : nullptr);
   if (!sk) return sk.error();
   r.skeleton = std::move(*sk);
+  if (queries) {
+    // The answers sit in the derived word's ?E modules, in the order the turtle met them.
+    for (const lsys::Module& m : word.modules) {
+      if (m.symbol != lsys::kSymLightQuery || r.queries.size() >= positions.size()) continue;
+      const double* p = word.params_of(m);
+      GrowQuery gq;
+      gq.position = positions[r.queries.size()];
+      gq.q = p[0];
+      if (m.param_count == 4) gq.toward = {p[1], p[2], p[3]};
+      r.queries.push_back(gq);
+    }
+  }
   r.skeleton.source.grammar = grammar_path;
   r.skeleton.source.seed = options.seed.value_or(g.seed);
   r.skeleton.source.steps = options.steps.value_or(g.steps);

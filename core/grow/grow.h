@@ -45,6 +45,13 @@ struct GrowLight {
 // query: only then does growing it trace light.
 bool grammar_queries_light(const lsys::Grammar& grammar);
 
+// A light query of the grown word and its last answer (light.md), in the plant's frame.
+struct GrowQuery {
+  glm::dvec3 position{0, 0, 0};  // where the turtle stood at the ?E, metres
+  double q = 0;                  // its first parameter: the last answer (or the grammar's value)
+  glm::dvec3 toward{0, 0, 0};    // its direction parameters ((0, 0, 0) for ?E(q))
+};
+
 // Everything `sylva grow` does: derive, interpret, build the skeleton, record the source.
 struct GrowResult {
   Skeleton skeleton;
@@ -53,6 +60,7 @@ struct GrowResult {
   lsys::InterpretStats interpret;
   TurtleStats turtle;
   LightGrowthStats light;  // zero without light queries
+  std::vector<GrowQuery> queries;  // the word's ?E modules in word order (none without)
   double seconds = 0;    // total
 };
 

@@ -116,6 +116,10 @@ TEST(LightGrowth, TheSkeletonGrowsWhereTheAnswersLetIt) {
   EXPECT_EQ(grown->skeleton.segment_count(), 3u);  // stopped at 3 m
   EXPECT_EQ(grown->light.answers, 9u);
   EXPECT_EQ(grown->light.queries, 9u);
+  // The last answer and where it was asked: the apex at 3 m, q = 0.3.
+  ASSERT_EQ(grown->queries.size(), 1u);
+  EXPECT_EQ(grown->queries[0].position, glm::dvec3(0, 3, 0));
+  EXPECT_DOUBLE_EQ(grown->queries[0].q, 0.3);
 }
 
 TEST(LightGrowth, AScenesPlantsAreAnsweredTogether) {
