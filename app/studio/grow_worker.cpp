@@ -23,11 +23,14 @@ struct GrowWorker::Cache {
   std::map<std::string, double> defines;
   std::optional<uint64_t> seed;
   uint64_t max_modules = 0;
+  Scene light;  // the words of a grammar with ?E depend on it
   std::shared_ptr<const lsys::Grammar> grammar;
   std::vector<std::optional<lsys::Word>> words;  // by step; nullopt: not kept (budget)
   bool matches(const GrowRequest& r) const {
     return grammar && text == r.text && file == r.file && defines == r.plants[0].defines &&
-           seed == r.plants[0].seed && max_modules == r.max_modules;
+           seed == r.plants[0].seed && max_modules == r.max_modules &&
+           (!grammar_queries_light(*grammar) || (light.sun == r.light.sun && light.ground == r.light.ground &&
+                                                  light.environment == r.light.environment));
   }
 };
 
@@ -166,6 +169,7 @@ GrowOutcome GrowWorker::grow(const GrowRequest& request, uint64_t gen, bool* can
     cache.defines = first.defines;
     cache.seed = first.seed;
     cache.max_modules = request.max_modules;
+    cache.light = request.light;
   }
   const lsys::Grammar& g = *cache.grammar;
   out.defines = g.defines;
@@ -201,7 +205,7 @@ GrowOutcome GrowWorker::grow(const GrowRequest& request, uint64_t gen, bool* can
       }
       return true;
     };
-    auto result = derive_word(g, options, {&cpu_light_oracle()});
+    auto result = derive_word(g, options, {&cpu_light_oracle(), &request.light}, &out.light);
     options.on_step = nullptr;
     if (stale(gen)) {
       cache.grammar.reset();  // the cache may be incomplete: derive again next time
@@ -254,7 +258,7 @@ GrowOutcome GrowWorker::grow(const GrowRequest& request, uint64_t gen, bool* can
     o.steps = v.steps;
     o.max_modules = request.max_modules;
     o.on_step = [&](int64_t, const lsys::Word&) { return !stale(gen); };
-    auto w = derive_word(*parsed, o, {&cpu_light_oracle()});
+    auto w = derive_word(*parsed, o, {&cpu_light_oracle(), &request.light});
     if (stale(gen)) return *cancelled = true, out;
     if (!w) return fail(w.error());
     auto sk = build(*parsed, *w);

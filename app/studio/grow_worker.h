@@ -51,6 +51,9 @@ struct GrowRequest {
   std::optional<int64_t> show_step;  // plants[0]: show this step's word, clamped to its
                                      // steps; unset: the last step
   uint64_t max_modules = 50'000'000;
+  // The light a grammar with ?E queries grows in (docs/spec/light.md): the scene's sun,
+  // ground and environment (its plants are not read). A grammar without queries ignores it.
+  Scene light;
 };
 
 struct GrowOutcome {
@@ -69,6 +72,7 @@ struct GrowOutcome {
   uint64_t leaves = 0;               // leaves (polygons) of all skeletons
   bool from_cache = false;           // plants[0]'s word came from the step cache
   std::string warning;               // e.g. interpretation stopped at maximum depth
+  LightGrowthStats light;            // what answering plants[0]'s ?E cost (zero without)
   double worker_seconds = 0;         // parse + derive + build, on the worker
   std::chrono::steady_clock::time_point submitted;  // when submit() was called
 };

@@ -311,6 +311,10 @@ void StudioApp::submit_regrow() {
     r.plants.push_back(std::move(v));
   }
   if (r.plants.empty()) return;
+  // The light ?E queries are answered in: the scene's sun, ground and environment.
+  r.light.sun = scene_.sun;
+  r.light.ground = scene_.ground;
+  r.light.environment = scene_.environment;
   latency_start_ = Clock::now();
   worker_->submit(std::move(r));
 }
@@ -599,6 +603,7 @@ void StudioApp::frame(double now) {
     draw_derivation();
     draw_view();
     draw_fog();
+    draw_light();
     ImGui::EndChild();
     keep("panels");
   }
@@ -1015,6 +1020,60 @@ void StudioApp::draw_fog() {
   keep("fog:photons");
   if (ImGui::Button("remove fog")) scene_.fog.reset();
   keep("fog:remove");
+}
+
+// docs/spec/light.md's environment, live: a grammar with ?E queries grows in the scene's sun
+// and this light; every change regrows it (a grammar without queries traces nothing, and
+// its plant is not regrown for the light).
+void StudioApp::draw_light() {
+  const bool open = ImGui::CollapsingHeader("Light (?E)");
+  keep("header:light");
+  if (!open) return;
+  LightEnvironment e = scene_.environment.value_or(LightEnvironment{});
+  const LightEnvironment before = e;
+  ImGui::SetNextItemWidth(130);
+  if (ImGui::BeginCombo("sky", light_sky_name(e.sky))) {
+    for (LightSky sky : {LightSky::sun, LightSky::uniform, LightSky::overcast, LightSky::sun_uniform,
+                         LightSky::sun_overcast})
+      if (ImGui::Selectable(light_sky_name(sky), sky == e.sky)) e.sky = sky;
+    ImGui::EndCombo();
+  }
+  keep("light:sky");
+  if (e.sky == LightSky::sun_uniform || e.sky == LightSky::sun_overcast) {
+    ImGui::SameLine();
+    float f = static_cast<float>(e.sun_fraction);
+    ImGui::SetNextItemWidth(120);
+    if (ImGui::SliderFloat("sun fraction", &f, 0, 1, "%.2f")) e.sun_fraction = f;
+    keep("light:sun_fraction");
+  }
+  uint64_t photons = e.photons;
+  const uint64_t photons_min = 1000, photons_max = 10'000'000;
+  ImGui::SetNextItemWidth(150);
+  ImGui::SliderScalar("photons##light", ImGuiDataType_U64, &photons, &photons_min, &photons_max, "%llu",
+                      ImGuiSliderFlags_Logarithmic);
+  e.photons = std::max<uint64_t>(1, photons);
+  keep("light:photons");
+  ImGui::SameLine();
+  float radius = static_cast<float>(e.sensor_radius_m);
+  ImGui::SetNextItemWidth(120);
+  if (ImGui::SliderFloat("sensor", &radius, 0.01f, 1, "%.2f m", ImGuiSliderFlags_Logarithmic))
+    e.sensor_radius_m = std::max(radius, 1e-3f);
+  keep("light:sensor_radius");
+  int every = static_cast<int>(e.every);
+  ImGui::SetNextItemWidth(90);
+  if (ImGui::SliderInt("every", &every, 1, 10, "%d steps")) e.every = static_cast<uint32_t>(std::clamp(every, 1, 10));
+  keep("light:every");
+  if (!(e == before)) {
+    scene_.environment = e;
+    submit_regrow();
+  }
+  if (plant_ && plant_->light.answers > 0)
+    ImGui::Text("%llu answers, %llu queries, %.2f s (%.2f s CPU tracing), noise %.1f%%",
+                static_cast<unsigned long long>(plant_->light.answers),
+                static_cast<unsigned long long>(plant_->light.queries), plant_->light.seconds,
+                plant_->light.cpu_seconds, 100 * plant_->light.mean_relative_error);
+  else
+    ImGui::TextDisabled("the grammar asks no ?E: no light is traced while it grows");
 }
 
 void StudioApp::draw_view() {

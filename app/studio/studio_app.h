@@ -169,6 +169,7 @@ class StudioApp {
   float message_bar_height(float width) const;  // the bar below the editor, wrapped to `width`
   void draw_view();
   void draw_fog();
+  void draw_light();
   void update_cones();  // the fog's cones for the plants and sun on screen (cone_worker.h)
   void draw_presets();
   void draw_modals();
