@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <glm/vec3.hpp>
 #include <cstdio>
 #include <limits>
 #include <string>
@@ -13,6 +15,7 @@
 
 #include "app/front/light.h"
 #include "core/grow/grow.h"
+#include "core/scene/scene_json.h"
 
 namespace sylva {
 namespace {
@@ -75,6 +78,47 @@ TEST(LightCompetition, ACrownLeansAwayFromItsNeighbourAndAStandShedsItsLowerBran
               "stand middle: %zu leaves, lowest %.2f m\n",
               a.leaves, a.lowest_leaf, a.centroid_x, left.leaves, right.leaves, left.centroid_x, right.centroid_x,
               middle.leaves, middle.lowest_leaf);
+}
+
+// presets/scenes/sapling_gap.scene.json: under a canopy with one gap (centred at x = 2.25,
+// z = 0, 4 m up) the sapling's tip moves toward the gap; in the open it grows straight up.
+TEST(LightSapling, UnderACanopyItGrowsTowardTheGap) {
+  auto read = read_scene_file(std::string(SYLVA_SOURCE_DIR) + "/presets/scenes/sapling_gap.scene.json");
+  ASSERT_TRUE(read) << read.error().format();
+  Scene open = *read;
+  open.plants.erase(open.plants.begin());  // the sapling alone, in the same sky
+  for (Scene* s : {&*read, &open}) {
+    Status grown = grow_scene_plants(*s, 1'000'000, {}, &cpu_light_oracle());
+    ASSERT_TRUE(grown) << grown.error().format();
+  }
+  auto tip = [](const Scene& s) {
+    const Joint& j = s.plants.back().skeleton->joints.back();
+    return glm::dvec3(j.position_m[0], j.position_m[1], j.position_m[2]);
+  };
+  const glm::dvec3 under = tip(*read), alone = tip(open);
+  std::printf("sapling tip under the gap (%.2f, %.2f, %.2f), in the open (%.2f, %.2f, %.2f)\n", under.x, under.y,
+              under.z, alone.x, alone.y, alone.z);
+  EXPECT_GT(under.x, 0.6) << "toward the gap";
+  EXPECT_LT(std::abs(under.z), 0.3);
+  EXPECT_LT(std::hypot(alone.x, alone.z), 0.3) << "the open overcast sky is the same all around";
+}
+
+// presets/light/self_organizing.lsys: the light alone shapes the crown. Grown 12 steps in
+// the default sun: every step answered, apices that fall below VMIN stop (so it grows
+// fewer internodes than the 2^12 - 1 of a tree whose every apex grows), leaves fall in shade.
+TEST(LightSelfOrganizing, TheLightAloneStopsApicesAndShedsLeaves) {
+  auto g = lsys::load_grammar(std::string(SYLVA_SOURCE_DIR) + "/presets/light/self_organizing.lsys");
+  ASSERT_TRUE(g) << g.error().format();
+  lsys::DeriveOptions o;
+  o.steps = 12;
+  auto grown = grow(*g, o, "self_organizing.lsys", {}, {&cpu_light_oracle()});
+  ASSERT_TRUE(grown) << grown.error().format();
+  EXPECT_EQ(grown->light.answers, 13u);
+  const uint64_t internodes = grown->skeleton.segment_count();
+  EXPECT_GT(internodes, 200u);
+  EXPECT_LT(internodes, 4095u) << "some apices stopped in shade";
+  EXPECT_LT(grown->skeleton.leaves.size(), internodes) << "one leaf per internode, less those that fell";
+  for (const GrowQuery& q : grown->queries) EXPECT_TRUE(q.q >= 0 && q.q <= 1);
 }
 
 }  // namespace
