@@ -119,6 +119,27 @@ TEST(LightTracer, UnderASlabOfRandomLeavesBeerLambertHolds) {
     }
 }
 
+TEST(LightTracer, OneFrustumInterceptsTheSunsIrradianceTimesItsProjectedArea) {
+  // A horizontal cylinder of radius a = 5 cm along x, from x = -1.5 to 1.5 m, 1.5 m above
+  // the centre of a sensor of radius R = 1 m, under a zenith sun: it takes out of the
+  // sensor exactly the light its projected area E·A⊥ intercepts, the strip |z| < a of the
+  // beam, whose track through the sphere is ∫ π(R² − z²) dz over |z| < a. So
+  // q = 1 − (2πR²a − 2πa³/3) / (4πR³/3) = 1 − 3a/(2R) + a³/(2R³) = 0.9250625.
+  Skeleton bar;
+  bar.joints = {{{-1.5, 1.5, 0}, 0.05, 0}, {{1.5, 1.5, 0}, 0.05, 0}};
+  bar.chains = {{0, 2, std::nullopt}};
+  const std::vector<Skeleton> plants = {bar};
+  const std::vector<glm::dvec3> sensors = {{0, 0, 0}};
+  Scene s = light_scene(LightSky::sun, {0, 1, 0}, 4'000'000, 1.0);
+  s.ground.height = -10;
+  s.sun.angular_radius_deg = 0;
+  auto a = PhotonLightOracle(2).answer(plants, sensors, s, 0);
+  ASSERT_TRUE(a);
+  const double expected = 1 - 3 * 0.05 / 2 + std::pow(0.05, 3) / 2;
+  EXPECT_NEAR((*a)[0].q, expected, 3 * (*a)[0].std_error) << "std error " << (*a)[0].std_error;
+  EXPECT_LT((*a)[0].std_error, 0.002);
+}
+
 TEST(LightTracer, ASensorIgnoresTheTwigItSitsOnButNotAnother) {
   // A vertical twig from y = 1 to 3 and a sensor on its side; a horizontal branch of
   // radius 0.3 along x at y = 3.5, whose axis passes 0.5 m above a second sensor.
