@@ -167,7 +167,7 @@ struct SensorGrid {
   }
 };
 
-constexpr double kCellScale = 0.5;  // cells per sensor spacing, measured: bench light --cost
+constexpr double kCellScale = 0.5;  // cell side per sensor spacing (the grid only finds crossings now)
 
 SensorGrid build_sensor_grid(std::span<const dvec3> sensors, double r) {
   SensorGrid g;
