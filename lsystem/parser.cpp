@@ -662,11 +662,17 @@ void Parser::check_brackets(const std::vector<ParsedModule>& ms, const char* wha
 }
 
 // The modules whose parameter count is part of their meaning (light.md): a light query
-// has 1 or 4 parameters, a tropism vector 3.
+// has 1 or 4 parameters, a turtle query 2 or 3, a tropism vector 3.
 void Parser::check_builtin_arity(const ParsedModule& m) {
   if (m.symbol == kSymLightQuery && m.args.size() != 1 && m.args.size() != 4)
     fail(m.loc, "?E takes 1 parameter, ?E(q), or 4, ?E(q, x, y, z), not " + std::to_string(m.args.size()) +
                     " (light.md)");
+  if (is_turtle_query(m.symbol) && m.args.size() != 2 && m.args.size() != 3)
+    fail(m.loc, std::string(m.symbol == kSymQueryPosition ? "?P" : m.symbol == kSymQueryHeading ? "?H"
+                            : m.symbol == kSymQueryLeft   ? "?L"
+                                                          : "?U") +
+                    " takes 2 parameters, (x, y), or 3, (x, y, z), not " + std::to_string(m.args.size()) +
+                    " (CPFG manual 6.9)");
   if (m.symbol == kSymTropismVector && m.args.size() != 3)
     fail(m.loc, "@Tp takes 3 parameters, @Tp(x, y, z), not " + std::to_string(m.args.size()));
 }

@@ -9,7 +9,7 @@ namespace sylva::lsys {
 
 namespace {
 constexpr const char* kBuiltinNames[kBuiltinSymbolCount] = {
-    "F", "f", "+", "-", "&", "^", "\\", "/", "|", "$", "[", "]", "!", "'", "%", "@T", "@Tp", "?E"};
+    "F", "f", "+", "-", "&", "^", "\\", "/", "|", "$", "[", "]", "!", "'", "%", "@T", "@Tp", "?E", "?P", "?H", "?L", "?U"};
 
 // Bytes in the UTF-8 sequence that starts with `lead` (1 for anything malformed; the
 // parser validates UTF-8 before tokenising).
@@ -27,7 +27,7 @@ SymbolTable::SymbolTable() {
   for (const char* name : kBuiltinNames) intern(name);
   declare_multichar("@T");
   declare_multichar("@Tp");
-  declare_multichar("?E");
+  for (const char* query : {"?E", "?P", "?H", "?L", "?U"}) declare_multichar(query);
 }
 
 SymbolId SymbolTable::intern(std::string_view name, bool* ok) {

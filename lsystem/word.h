@@ -37,8 +37,15 @@ enum BuiltinSymbol : SymbolId {
   kSymTropism,      // @T
   kSymTropismVector,// @Tp  set the tropism vector (light.md)
   kSymLightQuery,   // ?E   a light query, answered after every step (light.md)
+  kSymQueryPosition,// ?P   the turtle's position, filled after every step (CPFG manual 6.9)
+  kSymQueryHeading, // ?H   its heading
+  kSymQueryLeft,    // ?L   its left vector
+  kSymQueryUp,      // ?U   its up vector
   kBuiltinSymbolCount
 };
+
+// ?P, ?H, ?L or ?U: a query the turtle answers (CPFG manual 6.9).
+inline bool is_turtle_query(SymbolId s) { return s >= kSymQueryPosition && s <= kSymQueryUp; }
 
 // Work done by the symbol table's multi-character name lookups on this thread: one unit
 // per byte walked in the name trie. Exposed so tests can assert that declaring, tokenising

@@ -28,6 +28,7 @@
 #include "core/cpu/render_cpu.h"
 #include "app/front/render.h"
 #include "core/gl/render_gl.h"
+#include "core/grow/grow.h"
 #include "core/scene/scene.h"
 #include "core/util/clock.h"
 
@@ -130,7 +131,9 @@ void print_render_help() {
          "                         moves its plants as its animation key says (frame k at k/fps\n"
          "                         seconds), a grammar grows: frame k is k derivation steps\n"
          "                         (all: 0 to its derivation length), seen by the last frame's\n"
-         "                         camera. Each frame is written atomically as it finishes\n"
+         "                         camera; so does a scene without an animation key, every\n"
+         "                         plant that grows from a grammar in lockstep, in the scene's\n"
+         "                         light. Each frame is written atomically as it finishes\n"
          "      --fps F            frames per second of the video (and of a scene's time):\n"
          "                         default the scene's animation fps, 4 for a grammar\n"
          "      --video VIDEO      also encode the PNG frames into VIDEO (.mp4, .mkv, .webm,\n"
@@ -369,15 +372,17 @@ std::string seconds_text(double s) {
 // the GL backend the renderer is made once and every later frame re-skins and re-uploads
 // only the segment records (GlRenderer::update_plants) — with fog, whose photons and cones
 // depend on where the plants are, every frame is rendered whole. A grammar grows: frame k
-// is k derivation steps, each a new renderer sharing the context's programs.
+// is k derivation steps, each a new renderer sharing the context's programs; so does a
+// scene without an animation key whose plants grow from grammars (all in lockstep, in its
+// light): frame k is every plant grown min(k, its derivation length) steps.
 int run_render_frames(const RenderArgs& a) {
   const std::string& input = a.grammar.grammar;
   const std::string& pattern = a.grammar.output;
-  const bool growth = is_grammar_input(input);
-  if (!growth && !input.ends_with(".scene.json"))
-    throw UsageError{"--frames applies to a .scene.json scene with an animation key (its plants move) or a .lsys "
-                     "grammar (frame k is k derivation steps)"};
-  if (growth && a.grammar.steps) throw UsageError{"--frames on a grammar sets the derivation steps: leave out -n"};
+  const bool grammar_growth = is_grammar_input(input);
+  if (!grammar_growth && !input.ends_with(".scene.json"))
+    throw UsageError{"--frames applies to a .scene.json scene (with an animation key its plants move; without one "
+                     "they grow) or a .lsys grammar (frame k is k derivation steps)"};
+  if (grammar_growth && a.grammar.steps) throw UsageError{"--frames on a grammar sets the derivation steps: leave out -n"};
   if (!has_frame_placeholder(pattern))
     throw UsageError{"-o " + pattern + ": with --frames the output must hold {frame}, e.g. -o frames/f_{frame}.png"};
   check_pattern_separates(pattern, "{frame}");
@@ -405,7 +410,7 @@ int run_render_frames(const RenderArgs& a) {
   // The scene whose plants move, or the grammar's last frame (its camera and ground frame
   // every frame, so the plant grows in a still view).
   GrammarArgs last_args = a.grammar;
-  if (growth) {
+  if (grammar_growth) {
     int code = kOk;
     const std::optional<lsys::Grammar> g = load_grammar_for(a.grammar, &code);
     if (!g) return code;
@@ -421,8 +426,15 @@ int run_render_frames(const RenderArgs& a) {
   if (auto warning = empty_plants_warning(base, a.grammar.grammar)) std::cerr << *warning << "\n";
   apply_scene_flags(a, base);
   apply_camera_flags(a.camera, base.camera);
+  // A scene without an animation key grows, when any of its plants grows from a grammar.
+  const int64_t scene_length = grammar_growth || base.animation ? 0 : scene_growth_length(base);
+  const bool scene_growth = !grammar_growth && !base.animation &&
+                            std::ranges::any_of(base.plants, [](const ScenePlant& p) { return !p.grammar.empty(); });
+  const bool growth = grammar_growth || scene_growth;
   if (!growth && !base.animation)
-    throw UsageError{"--frames: " + input + " has no animation key, so its plants stand still (docs/animation.md)"};
+    throw UsageError{"--frames: " + input + " has no animation key and no plant that grows from a grammar: "
+                     "nothing moves or grows (docs/animation.md)"};
+  if (scene_growth && range.all) range = {0, static_cast<uint64_t>(scene_length), false};
   // --fps is a scene's time step too (docs/animation.md): frame k at k / fps seconds, and
   // `all` the frames of its duration at that rate.
   if (!growth && a.fps) {
@@ -506,9 +518,10 @@ int run_render_frames(const RenderArgs& a) {
     Scene scene = base;
     if (growth) {
       GrammarArgs step = a.grammar;
-      step.steps = static_cast<int64_t>(f);
+      if (grammar_growth) step.steps = static_cast<int64_t>(f);
       std::vector<RenderPass> ignored;
-      auto grown = load_render_input(step, a.width, a.height, ignored, Progress(&g_interrupted));
+      auto grown = load_render_input(step, a.width, a.height, ignored, Progress(&g_interrupted),
+                                     scene_growth ? std::optional<int64_t>(static_cast<int64_t>(f)) : std::nullopt);
       if (auto* code = std::get_if<ExitCode>(&grown)) {
         if (*code == kInterrupted) break;  // said below, with the frames kept
         return *code;

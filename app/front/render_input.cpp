@@ -27,7 +27,8 @@ bool is_render_input(const std::string& path) {
 
 std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std::optional<uint32_t> width,
                                                 std::optional<uint32_t> height,
-                                                std::vector<RenderPass>& passes, const Progress& progress) {
+                                                std::vector<RenderPass>& passes, const Progress& progress,
+                                                std::optional<int64_t> growth_step) {
   const std::string& input = grammar.grammar;
   const bool is_scene = input.ends_with(".scene.json"), is_skeleton = input.ends_with(".skel.json"),
              is_gltf = input.ends_with(".glb") || input.ends_with(".gltf");
@@ -43,7 +44,8 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
     passes.push_back({"read scene", seconds_since(start), ""});
     start = std::chrono::steady_clock::now();
     // A plant's grammar error: the grammar's place, and a note at the scene key naming it.
-    if (Status grown = grow_scene_plants(scene, grammar.max_modules, progress, &cpu_light_oracle()); !grown) {
+    if (Status grown = grow_scene_plants(scene, grammar.max_modules, progress, &cpu_light_oracle(), growth_step);
+        !grown) {
       if (grown.cancelled()) return kInterrupted;
       std::cerr << grown.error().format();
       return kInputError;

@@ -24,9 +24,12 @@ bool is_grammar_input(const std::string& path);  // .lsys, a cpfg .l, a vlab obj
 // `passes`. On failure prints the located error to stderr and returns the exit code.
 // `progress` reaches the derivation, interpretation and turtle (grow.h): cancelled (render's
 // SIGINT), it returns kInterrupted without a message — the caller says what was kept.
+// `growth_step` (a scene's growth animation, docs/animation.md): every plant of a scene
+// grows min(growth_step, its derivation length) steps.
 std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std::optional<uint32_t> width,
                                                 std::optional<uint32_t> height,
-                                                std::vector<RenderPass>& passes, const Progress& progress = {});
+                                                std::vector<RenderPass>& passes, const Progress& progress = {},
+                                                std::optional<int64_t> growth_step = std::nullopt);
 
 // The warning for plants of `scene` (loaded from `input`) that grew nothing to draw — no
 // segment and no leaf — or none where every plant has something (an empty plant is no

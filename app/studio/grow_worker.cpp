@@ -220,6 +220,7 @@ GrowOutcome GrowWorker::grow(const GrowRequest& request, uint64_t gen, bool* can
   }
   out.modules = word->size();
 
+  // The skeleton of word `w`, its ?E answers appended to out.queries.
   auto build = [&](const lsys::Grammar& grammar, const lsys::Word& w) -> Expected<Skeleton> {
     lsys::InterpretStats istats;
     auto interpreted = lsys::interpret(grammar, w, options, &istats);
@@ -229,7 +230,11 @@ GrowOutcome GrowWorker::grow(const GrowRequest& request, uint64_t gen, bool* can
                     std::to_string(grammar.max_depth) + " with " + std::to_string(istats.still_expandable) +
                     " modules still expandable";
     if (stale(gen)) return Diagnostic{};
-    return build_skeleton(*interpreted, grammar);
+    std::vector<glm::dvec3> positions;
+    const bool queries = grammar_queries_light(grammar);
+    auto sk = build_skeleton(*interpreted, grammar, nullptr, {}, queries ? &positions : nullptr);
+    out.queries.push_back(queries ? word_queries(w, positions) : std::vector<GrowQuery>{});
+    return sk;
   };
   auto record_source = [&](Skeleton& sk, const PlantVariant& v, uint64_t seed, int64_t steps) {
     sk.source.grammar = request.file;

@@ -61,6 +61,8 @@ struct GrowOutcome {
   std::optional<Diagnostic> error;   // the first parse or derivation error; then nothing below
                                      // but `defines` (empty) is set
   std::vector<Skeleton> skeletons;   // one per requested plant
+  std::vector<std::vector<GrowQuery>> queries;  // per skeleton: its ?E answers where the turtle
+                                     //   met them (the plant's frame; none without ?E)
   // plants[0]'s grammar: its defines after overrides, seed and derivation length.
   std::vector<lsys::Define> defines;
   uint64_t grammar_seed = 1;

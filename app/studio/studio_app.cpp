@@ -783,6 +783,15 @@ void StudioApp::draw_viewport(ImVec2 size) {
       }
     }
   }
+  query_dots_.clear();
+  if (show_queries_ && plant_) {
+    std::vector<PlantQueries> plants;
+    for (size_t k = 0; k < edited_plants_.size() && k < plant_->queries.size(); ++k)
+      plants.push_back({&scene_.plants[edited_plants_[k]], &plant_->queries[k]});
+    query_dots_ = studio::query_dots(scene_.camera, origin, image_size,
+                                     scene_.environment.value_or(LightEnvironment{}).sensor_radius_m, plants);
+    draw_query_dots(dl, query_dots_, origin, image_size);
+  }
   if (worker_->busy()) {
     int64_t step = 0, steps = 0;
     worker_->progress(&step, &steps);
@@ -1067,6 +1076,10 @@ void StudioApp::draw_light() {
     scene_.environment = e;
     submit_regrow();
   }
+  ImGui::Checkbox("colour queries by q", &show_queries_);
+  keep("light:show_queries");
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("draw every ?E over the picture, coloured by its last answer q (dark: shaded, yellow: open sky)");
   if (plant_ && plant_->light.answers > 0)
     ImGui::Text("%llu answers, %llu queries, %.2f s (%.2f s CPU tracing), noise %.1f%%",
                 static_cast<unsigned long long>(plant_->light.answers),

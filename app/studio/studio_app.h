@@ -28,6 +28,7 @@
 #include "app/studio/define_controls.h"
 #include "app/studio/document_files.h"
 #include "app/studio/grow_worker.h"
+#include "app/studio/light_overlay.h"
 #include "app/studio/orbit_camera.h"
 #include "app/studio/undo_history.h"
 #include "app/studio/viewport.h"
@@ -105,6 +106,9 @@ class StudioApp {
   const std::optional<GrowOutcome>& plant() const { return plant_; }  // the last good plant
   uint64_t plants_applied() const { return plants_applied_; }        // results put on screen
   bool plant_drawn() const { return drawn_version_ == plants_applied_ && plants_applied_ > 0; }
+  // The light queries drawn over the picture at the last frame (the Light panel's "colour
+  // queries by q"; empty while it is off).
+  const std::vector<QueryDot>& query_dots() const { return query_dots_; }
   GrowWorker& worker() { return *worker_; }
   const ConeWorker& cone_worker() const { return *cones_; }
   uint64_t cone_requests() const { return cone_requests_; }  // cone builds asked of the cone worker
@@ -223,6 +227,8 @@ class StudioApp {
   OrbitCamera orbit_;
   RenderOptions render_options_;
   bool bark_ = true;
+  bool show_queries_ = false;         // the Light panel's "colour queries by q"
+  std::vector<QueryDot> query_dots_;  // drawn at the last frame
   int skin_choice_ = 0;              // the view's skin control: 0 the scene's, 1 smooth, 2 paper
   float sun_azimuth_deg_ = 0, sun_elevation_deg_ = 45;
   bool view_half_res_ = false;

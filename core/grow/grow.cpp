@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <tuple>
@@ -16,18 +17,41 @@
 
 namespace sylva {
 
-bool grammar_queries_light(const lsys::Grammar& g) {
-  auto in = [](const lsys::Successor& s) {
-    return std::any_of(s.modules.begin(), s.modules.end(),
-                       [](const lsys::SuccessorModule& m) { return m.symbol == lsys::kSymLightQuery; });
+namespace {
+// Whether the axiom, a production or the homomorphism writes a module `pred` accepts.
+template <class Pred>
+bool grammar_writes(const lsys::Grammar& g, Pred pred) {
+  auto in = [&](const lsys::Successor& s) {
+    return std::any_of(s.modules.begin(), s.modules.end(), [&](const lsys::SuccessorModule& m) { return pred(m.symbol); });
   };
-  if (std::any_of(g.axiom.modules.begin(), g.axiom.modules.end(),
-                  [](const lsys::Module& m) { return m.symbol == lsys::kSymLightQuery; }))
+  if (std::any_of(g.axiom.modules.begin(), g.axiom.modules.end(), [&](const lsys::Module& m) { return pred(m.symbol); }))
     return true;
   for (const auto* list : {&g.productions, &g.homomorphism})
     for (const lsys::Production& p : *list)
       if (in(p.successor)) return true;
   return false;
+}
+}  // namespace
+
+bool grammar_queries_light(const lsys::Grammar& g) {
+  return grammar_writes(g, [](lsys::SymbolId s) { return s == lsys::kSymLightQuery; });
+}
+
+bool grammar_queries_turtle(const lsys::Grammar& g) { return grammar_writes(g, lsys::is_turtle_query); }
+
+std::vector<GrowQuery> word_queries(const lsys::Word& word, std::span<const glm::dvec3> positions) {
+  // The answers sit in the derived word's ?E modules, in the order the turtle met them.
+  std::vector<GrowQuery> out;
+  for (const lsys::Module& m : word.modules) {
+    if (m.symbol != lsys::kSymLightQuery || out.size() >= positions.size()) continue;
+    const double* p = word.params_of(m);
+    GrowQuery gq;
+    gq.position = positions[out.size()];
+    gq.q = p[0];
+    if (m.param_count == 4) gq.toward = {p[1], p[2], p[3]};
+    out.push_back(gq);
+  }
+  return out;
 }
 
 namespace {
@@ -53,18 +77,7 @@ Status finish_growth(const lsys::Grammar& g, const lsys::Word& word, const lsys:
                            queries ? &positions : nullptr);
   if (!sk) return sk.error();
   r.skeleton = std::move(*sk);
-  if (queries) {
-    // The answers sit in the derived word's ?E modules, in the order the turtle met them.
-    for (const lsys::Module& m : word.modules) {
-      if (m.symbol != lsys::kSymLightQuery || r.queries.size() >= positions.size()) continue;
-      const double* p = word.params_of(m);
-      GrowQuery gq;
-      gq.position = positions[r.queries.size()];
-      gq.q = p[0];
-      if (m.param_count == 4) gq.toward = {p[1], p[2], p[3]};
-      r.queries.push_back(gq);
-    }
-  }
+  if (queries) r.queries = word_queries(word, positions);
   r.skeleton.source.grammar = grammar_path;
   r.skeleton.source.seed = options.seed.value_or(g.seed);
   r.skeleton.source.steps = options.steps.value_or(g.steps);
@@ -72,28 +85,36 @@ Status finish_growth(const lsys::Grammar& g, const lsys::Word& word, const lsys:
   return {};
 }
 
-// ---- Growing in light (docs/spec/light.md) -------------------------------------------
+// ---- Growing with queries: light (docs/spec/light.md) and the turtle's (CPFG 6.9) ----
 
-// One plant growing in the light: its grammar, its derivation and where it stands.
+// One plant growing step by step: its grammar, its derivation and where it stands.
 struct LightJob {
   const lsys::Grammar* grammar = nullptr;
   lsys::DeriveOptions options;
   ScenePlant placement;  // position, rotation and scale (no skeleton)
   std::unique_ptr<lsys::Derivation> derivation;
+  bool turtle_queries = false;  // the grammar writes ?P, ?H, ?L or ?U
 };
 
-size_t count_queries(const lsys::Word& word) {
-  return static_cast<size_t>(std::count_if(word.modules.begin(), word.modules.end(),
-                                           [](const lsys::Module& m) { return m.symbol == lsys::kSymLightQuery; }));
+template <class Pred>
+size_t count_modules(const lsys::Word& word, Pred pred) {
+  return static_cast<size_t>(
+      std::count_if(word.modules.begin(), word.modules.end(), [&](const lsys::Module& m) { return pred(m.symbol); }));
 }
 
-// The job's current word as a skeleton placed in the world, its queries' positions
-// appended to `sensors` (world), in word order.
-Expected<Skeleton> placed_now(LightJob& job, std::vector<glm::dvec3>& sensors) {
+size_t count_queries(const lsys::Word& word) {
+  return count_modules(word, [](lsys::SymbolId s) { return s == lsys::kSymLightQuery; });
+}
+
+// The job's current word interpreted and drawn by the turtle, in the plant's frame: the
+// positions of its light queries appended to `light` and its turtle queries' answers to
+// `turtle` (either may be null), each checked against the derived word's count of them.
+Expected<Skeleton> turtle_now(LightJob& job, std::vector<glm::dvec3>* light, std::vector<glm::dvec3>* turtle) {
   const lsys::Grammar& g = *job.grammar;
   const lsys::Word& word = job.derivation->word();
   lsys::DeriveOptions quiet = job.options;
   quiet.progress = Progress(job.options.progress.cancel_flag());
+  quiet.on_step = nullptr;
   const lsys::Word* turtle_word = &word;
   Expected<lsys::Word> interpreted = lsys::Word{};
   if (!g.homomorphism.empty()) {
@@ -101,18 +122,55 @@ Expected<Skeleton> placed_now(LightJob& job, std::vector<glm::dvec3>& sensors) {
     if (!interpreted) return interpreted.error();
     turtle_word = &*interpreted;
   }
-  std::vector<glm::dvec3> local;
-  auto sk = build_skeleton(*turtle_word, g, nullptr, quiet.progress, &local);
+  const size_t light_before = light ? light->size() : 0, turtle_before = turtle ? turtle->size() : 0;
+  auto sk = build_skeleton(*turtle_word, g, nullptr, quiet.progress, light, turtle);
   if (!sk) return sk.error();
-  const size_t queries = count_queries(word);
-  if (local.size() != queries)
-    return g.error_at({}, "the homomorphism changes the number of ?E queries (" + std::to_string(queries) +
-                              " in the derived word, " + std::to_string(local.size()) +
+  auto check = [&](const char* what, size_t derived, size_t drawn) -> Status {
+    if (derived == drawn) return {};
+    return g.error_at({}, std::string("the homomorphism changes the number of ") + what + " queries (" +
+                              std::to_string(derived) + " in the derived word, " + std::to_string(drawn) +
                               " drawn); sylva answers them in word order, so it must keep each one (docs/light.md)");
+  };
+  if (light)
+    if (Status s = check("?E", count_queries(word), light->size() - light_before); !s) return s.error();
+  if (turtle)
+    if (Status s = check("turtle (?P ?H ?L ?U)", count_modules(word, lsys::is_turtle_query),
+                         turtle->size() - turtle_before);
+        !s)
+      return s.error();
+  return std::move(*sk);
+}
+
+// The job's current word as a skeleton placed in the world, its queries' positions
+// appended to `sensors` (world), in word order.
+Expected<Skeleton> placed_now(LightJob& job, std::vector<glm::dvec3>& sensors) {
+  std::vector<glm::dvec3> local;
+  auto sk = turtle_now(job, &local, nullptr);
+  if (!sk) return sk.error();
   ScenePlant p = job.placement;
   p.skeleton = std::move(*sk);
   for (const glm::dvec3& q : local) sensors.push_back(place_point(p, q));
   return place_plant(p);
+}
+
+// Writes the turtle's answers into the job's ?P, ?H, ?L and ?U (CPFG manual 6.9): x and y,
+// or x, y and z, in the plant's frame.
+Status fill_turtle_queries(LightJob& job) {
+  std::vector<glm::dvec3> answers;
+  if (auto sk = turtle_now(job, nullptr, &answers); !sk) return sk.error();
+  lsys::Word& word = job.derivation->word();
+  size_t next = 0;
+  for (const lsys::Module& m : word.modules) {
+    if (!lsys::is_turtle_query(m.symbol)) continue;
+    const glm::dvec3& a = answers[next++];
+    double* p = word.params.data() + m.param_begin;
+    for (uint32_t k = 0; k < m.param_count && k < 3; ++k) p[k] = a[static_cast<int>(k)];
+  }
+  return {};
+}
+
+Diagnostic no_oracle(const lsys::Grammar& g) {
+  return g.error_at({}, "this grammar asks for light (?E) but was grown without a light environment (docs/light.md)");
 }
 
 struct JobFailure {
@@ -123,11 +181,12 @@ struct JobFailure {
 // Answers every query of every job's current word at once, writing q (clamped to
 // [0, 1]) and the direction into each `?E`'s parameters. Nothing is traced without queries.
 std::optional<JobFailure> answer_queries(std::vector<LightJob>& jobs, std::span<const Skeleton> fixed,
-                                         const Scene& scene, const LightOracle& oracle, int64_t step,
+                                         const Scene& scene, const LightOracle* oracle, int64_t step,
                                          LightGrowthStats* stats) {
   size_t total = 0;
   for (LightJob& j : jobs) total += count_queries(j.derivation->word());
   if (total == 0) return std::nullopt;
+  if (!oracle) return JobFailure{0, no_oracle(*jobs[0].grammar)};
   const Clock::time_point t0 = Clock::now();
   std::vector<Skeleton> plants(fixed.begin(), fixed.end());
   std::vector<glm::dvec3> sensors;
@@ -137,7 +196,7 @@ std::optional<JobFailure> answer_queries(std::vector<LightJob>& jobs, std::span<
     plants.push_back(std::move(*sk));
   }
   LightAnswerStats answer_stats;
-  auto answers = oracle.answer(plants, sensors, scene, step, &answer_stats);
+  auto answers = oracle->answer(plants, sensors, scene, step, &answer_stats);
   if (!answers) return JobFailure{0, answers.error()};
   size_t next = 0;
   for (LightJob& j : jobs) {
@@ -161,26 +220,47 @@ std::optional<JobFailure> answer_queries(std::vector<LightJob>& jobs, std::span<
   return std::nullopt;
 }
 
-// Derives every job in lockstep (light.md): after the axiom and after every `every`-th
-// step, all queries of all jobs are answered at once. On success every derivation is done.
-std::optional<JobFailure> derive_in_light(std::vector<LightJob>& jobs, std::span<const Skeleton> fixed,
-                                          const Scene& scene, const LightOracle& oracle, LightGrowthStats* stats) {
+// Derives every job in lockstep (light.md). After the axiom and after every step, each
+// job that moved on has its turtle queries filled (CPFG manual 6.9); after the axiom and
+// after every `every`-th step, all light queries of all jobs are answered at once; then
+// each job's on_step sees its word, answers included. On success every derivation is done.
+std::optional<JobFailure> derive_stepped(std::vector<LightJob>& jobs, std::span<const Skeleton> fixed,
+                                         const Scene& scene, const LightOracle* oracle, LightGrowthStats* stats) {
   const uint32_t every = scene.environment.value_or(LightEnvironment{}).every;
+  std::vector<std::function<bool(int64_t, const lsys::Word&)>> on_step(jobs.size());
   for (size_t k = 0; k < jobs.size(); ++k) {
+    on_step[k] = std::move(jobs[k].options.on_step);
+    jobs[k].options.on_step = nullptr;
+    jobs[k].turtle_queries = grammar_queries_turtle(*jobs[k].grammar);
     jobs[k].derivation = std::make_unique<lsys::Derivation>(*jobs[k].grammar, jobs[k].options);
     if (Status s = jobs[k].derivation->start(); !s) return JobFailure{k, s.error()};
   }
-  if (auto f = answer_queries(jobs, fixed, scene, oracle, 0, stats)) return f;
+  std::vector<char> moved(jobs.size(), 1);
+  auto after = [&](int64_t step) -> std::optional<JobFailure> {
+    for (size_t k = 0; k < jobs.size(); ++k)
+      if (moved[k] && jobs[k].turtle_queries)
+        if (Status s = fill_turtle_queries(jobs[k]); !s) return JobFailure{k, s.error()};
+    if (step % every == 0)
+      if (auto f = answer_queries(jobs, fixed, scene, oracle, step, stats)) return f;
+    for (size_t k = 0; k < jobs.size(); ++k)
+      if (moved[k] && on_step[k] && !on_step[k](step, jobs[k].derivation->word())) {
+        Diagnostic d = jobs[k].grammar->error_at({}, "cancelled at step " + std::to_string(step));
+        d.cancelled = true;
+        return JobFailure{k, std::move(d)};
+      }
+    return std::nullopt;
+  };
+  if (auto f = after(0)) return f;
   for (int64_t step = 1;; ++step) {
     bool advanced = false;
     for (size_t k = 0; k < jobs.size(); ++k) {
-      if (jobs[k].derivation->done()) continue;
+      moved[k] = !jobs[k].derivation->done();
+      if (!moved[k]) continue;
       if (Status s = jobs[k].derivation->advance(); !s) return JobFailure{k, s.error()};
       advanced = true;
     }
     if (!advanced) return std::nullopt;
-    if (step % every == 0)
-      if (auto f = answer_queries(jobs, fixed, scene, oracle, step, stats)) return f;
+    if (auto f = after(step)) return f;
   }
 }
 
@@ -200,9 +280,6 @@ std::vector<Skeleton> grown_plants(const Scene& scene) {
   return out;
 }
 
-Diagnostic no_oracle(const lsys::Grammar& g) {
-  return g.error_at({}, "this grammar asks for light (?E) but was grown without a light environment (docs/light.md)");
-}
 
 }  // namespace
 
@@ -282,7 +359,7 @@ void grow_recipes_in_light(const Scene& scene, const Grammars& grammars, const s
   // The scene's plants that already have skeletons shade the growing ones.
   const std::vector<Skeleton> fixed = grown_plants(scene);
   LightGrowthStats stats;
-  if (auto f = derive_in_light(jobs, fixed, scene, *light, &stats)) {
+  if (auto f = derive_stepped(jobs, fixed, scene, light, &stats)) {
     grown[recipe_of_job[f->job]] = std::move(f->error);
     return;
   }
@@ -302,7 +379,16 @@ void grow_recipes_in_light(const Scene& scene, const Grammars& grammars, const s
 
 Expected<lsys::Word> derive_word(const lsys::Grammar& g, const lsys::DeriveOptions& options, const GrowLight& light,
                                  LightGrowthStats* stats, lsys::DeriveStats* derive_stats) {
-  if (!grammar_queries_light(g)) return lsys::derive(g, options, derive_stats);
+  const bool light_queries = grammar_queries_light(g);
+  if (!light_queries && !grammar_queries_turtle(g)) return lsys::derive(g, options, derive_stats);
+  if (!light_queries) {
+    // Turtle queries only (CPFG manual 6.9): the grammar alone, step by step, no light.
+    std::vector<LightJob> jobs(1);
+    jobs[0].grammar = &g;
+    jobs[0].options = options;
+    if (auto f = derive_stepped(jobs, {}, Scene{}, nullptr, stats)) return f->error;
+    return jobs[0].derivation->finish(derive_stats);
+  }
   if (!light.oracle) return no_oracle(g);
   const Scene scene = light.scene ? *light.scene : default_light_scene();
   const std::vector<Skeleton> fixed = grown_plants(scene);
@@ -323,7 +409,7 @@ Expected<lsys::Word> derive_word(const lsys::Grammar& g, const lsys::DeriveOptio
     jobs.push_back(job_for_plant(p, *neighbours.back(), options.max_modules, options.progress));
     plant_of_job.push_back(i);
   }
-  if (auto f = derive_in_light(jobs, fixed, scene, *light.oracle, stats))
+  if (auto f = derive_stepped(jobs, fixed, scene, light.oracle, stats))
     return f->job == 0 ? f->error : plant_error(scene, plant_of_job[f->job], f->error);
   return jobs[0].derivation->finish(derive_stats);
 }
@@ -345,7 +431,32 @@ Expected<GrowResult> grow(const lsys::Grammar& g, const lsys::DeriveOptions& opt
   return r;
 }
 
-Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& progress, const LightOracle* light) {
+Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& progress, const LightOracle* light,
+                         std::optional<int64_t> until_step) {
+  if (until_step) {
+    // The plants as they stood at that step: each one's steps capped, grown, and only the
+    // skeletons carried back, so the scene's own keys stay as they were written.
+    Scene capped = scene;
+    std::map<std::pair<std::string, std::map<std::string, double>>, std::optional<int64_t>> length_of;
+    for (ScenePlant& p : capped.plants) {
+      if (p.skeleton) continue;
+      if (!p.steps) {
+        auto [it, added] = length_of.try_emplace({p.grammar, p.defines});
+        if (added) {
+          lsys::ParseOptions parse;
+          parse.define_overrides = p.defines;
+          auto g = lsys::load_grammar(p.grammar, parse);
+          if (g) it->second = g->steps;  // a grammar that fails is reported below
+        }
+        p.steps = it->second;
+      }
+      if (p.steps) p.steps = std::min(*p.steps, *until_step);
+    }
+    Status grown = grow_scene_plants(capped, max_modules, progress, light);
+    for (size_t i = 0; i < scene.plants.size(); ++i)
+      if (!scene.plants[i].skeleton && capped.plants[i].skeleton) scene.plants[i].skeleton = std::move(capped.plants[i].skeleton);
+    return grown;
+  }
   // Where the scene names plant i's grammar: its own entry or its scatter entry.
   auto named_by = [&](size_t i) {
     const ScenePlant& p = scene.plants[i];
@@ -443,6 +554,13 @@ Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& pro
   }
   progress.report(1, "grow");
   return {};
+}
+
+int64_t scene_growth_length(const Scene& scene) {
+  int64_t last = 0;
+  for (const ScenePlant& p : scene.plants)
+    if (!p.grammar.empty() && p.skeleton) last = std::max(last, p.skeleton->source.steps);
+  return last;
 }
 
 }  // namespace sylva

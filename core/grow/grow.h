@@ -6,6 +6,8 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
+#include <span>
 #include <string>
 
 #include "core/geometry/skeleton.h"
@@ -44,6 +46,9 @@ struct GrowLight {
 // Whether any module the grammar writes (axiom, productions, homomorphism) is a light
 // query: only then does growing it trace light.
 bool grammar_queries_light(const lsys::Grammar& grammar);
+// Whether it writes a turtle query (?P, ?H, ?L or ?U; CPFG manual 6.9): then every step's
+// word is interpreted and drawn by the turtle, which fills them (no light is traced).
+bool grammar_queries_turtle(const lsys::Grammar& grammar);
 
 // A light query of the grown word and its last answer (light.md), in the plant's frame.
 struct GrowQuery {
@@ -51,6 +56,11 @@ struct GrowQuery {
   double q = 0;                  // its first parameter: the last answer (or the grammar's value)
   glm::dvec3 toward{0, 0, 0};    // its direction parameters ((0, 0, 0) for ?E(q))
 };
+
+// The ?E modules of the derived `word`, in word order, each paired with the position the
+// turtle recorded for it (`positions`, in the order the turtle met them: build_skeleton's
+// queries); the first min(queries, positions) of them.
+std::vector<GrowQuery> word_queries(const lsys::Word& word, std::span<const glm::dvec3> positions);
 
 // Everything `sylva grow` does: derive, interpret, build the skeleton, record the source.
 struct GrowResult {
@@ -92,7 +102,15 @@ Expected<lsys::Word> derive_word(const lsys::Grammar& grammar, const lsys::Deriv
 // the scene's light (light.md): step k of each is interpreted before step k's queries
 // are answered, so neighbours shade each other; plants that already have skeletons shade
 // them too. `light` answers the queries (null with queries: an error).
+// `until_step` (a growth animation's frame, docs/animation.md): every plant grows
+// min(until_step, its derivation length) steps — the scene as it stood at that step of
+// its growth, identical to the whole growth's words at that step, light included.
 Status grow_scene_plants(Scene& scene, uint64_t max_modules = 50'000'000, const Progress& progress = {},
-                         const LightOracle* light = nullptr);
+                         const LightOracle* light = nullptr, std::optional<int64_t> until_step = std::nullopt);
+
+// The derivation length of the scene's longest-growing plant (its `steps` key, else its
+// grammar's `derivation length:`) after grow_scene_plants: the last frame of its growth
+// animation; 0 when no plant grew from a grammar.
+int64_t scene_growth_length(const Scene& scene);
 
 }  // namespace sylva

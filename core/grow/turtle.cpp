@@ -125,6 +125,44 @@ dvec3 rotate_about(const dvec3& v, const dvec3& k, double angle_rad) {
   return v * c + glm::cross(k, v) * s + k * glm::dot(k, v) * (1 - c);
 }
 
+// @R(hx, hy, hz) and @R(hx, hy, hz, ux, uy, uz) (CPFG manual 6.2): the heading set to the
+// given direction (normalised); without an up vector the frame turns by the least rotation
+// that takes the old heading to the new one (its left and up "rotate least"); with one, up
+// is that vector made perpendicular to the heading and normalised, and left = up × heading.
+void set_heading(TurtleState& t, uint32_t count, const double* p) {
+  if (count != 3 && count != 6) throw TurtleFailure{"@R takes 3 parameters, @R(hx, hy, hz), or 6, with the up vector"};
+  for (uint32_t k = 0; k < count; ++k)
+    if (!std::isfinite(p[k])) throw TurtleFailure{"@R's vectors must be finite"};
+  const dvec3 h(p[0], p[1], p[2]);
+  const double hl = glm::length(h);
+  if (!(hl > 0) || !std::isfinite(hl)) throw TurtleFailure{"@R's heading must not be zero"};
+  const dvec3 heading = h / hl;
+  if (count == 6) {
+    const dvec3 u(p[3], p[4], p[5]);
+    const dvec3 across = u - glm::dot(u, heading) * heading;
+    const double al = glm::length(across);
+    if (!(al > 1e-12 * glm::length(u)) || !std::isfinite(al))
+      throw TurtleFailure{"@R's up vector must not be zero or along the heading"};
+    t.heading = heading;
+    t.up = across / al;
+    t.left = glm::cross(t.up, t.heading);
+    return;
+  }
+  // The least rotation from the old heading to the new: about old × new by their angle
+  // (atan2 of |cross| and dot, exact near 0 and 180 degrees); a reversal turns about U.
+  const dvec3 axis = glm::cross(t.heading, heading);
+  const double sin_a = glm::length(axis), cos_a = glm::dot(t.heading, heading);
+  if (sin_a > 1e-15) {
+    const dvec3 k = axis / sin_a;
+    const double angle = std::atan2(sin_a, cos_a);
+    t.left = rotate_about(t.left, k, angle);
+  } else if (cos_a < 0) {
+    t.left = -t.left;  // 180 degrees about U, as |
+  }
+  t.heading = heading;
+  orthonormalize(t);
+}
+
 // The places of the grammar that write a module with `symbol`: the axiom, then every
 // production and interpretation production whose successor holds it, in file order.
 // Modules carry no source place (derive.h), so this is where a turtle error can point.
@@ -149,7 +187,7 @@ std::vector<SourceLoc> places_writing(const lsys::Grammar& g, lsys::SymbolId sym
 
 // What the turtle makes of a cpfg file's own symbols (CPFG manual 6; docs/cpfg.md).
 enum class CpfgKind : uint8_t {
-  kNone, kDraw, kMove, kColorUp, kColorDown, kWidthUp, kWidthDown, kLevel, kSetPosition, kUnsupported
+  kNone, kDraw, kMove, kColorUp, kColorDown, kWidthUp, kWidthDown, kLevel, kSetPosition, kSetHeading, kUnsupported
 };
 
 struct CpfgSymbols {
@@ -172,9 +210,9 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
   set("!", CpfgKind::kWidthDown);
   set("@v", CpfgKind::kLevel);
   set("@M", CpfgKind::kSetPosition);
+  set("@R", CpfgKind::kSetHeading);
   for (const char* name : {"~", "@o", "@c", "@O", "@Gs", "@Gc", "@Ge", "@Gr", "@Gt", "@T", "@Ts", "@Td", "@Tf",
-                           "@D", "@Di", "@Dd", "@R", "@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc", "?P", "?H", "?L",
-                           "?U"})
+                           "@D", "@Di", "@Dd", "@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc"})
     set(name, CpfgKind::kUnsupported);
   return out;
 }
@@ -186,16 +224,16 @@ std::string cpfg_feature(const std::string& name) {
   if (name.rfind("@G", 0) == 0) return "a generalized cylinder, CPFG manual 6.7.3";
   if (name.rfind("@T", 0) == 0) return "a view-file tropism, CPFG manual 6.8";
   if (name.rfind("@D", 0) == 0) return "the turtle's scale, CPFG manual 6.3";
-  if (name == "@R") return "setting the heading, CPFG manual 6.2";
   if (name == "@;" || name == "@,") return "a back-side colour, CPFG manual 6.3";
   if (name.rfind("@P", 0) == 0 || name.rfind("@b", 0) == 0) return "a B-spline surface patch, CPFG manual 6.7.2";
-  return "a turtle query, CPFG manual 6.9";
+  return "a cpfg turtle command, CPFG manual chapter 6";
 }
 
 }  // namespace
 
 Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g, TurtleStats* stats,
-                                  const Progress& progress, std::vector<glm::dvec3>* queries) {
+                                  const Progress& progress, std::vector<glm::dvec3>* queries,
+                                  std::vector<glm::dvec3>* turtle_queries) {
   using namespace lsys;
   auto t0 = std::chrono::steady_clock::now();
   const TurtleDefaults& d = g.turtle;
@@ -307,6 +345,9 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
             t.branch_pending = false;
             continue;
           }
+          case CpfgKind::kSetHeading:  // @R (CPFG manual 6.2)
+            set_heading(t, m.param_count, p);
+            continue;
           case CpfgKind::kUnsupported:
             throw TurtleFailure{"'" + g.symbols.name(m.symbol) + "' (" + cpfg_feature(g.symbols.name(m.symbol)) +
                                 ") is not supported yet (docs/cpfg.md)"};
@@ -440,6 +481,18 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           break;
         case kSymLightQuery:
           if (queries) queries->push_back(t.position);
+          break;
+        case kSymQueryPosition:
+          if (turtle_queries) turtle_queries->push_back(t.position);
+          break;
+        case kSymQueryHeading:
+          if (turtle_queries) turtle_queries->push_back(t.heading);
+          break;
+        case kSymQueryLeft:
+          if (turtle_queries) turtle_queries->push_back(t.left);
+          break;
+        case kSymQueryUp:
+          if (turtle_queries) turtle_queries->push_back(t.up);
           break;
         default:
           break;  // carried through, ignored by the turtle

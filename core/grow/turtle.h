@@ -43,9 +43,13 @@ struct TurtleStats {
 // settings of `grammar`. `progress` (progress.h) is checked and told the fraction of the
 // word read every 64 Ki modules; cancelled: cancelled_diagnostic(). `queries`, when
 // given, receives the turtle's position at each light query `?E` of the word, in word
-// order (docs/spec/light.md: where the query's sensor sits).
+// order (docs/spec/light.md: where the query's sensor sits). `turtle_queries`, when given,
+// receives the answer of each turtle query of the word, in word order (CPFG manual 6.9):
+// the position for ?P, the heading for ?H, the left vector for ?L, the up vector for ?U,
+// in the skeleton's frame (metres; unit vectors).
 Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& grammar,
                                   TurtleStats* stats = nullptr, const Progress& progress = {},
-                                  std::vector<glm::dvec3>* queries = nullptr);
+                                  std::vector<glm::dvec3>* queries = nullptr,
+                                  std::vector<glm::dvec3>* turtle_queries = nullptr);
 
 }  // namespace sylva

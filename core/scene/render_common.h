@@ -3,6 +3,8 @@
 // stream and the sun-disc sampling. The shading model and its constants: core/light/shading.h.
 #pragma once
 
+#include <optional>
+
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <numbers>
@@ -44,6 +46,20 @@ inline Ray frame_ray(const CameraFrame& f, double x, double y) {
   const double sx = (2 * x / f.width - 1) * f.half_width;
   const double sy = (1 - 2 * y / f.height) * f.half_height;
   return {f.eye, f.forward + sx * f.right + sy * f.up};
+}
+
+// The continuous pixel position of world point `p` in `f`'s image (y downward; frame_ray's
+// inverse), and its depth along `forward`; nullopt for a point not in front of the eye.
+struct FramePixel {
+  double x = 0, y = 0, depth = 0;
+};
+inline std::optional<FramePixel> frame_pixel(const CameraFrame& f, const glm::dvec3& p) {
+  const glm::dvec3 d = p - f.eye;
+  const double depth = glm::dot(d, f.forward);
+  if (!(depth > 0)) return std::nullopt;
+  const double sx = glm::dot(d, f.right) / depth / f.half_width;
+  const double sy = glm::dot(d, f.up) / depth / f.half_height;
+  return FramePixel{(sx + 1) * 0.5 * f.width, (1 - sy) * 0.5 * f.height, depth};
 }
 
 // A unit direction on the sun's disc of angular radius acos(cos_alpha) around

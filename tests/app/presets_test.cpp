@@ -66,6 +66,9 @@ const Preset kPresets[] = {
     // The well of Bhagvat et al. 2009, Figure 10, one part per PART (presets/scenes/well.scene.json
     // holds all four: 8 segments, tests/grow/paper_scenes_test.cpp); PART 0 is the wall.
     {"well", 1, std::nullopt},
+    // Synthetic topiary (Prusinkiewicz, James and Měch 1994): apices that query their
+    // position (?P) and are cut outside a ball.
+    {"topiary", 21576, std::nullopt, 33723},
 };
 
 fs::path presets_dir() { return fs::path(SYLVA_SOURCE_DIR) / "presets"; }

@@ -1,6 +1,6 @@
 // render_frames_cli_test.cpp — `sylva render --frames` (docs/animation.md): a scene's
-// animation key moving its plants frame by frame, a grammar growing over its derivation
-// steps, the per-frame outputs, the video through ffmpeg, and the usage errors.
+// animation key moving its plants frame by frame, a grammar (or a scene without an
+// animation key) growing over its derivation steps, the per-frame outputs, the video through ffmpeg, and the usage errors.
 // Every render here passes --spp 1 (the pixel centres): these tests are about what is
 // drawn, not how it is sampled, and the default of 8 samples would cost 8 times the time
 // (RenderCli.TheDefaultIsEightSamplesPerPixel pins the default).
@@ -143,6 +143,42 @@ TEST(RenderFrames, AGrammarGrowsOneDerivationStepPerFrameSeenByTheLastFramesCame
   EXPECT_TRUE(fs::exists(dir.file("a_0000.png")));
 }
 
+TEST(RenderFrames, ASceneWithoutAnimationGrowsItsPlantsInLockstepInItsLight) {
+  // docs/animation.md: frame k is every plant grown min(k, its derivation length) steps,
+  // all in lockstep in the scene's light (light.md), seen by the scene's camera. Two
+  // competing trees (presets/light/competition.lsys: every step reads its ?E answers), one
+  // of them stopped at 3 steps by its own key.
+  TempDir dir;
+  fs::copy_file(std::string(SYLVA_SOURCE_DIR) + "/presets/light/competition.lsys", dir.file("competition.lsys"));
+  auto scene = [&](const std::string& name, const std::string& steps) {
+    return dir.write(name, R"({"image": {"width": 48, "height": 36},
+      "camera": {"eye": [0, 1.5, 6], "target": [0, 1, 0]},
+      "environment": {"photons": 20000, "every": 1, "seed": 3},
+      "plants": [{"grammar": "competition.lsys", "position": [-0.5, 0, 0], "steps": )" + steps + R"(},
+                 {"grammar": "competition.lsys", "position": [0.5, 0, 0], "steps": 3}]})");
+  };
+  const std::string growing = scene("grow.scene.json", "5");
+  ProcessResult r = run_sylva({"render", "--spp", "1", growing, "--frames", "all", "-o", dir.file("g_{frame}.png"),
+                               "--backend", "cpu"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  // all: frames 0 to the longest derivation, 5.
+  EXPECT_NE(r.err.find("6 frames in"), std::string::npos) << describe(r);
+  EXPECT_TRUE(fs::exists(dir.file("g_0005.png")));
+  EXPECT_FALSE(fs::exists(dir.file("g_0006.png")));
+  // Frame 4 is the scene with its first tree grown 4 steps (the second stopped at 3):
+  // the same words as the whole growth's at step 4, light answers included.
+  ProcessResult four = run_sylva({"render", "--spp", "1", scene("four.scene.json", "4"), "-o", dir.file("four.png"),
+                                  "--backend", "cpu"});
+  ASSERT_EQ(four.exit_code, 0) << describe(four);
+  EXPECT_EQ(mean_abs_difference(pixels(dir.file("g_0004.png")), pixels(dir.file("four.png"))), 0.0);
+  // The last frame is the still scene's picture; earlier frames are not.
+  ProcessResult still = run_sylva({"render", "--spp", "1", growing, "-o", dir.file("still.png"), "--backend", "cpu"});
+  ASSERT_EQ(still.exit_code, 0) << describe(still);
+  EXPECT_EQ(mean_abs_difference(pixels(dir.file("g_0005.png")), pixels(dir.file("still.png"))), 0.0);
+  EXPECT_GT(mean_abs_difference(pixels(dir.file("g_0004.png")), pixels(dir.file("still.png"))), 1e-4);
+  EXPECT_GT(mean_abs_difference(pixels(dir.file("g_0002.png")), pixels(dir.file("g_0004.png"))), 1e-4);
+}
+
 TEST(RenderFrames, TheVideoIsEncodedWithFfmpegOrRefusedBeforeAnyFrame) {
   TempDir dir;
   const std::string scene = write_scene(dir, kDance);
@@ -177,9 +213,7 @@ TEST(RenderFrames, TheVideoIsEncodedWithFfmpegOrRefusedBeforeAnyFrame) {
 TEST(RenderFrames, BadFrameRequestsAreUsageErrors) {
   TempDir dir;
   const std::string scene = write_scene(dir, kDance);
-  const std::string still = dir.file("still.scene.json");
-  fs::copy_file(write_scene(dir, ""), still);
-  write_scene(dir, kDance);
+  const std::string empty = dir.write("empty.scene.json", R"({"plants": []})");
   fs::copy_file(kElm, dir.file("elm.lsys"));
   ASSERT_EQ(run_sylva({"grow", kElm, "-o", dir.file("elm.skel.json")}).exit_code, 0);
   struct Case {
@@ -194,7 +228,7 @@ TEST(RenderFrames, BadFrameRequestsAreUsageErrors) {
            {{scene, "--frames", "0..100000", "-o", f}, "at most 100000 frames"},
            {{scene, "--frames", "x", "-o", f}, "expected all, a frame N or a range A..B"},
            {{scene, "--frames", "-1..2", "-o", f}, "expected all, a frame N or a range A..B"},
-           {{still, "--frames", "0..1", "-o", f}, "has no animation key"},
+           {{empty, "--frames", "0..1", "-o", f}, "has no animation key and no plant that grows"},
            {{dir.file("elm.skel.json"), "--frames", "0..1", "-o", f}, "--frames applies to a .scene.json scene"},
            {{dir.file("elm.lsys"), "--frames", "0..1", "-n", "3", "-o", f}, "leave out -n"},
            {{scene, "--frames", "0..1", "-o", f, "--video", dir.file("v.avi")}, "expected a .mp4"},

@@ -919,7 +919,7 @@ TEST(TurtleCpfg, AtMSetsThePositionAndAtVLevelsTheTurtle) {
 TEST(TurtleCpfg, SymbolsSylvaDoesNotDrawYetAreErrorsNamingTheFeature) {
   const std::pair<const char*, const char*> cases[] = {
       {"F@o(2)", "sphere"}, {"F~l(1)", "surface"}, {"@Gs F @Ge", "generalized cylinder"},
-      {"F@T(1,0.2)F", "tropism"}, {"F?P(0,0,0)", "turtle query"}};
+      {"F@T(1,0.2)F", "tropism"}, {"F@D(2)F", "scale"}};
   for (const auto& [axiom, feature] : cases) {
     const std::string message = grow_error(cpfg(axiom));
     EXPECT_NE(message.find(feature), std::string::npos) << axiom << ": " << message;

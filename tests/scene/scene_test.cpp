@@ -14,6 +14,7 @@
 #include <random>
 #include <set>
 
+#include "core/scene/render_common.h"
 #include "core/scene/scatter.h"
 #include "core/scene/scene_json.h"
 #include "tests/support/test_textures.h"
@@ -942,6 +943,31 @@ TEST(SceneSkinKey, AnythingButSmoothOrPaperIsAnErrorAtTheKey) {
   EXPECT_NE(e.message.find("plants[0].skin must be"), std::string::npos) << e.message;
   e = expect_error("{\"plants\": [], \"scatter\": [{\"grammar\": \"g.lsys\", \"count\": 1, \"skin\": \"Paper\"}]}");
   EXPECT_NE(e.message.find("scatter[0].skin must be"), std::string::npos) << e.message;
+}
+
+TEST(CameraFrame, FramePixelInvertsFrameRayAndRefusesPointsBehindTheEye) {
+  // Random cameras and pixels: the point at distance t along a pixel's ray projects back to
+  // that pixel at depth t·(forward · direction); a point behind the eye has no pixel.
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 200; ++trial) {
+    Scene s;
+    s.camera.eye = {5 * u(rng), 5 * u(rng), 5 * u(rng)};
+    s.camera.target = s.camera.eye + glm::dvec3(u(rng), u(rng), u(rng) + 2.5);
+    s.camera.fov_y_deg = 20 + 70 * (u(rng) + 1);
+    s.width = 320;
+    s.height = 200;
+    const render_common::CameraFrame f = render_common::camera_frame(s);
+    const double x = 160 + 160 * u(rng), y = 100 + 100 * u(rng), t = 0.1 + 50 * (u(rng) + 1);
+    const Ray r = render_common::frame_ray(f, x, y);
+    const auto p = render_common::frame_pixel(f, r.origin + t * r.direction);
+    ASSERT_TRUE(p);
+    EXPECT_NEAR(p->x, x, 1e-6);
+    EXPECT_NEAR(p->y, y, 1e-6);
+    EXPECT_NEAR(p->depth, t * glm::dot(r.direction, f.forward), 1e-6 * t);
+    EXPECT_FALSE(render_common::frame_pixel(f, r.origin - t * r.direction));
+    EXPECT_FALSE(render_common::frame_pixel(f, f.eye));
+  }
 }
 
 }  // namespace

@@ -146,7 +146,8 @@ def test_frames_refuse_bad_batches_before_any_task(tmp_path, client, sylva_binar
 
 
 def test_a_failing_frame_raises_the_commands_message(tmp_path, client, sylva_binary, repo):
-    still = repo / "presets/scenes/pine.scene.json"  # no animation key: --frames refuses it
+    still = tmp_path / "empty.scene.json"  # nothing moves or grows: --frames refuses it
+    still.write_text('{"plants": []}')
     with pytest.raises(RuntimeError, match="--frames 0 failed"):
         sylva_dask.frames(client, str(still), [0], str(tmp_path / "f_{frame}.png"), sylva=sylva_binary)
 

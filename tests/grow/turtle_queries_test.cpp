@@ -1,0 +1,180 @@
+// Tests for the turtle's queries ?P, ?H, ?L and ?U (CPFG manual 6.9; docs/cpfg.md): filled
+// after the axiom and after every step from the turtle's state where each stands, read by
+// the next step's conditions and context, in sylva files and cpfg files alike; arity and
+// homomorphism errors; light never traced for them.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+
+#include "core/grow/grow.h"
+
+namespace sylva {
+namespace {
+
+lsys::Grammar parsed(const std::string& text, const std::string& file = "queries.lsys") {
+  auto g = lsys::parse_grammar(text, file);
+  if (!g) ADD_FAILURE() << g.error().format();
+  return g ? std::move(*g) : lsys::Grammar{};
+}
+
+Expected<lsys::Word> derived_word(const lsys::Grammar& g, int64_t steps) {
+  lsys::DeriveOptions o;
+  o.steps = steps;
+  return derive_word(g, o);
+}
+
+std::string derived(const lsys::Grammar& g, int64_t steps) {
+  auto w = derived_word(g, steps);
+  if (!w) return "error: " + w.error().message;
+  return lsys::print_word(*w, g.symbols);
+}
+
+// The parameters of the n-th module with `symbol` in `word`.
+std::vector<double> params_of(const lsys::Word& word, lsys::SymbolId symbol, size_t n = 0) {
+  for (const lsys::Module& m : word.modules)
+    if (m.symbol == symbol && n-- == 0) return {word.params_of(m), word.params_of(m) + m.param_count};
+  return {};
+}
+
+TEST(TurtleQueries, PositionIsFilledAfterEveryStepAndReadByTheNextStep) {
+  // The QueryPosition pattern: an apex climbs one metre a step while the position after it
+  // is below 2.5 m, then stops. On the axiom ?P reads y = 0; after steps 1, 2, 3: 1, 2, 3.
+  const lsys::Grammar g = parsed(
+      "module: A\n"
+      "axiom: A ?P(-1, -1)\n"
+      "A > ?P(x, y) : y < 2.5 -> F(1) A\n");
+  EXPECT_EQ(derived(g, 6), "F(1)F(1)F(1)A?P(0,3)");
+  EXPECT_EQ(derived(g, 0), "A?P(0,0)") << "the axiom's queries are filled too";
+}
+
+TEST(TurtleQueries, EachQueryAnswersItsVectorOfTheTurtleWhereItStands) {
+  // Turned 30 degrees (+, toward L) and pitched down 20 (&), then one metre forward: the
+  // answers are the turtle's state there, which the skeleton's last segment also records.
+  const lsys::Grammar g = parsed(
+      "module: A\n"
+      "axiom: +(30) &(20) F(1) ?P(0, 0, 0) ?H(0, 0, 0) ?L(0, 0, 0) ?U(0, 0, 0) [ /(90) ?U(0, 0, 0) ]\n");
+  auto w = derived_word(g, 1);
+  ASSERT_TRUE(w) << w.error().format();
+  const auto p = params_of(*w, lsys::kSymQueryPosition), h = params_of(*w, lsys::kSymQueryHeading),
+             l = params_of(*w, lsys::kSymQueryLeft), u = params_of(*w, lsys::kSymQueryUp),
+             rolled = params_of(*w, lsys::kSymQueryUp, 1);
+  ASSERT_EQ(p.size(), 3u);
+  ASSERT_EQ(rolled.size(), 3u);
+  auto sk = build_skeleton(*w, g);
+  ASSERT_TRUE(sk);
+  ASSERT_EQ(sk->joints.size(), 2u);
+  const glm::dvec3 end(sk->joints[1].position_m[0], sk->joints[1].position_m[1], sk->joints[1].position_m[2]);
+  const glm::dvec3 start(sk->joints[0].position_m[0], sk->joints[0].position_m[1], sk->joints[0].position_m[2]);
+  const glm::dvec3 P(p[0], p[1], p[2]), H(h[0], h[1], h[2]), L(l[0], l[1], l[2]), U(u[0], u[1], u[2]);
+  EXPECT_NEAR(glm::length(P - end), 0, 1e-12);
+  EXPECT_NEAR(glm::length(H - glm::normalize(end - start)), 0, 1e-12);
+  // An orthonormal right-handed frame (H × L = U), L turned 30° off -x and pitched with H.
+  EXPECT_NEAR(glm::length(L), 1, 1e-12);
+  EXPECT_NEAR(glm::dot(H, L), 0, 1e-12);
+  EXPECT_NEAR(glm::length(glm::cross(H, L) - U), 0, 1e-12);
+  EXPECT_GT(glm::length(L - glm::dvec3(-1, 0, 0)), 0.1);
+  // /(90) rolls U toward L... so the branch's up is the trunk's ±left (the sign is the roll's).
+  EXPECT_NEAR(std::abs(glm::dot(glm::dvec3(rolled[0], rolled[1], rolled[2]), L)), 1, 1e-12);
+  // + turned H about U = +z, & pitched it 20° toward -U.
+  EXPECT_NEAR(H.z, -std::sin(glm::radians(20.0)), 1e-12);
+}
+
+TEST(TurtleQueries, TwoParametersTakeXAndY) {
+  const lsys::Grammar g = parsed("module: A\naxiom: +(90) F(2) ?H(7, 7) ?P(7, 7)\n");
+  EXPECT_EQ(derived(g, 0), "+(90)F(2)?H(-1,0)?P(-2,0)");
+}
+
+TEST(TurtleQueries, ACpfgFileFillsThemTheSameWay) {
+  const lsys::Grammar g = parsed(
+      "Lsystem: 1\nderivation length: 3\nAxiom: A?P(0,0)\nA --> F(1)A\nendlsystem\n", "q.l");
+  auto w = derived_word(g, 3);
+  ASSERT_TRUE(w) << w.error().format();
+  const auto p = params_of(*w, lsys::kSymQueryPosition);
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_NEAR(p[0], 0, 1e-12);
+  EXPECT_NEAR(p[1], 3, 1e-12);
+}
+
+TEST(TurtleQueries, TheHomomorphismIsWhatTheTurtleReads) {
+  // A is drawn as two metres: the query after two A's stands four metres up. A homomorphism
+  // that drops a query is an error naming the counts.
+  const lsys::Grammar g = parsed("module: A\naxiom: A A ?P(0, 0)\nhomomorphism:\nA -> F(2)\n");
+  EXPECT_EQ(derived(g, 0), "AA?P(0,4)");
+  const lsys::Grammar dropped = parsed("module: A\naxiom: A ?P(0, 0)\nhomomorphism:\n?P(x, y) -> F(1)\n");
+  const std::string error = derived(dropped, 0);
+  EXPECT_NE(error.find("changes the number of turtle (?P ?H ?L ?U) queries (1 in the derived word, 0 drawn)"),
+            std::string::npos)
+      << error;
+}
+
+TEST(TurtleQueries, AreNotLightQueriesAndNeedNoLight) {
+  const lsys::Grammar g = parsed("module: A\naxiom: A ?P(0, 0)\nA -> F(1) A\n");
+  EXPECT_TRUE(grammar_queries_turtle(g));
+  EXPECT_FALSE(grammar_queries_light(g));
+  LightGrowthStats stats;
+  lsys::DeriveOptions o;
+  o.steps = 2;
+  auto w = derive_word(g, o, {}, &stats);
+  ASSERT_TRUE(w) << w.error().format();
+  EXPECT_EQ(stats.answers, 0u);
+  EXPECT_FALSE(grammar_queries_turtle(parsed("module: A\naxiom: A ?E(1)\nA -> F(1) A\n")));
+}
+
+// The three vectors a cpfg axiom's ?P? modules receive: `axiom` followed by ?H, ?L and ?U.
+std::array<glm::dvec3, 3> frame_after(const std::string& axiom) {
+  const lsys::Grammar g =
+      parsed("Lsystem: 1\nderivation length: 0\nAxiom: " + axiom + "?H(0,0,0)?L(0,0,0)?U(0,0,0)\nendlsystem\n", "r.l");
+  auto w = derived_word(g, 0);
+  if (!w) {
+    ADD_FAILURE() << w.error().format();
+    return {};
+  }
+  std::array<glm::dvec3, 3> out;
+  const lsys::SymbolId ids[3] = {lsys::kSymQueryHeading, lsys::kSymQueryLeft, lsys::kSymQueryUp};
+  for (int k = 0; k < 3; ++k) {
+    const auto v = params_of(*w, ids[k]);
+    if (v.size() == 3) out[static_cast<size_t>(k)] = {v[0], v[1], v[2]};
+  }
+  return out;
+}
+
+bool near(const glm::dvec3& a, const glm::dvec3& b) { return glm::length(a - b) < 1e-12; }
+
+TEST(TurtleQueries, CpfgAtRSetsTheHeadingByTheLeastRotationOrWithItsUpVector) {
+  // CPFG manual 6.2. The turtle starts with H = +y, L = -x, U = +z. Turning H to +x rotates
+  // about -z: U stays, L becomes +y. A reversal turns about U, as |.
+  auto f = frame_after("@R(2,0,0)");
+  EXPECT_TRUE(near(f[0], {1, 0, 0}));
+  EXPECT_TRUE(near(f[1], {0, 1, 0}));
+  EXPECT_TRUE(near(f[2], {0, 0, 1}));
+  f = frame_after("@R(0,-3,0)");
+  EXPECT_TRUE(near(f[0], {0, -1, 0}));
+  EXPECT_TRUE(near(f[1], {1, 0, 0}));
+  EXPECT_TRUE(near(f[2], {0, 0, 1}));
+  // With an up vector: up made perpendicular to H and normalised, L = U x H.
+  f = frame_after("@R(1,0,0,1,1,1)");
+  const double r = 1 / std::sqrt(2.0);
+  EXPECT_TRUE(near(f[0], {1, 0, 0}));
+  EXPECT_TRUE(near(f[2], {0, r, r}));
+  EXPECT_TRUE(near(f[1], {0, r, -r}));
+  // After a roll and a pitch, @R still sets the heading absolutely, and F follows it.
+  const lsys::Grammar g = parsed("Lsystem: 1\nderivation length: 0\nAxiom: /(33)&(20)@R(0,0,1)F(2)?P(0,0,0)\nendlsystem\n", "r.l");
+  auto w = derived_word(g, 0);
+  ASSERT_TRUE(w);
+  const auto p = params_of(*w, lsys::kSymQueryPosition);
+  ASSERT_EQ(p.size(), 3u);
+  EXPECT_TRUE(near({p[0], p[1], p[2]}, {0, 0, 2}));
+  // Bad vectors are errors naming @R.
+  for (const char* bad : {"@R(0,0,0)F", "@R(1,0,0,2,0,0)F", "@R(1,0)F"}) {
+    const lsys::Grammar b = parsed(std::string("Lsystem: 1\nAxiom: ") + bad + "\nendlsystem\n", "r.l");
+    auto sk = build_skeleton(b.axiom, b);
+    ASSERT_FALSE(sk) << bad;
+    EXPECT_NE(sk.error().message.find("@R"), std::string::npos) << sk.error().message;
+  }
+}
+
+}  // namespace
+}  // namespace sylva
