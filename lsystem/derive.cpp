@@ -9,6 +9,7 @@
 #include "lsystem/derive.h"
 
 #include <algorithm>
+#include <optional>
 #include <cassert>
 #include <chrono>
 #include <cmath>
@@ -19,6 +20,9 @@ namespace {
 
 constexpr uint64_t kAxiomKeyBase = 0xA7104D5EEDULL;
 constexpr uint64_t kHomomorphismStreamBase = 0x40000000ULL;
+// Decomposition's streams: step k's pass d draws from base + k·(kMaxDecompositionDepth + 2) + d.
+constexpr uint64_t kDecompositionStreamBase = 0xDEC0000000000ULL;
+constexpr uint64_t kMaxDecompositionDepth = 1000;  // the parser's limit on maximum depth
 constexpr uint64_t kBlockStreamBase = 0xB10C0000ULL;  // + 4 * step + which block
 constexpr uint32_t kNoMatch = 0xFFFFFFFFu;
 constexpr size_t kMaxParams = 0xFFFFFFF0u;
@@ -578,6 +582,60 @@ void run_block(const Grammar& g, Block block, int64_t step, uint64_t* seed, Eval
 
 }  // namespace
 
+namespace {
+
+// Applies `productions` (those `rewriter` was made with) to `cur` recursively, up to
+// `max_depth` passes, leaving the result in `cur` (`next` is scratch): homomorphism and
+// decomposition alike (CPFG manual 4.3, 4.4). Without context, depth first (pass d
+// rewrites what pass d - 1 produced, with stream `stream_base + d`); with context, pass by
+// pass over the whole word, each with its context in the word of the pass before. Returns
+// the passes performed; with `count_left`, `*left` counts the modules left unexpanded at
+// the depth limit that a production could still rewrite. Throws as the rewriter does
+// (DeriveCancelled when `progress` is cancelled between passes).
+int apply_recursively(Rewriter& rewriter, const std::vector<Production>& productions,
+                      const std::vector<std::vector<uint32_t>>& by_symbol, Word& cur, Word& next, uint64_t stream_base,
+                      int max_depth, uint64_t budget, const Progress& progress, bool count_left, uint64_t* left) {
+  *left = 0;
+  const bool context =
+      std::any_of(productions.begin(), productions.end(), [](const Production& p) { return p.has_context(); });
+  if (!context) {
+    // Without context, pass d reads nothing but the modules pass d - 1 produced: expand
+    // each module depth first, so unexpandable modules are not copied once per pass.
+    int deepest = 0;
+    next.clear();
+    rewriter.expand(cur, next, stream_base, max_depth, budget, progress, &deepest, left);
+    if (!count_left) *left = 0;
+    std::swap(cur, next);
+    return std::min(deepest + 1, max_depth);
+  }
+  // Context reads the whole word of the pass before: pass by pass, each over the word.
+  std::vector<uint8_t> active(cur.size(), 1), next_active;
+  int depth = 1;
+  for (; depth <= max_depth; ++depth) {
+    if (progress.cancelled()) throw DeriveCancelled{};
+    next.clear();
+    next_active.clear();
+    rewriter.current_production = nullptr;
+    rewriter.current_depth = depth;
+    // Passes until nothing expands: each reports within the pass only (how many passes
+    // there will be is not known), monotone across passes by the share scheme 1 - 2^-depth.
+    const double first = 1 - std::ldexp(1.0, -(depth - 1)), last = 1 - std::ldexp(1.0, -depth);
+    rewriter.rewrite(cur, next, stream_base + static_cast<uint64_t>(depth), &active, &next_active,
+                     progress.part(first, last), "interpret");
+    const bool changed = std::find(next_active.begin(), next_active.end(), 1) != next_active.end();
+    std::swap(cur, next);
+    std::swap(active, next_active);
+    if (!changed) break;
+  }
+  // Modules produced by the last pass that still have a production: left unexpanded.
+  if (depth > max_depth && count_left)
+    for (size_t i = 0; i < cur.size(); ++i)
+      if (active[i] && !by_symbol[cur.modules[i].symbol].empty()) ++*left;
+  return std::min(depth, max_depth);
+}
+
+}  // namespace
+
 struct Derivation::Impl {
   Impl(const Grammar& grammar, const DeriveOptions& o)
       : g(grammar),
@@ -586,7 +644,32 @@ struct Derivation::Impl {
         seed(o.seed.value_or(grammar.seed)),
         globals(grammar.global_names.size(), 0.0),
         context{globals.data()},
-        rewriter(grammar, grammar.productions, grammar.productions_by_symbol, seed, o.max_modules, &context) {}
+        rewriter(grammar, grammar.productions, grammar.productions_by_symbol, seed, o.max_modules, &context) {
+    if (!grammar.decomposition.empty()) {
+      decomposer.emplace(grammar, grammar.decomposition, grammar.decomposition_by_symbol, seed, o.max_modules,
+                         &context);
+      decompose_budget =
+          o.max_modules > UINT64_MAX / kInterpretBudgetFactor ? UINT64_MAX : o.max_modules * kInterpretBudgetFactor;
+      decomposer->set_work_budget(decompose_budget);
+    }
+  }
+
+  // The decomposition productions applied to `cur` (CPFG manual 4.4), each step's from
+  // its own streams; the rewriter that failed, if one throws, is `active`.
+  void decompose(int64_t at) {
+    if (!decomposer) return;
+    active = &*decomposer;
+    decomposer->set_seed(seed);
+    decomposer->current_production = nullptr;
+    uint64_t left = 0;
+    apply_recursively(*decomposer, g.decomposition, g.decomposition_by_symbol, cur, next,
+                      kDecompositionStreamBase + static_cast<uint64_t>(at) * (kMaxDecompositionDepth + 2),
+                      g.decomposition_depth, decompose_budget, options.progress, false, &left);
+    if (cur.size() > options.max_modules)
+      throw DeriveFailure{{}, "the decomposition makes more than --max-modules (" +
+                                  std::to_string(options.max_modules) + ") modules"};
+    active = &rewriter;
+  }
 
   // on_step's "no" is a cancellation too: its Diagnostic has `cancelled` set.
   Diagnostic stopped_at(int64_t at) const {
@@ -603,6 +686,9 @@ struct Derivation::Impl {
   std::vector<double> globals;
   EvalContext context;
   Rewriter rewriter;
+  std::optional<Rewriter> decomposer;  // with decomposition productions only
+  Rewriter* active = &rewriter;        // the one whose production an error names
+  uint64_t decompose_budget = 0;       // modules a step's decomposition may write
   std::chrono::steady_clock::time_point t0 = std::chrono::steady_clock::now();
   Word cur, next;
   uint64_t peak = 0;
@@ -652,6 +738,18 @@ Status Derivation::start() {
   }
   if (g.uses_cut) apply_cut(m.cur);
   m.rewriter.set_seed(m.seed);
+  if (m.decomposer) {
+    try {
+      m.decompose(0);
+      if (g.uses_cut) apply_cut(m.cur);
+    } catch (const DeriveCancelled&) {
+      return cancelled_diagnostic();
+    } catch (const DeriveFailure& f) {
+      return failure_diagnostic(g, *m.active, f.message, f.loc, "step", 0);
+    } catch (const EvalError& e) {
+      return failure_diagnostic(g, *m.active, e.message, e.loc, "step", 0);
+    }
+  }
   m.peak = m.cur.capacity_bytes();
   if (m.options.on_step && !m.options.on_step(0, m.cur)) return m.stopped_at(0);
   m.failed = false;
@@ -684,15 +782,19 @@ Status Derivation::advance() {
     m.growth = m.cur.size() ? std::max(1.0, static_cast<double>(m.next.size()) / static_cast<double>(m.cur.size()))
                             : 2.0;
     std::swap(m.cur, m.next);
+    if (m.decomposer) {
+      m.decompose(step);
+      if (g.uses_cut) apply_cut(m.cur);
+    }
     m.rewriter.current_production = nullptr;
     run_block(g, Block::kEndEach, step, &m.seed, m.context);
     if (m.options.on_step && !m.options.on_step(step, m.cur)) return m.stopped_at(step);
   } catch (const DeriveCancelled&) {
     return cancelled_diagnostic();
   } catch (const DeriveFailure& f) {
-    return failure_diagnostic(g, m.rewriter, f.message, f.loc, "step", step);
+    return failure_diagnostic(g, *m.active, f.message, f.loc, "step", step);
   } catch (const EvalError& e) {
-    return failure_diagnostic(g, m.rewriter, e.message, e.loc, "step", step);
+    return failure_diagnostic(g, *m.active, e.message, e.loc, "step", step);
   } catch (const std::bad_alloc&) {
     return g.error_at({}, "out of memory at step " + std::to_string(step) +
                               "; lower --max-modules or the derivation length");
@@ -751,44 +853,11 @@ Expected<Word> interpret(const Grammar& g, const Word& word, const DeriveOptions
                               ? UINT64_MAX
                               : options.max_modules * kInterpretBudgetFactor;
   rewriter.set_work_budget(budget);
-  const bool context = std::any_of(g.homomorphism.begin(), g.homomorphism.end(),
-                                   [](const Production& p) { return p.has_context(); });
   int depth = 0;  // passes performed, as stats report them
   uint64_t left = 0;
   try {
-    if (!context) {
-      // Without context, pass d reads nothing but the modules pass d - 1 produced: expand
-      // each module depth first, so unexpandable modules are not copied once per pass.
-      int deepest = 0;
-      rewriter.expand(cur, next, kHomomorphismStreamBase, g.max_depth, budget, options.progress, &deepest, &left);
-      depth = std::min(deepest + 1, g.max_depth);
-      std::swap(cur, next);
-    } else {
-      // Context reads the whole word of the pass before: pass by pass, each over the word.
-      std::vector<uint8_t> active(cur.size(), 1), next_active;
-      for (depth = 1; depth <= g.max_depth; ++depth) {
-        if (options.progress.cancelled()) return cancelled_diagnostic();
-        next.clear();
-        next_active.clear();
-        rewriter.current_production = nullptr;
-        rewriter.current_depth = depth;
-        // Passes until nothing expands: each reports within the pass only (how many
-        // passes there will be is not known), monotone across passes by the share scheme
-        // 1 - 2^-depth.
-        const double first = 1 - std::ldexp(1.0, -(depth - 1)), last = 1 - std::ldexp(1.0, -depth);
-        rewriter.rewrite(cur, next, kHomomorphismStreamBase + static_cast<uint64_t>(depth), &active, &next_active,
-                         options.progress.part(first, last), "interpret");
-        bool changed = std::find(next_active.begin(), next_active.end(), 1) != next_active.end();
-        std::swap(cur, next);
-        std::swap(active, next_active);
-        if (!changed) break;
-      }
-      // Modules produced by the last pass that still have a production: left unexpanded.
-      if (depth > g.max_depth && g.depth_warnings)
-        for (size_t i = 0; i < cur.size(); ++i)
-          if (active[i] && !g.homomorphism_by_symbol[cur.modules[i].symbol].empty()) ++left;
-      depth = std::min(depth, g.max_depth);
-    }
+    depth = apply_recursively(rewriter, g.homomorphism, g.homomorphism_by_symbol, cur, next, kHomomorphismStreamBase,
+                              g.max_depth, budget, options.progress, g.depth_warnings, &left);
   } catch (const DeriveCancelled&) {
     return cancelled_diagnostic();
   } catch (const DeriveFailure& f) {

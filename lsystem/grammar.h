@@ -120,10 +120,16 @@ struct Grammar {
   Program program;           // all compiled expressions
   std::vector<Production> productions;
   std::vector<Production> homomorphism;
+  // Decomposition productions (CPFG manual 4.4): applied recursively, up to
+  // decomposition_depth passes, to the axiom and after every step's rewriting, before
+  // EndEach; their results stay in the word.
+  std::vector<Production> decomposition;
+  int decomposition_depth = 16;  // a cpfg file's default: 1, as its homomorphism's
   std::vector<uint8_t> ignored;  // by symbol id: skipped when matching context
   // Index lists by predecessor symbol, in file order.
   std::vector<std::vector<uint32_t>> productions_by_symbol;
   std::vector<std::vector<uint32_t>> homomorphism_by_symbol;
+  std::vector<std::vector<uint32_t>> decomposition_by_symbol;
   bool uses_random = false;   // any stochastic production or random function
   bool uses_context = false;  // any production with left or right context
   bool uses_cut = false;      // % appears in a successor or the axiom

@@ -251,12 +251,16 @@ class Parser {
   // ---- lines ----
   void parse_define(const LogicalLine& line);
   bool try_directive(const LogicalLine& line);
-  void parse_production(const LogicalLine& line, bool homomorphism);
+  // The part of the grammar its productions go to (sections `productions:`,
+  // `decomposition:`, `homomorphism:`).
+  enum class Section { kProductions, kDecomposition, kHomomorphism };
+  Section section_ = Section::kProductions;
+  void parse_production(const LogicalLine& line);
   void declare_modules(Cursor c);
   void set_ignore(Cursor c);
 
   // ---- cpfg model files (docs/cpfg.md) ----
-  bool cpfg_line(const LogicalLine& line, std::string_view rest, bool* homomorphism);
+  bool cpfg_line(const LogicalLine& line, std::string_view rest);
   void set_consider(Cursor c);
   // Statements (CPFG manual 3.2, 4.1): `{ ... }` at c, compiled into one program that leaves
   // 0 on the stack. With `scope` (a production) a new name assigned is a local slot there;
@@ -912,7 +916,7 @@ bool Parser::try_directive(const LogicalLine& line) {
       double n = constant_expression(value, "maximum depth");
       if (n < 0 || n != std::floor(n) || n > kMaxDepthLimit)
         fail(value.loc(), "maximum depth must be an integer from 0 to 1000");
-      g_.max_depth = static_cast<int>(n);
+      (section_ == Section::kDecomposition ? g_.decomposition_depth : g_.max_depth) = static_cast<int>(n);
     } else {  // axiom / ω
       if (have_axiom_) fail(loc, "the axiom is given twice");
       have_axiom_ = true;
@@ -932,7 +936,7 @@ bool Parser::try_directive(const LogicalLine& line) {
   return false;
 }
 
-void Parser::parse_production(const LogicalLine& line, bool homomorphism) {
+void Parser::parse_production(const LogicalLine& line) {
   Cursor all{&line, 0, line.text.size()};
   all.skip_spaces();
   Production p;
@@ -1088,12 +1092,15 @@ void Parser::parse_production(const LogicalLine& line, bool homomorphism) {
   p.slot_count = static_cast<uint32_t>(scope.size());  // the formal parameters, then the locals
   for (const Expr& e : p.successor.args)
     if (e.uses_random) g_.uses_random = true;
-  (homomorphism ? g_.homomorphism : g_.productions).push_back(std::move(p));
+  (section_ == Section::kHomomorphism    ? g_.homomorphism
+   : section_ == Section::kDecomposition ? g_.decomposition
+                                          : g_.productions)
+      .push_back(std::move(p));
 }
 
 // A line of a cpfg file that only cpfg has; true when it was one. Productions and the
 // directives both formats share go on to the common code.
-bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest, bool* homomorphism) {
+bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest) {
   Cursor c{&line, 0, line.text.size()};
   c.skip_spaces();
   const std::string folded = lower_ascii(rest);
@@ -1122,23 +1129,32 @@ bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest, bool* hom
     seen_end_ = true;
     return true;
   }
-  if (keyword("homomorphism", true, &value)) {
+  for (const char* part : {"homomorphism", "decomposition"}) {
+    if (!keyword(part, true, &value)) continue;
     const std::string option = lower_ascii(value.rest());
     std::string_view o = option;
     while (!o.empty() && is_space(o.front())) o.remove_prefix(1);
-    if (!o.empty() && o != "warnings" && o != "no warnings")
-      fail(value.loc(), "expected 'warnings' or 'no warnings' after 'homomorphism:'");
-    g_.depth_warnings = o == "warnings";
-    *homomorphism = true;
+    if (!o.empty() && o != "warnings" && o != "no warnings") {
+      value.skip_spaces();
+      fail(value.loc(), std::string("expected 'warnings' or 'no warnings' after '") + part + ":'");
+    }
+    const bool homomorphism = part[0] == 'h';
+    if (homomorphism) g_.depth_warnings = o == "warnings";
+    // Decomposition comes after the productions and before the homomorphism (manual 4.4).
+    if (!homomorphism && section_ == Section::kHomomorphism)
+      fail(c.loc(), "'decomposition:' must come before 'homomorphism:' (CPFG manual 4.4)");
+    section_ = homomorphism ? Section::kHomomorphism : Section::kDecomposition;
     return true;
   }
   // The homomorphism's own generator (manual 4.3.3): sylva's homomorphism draws from streams
   // keyed by module and depth already, so a redraw never changes it; the value is read only.
-  if (*homomorphism && keyword("seed", false, &value)) {
+  // Decomposition draws from the L-system's generator: it has no seed of its own (4.4).
+  if (section_ == Section::kHomomorphism && keyword("seed", false, &value)) {
     constant_expression(value, "the homomorphism's seed");
     return true;
   }
-  if (keyword("decomposition", true, nullptr)) unsupported("decomposition (CPFG manual 4.4)");
+  if (section_ == Section::kDecomposition && keyword("seed", false, nullptr))
+    fail(c.loc(), "decomposition draws from the L-system's generator: it takes no 'seed:' (CPFG manual 4.4)");
   if (folded.compare(0, 4, "ring") == 0 && folded.find("lsystem") != std::string::npos)
     unsupported("a ring L-system (CPFG manual 3.1.1)");
   if (keyword("consider", false, &value)) {
@@ -1451,6 +1467,7 @@ void Parser::parse(const std::string& text) {
     g_.cpfg = true;
     g_.turtle.angle_deg = 45;  // the view file's default angle increment (CPFG manual 8.1.1)
     g_.max_depth = 1;          // a homomorphism is applied once unless 'maximum depth:' says more
+    g_.decomposition_depth = 1;  // ... and so is a decomposition (manual 4.4)
     g_.depth_warnings = false; // ... and says nothing of what is left unless asked (manual 4.3.1)
     g_.turtle.width = 1 * g_.turtle.width_scale;  // the initial line width, 1 (manual 8.1.1)
     std::string body = text;
@@ -1485,7 +1502,6 @@ void Parser::parse(const std::string& text) {
       fail({0, 0}, "-D " + name + ": the grammar has no '#define " + name + "'");
   }
   // Pass 3: directives, sections and productions.
-  bool homomorphism = false;
   for (const LogicalLine& line : lines) {
     LineKind kind = classify(line);
     if (kind != LineKind::kOther) continue;
@@ -1493,7 +1509,7 @@ void Parser::parse(const std::string& text) {
     c.skip_spaces();
     std::string_view rest = c.rest();
     while (!rest.empty() && is_space(rest.back())) rest.remove_suffix(1);
-    if (g_.cpfg && cpfg_line(line, rest, &homomorphism)) continue;
+    if (g_.cpfg && cpfg_line(line, rest)) continue;
     if (rest.substr(0, 7) == "#ignore") {
       Cursor v = c.sub(c.pos + 7, line.text.size());
       v.skip_spaces();
@@ -1514,15 +1530,19 @@ void Parser::parse(const std::string& text) {
       return true;
     };
     if (section("productions")) {
-      homomorphism = false;
+      section_ = Section::kProductions;
+      continue;
+    }
+    if (section("decomposition")) {
+      section_ = Section::kDecomposition;
       continue;
     }
     if (section("homomorphism") || section("interpretation")) {
-      homomorphism = true;
+      section_ = Section::kHomomorphism;
       continue;
     }
     if (find_top_level(c, "->") != std::string::npos) {
-      parse_production(line, homomorphism);
+      parse_production(line);
       continue;
     }
     if (try_directive(line)) continue;
@@ -1553,6 +1573,9 @@ void Parser::parse(const std::string& text) {
   }
   g_.productions_by_symbol.assign(nsym, {});
   g_.homomorphism_by_symbol.assign(nsym, {});
+  g_.decomposition_by_symbol.assign(nsym, {});
+  for (uint32_t i = 0; i < g_.decomposition.size(); ++i)
+    g_.decomposition_by_symbol[g_.decomposition[i].predecessor.symbol].push_back(i);
   for (uint32_t i = 0; i < g_.productions.size(); ++i)
     g_.productions_by_symbol[g_.productions[i].predecessor.symbol].push_back(i);
   for (uint32_t i = 0; i < g_.homomorphism.size(); ++i)
@@ -1662,6 +1685,7 @@ Expected<Word> parse_word(std::string_view text, Grammar& grammar) {
     grammar.ignored.resize(nsym, 0);
     grammar.productions_by_symbol.resize(nsym);
     grammar.homomorphism_by_symbol.resize(nsym);
+    grammar.decomposition_by_symbol.resize(nsym);
     return w;
   } catch (const ParseFailure& f) {
     Diagnostic d = diagnostic_at("<word>", f.loc, f.message);

@@ -26,7 +26,7 @@ bool grammar_writes(const lsys::Grammar& g, Pred pred) {
   };
   if (std::any_of(g.axiom.modules.begin(), g.axiom.modules.end(), [&](const lsys::Module& m) { return pred(m.symbol); }))
     return true;
-  for (const auto* list : {&g.productions, &g.homomorphism})
+  for (const auto* list : {&g.productions, &g.decomposition, &g.homomorphism})
     for (const lsys::Production& p : *list)
       if (in(p.successor)) return true;
   return false;

@@ -43,7 +43,7 @@ struct GrowLight {
   const Scene* scene = nullptr;
 };
 
-// Whether any module the grammar writes (axiom, productions, homomorphism) is a light
+// Whether any module the grammar writes (axiom, productions, decomposition, homomorphism) is a light
 // query: only then does growing it trace light.
 bool grammar_queries_light(const lsys::Grammar& grammar);
 // Whether it writes a turtle query (?P, ?H, ?L or ?U; CPFG manual 6.9): then every step's

@@ -125,28 +125,29 @@ dvec3 rotate_about(const dvec3& v, const dvec3& k, double angle_rad) {
   return v * c + glm::cross(k, v) * s + k * glm::dot(k, v) * (1 - c);
 }
 
-// @R(hx, hy, hz) and @R(hx, hy, hz, ux, uy, uz) (CPFG manual 6.2): the heading set to the
-// given direction (normalised); without an up vector the frame turns by the least rotation
-// that takes the old heading to the new one (its left and up "rotate least"); with one, up
-// is that vector made perpendicular to the heading and normalised, and left = up × heading.
+// @R(hx, hy[, hz]) and @R(hx, hy, hz, ux, uy, uz) (CPFG manual 6.2, as cpfg does it): the
+// heading set to the given direction (normalised; z = 0 with two parameters; a zero vector
+// is the initial heading, +y). With an up vector that is not zero and perpendicular to the
+// heading, up is that vector normalised and left = up × heading; otherwise the frame turns
+// by the least rotation that takes the old heading to the new one (left and up "rotate
+// least").
 void set_heading(TurtleState& t, uint32_t count, const double* p) {
-  if (count != 3 && count != 6) throw TurtleFailure{"@R takes 3 parameters, @R(hx, hy, hz), or 6, with the up vector"};
-  for (uint32_t k = 0; k < count; ++k)
+  if (count < 2) throw TurtleFailure{"@R takes the heading: @R(hx, hy, hz), or with the up vector, @R(hx, hy, hz, ux, uy, uz)"};
+  for (uint32_t k = 0; k < count && k < 6; ++k)
     if (!std::isfinite(p[k])) throw TurtleFailure{"@R's vectors must be finite"};
-  const dvec3 h(p[0], p[1], p[2]);
+  const dvec3 h(p[0], p[1], count >= 3 ? p[2] : 0.0);
   const double hl = glm::length(h);
-  if (!(hl > 0) || !std::isfinite(hl)) throw TurtleFailure{"@R's heading must not be zero"};
-  const dvec3 heading = h / hl;
-  if (count == 6) {
+  if (!std::isfinite(hl)) throw TurtleFailure{"@R's vectors must be finite"};
+  const dvec3 heading = hl > 0 ? h / hl : dvec3(0, 1, 0);
+  if (count >= 6) {
     const dvec3 u(p[3], p[4], p[5]);
-    const dvec3 across = u - glm::dot(u, heading) * heading;
-    const double al = glm::length(across);
-    if (!(al > 1e-12 * glm::length(u)) || !std::isfinite(al))
-      throw TurtleFailure{"@R's up vector must not be zero or along the heading"};
-    t.heading = heading;
-    t.up = across / al;
-    t.left = glm::cross(t.up, t.heading);
-    return;
+    const double ul = glm::length(u);
+    if (ul > 0 && std::isfinite(ul) && std::abs(glm::dot(u / ul, heading)) <= 1e-12) {
+      t.heading = heading;
+      t.up = glm::normalize(u - glm::dot(u, heading) * heading);
+      t.left = glm::cross(t.up, t.heading);
+      return;
+    }
   }
   // The least rotation from the old heading to the new: about old × new by their angle
   // (atan2 of |cross| and dot, exact near 0 and 180 degrees); a reversal turns about U.
@@ -154,8 +155,7 @@ void set_heading(TurtleState& t, uint32_t count, const double* p) {
   const double sin_a = glm::length(axis), cos_a = glm::dot(t.heading, heading);
   if (sin_a > 1e-15) {
     const dvec3 k = axis / sin_a;
-    const double angle = std::atan2(sin_a, cos_a);
-    t.left = rotate_about(t.left, k, angle);
+    t.left = rotate_about(t.left, k, std::atan2(sin_a, cos_a));
   } else if (cos_a < 0) {
     t.left = -t.left;  // 180 degrees about U, as |
   }
@@ -173,7 +173,7 @@ std::vector<SourceLoc> places_writing(const lsys::Grammar& g, lsys::SymbolId sym
       places.push_back(g.axiom_loc);
       break;
     }
-  for (const auto* list : {&g.productions, &g.homomorphism})
+  for (const auto* list : {&g.productions, &g.decomposition, &g.homomorphism})
     for (const lsys::Production& p : *list)
       for (const lsys::SuccessorModule& m : p.successor.modules)
         if (m.symbol == symbol) {

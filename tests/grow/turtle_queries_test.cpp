@@ -154,12 +154,21 @@ TEST(TurtleQueries, CpfgAtRSetsTheHeadingByTheLeastRotationOrWithItsUpVector) {
   EXPECT_TRUE(near(f[0], {0, -1, 0}));
   EXPECT_TRUE(near(f[1], {1, 0, 0}));
   EXPECT_TRUE(near(f[2], {0, 0, 1}));
-  // With an up vector: up made perpendicular to H and normalised, L = U x H.
-  f = frame_after("@R(1,0,0,1,1,1)");
+  // With an up vector perpendicular to H: that up, normalised, and L = U x H.
+  f = frame_after("@R(1,0,0,0,2,2)");
   const double r = 1 / std::sqrt(2.0);
   EXPECT_TRUE(near(f[0], {1, 0, 0}));
   EXPECT_TRUE(near(f[2], {0, r, r}));
   EXPECT_TRUE(near(f[1], {0, r, -r}));
+  // An up vector that is not perpendicular (or zero) is ignored as cpfg ignores it: the
+  // least rotation again. Two parameters are x and y; a zero heading is +y.
+  f = frame_after("@R(1,0,0,1,1,1)");
+  EXPECT_TRUE(near(f[1], {0, 1, 0}));
+  EXPECT_TRUE(near(f[2], {0, 0, 1}));
+  f = frame_after("@R(0,-3)");
+  EXPECT_TRUE(near(f[0], {0, -1, 0}));
+  f = frame_after("+(90)@R(0,0,0)");
+  EXPECT_TRUE(near(f[0], {0, 1, 0}));
   // After a roll and a pitch, @R still sets the heading absolutely, and F follows it.
   const lsys::Grammar g = parsed("Lsystem: 1\nderivation length: 0\nAxiom: /(33)&(20)@R(0,0,1)F(2)?P(0,0,0)\nendlsystem\n", "r.l");
   auto w = derived_word(g, 0);
@@ -167,8 +176,8 @@ TEST(TurtleQueries, CpfgAtRSetsTheHeadingByTheLeastRotationOrWithItsUpVector) {
   const auto p = params_of(*w, lsys::kSymQueryPosition);
   ASSERT_EQ(p.size(), 3u);
   EXPECT_TRUE(near({p[0], p[1], p[2]}, {0, 0, 2}));
-  // Bad vectors are errors naming @R.
-  for (const char* bad : {"@R(0,0,0)F", "@R(1,0,0,2,0,0)F", "@R(1,0)F"}) {
+  // No heading is an error naming @R.
+  for (const char* bad : {"@R F", "@R(1)F"}) {
     const lsys::Grammar b = parsed(std::string("Lsystem: 1\nAxiom: ") + bad + "\nendlsystem\n", "r.l");
     auto sk = build_skeleton(b.axiom, b);
     ASSERT_FALSE(sk) << bad;

@@ -252,23 +252,24 @@ TEST(CpfgModel, ConsiderMakesContextSeeOnlyTheNamedModules) {
             std::string::npos);
 }
 
+// The word the turtle reads: `g` derived and interpreted, printed (or the error).
+std::string drawn_text(const Grammar& g) {
+  auto w = derive(g);
+  if (!w.ok()) return "<error: " + w.error().message + ">";
+  auto drawn = interpret(g, *w);
+  if (!drawn.ok()) return "<error: " + drawn.error().message + ">";
+  return print_word(*drawn, g.symbols);
+}
+
 TEST(CpfgModel, AHomomorphismIsAppliedOnceUnlessMaximumDepthSaysMore) {
   Grammar once = parse_ok("Lsystem: 1\nAxiom: X\nhomomorphism\nX --> Y\nY --> F\nendlsystem\n");
   EXPECT_EQ(once.max_depth, 1);
-  auto w = derive(once);
-  ASSERT_TRUE(w.ok());
-  auto drawn = interpret(once, *w);
-  ASSERT_TRUE(drawn.ok());
-  EXPECT_EQ(print_word(*drawn, once.symbols), "Y");
+  EXPECT_EQ(drawn_text(once), "Y");
   // A seed after 'homomorphism' is the homomorphism's (manual 4.3.3), never the derivation's.
   Grammar twice = parse_ok(
       "Lsystem: 1\nseed: 5\nAxiom: X\nhomomorphism: warnings\nseed: 9\nmaximum depth: 2\nX --> Y\nY --> F\nendlsystem\n");
   EXPECT_EQ(twice.seed, 5u);
-  auto w2 = derive(twice);
-  ASSERT_TRUE(w2.ok());
-  auto drawn2 = interpret(twice, *w2);
-  ASSERT_TRUE(drawn2.ok());
-  EXPECT_EQ(print_word(*drawn2, twice.symbols), "F");
+  EXPECT_EQ(drawn_text(twice), "F");
 }
 
 TEST(CpfgModel, TheChapterSixModuleNamesAreOneModuleEach) {
@@ -284,13 +285,68 @@ TEST(CpfgModel, WhatSylvaCannotReadYetIsAnErrorAtItsPlaceNamingTheFeature) {
       {"Lsystem: 1\nAxiom: F\ndefine: { array a[3]; }\nendlsystem\n", 3, 1, "arrays"},
       {"Lsystem: 1\nAxiom: F\nF : {a[1] = 2;} * --> F\nendlsystem\n", 3, 7, "arrays"},
       {"Lsystem: 1\nring lsystem\nAxiom: F\nendlsystem\n", 2, 1, "ring L-system"},
-      {"Lsystem: 1\nAxiom: F\ndecomposition\nendlsystem\n", 3, 1, "decomposition"},
       {"Lsystem: 1\nAxiom: F\nendlsystem\nLsystem: 2\nAxiom: G\nendlsystem\n", 4, 1, "sub-L-systems"},
   };
   for (const LocatedError& c : cases) {
     expect_located(c);
     EXPECT_NE(parse_error(c.text).message.find("not supported yet"), std::string::npos) << c.text;
   }
+}
+
+// ---- decomposition (CPFG manual 4.4) ----
+
+TEST(CpfgDecomposition, AppliesAfterEveryStepAndItsResultsStayInTheWord) {
+  // Depth 1 (cpfg's default): step 1: A -> A B, then B -> F C: AFC. Step 2: A -> A B (F and
+  // C have no production), then B -> F C and the C of step 1 -> [+F]: AFCF[+F].
+  const std::string model = "Lsystem: 1\nderivation length: 2\nAxiom: A\nA --> A B\ndecomposition:\nB --> F C\n"
+                            "C --> [+F]\nendlsystem\n";
+  EXPECT_EQ(derive_text(model), "AFCF[+F]");
+  // maximum depth: 2 decomposes what it decomposed once more; the homomorphism keeps its
+  // own depth, and decomposition results are what the homomorphism (and the next step) see.
+  const std::string deep = "Lsystem: 1\nderivation length: 2\nAxiom: A\nA --> A B\ndecomposition:\nmaximum depth: 2\n"
+                           "B --> F C\nC --> [+F]\nhomomorphism:\nmaximum depth: 3\nF --> G\nendlsystem\n";
+  EXPECT_EQ(derive_text(deep), "AF[+F]F[+F]");
+  Grammar g = parse_ok(deep);
+  EXPECT_EQ(g.decomposition_depth, 2);
+  EXPECT_EQ(g.max_depth, 3);
+  EXPECT_EQ(g.decomposition.size(), 2u);
+  EXPECT_EQ(g.productions.size(), 1u);
+  EXPECT_EQ(g.homomorphism.size(), 1u);
+  EXPECT_EQ(drawn_text(g), "AG[+G]G[+G]");
+}
+
+TEST(CpfgDecomposition, TheAxiomIsDecomposedAndContextAndParametersWork) {
+  // The axiom is decomposed before anything reads it (step 0); a parametric decomposition
+  // with a condition, and one with context: B(n) splits while n > 1, into halves; a C
+  // after a B becomes D.
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 0\nAxiom: B(4)\ndecomposition:\nmaximum depth: 5\n"
+                        "B(n) : n > 1 --> B(n/2)B(n/2)\nendlsystem\n"),
+            "B(1)B(1)B(1)B(1)");
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: B C C\nC --> C\ndecomposition:\nB < C --> D\n"
+                        "endlsystem\n"),
+            "BDC");
+  // sylva's own format has the section too (default depth 16, as its homomorphism).
+  EXPECT_EQ(derive_text("module: A B C\nderivation length: 2\naxiom: A B\nA -> A B\ndecomposition:\nB -> F C\n"
+                        "C -> [+F]\n"),
+            "AF[+F]F[+F]F[+F]");
+}
+
+TEST(CpfgDecomposition, ErrorsArePlacedAndItsGrowthIsBounded) {
+  const LocatedError cases[] = {
+      {"Lsystem: 1\nAxiom: F\nhomomorphism:\nF --> G\ndecomposition:\nG --> F\nendlsystem\n", 5, 1,
+       "'decomposition:' must come before 'homomorphism:'"},
+      {"Lsystem: 1\nAxiom: F\ndecomposition:\nseed: 3\nendlsystem\n", 4, 1, "takes no 'seed:'"},
+      {"Lsystem: 1\nAxiom: F\ndecomposition: often\nendlsystem\n", 3, 16, "expected 'warnings' or 'no warnings'"},
+  };
+  for (const LocatedError& c : cases) expect_located(c);
+  // A decomposition that doubles at every pass stops at --max-modules with an error.
+  Grammar g = parse_ok("Lsystem: 1\nderivation length: 1\nAxiom: B\ndecomposition:\nmaximum depth: 40\nB --> BB\n"
+                       "endlsystem\n");
+  DeriveOptions o;
+  o.max_modules = 1000;
+  auto w = derive(g, o);
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.error().message.find("max"), std::string::npos) << w.error().format();
 }
 
 // ---- statements (CPFG manual 3.2, 4.1) ----
