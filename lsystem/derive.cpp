@@ -318,10 +318,13 @@ class Rewriter {
   // the branch we are in (its "["), so the context is the module below on the path.
   bool match_left(const Production& p, size_t i) {
     const Word& w = *in_;
+    const size_t n = w.size();
     uint32_t j = i ? static_cast<uint32_t>(i - 1) : kNoMatch;
     for (size_t k = p.left_context.size(); k-- > 0;) {
       ++context_steps_;
       if (j != kNoMatch) j = skip_left_[j];
+      // A ring L-system (CPFG manual 3.1.1): before the first module comes the last.
+      if (j == kNoMatch && g_.ring && n > 0) j = skip_left_[n - 1];
       if (j == kNoMatch) return false;
       const Module& m = w.modules[j];
       if (m.symbol == kSymPop) return false;  // an unmatched ']'
@@ -344,6 +347,8 @@ class Rewriter {
     for (size_t k = 0; k < p.right_context.size(); ++k) {
       ++context_steps_;
       const PatternModule& pm = p.right_context[k];
+      // A ring L-system (CPFG manual 3.1.1): after the last module comes the first.
+      if (j >= n && g_.ring && n > 0 && entered_.empty()) j = 0;
       if (j >= n) return false;
       if (pm.symbol == kSymPush) {
         j = skip_ignored_[j];
@@ -366,6 +371,7 @@ class Rewriter {
         continue;
       }
       j = skip_right_[j];
+      if (j >= n && g_.ring && n > 0 && entered_.empty()) j = skip_right_[0];
       if (j >= n) return false;
       const Module& m = w.modules[j];
       if (m.symbol == kSymPush || m.symbol == kSymPop) return false;  // an unclosed '[', the branch's end
@@ -634,6 +640,13 @@ int apply_recursively(Rewriter& rewriter, const std::vector<Production>& product
   return std::min(depth, max_depth);
 }
 
+// The globals before the Start block: the arrays' initialisers, every other one 0.
+std::vector<double> initial_globals(const Grammar& g) {
+  std::vector<double> v = g.global_initial;
+  v.resize(g.global_names.size(), 0.0);
+  return v;
+}
+
 }  // namespace
 
 struct Derivation::Impl {
@@ -642,7 +655,7 @@ struct Derivation::Impl {
         options(o),
         steps(o.steps.value_or(grammar.steps)),
         seed(o.seed.value_or(grammar.seed)),
-        globals(grammar.global_names.size(), 0.0),
+        globals(initial_globals(grammar)),
         context{globals.data()},
         rewriter(grammar, grammar.productions, grammar.productions_by_symbol, seed, o.max_modules, &context) {
     if (!grammar.decomposition.empty()) {
@@ -845,8 +858,7 @@ Expected<Word> interpret(const Grammar& g, const Word& word, const DeriveOptions
   }
   Word next;
   // The globals as the derivation left them (a word from elsewhere: all 0).
-  std::vector<double> globals = word.globals;
-  globals.resize(g.global_names.size(), 0.0);
+  std::vector<double> globals = word.globals.size() == g.global_names.size() ? word.globals : initial_globals(g);
   EvalContext eval_context{globals.data()};
   Rewriter rewriter(g, g.homomorphism, g.homomorphism_by_symbol, seed, options.max_modules, &eval_context);
   const uint64_t budget = options.max_modules > UINT64_MAX / kInterpretBudgetFactor

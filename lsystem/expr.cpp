@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <string>
 
 namespace sylva::lsys {
 
@@ -53,6 +55,13 @@ void reduce_degrees(double degrees, int* quadrant, double* rem_rad) {
   double q = std::nearbyint(r / 90.0);
   *rem_rad = (r - q * 90.0) * kRadPerDeg;
   *quadrant = static_cast<int>(q) & 3;
+}
+
+// An array index as a message shows it: %g (NaN and infinities by name).
+std::string index_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
 }
 
 [[noreturn]] void fail(SourceLoc loc, std::string message) {
@@ -156,6 +165,30 @@ double Program::run(const Expr& e, double* slots, Rng* rng, EvalContext* context
         pc = in.arg - 1;
         break;
       case Op::kPop: --sp; break;
+      case Op::kDup: stack[sp] = stack[sp - 1]; ++sp; break;
+      case Op::kArrayIndex: {
+        const ArrayInfo& a = arrays[in.arg];
+        const size_t rank = a.dims.size();
+        sp -= static_cast<int>(rank);
+        uint64_t flat = 0;
+        for (size_t k = 0; k < rank; ++k) {
+          const double v = stack[sp + static_cast<int>(k)];
+          // C's conversion, as cpfg's: the index truncated toward zero.
+          if (!(v > -1.0) || !(v < static_cast<double>(a.dims[k])))
+            fail(locs[pc], "index " + index_text(v) + " is outside " + a.name + "'s " +
+                               (rank == 1 ? std::string("0 .. ") + std::to_string(a.dims[k] - 1)
+                                          : "dimension " + std::to_string(k + 1) + " (0 .. " +
+                                                std::to_string(a.dims[k] - 1) + ")"));
+          flat = flat * a.dims[k] + static_cast<uint64_t>(std::trunc(v));
+        }
+        stack[sp++] = static_cast<double>(a.base + flat);
+        break;
+      }
+      case Op::kLoadAt: stack[sp - 1] = context->globals[static_cast<size_t>(stack[sp - 1])]; break;
+      case Op::kStoreAt:
+        sp -= 2;
+        context->globals[static_cast<size_t>(stack[sp])] = stack[sp + 1];
+        break;
       case Op::kCall: {
         double r = 0;
         double* a = nullptr;

@@ -34,6 +34,11 @@ enum class Op : uint8_t {
   kJumpIfZero,  // pop a; if a == 0 { pc = arg }
   kLoop,        // pc = arg (a loop's backward jump: counted against kMaxLoopIterations)
   kPop,         // drop the top (an expression used as a statement)
+  // Arrays (cpfg's `define: { array a[n, m]; }`, CPFG manual 2.2.2), stored in the globals:
+  kArrayIndex,  // pop the rank indices of array `arg` (first below); check each; push the element's global index
+  kLoadAt,      // pop an index; push globals[index]
+  kStoreAt,     // pop a value, pop an index; globals[index] = value
+  kDup,         // push the top again
 };
 
 enum class Func : uint8_t {
@@ -86,11 +91,19 @@ struct EvalContext {
 // parser lets a compiled expression need ("expression nested too deeply" beyond).
 inline constexpr int kMaxEvalStack = 512;
 
+// A cpfg array: its elements are the globals base .. base + size − 1, row-major.
+struct ArrayInfo {
+  std::string name;
+  uint32_t base = 0;
+  std::vector<uint32_t> dims;  // each at least 1
+};
+
 // All compiled code of one grammar.
 struct Program {
   std::vector<Instr> code;
   std::vector<double> consts;
   std::vector<SourceLoc> locs;  // parallel to code: the place of each operation
+  std::vector<ArrayInfo> arrays;
 
   // Evaluates `e` with formal parameters `slots` and random stream `rng` (only touched
   // by rand/uniform/gauss). Throws EvalError on division by zero or a non-finite result.

@@ -102,6 +102,7 @@ struct Grammar {
   // A cpfg file's global variables (assigned in its blocks) and its blocks (CPFG manual 4.1):
   // Start before the axiom, StartEach and EndEach around every step, End after the last.
   std::vector<std::string> global_names;     // a global's index is its place here
+  std::vector<double> global_initial;        // their values before the Start block (arrays' initialisers; else 0)
   Expr start_block, start_each_block, end_each_block, end_block;  // kind kNone: none
   SymbolTable symbols;
   std::vector<Define> defines;
@@ -133,6 +134,7 @@ struct Grammar {
   bool uses_random = false;   // any stochastic production or random function
   bool uses_context = false;  // any production with left or right context
   bool uses_cut = false;      // % appears in a successor or the axiom
+  bool ring = false;          // a cpfg 'ring lsystem': context wraps from the word's end to its start (manual 3.1.1)
 
   // The physical source line at `loc` (in its file) without its newline, for messages.
   std::string_view source_line(SourceLoc loc) const;

@@ -8,6 +8,8 @@
 // reads no formal parameter and draws no random number is evaluated once and stored as a
 // constant. Recursion is bounded (kMaxNesting) so hostile input cannot overflow the stack.
 #include <algorithm>
+#include <functional>
+#include <numeric>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -282,6 +284,9 @@ class Parser {
   bool consider_ = false;      // cpfg: a 'consider:' list names the modules context sees
   std::vector<uint8_t> considered_;  // by symbol id
   std::unordered_map<std::string, uint32_t> global_index_;  // cpfg: global variables by name
+  std::unordered_map<std::string, uint32_t> array_index_;   // cpfg: arrays by name (Program::arrays)
+  void define_arrays(Cursor value);
+  void parse_array_element(Cursor& c, ExprBuild& b, const Scope* scope, uint32_t array, SourceLoc loc);
   bool globals_visible_ = false;  // compiling a production or a block: globals may be read
 };
 
@@ -536,6 +541,14 @@ void Parser::parse_primary(Cursor& c, ExprBuild& b, const Scope* scope) {
                       std::to_string(args));
       if (info.random) b.uses_random = true;
       emit(b, Op::kCall, 0, loc, 1 - args, fn);
+      return;
+    }
+    if (c.peek() == '[' && globals_visible_) {
+      auto a = array_index_.find(name);
+      if (a == array_index_.end()) fail(loc, "'" + name + "' is not an array (CPFG manual 2.2.2: 'define: { array " + name + "[n]; }')");
+      parse_array_element(c, b, scope, a->second, loc);
+      b.uses_slot = true;  // not a constant: read when evaluated
+      emit(b, Op::kLoadAt, 0, loc, 0);
       return;
     }
     c.pos = after;
@@ -1155,13 +1168,21 @@ bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest) {
   }
   if (section_ == Section::kDecomposition && keyword("seed", false, nullptr))
     fail(c.loc(), "decomposition draws from the L-system's generator: it takes no 'seed:' (CPFG manual 4.4)");
-  if (folded.compare(0, 4, "ring") == 0 && folded.find("lsystem") != std::string::npos)
-    unsupported("a ring L-system (CPFG manual 3.1.1)");
+  if (folded.compare(0, 4, "ring") == 0 && folded.find("lsystem") != std::string::npos) {
+    // "ring lsystem" (manual 3.1.1), with any spacing, before the axiom.
+    std::string words;
+    for (char ch : folded)
+      if (!is_space(ch)) words += ch;
+    if (words != "ringlsystem" && words != "ringlsystem:") fail(c.loc(), "expected 'ring lsystem' (CPFG manual 3.1.1)");
+    if (have_axiom_) fail(c.loc(), "'ring lsystem' must come before the axiom (CPFG manual 3.1.1)");
+    g_.ring = true;
+    return true;
+  }
   if (keyword("consider", false, &value)) {
     set_consider(value);
     return true;
   }
-  if (keyword("define", false, nullptr)) unsupported("'define:' arrays (CPFG manual 2.2.2)");
+  if (keyword("define", false, nullptr)) return true;  // its arrays: define_arrays, before the productions
   const std::pair<const char*, Expr*> blocks[] = {{"start", &g_.start_block}, {"starteach", &g_.start_each_block},
                                                   {"endeach", &g_.end_each_block}, {"end", &g_.end_block}};
   for (const auto& [block, expr] : blocks) {
@@ -1304,7 +1325,32 @@ void Parser::parse_statement(Cursor& c, ExprBuild& b, Scope* scope) {
     while (is_ident_char(probe.peek())) ++probe.pos;
     const std::string name = c.line->text.substr(name_start, probe.pos - name_start);
     probe.skip_spaces();
-    if (probe.peek() == '[') fail(probe.loc(), "arrays (CPFG manual 2.2.2) are not supported yet (docs/cpfg.md)");
+    if (probe.peek() == '[') {
+      // "a[i] = expr;" (or += -= *= /=): the element's index, then the value, stored.
+      auto a = array_index_.find(name);
+      if (a == array_index_.end()) fail(loc, "'" + name + "' is not an array (CPFG manual 2.2.2: 'define: { array " + name + "[n]; }')");
+      parse_array_element(probe, b, scope, a->second, loc);
+      probe.skip_spaces();
+      char op = 0;
+      if ((probe.peek() == '+' || probe.peek() == '-' || probe.peek() == '*' || probe.peek() == '/') && probe.peek(1) == '=')
+        op = probe.peek(), ++probe.pos;
+      if (probe.peek() != '=' || probe.peek(1) == '=')
+        fail(probe.loc(), "expected '=' after the element of '" + name + "' (an element is assigned, not used, as a statement)");
+      const SourceLoc op_loc = probe.loc();
+      ++probe.pos;
+      c = probe;
+      if (op) {
+        emit(b, Op::kDup, 0, loc, +1);
+        emit(b, Op::kLoadAt, 0, loc, 0);
+      }
+      parse_or(c, b, scope);
+      if (op) emit(b, op == '+' ? Op::kAdd : op == '-' ? Op::kSub : op == '*' ? Op::kMul : Op::kDiv, 0, op_loc, -1);
+      emit(b, Op::kStoreAt, 0, loc, -2);
+      c.skip_spaces();
+      if (c.peek() != ';') fail(c.loc(), "expected ';' after the assignment to '" + name + "[...]' (cpfg ends every one with ';')");
+      ++c.pos;
+      return;
+    }
     char compound = 0;
     if ((probe.peek() == '+' || probe.peek() == '-' || probe.peek() == '*' || probe.peek() == '/') && probe.peek(1) == '=')
       compound = probe.peek(), ++probe.pos;
@@ -1351,6 +1397,126 @@ void Parser::parse_statement(Cursor& c, ExprBuild& b, Scope* scope) {
   ++c.pos;
 }
 
+// The most elements all of a grammar's arrays may hold (docs/limits.md).
+constexpr uint64_t kMaxArrayElements = 1'000'000;
+
+// `define: { array a[d1, d2, ...] = { v, ... }; array b[n]; ... }` (CPFG manual 2.2.2): each
+// array's elements become globals (row-major, 0 unless initialised), visible to every block,
+// production and successor. Dimensions are constant positive integers; an initialiser
+// gives at most as many constant values as the array has elements (the rest stay 0).
+void Parser::define_arrays(Cursor c) {
+  c.skip_spaces();
+  if (c.peek() != '{') fail(c.loc(), "expected '{' after 'define:' (CPFG manual 2.2.2: define: { array a[3]; })");
+  ++c.pos;
+  uint64_t total = 0;
+  for (const ArrayInfo& a : g_.program.arrays)
+    total += std::accumulate(a.dims.begin(), a.dims.end(), uint64_t{1}, std::multiplies<>());
+  for (;;) {
+    c.skip_spaces();
+    if (c.peek() == '}') {
+      ++c.pos;
+      c.skip_spaces();
+      if (c.peek() == ';') ++c.pos;
+      c.skip_spaces();
+      if (!c.at_end()) fail(c.loc(), "unexpected " + quote_char(c.peek()) + " after the 'define:' block");
+      return;
+    }
+    if (c.at_end()) fail(c.loc(), "the 'define:' block is never closed with '}'");
+    if (!word_at(c, "array")) fail(c.loc(), "expected 'array name[size];' in the 'define:' block");
+    c.skip_spaces();
+    const SourceLoc name_loc = c.loc();
+    if (!is_ident_start(c.peek())) fail(c.loc(), "expected the array's name after 'array'");
+    const size_t start = c.pos;
+    while (is_ident_char(c.peek())) ++c.pos;
+    const std::string name = c.line->text.substr(start, c.pos - start);
+    if (array_index_.count(name) || global_index_.count(name) || define_values_.count(name))
+      fail(name_loc, "'" + name + "' is already defined");
+    c.skip_spaces();
+    if (c.peek() != '[') fail(c.loc(), "expected '[' and the array's size after '" + name + "'");
+    ++c.pos;
+    ArrayInfo a;
+    a.name = name;
+    uint64_t size = 1;
+    for (;;) {
+      c.skip_spaces();
+      const SourceLoc at = c.loc();
+      size_t end = c.pos;
+      while (end < c.end && c.line->text[end] != ',' && c.line->text[end] != ']') ++end;
+      if (end >= c.end) fail(at, "the size of '" + name + "' is never closed with ']'");
+      const double d = constant_expression(c.sub(c.pos, end), "an array's size");
+      if (!(d >= 1) || d != std::floor(d) || d > static_cast<double>(kMaxArrayElements))
+        fail(at, "an array's size must be an integer from 1 to " + std::to_string(kMaxArrayElements));
+      a.dims.push_back(static_cast<uint32_t>(d));
+      size *= static_cast<uint64_t>(d);
+      if (total + size > kMaxArrayElements)
+        fail(at, "the arrays hold more than " + std::to_string(kMaxArrayElements) + " elements (docs/limits.md)");
+      c.pos = end + 1;
+      if (c.line->text[end] == ']') break;
+    }
+    total += size;
+    a.base = static_cast<uint32_t>(g_.global_names.size());
+    for (uint64_t k = 0; k < size; ++k) g_.global_names.push_back(name + "[" + std::to_string(k) + "]");
+    g_.global_initial.resize(g_.global_names.size(), 0.0);
+    c.skip_spaces();
+    if (c.peek() == '=') {
+      ++c.pos;
+      c.skip_spaces();
+      if (c.peek() != '{') fail(c.loc(), "expected '{' and the values of '" + name + "'");
+      ++c.pos;
+      uint64_t k = 0;
+      for (;;) {
+        c.skip_spaces();
+        const SourceLoc at = c.loc();
+        size_t end = c.pos;
+        while (end < c.end && c.line->text[end] != ',' && c.line->text[end] != '}') ++end;
+        if (end >= c.end) fail(at, "the values of '" + name + "' are never closed with '}'");
+        if (k >= size) fail(at, "'" + name + "' has " + std::to_string(size) + " elements: too many values");
+        g_.global_initial[a.base + k++] = constant_expression(c.sub(c.pos, end), "an array's value");
+        c.pos = end + 1;
+        if (c.line->text[end] == '}') break;
+      }
+      c.skip_spaces();
+    }
+    if (c.peek() != ';') fail(c.loc(), "expected ';' after the array '" + name + "'");
+    ++c.pos;
+    array_index_.emplace(name, static_cast<uint32_t>(g_.program.arrays.size()));
+    g_.program.arrays.push_back(std::move(a));
+  }
+}
+
+// `[i, j]` or `[i][j]` after array `array`'s name: its indices, one per dimension, then
+// kArrayIndex (the element's global index on the stack).
+void Parser::parse_array_element(Cursor& c, ExprBuild& b, const Scope* scope, uint32_t array, SourceLoc loc) {
+  const ArrayInfo& a = g_.program.arrays[array];
+  const size_t rank = a.dims.size();
+  size_t given = 0;
+  c.skip_spaces();
+  while (c.peek() == '[') {
+    ++c.pos;
+    for (;;) {
+      if (++given > rank)
+        fail(c.loc(), "'" + a.name + "' has " + std::to_string(rank) + (rank == 1 ? " dimension" : " dimensions"));
+      parse_or(c, b, scope);
+      c.skip_spaces();
+      if (c.peek() == ',') {
+        ++c.pos;
+        continue;
+      }
+      if (c.peek() == ']') {
+        ++c.pos;
+        break;
+      }
+      fail(c.loc(), "expected ',' or ']' in the index of '" + a.name + "'");
+    }
+    c.skip_spaces();
+    if (given == rank) break;
+  }
+  if (given != rank)
+    fail(loc, "'" + a.name + "' has " + std::to_string(rank) + (rank == 1 ? " dimension" : " dimensions") +
+                  ": give an index for each");
+  emit(b, Op::kArrayIndex, array, loc, 1 - static_cast<int>(rank));
+}
+
 // Registers every name a Start/StartEach/EndEach/End block assigns as a global variable
 // (CPFG manual 4.1), before anything is compiled, so a block may read a global another block
 // (or a later line) assigns.
@@ -1382,6 +1548,7 @@ void Parser::collect_globals(const std::vector<LogicalLine>& lines) {
         if (!define_values_.count(name) && !global_index_.count(name)) {
           global_index_.emplace(name, static_cast<uint32_t>(g_.global_names.size()));
           g_.global_names.push_back(name);
+          g_.global_initial.push_back(0.0);
         }
       }
       i = e - 1;
@@ -1409,7 +1576,7 @@ std::vector<LogicalLine> Parser::join_statement_lines(std::vector<LogicalLine> l
       while (k < folded.size() && is_space(folded[k])) ++k;
       const size_t colon = line.text.find(':');
       from = colon == std::string::npos || colon >= end ? end : colon + 1;
-      for (const char* header : {"axiom", "seed", "derivation", "ignore", "consider", "maximum", "lsystem", "define"})
+      for (const char* header : {"axiom", "seed", "derivation", "ignore", "consider", "maximum", "lsystem"})
         if (folded.compare(k, std::strlen(header), header) == 0) from = end;
     }
     for (size_t i = from; i < end; ++i) {
@@ -1501,6 +1668,19 @@ void Parser::parse(const std::string& text) {
     if (!g_.cpfg && !define_values_.count(name))
       fail({0, 0}, "-D " + name + ": the grammar has no '#define " + name + "'");
   }
+  // Pass 2b (cpfg): the arrays of 'define:', before anything that may read them is compiled.
+  if (g_.cpfg)
+    for (const LogicalLine& line : lines) {
+      Cursor c{&line, 0, line.text.size()};
+      c.skip_spaces();
+      const std::string folded = lower_ascii(std::string(c.rest().substr(0, 7)));
+      if (folded.compare(0, 6, "define") != 0 || (folded.size() > 6 && is_ident_char(folded[6]))) continue;
+      Cursor v = c.sub(c.pos + 6, line.text.size());
+      v.skip_spaces();
+      if (v.peek() != ':') continue;
+      ++v.pos;
+      define_arrays(v);
+    }
   // Pass 3: directives, sections and productions.
   for (const LogicalLine& line : lines) {
     LineKind kind = classify(line);

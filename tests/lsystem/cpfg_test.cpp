@@ -282,15 +282,89 @@ TEST(CpfgModel, TheChapterSixModuleNamesAreOneModuleEach) {
 
 TEST(CpfgModel, WhatSylvaCannotReadYetIsAnErrorAtItsPlaceNamingTheFeature) {
   const LocatedError cases[] = {
-      {"Lsystem: 1\nAxiom: F\ndefine: { array a[3]; }\nendlsystem\n", 3, 1, "arrays"},
-      {"Lsystem: 1\nAxiom: F\nF : {a[1] = 2;} * --> F\nendlsystem\n", 3, 7, "arrays"},
-      {"Lsystem: 1\nring lsystem\nAxiom: F\nendlsystem\n", 2, 1, "ring L-system"},
       {"Lsystem: 1\nAxiom: F\nendlsystem\nLsystem: 2\nAxiom: G\nendlsystem\n", 4, 1, "sub-L-systems"},
   };
   for (const LocatedError& c : cases) {
     expect_located(c);
     EXPECT_NE(parse_error(c.text).message.find("not supported yet"), std::string::npos) << c.text;
   }
+}
+
+// ---- ring L-systems (CPFG manual 3.1.1) ----
+
+TEST(CpfgRing, ContextWrapsFromTheLastModuleToTheFirstAndBack) {
+  // The manual's example: the A of "A B C" has C as its left context in a ring.
+  EXPECT_EQ(derive_text("Lsystem: 1\nring lsystem\nderivation length: 1\nAxiom: A B C\nC < A --> X\nendlsystem\n"),
+            "XBC");
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: A B C\nC < A --> X\nendlsystem\n"), "ABC");
+  // Right context: C's right neighbour is A; a context longer than one module wraps on.
+  EXPECT_EQ(derive_text("Lsystem: 1\nring lsystem\nderivation length: 1\nAxiom: A B C\nC > A B --> Y\n"
+                        "B < C > A --> Z\nendlsystem\n"),
+            "ABY");
+  // A signal passed around a ring of cells: each cell takes its left neighbour's value, so
+  // after three steps on three cells every value is back where it started.
+  const std::string cells = "Lsystem: 1\nring lsystem\nderivation length: N\nAxiom: c(1) c(2) c(3)\n"
+                            "c(l) < c(x) --> c(l)\nendlsystem\n";
+  auto after = [&](int n) {
+    std::string m = cells;
+    m.replace(m.find("N"), 1, std::to_string(n));
+    return derive_text(m);
+  };
+  EXPECT_EQ(after(1), "c(3)c(1)c(2)");
+  EXPECT_EQ(after(3), "c(1)c(2)c(3)");
+  // Ignored modules are passed over across the seam too.
+  EXPECT_EQ(derive_text("Lsystem: 1\nring lsystem\nignore: +\nderivation length: 1\nAxiom: A B C +\nC < A --> X\n"
+                        "endlsystem\n"),
+            "XBC+");
+  // 'ring lsystem' comes before the axiom.
+  expect_located({"Lsystem: 1\nAxiom: A\nring lsystem\nendlsystem\n", 3, 1, "before the axiom"});
+}
+
+// ---- arrays (CPFG manual 2.2.2) ----
+
+TEST(CpfgArrays, DefineInitialiseReadAndAssignFromBlocksProductionsAndSuccessors) {
+  // Len is initialised, G is 2 x 2 row-major (read as G[i, j] or G[i][j]), Count starts at
+  // 0; the Start block sets Count[0]; every step's statements count in Count[1]. The define
+  // block spans lines and its size is a #define.
+  const std::string model =
+      "#define N 3\nLsystem: 1\nderivation length: 3\n"
+      "define: { array Len[N] = {1, 0.5, 0.25};\n          array G[2,2] = {1, 2,\n 3, 4};\n"
+      "          array Count[2]; }\n"
+      "Start: { Count[0] = 10; }\nAxiom: A(0)\n"
+      "A(i) : i < N { Count[1] += 1; x = G[1,0] + G[0][1]; } --> F(Len[i]) B(x, Count[0], Count[1]) A(i+1)\n"
+      "endlsystem\n";
+  EXPECT_EQ(derive_text(model), "F(1)B(5,10,1)F(0.5)B(5,10,2)F(0.25)B(5,10,3)A(3)");
+  Grammar g = parse_ok(model);
+  ASSERT_EQ(g.program.arrays.size(), 3u);
+  EXPECT_EQ(g.program.arrays[1].dims, (std::vector<uint32_t>{2, 2}));
+  EXPECT_EQ(g.global_names.size(), 3u + 4u + 2u);
+  // An index is truncated toward zero, as C converts it (1.9 reads element 1); compound
+  // assignments read and write the same element.
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\ndefine: { array a[3] = {4, 5, 6}; }\nAxiom: A\n"
+                        "A : { a[2] *= 10; a[0] -= 1; } --> B(a[1.9], a[2], a[0])\nendlsystem\n"),
+            "B(5,60,3)");
+}
+
+TEST(CpfgArrays, BadDefinitionsAndIndicesAreErrorsAtTheirPlace) {
+  const LocatedError cases[] = {
+      {"Lsystem: 1\ndefine: { array a[0]; }\nAxiom: F\nendlsystem\n", 2, 19, "an array's size must be"},
+      {"Lsystem: 1\ndefine: { array a[2] = {1, 2, 3}; }\nAxiom: F\nendlsystem\n", 2, 31, "too many values"},
+      {"Lsystem: 1\ndefine: { array a[2]; array a[3]; }\nAxiom: F\nendlsystem\n", 2, 29, "already defined"},
+      {"Lsystem: 1\ndefine: { vector a[2]; }\nAxiom: F\nendlsystem\n", 2, 11, "expected 'array"},
+      {"Lsystem: 1\ndefine: { array a[2000000]; }\nAxiom: F\nendlsystem\n", 2, 19, "an array's size must be"},
+      {"Lsystem: 1\ndefine: { array a[2,2]; }\nAxiom: F\nF : { x = a[1]; } --> F\nendlsystem\n", 4, 11,
+       "give an index for each"},
+      {"Lsystem: 1\nAxiom: F\nF : { b[1] = 2; } --> F\nendlsystem\n", 3, 7, "'b' is not an array"},
+  };
+  for (const LocatedError& c : cases) expect_located(c);
+  // An index outside the array is an error when it is evaluated, at the element.
+  Grammar g = parse_ok("Lsystem: 1\nderivation length: 1\ndefine: { array a[2]; }\nAxiom: A(-1)\n"
+                       "A(i) --> B(a[i])\nendlsystem\n");
+  auto w = derive(g);
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.error().message.find("index -1 is outside a's 0 .. 1"), std::string::npos) << w.error().format();
+  EXPECT_EQ(w.error().loc.line, 5u);
+  EXPECT_EQ(w.error().loc.column, 12u);
 }
 
 // ---- decomposition (CPFG manual 4.4) ----
