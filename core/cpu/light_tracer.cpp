@@ -366,10 +366,8 @@ LightSource light_source(const Scene& scene) {
 }
 
 // The unit direction toward the light of one photon, from its stream.
-dvec3 photon_toward(const LightSource& src, Rng& rng, bool* from_sun) {
-  const double pick = rng.next_double();
-  *from_sun = pick < src.sun_share;
-  if (*from_sun) {
+dvec3 photon_toward(const LightSource& src, Rng& rng) {
+  if (rng.next_double() < src.sun_share) {
     // Uniform over the sun's disc: 1 − cos θ uniform in [0, 1 − cos α].
     const double one_minus_cos = rng.next_double() * src.one_minus_cos_alpha;
     const double cos_t = 1 - one_minus_cos;
@@ -547,8 +545,7 @@ Expected<std::vector<LightAnswer>> gather_light(std::span<const Skeleton> plants
     dvec3 dir(0);
     for (uint64_t k = 0; any_light && k < rays; ++k) {
       Rng rng(mix_pair(mix_pair(stream, s), k));
-      bool from_sun = false;
-      const dvec3 toward = photon_toward(src, rng, &from_sun);
+      const dvec3 toward = photon_toward(src, rng);
       if (toward.y <= 0) continue;  // the ground
       const Ray ray{sensors[s], toward};
       double from = 0;
