@@ -18,7 +18,8 @@
 namespace sylva {
 
 namespace {
-// Whether the axiom, a production or the homomorphism writes a module `pred` accepts.
+// Whether the axiom, a production, the decomposition or the homomorphism writes a module
+// `pred` accepts.
 template <class Pred>
 bool grammar_writes(const lsys::Grammar& g, Pred pred) {
   auto in = [&](const lsys::Successor& s) {
