@@ -197,7 +197,12 @@ class Rewriter {
   uint64_t context_steps() const { return context_steps_; }
   // Modules written (to the result, and by expand() to its stack): interpretation's work.
   uint64_t work() const { return work_; }
-  void set_work_budget(uint64_t budget) { work_budget_ = budget; }
+  // Starts counting the work of the passes to come against `budget`, naming `what` spends it.
+  void set_work_budget(uint64_t budget, const char* what = "the interpretation") {
+    work_ = 0;
+    work_budget_ = budget;
+    budget_what_ = what;
+  }
   void set_seed(uint64_t seed) { seed_ = seed; }
 
   // Index of the module whose production failed, for messages.
@@ -233,7 +238,7 @@ class Rewriter {
                                 "the derivation length"};
   }
   [[noreturn]] void over_budget() {
-    throw DeriveFailure{{}, "the interpretation exceeds its budget of " + std::to_string(work_budget_) +
+    throw DeriveFailure{{}, std::string(budget_what_) + " exceeds its budget of " + std::to_string(work_budget_) +
                                 " modules written (16 x --max-modules); lower `maximum depth:` or raise --max-modules"};
   }
   [[noreturn]] void too_many_params() {
@@ -513,6 +518,7 @@ class Rewriter {
   bool uses_left_context_ = false, uses_right_context_ = false;
   uint64_t context_steps_ = 0;
   uint64_t work_ = 0, work_budget_ = UINT64_MAX;
+  const char* budget_what_ = "the interpretation";
   Word stack_, successor_;
   std::vector<int> stack_depth_;
   std::vector<std::pair<const Production*, double>> candidates_;
@@ -640,6 +646,12 @@ int apply_recursively(Rewriter& rewriter, const std::vector<Production>& product
   return std::min(depth, max_depth);
 }
 
+// What a homomorphism or decomposition may write in one application: 16 × --max-modules
+// (docs/limits.md "Work"), saturating.
+uint64_t recursion_budget(uint64_t max_modules) {
+  return max_modules > UINT64_MAX / kInterpretBudgetFactor ? UINT64_MAX : max_modules * kInterpretBudgetFactor;
+}
+
 // The globals before the Start block: the arrays' initialisers, every other one 0.
 std::vector<double> initial_globals(const Grammar& g) {
   std::vector<double> v = g.global_initial;
@@ -658,13 +670,9 @@ struct Derivation::Impl {
         globals(initial_globals(grammar)),
         context{globals.data()},
         rewriter(grammar, grammar.productions, grammar.productions_by_symbol, seed, o.max_modules, &context) {
-    if (!grammar.decomposition.empty()) {
+    if (!grammar.decomposition.empty())
       decomposer.emplace(grammar, grammar.decomposition, grammar.decomposition_by_symbol, seed, o.max_modules,
                          &context);
-      decompose_budget =
-          o.max_modules > UINT64_MAX / kInterpretBudgetFactor ? UINT64_MAX : o.max_modules * kInterpretBudgetFactor;
-      decomposer->set_work_budget(decompose_budget);
-    }
   }
 
   // The decomposition productions applied to `cur` (CPFG manual 4.4), each step's from
@@ -674,13 +682,14 @@ struct Derivation::Impl {
     active = &*decomposer;
     decomposer->set_seed(seed);
     decomposer->current_production = nullptr;
+    // Each step's decomposition has the budget of one interpretation (the rewriter holds
+    // every word it writes to --max-modules).
+    const uint64_t budget = recursion_budget(options.max_modules);
+    decomposer->set_work_budget(budget, "the decomposition");
     uint64_t left = 0;
     apply_recursively(*decomposer, g.decomposition, g.decomposition_by_symbol, cur, next,
                       kDecompositionStreamBase + static_cast<uint64_t>(at) * (kMaxDecompositionDepth + 2),
-                      g.decomposition_depth, decompose_budget, options.progress, false, &left);
-    if (cur.size() > options.max_modules)
-      throw DeriveFailure{{}, "the decomposition makes more than --max-modules (" +
-                                  std::to_string(options.max_modules) + ") modules"};
+                      g.decomposition_depth, budget, options.progress, false, &left);
     active = &rewriter;
   }
 
@@ -701,7 +710,6 @@ struct Derivation::Impl {
   Rewriter rewriter;
   std::optional<Rewriter> decomposer;  // with decomposition productions only
   Rewriter* active = &rewriter;        // the one whose production an error names
-  uint64_t decompose_budget = 0;       // modules a step's decomposition may write
   std::chrono::steady_clock::time_point t0 = std::chrono::steady_clock::now();
   Word cur, next;
   uint64_t peak = 0;
@@ -861,9 +869,7 @@ Expected<Word> interpret(const Grammar& g, const Word& word, const DeriveOptions
   std::vector<double> globals = word.globals.size() == g.global_names.size() ? word.globals : initial_globals(g);
   EvalContext eval_context{globals.data()};
   Rewriter rewriter(g, g.homomorphism, g.homomorphism_by_symbol, seed, options.max_modules, &eval_context);
-  const uint64_t budget = options.max_modules > UINT64_MAX / kInterpretBudgetFactor
-                              ? UINT64_MAX
-                              : options.max_modules * kInterpretBudgetFactor;
+  const uint64_t budget = recursion_budget(options.max_modules);
   rewriter.set_work_budget(budget);
   int depth = 0;  // passes performed, as stats report them
   uint64_t left = 0;

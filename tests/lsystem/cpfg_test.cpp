@@ -421,6 +421,17 @@ TEST(CpfgDecomposition, ErrorsArePlacedAndItsGrowthIsBounded) {
   auto w = derive(g, o);
   ASSERT_FALSE(w.ok());
   EXPECT_NE(w.error().message.find("max"), std::string::npos) << w.error().format();
+  // The budget (16 × --max-modules written) is each step's, not the derivation's: 60
+  // modules decomposed at each of 40 steps write far more than 16 × 100 in all, and pass.
+  std::string sixty;
+  for (int k = 0; k < 60; ++k) sixty += "B";
+  Grammar many = parse_ok("Lsystem: 1\nderivation length: 40\nAxiom: " + sixty +
+                          "\ndecomposition:\nB --> B\nendlsystem\n");
+  DeriveOptions small;
+  small.max_modules = 100;
+  auto long_run = derive(many, small);
+  ASSERT_TRUE(long_run.ok()) << long_run.error().format();
+  EXPECT_EQ(long_run->size(), 60u);
 }
 
 // ---- statements (CPFG manual 3.2, 4.1) ----
