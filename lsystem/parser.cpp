@@ -1270,6 +1270,19 @@ void Parser::parse_condition_in_parens(Cursor& c, ExprBuild& b, Scope* scope, co
   ++c.pos;
 }
 
+// The operator of a compound assignment at `c` ('+' for "+=", and -, *, /), stepping
+// over it to its '='; 0 (and `c` unmoved) for anything else.
+char compound_assignment(Cursor& c) {
+  const char op = c.peek();
+  if ((op == '+' || op == '-' || op == '*' || op == '/') && c.peek(1) == '=') {
+    ++c.pos;
+    return op;
+  }
+  return 0;
+}
+
+Op compound_op(char op) { return op == '+' ? Op::kAdd : op == '-' ? Op::kSub : op == '*' ? Op::kMul : Op::kDiv; }
+
 void Parser::parse_statement(Cursor& c, ExprBuild& b, Scope* scope) {
   c.skip_spaces();
   const SourceLoc loc = c.loc();
@@ -1331,9 +1344,7 @@ void Parser::parse_statement(Cursor& c, ExprBuild& b, Scope* scope) {
       if (a == array_index_.end()) fail(loc, "'" + name + "' is not an array (CPFG manual 2.2.2: 'define: { array " + name + "[n]; }')");
       parse_array_element(probe, b, scope, a->second, loc);
       probe.skip_spaces();
-      char op = 0;
-      if ((probe.peek() == '+' || probe.peek() == '-' || probe.peek() == '*' || probe.peek() == '/') && probe.peek(1) == '=')
-        op = probe.peek(), ++probe.pos;
+      const char op = compound_assignment(probe);
       if (probe.peek() != '=' || probe.peek(1) == '=')
         fail(probe.loc(), "expected '=' after the element of '" + name + "' (an element is assigned, not used, as a statement)");
       const SourceLoc op_loc = probe.loc();
@@ -1344,16 +1355,14 @@ void Parser::parse_statement(Cursor& c, ExprBuild& b, Scope* scope) {
         emit(b, Op::kLoadAt, 0, loc, 0);
       }
       parse_or(c, b, scope);
-      if (op) emit(b, op == '+' ? Op::kAdd : op == '-' ? Op::kSub : op == '*' ? Op::kMul : Op::kDiv, 0, op_loc, -1);
+      if (op) emit(b, compound_op(op), 0, op_loc, -1);
       emit(b, Op::kStoreAt, 0, loc, -2);
       c.skip_spaces();
       if (c.peek() != ';') fail(c.loc(), "expected ';' after the assignment to '" + name + "[...]' (cpfg ends every one with ';')");
       ++c.pos;
       return;
     }
-    char compound = 0;
-    if ((probe.peek() == '+' || probe.peek() == '-' || probe.peek() == '*' || probe.peek() == '/') && probe.peek(1) == '=')
-      compound = probe.peek(), ++probe.pos;
+    const char compound = compound_assignment(probe);
     if (probe.peek() == '=' && probe.peek(1) != '=') {
       const SourceLoc op_loc = probe.loc();
       ++probe.pos;
@@ -1375,10 +1384,7 @@ void Parser::parse_statement(Cursor& c, ExprBuild& b, Scope* scope) {
       }
       if (compound) emit(b, global ? Op::kGlobal : Op::kSlot, index, loc, +1);
       parse_or(c, b, scope);
-      if (compound) {
-        const Op op = compound == '+' ? Op::kAdd : compound == '-' ? Op::kSub : compound == '*' ? Op::kMul : Op::kDiv;
-        emit(b, op, 0, op_loc, -1);
-      }
+      if (compound) emit(b, compound_op(compound), 0, op_loc, -1);
       emit(b, global ? Op::kStoreGlobal : Op::kStore, index, loc, -1);
       c.skip_spaces();
       if (c.peek() != ';') fail(c.loc(), "expected ';' after the assignment to '" + name + "' (cpfg ends every one with ';')");

@@ -483,16 +483,13 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           if (queries) queries->push_back(t.position);
           break;
         case kSymQueryPosition:
-          if (turtle_queries) turtle_queries->push_back(t.position);
-          break;
         case kSymQueryHeading:
-          if (turtle_queries) turtle_queries->push_back(t.heading);
-          break;
         case kSymQueryLeft:
-          if (turtle_queries) turtle_queries->push_back(t.left);
-          break;
         case kSymQueryUp:
-          if (turtle_queries) turtle_queries->push_back(t.up);
+          if (turtle_queries) {
+            const dvec3* answer[] = {&t.position, &t.heading, &t.left, &t.up};  // in BuiltinSymbol order
+            turtle_queries->push_back(*answer[symbol - kSymQueryPosition]);
+          }
           break;
         default:
           break;  // carried through, ignored by the turtle
