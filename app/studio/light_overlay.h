@@ -1,9 +1,9 @@
-// light_overlay.h — the studio's colouring of light queries by their answers (docs/studio.md
-// "Light (?E)"): every `?E` of the grown plants drawn as a dot over the picture at the
-// turtle's position where it stands, coloured by its q on a viridis ramp (dark violet at
-// 0, yellow at 1) and as large as its sensor sphere seen from the camera (2 to 9 pixels).
-// Dots are drawn far to near, so nearer ones cover farther ones; the picture's depth does
-// not hide them (a bud inside the crown is the one to see).
+// light_overlay.h — the studio's colouring of light queries by their answers (docs/light.md
+// "Front ends", the Light (?E) panel): every `?E` of the grown plants drawn as a dot over
+// the picture at the turtle's position where it stands, coloured by its q on a viridis
+// ramp (dark violet at 0, yellow at 1) and as large as its sensor sphere seen from the
+// camera (2 to 9 pixels). Dots are drawn far to near, so nearer ones cover farther ones;
+// the picture's depth does not hide them (a bud inside the crown is the one to see).
 #pragma once
 
 #include <imgui.h>

@@ -783,14 +783,21 @@ void StudioApp::draw_viewport(ImVec2 size) {
       }
     }
   }
-  query_dots_.clear();
   if (show_queries_ && plant_) {
-    std::vector<PlantQueries> plants;
-    for (size_t k = 0; k < edited_plants_.size() && k < plant_->queries.size(); ++k)
-      plants.push_back({&scene_.plants[edited_plants_[k]], &plant_->queries[k]});
-    query_dots_ = studio::query_dots(scene_.camera, origin, image_size,
-                                     scene_.environment.value_or(LightEnvironment{}).sensor_radius_m, plants);
+    // Projected and sorted again only when the view, the panel or the plant changed.
+    const double radius = scene_.environment.value_or(LightEnvironment{}).sensor_radius_m;
+    const QueryDotsKey key{scene_.camera, origin.x, origin.y, image_size.x, image_size.y, radius, plants_applied_};
+    if (!(key == query_dots_key_)) {
+      std::vector<PlantQueries> plants;
+      for (size_t k = 0; k < edited_plants_.size() && k < plant_->queries.size(); ++k)
+        plants.push_back({&scene_.plants[edited_plants_[k]], &plant_->queries[k]});
+      query_dots_ = studio::query_dots(scene_.camera, origin, image_size, radius, plants);
+      query_dots_key_ = key;
+    }
     draw_query_dots(dl, query_dots_, origin, image_size);
+  } else {
+    query_dots_.clear();
+    query_dots_key_ = {};
   }
   if (worker_->busy()) {
     int64_t step = 0, steps = 0;

@@ -229,6 +229,16 @@ class StudioApp {
   bool bark_ = true;
   bool show_queries_ = false;         // the Light panel's "colour queries by q"
   std::vector<QueryDot> query_dots_;  // drawn at the last frame
+  // What query_dots_ were projected for: the camera, the image's place and size on the
+  // screen, the sensor radius and the plant (plants_applied_; 0: none yet).
+  struct QueryDotsKey {
+    Camera camera;
+    float x = 0, y = 0, width = 0, height = 0;
+    double radius = 0;
+    uint64_t plants = 0;
+    bool operator==(const QueryDotsKey&) const = default;
+  };
+  QueryDotsKey query_dots_key_;
   int skin_choice_ = 0;              // the view's skin control: 0 the scene's, 1 smooth, 2 paper
   float sun_azimuth_deg_ = 0, sun_elevation_deg_ = 45;
   bool view_half_res_ = false;

@@ -4,6 +4,7 @@
 // and regrow the plant, the cost is shown, and the environment is saved with the scene.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <set>
@@ -160,6 +161,23 @@ TEST(StudioLight, AToggleColoursEveryQueryByItsAnswerOverThePicture) {
   std::set<ImU32> colours;
   for (const QueryDot& d : dots) colours.insert(d.colour);
   EXPECT_GE(colours.size(), 3u);
+  // The dots follow the camera: orbiting the view moves them (they are projected again).
+  const std::vector<QueryDot> before = dots;
+  const auto v = *app->rect("viewport");
+  io.MousePos = v.centre();
+  ui.frame(*app);
+  io.MouseDown[0] = true;
+  for (int i = 0; i < 4; ++i) {
+    io.MousePos.x += 15;
+    ui.frame(*app);
+  }
+  io.MouseDown[0] = false;
+  ui.frames(*app, 2);
+  ASSERT_EQ(app->query_dots().size(), before.size());
+  double moved = 0;
+  for (size_t i = 0; i < before.size(); ++i)
+    moved = std::max<double>(moved, std::abs(app->query_dots()[i].centre.x - before[i].centre.x));
+  EXPECT_GT(moved, 2.0) << "the view turned; the dots stayed";
   // Toggled off again: nothing is drawn.
   io.MousePos = ImVec2(app->rect("light:show_queries")->min.x + 6, app->rect("light:show_queries")->centre().y);
   io.MouseDown[0] = true;
