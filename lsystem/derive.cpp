@@ -70,49 +70,109 @@ class Rewriter {
           p.probability.kind == Expr::Kind::kNone && p.successor.all_constant)
         direct_[s] = &p;
     }
-    for (const Production& p : productions_) {
-      uses_context_ |= p.has_context();
-      uses_left_context_ |= !p.left_context.empty();
-      uses_right_context_ |= !p.right_context.empty();
-    }
+    for (const std::vector<uint32_t>& rules : by_symbol_)
+      for (uint32_t r : rules) {
+        const Production& p = productions_[r];
+        uses_context_ |= p.has_context();
+        uses_left_context_ |= !p.left_context.empty() && !p.new_left;
+        uses_right_context_ |= !p.right_context.empty() && !p.new_right;
+        uses_new_left_ |= p.new_left;
+        uses_new_right_ |= p.new_right;
+      }
   }
 
-  // Rewrites `in` into `out` (cleared first). `stream` distinguishes steps/passes in the
+  // Rewrites `in` into `out` (empty). `stream` distinguishes steps/passes in the
   // random streams. With `active_in`, only modules flagged there are rewritten (the
   // others are copied) and `active_out` flags the modules produced by a production.
   // `progress` is checked, and told the fraction of `in` rewritten, every 64 Ki modules.
+  // `backward` (a backward pass, grammar.h) writes the new word from its end: each module's
+  // `>>` context is what the modules to its right have already become.
   void rewrite(const Word& in, Word& out, uint64_t stream, const std::vector<uint8_t>* active_in,
-               std::vector<uint8_t>* active_out, const Progress& progress, const char* stage) {
+               std::vector<uint8_t>* active_out, const Progress& progress, const char* stage,
+               bool backward = false) {
+    assert(out.size() == 0);
+    if (backward) {
+      assert(!active_in && !active_out);
+      rewrite_backward(in, out, stream, progress, stage);
+      return;
+    }
     in_ = &in;
     out_ = &out;
     const bool keyed = !in.lineage.empty();
     if (uses_context_) compute_brackets(in);
+    if (uses_new_left_) {
+      new_skip_left_.clear();
+      new_open_.clear();
+    }
     const size_t n = in.size();
     for (size_t i = 0; i < n; ++i) {
       if ((i & kProgressChunkMask) == 0 && i != 0) {
         if (progress.cancelled()) throw DeriveCancelled{};
         progress.report(static_cast<double>(i) / static_cast<double>(n), stage);
       }
-      const Module& m = in.modules[i];
-      const Production* chosen = nullptr;
       Rng rng;
-      if ((!active_in || (*active_in)[i]) && !by_symbol_[m.symbol].empty()) {
-        const Production* direct = direct_[m.symbol];
-        if (direct && direct->predecessor.arity == m.param_count) {
-          chosen = direct;
-        } else {
-          if (keyed) rng = Rng(mix_pair(mix_pair(seed_, in.lineage[i]), stream));
-          chosen = choose(i, m, rng);
-        }
-      }
+      const Production* chosen = (!active_in || (*active_in)[i]) ? select(in, i, stream, rng) : nullptr;
       if (!chosen) {
         copy_module(in, i, out);
         if (active_out) active_out->push_back(0);
-        continue;
+      } else {
+        apply(*chosen, i, rng, keyed);
+        if (active_out) active_out->resize(out.size(), 1);
       }
-      apply(*chosen, i, rng, keyed);
-      if (active_out) active_out->resize(out.size(), 1);
+      if (uses_new_left_) extend_left_tables(out);
     }
+  }
+
+  // The production that rewrites module i of `in` (in_), or null: the prebuilt fast path, else
+  // choose() with the module's random stream for `stream` (set in `rng`).
+  const Production* select(const Word& in, size_t i, uint64_t stream, Rng& rng) {
+    const Module& m = in.modules[i];
+    if (by_symbol_[m.symbol].empty()) return nullptr;
+    const Production* direct = direct_[m.symbol];
+    if (direct && direct->predecessor.arity == m.param_count) return direct;
+    if (!in.lineage.empty()) rng = Rng(mix_pair(mix_pair(seed_, in.lineage[i]), stream));
+    return choose(i, m, rng);
+  }
+
+  // A backward pass: `in` read from its last module to its first, each module's successor
+  // put before what the modules to its right became. The new word is built in `reversed_`
+  // (its last module first), so that its context tables grow by appending, then turned round.
+  void rewrite_backward(const Word& in, Word& out, uint64_t stream, const Progress& progress, const char* stage) {
+    in_ = &in;
+    Word& rev = reversed_;
+    rev.clear();
+    out_ = &rev;
+    const bool keyed = !in.lineage.empty();
+    if (uses_context_) compute_brackets(in);
+    new_match_.clear();
+    new_open_.clear();
+    new_skip_ignored_.clear();
+    new_skip_right_.clear();
+    new_branch_end_.clear();
+    const size_t n = in.size();
+    for (size_t done = 0; done < n; ++done) {
+      if ((done & kProgressChunkMask) == 0 && done != 0) {
+        if (progress.cancelled()) throw DeriveCancelled{};
+        progress.report(static_cast<double>(done) / static_cast<double>(n), stage);
+      }
+      const size_t i = n - 1 - done;
+      Rng rng;
+      const Production* chosen = select(in, i, stream, rng);
+      if (!chosen) {
+        copy_module(in, i, rev);
+      } else {
+        successor_.clear();
+        out_ = &successor_;
+        apply(*chosen, i, rng, keyed);
+        out_ = &rev;
+        for (size_t k = successor_.size(); k-- > 0;) copy_module(successor_, k, rev);
+      }
+      if (uses_new_right_) extend_right_tables(rev);
+    }
+    out_ = &out;
+    out.modules.reserve(rev.size());
+    out.params.reserve(rev.params.size());
+    for (size_t r = rev.size(); r-- > 0;) copy_module(rev, r, out);
   }
 
   // True if some production of m's symbol takes m's parameter count (only those could apply).
@@ -245,8 +305,7 @@ class Rewriter {
     throw DeriveFailure{{}, "the word holds more than 4 billion parameters"};
   }
 
-  void bind(const PatternModule& pm, const Module& m) {
-    const double* p = in_->params_of(m);
+  void bind(const PatternModule& pm, const double* p) {
     for (uint16_t k = 0; k < pm.arity; ++k) slots_[pm.first_slot + k] = p[k];
   }
 
@@ -319,23 +378,103 @@ class Rewriter {
 
   bool ignored(SymbolId s) const { return g_.ignored[s] != 0; }
 
+  // The new word a forward pass has written so far: its left-context table grows with it
+  // (compute_left_table's rule, one module at a time).
+  void extend_left_tables(const Word& w) {
+    for (size_t j = new_skip_left_.size(); j < w.size(); ++j) {
+      const SymbolId s = w.modules[j].symbol;
+      const uint32_t before = j ? new_skip_left_[j - 1] : kNoMatch;
+      if (s == kSymPush) {
+        new_open_.push_back(static_cast<uint32_t>(j));
+        new_skip_left_.push_back(before);
+      } else if (ignored(s)) {
+        new_skip_left_.push_back(before);
+      } else if (s == kSymPop && !new_open_.empty()) {
+        const uint32_t open = new_open_.back();
+        new_open_.pop_back();
+        new_skip_left_.push_back(open ? new_skip_left_[open - 1] : kNoMatch);
+      } else {
+        new_skip_left_.push_back(static_cast<uint32_t>(j));
+      }
+    }
+  }
+
+  // The new word a backward pass has written so far, stored last module first (storage
+  // index r; the module to the right of r is r - 1): its right-context tables grow with it
+  // (compute_right_tables' rule), in storage indices, kEnd for "past the word's end".
+  static constexpr uint32_t kEnd = 0xFFFFFFFEu;
+  void extend_right_tables(const Word& rev) {
+    for (size_t r = new_match_.size(); r < rev.size(); ++r) {
+      const SymbolId s = rev.modules[r].symbol;
+      const uint32_t self = static_cast<uint32_t>(r);
+      const uint32_t after = r ? self - 1 : kEnd;
+      auto at = [](const std::vector<uint32_t>& t, uint32_t k) { return k == kEnd ? kEnd : t[k]; };
+      new_match_.push_back(kNoMatch);
+      if (s == kSymPop) {
+        new_open_.push_back(self);  // a ']' waits for its '['
+      } else if (s == kSymPush && !new_open_.empty()) {
+        new_match_[r] = new_open_.back();
+        new_match_[new_open_.back()] = self;
+        new_open_.pop_back();
+      }
+      new_skip_ignored_.push_back(ignored(s) ? at(new_skip_ignored_, after) : self);
+      uint32_t skip = self, end;
+      if (ignored(s)) {
+        skip = at(new_skip_right_, after);
+        end = at(new_branch_end_, after);
+      } else if (s == kSymPush && new_match_[r] != kNoMatch) {
+        const uint32_t close = new_match_[r];
+        const uint32_t past = close ? close - 1 : kEnd;
+        skip = at(new_skip_right_, past);
+        end = at(new_branch_end_, past);
+      } else if (s == kSymPush) {
+        end = kNoMatch;
+      } else if (s == kSymPop) {
+        end = self;
+      } else {
+        end = at(new_branch_end_, after);
+      }
+      new_skip_right_.push_back(skip);
+      new_branch_end_.push_back(end);
+    }
+  }
+
+  // A word as right context sees it, in reading order 0..n (n: past its end): the word
+  // before the pass (its tables as compute_right_tables made them), or a backward pass's new
+  // word (stored reversed, its tables in storage indices).
+  struct RightView {
+    const Word* w;
+    const std::vector<uint32_t> *match, *skip_ignored, *skip_right, *branch_end;
+    size_t n;
+    bool reversed;
+    bool ring;
+    const Module& at(size_t j) const { return w->modules[reversed ? n - 1 - j : j]; }
+    uint32_t get(const std::vector<uint32_t>& t, size_t j) const {
+      if (!reversed) return t[j];
+      if (j >= n) return static_cast<uint32_t>(n);
+      const uint32_t v = t[n - 1 - j];
+      return v == kNoMatch ? kNoMatch : v == kEnd ? static_cast<uint32_t>(n) : static_cast<uint32_t>(n - 1 - v);
+    }
+  };
+
   // ABOP 1.8: going left, skip completed branches ("[...]" before us) and climb out of
   // the branch we are in (its "["), so the context is the module below on the path.
-  bool match_left(const Production& p, size_t i) {
-    const Word& w = *in_;
+  // `end` is the predecessor's place in `w` (the context ends just before it).
+  bool match_left(const std::vector<PatternModule>& context, const Word& w, const std::vector<uint32_t>& skip_left,
+                  size_t end, bool ring) {
     const size_t n = w.size();
-    uint32_t j = i ? static_cast<uint32_t>(i - 1) : kNoMatch;
-    for (size_t k = p.left_context.size(); k-- > 0;) {
+    uint32_t j = end ? static_cast<uint32_t>(end - 1) : kNoMatch;
+    for (size_t k = context.size(); k-- > 0;) {
       ++context_steps_;
-      if (j != kNoMatch) j = skip_left_[j];
+      if (j != kNoMatch) j = skip_left[j];
       // A ring L-system (CPFG manual 3.1.1): before the first module comes the last.
-      if (j == kNoMatch && g_.ring && n > 0) j = skip_left_[n - 1];
+      if (j == kNoMatch && ring && n > 0) j = skip_left[n - 1];
       if (j == kNoMatch) return false;
       const Module& m = w.modules[j];
       if (m.symbol == kSymPop) return false;  // an unmatched ']'
-      const PatternModule& pm = p.left_context[k];
+      const PatternModule& pm = context[k];
       if (m.symbol != pm.symbol || m.param_count != pm.arity) return false;
-      bind(pm, m);
+      bind(pm, w.params_of(m));
       j = j ? j - 1 : kNoMatch;
     }
     return true;
@@ -343,55 +482,72 @@ class Rewriter {
 
   // ABOP 1.8: going right, skip whole branches the pattern does not enter; '[' in the
   // pattern enters a branch, ']' in the pattern skips the rest of the current branch;
-  // the end of the current branch ends the context.
-  bool match_right(const Production& p, size_t i) {
-    const Word& w = *in_;
-    const size_t n = w.size();
-    size_t j = i + 1;
+  // the end of the current branch ends the context. `j` is the first module after the predecessor.
+  bool match_right(const std::vector<PatternModule>& context, const RightView& v, size_t j) {
+    const size_t n = v.n;
+    const bool ring = v.ring;
     entered_.clear();
-    for (size_t k = 0; k < p.right_context.size(); ++k) {
+    for (size_t k = 0; k < context.size(); ++k) {
       ++context_steps_;
-      const PatternModule& pm = p.right_context[k];
+      const PatternModule& pm = context[k];
       // A ring L-system (CPFG manual 3.1.1): after the last module comes the first.
-      if (j >= n && g_.ring && n > 0 && entered_.empty()) j = 0;
+      if (j >= n && ring && n > 0 && entered_.empty()) j = 0;
       if (j >= n) return false;
       if (pm.symbol == kSymPush) {
-        j = skip_ignored_[j];
-        if (j >= n || w.modules[j].symbol != kSymPush) return false;
+        j = v.get(*v.skip_ignored, j);
+        if (j >= n || v.at(j).symbol != kSymPush) return false;
         entered_.push_back(static_cast<uint32_t>(j));
         ++j;
         continue;
       }
       if (pm.symbol == kSymPop) {
-        if (skip_ignored_[j] >= n) return false;
+        if (v.get(*v.skip_ignored, j) >= n) return false;
         size_t close;
         if (!entered_.empty()) {
-          close = match_[entered_.back()];
+          close = v.get(*v.match, entered_.back());
           entered_.pop_back();
         } else {
-          close = branch_end_[j];
+          close = v.get(*v.branch_end, j);
         }
         if (close >= n) return false;
         j = close + 1;
         continue;
       }
-      j = skip_right_[j];
-      if (j >= n && g_.ring && n > 0 && entered_.empty()) j = skip_right_[0];
+      j = v.get(*v.skip_right, j);
+      if (j >= n && ring && n > 0 && entered_.empty()) j = v.get(*v.skip_right, 0);
       if (j >= n) return false;
-      const Module& m = w.modules[j];
+      const Module& m = v.at(j);
       if (m.symbol == kSymPush || m.symbol == kSymPop) return false;  // an unclosed '[', the branch's end
       if (m.symbol != pm.symbol || m.param_count != pm.arity) return false;
-      bind(pm, m);
+      bind(pm, v.w->params_of(m));
       ++j;
     }
     return true;
   }
 
   // Binds the predecessor and contexts of `p` at module i; false if they do not match.
+  // New context (p.new_left, p.new_right) reads the new word this pass has written: before
+  // the predecessor's place in a forward pass, after it in a backward one; it never wraps.
   bool matches(const Production& p, size_t i, const Module& m) {
-    bind(p.predecessor, m);
-    if (!p.left_context.empty() && !match_left(p, i)) return false;
-    if (!p.right_context.empty() && !match_right(p, i)) return false;
+    bind(p.predecessor, in_->params_of(m));
+    if (!p.left_context.empty()) {
+      const bool ok = p.new_left ? match_left(p.left_context, *out_, new_skip_left_, out_->size(), false)
+                                 : match_left(p.left_context, *in_, skip_left_, i, g_.ring);
+      if (!ok) return false;
+    }
+    if (!p.right_context.empty()) {
+      const bool ok =
+          p.new_right
+              ? match_right(p.right_context,
+                            RightView{&reversed_, &new_match_, &new_skip_ignored_, &new_skip_right_, &new_branch_end_,
+                                      reversed_.size(), true, false},
+                            0)
+              : match_right(p.right_context,
+                            RightView{in_, &match_, &skip_ignored_, &skip_right_, &branch_end_, in_->size(), false,
+                                      g_.ring},
+                            i + 1);
+      if (!ok) return false;
+    }
     return true;
   }
 
@@ -515,7 +671,12 @@ class Rewriter {
   std::vector<uint32_t> entered_;
   std::vector<uint32_t> skip_ignored_, skip_right_, branch_end_;
   std::vector<uint32_t> skip_left_;
-  bool uses_left_context_ = false, uses_right_context_ = false;
+  bool uses_left_context_ = false, uses_right_context_ = false;  // old context (the word before the pass)
+  bool uses_new_left_ = false, uses_new_right_ = false;          // new context (grammar.h)
+  // The new word's context tables (extend_left_tables, extend_right_tables) and a backward
+  // pass's new word, stored reversed.
+  std::vector<uint32_t> new_skip_left_, new_open_, new_match_, new_skip_ignored_, new_skip_right_, new_branch_end_;
+  Word reversed_;
   uint64_t context_steps_ = 0;
   uint64_t work_ = 0, work_budget_ = UINT64_MAX;
   const char* budget_what_ = "the interpretation";
@@ -668,8 +829,11 @@ struct Derivation::Impl {
         steps(o.steps.value_or(grammar.steps)),
         seed(o.seed.value_or(grammar.seed)),
         globals(initial_globals(grammar)),
-        context{globals.data()},
-        rewriter(grammar, grammar.productions, grammar.productions_by_symbol, seed, o.max_modules, &context) {
+        context{globals.data()} {
+    passes.reserve(grammar.passes.size());
+    for (const Grammar::Pass& pass : grammar.passes)
+      passes.emplace_back(grammar, grammar.productions, pass.by_symbol, seed, o.max_modules, &context);
+    active = &passes[0];
     if (!grammar.decomposition.empty())
       decomposer.emplace(grammar, grammar.decomposition, grammar.decomposition_by_symbol, seed, o.max_modules,
                          &context);
@@ -690,7 +854,15 @@ struct Derivation::Impl {
     apply_recursively(*decomposer, g.decomposition, g.decomposition_by_symbol, cur, next,
                       kDecompositionStreamBase + static_cast<uint64_t>(at) * (kMaxDecompositionDepth + 2),
                       g.decomposition_depth, budget, options.progress, false, &left);
-    active = &rewriter;
+    active = &passes[0];
+  }
+
+  // Every rewriter's production cleared (an error after this names none) and seed set.
+  void reset_rewriters() {
+    for (Rewriter& r : passes) {
+      r.current_production = nullptr;
+      r.set_seed(seed);
+    }
   }
 
   // on_step's "no" is a cancellation too: its Diagnostic has `cancelled` set.
@@ -707,9 +879,9 @@ struct Derivation::Impl {
   // A cpfg file's global variables, 0 until a block or a production assigns them.
   std::vector<double> globals;
   EvalContext context;
-  Rewriter rewriter;
+  std::vector<Rewriter> passes;        // one per pass of a step (Grammar::passes)
   std::optional<Rewriter> decomposer;  // with decomposition productions only
-  Rewriter* active = &rewriter;        // the one whose production an error names
+  Rewriter* active = nullptr;          // the one whose production an error names
   std::chrono::steady_clock::time_point t0 = std::chrono::steady_clock::now();
   Word cur, next;
   uint64_t peak = 0;
@@ -758,7 +930,7 @@ Status Derivation::start() {
     for (size_t i = 0; i < m.cur.size(); ++i) m.cur.lineage[i] = mix_pair(kAxiomKeyBase, i);
   }
   if (g.uses_cut) apply_cut(m.cur);
-  m.rewriter.set_seed(m.seed);
+  m.reset_rewriters();
   if (m.decomposer) {
     try {
       m.decompose(0);
@@ -785,29 +957,36 @@ Status Derivation::advance() {
   const int64_t step = ++m.step;
   try {
     if (m.options.progress.cancelled()) return cancelled_diagnostic();
-    m.next.clear();
-    reserve_for_growth(m.next, m.cur.size(), m.growth, m.options.max_modules);
-    if (g.uses_random) m.next.lineage.reserve(m.next.modules.capacity());
-    m.rewriter.current_production = nullptr;
+    m.reset_rewriters();
     run_block(g, Block::kStartEach, step, &m.seed, m.context);
-    m.rewriter.set_seed(m.seed);
+    m.reset_rewriters();
     // Step k is the k-th equal share of the whole (the last steps are the longest, so
-    // the bar slows down; it never goes back).
-    const Progress step_progress =
-        m.options.progress.part(static_cast<double>(step - 1) / static_cast<double>(m.steps),
-                                static_cast<double>(step) / static_cast<double>(m.steps));
-    m.rewriter.rewrite(m.cur, m.next, static_cast<uint64_t>(step), nullptr, nullptr, step_progress, "derive");
-    if (g.uses_cut) apply_cut(m.next);
-    if (step < m.steps) step_progress.report(1, "derive");  // the last step's 1 is the whole's
-    m.peak = std::max<uint64_t>(m.peak, m.cur.capacity_bytes() + m.next.capacity_bytes());
-    m.growth = m.cur.size() ? std::max(1.0, static_cast<double>(m.next.size()) / static_cast<double>(m.cur.size()))
-                            : 2.0;
-    std::swap(m.cur, m.next);
+    // the bar slows down; it never goes back); its passes share it equally.
+    const size_t pass_count = m.passes.size();
+    const double share = 1.0 / static_cast<double>(m.steps) / static_cast<double>(pass_count);
+    for (size_t k = 0; k < pass_count; ++k) {
+      m.active = &m.passes[k];
+      const uint64_t before = m.cur.size();
+      m.next.clear();
+      reserve_for_growth(m.next, m.cur.size(), m.growth, m.options.max_modules);
+      if (g.uses_random) m.next.lineage.reserve(m.next.modules.capacity());
+      const double begin = static_cast<double>(step - 1) / static_cast<double>(m.steps) + share * static_cast<double>(k);
+      const Progress pass_progress = m.options.progress.part(begin, begin + share);
+      // Pass 0 keeps the streams a one-pass grammar always had: the step's number.
+      const uint64_t stream = static_cast<uint64_t>(step) | (static_cast<uint64_t>(k) << 56);
+      m.passes[k].rewrite(m.cur, m.next, stream, nullptr, nullptr, pass_progress, "derive", g.passes[k].backward);
+      if (g.uses_cut) apply_cut(m.next);
+      if (step < m.steps || k + 1 < pass_count) pass_progress.report(1, "derive");  // the last 1 is the whole's
+      m.peak = std::max<uint64_t>(m.peak, m.cur.capacity_bytes() + m.next.capacity_bytes());
+      m.growth = before ? std::max(1.0, static_cast<double>(m.next.size()) / static_cast<double>(before)) : 2.0;
+      std::swap(m.cur, m.next);
+    }
+    m.active = &m.passes[0];
     if (m.decomposer) {
       m.decompose(step);
       if (g.uses_cut) apply_cut(m.cur);
     }
-    m.rewriter.current_production = nullptr;
+    m.reset_rewriters();
     run_block(g, Block::kEndEach, step, &m.seed, m.context);
     if (m.options.on_step && !m.options.on_step(step, m.cur)) return m.stopped_at(step);
   } catch (const DeriveCancelled&) {
@@ -829,18 +1008,19 @@ Expected<Word> Derivation::finish(DeriveStats* stats) {
   const Grammar& g = m.g;
   assert(m.started && !m.failed);
   try {
-    m.rewriter.current_production = nullptr;
+    m.reset_rewriters();
     run_block(g, Block::kEnd, m.steps, &m.seed, m.context);
   } catch (const DeriveFailure& f) {
-    return failure_diagnostic(g, m.rewriter, f.message, f.loc, "step", m.steps + 1);
+    return failure_diagnostic(g, m.passes[0], f.message, f.loc, "step", m.steps + 1);
   } catch (const EvalError& e) {
-    return failure_diagnostic(g, m.rewriter, e.message, e.loc, "step", m.steps + 1);
+    return failure_diagnostic(g, m.passes[0], e.message, e.loc, "step", m.steps + 1);
   }
   if (stats) {
     stats->steps = m.step;
     stats->modules = m.cur.size();
     stats->peak_bytes = m.peak;
-    stats->context_steps = m.rewriter.context_steps();
+    stats->context_steps = 0;
+    for (const Rewriter& r : m.passes) stats->context_steps += r.context_steps();
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - m.t0).count();
   }
   m.options.progress.report(1, "derive");

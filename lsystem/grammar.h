@@ -56,6 +56,11 @@ struct Production {
   Expr after;                                // cpfg statements run when the production applies
   Expr probability;                          // kind kNone: not stochastic
   Successor successor;
+  // New context (lpfg's `<<` and `>>`, docs/grammar-notes.md "Passes"): the context is matched
+  // in the word this pass has already written, not in the word before it. `<<` only in a
+  // forward pass, `>>` only in a backward one.
+  bool new_left = false, new_right = false;
+  uint32_t pass = 0;                         // the pass it belongs to (Grammar::passes)
   bool has_context() const { return !left_context.empty() || !right_context.empty(); }
   bool has_statements() const { return before.kind != Expr::Kind::kNone || after.kind != Expr::Kind::kNone; }
 };
@@ -127,8 +132,17 @@ struct Grammar {
   std::vector<Production> decomposition;
   int decomposition_depth = 16;  // a cpfg file's default: 1, as its homomorphism's
   std::vector<uint8_t> ignored;  // by symbol id: skipped when matching context
+  // A derivation step rewrites the word once per pass, in file order (`pass: forward` /
+  // `pass: backward` lines split the productions; without them there is one forward pass).
+  // A forward pass writes the new word left to right, a backward one right to left, so new
+  // context reaches across the whole word in one step (docs/grammar-notes.md "Passes").
+  struct Pass {
+    bool backward = false;
+    SourceLoc loc;                                  // its `pass:` line ({0, 0}: the implicit one)
+    std::vector<std::vector<uint32_t>> by_symbol;   // its productions by predecessor, in file order
+  };
+  std::vector<Pass> passes{1};
   // Index lists by predecessor symbol, in file order.
-  std::vector<std::vector<uint32_t>> productions_by_symbol;
   std::vector<std::vector<uint32_t>> homomorphism_by_symbol;
   std::vector<std::vector<uint32_t>> decomposition_by_symbol;
   bool uses_random = false;   // any stochastic production or random function

@@ -82,6 +82,7 @@ using namespace detail;  // NOLINT: the parser is the detail's main user
 constexpr int kMaxNesting = 128;     // parentheses / unary operators / calls
 constexpr int64_t kMaxSteps = 1000000;
 constexpr int kMaxDepthLimit = 1000;
+constexpr size_t kMaxPasses = 255;  // derive.cpp keys a pass's random streams by its index below 256
 
 std::string quote_char(char c) {
   if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
@@ -279,6 +280,9 @@ class Parser {
   const ParseOptions& options_;
   std::unordered_map<std::string, double> define_values_;
   bool have_axiom_ = false;
+  bool pass_has_productions_ = false;  // the current pass (Grammar::passes.back()) has a production
+  bool explicit_pass_ = false;         // a 'pass:' line started the current pass
+  bool pass_line(const Cursor& c, std::string_view rest);
   bool seen_lsystem_ = false;  // cpfg: the 'Lsystem:' line was read
   bool seen_end_ = false;      // cpfg: the 'endlsystem' line was read
   bool consider_ = false;      // cpfg: a 'consider:' list names the modules context sees
@@ -1008,26 +1012,52 @@ void Parser::parse_production(const LogicalLine& line) {
     while (!ct.empty() && is_space(ct.back())) ct.remove_suffix(1);
     has_condition = ct != "*";
   }
-  // Context split at top-level '<' and '>'.
+  // Context split at top-level '<' and '>' (or lpfg's new context '<<' and '>>').
   size_t lt = find_top_level(context, "<");
   size_t gt = find_top_level(context, ">");
   if (lt != std::string::npos && gt != std::string::npos && gt < lt)
     fail(context.loc_at(gt), "the right context '>' must come after the left context '<'");
+  const std::string& text = line.text;
+  p.new_left = lt != std::string::npos && lt + 1 < context.end && text[lt + 1] == '<';
+  p.new_right = gt != std::string::npos && gt + 1 < context.end && text[gt + 1] == '>';
+  const size_t lt_len = p.new_left ? 2 : 1, gt_len = p.new_right ? 2 : 1;
+  const char* lt_name = p.new_left ? "'<<'" : "'<'";
+  const char* gt_name = p.new_right ? "'>>'" : "'>'";
   Cursor lctx = context.sub(context.pos, lt == std::string::npos ? context.pos : lt);
-  Cursor pred = context.sub(lt == std::string::npos ? context.pos : lt + 1,
+  Cursor pred = context.sub(lt == std::string::npos ? context.pos : lt + lt_len,
                             gt == std::string::npos ? context.end : gt);
-  Cursor rctx = context.sub(gt == std::string::npos ? context.end : gt + 1, context.end);
+  Cursor rctx = context.sub(gt == std::string::npos ? context.end : gt + gt_len, context.end);
   if (lt != std::string::npos) {
     Cursor t = lctx;
     t.skip_spaces();
-    if (t.at_end()) fail(context.loc_at(lt), "expected a left context before '<'");
-    if (find_top_level(context.sub(lt + 1, context.end), "<") != std::string::npos)
-      fail(context.loc_at(find_top_level(context.sub(lt + 1, context.end), "<")), "a production has at most one '<'");
+    if (t.at_end()) fail(context.loc_at(lt), std::string("expected a left context before ") + lt_name);
+    const size_t again = find_top_level(context.sub(lt + lt_len, context.end), "<");
+    if (again != std::string::npos) fail(context.loc_at(again), "a production has at most one left context");
   }
   if (gt != std::string::npos) {
     Cursor t = rctx;
     t.skip_spaces();
-    if (t.at_end()) fail(context.loc_at(gt), "expected a right context after '>'");
+    if (t.at_end()) fail(context.loc_at(gt), std::string("expected a right context after ") + gt_name);
+    const size_t again = find_top_level(context.sub(gt + gt_len, context.end), ">");
+    if (again != std::string::npos) fail(context.loc_at(again), "a production has at most one right context");
+  }
+  if (p.new_left || p.new_right) {
+    const SourceLoc at = context.loc_at(p.new_left ? lt : gt);
+    if (section_ != Section::kProductions)
+      fail(at, std::string("new context (") + (p.new_left ? lt_name : gt_name) +
+                   ") reads the word a derivation pass is writing: it belongs to the productions, not to the " +
+                   (section_ == Section::kHomomorphism ? "homomorphism" : "decomposition"));
+    const bool backward = g_.passes.back().backward;
+    if (p.new_left && backward)
+      fail(at, "'<<' reads the new word to the left, which a backward pass has not written yet: put this "
+               "production under 'pass: forward' (docs/grammar-notes.md \"Passes\")");
+    if (p.new_right && !backward)
+      fail(at, "'>>' reads the new word to the right, which a forward pass has not written yet: put this "
+               "production under 'pass: backward' (docs/grammar-notes.md \"Passes\")");
+  }
+  if (section_ == Section::kProductions) {
+    p.pass = static_cast<uint32_t>(g_.passes.size() - 1);
+    pass_has_productions_ = true;
   }
   Scope scope;
   {
@@ -1197,6 +1227,34 @@ bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest) {
     return true;
   }
   return false;
+}
+
+// A `pass: forward` or `pass: backward` line (docs/grammar-notes.md "Passes"): the productions
+// after it, up to the next, form one pass of every derivation step. The first such line
+// before any production gives the implicit first pass its direction. True when it was one.
+bool Parser::pass_line(const Cursor& c, std::string_view rest) {
+  if (rest.substr(0, 4) != "pass") return false;
+  size_t k = 4;
+  while (k < rest.size() && is_space(rest[k])) ++k;
+  if (k >= rest.size() || rest[k] != ':') return false;
+  ++k;
+  while (k < rest.size() && is_space(rest[k])) ++k;
+  const SourceLoc at = c.loc_at(c.pos + k);
+  const std::string_view dir = rest.substr(k);
+  if (dir != "forward" && dir != "backward")
+    fail(at, "expected 'forward' or 'backward' after 'pass:' (the direction the pass writes the new word in)");
+  if (section_ != Section::kProductions)
+    fail(c.loc(), "'pass:' splits the productions; it cannot stand in the homomorphism or decomposition");
+  if (explicit_pass_ && !pass_has_productions_) fail(g_.passes.back().loc, "this pass has no productions");
+  if (pass_has_productions_) {
+    if (g_.passes.size() >= kMaxPasses) fail(c.loc(), "more than " + std::to_string(kMaxPasses) + " passes");
+    g_.passes.emplace_back();
+  }
+  g_.passes.back().backward = dir == "backward";
+  g_.passes.back().loc = c.loc();
+  explicit_pass_ = true;
+  pass_has_productions_ = false;
+  return true;
 }
 
 void Parser::set_consider(Cursor c) {
@@ -1719,6 +1777,7 @@ void Parser::parse(const std::string& text) {
       section_ = Section::kProductions;
       continue;
     }
+    if (pass_line(c, rest)) continue;
     if (section("decomposition")) {
       section_ = Section::kDecomposition;
       continue;
@@ -1757,13 +1816,15 @@ void Parser::parse(const std::string& text) {
     considered_.resize(nsym, 0);
     for (size_t k = 0; k < nsym; ++k) g_.ignored[k] = k != kSymPush && k != kSymPop && !considered_[k];
   }
-  g_.productions_by_symbol.assign(nsym, {});
+  if (explicit_pass_ && !pass_has_productions_)
+    fail(g_.passes.back().loc, "this pass has no productions");
+  for (Grammar::Pass& pass : g_.passes) pass.by_symbol.assign(nsym, {});
   g_.homomorphism_by_symbol.assign(nsym, {});
   g_.decomposition_by_symbol.assign(nsym, {});
   for (uint32_t i = 0; i < g_.decomposition.size(); ++i)
     g_.decomposition_by_symbol[g_.decomposition[i].predecessor.symbol].push_back(i);
   for (uint32_t i = 0; i < g_.productions.size(); ++i)
-    g_.productions_by_symbol[g_.productions[i].predecessor.symbol].push_back(i);
+    g_.passes[g_.productions[i].pass].by_symbol[g_.productions[i].predecessor.symbol].push_back(i);
   for (uint32_t i = 0; i < g_.homomorphism.size(); ++i)
     g_.homomorphism_by_symbol[g_.homomorphism[i].predecessor.symbol].push_back(i);
   for (size_t i = 0; i < g_.axiom.size(); ++i)
@@ -1869,7 +1930,7 @@ Expected<Word> parse_word(std::string_view text, Grammar& grammar) {
     Word w = parser.parse_word_line(line);
     const size_t nsym = grammar.symbols.size();  // the word may name new modules
     grammar.ignored.resize(nsym, 0);
-    grammar.productions_by_symbol.resize(nsym);
+    for (Grammar::Pass& pass : grammar.passes) pass.by_symbol.resize(nsym);
     grammar.homomorphism_by_symbol.resize(nsym);
     grammar.decomposition_by_symbol.resize(nsym);
     return w;

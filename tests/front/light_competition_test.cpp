@@ -103,22 +103,88 @@ TEST(LightSapling, UnderACanopyItGrowsTowardTheGap) {
   EXPECT_LT(std::hypot(alone.x, alone.z), 0.3) << "the open overcast sky is the same all around";
 }
 
-// presets/light/self_organizing.lsys: the light alone shapes the crown. Grown 12 steps in
-// the default sun: every step answered, apices that fall below VMIN stop (so it grows
-// fewer internodes than the 2^12 - 1 of a tree whose every apex grows), leaves fall in shade.
-TEST(LightSelfOrganizing, TheLightAloneStopsApicesAndShedsLeaves) {
+// presets/light/self_organizing.lsys: the light alone shapes the crown, its vigour allocated
+// by the extended Borchert–Honda model (Pałubicki et al. 2009) in two passes a step
+// (docs/grammar-notes.md "Passes"). Grown 12 steps in the default sun, the word is read
+// back: every fork's light is the sum of its children's (the backward pass), every fork's
+// vigour is split between them exactly by LAMBDA and their light (the forward pass), the
+// root's vigour is ALPHA times the light the whole tree gathers, and the lower crown sheds.
+TEST(LightSelfOrganizing, VigourIsAllocatedByBorchertHondaFromTheLightGatheredAlongWholeBranches) {
   auto g = lsys::load_grammar(std::string(SYLVA_SOURCE_DIR) + "/presets/light/self_organizing.lsys");
   ASSERT_TRUE(g) << g.error().format();
+  auto define = [&](const char* name) {
+    for (const lsys::Define& d : g->defines)
+      if (d.name == name) return d.value;
+    ADD_FAILURE() << "no #define " << name;
+    return 0.0;
+  };
+  const double lambda = define("LAMBDA"), alpha = define("ALPHA");
   lsys::DeriveOptions o;
   o.steps = 12;
-  auto grown = grow(*g, o, "self_organizing.lsys", {}, {&cpu_light_oracle()});
-  ASSERT_TRUE(grown) << grown.error().format();
-  EXPECT_EQ(grown->light.answers, 13u);
-  const uint64_t internodes = grown->skeleton.segment_count();
-  EXPECT_GT(internodes, 200u);
-  EXPECT_LT(internodes, 4095u) << "some apices stopped in shade";
-  EXPECT_LT(grown->skeleton.leaves.size(), internodes) << "one leaf per internode, less those that fell";
-  for (const GrowQuery& q : grown->queries) EXPECT_TRUE(q.q >= 0 && q.q <= 1);
+  LightGrowthStats stats;
+  auto word = derive_word(*g, o, {&cpu_light_oracle()}, &stats);
+  ASSERT_TRUE(word) << word.error().format();
+  EXPECT_EQ(stats.answers, 13u) << "one answer a step, whatever its passes";
+
+  // The nodes N(k, a, Q, M, L, v, r, c) and, for each internode, its lateral and main child.
+  lsys::SymbolId n_id = 0, turn = 0, roll = 0;
+  ASSERT_TRUE(g->symbols.find("N", &n_id));
+  turn = lsys::kSymPitchDown;
+  roll = lsys::kSymRollRight;
+  const lsys::Word& w = *word;
+  auto skip = [&](size_t j) {  // the ignore list: & / @Tp
+    while (j < w.size() && (w.modules[j].symbol == turn || w.modules[j].symbol == roll ||
+                            w.modules[j].symbol == lsys::kSymTropismVector))
+      ++j;
+    return j;
+  };
+  auto node = [&](size_t j) { return w.params_of(w.modules[j]); };
+  std::vector<size_t> close(w.size(), 0), open;
+  for (size_t j = 0; j < w.size(); ++j) {
+    if (w.modules[j].symbol == lsys::kSymPush) open.push_back(j);
+    if (w.modules[j].symbol == lsys::kSymPop) {
+      close[open.back()] = j;
+      open.pop_back();
+    }
+  }
+  ASSERT_GE(w.size(), 2u);
+  ASSERT_EQ(w.modules[0].symbol, n_id);
+  const double* root = node(0);
+  ASSERT_EQ(root[0], 3);
+  EXPECT_NEAR(root[5], alpha * root[2], 1e-9 * root[5]) << "the root's vigour: ALPHA times the tree's light";
+  size_t forks = 0, stubs = 0, buds = 0;
+  for (size_t i = 0; i < w.size(); ++i) {
+    if (w.modules[i].symbol != n_id) continue;
+    const double* p = node(i);
+    if (p[0] == 2) ++stubs;
+    if (p[0] == 1) ++buds;
+    if (p[0] != 0 || p[3] + p[4] == 0) continue;  // an internode grown this step: its children wait a step
+    const size_t bracket = skip(i + 1);
+    ASSERT_EQ(w.modules[bracket].symbol, lsys::kSymPush) << "an internode is followed by its lateral";
+    const size_t lat_at = skip(bracket + 1), main_at = skip(close[bracket] + 1);
+    ASSERT_EQ(w.modules[lat_at].symbol, n_id);
+    ASSERT_EQ(w.modules[main_at].symbol, n_id);
+    const double *lat = node(lat_at), *main = node(main_at);
+    if (lat[0] == 2) continue;  // shed this step: its share went with it
+    ++forks;
+    EXPECT_NEAR(p[2], p[3] + p[4], 1e-9 * p[2]) << "Q is the sum of the children's";
+    EXPECT_NEAR(p[3], main[2], 1e-9 * p[3]) << "M is the main child's light";
+    EXPECT_NEAR(p[4], lat[2], 1e-9 * (p[4] + 1e-12)) << "L is the lateral's light";
+    const double weights = lambda * p[3] + (1 - lambda) * p[4] + 1e-12;
+    EXPECT_NEAR(main[5], p[5] * lambda * p[3] / weights, 1e-9 * p[5]) << "the main child's share";
+    EXPECT_NEAR(lat[5], p[5] * (1 - lambda) * p[4] / weights, 1e-9 * p[5]) << "the lateral's share";
+  }
+  std::printf("%zu forks checked, %zu buds, %zu shed stubs, %zu modules\n", forks, buds, stubs, w.size());
+  EXPECT_GT(forks, 100u);
+  EXPECT_GT(stubs, 10u) << "the shaded lower crown is shed";
+  size_t answered = 0;
+  for (const lsys::Module& m : w.modules)
+    if (m.symbol == lsys::kSymLightQuery) {
+      const double q = w.params_of(m)[0];
+      EXPECT_TRUE(q >= 0 && q <= 1) << q;
+      answered += q < 1;
+    }
+  EXPECT_GT(answered, buds / 2) << "most buds are shaded a little";
 }
 
 }  // namespace

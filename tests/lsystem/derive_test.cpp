@@ -13,12 +13,7 @@ namespace {
 
 using testing::derive_text;
 using testing::parse_ok;
-
-DeriveOptions steps(int64_t n) {
-  DeriveOptions o;
-  o.steps = n;
-  return o;
-}
+using testing::steps;
 
 TEST(Derive, RewritesInParallelAndCopiesModulesWithoutRules) {
   EXPECT_EQ(derive_text("axiom: F\nF -> F[+F]F\n", steps(2)), "F[+F]F[+F[+F]F]F[+F]F");

@@ -26,6 +26,13 @@ inline Diagnostic parse_error(const std::string& text, const ParseOptions& optio
   return g.error();
 }
 
+// Derive options for `n` steps.
+inline DeriveOptions steps(int64_t n) {
+  DeriveOptions o;
+  o.steps = n;
+  return o;
+}
+
 // Derives `text` and prints the word ("<error: ...>" on failure).
 inline std::string derive_text(const std::string& text, DeriveOptions options = {}) {
   auto g = parse_grammar(text, "test.lsys");
