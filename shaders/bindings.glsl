@@ -20,6 +20,10 @@
 #define FOG_COUNTERS_BINDING 11   // fog_lists.glsl FogCounters: the frame's counts
 #define INSTANCES_BINDING 12      // instances.glsl Instances: INSTANCED's per plant transforms
 #define MATERIAL_MAPS_BINDING 13  // bark.glsl MaterialMapsBuffer: a MaterialMaps per material slot
+#define FOG_MAPS_BINDING 14       // fog_map.glsl FogMaps: a GpuSunMap per sun map (fog mode map)
+#define FOG_MAP_SLOTS_BINDING 15  // fog_map.glsl FogMapSlots: per tile of every map, its slot
+#define FOG_MAP_RANGES_BINDING 16 // fog_map.glsl FogMapRanges: per slot, its smallest and largest height
+#define FOG_MAP_TEXELS_BINDING 17 // fog_map.glsl FogMapTexels: per texel of every slot, its height
 
 // Texture units. Bark images take units BARK_TEXTURES_UNIT .. + MAX_BARK_IMAGES − 1; the
 // G-buffer, the shadow map and the accumulated beauty sit above them, so no pass rebinds
@@ -43,6 +47,9 @@
 #define FOG_LIST_END 0xFFFFFFFFu  // the end of a pixel's interval list (fog_lists.glsl)
 #define FOG_MAX_INTERVALS 16      // merged intervals the fog resolve holds per pixel (fog.frag.glsl)
 #define FOG_MAX_LIST_NODES 1024u  // list nodes the fog resolve walks per pixel (more: marched whole)
+#define FOG_MAP_NO_SLOT 0xFFFFFFFFu  // a sun map's tile that is not allocated (fog_map.glsl)
+#define FOG_MAP_TILE 32           // texels a side of a sun map's tile (fog_map.glsl)
+#define FOG_MAX_MAPS 64           // sun maps the fog resolve walks (fog.frag.glsl FOG_MAP)
 
 // Uniform blocks (std140): none. The views (views.glsl's camera and sun uniforms) and the
 // shading parameters are default-block uniforms set by name (core/gl/gl_views.h,

@@ -19,6 +19,9 @@
 //               lookup each. The expectation is the CPU medium's (V = 1 outside the cones,
 //               the shadow test inside), every sample spent where a shadow may be.
 //   FOG_FAST    the same intervals, V = 0 inside them, closed form outside: no lookup.
+//   FOG_MAP     the sun-space depth maps (fog_map.glsl), walked texel by texel along the
+//               whole sunlit stretch: closed form over the parts in front of each map,
+//               the maps' results averaged — the CPU's map mode, no lookup, no random number.
 // A pixel whose list is incomplete (the node buffer was full, or its merged intervals
 // exceed FOG_MAX_INTERVALS) is marched as FOG_BRUTE: unbiased, slower, counted.
 // Without SUN (no sunlight reaches the fog) only the sky term and T are computed.
@@ -55,6 +58,10 @@ uniform vec2 u_light_depth;
 uniform float u_depth_bias;
 #if defined(FOG_MEDIUM) || defined(FOG_FAST)
 uniform bool u_cones;              // a cone set is uploaded (else every ray is marched whole)
+#endif
+#ifdef FOG_MAP
+uniform vec3 u_eye_rel_maps;       // eye − the map set's origin (GlFogMaps::origin)
+uniform uint u_map_count;          // maps uploaded, 1 .. FOG_MAX_MAPS
 #endif
 #endif
 
@@ -154,7 +161,15 @@ void main() {
     uint pixel_index = uint(gl_FragCoord.y) * uint(u_image_size.x) + uint(gl_FragCoord.x);
     uint stream = fog_hash(pixel_index ^ fog_hash(u_seed));
     float sun = 0.0;
-#if defined(FOG_MEDIUM) || defined(FOG_FAST)
+#if defined(FOG_MAP)
+    uint texels = 0u;
+    bool capped = false;
+    for (uint k = 0u; k < uint(FOG_MAX_MAPS); ++k) {
+      if (k >= u_map_count) break;
+      sun += fog_map_sun(m, o, d, s, a, b, u_eye_rel_maps, k, texels, capped);
+    }
+    sun /= float(max(u_map_count, 1u));
+#elif defined(FOG_MEDIUM) || defined(FOG_FAST)
     float starts[FOG_MAX_INTERVALS], ends[FOG_MAX_INTERVALS];
     for (int i = 0; i < FOG_MAX_INTERVALS; ++i) starts[i] = ends[i] = 0.0;  // (inout below)
     int count = 0;

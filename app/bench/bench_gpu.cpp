@@ -104,7 +104,7 @@ void print_help() {
          "  --quick                 a 160x120 image, 3 frames after 1, fewer settings (tests)\n"
          "  --reference-steps N     uniform relief steps of the reference (default 1024)\n"
          "  --reference-bisection N bisection steps of the reference (default 24)\n"
-         "  --fog                   the fog pass instead: brute at 16..256 steps, fast and medium on\n"
+         "  --fog                   the fog pass instead: brute at 16..256 steps, fast, medium and map on\n"
          "                          foggy scenes (default elm_grove_low_sun), fog GPU ms and the fog\n"
          "                          AOV's RMSE against the CPU reference (default bench_gpu_fog.csv,\n"
          "                          .png; --quick: 96x72, brute 16 and 64, 2 frames after 1)\n"

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <sstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <variant>
@@ -20,6 +21,7 @@
 #include "app/front/render_input.h"
 #include "core/cpu/photons.h"
 #include "core/cpu/render_cpu.h"
+#include "core/cpu/sun_maps.h"
 #include "core/gl/render_gl.h"
 #include "core/util/parallel.h"
 
@@ -28,17 +30,26 @@ namespace sylva::cli {
 namespace {
 
 struct FogMethod {
-  std::string name;  // "brute 64", "fast", "medium 64"
+  std::string name;  // "brute 64", "fast", "medium 64", "map 2048²"
   FogMode mode;
   uint32_t steps;
+  uint32_t map_resolution = 0;  // map: texels a side
 };
 
-std::vector<FogMethod> fog_methods(bool quick, uint32_t medium_steps) {
+std::vector<FogMethod> fog_methods(bool quick, uint32_t medium_steps, uint32_t map_resolution) {
   std::vector<FogMethod> m;
   for (uint32_t n : quick ? std::vector<uint32_t>{16, 64} : std::vector<uint32_t>{16, 32, 64, 128, 256})
     m.push_back({"brute " + std::to_string(n), FogMode::brute, n});
   m.push_back({"fast", FogMode::fast, medium_steps});
   m.push_back({"medium " + std::to_string(medium_steps), FogMode::medium, medium_steps});
+  // map at the scene's resolution, and (not --quick) coarser: its error against its cost.
+  std::vector<uint32_t> sides = {map_resolution};
+  if (!quick)
+    for (uint32_t side : {512u, 1024u, 4096u})
+      if (side != map_resolution) sides.push_back(side);
+  std::sort(sides.begin(), sides.end());
+  for (uint32_t side : sides)
+    m.push_back({"map " + std::to_string(side) + "\u00b2", FogMode::map, medium_steps, side});
   return m;
 }
 
@@ -88,7 +99,7 @@ const char* const kGpuFogCsvColumns =
 int run_gpu_fog_rows(const GpuFogArgs& a, const std::string& device, const GlContextInfo& gl) {
   // Each row as it finishes, with a progress line (bench_rows.h): a long run stopped
   // early keeps what it measured.
-  const size_t planned = a.inputs.size() * a.sizes.size() * fog_methods(a.quick, 1).size();
+  const size_t planned = a.inputs.size() * a.sizes.size() * fog_methods(a.quick, 1, Fog{}.map_resolution).size();
   BenchRows csv("sylva bench gpu --fog", a.csv,
                 "# sylva bench gpu --fog on " + device + " (" + gl.describe() + "), " + std::to_string(a.frames) +
                     " frames after " + std::to_string(a.warmup) + " warm-up frames, sun as a point\n" +
@@ -141,8 +152,9 @@ int run_gpu_fog_rows(const GpuFogArgs& a, const std::string& device, const GlCon
       }
       std::cerr << "sylva bench gpu --fog: reference of " << pixels.size() << " pixels in " << reference_s << " s\n";
       std::unique_ptr<const SunCones> cones[2];  // fast's, medium's (the automatic choice weighs misses apart)
+      std::map<uint32_t, SunMaps> maps;           // map's by resolution, built once on the CPU (its cost: stderr)
       PlotPanel panel{where + ", " + device, "fog GPU time per frame (ms)", "fog RMSE / mean", {}};
-      for (const FogMethod& m : fog_methods(a.quick, scene.fog->steps)) {
+      for (const FogMethod& m : fog_methods(a.quick, scene.fog->steps, scene.fog->map_resolution)) {
         Scene s = scene;
         s.fog->mode = m.mode;
         s.fog->steps = m.steps;
@@ -155,7 +167,21 @@ int run_gpu_fog_rows(const GpuFogArgs& a, const std::string& device, const GlCon
         FogError e{std::nan(""), std::nan(""), std::nan("")};
         try {
           GlRenderer renderer(s, options);
-          if (m.mode != FogMode::brute) {
+          if (m.mode == FogMode::map) {
+            auto found = maps.find(m.map_resolution);
+            if (found == maps.end()) {
+              SunMapOptions mo;
+              mo.resolution = m.map_resolution;
+              mo.disc_maps = s.fog->map_directions;
+              mo.threads = threads;
+              Expected<SunMaps> built = build_sun_maps_of(geometry, s, std::min(photons, kSunMapTilePhotons), mo, nullptr);
+              if (!built) throw std::runtime_error(built.error().message);
+              found = maps.emplace(m.map_resolution, std::move(*built)).first;
+              std::cerr << "sylva bench gpu --fog: sun maps of " << where << ": " << found->second.describe() << " in "
+                        << found->second.seconds << " s on the CPU\n";
+            }
+            renderer.set_fog_maps(found->second.maps);
+          } else if (m.mode != FogMode::brute) {
             std::unique_ptr<const SunCones>& c = cones[m.mode == FogMode::medium ? 1 : 0];
             if (!c) c = build_sun_cones(geometry, s, sun_cone_options_for(m.mode, photons, std::nullopt, threads, nullptr));
             renderer.set_fog_cones(c->cones);

@@ -1,6 +1,7 @@
 // render.cpp — see render.h.
 #include "app/front/render.h"
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -25,8 +26,32 @@ GlConeSource sun_cone_source(const Scene& scene, const RenderOptions& options) {
   };
 }
 
+SunMaps sun_maps_for(const Scene& scene, const RenderOptions& options, std::vector<RenderPass>* passes) {
+  const SceneGeometry geometry = options.geometry.instance
+                                     ? build_instanced_geometry(scene, options.skin, GeometryOptions{}, passes)
+                                     : build_scene_geometry(scene, options.skin, GeometryOptions{}, passes);
+  Expected<SunMaps> maps = build_sun_maps_of(geometry, scene, sun_map_tile_photons(scene, options),
+                                             sun_map_options_for(scene, options), passes);
+  if (!maps) throw SunMapsRefused(maps.error().message);
+  return std::move(*maps);
+}
+
 RenderResult render_gl_scene(const Scene& scene, const RenderOptions& options, GlFrameStats* stats) {
-  return render_gl(scene, options, stats, sun_cone_source(scene, options));
+  const FogMode mode = scene.fog ? options.fog.mode.value_or(scene.fog->mode) : FogMode::brute;
+  if ((mode != FogMode::map && mode != FogMode::automatic) || !options.fog.maps.empty())
+    return render_gl(scene, options, stats, sun_cone_source(scene, options));
+  std::vector<RenderPass> passes;
+  const SunMaps maps = sun_maps_for(scene, options, &passes);
+  if (maps.cancelled) {
+    RenderResult cancelled;
+    cancelled.cancelled = true;
+    return cancelled;
+  }
+  RenderOptions with_maps = options;
+  with_maps.fog.maps = maps.maps;
+  RenderResult result = render_gl(scene, with_maps, stats);
+  result.passes.insert(result.passes.begin(), passes.begin(), passes.end());
+  return result;
 }
 
 }  // namespace sylva

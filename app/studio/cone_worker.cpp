@@ -4,6 +4,7 @@
 #include <chrono>
 #include <exception>
 
+#include "app/front/render.h"
 #include "core/cpu/photons.h"
 #include "core/cpu/render_cpu.h"
 
@@ -81,14 +82,26 @@ void ConeWorker::run() {
     bool completed = false;
     const auto start = std::chrono::steady_clock::now();
     try {
-      const SceneGeometry geometry = build_scene_geometry(request.scene, request.skin);
-      std::unique_ptr<const SunCones> built = build_sun_cones(
-          geometry, request.scene, sun_cone_options_for(request.mode, request.photons, std::nullopt, 0, &cancel_));
-      if (!built->cancelled) {
-        const ConeSet* set = &built->cones;
-        const std::shared_ptr<const SunCones> owner(std::move(built));
-        result.cones = std::shared_ptr<const ConeSet>(owner, set);  // keeps the whole SunCones
-        completed = true;
+      if (request.mode == FogMode::map) {
+        RenderOptions options;
+        options.skin = request.skin;
+        options.fog.photons = request.photons;
+        options.progress = Progress(&cancel_);
+        SunMaps maps = sun_maps_for(request.scene, options, nullptr);
+        if (!maps.cancelled) {
+          result.maps = std::make_shared<const std::vector<SunDepthMap>>(std::move(maps.maps));
+          completed = true;
+        }
+      } else {
+        const SceneGeometry geometry = build_scene_geometry(request.scene, request.skin);
+        std::unique_ptr<const SunCones> built = build_sun_cones(
+            geometry, request.scene, sun_cone_options_for(request.mode, request.photons, std::nullopt, 0, &cancel_));
+        if (!built->cancelled) {
+          const ConeSet* set = &built->cones;
+          const std::shared_ptr<const SunCones> owner(std::move(built));
+          result.cones = std::shared_ptr<const ConeSet>(owner, set);  // keeps the whole SunCones
+          completed = true;
+        }
       }
     } catch (const std::exception&) {
       completed = false;  // the plants cannot be traced (none): no cones, the fog draws brute

@@ -1,5 +1,6 @@
 // cone_worker.h — the studio's fog cone thread: sun photons and shadow cones
-// (core/cpu/photons.h build_sun_cones, Hougs and Day 2001 sec. 3) for the plants and sun on screen,
+// (core/cpu/photons.h build_sun_cones, Hougs and Day 2001 sec. 3) — or for fog mode map the
+// sun maps (core/cpu/sun_maps.h, app/front/render.h sun_maps_for) — for the plants and sun on screen,
 // built off the UI thread, because they are viewpoint independent but cost seconds on a
 // dense canopy (docs/benchmarks.md). The UI submits whenever the plants, the sun, the
 // photon count or the cone kind changed — never for a camera move — and hands each result
@@ -19,6 +20,7 @@
 #include <optional>
 #include <thread>
 
+#include "core/light/sun_map.h"
 #include "core/scene/render_types.h"
 #include "core/scene/scene.h"
 
@@ -31,14 +33,15 @@ namespace sylva::studio {
 struct ConeRequest {
   Scene scene;         // the plants with their skeletons, the sun, the fog
   SkinOptions skin;    // how the plants are skinned (the photons hit those frusta)
-  FogMode mode = FogMode::fast;  // medium or fast: what the automatic parameters weigh
+  FogMode mode = FogMode::fast;  // medium or fast: what the automatic parameters weigh; map: the sun maps
   uint64_t photons = 0;
 };
 
 struct ConeResult {
   uint64_t generation = 0;
   std::shared_ptr<const ConeSet> cones;  // empty set: a sun below the horizon
-  double seconds = 0;                    // photons + cones, on the worker
+  std::shared_ptr<const std::vector<SunDepthMap>> maps;  // mode map's instead (none: a sun below the horizon)
+  double seconds = 0;                    // photons + cones (or maps), on the worker
 };
 
 class ConeWorker {

@@ -34,10 +34,12 @@ std::vector<double> view_key(const Scene& s) {
           s.fog ? static_cast<double>(s.fog->steps) : 0};
 }
 
-// The scene the renderer draws: a cone mode without cones yet is drawn brute (the same
-// fog, slower) until the cone worker's first cones arrive.
-Scene drawable(const Scene& scene, bool have_cones) {
-  if (!scene.fog || have_cones || scene.fog->mode == FogMode::brute) return scene;
+// The scene the renderer draws: a cone mode without cones yet (mode map without maps) is
+// drawn brute (the same fog, slower) until the cone worker's first cones (maps) arrive.
+Scene drawable(const Scene& scene, bool have_cones, bool have_maps) {
+  if (!scene.fog || scene.fog->mode == FogMode::brute) return scene;
+  const bool map = scene.fog->mode == FogMode::map || scene.fog->mode == FogMode::automatic;  // auto: map on GL
+  if (map ? have_maps : have_cones) return scene;
   Scene s = scene;
   s.fog->mode = FogMode::brute;
   return s;
@@ -113,8 +115,9 @@ struct GlViewport::Shared {
     uint64_t version;
   };
   std::optional<View> view;
-  std::function<void(GlRenderer*, const RenderOptions&, bool)> task;  // an export, run and waited for
+  std::function<void(GlRenderer*, const RenderOptions&, bool, bool)> task;  // an export, run and waited for
   std::shared_ptr<const ConeSet> cones;  // newer fog cones, not yet taken
+  std::shared_ptr<const std::vector<SunDepthMap>> maps;  // newer sun maps, not yet taken
   // Results.
   std::optional<Picture> picture;
   uint64_t built_version = 0;  // the plants the render thread's renderer holds
@@ -173,14 +176,21 @@ void GlViewport::run() {
   uint64_t version = 0;
   std::shared_ptr<const ConeSet> cones;  // the last fog cones given: every renderer draws them
   bool cones_applied = false;            // uploaded into the current renderer
+  std::shared_ptr<const std::vector<SunDepthMap>> maps;  // the same for the sun maps
+  bool maps_applied = false;
   for (;;) {
     std::optional<Shared::Plants> plants;
     std::optional<Shared::View> view;
-    std::function<void(GlRenderer*, const RenderOptions&, bool)> task;
+    std::function<void(GlRenderer*, const RenderOptions&, bool, bool)> task;
     {
       std::unique_lock<std::mutex> lock(sh.mutex);
-      sh.wake.wait(lock, [&] { return sh.quit || sh.plants || sh.view || sh.task || sh.cones; });
+      sh.wake.wait(lock, [&] { return sh.quit || sh.plants || sh.view || sh.task || sh.cones || sh.maps; });
       if (sh.quit) break;
+      if (sh.maps) {
+        maps = std::move(sh.maps);
+        sh.maps.reset();
+        maps_applied = false;
+      }
       if (sh.cones) {
         cones = std::move(sh.cones);
         sh.cones.reset();
@@ -224,12 +234,17 @@ void GlViewport::run() {
       upload_ms = ms_since(start);
       unshown_plants = renderer != nullptr;
       cones_applied = false;
+      maps_applied = false;
     }
     if (renderer && cones && !cones_applied) {
       renderer->set_fog_cones(*cones);
       cones_applied = true;
     }
-    if (task) task(renderer.get(), options, cones_applied);
+    if (renderer && maps && !maps_applied && !maps->empty()) {
+      renderer->set_fog_maps(*maps);
+      maps_applied = true;
+    }
+    if (task) task(renderer.get(), options, cones_applied, maps_applied);
     // Hands a picture (or the error) to the UI thread; `last`: the render thread is done.
     auto publish = [&](std::optional<Picture> picture, bool last) {
       const bool any = picture || !error.empty();
@@ -256,7 +271,7 @@ void GlViewport::run() {
         bool newer_waiting = false;
         if (unshown_plants && last_full_ms > sh.preview_above_ms) {
           renderer->set_shadow_map_texels(kPreviewShadowTexels);
-          Picture quick = present(*renderer, preview_of(drawable(view->scene, cones_applied)), target);
+          Picture quick = present(*renderer, preview_of(drawable(view->scene, cones_applied, maps_applied)), target);
           renderer->set_shadow_map_texels(0);
           quick.plants_version = version;
           quick.preview = true;
@@ -266,7 +281,7 @@ void GlViewport::run() {
           newer_waiting = sh.plants.has_value();
         }
         if (!newer_waiting) {
-          picture = present(*renderer, drawable(view->scene, cones_applied), target);
+          picture = present(*renderer, drawable(view->scene, cones_applied, maps_applied), target);
           picture->plants_version = version;
           last_full_ms = picture->render_ms;
           unshown_plants = false;
@@ -292,6 +307,15 @@ void GlViewport::set_plants(const Scene& scene, const RenderOptions& options) {
   shared_->wake.notify_all();
 }
 
+void GlViewport::set_fog_maps(std::shared_ptr<const std::vector<SunDepthMap>> maps) {
+  {
+    std::lock_guard<std::mutex> lock(shared_->mutex);
+    shared_->maps = std::move(maps);
+  }
+  shared_->wake.notify_all();
+  asked_view_.clear();  // the next image() asks for the picture with them
+}
+
 void GlViewport::set_fog_cones(std::shared_ptr<const ConeSet> cones) {
   {
     std::lock_guard<std::mutex> lock(shared_->mutex);
@@ -303,7 +327,7 @@ void GlViewport::set_fog_cones(std::shared_ptr<const ConeSet> cones) {
 
 bool GlViewport::busy() const {
   std::lock_guard<std::mutex> lock(shared_->mutex);
-  return shared_->working || shared_->plants || shared_->view || shared_->picture || shared_->cones;
+  return shared_->working || shared_->plants || shared_->view || shared_->picture || shared_->cones || shared_->maps;
 }
 
 void GlViewport::take_picture() {
@@ -369,7 +393,8 @@ std::optional<std::string> GlViewport::write_image(const Scene& scene, const Ren
   auto result = done.get_future();
   {
     std::lock_guard<std::mutex> lock(shared_->mutex);
-    shared_->task = [&](GlRenderer* current, const RenderOptions& current_options, bool current_has_cones) {
+    shared_->task = [&](GlRenderer* current, const RenderOptions& current_options, bool current_has_cones,
+                        bool current_has_maps) {
       try {
         std::unique_ptr<GlRenderer> own;
         GlRenderer* r = current;
@@ -378,7 +403,8 @@ std::optional<std::string> GlViewport::write_image(const Scene& scene, const Ren
           own = std::make_unique<GlRenderer>(scene, options);
           r = own.get();
         }
-        RenderResult rendered = r->render(drawable(scene, r == current && current_has_cones));
+        RenderResult rendered =
+            r->render(drawable(scene, r == current && current_has_cones, r == current && current_has_maps));
         Expected<std::vector<std::string>> written = write_render(path, rendered.image);
         std::optional<std::string> error;
         if (!written) {

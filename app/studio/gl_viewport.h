@@ -49,6 +49,7 @@ class GlViewport : public Viewport {
   ViewImage image(const Scene& scene) override;
   const ViewStats& stats() const override { return stats_; }
   void set_fog_cones(std::shared_ptr<const ConeSet> cones) override;
+  void set_fog_maps(std::shared_ptr<const std::vector<SunDepthMap>> maps) override;
   bool busy() const override;
   std::optional<std::string> write_image(const Scene& scene, const RenderOptions& options,
                                          const std::string& path) override;

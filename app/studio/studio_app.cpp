@@ -950,14 +950,20 @@ void StudioApp::draw_derivation() {
 }
 
 // The fog's cone modes (medium, fast, auto) need the shadow cones of the plants on screen
-// under the sun: asked of the cone worker when the plants, how they are skinned, the sun,
-// the photons or the cones' kind changed — never for the camera or the medium, which the
-// same cones serve. The viewport draws with the last cones until the new ones arrive.
+// under the sun, mode map their sun maps: asked of the cone worker when the plants, how they
+// are skinned, the sun, the photons, the cones' kind or the maps' resolution or directions
+// changed — never for the camera or the medium, which the same cones (maps) serve. The
+// viewport draws with the last ones until the new ones arrive.
 void StudioApp::update_cones() {
-  if (std::optional<ConeResult> done = cones_->poll(); done && viewport_)
-    viewport_->set_fog_cones(std::move(done->cones));
+  if (std::optional<ConeResult> done = cones_->poll(); done && viewport_) {
+    if (done->maps) viewport_->set_fog_maps(std::move(done->maps));
+    else viewport_->set_fog_cones(std::move(done->cones));
+  }
   if (!viewport_ || !plant_ || !scene_.fog || scene_.fog->mode == FogMode::brute) return;
-  const FogMode kind = scene_.fog->mode == FogMode::medium ? FogMode::medium : FogMode::fast;
+  // auto is map on the GL backend (core/gl/render_gl.cpp gl_fog_mode_of).
+  const FogMode kind = scene_.fog->mode == FogMode::medium                                         ? FogMode::medium
+                       : scene_.fog->mode == FogMode::map || scene_.fog->mode == FogMode::automatic ? FogMode::map
+                                                                                                    : FogMode::fast;
   const glm::dvec3 sun = unit_sun_direction(scene_.sun.direction);
   std::vector<double> key = {static_cast<double>(plants_applied_),
                              sun.x,
@@ -968,7 +974,9 @@ void StudioApp::update_cones() {
                              static_cast<double>(scene_.fog->photons),
                              static_cast<double>(kind),
                              static_cast<double>(render_options_.skin.knuckle_frusta),
-                             render_options_.geometry.relief ? 1.0 : 0.0};
+                             render_options_.geometry.relief ? 1.0 : 0.0,
+                             static_cast<double>(scene_.fog->map_resolution),
+                             static_cast<double>(scene_.fog->map_directions)};
   if (key == cone_key_) return;
   cone_key_ = std::move(key);
   ++cone_requests_;
@@ -1010,7 +1018,7 @@ void StudioApp::draw_fog() {
     keep("fog:top");
   }
   // The GL backend's modes (docs/gl-fog.md); refined and reference are the CPU's.
-  const FogMode modes[] = {FogMode::automatic, FogMode::brute, FogMode::medium, FogMode::fast};
+  const FogMode modes[] = {FogMode::automatic, FogMode::brute, FogMode::medium, FogMode::fast, FogMode::map};
   ImGui::SetNextItemWidth(100);
   if (ImGui::BeginCombo("mode", fog_mode_name(f.mode))) {
     for (FogMode m : modes)

@@ -18,6 +18,7 @@
 
 #include <imgui.h>
 
+#include "core/light/sun_map.h"
 #include "core/scene/render_types.h"
 #include "core/scene/scene.h"
 
@@ -61,6 +62,8 @@ class Viewport {
   // the last cones: they keep drawing until newer come; before the first the fog is drawn
   // brute. A camera move never needs new ones.
   virtual void set_fog_cones(std::shared_ptr<const ConeSet> cones) = 0;
+  // The same for fog mode map's sun maps (the cone worker builds them for mode map).
+  virtual void set_fog_maps(std::shared_ptr<const std::vector<SunDepthMap>> maps) = 0;
   // Whether a picture is being made (the UI keeps drawing frames to show it when done).
   virtual bool busy() const { return false; }
   // Renders `scene` at its width × height with `options` through the same renderer as

@@ -696,13 +696,8 @@ RenderResult render_cpu(const Scene& scene, const RenderOptions& options) {
     if (fog_options.mode == FogMode::map) {
       cones = nullptr;  // the maps' tiles index the shadow (docs/fog-map.md): every ray walks them whole
       if (fog_options.maps.empty()) {
-        SunMapOptions mo;
-        mo.resolution = options.fog.map_resolution.value_or(scene.fog->map_resolution);
-        mo.disc_maps = options.fog.map_directions.value_or(scene.fog->map_directions);
-        mo.threads = options.threads;
-        mo.cancel = options.progress.cancel_flag();
-        const uint64_t photons = std::min(options.fog.photons.value_or(scene.fog->photons), kSunMapTilePhotons);
-        sun_maps.emplace(build_sun_maps_of(geometry, scene, photons, mo, &result.passes));
+        sun_maps.emplace(build_sun_maps_of(geometry, scene, sun_map_tile_photons(scene, options),
+                                           sun_map_options_for(scene, options), &result.passes));
         if (!*sun_maps) throw SunMapsRefused(sun_maps->error().message);
         if ((*sun_maps)->cancelled) {
           result.cancelled = true;

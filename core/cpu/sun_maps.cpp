@@ -1,6 +1,7 @@
 // sun_maps.cpp — building the sun-space depth maps (sun_maps.h).
 #include "core/cpu/sun_maps.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <glm/geometric.hpp>
@@ -153,6 +154,19 @@ Expected<SunMaps> build_sun_maps_of(const SceneGeometry& geometry, const Scene& 
   Expected<SunMaps> maps = build_sun_maps(tracer, traced.vectors, options);
   if (maps && passes) passes->push_back({"sun maps", maps->seconds, maps->describe()});
   return maps;
+}
+
+SunMapOptions sun_map_options_for(const Scene& scene, const RenderOptions& options) {
+  SunMapOptions mo;
+  mo.resolution = options.fog.map_resolution.value_or(scene.fog->map_resolution);
+  mo.disc_maps = options.fog.map_directions.value_or(scene.fog->map_directions);
+  mo.threads = options.threads;
+  mo.cancel = options.progress.cancel_flag();
+  return mo;
+}
+
+uint64_t sun_map_tile_photons(const Scene& scene, const RenderOptions& options) {
+  return std::min(options.fog.photons.value_or(scene.fog->photons), kSunMapTilePhotons);
 }
 
 }  // namespace sylva

@@ -66,6 +66,12 @@ struct SunMaps {
 // (measured on the pine stand: 10⁴, 10⁵ and 10⁶ give the same image, docs/fog-map.md).
 constexpr uint64_t kSunMapTilePhotons = 100'000;
 
+// The options `options` and `scene`'s fog ask for (resolution and directions: the flags', else
+// the fog's; threads and cancellation: the render's), and the photons that find the tiles
+// (the fog's photons, at most kSunMapTilePhotons): what render_cpu and the GL front end build.
+SunMapOptions sun_map_options_for(const Scene& scene, const RenderOptions& options);
+uint64_t sun_map_tile_photons(const Scene& scene, const RenderOptions& options);
+
 // The directions of the maps for a sun toward unit `to_sun` of angular radius `radius_rad`
 // (0: one, the centre).
 std::vector<glm::dvec3> sun_map_directions(const glm::dvec3& to_sun, double radius_rad, uint32_t disc_maps);

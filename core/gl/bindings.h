@@ -30,6 +30,10 @@ inline constexpr uint32_t kFogOverflowBinding = 10;  // uint32 per pixel: 1 = it
 inline constexpr uint32_t kFogCountersBinding = 11;  // GlFogCounters
 inline constexpr uint32_t kInstancesBinding = 12;    // GpuInstance per plant drawn as an instance (INSTANCED)
 inline constexpr uint32_t kMaterialMapsBinding = 13; // MaterialMapsRecord per material slot
+inline constexpr uint32_t kFogMapsBinding = 14;      // GpuSunMapRecord per sun map (fog mode map)
+inline constexpr uint32_t kFogMapSlotsBinding = 15;  // uint32 per tile of every map: its slot (global)
+inline constexpr uint32_t kFogMapRangesBinding = 16; // vec2 per slot: its smallest and largest height
+inline constexpr uint32_t kFogMapTexelsBinding = 17; // float per texel of every slot (32 × 32 a slot)
 
 // Texture units.
 inline constexpr uint32_t kBarkTexturesUnit = 0;  // bark image i at kBarkTexturesUnit + i
@@ -52,6 +56,9 @@ inline constexpr uint32_t kPyramidVertices = 36;  // vertex pulling: 36 vertices
 inline constexpr uint32_t kFogListEnd = 0xFFFFFFFFu;  // the end of a pixel's interval list
 inline constexpr uint32_t kFogMaxIntervals = 16;      // merged intervals the resolve holds per pixel
 inline constexpr uint32_t kFogMaxListNodes = 1024;    // nodes the resolve walks per pixel (more: marched whole)
+inline constexpr uint32_t kFogMaxMaps = 64;           // sun maps the fog pass walks (kFogMaxMapDirections)
+inline constexpr uint32_t kFogMapNoSlot = 0xFFFFFFFFu;  // a tile not allocated (SunDepthMap::kNoSlot)
+inline constexpr uint32_t kFogMapTile = 32;           // texels a tile's side (SunDepthMap::kTile)
 
 static_assert(kBarkTexturesUnit + kMaxBarkImages <= kGNormalDistanceUnit,
               "the bark images' units must not reach the G-buffer's");
@@ -93,6 +100,13 @@ inline constexpr GlslConstant kGlslConstants[] = {
     {"FOG_COUNTERS_BINDING", kFogCountersBinding},
     {"INSTANCES_BINDING", kInstancesBinding},
     {"MATERIAL_MAPS_BINDING", kMaterialMapsBinding},
+    {"FOG_MAPS_BINDING", kFogMapsBinding},
+    {"FOG_MAP_SLOTS_BINDING", kFogMapSlotsBinding},
+    {"FOG_MAP_RANGES_BINDING", kFogMapRangesBinding},
+    {"FOG_MAP_TEXELS_BINDING", kFogMapTexelsBinding},
+    {"FOG_MAP_NO_SLOT", kFogMapNoSlot},
+    {"FOG_MAP_TILE", kFogMapTile},
+    {"FOG_MAX_MAPS", kFogMaxMaps},
     {"FOG_LIST_END", kFogListEnd},
     {"FOG_MAX_INTERVALS", kFogMaxIntervals},
     {"FOG_MAX_LIST_NODES", kFogMaxListNodes},
@@ -152,6 +166,18 @@ struct GpuShadowConeRecord {
 };
 static_assert(sizeof(GpuShadowConeRecord) == 48 && offsetof(GpuShadowConeRecord, axis_end) == 16 &&
               offsetof(GpuShadowConeRecord, slope_plant) == 32);
+
+// fog_map.glsl's GpuSunMap: one sun-space depth map's frame (core/light/sun_map.h), its centre
+// relative to the map set's origin (GlFogMaps::origin), and where its tiles and slots start
+// in the shared arrays.
+struct GpuSunMapRecord {
+  float centre_half[4];   // centre − origin, half_extent_m
+  float to_sun_texel[4];  // s (unit), texel_m
+  float e0_size[4];       // e0, size (texels a side)
+  float e1_tiles[4];      // e1, tiles a side
+  uint32_t first_tile[4]; // the map's first entry in the slots array, 0, 0, 0
+};
+static_assert(sizeof(GpuSunMapRecord) == 80 && offsetof(GpuSunMapRecord, first_tile) == 64);
 
 // fog_lists.glsl's FogNode (12 bytes) and FogCounters.
 struct FogNodeRecord {

@@ -1,16 +1,20 @@
-// gl_fog.h — the fog's buffers on the GPU for the cone modes (render_gl.cpp; docs/gl-fog.md):
+// gl_fog.h — the fog's buffers on the GPU (render_gl.cpp; docs/gl-fog.md): for the cone modes
 // the shadow cones, uploaded once per (plants, sun) as apex-free conical frusta
 // (shaders/shadow_cones.glsl), and the per-pixel lists of their intervals along the camera
-// rays that the cone pass appends to (shaders/fog_lists.glsl) and the fog resolve reads.
+// rays that the cone pass appends to (shaders/fog_lists.glsl) and the fog resolve reads; for
+// mode map the sun-space depth maps (core/light/sun_map.h), uploaded once per (plants, sun)
+// as the CPU built them (shaders/fog_map.glsl walks them).
 // Preconditions: as gl_objects.h. Failures throw GlError.
 #pragma once
 
 #include <cstdint>
 #include <glm/vec3.hpp>
+#include <span>
 
 #include "core/gl/bindings.h"
 #include "core/gl/gl_objects.h"
 #include "core/light/shadow_cones.h"
+#include "core/light/sun_map.h"
 
 namespace sylva {
 
@@ -23,6 +27,19 @@ struct GlFogCones {
   uint64_t bytes = 0;
 };
 GlFogCones upload_fog_cones(const ConeSet& set);
+
+// Sun maps on the GPU: a GpuSunMapRecord per map, positions relative to `origin` (the first
+// map's centre, in double); every map's tile slots (made global: the map's first slot
+// added), every slot's height range and texels, each in one buffer (bindings.h).
+struct GlFogMaps {
+  GlBuffer records, slots, ranges, texels;
+  uint32_t count = 0;
+  glm::dvec3 origin{0};
+  uint64_t bytes = 0;
+  void bind() const;  // at bindings.h's kFogMapsBinding .. kFogMapTexelsBinding
+};
+// Throws GlError for more than kFogMaxMaps maps or none.
+GlFogMaps upload_fog_maps(std::span<const SunDepthMap> maps);
 
 // The per-pixel interval lists: linked lists in shader storage, a node per cone fragment
 // taken with an atomic counter. A fragment that finds the node buffer full marks its pixel

@@ -58,6 +58,7 @@ struct GlFrameStats {
   uint32_t fog_steps = 0;      // its samples along each ray
   uint32_t fog_cones = 0;      // shadow cones drawn by the cone pass (0: none ran)
   uint32_t fog_list_capacity = 0;  // interval list nodes held
+  uint64_t fog_map_bytes = 0;  // mode map: the sun maps' bytes on the GPU (0: none bound)
   // The cone pass's counts, read by wait_for_frame (fog_counted) once the GPU is done:
   bool fog_counted = false;
   uint64_t fog_fragments = 0;           // intervals appended over the frame

@@ -191,19 +191,24 @@ const char* gl_fog_mode_name(GlFogMode mode) {
     case GlFogMode::brute: return "brute";
     case GlFogMode::medium: return "medium";
     case GlFogMode::fast: return "fast";
+    case GlFogMode::map: return "map";
   }
   return "?";
 }
 
 ShaderProgramSource fog_program(bool sun, GlFogMode mode) {
   ShaderProgramSource p;
-  const char* mode_define = mode == GlFogMode::brute ? "FOG_BRUTE" : mode == GlFogMode::medium ? "FOG_MEDIUM" : "FOG_FAST";
+  const char* mode_define = mode == GlFogMode::brute    ? "FOG_BRUTE"
+                            : mode == GlFogMode::medium ? "FOG_MEDIUM"
+                            : mode == GlFogMode::fast   ? "FOG_FAST"
+                                                        : "FOG_MAP";
   std::vector<std::string> defines = {mode_define, "FOG_NEGLIGIBLE_DEPTH " + glsl_float(kFogNegligibleDepth)};
   if (sun) defines.push_back("SUN");
   p.name = std::string("fog[") + mode_define + (sun ? " SUN]" : "]");
   p.vertex = {ShaderStage::vertex, {"fullscreen.vert.glsl"}, {}};
   std::vector<std::string> files = {"fog.glsl"};
-  if (mode != GlFogMode::brute) files.push_back("fog_lists.glsl");
+  if (mode == GlFogMode::medium || mode == GlFogMode::fast) files.push_back("fog_lists.glsl");
+  if (mode == GlFogMode::map) files.push_back("fog_map.glsl");
   p.fragment = {ShaderStage::fragment, with(files, "fog.frag.glsl"), defines};
   return p;
 }
@@ -261,7 +266,8 @@ std::vector<ShaderProgramSource> all_shader_programs() {
   for (bool sun : {false, true})
     for (bool fog : {false, true}) all.push_back(shade_program(sun, fog));
   for (bool sun : {false, true})
-    for (GlFogMode mode : {GlFogMode::brute, GlFogMode::medium, GlFogMode::fast}) all.push_back(fog_program(sun, mode));
+    for (GlFogMode mode : {GlFogMode::brute, GlFogMode::medium, GlFogMode::fast, GlFogMode::map})
+      all.push_back(fog_program(sun, mode));
   all.push_back(fog_cones_program());
   for (bool srgb : {false, true}) all.push_back(present_program(srgb));
   return all;

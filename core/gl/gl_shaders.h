@@ -115,8 +115,9 @@ enum class GlFogMode {
   brute,   // FOG_BRUTE: the shadow map marched along the whole ray
   medium,  // FOG_MEDIUM: closed form outside the cone intervals, the map marched inside
   fast,    // FOG_FAST: closed form outside the cone intervals, V = 0 inside
+  map,     // FOG_MAP: the sun maps walked texel by texel (fog_map.glsl), closed form over the lit parts
 };
-const char* gl_fog_mode_name(GlFogMode mode);  // "brute", "medium", "fast" (docs/spec/fog.md's)
+const char* gl_fog_mode_name(GlFogMode mode);  // "brute", "medium", "fast", "map" (docs/spec/fog.md's)
 
 // The fog pass (fullscreen.vert.glsl + fog.glsl [+ fog_lists.glsl] + fog.frag.glsl): the
 // light the fog scatters toward the eye, added into the accumulated beauty, and the fog

@@ -117,15 +117,17 @@ ShadowFrame shadow_frame(const std::vector<Sphere>& spheres, const glm::dvec3& d
 
 namespace {
 
-// The fog pass's mode for the mode `options` or the scene ask for (auto: the cone-interval
-// pass, fast; docs/spec/fog.md), or nullopt where the GPU has none: refined and reference
-// (their exact shadow transitions need shadow rays, docs/gl-fog.md).
+// The fog pass's mode for the mode `options` or the scene ask for (auto: map, the only GL
+// mode that reaches below the shadow map's floor — docs/spec/fog.md's "refined's accuracy
+// fastest", measured in docs/benchmarks.md), or nullopt where the GPU has none: refined and
+// reference (their exact shadow transitions need shadow rays, docs/gl-fog.md).
 std::optional<GlFogMode> gl_fog_mode_of(FogMode mode) {
   switch (mode) {
     case FogMode::brute: return GlFogMode::brute;
     case FogMode::medium: return GlFogMode::medium;
-    case FogMode::fast:
-    case FogMode::automatic: return GlFogMode::fast;
+    case FogMode::fast: return GlFogMode::fast;
+    case FogMode::automatic:
+    case FogMode::map: return GlFogMode::map;
     default: return std::nullopt;
   }
 }
@@ -140,8 +142,8 @@ std::optional<std::string> gl_fog_unsupported(const Scene& scene, const RenderOp
   if (!scene.fog) return std::nullopt;
   const FogMode mode = requested_fog_mode(scene, options);
   if (gl_fog_mode_of(mode)) return std::nullopt;
-  return std::string("the GL backend's fog pass runs brute, medium and fast (auto) only (the fog asks for ") +
-         fog_mode_name(mode) + "; --fog-mode brute, medium or fast draws it with OpenGL)";
+  return std::string("the GL backend's fog pass runs brute, medium, fast and map (auto) only (the fog asks for ") +
+         fog_mode_name(mode) + "; --fog-mode brute, medium, fast or map draws it with OpenGL)";
 }
 
 }  // namespace
@@ -170,6 +172,7 @@ struct GlRenderer::Frame {
   bool fog_on = false;     // the scene has fog: shade[FOG] and the fog pass
   GlFogMode fog_mode = GlFogMode::brute;
   bool fog_cones = false;  // a cone mode with cones uploaded: the cone pass runs
+  bool fog_maps = false;   // mode map: the sun maps are bound
   uint32_t fog_steps = 0;  // the fog's samples along each ray (brute; medium inside the cones)
   std::vector<uint32_t> eye_inside;  // frusta whose pyramid may reach the eye's near plane
                                      // (instanced: pairs of instance, record)
@@ -210,6 +213,7 @@ struct GlRenderer::State {
   std::vector<std::vector<Sphere>> draw_spheres;
   FrustaFeatures features;           // the frusta program's switches for this scene (gl_shaders.h)
   std::optional<GlFogCones> fog_cones;  // set_fog_cones: once per (plants, sun)
+  std::optional<GlFogMaps> fog_maps;    // set_fog_maps: once per (plants, sun)
   GlFogLists fog_lists;                 // the cone intervals per pixel (cone modes)
   uint32_t fog_nodes_wanted = 0;        // the most list nodes a cone pass asked for so far
   std::unique_ptr<GlBarkMaps> bark_maps;
@@ -504,7 +508,11 @@ struct GlRenderer::State {
     set_uniform(p, "u_sky", scene.sky);
     set_uniform(p, "u_sun_radiance", f.sun_radiance);
     set_uniform_uint(p, "u_steps", f.fog_steps);
-    if (f.fog_mode == GlFogMode::brute) return;
+    if (f.fog_maps) {
+      set_uniform(p, "u_eye_rel_maps", f.camera.eye - fog_maps->origin);
+      set_uniform_uint(p, "u_map_count", fog_maps->count);
+    }
+    if (f.fog_mode == GlFogMode::brute || f.fog_mode == GlFogMode::map) return;
     set_uniform_int(p, "u_cones", f.fog_cones ? 1 : 0);
     if (!f.fog_cones) return;
     const GLuint c = f.fog_cones_program;
@@ -643,6 +651,12 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options, std::sh
 GlRenderer::~GlRenderer() = default;
 
 void GlRenderer::set_conservative_depth(bool on) { state_->features.conservative_depth = on; }
+
+uint64_t GlRenderer::set_fog_maps(std::span<const SunDepthMap> maps) {
+  state_->fog_maps = upload_fog_maps(maps);
+  check_gl("set_fog_maps");
+  return state_->fog_maps->bytes;
+}
 
 uint64_t GlRenderer::set_fog_cones(const ConeSet& cones) {
   state_->fog_cones = upload_fog_cones(cones);
@@ -792,9 +806,14 @@ void GlRenderer::begin_frame(const Scene& scene, Frame& f) {
   f.fog_on = scene.fog.has_value();
   if (f.fog_on) {
     f.fog_mode = *gl_fog_mode_of(requested_fog_mode(scene, st.options));
-    if (f.fog_mode != GlFogMode::brute && !st.fog_cones)
+    const bool cone_mode = f.fog_mode == GlFogMode::medium || f.fog_mode == GlFogMode::fast;
+    if (cone_mode && !st.fog_cones)
       throw GlError("the GL fog pass's cone modes (medium, fast) need shadow cones (GlRenderer::set_fog_cones; render_gl builds them)");
-    f.fog_cones = f.fog_mode != GlFogMode::brute && st.fog_cones;
+    if (f.fog_mode == GlFogMode::map && !st.fog_maps)
+      throw GlError("the GL fog pass's mode map needs sun maps (GlRenderer::set_fog_maps; render_gl takes options.fog.maps)");
+    f.fog_cones = cone_mode && st.fog_cones;
+    f.fog_maps = f.fog_mode == GlFogMode::map;
+    if (f.fog_maps) s.fog_map_bytes = st.fog_maps->bytes;
     f.fog_steps = std::clamp(st.options.fog.steps.value_or(scene.fog->steps), 1u, kFogMaxSteps);
     s.fog_mode = gl_fog_mode_name(f.fog_mode);
     s.fog_steps = f.fog_steps;
@@ -824,6 +843,7 @@ void GlRenderer::begin_frame(const Scene& scene, Frame& f) {
     st.fog_lists.bind();
     st.fog_lists.clear_frame();
   }
+  if (f.fog_maps) st.fog_maps->bind();
   st.timers.begin_frame(s.frame);
 }
 
@@ -1176,7 +1196,15 @@ RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrame
   }
   GlRenderer& renderer = *built;
   std::vector<RenderPass> cone_passes;
-  if (scene.fog && requested_fog_mode(scene, options) != FogMode::brute) {
+  if (scene.fog && gl_fog_mode_of(requested_fog_mode(scene, options)) == GlFogMode::map) {
+    // Mode map: the caller's sun maps (the CPU builds them, app/front/render.h), uploaded once.
+    if (options.fog.maps.empty())
+      throw GlError("the GL fog pass's mode map needs sun maps (render_gl's options.fog.maps)");
+    const Clock::time_point start = Clock::now();
+    const uint64_t bytes = renderer.set_fog_maps(options.fog.maps);
+    cone_passes.push_back({"map upload", seconds_since(start),
+                           std::to_string(options.fog.maps.size()) + " maps, " + std::to_string(bytes >> 10) + " KiB"});
+  } else if (scene.fog && requested_fog_mode(scene, options) != FogMode::brute) {
     // The cone modes: the caller's shadow cones (the CPU's sun photons), uploaded once.
     if (!cones)
       throw GlError("the GL fog pass's cone modes (medium, fast) need shadow cones (render_gl's cone source)");

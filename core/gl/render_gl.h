@@ -74,6 +74,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -82,6 +83,7 @@
 #include "core/gl/gl_context.h"
 #include "core/gl/gl_frame_stats.h"
 #include "core/gl/gl_target.h"
+#include "core/light/sun_map.h"
 #include "core/scene/render_types.h"
 #include "core/scene/scene.h"
 #include "core/light/shadow_cones.h"
@@ -190,6 +192,9 @@ class GlRenderer {
   // (a new sun). Returns the bytes uploaded. Without them the cone modes are refused
   // (GlError).
   uint64_t set_fog_cones(const ConeSet& cones);
+  // The sun maps fog mode map walks (core/light/sun_map.h, built by the CPU), uploaded once
+  // per (plants, sun); returns the bytes uploaded. Throws GlError for none or too many.
+  uint64_t set_fog_maps(std::span<const SunDepthMap> maps);
 
   uint64_t frusta() const;          // frusta uploaded
   uint64_t uploaded_bytes() const;  // bytes in the segment and id buffers (or the mesh's)

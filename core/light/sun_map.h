@@ -82,8 +82,16 @@ class SunDepthMap {
 
   size_t memory_bytes() const;
 
- private:
+  // The storage as it is, for an upload (core/gl/gl_fog.h): the slot of every tile of the
+  // grid (row-major, kNoSlot: not allocated), every slot's texels (kTile² row-major heights
+  // relative to the centre, kNoPlant where none) and its smallest and largest height.
   static constexpr uint32_t kNoSlot = 0xFFFFFFFFu;
+  const std::vector<uint32_t>& slot_of_tile() const { return slot_of_tile_; }
+  const std::vector<float>& texels() const { return texels_; }
+  const std::vector<float>& tile_min() const { return tile_min_; }
+  const std::vector<float>& tile_max() const { return tile_max_; }
+
+ private:
   SunMapFrame frame_;
   uint32_t tiles_ = 0;
   std::vector<uint32_t> slot_of_tile_;  // kNoSlot: not allocated

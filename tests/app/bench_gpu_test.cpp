@@ -386,9 +386,10 @@ const std::vector<std::string> kFogColumns = {
     "fog_ms_median", "cones_ms_median", "frame_gpu_ms_median", "cones", "photons", "overflow_pixels", "fog_rmse",
     "fog_rmse_relative", "fog_bias_relative", "reference"};
 
-// `bench gpu --fog --quick`: the elm grove at 96x72, brute 16 and 64, fast and medium, each
-// a measured row with the fog pass's GPU time and its RMSE against the CPU reference; the
-// cone modes with their cones and cone pass. Brute's error falls as its steps grow.
+// `bench gpu --fog --quick`: the elm grove at 96x72, brute 16 and 64, fast, medium and map,
+// each a measured row with the fog pass's GPU time and its RMSE against the CPU reference;
+// the cone modes with their cones and cone pass, map with neither. Brute's error falls as its
+// steps grow, and map (exact up to its map) beats brute 16.
 TEST(BenchGpuFog, QuickRunWritesTheFogRowsWithTimesAndErrors) {
   TempDir dir;
   const ProcessResult r = run_sylva({"bench", "gpu", "--fog", "--quick", "--csv", dir.file("fog.csv"), "--plot",
@@ -399,9 +400,9 @@ TEST(BenchGpuFog, QuickRunWritesTheFogRowsWithTimesAndErrors) {
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_EQ(read_file(dir.file("fog.png")).substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   const std::vector<CsvRow> rows = read_csv(read_file(dir.file("fog.csv")), kFogColumns);
-  ASSERT_EQ(rows.size(), 4u);
-  const char* const methods[] = {"brute 16", "brute 64", "fast", "medium 64"};
-  const char* const modes[] = {"brute", "brute", "fast", "medium"};
+  ASSERT_EQ(rows.size(), 5u);
+  const char* const methods[] = {"brute 16", "brute 64", "fast", "medium 64", "map 2048\u00b2"};
+  const char* const modes[] = {"brute", "brute", "fast", "medium", "map"};
   for (size_t i = 0; i < rows.size(); ++i) {
     const CsvRow& row = rows[i];
     SCOPED_TRACE(row.at("method"));
@@ -416,11 +417,12 @@ TEST(BenchGpuFog, QuickRunWritesTheFogRowsWithTimesAndErrors) {
     EXPECT_GE(number(row, "frame_gpu_ms_median"), number(row, "fog_ms_median"));
     EXPECT_GT(number(row, "fog_rmse_relative"), 0.0);
     EXPECT_LT(std::abs(number(row, "fog_bias_relative")), 1.0);
-    const bool cones = i >= 2;
+    const bool cones = i == 2 || i == 3;
     EXPECT_EQ(number(row, "cones") > 0, cones);
     EXPECT_EQ(number(row, "cones_ms_median") > 0, cones);
   }
   EXPECT_LT(number(rows[1], "fog_rmse_relative"), number(rows[0], "fog_rmse_relative")) << "64 steps beat 16";
+  EXPECT_LT(number(rows[4], "fog_rmse_relative"), number(rows[0], "fog_rmse_relative")) << "map beats brute 16";
 }
 
 TEST(BenchGpuFog, AStridedReferenceMeasuresTheErrorOnItsGrid) {
@@ -434,7 +436,7 @@ TEST(BenchGpuFog, AStridedReferenceMeasuresTheErrorOnItsGrid) {
   // 96x72 every 4th pixel each way: 24 x 18.
   EXPECT_NE(r.err.find("reference of 432 pixels"), std::string::npos) << r.err;
   const std::vector<CsvRow> rows = read_csv(read_file(dir.file("fog.csv")), kFogColumns);
-  ASSERT_EQ(rows.size(), 4u);
+  ASSERT_EQ(rows.size(), 5u);
   for (const CsvRow& row : rows) {
     SCOPED_TRACE(row.at("method"));
     EXPECT_EQ(row.at("status"), "ok") << row.at("reason");

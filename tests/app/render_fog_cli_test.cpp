@@ -113,12 +113,12 @@ TEST(RenderFogCli, TheGlBackendRefusesTheFogModesItLacksWithStatusOneAndAutoFall
   const std::string scene = write_scene(dir, kFog);
   ProcessResult r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "gl", "--fog-mode", "refined"});
   EXPECT_EQ(r.exit_code, 1) << describe(r);
-  EXPECT_NE(r.err.find("fog pass runs brute, medium and fast (auto) only (the fog asks for refined"), std::string::npos)
+  EXPECT_NE(r.err.find("fog pass runs brute, medium, fast and map (auto) only (the fog asks for refined"), std::string::npos)
       << describe(r);
   EXPECT_FALSE(std::filesystem::exists(dir.file("f.png")));
   r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--fog-mode", "reference", "--fog-steps", "2", "--verbose"});
   EXPECT_EQ(r.exit_code, 0) << describe(r);
-  EXPECT_NE(r.err.find("the OpenGL backend cannot draw this (the GL backend's fog pass runs brute, medium and fast (auto) only"),
+  EXPECT_NE(r.err.find("the OpenGL backend cannot draw this (the GL backend's fog pass runs brute, medium, fast and map (auto) only"),
             std::string::npos)
       << describe(r);
   EXPECT_NE(r.err.find("fog (thread time)"), std::string::npos) << describe(r);
@@ -227,14 +227,34 @@ TEST(RenderFogCli, OnlyTheConeAndMapModesTraceSunPhotons) {
 TEST(RenderFogCli, SunMapsOverTheMemoryBoundAreBadInputAndNothingIsWritten) {
   TempDir dir;
   const std::string scene = write_scene(dir, R"({"mode": "map", "top": 20, "photons": 20000})");
-  ProcessResult r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "cpu",
-                               "--fog-map-resolution", "65536", "--fog-map-directions", "64"});
-  EXPECT_EQ(r.exit_code, 1) << describe(r);
-  EXPECT_NE(r.err.find("sylva render: error: the sun maps would need"), std::string::npos) << describe(r);
-  EXPECT_NE(r.err.find("more than the limit of 64.0 MiB: lower the resolution or the disc directions"),
-            std::string::npos)
-      << describe(r);
-  EXPECT_FALSE(std::filesystem::exists(dir.file("f.png")));
+  for (const char* backend : {"cpu", "gl"}) {
+    ProcessResult r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", backend,
+                                 "--fog-map-resolution", "65536", "--fog-map-directions", "64"});
+    if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 core context") != std::string::npos) continue;
+    EXPECT_EQ(r.exit_code, 1) << backend << ": " << describe(r);
+    EXPECT_NE(r.err.find("sylva render: error: the sun maps would need"), std::string::npos) << describe(r);
+    EXPECT_NE(r.err.find("more than the limit of 64.0 MiB: lower the resolution or the disc directions"),
+              std::string::npos)
+        << describe(r);
+    EXPECT_FALSE(std::filesystem::exists(dir.file("f.png")));
+  }
+}
+
+// Mode map on the GL backend: the CPU builds the sun maps (their passes listed), the GL fog
+// pass walks them (render_gl_fog_test.cpp compares the images); no cones, no cone pass.
+TEST(RenderFogCli, MapDrawsOnTheGlBackendWithTheCpusSunMaps) {
+  TempDir dir;
+  const std::string scene = write_scene(dir, R"({"mode": "map", "top": 20, "photons": 20000})");
+  ProcessResult r =
+      run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "gl", "--verbose"});
+  if (r.exit_code == 1 && r.err.find("no OpenGL 4.5 core context") != std::string::npos)
+    SYLVA_SKIP_WITHOUT_GL("no OpenGL context on this machine");
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.err.find("  sun maps "), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("  map upload "), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("fog[FOG_MAP SUN]"), std::string::npos) << describe(r);
+  EXPECT_EQ(r.err.find("shadow cones"), std::string::npos) << describe(r);
+  EXPECT_TRUE(std::filesystem::exists(dir.file("f.png")));
 }
 
 TEST(RenderFogCli, TheConeParametersAreTheFlagsOrTheAutomaticChoiceWithItsReport) {

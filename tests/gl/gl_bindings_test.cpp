@@ -162,6 +162,19 @@ TEST(GlBindings, TheDriverLaysEveryRecordOutAsItsCppMirror) {
   EXPECT_EQ(stride(shade.id(), "plant_bark[0]"), static_cast<GLint>(sizeof(gl::PlantBarkRecord)));
   EXPECT_EQ(stride(mesh.id(), "mesh_frusta[0].origin_hi"), static_cast<GLint>(sizeof(gl::MeshFrustumRecord)));
   EXPECT_EQ(offset(mesh.id(), "mesh_frusta[0].ids"), static_cast<GLint>(offsetof(gl::MeshFrustumRecord, ids)));
+
+  // fog_map.glsl's sun maps (fog mode map): the frame records and where the arrays bind.
+  const GlProgramObject fog_map = build(fog_program(true, GlFogMode::map));
+  const GLuint m = fog_map.id();
+  EXPECT_EQ(stride(m, "fog_maps[0].centre_half"), static_cast<GLint>(sizeof(gl::GpuSunMapRecord)));
+  EXPECT_EQ(offset(m, "fog_maps[0].to_sun_texel"), static_cast<GLint>(offsetof(gl::GpuSunMapRecord, to_sun_texel)));
+  EXPECT_EQ(offset(m, "fog_maps[0].e0_size"), static_cast<GLint>(offsetof(gl::GpuSunMapRecord, e0_size)));
+  EXPECT_EQ(offset(m, "fog_maps[0].e1_tiles"), static_cast<GLint>(offsetof(gl::GpuSunMapRecord, e1_tiles)));
+  EXPECT_EQ(offset(m, "fog_maps[0].first_tile"), static_cast<GLint>(offsetof(gl::GpuSunMapRecord, first_tile)));
+  EXPECT_EQ(block_binding(m, "FogMaps"), static_cast<GLint>(gl::kFogMapsBinding));
+  EXPECT_EQ(block_binding(m, "FogMapSlots"), static_cast<GLint>(gl::kFogMapSlotsBinding));
+  EXPECT_EQ(block_binding(m, "FogMapRanges"), static_cast<GLint>(gl::kFogMapRangesBinding));
+  EXPECT_EQ(block_binding(m, "FogMapTexels"), static_cast<GLint>(gl::kFogMapTexelsBinding));
 }
 
 TEST(GlObjects, AHandleOwnsItsObjectUntilResetAndMovesIt) {

@@ -101,7 +101,7 @@ TEST(GlFog, ASceneWithoutFogRunsNoneOfIt) {
 TEST(GlFog, TheGlBackendRefusesTheModesItDoesNotImplementSayingWhich) {
   Scene s = foggy_cylinder(8);
   RenderOptions options;
-  for (FogMode mode : {FogMode::brute, FogMode::medium, FogMode::fast, FogMode::automatic}) {
+  for (FogMode mode : {FogMode::brute, FogMode::medium, FogMode::fast, FogMode::automatic, FogMode::map}) {
     options.fog.mode = mode;
     EXPECT_FALSE(gl_unsupported(s, options)) << fog_mode_name(mode);
   }
@@ -109,13 +109,13 @@ TEST(GlFog, TheGlBackendRefusesTheModesItDoesNotImplementSayingWhich) {
     options.fog.mode = mode;
     const std::optional<std::string> why = gl_unsupported(s, options);
     ASSERT_TRUE(why) << fog_mode_name(mode);
-    EXPECT_NE(why->find("runs brute, medium and fast (auto) only"), std::string::npos) << *why;
+    EXPECT_NE(why->find("runs brute, medium, fast and map (auto) only"), std::string::npos) << *why;
     EXPECT_NE(why->find(fog_mode_name(mode)), std::string::npos) << *why;
   }
   SYLVA_REQUIRE_GL();
   EXPECT_THROW(GlRenderer(s, options), GlError);
-  // medium and fast need cones: a renderer without them refuses to draw.
-  for (FogMode mode : {FogMode::medium, FogMode::fast}) {
+  // medium and fast need cones, map needs maps: a renderer without them refuses to draw.
+  for (FogMode mode : {FogMode::medium, FogMode::fast, FogMode::map}) {
     options.fog.mode = mode;
     GlRenderer renderer(s, options);
     EXPECT_THROW(renderer.draw(s), GlError) << fog_mode_name(mode);
@@ -368,6 +368,66 @@ TEST(GlFog, FastOnTheGpuMatchesTheCpusFastOnTheCanopy) {
   EXPECT_GE(m.close, m.same * 99 / 100);
   EXPECT_LE(m.error.relative_rmse(), 1e-3);
   EXPECT_LE(std::abs(m.error.relative_bias()), 1e-4);
+}
+
+// map is deterministic (the sun maps walked texel by texel, closed form over the lit parts),
+// so with the same maps GL and CPU agree to float: the walk in float (a crossing moved by
+// ~1e-6 relative) against double. Stated as for fast: 99 % of the pixels whose end both see
+// alike within 1e-3 relative, the whole image's RMSE within 1e-3 of the mean and |bias| within
+// 1e-4; with a disc sun (four maps, averaged) the same.
+struct MapMatch {
+  size_t same = 0, close = 0;
+  FogError error;
+};
+MapMatch map_against_the_cpu(const char* what, const Scene& s, size_t want_maps) {
+  const auto maps = gl_test::cpu_sun_maps(s);
+  EXPECT_EQ(maps->size(), want_maps);
+  RenderOptions options;
+  options.aovs = kAovFog | kAovDepth;
+  options.fog.mode = FogMode::map;
+  options.fog.maps = *maps;
+  const RenderImage cpu = gl_test::cpu_render(s, options).image;
+  GlRenderer renderer(s, options);
+  const uint64_t bytes = renderer.set_fog_maps(*maps);
+  const RenderImage gl = renderer.render(s).image;
+  const GlFrameStats stats = renderer.wait_for_frame();
+  EXPECT_EQ(stats.fog_mode, "map");
+  EXPECT_EQ(stats.pass(GlPass::fog).program, "fog[FOG_MAP SUN]");
+  EXPECT_EQ(stats.fog_map_bytes, bytes);
+  EXPECT_EQ(stats.fog_cones, 0u) << "no cone pass";
+  MapMatch m;
+  const size_t pixels = size_t{s.width} * s.height;
+  for (size_t p = 0; p < pixels; ++p) {
+    if (!same_end(gl, cpu, p)) continue;
+    ++m.same;
+    bool ok = true;
+    for (int k = 0; k < 3; ++k) ok = ok && std::abs(gl.fog[p * 4 + k] - cpu.fog[p * 4 + k]) <= 1e-3 * cpu.fog[p * 4 + k] + 1e-9;
+    m.close += ok ? 1 : 0;
+  }
+  m.error = fog_error(gl, cpu);
+  std::printf("[ fog ] %s, map, %zu maps (%llu KiB): %zu of %zu pixels within 1e-3, RMSE %.3g of the mean, bias %+.3g\n",
+              what, maps->size(), static_cast<unsigned long long>(bytes >> 10), m.close, m.same,
+              m.error.relative_rmse(), m.error.relative_bias());
+  return m;
+}
+
+TEST(GlFog, MapOnTheGpuMatchesTheCpusMapWithTheSameMaps) {
+  SYLVA_REQUIRE_GL();
+  Scene point = elm_grove(120, 90, 64);
+  point.fog->map_resolution = 1024;
+  const MapMatch m = map_against_the_cpu("elm grove, point sun", point, 1);
+  EXPECT_GE(m.close, m.same * 99 / 100);
+  EXPECT_LE(m.error.relative_rmse(), 1e-3);
+  EXPECT_LE(std::abs(m.error.relative_bias()), 1e-4);
+  Scene disc = point;
+  disc.sun.angular_radius_deg = 2;  // a wide disc: the four maps see different shadows
+  disc.fog->map_directions = 4;
+  const MapMatch d = map_against_the_cpu("elm grove, disc sun", disc, 4);
+  EXPECT_GE(d.close, d.same * 99 / 100);
+  EXPECT_LE(d.error.relative_rmse(), 1e-3);
+  EXPECT_LE(std::abs(d.error.relative_bias()), 1e-4);
+  // The maps matter: without the plants' shadows the fog is brighter.
+  EXPECT_GT(fog_error(render(point, true, FogMode::fast), render(point, false, FogMode::map)).rmse, 0.0);
 }
 
 // medium: V = 1 outside the cone intervals (closed form), the shadow map marched inside

@@ -44,12 +44,17 @@ class FakeViewport : public Viewport {
     ++fog_cones_calls;
     last_cones = std::move(cones);
   }
+  void set_fog_maps(std::shared_ptr<const std::vector<SunDepthMap>> maps) override {
+    ++fog_maps_calls;
+    last_maps = std::move(maps);
+  }
   const ViewStats& stats() const override { return stats_; }
   std::optional<std::string> write_image(const Scene&, const RenderOptions&, const std::string&) override {
     return std::string("no renderer in the headless tests");
   }
-  int set_plants_calls = 0, renders = 0, last_plants = -1, fog_cones_calls = 0;
+  int set_plants_calls = 0, renders = 0, last_plants = -1, fog_cones_calls = 0, fog_maps_calls = 0;
   std::shared_ptr<const ConeSet> last_cones;
+  std::shared_ptr<const std::vector<SunDepthMap>> last_maps;
   uint64_t segments = 0;
   std::vector<SkinStyle> skins;  // each plant's, as the last set_plants saw them
   std::vector<double> last_key;

@@ -122,6 +122,36 @@ TEST_F(FogFixture, CameraMovesAndTheMediumNeverRebuildTheConesTheSunDoesOnTheWor
   EXPECT_EQ(app->cone_requests(), asked) << "a sun at rest asks nothing more";
 }
 
+// Mode map from the panel's list (auto, brute, medium, fast, map): the cone worker builds the
+// plants' sun maps and the viewport gets them; a camera move never rebuilds them, a new sun does.
+TEST_F(FogFixture, MapFromTheModeListBuildsSunMapsOnTheWorkerOncePerSun) {
+  auto app = opened();
+  ASSERT_TRUE(show(*app, "fog:mode"));
+  const WidgetRect combo = *app->rect("fog:mode");
+  const ImGuiStyle& style = ImGui::GetStyle();
+  const float row = ImGui::GetFontSize() + style.ItemSpacing.y;
+  // The list opens below the control, or above it where the window has no room below.
+  for (float y : {combo.max.y + style.WindowPadding.y + 4.5f * row, combo.min.y - style.WindowPadding.y - 0.5f * row}) {
+    ui.click(*app, combo.centre());
+    ui.click(*app, ImVec2(combo.min.x + 10, y));
+    ui.frames(*app, 2);
+    if (app->scene().fog->mode == FogMode::map) break;
+  }
+  ASSERT_EQ(app->scene().fog->mode, FogMode::map);
+  ASSERT_TRUE(ui.until(*app, [&] { return !app->cone_worker().busy() && viewport.fog_maps_calls > 0; }));
+  ASSERT_TRUE(viewport.last_maps);
+  ASSERT_EQ(viewport.last_maps->size(), 1u) << "a point sun: one map";
+  EXPECT_GT(viewport.last_maps->front().allocated_tiles(), 0u) << "the tree's tiles";
+  const uint64_t asked = app->cone_requests();
+  ASSERT_TRUE(ui.orbit(*app));
+  ui.frames(*app, 5);
+  EXPECT_EQ(app->cone_requests(), asked) << "a camera move never rebuilds the maps";
+  const int given = viewport.fog_maps_calls;
+  ASSERT_TRUE(drag_slider(*app, "sun azimuth"));
+  EXPECT_GT(app->cone_requests(), asked);
+  ASSERT_TRUE(ui.until(*app, [&] { return !app->cone_worker().busy() && viewport.fog_maps_calls > given; }));
+}
+
 TEST_F(FogFixture, FogSettingsAreSavedIntoTheScene) {
   auto app = opened();
   ASSERT_TRUE(drag_slider(*app, "fog:sigma_s"));

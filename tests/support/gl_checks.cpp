@@ -59,6 +59,11 @@ std::shared_ptr<const ConeSet> cpu_cones(const Scene& scene, FogMode mode, uint6
   return std::shared_ptr<const ConeSet>(cones, &cones->cones);
 }
 
+std::shared_ptr<const std::vector<SunDepthMap>> cpu_sun_maps(const Scene& scene) {
+  SunMaps maps = sun_maps_for(scene, RenderOptions{}, nullptr);
+  return std::make_shared<const std::vector<SunDepthMap>>(std::move(maps.maps));
+}
+
 Scene scene_around(const Skeleton& skeleton, uint32_t width, uint32_t height) {
   Scene scene = default_scene_for(skeleton, width, height);
   scene.plants.front().skeleton = skeleton;

@@ -13,6 +13,7 @@
 #include "core/gl/gl_context.h"
 #include "core/gl/gl_frame_stats.h"
 #include "core/light/shadow_cones.h"
+#include "core/light/sun_map.h"
 #include "core/scene/render_types.h"
 #include "core/scene/scene.h"
 #include "tests/support/requirements.h"
@@ -47,6 +48,10 @@ RenderResult gl_render(const Scene& scene, const RenderOptions& options = {}, Gl
 // The CPU's shadow cones of `scene`'s plants (skinned in the world) and sun for fog mode
 // `mode` from `photons` sun photons (core/cpu/photons.h build_sun_cones).
 std::shared_ptr<const ConeSet> cpu_cones(const Scene& scene, FogMode mode, uint64_t photons);
+
+// Fog mode map's sun maps of `scene`'s plants and sun as the CLI builds them (app/front/render.h
+// sun_maps_for: the scene fog's resolution and directions).
+std::shared_ptr<const std::vector<SunDepthMap>> cpu_sun_maps(const Scene& scene);
 
 // A scene around `skeleton`: 256×192 unless given, the default scene's camera and sun.
 Scene scene_around(const Skeleton& skeleton, uint32_t width = 256, uint32_t height = 192);
