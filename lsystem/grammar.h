@@ -81,6 +81,10 @@ struct TurtleDefaults {
   double width_increment = 0;
   uint32_t color_increment = 1;
   uint32_t initial_color = 0;  // the material index the turtle starts with (a view file's)
+  // The turtle's scale (CPFG manual 6.3, 8.1.1): `initial scale:` and `scale multiplier:`,
+  // which @D, @Di and @Dd change; lengths and set widths are multiplied by it.
+  double initial_scale = 1;
+  double scale_multiplier = 1;
 };
 
 // A file a cpfg grammar read with #include (lsystem/cpfg_preprocessor.h).

@@ -129,6 +129,11 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
       }
     } else if (name == "line width increment") {
       if (value(0, &v)) width_increment = v;
+    } else if (name == "initial scale" || name == "scale multiplier") {
+      if (!value(0, &v)) return;
+      if (v == 0 || !std::isfinite(v) || std::abs(v) > 1e12)
+        return fail_here(values[0].column + value_column - 1, "'" + name + ":' must be a non-zero number of at most 1e12");
+      (name == "initial scale" ? t.initial_scale : t.scale_multiplier) = v;
     } else if (name == "line style") {
       if (values.empty()) return fail_here(value_column, "'line style:' needs pixel, polygon or cylinder");
       const std::string style = lower_ascii(values[0].text);
@@ -176,9 +181,6 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
       t.has_tropism = true;
       for (int k = 0; k < 3; ++k) t.tropism[k] = vec[k] * intensity;
       t.tropism_e = elasticity;
-    } else if (name == "initial scale" || name == "scale multiplier") {
-      if (value(0, &v) && v != 1)
-        fail_here(values[0].column + value_column - 1, "'" + name + ":' other than 1 (the turtle's scale) is not supported yet (docs/cpfg.md)");
     }
     // Every other command only changes cpfg's window, its lights, textures or fonts: read
     // and ignored (docs/cpfg.md).

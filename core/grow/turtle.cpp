@@ -31,6 +31,7 @@ struct TurtleState {
   int64_t chain = -1;          // chain the turtle stands on, or -1
   int64_t joint = -1;          // joint index within that chain
   bool branch_pending = false; // set by '[': the next F starts a new chain
+  double scale = 1;            // cpfg's turtle scale (@D, @Di, @Dd; CPFG manual 6.3): lengths and set widths
 };
 
 // A polygon between `{` and `}` (docs/spec/grammar.md, ABOP 1.10 and 5.1; cpfg): the joint the
@@ -187,7 +188,8 @@ std::vector<SourceLoc> places_writing(const lsys::Grammar& g, lsys::SymbolId sym
 
 // What the turtle makes of a cpfg file's own symbols (CPFG manual 6; docs/cpfg.md).
 enum class CpfgKind : uint8_t {
-  kNone, kDraw, kMove, kColorUp, kColorDown, kWidthUp, kWidthDown, kLevel, kSetPosition, kSetHeading, kUnsupported
+  kNone, kDraw, kMove, kColorUp, kColorDown, kWidthUp, kWidthDown, kLevel, kSetPosition, kSetHeading, kCircle, kSphere,
+  kScaleSet, kScaleUp, kScaleDown, kUnsupported
 };
 
 struct CpfgSymbols {
@@ -211,19 +213,29 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
   set("@v", CpfgKind::kLevel);
   set("@M", CpfgKind::kSetPosition);
   set("@R", CpfgKind::kSetHeading);
-  for (const char* name : {"~", "@o", "@c", "@O", "@Gs", "@Gc", "@Ge", "@Gr", "@Gt", "@T", "@Ts", "@Td", "@Tf",
-                           "@D", "@Di", "@Dd", "@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc"})
+  set("@c", CpfgKind::kCircle);
+  set("@O", CpfgKind::kSphere);
+  set("@D", CpfgKind::kScaleSet);
+  set("@Di", CpfgKind::kScaleUp);
+  set("@Dd", CpfgKind::kScaleDown);
+  for (const char* name : {"~", "@o", "@Gs", "@Gc", "@Ge", "@Gr", "@Gt", "@T", "@Ts", "@Td", "@Tf",
+                           "@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc"})
     set(name, CpfgKind::kUnsupported);
   return out;
 }
 
+// @c's polygon and @O's frusta (docs/cpfg.md): a 24-gon's area is 1.1 % short of the
+// circle's; 16 frusta inscribed in the sphere's profile hold 99.0 % of its volume.
+constexpr int kCircleSides = 24;
+constexpr int kSphereSegments = 16;
+constexpr double kPi = 3.14159265358979323846;
+
 // The feature a cpfg symbol sylva does not draw yet belongs to, for its error.
 std::string cpfg_feature(const std::string& name) {
   if (name == "~") return "a predefined surface, CPFG manual 6.7.1";
-  if (name == "@o" || name == "@c" || name == "@O") return "a sphere or circle, CPFG manual 6.6";
+  if (name == "@o") return "a circle in the plane of the screen, CPFG manual 6.6: it turns with the camera, which a skeleton cannot; @c draws one in the HL plane";
   if (name.rfind("@G", 0) == 0) return "a generalized cylinder, CPFG manual 6.7.3";
   if (name.rfind("@T", 0) == 0) return "a view-file tropism, CPFG manual 6.8";
-  if (name.rfind("@D", 0) == 0) return "the turtle's scale, CPFG manual 6.3";
   if (name == "@;" || name == "@,") return "a back-side colour, CPFG manual 6.3";
   if (name.rfind("@P", 0) == 0 || name.rfind("@b", 0) == 0) return "a B-spline surface patch, CPFG manual 6.7.2";
   return "a cpfg turtle command, CPFG manual chapter 6";
@@ -241,6 +253,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   t.tropism = dvec3(d.tropism[0], d.tropism[1], d.tropism[2]);
   t.radius = d.width;
   t.material = d.initial_color;
+  t.scale = d.initial_scale;
   t.tropism_e = d.has_tropism ? d.tropism_e : 0.0;
   std::vector<TurtleState> stack;
   std::vector<PendingJoint> joints;
@@ -309,7 +322,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
         continue;
       }
       if (m.symbol == sym_move) {  // G: move without drawing and without ending the chain
-        t.position += t.heading * (has ? p[0] : d.step);
+        t.position += t.heading * ((has ? p[0] : d.step) * t.scale);
         check_position(t.position);
         continue;
       }
@@ -330,7 +343,9 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           case CpfgKind::kWidthUp:
           case CpfgKind::kWidthDown: {
             const double sign = cpfg.kind[symbol] == CpfgKind::kWidthUp ? 1.0 : -1.0;
-            t.radius = has ? p[0] * d.width_scale : t.radius + sign * d.width_increment * d.width_scale;
+            // cpfg scales a width set or stepped by the turtle's scale (interpret.c).
+            t.radius = has ? p[0] * d.width_scale * t.scale
+                           : t.radius + sign * d.width_increment * d.width_scale * t.scale;
             if (!(t.radius >= 0) || !std::isfinite(t.radius)) throw TurtleFailure{"the line width must be finite and not negative"};
             if (t.radius > kMaxCoordinateM) throw TurtleFailure{"the radius exceeds the limit of 1e12 m (docs/limits.md)"};
             continue;
@@ -348,6 +363,61 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           case CpfgKind::kSetHeading:  // @R (CPFG manual 6.2)
             set_heading(t, m.param_count, p);
             continue;
+          case CpfgKind::kScaleSet:    // @D(s): the scale is s (CPFG manual 6.3)
+          case CpfgKind::kScaleUp:     // @Di(s): times s, else times the view file's scale multiplier
+          case CpfgKind::kScaleDown: {  // @Dd(s): over s, else over the multiplier
+            // As cpfg's source does it (blackbox.c): @Di(s) and @Dd(s) multiply and divide by s.
+            const CpfgKind kind = cpfg.kind[symbol];
+            if (kind == CpfgKind::kScaleSet && !has) throw TurtleFailure{"@D needs the scale: @D(s)"};
+            const double factor = has ? p[0] : d.scale_multiplier;
+            if (kind != CpfgKind::kScaleSet && factor == 0)
+              throw TurtleFailure{"the factor of " + g.symbols.name(m.symbol) + " must not be 0"};
+            const double next = kind == CpfgKind::kScaleSet ? factor
+                                : kind == CpfgKind::kScaleUp ? t.scale * factor
+                                                             : t.scale / factor;
+            if (!std::isfinite(next) || std::abs(next) > kMaxCoordinateM)
+              throw TurtleFailure{"the turtle's scale must be finite and at most 1e12"};
+            t.scale = next;
+            continue;
+          }
+          case CpfgKind::kCircle:  // @c(d): a disc of diameter d in the HL plane (CPFG manual 6.6)
+          case CpfgKind::kSphere: {  // @O(d): a sphere of diameter d
+            // Diameter: the parameter, else the current line width (the drawn diameter).
+            const double radius = has ? 0.5 * p[0] * t.scale : t.radius;
+            if (!(radius >= 0) || !std::isfinite(radius) || radius > kMaxCoordinateM)
+              throw TurtleFailure{"a diameter must be finite, not negative and at most 2e12 m"};
+            if (radius == 0) continue;
+            std::optional<ChainParent> at;
+            if (t.chain >= 0) at = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
+            if (cpfg.kind[symbol] == CpfgKind::kCircle) {
+              // A leaf: kCircleSides vertices around the turtle in the plane of H and L.
+              std::vector<std::array<double, 3>> vertices;
+              for (int k = 0; k < kCircleSides; ++k) {
+                const double a = 2 * kPi * k / kCircleSides;
+                const dvec3 v = t.position + radius * (std::cos(a) * t.heading + std::sin(a) * t.left);
+                check_position(v);
+                vertices.push_back({v.x, v.y, v.z});
+              }
+              if (leaves.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
+              leaves.push_back(Leaf{at, t.material, std::move(vertices)});
+              continue;
+            }
+            // A chain of its own, hung from the joint the turtle stands on: kSphereSegments
+            // frusta along H through the turtle's position, the profile inscribed in the
+            // circle of the radius (tips at both poles). The turtle does not move.
+            if (chain_joint_count.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many chains"};
+            const uint32_t c = static_cast<uint32_t>(chain_joint_count.size());
+            chain_joint_count.push_back(kSphereSegments + 1);
+            chain_parent.push_back(at);
+            for (int k = 0; k <= kSphereSegments; ++k) {
+              const double a = kPi * k / kSphereSegments;
+              const dvec3 v = t.position - radius * std::cos(a) * t.heading;
+              check_position(v);
+              const double r = k == 0 || k == kSphereSegments ? 0.0 : radius * std::sin(a);
+              joints.push_back({c, Joint{{v.x, v.y, v.z}, r, t.material}});
+            }
+            continue;
+          }
           case CpfgKind::kUnsupported:
             throw TurtleFailure{"'" + g.symbols.name(m.symbol) + "' (" + cpfg_feature(g.symbols.name(m.symbol)) +
                                 ") is not supported yet (docs/cpfg.md)"};
@@ -357,7 +427,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
       if ((symbol == kSymF || symbol == kSymf) && !polygons.empty() && symbol == m.symbol) {
         // Inside a polygon F and f move without drawing, keep the chain, and record the
         // turtle's new position as the polygon's next vertex (cpfg; docs/spec/grammar.md).
-        const double len = has ? p[0] : d.step;
+        const double len = (has ? p[0] : d.step) * t.scale;
         if (len == 0) ++zero_moves;
         t.position += t.heading * len;
         check_position(t.position);
@@ -366,7 +436,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
       }
       switch (symbol) {
         case kSymF: {
-          const double len = has ? p[0] : d.step;
+          const double len = (has ? p[0] : d.step) * t.scale;
           if (len == 0) {
             ++zero_moves;
             break;
@@ -407,7 +477,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           break;
         }
         case kSymf: {
-          const double len = has ? p[0] : d.step;
+          const double len = (has ? p[0] : d.step) * t.scale;
           if (len == 0) ++zero_moves;
           t.position += t.heading * len;
           check_position(t.position);

@@ -916,10 +916,83 @@ TEST(TurtleCpfg, AtMSetsThePositionAndAtVLevelsTheTurtle) {
   EXPECT_NEAR(level.joints[1].position_m[1], 0, kTolerance);  // + turned H within the horizontal
 }
 
+// @c(d) (CPFG manual 6.6): a disc of diameter d in the plane of H and L, a leaf hung from the
+// joint the turtle stands on, in the current colour; @O(d): a sphere of diameter d around the
+// turtle, a chain of its own of 16 frusta from pole to pole (tips at both), hung from that
+// joint; without a parameter the diameter is the line width drawn. Neither moves the turtle.
+TEST(TurtleCpfg, AtCDrawsADiscAndAtOASphereWhereTheTurtleStands) {
+  const Skeleton sk = skeleton_of(cpfg("F(1)@O(1);(2)@c(0.5)F(1)+(90)@O"));
+  ASSERT_EQ(sk.chains.size(), 3u);
+  // The stem goes on through both: one chain of three joints.
+  EXPECT_EQ(sk.chains[0].joint_count, 3u);
+  EXPECT_TRUE(near(position_at(sk, 0, 2), {0, 2, 0}));
+  // The first sphere: radius 0.5 around (0, 1, 0), along H = +y, hung from joint 1.
+  const Chain& sphere = sk.chains[1];
+  ASSERT_TRUE(sphere.parent);
+  EXPECT_EQ(*sphere.parent, (ChainParent{0, 1}));
+  ASSERT_EQ(sphere.joint_count, 17u);
+  double widest = 0;
+  for (uint32_t k = 0; k < sphere.joint_count; ++k) {
+    const Joint& j = sk.joints[sphere.first_joint + k];
+    const double from_centre = std::hypot(j.position_m[0], j.position_m[1] - 1, j.position_m[2]);
+    // Every ring lies on the sphere: its distance along H and its radius make 0.5.
+    EXPECT_NEAR(std::hypot(from_centre, j.radius_m), 0.5, 1e-12) << k;
+    widest = std::max(widest, j.radius_m);
+  }
+  EXPECT_EQ(sk.joints[sphere.first_joint].radius_m, 0.0);
+  EXPECT_EQ(sk.joints[sphere.first_joint + 16].radius_m, 0.0);
+  EXPECT_NEAR(widest, 0.5, 1e-12);
+  EXPECT_TRUE(near(position_at(sk, 1, 0), {0, 0.5, 0}));
+  EXPECT_TRUE(near(position_at(sk, 1, 16), {0, 1.5, 0}));
+  // The disc: 24 vertices at 0.25 from (0, 1, 0) in the xy plane (H = +y, L = −x), colour 2.
+  ASSERT_EQ(sk.leaves.size(), 1u);
+  const Leaf& disc = sk.leaves[0];
+  EXPECT_EQ(disc.material, 2u);
+  ASSERT_TRUE(disc.joint);
+  EXPECT_EQ(*disc.joint, (ChainParent{0, 1}));
+  ASSERT_EQ(disc.vertices_m.size(), 24u);
+  for (const auto& v : disc.vertices_m) {
+    EXPECT_NEAR(std::hypot(v[0], v[1] - 1), 0.25, 1e-12);
+    EXPECT_NEAR(v[2], 0, 1e-12);
+  }
+  // Without a parameter: the line width's diameter (radius 0.05, a cpfg file's width 1),
+  // along the turned heading, from the stem's tip.
+  const Chain& small = sk.chains[2];
+  EXPECT_EQ(*small.parent, (ChainParent{0, 2}));
+  double widest_small = 0;
+  for (uint32_t k = 0; k < small.joint_count; ++k) widest_small = std::max(widest_small, sk.joints[small.first_joint + k].radius_m);
+  EXPECT_NEAR(widest_small, 0.05, 1e-12);
+  EXPECT_TRUE(near(position_at(sk, 2, 0), {0.05, 2, 0}));  // + turned H from +y to −x; the pole behind is +x
+  EXPECT_NE(grow_error(cpfg("F@O(-1)")).find("diameter"), std::string::npos);
+}
+
+// The turtle's scale (CPFG manual 6.3, as cpfg's interpret.c and blackbox.c apply it): @D(s)
+// sets it, @Di(s) multiplies and @Dd(s) divides it by s (by the view file's scale multiplier
+// without one); it multiplies every move's length and every width set or stepped, and @c /
+// @O's diameters; brackets keep it.
+TEST(TurtleCpfg, AtDScalesLengthsAndWidthsAndBracketsKeepTheScale) {
+  const Skeleton sk = skeleton_of(cpfg("F(1)@D(2)F(1)[@Di(0.25)F(2)]F(1)@Dd(4)!(2)F(1)"));
+  // Stem: 1, then 2 (scale 2), then 2 after the branch (its 0.5 stayed inside), then 0.5.
+  ASSERT_EQ(sk.chains.size(), 2u);
+  EXPECT_TRUE(near(position_at(sk, 0, 1), {0, 1, 0}));
+  EXPECT_TRUE(near(position_at(sk, 0, 2), {0, 3, 0}));
+  EXPECT_TRUE(near(position_at(sk, 0, 3), {0, 5, 0}));
+  EXPECT_TRUE(near(position_at(sk, 0, 4), {0, 5.5, 0}));
+  EXPECT_TRUE(near(position_at(sk, 1, 1), {0, 4, 0}));  // 2 × 0.5 from y = 3
+  // !(2) at scale 0.5: a width of 1, radius 0.05.
+  EXPECT_DOUBLE_EQ(sk.joints[sk.chains[0].first_joint + 4].radius_m, 2 * 0.05 * 0.5);
+  const Skeleton ball = skeleton_of(cpfg("@D(3)@O(1)"));
+  double widest = 0;
+  for (const Joint& j : ball.joints) widest = std::max(widest, j.radius_m);
+  EXPECT_NEAR(widest, 1.5, 1e-12);
+  EXPECT_NE(grow_error(cpfg("F@DF")).find("@D needs the scale"), std::string::npos);
+  EXPECT_NE(grow_error(cpfg("F@Di(0)F")).find("must not be 0"), std::string::npos);
+}
+
 TEST(TurtleCpfg, SymbolsSylvaDoesNotDrawYetAreErrorsNamingTheFeature) {
   const std::pair<const char*, const char*> cases[] = {
-      {"F@o(2)", "sphere"}, {"F~l(1)", "surface"}, {"@Gs F @Ge", "generalized cylinder"},
-      {"F@T(1,0.2)F", "tropism"}, {"F@D(2)F", "scale"}};
+      {"F@o(2)", "plane of the screen"}, {"F~l(1)", "surface"}, {"@Gs F @Ge", "generalized cylinder"},
+      {"F@T(1,0.2)F", "tropism"}, {"F@;F", "back-side colour"}};
   for (const auto& [axiom, feature] : cases) {
     const std::string message = grow_error(cpfg(axiom));
     EXPECT_NE(message.find(feature), std::string::npos) << axiom << ": " << message;

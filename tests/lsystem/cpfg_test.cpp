@@ -562,6 +562,19 @@ TEST(VlabObject, AFolderIsReadThroughItsSpecificationsCpfgCommandAndItsViewFile)
   ASSERT_TRUE(shaded.ok()) << shaded.error().format();
   EXPECT_EQ(shaded->turtle.angle_deg, 30);
   EXPECT_DOUBLE_EQ(shaded->turtle.width, 0.1);
+  EXPECT_EQ(shaded->turtle.initial_scale, 1);
+  EXPECT_EQ(shaded->turtle.scale_multiplier, 1);
+  // The turtle's scale (manual 8.1.1, 6.3): its initial value and @Di / @Dd's multiplier.
+  folder.write("plant.v", "initial scale: 3\nscale multiplier: 0.5\n");
+  auto scaled = load_grammar(folder.dir().string());
+  ASSERT_TRUE(scaled.ok()) << scaled.error().format();
+  EXPECT_EQ(scaled->turtle.initial_scale, 3);
+  EXPECT_EQ(scaled->turtle.scale_multiplier, 0.5);
+  folder.write("plant.v", "angle factor: 8\nscale multiplier: 0\n");
+  auto zero = load_grammar(folder.dir().string());
+  ASSERT_FALSE(zero.ok());
+  EXPECT_EQ(zero.error().loc.line, 2u);
+  EXPECT_NE(zero.error().message.find("must be a non-zero number"), std::string::npos) << zero.error().message;
 }
 
 TEST(VlabObject, WhatSylvaCannotFollowIsAnErrorAtItsPlace) {
@@ -584,7 +597,7 @@ TEST(VlabObject, WhatSylvaCannotFollowIsAnErrorAtItsPlace) {
       {"run:\n\tcpfg plant.l plant.v\n", "angle factor: 0\n", "plant.v", 1, 15, "must not be 0"},
       {"run:\n\tcpfg plant.l plant.v\n", "initial line width: wide\n", "plant.v", 1, 21, "needs a number"},
       {"run:\n\tcpfg plant.l plant.v\n", "tropism: T: 0 -1 0 A: 90 E: 0.2\n", "plant.v", 1, 9, "toward an angle"},
-      {"run:\n\tcpfg plant.l plant.v\n", "initial scale: 2\n", "plant.v", 1, 16, "turtle's scale"},
+      {"run:\n\tcpfg plant.l plant.v\n", "scale multiplier: 0\n", "plant.v", 1, 19, "must be a non-zero number"},
       {"run:\n\tcpfg plant.l missing.v\n", "", "missing.v", 0, 0, "cannot open"},
   };
   for (const Case& c : cases) {
