@@ -150,6 +150,8 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
         if (v < 0 || v != std::floor(v)) return fail_here(values[0].column + value_column - 1, "a colour increment is a whole number from 0");
         t.color_increment = static_cast<uint32_t>(v);
       }
+    } else if (name == "torque") {
+      return fail_here(1, "a torque (a twist toward a vector, CPFG manual 8.1.8) is not supported yet (docs/cpfg.md)");
     } else if (name == "tropism") {
       // "T: x y z A: angle I: intensity E: elasticity S: step" (manual 8.1.8).
       if (t.has_tropism)
@@ -178,8 +180,13 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
       if (!has_vector) return fail_here(value_column, "a tropism needs its vector: 'tropism: T: x y z ...'");
       if (angle != 0)
         return fail_here(value_column, "a tropism toward an angle (A:, CPFG manual 8.1.8) is not supported yet (docs/cpfg.md)");
+      // As cpfg's read_movement (cpfg/movements.c): T normalised, times the intensity, the
+      // factor I / |T| clamped to [-1, 1] — so an intensity above 1 bends no more than 1.
+      const double length = std::sqrt(vec[0] * vec[0] + vec[1] * vec[1] + vec[2] * vec[2]);
+      if (!(length > 0) || !std::isfinite(length)) return fail_here(value_column, "a tropism's vector must not be 0");
+      const double factor = std::clamp(intensity / length, -1.0, 1.0);
       t.has_tropism = true;
-      for (int k = 0; k < 3; ++k) t.tropism[k] = vec[k] * intensity;
+      for (int k = 0; k < 3; ++k) t.tropism[k] = vec[k] * factor;
       t.tropism_e = elasticity;
     }
     // Every other command only changes cpfg's window, its lights, textures or fonts: read

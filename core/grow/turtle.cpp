@@ -32,6 +32,10 @@ struct TurtleState {
   int64_t joint = -1;          // joint index within that chain
   bool branch_pending = false; // set by '[': the next F starts a new chain
   double scale = 1;            // cpfg's turtle scale (@D, @Di, @Dd; CPFG manual 6.3): lengths and set widths
+  // A cpfg file's frame of the last drawn segment (cpfg's prev_heading, prev_up: set after
+  // every F and G, and by @Tf): what @R and the view file's tropism turn the up vector from.
+  dvec3 prev_heading{0, 1, 0};
+  dvec3 prev_up{0, 0, 1};
 };
 
 // A polygon between `{` and `}` (docs/spec/grammar.md, ABOP 1.10 and 5.1; cpfg): the joint the
@@ -126,12 +130,64 @@ dvec3 rotate_about(const dvec3& v, const dvec3& k, double angle_rad) {
   return v * c + glm::cross(k, v) * s + k * glm::dot(k, v) * (1 - c);
 }
 
+// The least rotation of the frame that takes its heading to `heading` (about old × new by
+// their angle, atan2 of |cross| and dot, exact near 0 and 180 degrees); a reversal turns
+// about U, as |.
+void turn_heading_least(TurtleState& t, const dvec3& heading) {
+  const dvec3 axis = glm::cross(t.heading, heading);
+  const double sin_a = glm::length(axis), cos_a = glm::dot(t.heading, heading);
+  if (sin_a > 1e-15) {
+    const dvec3 k = axis / sin_a;
+    t.left = rotate_about(t.left, k, std::atan2(sin_a, cos_a));
+  } else if (cos_a < 0) {
+    t.left = -t.left;  // 180 degrees about U, as |
+  }
+  t.heading = heading;
+  orthonormalize(t);
+}
+
+// cpfg's adjust_up_and_left (cpfg/turtle.c), after the heading was set or bent: where the
+// heading has moved from the last drawn segment's (|prev H × H| > 1e-6), up is that
+// segment's up turned by the least rotation from its heading to the current one — so a
+// roll (/ \) since that segment is undone, as in cpfg (its @Tf keeps one); otherwise up
+// stays. Left = up × heading in sylva's frame. An up left parallel to the heading (a
+// degenerate case cpfg does not guard) falls back to the least rotation of the frame.
+void adjust_up_and_left(TurtleState& t, const dvec3& old_heading) {
+  const dvec3 axis = glm::cross(t.prev_heading, t.heading);
+  const double sin_a = glm::length(axis);
+  dvec3 up = t.up;
+  if (sin_a > 1e-6) up = rotate_about(t.prev_up, axis / sin_a, std::atan2(sin_a, glm::dot(t.prev_heading, t.heading)));
+  up -= glm::dot(up, t.heading) * t.heading;
+  const double ul = glm::length(up);
+  if (!(ul > 1e-9)) {
+    const dvec3 heading = t.heading;
+    t.heading = old_heading;
+    turn_heading_least(t, heading);
+    return;
+  }
+  t.up = up / ul;
+  t.left = glm::cross(t.up, t.heading);
+}
+
+// The view file's tropism (CPFG manual 8.1.8) as cpfg's movement_adjust applies it before
+// every F, G, f and g (cpfg/movements.c, one orthotropism): H turned toward T about H × T by
+// e·|H × T| radians, at most 1 (T as the view file gave it, scaled by its intensity:
+// vlab_object.cpp), then the up vector as adjust_up_and_left makes it; no turn below 1e-6.
+void cpfg_bend(TurtleState& t) {
+  const dvec3 rot = glm::cross(t.heading, t.tropism_e * t.tropism);
+  const double len = glm::length(rot);
+  if (!(len >= 1e-6)) return;
+  const dvec3 old_heading = t.heading;
+  t.heading = glm::normalize(rotate_about(t.heading, rot / len, std::min(len, 1.0)));
+  adjust_up_and_left(t, old_heading);
+}
+
 // @R(hx, hy[, hz]) and @R(hx, hy, hz, ux, uy, uz) (CPFG manual 6.2, as cpfg does it): the
 // heading set to the given direction (normalised; z = 0 with two parameters; a zero vector
 // is the initial heading, +y). With an up vector that is not zero and perpendicular to the
-// heading, up is that vector normalised and left = up × heading; otherwise the frame turns
-// by the least rotation that takes the old heading to the new one (left and up "rotate
-// least").
+// heading, up is that vector normalised and left = up × heading; otherwise up and left as
+// cpfg's adjust_up_and_left makes them: the last drawn segment's up turned by the least
+// rotation from its heading to the new one.
 void set_heading(TurtleState& t, uint32_t count, const double* p) {
   if (count < 2) throw TurtleFailure{"@R takes the heading: @R(hx, hy, hz), or with the up vector, @R(hx, hy, hz, ux, uy, uz)"};
   for (uint32_t k = 0; k < count && k < 6; ++k)
@@ -150,18 +206,9 @@ void set_heading(TurtleState& t, uint32_t count, const double* p) {
       return;
     }
   }
-  // The least rotation from the old heading to the new: about old × new by their angle
-  // (atan2 of |cross| and dot, exact near 0 and 180 degrees); a reversal turns about U.
-  const dvec3 axis = glm::cross(t.heading, heading);
-  const double sin_a = glm::length(axis), cos_a = glm::dot(t.heading, heading);
-  if (sin_a > 1e-15) {
-    const dvec3 k = axis / sin_a;
-    t.left = rotate_about(t.left, k, std::atan2(sin_a, cos_a));
-  } else if (cos_a < 0) {
-    t.left = -t.left;  // 180 degrees about U, as |
-  }
+  const dvec3 old_heading = t.heading;
   t.heading = heading;
-  orthonormalize(t);
+  adjust_up_and_left(t, old_heading);
 }
 
 // The places of the grammar that write a module with `symbol`: the axiom, then every
@@ -189,7 +236,7 @@ std::vector<SourceLoc> places_writing(const lsys::Grammar& g, lsys::SymbolId sym
 // What the turtle makes of a cpfg file's own symbols (CPFG manual 6; docs/cpfg.md).
 enum class CpfgKind : uint8_t {
   kNone, kDraw, kMove, kColorUp, kColorDown, kWidthUp, kWidthDown, kLevel, kSetPosition, kSetHeading, kCircle, kSphere,
-  kScaleSet, kScaleUp, kScaleDown, kUnsupported
+  kScaleSet, kScaleUp, kScaleDown, kForceTwist, kUnsupported
 };
 
 struct CpfgSymbols {
@@ -218,7 +265,8 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
   set("@D", CpfgKind::kScaleSet);
   set("@Di", CpfgKind::kScaleUp);
   set("@Dd", CpfgKind::kScaleDown);
-  for (const char* name : {"~", "@o", "@Gs", "@Gc", "@Ge", "@Gr", "@Gt", "@T", "@Ts", "@Td", "@Tf",
+  set("@Tf", CpfgKind::kForceTwist);
+  for (const char* name : {"~", "@o", "@Gs", "@Gc", "@Ge", "@Gr", "@Gt", "@T", "@Ts", "@Td",
                            "@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc"})
     set(name, CpfgKind::kUnsupported);
   return out;
@@ -363,6 +411,10 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           case CpfgKind::kSetHeading:  // @R (CPFG manual 6.2)
             set_heading(t, m.param_count, p);
             continue;
+          case CpfgKind::kForceTwist:  // @Tf (manual 6.8): the rolls so far stay (cpfg's prev frame := the frame)
+            t.prev_heading = t.heading;
+            t.prev_up = t.up;
+            continue;
           case CpfgKind::kScaleSet:    // @D(s): the scale is s (CPFG manual 6.3)
           case CpfgKind::kScaleUp:     // @Di(s): times s, else times the view file's scale multiplier
           case CpfgKind::kScaleDown: {  // @Dd(s): over s, else over the multiplier
@@ -424,6 +476,9 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           case CpfgKind::kNone: break;
         }
       }
+      // A cpfg file's view-file tropism turns the turtle before every F, G, f and g (cpfg's
+      // movement_adjust); sylva's own format bends after every F (ABOP 2.2, below).
+      if (g.cpfg && (symbol == kSymF || symbol == kSymf) && t.tropism_e != 0.0) cpfg_bend(t);
       if ((symbol == kSymF || symbol == kSymf) && !polygons.empty() && symbol == m.symbol) {
         // Inside a polygon F and f move without drawing, keep the chain, and record the
         // turtle's new position as the polygon's next vertex (cpfg; docs/spec/grammar.md).
@@ -432,11 +487,13 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
         t.position += t.heading * len;
         check_position(t.position);
         record_vertex(polygons.back(), t.position);
+        if (g.cpfg && symbol == kSymF) t.prev_heading = t.heading, t.prev_up = t.up;
         continue;
       }
       switch (symbol) {
         case kSymF: {
           const double len = (has ? p[0] : d.step) * t.scale;
+          if (g.cpfg) t.prev_heading = t.heading, t.prev_up = t.up;  // cpfg: the frame of the last F or G
           if (len == 0) {
             ++zero_moves;
             break;
@@ -462,7 +519,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
                             Joint{{t.position.x, t.position.y, t.position.z}, t.radius, t.material}});
           ++chain_joint_count[t.chain];
           ++t.joint;
-          if (t.tropism_e != 0.0) {
+          if (t.tropism_e != 0.0 && !g.cpfg) {
             // ABOP 2.2: rotate the frame about H × T by e·|H × T|.
             const dvec3 axis = glm::cross(t.heading, t.tropism);
             const double len_axis = glm::length(axis);

@@ -143,6 +143,70 @@ std::array<glm::dvec3, 3> frame_after(const std::string& axiom) {
 
 bool near(const glm::dvec3& a, const glm::dvec3& b) { return glm::length(a - b) < 1e-12; }
 
+// The frame after `axiom` in a cpfg file whose view file gave the tropism T = (tx, ty, tz)
+// with elasticity e (set on the parsed grammar, as vlab_object.cpp does).
+std::array<glm::dvec3, 4> tropism_frame_after(const std::string& axiom, glm::dvec3 tropism, double e) {
+  lsys::Grammar g = parsed("Lsystem: 1\nderivation length: 0\nAxiom: " + axiom +
+                               "?P(0,0,0)?H(0,0,0)?L(0,0,0)?U(0,0,0)\nendlsystem\n",
+                           "t.l");
+  g.turtle.has_tropism = e != 0;
+  g.turtle.tropism[0] = tropism.x, g.turtle.tropism[1] = tropism.y, g.turtle.tropism[2] = tropism.z;
+  g.turtle.tropism_e = e;
+  auto w = derived_word(g, 0);
+  if (!w) {
+    ADD_FAILURE() << w.error().format();
+    return {};
+  }
+  std::array<glm::dvec3, 4> out;
+  const lsys::SymbolId ids[4] = {lsys::kSymQueryPosition, lsys::kSymQueryHeading, lsys::kSymQueryLeft,
+                                 lsys::kSymQueryUp};
+  for (int k = 0; k < 4; ++k) {
+    const auto v = params_of(*w, ids[k]);
+    if (v.size() == 3) out[static_cast<size_t>(k)] = {v[0], v[1], v[2]};
+  }
+  return out;
+}
+
+// A cpfg file's view-file tropism, as cpfg's movement_adjust (cpfg/movements.c): before every
+// F, G, f and g — not after every F, as ABOP's rule in sylva's own format — H turns toward T
+// by e·|H × T| radians, at most 1; the up vector is the last drawn segment's turned by the
+// least rotation to the new heading, so a roll since that segment is undone unless @Tf.
+TEST(TurtleQueries, CpfgViewFileTropismTurnsBeforeEveryMoveAsCpfgDoes) {
+  const glm::dvec3 x(1, 0, 0);
+  // Before the first F: 0.5 rad from +y toward +x, so the first segment already leans.
+  auto f = tropism_frame_after("F(1)", x, 0.5);
+  EXPECT_TRUE(near(f[0], {std::sin(0.5), std::cos(0.5), 0}));
+  // Before the second: e·|H × T| = 0.5·cos(0.5) more.
+  const double second = 0.5 + 0.5 * std::cos(0.5);
+  f = tropism_frame_after("F(1)F(1)", x, 0.5);
+  EXPECT_TRUE(near(f[1], {std::sin(second), std::cos(second), 0}));
+  // f and g turn it too, G as F.
+  f = tropism_frame_after("f(1)g(1)G(1)", x, 0.5);
+  const double third = second + 0.5 * std::cos(second);
+  EXPECT_TRUE(near(f[1], {std::sin(third), std::cos(third), 0}));
+  // At most 1 radian a move.
+  f = tropism_frame_after("F(1)", x, 5);
+  EXPECT_TRUE(near(f[0], {std::sin(1.0), std::cos(1.0), 0}));
+  // A roll before the next move is undone (the up of the last segment, carried along)...
+  const auto unrolled = tropism_frame_after("F(1)/(90)F(1)", x, 0.5);
+  const auto plain = tropism_frame_after("F(1)F(1)", x, 0.5);
+  EXPECT_TRUE(near(unrolled[3], plain[3]));
+  EXPECT_TRUE(near(unrolled[2], plain[2]));
+  // ... unless @Tf keeps it: then up is the rolled up, turned with the heading.
+  const auto kept = tropism_frame_after("F(1)/(90)@TfF(1)", x, 0.5);
+  EXPECT_FALSE(near(kept[3], plain[3]));
+  EXPECT_NEAR(glm::dot(kept[3], plain[3]), 0, 1e-12) << "a quarter roll: the ups are perpendicular";
+  EXPECT_TRUE(near(kept[1], plain[1])) << "the heading is the same";
+  // Every frame stays orthonormal and right-handed (H × L = U).
+  for (const auto& frame : {unrolled, kept}) {
+    EXPECT_NEAR(glm::length(frame[1]), 1, 1e-12);
+    EXPECT_TRUE(near(glm::cross(frame[1], frame[2]), frame[3]));
+  }
+  // Without a tropism the roll stays.
+  const auto untouched = tropism_frame_after("F(1)/(90)F(1)", x, 0);
+  EXPECT_TRUE(near(untouched[3], {1, 0, 0}) || near(untouched[3], {-1, 0, 0})) << untouched[3].x;
+}
+
 TEST(TurtleQueries, CpfgAtRSetsTheHeadingByTheLeastRotationOrWithItsUpVector) {
   // CPFG manual 6.2. The turtle starts with H = +y, L = -x, U = +z. Turning H to +x rotates
   // about -z: U stays, L becomes +y. A reversal turns about U, as |.
@@ -169,6 +233,15 @@ TEST(TurtleQueries, CpfgAtRSetsTheHeadingByTheLeastRotationOrWithItsUpVector) {
   EXPECT_TRUE(near(f[0], {0, -1, 0}));
   f = frame_after("+(90)@R(0,0,0)");
   EXPECT_TRUE(near(f[0], {0, 1, 0}));
+  // The up vector comes from the last drawn segment's (cpfg's adjust_up_and_left): a roll
+  // since then is undone, as cpfg does; after an F the roll is that segment's and stays.
+  f = frame_after("/(90)@R(1,0,0)");
+  EXPECT_TRUE(near(f[0], {1, 0, 0}));
+  EXPECT_TRUE(near(f[1], {0, 1, 0}));
+  EXPECT_TRUE(near(f[2], {0, 0, 1}));
+  f = frame_after("/(90)F@R(1,0,0)");
+  EXPECT_TRUE(near(f[0], {1, 0, 0}));
+  EXPECT_FALSE(near(f[2], {0, 0, 1}));
   // After a roll and a pitch, @R still sets the heading absolutely, and F follows it.
   const lsys::Grammar g = parsed("Lsystem: 1\nderivation length: 0\nAxiom: /(33)&(20)@R(0,0,1)F(2)?P(0,0,0)\nendlsystem\n", "r.l");
   auto w = derived_word(g, 0);

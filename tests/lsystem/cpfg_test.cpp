@@ -554,8 +554,12 @@ TEST(VlabObject, AFolderIsReadThroughItsSpecificationsCpfgCommandAndItsViewFile)
   EXPECT_EQ(g->turtle.initial_color, 3u);
   EXPECT_EQ(g->turtle.color_increment, 2u);
   EXPECT_TRUE(g->turtle.has_tropism);
-  EXPECT_EQ(g->turtle.tropism[1], -2);           // T scaled by the intensity
+  EXPECT_EQ(g->turtle.tropism[1], -1);           // T normalised times I, the factor at most 1 (cpfg)
   EXPECT_EQ(g->turtle.tropism_e, 0.1);
+  folder.write("plant.v", "tropism: T: 0 -4 0 I: 0.5 E: 0.2\n");
+  auto weak = load_grammar(folder.dir().string());
+  ASSERT_TRUE(weak.ok()) << weak.error().format();
+  EXPECT_EQ(weak->turtle.tropism[1], -0.5);      // (0, -4, 0) / 4 × 0.5
   // A world-unit style makes a width a diameter.
   folder.write("plant.v", "angle increment: 30\ninitial line width: 0.2 shaded\n");
   auto shaded = load_grammar(folder.dir().string());
@@ -598,6 +602,8 @@ TEST(VlabObject, WhatSylvaCannotFollowIsAnErrorAtItsPlace) {
       {"run:\n\tcpfg plant.l plant.v\n", "initial line width: wide\n", "plant.v", 1, 21, "needs a number"},
       {"run:\n\tcpfg plant.l plant.v\n", "tropism: T: 0 -1 0 A: 90 E: 0.2\n", "plant.v", 1, 9, "toward an angle"},
       {"run:\n\tcpfg plant.l plant.v\n", "scale multiplier: 0\n", "plant.v", 1, 19, "must be a non-zero number"},
+      {"run:\n\tcpfg plant.l plant.v\n", "torque: T: 0 1 0 E: 0.1\n", "plant.v", 1, 1, "a torque"},
+      {"run:\n\tcpfg plant.l plant.v\n", "tropism: T: 0 0 0 E: 0.1\n", "plant.v", 1, 9, "must not be 0"},
       {"run:\n\tcpfg plant.l missing.v\n", "", "missing.v", 0, 0, "cannot open"},
   };
   for (const Case& c : cases) {
