@@ -694,8 +694,10 @@ void Parser::check_builtin_arity(const ParsedModule& m) {
                                                           : "?U") +
                     " takes 2 parameters, (x, y), or 3, (x, y, z), not " + std::to_string(m.args.size()) +
                     " (CPFG manual 6.9)");
-  if (m.symbol == kSymTropismVector && m.args.size() != 3)
-    fail(m.loc, "@Tp takes 3 parameters, @Tp(x, y, z), not " + std::to_string(m.args.size()));
+  // In a cpfg file a bare @Tp is cpfg's (manual 6.8: undo the twist since the last segment).
+  if (m.symbol == kSymTropismVector && m.args.size() != 3 && !(g_.cpfg && m.args.empty()))
+    fail(m.loc, "@Tp takes 3 parameters, @Tp(x, y, z)" + std::string(g_.cpfg ? ", or none (CPFG manual 6.8)" : "") +
+                    ", not " + std::to_string(m.args.size()));
 }
 
 Successor Parser::compile_successor(Cursor c, const Scope& scope, const char* what) {

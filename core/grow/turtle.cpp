@@ -601,7 +601,11 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           if (!has) throw TurtleFailure{"@T needs the susceptibility: @T(e)"};
           t.tropism_e = p[0];
           break;
-        case kSymTropismVector:  // the parser holds its arity at 3
+        case kSymTropismVector:  // the parser holds its arity at 3 (or 0 in a cpfg file)
+          if (m.param_count == 0) {  // cpfg's bare @Tp (manual 6.8): the up from the last segment's frame
+            adjust_up_and_left(t, t.heading);
+            break;
+          }
           t.tropism = dvec3(p[0], p[1], p[2]);
           if (!std::isfinite(t.tropism.x) || !std::isfinite(t.tropism.y) || !std::isfinite(t.tropism.z))
             throw TurtleFailure{"the tropism vector must be finite"};

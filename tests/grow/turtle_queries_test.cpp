@@ -202,6 +202,14 @@ TEST(TurtleQueries, CpfgViewFileTropismTurnsBeforeEveryMoveAsCpfgDoes) {
     EXPECT_NEAR(glm::length(frame[1]), 1, 1e-12);
     EXPECT_TRUE(near(glm::cross(frame[1], frame[2]), frame[3]));
   }
+  // A bare @Tp (manual 6.8) undoes the twist since the last segment the same way, at once:
+  // after a pitch and a roll, up is the last segment's turned by the least rotation.
+  const auto twisted = tropism_frame_after("F(1)&(30)/(90)", x, 0);
+  const auto untwisted = tropism_frame_after("F(1)&(30)/(90)@Tp", x, 0);
+  const auto pitched = tropism_frame_after("F(1)&(30)", x, 0);
+  EXPECT_TRUE(near(untwisted[1], twisted[1])) << "the heading stays";
+  EXPECT_TRUE(near(untwisted[3], pitched[3])) << "the roll is undone, the pitch kept";
+  EXPECT_FALSE(near(twisted[3], pitched[3]));
   // Without a tropism the roll stays.
   const auto untouched = tropism_frame_after("F(1)/(90)F(1)", x, 0);
   EXPECT_TRUE(near(untouched[3], {1, 0, 0}) || near(untouched[3], {-1, 0, 0})) << untouched[3].x;
