@@ -65,6 +65,17 @@ struct Production {
   bool has_statements() const { return before.kind != Expr::Kind::kNone || after.kind != Expr::Kind::kNone; }
 };
 
+// One `tropism:` line of a cpfg view file (CPFG manual 8.1.8; docs/cpfg.md): its id is its
+// place plus 1. `vector` is T normalised times the intensity (the factor clamped to [-1, 1],
+// as cpfg's read_movement); `angle_deg` the angle A the shoots seek to T (0: orthotropism).
+struct ViewTropism {
+  double vector[3] = {0, 0, 0};
+  double angle_deg = 0;
+  double elasticity = 0;  // E: the initial elasticity
+  double step = 0;        // S: @Ti and @Td's step without a value
+};
+inline constexpr size_t kMaxViewTropisms = 8;
+
 // Turtle settings from the header (docs/spec/grammar.md "Header directives").
 struct TurtleDefaults {
   double angle_deg = 90;
@@ -85,6 +96,10 @@ struct TurtleDefaults {
   // which @D, @Di and @Dd change; lengths and set widths are multiplied by it.
   double initial_scale = 1;
   double scale_multiplier = 1;
+  // A cpfg file's tropisms (the view file's `tropism:` lines, ids 1, 2, ...): the turtle
+  // bends by all of them before every move, as cpfg does (docs/cpfg.md). sylva's own
+  // `tropism:` header (has_tropism) stands for one orthotropism in a cpfg file without them.
+  std::vector<ViewTropism> view_tropisms;
 };
 
 // A file a cpfg grammar read with #include (lsystem/cpfg_preprocessor.h).

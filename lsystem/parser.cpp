@@ -1689,7 +1689,7 @@ LineKind classify(const LogicalLine& line) {
 // cpfg file reads `@Gs` as one module, as cpfg does.
 constexpr const char* kCpfgModuleNames[] = {
     "@Gc", "@Ge", "@Gr", "@Gs", "@Gt", "@L",  "@O",  "@PC", "@PD", "@PS", "@T",  "@Td", "@Tf", "@Tp", "@Ts",
-    "@Tx", "@bc", "@bo", "@c",  "@o",  "@v",  "@M",  "@m",  "@R",  "@D",  "@Di", "@Dd", "@;",  "@,",  "?P",
+    "@Tx", "@Ti", "@bc", "@bo", "@c",  "@o",  "@v",  "@M",  "@m",  "@R",  "@D",  "@Di", "@Dd", "@;",  "@,",  "?P",
     "?H",  "?L",  "?U",  "?E"};
 
 void Parser::parse(const std::string& text) {

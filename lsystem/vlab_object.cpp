@@ -154,9 +154,9 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
       return fail_here(1, "a torque (a twist toward a vector, CPFG manual 8.1.8) is not supported yet (docs/cpfg.md)");
     } else if (name == "tropism") {
       // "T: x y z A: angle I: intensity E: elasticity S: step" (manual 8.1.8).
-      if (t.has_tropism)
-        return fail_here(1, "a second tropism (tropism ids, CPFG manual 8.1.8) is not supported yet (docs/cpfg.md)");
-      double vec[3] = {0, 0, 0}, intensity = 1, elasticity = 0, angle = 0;
+      if (t.view_tropisms.size() >= lsys::kMaxViewTropisms)
+        return fail_here(1, "more than " + std::to_string(lsys::kMaxViewTropisms) + " tropisms");
+      double vec[3] = {0, 0, 0}, intensity = 1, elasticity = 0, angle = 0, step = 0;
       bool has_vector = false;
       for (size_t k = 0; k < values.size(); ++k) {
         const std::string key = values[k].text;
@@ -171,23 +171,23 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
         } else if (key == "E:") {
           if (!read(&elasticity)) return;
         } else if (key == "S:") {
-          double step = 0;
           if (!read(&step)) return;
         } else {
           return fail_here(values[k].column + value_column - 1, "expected T:, A:, I:, E: or S: in the tropism");
         }
       }
       if (!has_vector) return fail_here(value_column, "a tropism needs its vector: 'tropism: T: x y z ...'");
-      if (angle != 0)
-        return fail_here(value_column, "a tropism toward an angle (A:, CPFG manual 8.1.8) is not supported yet (docs/cpfg.md)");
       // As cpfg's read_movement (cpfg/movements.c): T normalised, times the intensity, the
       // factor I / |T| clamped to [-1, 1] — so an intensity above 1 bends no more than 1.
       const double length = std::sqrt(vec[0] * vec[0] + vec[1] * vec[1] + vec[2] * vec[2]);
       if (!(length > 0) || !std::isfinite(length)) return fail_here(value_column, "a tropism's vector must not be 0");
       const double factor = std::clamp(intensity / length, -1.0, 1.0);
-      t.has_tropism = true;
-      for (int k = 0; k < 3; ++k) t.tropism[k] = vec[k] * factor;
-      t.tropism_e = elasticity;
+      lsys::ViewTropism tropism;
+      for (int k = 0; k < 3; ++k) tropism.vector[k] = vec[k] * factor;
+      tropism.angle_deg = angle;
+      tropism.elasticity = elasticity;
+      tropism.step = step;
+      t.view_tropisms.push_back(tropism);
     }
     // Every other command only changes cpfg's window, its lights, textures or fonts: read
     // and ignored (docs/cpfg.md).

@@ -36,6 +36,9 @@ struct TurtleState {
   // every F and G, and by @Tf): what @R and the view file's tropism turn the up vector from.
   dvec3 prev_heading{0, 1, 0};
   dvec3 prev_up{0, 0, 1};
+  // A cpfg file's elasticity of each view-file tropism (by id − 1): @Ti, @Td, @Ts change it
+  // for the rest of the branch.
+  std::array<double, lsys::kMaxViewTropisms> elasticity{};
 };
 
 // A polygon between `{` and `}` (docs/spec/grammar.md, ABOP 1.10 and 5.1; cpfg): the joint the
@@ -169,12 +172,29 @@ void adjust_up_and_left(TurtleState& t, const dvec3& old_heading) {
   t.left = glm::cross(t.up, t.heading);
 }
 
-// The view file's tropism (CPFG manual 8.1.8) as cpfg's movement_adjust applies it before
-// every F, G, f and g (cpfg/movements.c, one orthotropism): H turned toward T about H × T by
-// e·|H × T| radians, at most 1 (T as the view file gave it, scaled by its intensity:
-// vlab_object.cpp), then the up vector as adjust_up_and_left makes it; no turn below 1e-6.
-void cpfg_bend(TurtleState& t) {
-  const dvec3 rot = glm::cross(t.heading, t.tropism_e * t.tropism);
+// The view file's tropisms (CPFG manual 8.1.8) as cpfg's movement_adjust applies them before
+// every F, G, f and g (cpfg/movements.c): one desired direction V, the sum over tropisms i of
+// cos(A_i)·e_i·T_i and, where A_i is not 0, sin(A_i)·e_i·T_i × (H × T_i) / |H × T_i| (H × T_i
+// replaced by L where H is along T_i); H turned toward V about H × V by |H × V| radians, at
+// most 1; then the up vector as adjust_up_and_left makes it. No turn below 1e-6. The first
+// tropism's vector is the turtle's (t.tropism: @Tp(x, y, z) sets it).
+void cpfg_bend(TurtleState& t, const std::vector<lsys::ViewTropism>& tropisms) {
+  dvec3 desired(0, 0, 0);
+  for (size_t i = 0; i < tropisms.size(); ++i) {
+    const lsys::ViewTropism& tr = tropisms[i];
+    const dvec3 T = i == 0 ? t.tropism : dvec3(tr.vector[0], tr.vector[1], tr.vector[2]);  // @Tp sets the first
+    const double e = t.elasticity[i];
+    const double a = tr.angle_deg;
+    desired += lsys::cos_deg(a) * e * T;
+    const double sin_a = lsys::sin_deg(a);
+    if (sin_a != 0) {
+      dvec3 across = glm::cross(t.heading, T);
+      double len = glm::length(across);
+      if (len < 1e-7) across = t.left, len = 1;
+      desired += (sin_a * e / len) * glm::cross(T, across);
+    }
+  }
+  const dvec3 rot = glm::cross(t.heading, desired);
   const double len = glm::length(rot);
   if (!(len >= 1e-6)) return;
   const dvec3 old_heading = t.heading;
@@ -236,7 +256,7 @@ std::vector<SourceLoc> places_writing(const lsys::Grammar& g, lsys::SymbolId sym
 // What the turtle makes of a cpfg file's own symbols (CPFG manual 6; docs/cpfg.md).
 enum class CpfgKind : uint8_t {
   kNone, kDraw, kMove, kColorUp, kColorDown, kWidthUp, kWidthDown, kLevel, kSetPosition, kSetHeading, kCircle, kSphere,
-  kScaleSet, kScaleUp, kScaleDown, kForceTwist, kUnsupported
+  kScaleSet, kScaleUp, kScaleDown, kForceTwist, kElasticityUp, kElasticityDown, kElasticitySet, kUnsupported
 };
 
 struct CpfgSymbols {
@@ -266,7 +286,11 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
   set("@Di", CpfgKind::kScaleUp);
   set("@Dd", CpfgKind::kScaleDown);
   set("@Tf", CpfgKind::kForceTwist);
-  for (const char* name : {"~", "@o", "@Gs", "@Gc", "@Ge", "@Gr", "@Gt", "@T", "@Ts", "@Td",
+  set("@T", CpfgKind::kElasticityUp);  // the manual's name; cpfg's source reads @Ti
+  set("@Ti", CpfgKind::kElasticityUp);
+  set("@Td", CpfgKind::kElasticityDown);
+  set("@Ts", CpfgKind::kElasticitySet);
+  for (const char* name : {"~", "@o", "@Gs", "@Gc", "@Ge", "@Gr", "@Gt",
                            "@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc"})
     set(name, CpfgKind::kUnsupported);
   return out;
@@ -303,6 +327,24 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   t.material = d.initial_color;
   t.scale = d.initial_scale;
   t.tropism_e = d.has_tropism ? d.tropism_e : 0.0;
+  // A cpfg file's tropisms: its view file's, else sylva's `tropism:` header as one
+  // orthotropism (docs/cpfg.md); their elasticities start at E.
+  std::vector<lsys::ViewTropism> cpfg_tropisms;
+  if (g.cpfg) {
+    cpfg_tropisms = d.view_tropisms;
+    if (cpfg_tropisms.empty() && d.has_tropism) {
+      lsys::ViewTropism one;
+      for (int k = 0; k < 3; ++k) one.vector[k] = d.tropism[k];
+      one.elasticity = d.tropism_e;
+      cpfg_tropisms.push_back(one);
+    }
+    if (cpfg_tropisms.size() > lsys::kMaxViewTropisms) cpfg_tropisms.resize(lsys::kMaxViewTropisms);
+    for (size_t i = 0; i < cpfg_tropisms.size(); ++i) t.elasticity[i] = cpfg_tropisms[i].elasticity;
+    // The first tropism's vector rides on the turtle, so @Tp(x, y, z) sets it for the branch.
+    if (!cpfg_tropisms.empty())
+      t.tropism = dvec3(cpfg_tropisms[0].vector[0], cpfg_tropisms[0].vector[1], cpfg_tropisms[0].vector[2]);
+    t.tropism_e = 0;  // a cpfg file bends by cpfg_bend only
+  }
   std::vector<TurtleState> stack;
   std::vector<PendingJoint> joints;
   std::vector<uint32_t> chain_joint_count;
@@ -411,6 +453,23 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           case CpfgKind::kSetHeading:  // @R (CPFG manual 6.2)
             set_heading(t, m.param_count, p);
             continue;
+          case CpfgKind::kElasticityUp:    // @T(id, v) / @Ti(id, v): tropism id's elasticity + v (or + its S:)
+          case CpfgKind::kElasticityDown:  // @Td(id, v): − v (or − S:)
+          case CpfgKind::kElasticitySet: {  // @Ts(id, v): v (or 0) — all for the rest of the branch
+            if (!has) continue;  // as cpfg: without the id nothing changes
+            const double id = p[0];
+            if (!(id >= 1) || id != std::floor(id) || id > static_cast<double>(cpfg_tropisms.size()))
+              throw TurtleFailure{g.symbols.name(m.symbol) + "'s first parameter is a tropism id from 1 to " +
+                                  std::to_string(cpfg_tropisms.size()) + " (the view file's tropism: lines)"};
+            const size_t i = static_cast<size_t>(id) - 1;
+            const CpfgKind kind = cpfg.kind[symbol];
+            const double value = m.param_count >= 2 ? p[1] : kind == CpfgKind::kElasticitySet ? 0.0 : cpfg_tropisms[i].step;
+            if (!std::isfinite(value)) throw TurtleFailure{"an elasticity must be finite"};
+            t.elasticity[i] = kind == CpfgKind::kElasticitySet ? value
+                              : kind == CpfgKind::kElasticityUp ? t.elasticity[i] + value
+                                                                : t.elasticity[i] - value;
+            continue;
+          }
           case CpfgKind::kForceTwist:  // @Tf (manual 6.8): the rolls so far stay (cpfg's prev frame := the frame)
             t.prev_heading = t.heading;
             t.prev_up = t.up;
@@ -478,7 +537,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
       }
       // A cpfg file's view-file tropism turns the turtle before every F, G, f and g (cpfg's
       // movement_adjust); sylva's own format bends after every F (ABOP 2.2, below).
-      if (g.cpfg && (symbol == kSymF || symbol == kSymf) && t.tropism_e != 0.0) cpfg_bend(t);
+      if (!cpfg_tropisms.empty() && (symbol == kSymF || symbol == kSymf)) cpfg_bend(t, cpfg_tropisms);
       if ((symbol == kSymF || symbol == kSymf) && !polygons.empty() && symbol == m.symbol) {
         // Inside a polygon F and f move without drawing, keep the chain, and record the
         // turtle's new position as the polygon's next vertex (cpfg; docs/spec/grammar.md).

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <functional>
 #include <cmath>
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
@@ -143,18 +144,18 @@ std::array<glm::dvec3, 3> frame_after(const std::string& axiom) {
 
 bool near(const glm::dvec3& a, const glm::dvec3& b) { return glm::length(a - b) < 1e-12; }
 
-// The frame after `axiom` in a cpfg file whose view file gave the tropism T = (tx, ty, tz)
-// with elasticity e (set on the parsed grammar, as vlab_object.cpp does).
-std::array<glm::dvec3, 4> tropism_frame_after(const std::string& axiom, glm::dvec3 tropism, double e) {
+// Position, heading, left and up after `axiom` in a cpfg file, its grammar changed by `set`
+// first (the turtle settings a view file would give); an error goes to *error, else fails.
+std::array<glm::dvec3, 4> cpfg_frame_after(const std::string& axiom, const std::function<void(lsys::Grammar&)>& set,
+                                           std::string* error = nullptr) {
   lsys::Grammar g = parsed("Lsystem: 1\nderivation length: 0\nAxiom: " + axiom +
                                "?P(0,0,0)?H(0,0,0)?L(0,0,0)?U(0,0,0)\nendlsystem\n",
                            "t.l");
-  g.turtle.has_tropism = e != 0;
-  g.turtle.tropism[0] = tropism.x, g.turtle.tropism[1] = tropism.y, g.turtle.tropism[2] = tropism.z;
-  g.turtle.tropism_e = e;
+  set(g);
   auto w = derived_word(g, 0);
   if (!w) {
-    ADD_FAILURE() << w.error().format();
+    if (error) *error = w.error().format();
+    else ADD_FAILURE() << w.error().format();
     return {};
   }
   std::array<glm::dvec3, 4> out;
@@ -165,6 +166,16 @@ std::array<glm::dvec3, 4> tropism_frame_after(const std::string& axiom, glm::dve
     if (v.size() == 3) out[static_cast<size_t>(k)] = {v[0], v[1], v[2]};
   }
   return out;
+}
+
+// ... with one tropism T of elasticity e (sylva's `tropism:` header, which stands for one in a
+// cpfg file without view-file tropisms).
+std::array<glm::dvec3, 4> tropism_frame_after(const std::string& axiom, glm::dvec3 tropism, double e) {
+  return cpfg_frame_after(axiom, [&](lsys::Grammar& g) {
+    g.turtle.has_tropism = e != 0;
+    g.turtle.tropism[0] = tropism.x, g.turtle.tropism[1] = tropism.y, g.turtle.tropism[2] = tropism.z;
+    g.turtle.tropism_e = e;
+  });
 }
 
 // A cpfg file's view-file tropism, as cpfg's movement_adjust (cpfg/movements.c): before every
@@ -213,6 +224,56 @@ TEST(TurtleQueries, CpfgViewFileTropismTurnsBeforeEveryMoveAsCpfgDoes) {
   // Without a tropism the roll stays.
   const auto untouched = tropism_frame_after("F(1)/(90)F(1)", x, 0);
   EXPECT_TRUE(near(untouched[3], {1, 0, 0}) || near(untouched[3], {-1, 0, 0})) << untouched[3].x;
+}
+
+// ... with the view file's tropism lines (ids 1, 2, ...; vlab_object.cpp fills them).
+std::array<glm::dvec3, 4> tropisms_frame_after(const std::string& axiom, std::vector<lsys::ViewTropism> tropisms,
+                                               std::string* error = nullptr) {
+  return cpfg_frame_after(axiom, [&](lsys::Grammar& g) { g.turtle.view_tropisms = tropisms; }, error);
+}
+
+lsys::ViewTropism view_tropism(glm::dvec3 t, double e, double angle_deg = 0, double step = 0) {
+  lsys::ViewTropism v;
+  v.vector[0] = t.x, v.vector[1] = t.y, v.vector[2] = t.z;
+  v.elasticity = e;
+  v.angle_deg = angle_deg;
+  v.step = step;
+  return v;
+}
+
+// Several tropisms (cpfg/movements.c movement_adjust): one desired direction, the sum of
+// cos(A)·e·T and, for A ≠ 0, sin(A)·e·T × (H × T) / |H × T|; @T(id, v) / @Ti, @Td and @Ts
+// change one tropism's elasticity for the rest of the branch.
+TEST(TurtleQueries, CpfgTropismIdsSumIntoOneTurnAndTheirElasticitiesFollowTheBranch) {
+  const glm::dvec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
+  // Two orthotropisms: V = 0.3 x + 0.2 z (perpendicular to H = +y): H turns toward V by |V|.
+  auto f = tropisms_frame_after("F(1)", {view_tropism(x, 0.3), view_tropism(z, 0.2)});
+  const glm::dvec3 v(0.3, 0, 0.2);
+  const double turn = glm::length(v);
+  EXPECT_TRUE(near(f[0], std::cos(turn) * y + std::sin(turn) * v / turn)) << f[0].x << " " << f[0].z;
+  // Diatropism (A = 90 degrees): a shoot at 45 degrees from T = x turns away from it, toward
+  // the plane across T, by e·sin 45°.
+  f = tropisms_frame_after("-(45)F(1)", {view_tropism(x, 0.5, 90)});
+  const double from_y = std::acos(-1.0) / 4 - 0.5 * std::sin(std::acos(-1.0) / 4);
+  EXPECT_TRUE(near(f[0], {std::sin(from_y), std::cos(from_y), 0})) << f[0].x << " " << f[0].y;
+  // A shoot across T already is where diatropism wants it: no turn.
+  f = tropisms_frame_after("F(1)", {view_tropism(x, 0.5, 90)});
+  EXPECT_TRUE(near(f[0], {0, 1, 0}));
+  // Elasticities: @Ts(1, 0) stops tropism 1 in its branch only; @Ti(1) adds its step, @T(1, v)
+  // (the manual's name) adds v, @Td(1, v) takes v.
+  const std::vector<lsys::ViewTropism> one = {view_tropism(x, 0.5, 0, 0.25)};
+  f = tropisms_frame_after("[@Ts(1,0)F(1)]F(1)", one);
+  EXPECT_TRUE(near(f[0], {std::sin(0.5), std::cos(0.5), 0})) << "the main axis bends";
+  f = tropisms_frame_after("@Ts(1,0)F(1)", one);
+  EXPECT_TRUE(near(f[0], {0, 1, 0})) << "the branch that set 0 does not";
+  f = tropisms_frame_after("@Ts(1,0)@Ti(1)F(1)", one);
+  EXPECT_TRUE(near(f[0], {std::sin(0.25), std::cos(0.25), 0}));
+  f = tropisms_frame_after("@Ts(1,0)@T(1,0.4)@Td(1,0.1)F(1)", one);
+  EXPECT_TRUE(near(f[0], {std::sin(0.3), std::cos(0.3), 0}));
+  // An id that is not a tropism's is an error naming the ids there are.
+  std::string error;
+  tropisms_frame_after("@Ti(2,1)F", one, &error);
+  EXPECT_NE(error.find("a tropism id from 1 to 1"), std::string::npos) << error;
 }
 
 TEST(TurtleQueries, CpfgAtRSetsTheHeadingByTheLeastRotationOrWithItsUpVector) {

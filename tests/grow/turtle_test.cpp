@@ -992,7 +992,7 @@ TEST(TurtleCpfg, AtDScalesLengthsAndWidthsAndBracketsKeepTheScale) {
 TEST(TurtleCpfg, SymbolsSylvaDoesNotDrawYetAreErrorsNamingTheFeature) {
   const std::pair<const char*, const char*> cases[] = {
       {"F@o(2)", "plane of the screen"}, {"F~l(1)", "surface"}, {"@Gs F @Ge", "generalized cylinder"},
-      {"F@T(1,0.2)F", "tropism"}, {"F@;F", "back-side colour"}};
+      {"F@PS(1)F", "patch"}, {"F@;F", "back-side colour"}};
   for (const auto& [axiom, feature] : cases) {
     const std::string message = grow_error(cpfg(axiom));
     EXPECT_NE(message.find(feature), std::string::npos) << axiom << ": " << message;

@@ -553,13 +553,19 @@ TEST(VlabObject, AFolderIsReadThroughItsSpecificationsCpfgCommandAndItsViewFile)
   EXPECT_EQ(g->turtle.width_increment, 0.5);
   EXPECT_EQ(g->turtle.initial_color, 3u);
   EXPECT_EQ(g->turtle.color_increment, 2u);
-  EXPECT_TRUE(g->turtle.has_tropism);
-  EXPECT_EQ(g->turtle.tropism[1], -1);           // T normalised times I, the factor at most 1 (cpfg)
-  EXPECT_EQ(g->turtle.tropism_e, 0.1);
-  folder.write("plant.v", "tropism: T: 0 -4 0 I: 0.5 E: 0.2\n");
+  ASSERT_EQ(g->turtle.view_tropisms.size(), 1u);
+  EXPECT_FALSE(g->turtle.has_tropism) << "a view file's tropisms are cpfg's, not the ABOP header's";
+  EXPECT_EQ(g->turtle.view_tropisms[0].vector[1], -1);  // T normalised times I, the factor at most 1 (cpfg)
+  EXPECT_EQ(g->turtle.view_tropisms[0].elasticity, 0.1);
+  EXPECT_EQ(g->turtle.view_tropisms[0].angle_deg, 0);
+  // Several tropisms, ids in order: a weak one, and a diatropism with its step.
+  folder.write("plant.v", "tropism: T: 0 -4 0 I: 0.5 E: 0.2\ntropism: T: 1 0 0 A: 90 E: 0.1 S: 0.05\n");
   auto weak = load_grammar(folder.dir().string());
   ASSERT_TRUE(weak.ok()) << weak.error().format();
-  EXPECT_EQ(weak->turtle.tropism[1], -0.5);      // (0, -4, 0) / 4 × 0.5
+  ASSERT_EQ(weak->turtle.view_tropisms.size(), 2u);
+  EXPECT_EQ(weak->turtle.view_tropisms[0].vector[1], -0.5);  // (0, -4, 0) / 4 × 0.5
+  EXPECT_EQ(weak->turtle.view_tropisms[1].angle_deg, 90);
+  EXPECT_EQ(weak->turtle.view_tropisms[1].step, 0.05);
   // A world-unit style makes a width a diameter.
   folder.write("plant.v", "angle increment: 30\ninitial line width: 0.2 shaded\n");
   auto shaded = load_grammar(folder.dir().string());
@@ -600,7 +606,7 @@ TEST(VlabObject, WhatSylvaCannotFollowIsAnErrorAtItsPlace) {
       {"run:\n\tlpfg plant.l plant.v\n", "angle factor: 8\n", "specifications", 0, 0, "no cpfg command"},
       {"run:\n\tcpfg plant.l plant.v\n", "angle factor: 0\n", "plant.v", 1, 15, "must not be 0"},
       {"run:\n\tcpfg plant.l plant.v\n", "initial line width: wide\n", "plant.v", 1, 21, "needs a number"},
-      {"run:\n\tcpfg plant.l plant.v\n", "tropism: T: 0 -1 0 A: 90 E: 0.2\n", "plant.v", 1, 9, "toward an angle"},
+      {"run:\n\tcpfg plant.l plant.v\n", "tropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\n", "plant.v", 9, 1, "more than 8 tropisms"},
       {"run:\n\tcpfg plant.l plant.v\n", "scale multiplier: 0\n", "plant.v", 1, 19, "must be a non-zero number"},
       {"run:\n\tcpfg plant.l plant.v\n", "torque: T: 0 1 0 E: 0.1\n", "plant.v", 1, 1, "a torque"},
       {"run:\n\tcpfg plant.l plant.v\n", "tropism: T: 0 0 0 E: 0.1\n", "plant.v", 1, 9, "must not be 0"},
