@@ -37,8 +37,7 @@ SunMaps sun_maps_for(const Scene& scene, const RenderOptions& options, std::vect
 }
 
 RenderResult render_gl_scene(const Scene& scene, const RenderOptions& options, GlFrameStats* stats) {
-  const FogMode mode = scene.fog ? options.fog.mode.value_or(scene.fog->mode) : FogMode::brute;
-  if ((mode != FogMode::map && mode != FogMode::automatic) || !options.fog.maps.empty())
+  if (!scene.fog || !gl_fog_walks_maps(options.fog.mode.value_or(scene.fog->mode)) || !options.fog.maps.empty())
     return render_gl(scene, options, stats, sun_cone_source(scene, options));
   std::vector<RenderPass> passes;
   const SunMaps maps = sun_maps_for(scene, options, &passes);

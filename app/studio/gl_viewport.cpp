@@ -38,8 +38,7 @@ std::vector<double> view_key(const Scene& s) {
 // drawn brute (the same fog, slower) until the cone worker's first cones (maps) arrive.
 Scene drawable(const Scene& scene, bool have_cones, bool have_maps) {
   if (!scene.fog || scene.fog->mode == FogMode::brute) return scene;
-  const bool map = scene.fog->mode == FogMode::map || scene.fog->mode == FogMode::automatic;  // auto: map on GL
-  if (map ? have_maps : have_cones) return scene;
+  if (gl_fog_walks_maps(scene.fog->mode) ? have_maps : have_cones) return scene;
   Scene s = scene;
   s.fog->mode = FogMode::brute;
   return s;

@@ -11,6 +11,7 @@
 #include <imgui_stdlib.h>
 
 #include "core/grow/grow.h"
+#include "core/gl/render_gl.h"
 #include "core/io/gltf.h"
 #include "core/geometry/skeleton.h"
 #include "core/scene/scene_json.h"
@@ -960,10 +961,9 @@ void StudioApp::update_cones() {
     else viewport_->set_fog_cones(std::move(done->cones));
   }
   if (!viewport_ || !plant_ || !scene_.fog || scene_.fog->mode == FogMode::brute) return;
-  // auto is map on the GL backend (core/gl/render_gl.cpp gl_fog_mode_of).
-  const FogMode kind = scene_.fog->mode == FogMode::medium                                         ? FogMode::medium
-                       : scene_.fog->mode == FogMode::map || scene_.fog->mode == FogMode::automatic ? FogMode::map
-                                                                                                    : FogMode::fast;
+  const FogMode kind = gl_fog_walks_maps(scene_.fog->mode)        ? FogMode::map
+                       : scene_.fog->mode == FogMode::medium       ? FogMode::medium
+                                                                   : FogMode::fast;
   const glm::dvec3 sun = unit_sun_direction(scene_.sun.direction);
   std::vector<double> key = {static_cast<double>(plants_applied_),
                              sun.x,

@@ -148,6 +148,8 @@ std::optional<std::string> gl_fog_unsupported(const Scene& scene, const RenderOp
 
 }  // namespace
 
+bool gl_fog_walks_maps(FogMode mode) { return gl_fog_mode_of(mode) == GlFogMode::map; }
+
 std::optional<std::string> gl_unsupported(const Scene& scene, const RenderOptions& options) {
   if (auto why = gl_fog_unsupported(scene, options)) return why;
   const size_t images = bark_image_files(scene, options).size();  // what GlBarkMaps uploads
@@ -1196,7 +1198,7 @@ RenderResult render_gl(const Scene& scene, const RenderOptions& options, GlFrame
   }
   GlRenderer& renderer = *built;
   std::vector<RenderPass> cone_passes;
-  if (scene.fog && gl_fog_mode_of(requested_fog_mode(scene, options)) == GlFogMode::map) {
+  if (scene.fog && gl_fog_walks_maps(requested_fog_mode(scene, options))) {
     // Mode map: the caller's sun maps (the CPU builds them, app/front/render.h), uploaded once.
     if (options.fog.maps.empty())
       throw GlError("the GL fog pass's mode map needs sun maps (render_gl's options.fog.maps)");

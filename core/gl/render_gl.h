@@ -94,6 +94,11 @@ namespace sylva {
 // images than it binds), or nullopt when it can.
 std::optional<std::string> gl_unsupported(const Scene& scene, const RenderOptions& options);
 
+// Whether the GL fog pass draws fog mode `mode` by walking sun maps (map, and auto, which is
+// map on the GL backend: docs/gl-fog.md sec. 2b), so that its caller must bring them
+// (options.fog.maps, GlRenderer::set_fog_maps).
+bool gl_fog_walks_maps(FogMode mode);
+
 // A scene's plants on the GPU: skinned and uploaded once, drawn any number of times.
 //
 // Contract:

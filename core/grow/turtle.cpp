@@ -8,6 +8,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/util/limits.h"
+#include "core/util/math.h"
 #include "lsystem/expr.h"
 
 namespace sylva {
@@ -300,7 +301,6 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
 // circle's; 16 frusta inscribed in the sphere's profile hold 99.0 % of its volume.
 constexpr int kCircleSides = 24;
 constexpr int kSphereSegments = 16;
-constexpr double kPi = 3.14159265358979323846;
 
 // The feature a cpfg symbol sylva does not draw yet belongs to, for its error.
 std::string cpfg_feature(const std::string& name) {
@@ -578,7 +578,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
                             Joint{{t.position.x, t.position.y, t.position.z}, t.radius, t.material}});
           ++chain_joint_count[t.chain];
           ++t.joint;
-          if (t.tropism_e != 0.0 && !g.cpfg) {
+          if (t.tropism_e != 0.0) {  // 0 in a cpfg file: cpfg_bend does its bending
             // ABOP 2.2: rotate the frame about H × T by e·|H × T|.
             const dvec3 axis = glm::cross(t.heading, t.tropism);
             const double len_axis = glm::length(axis);

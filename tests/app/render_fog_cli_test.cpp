@@ -240,8 +240,8 @@ TEST(RenderFogCli, SunMapsOverTheMemoryBoundAreBadInputAndNothingIsWritten) {
   }
 }
 
-// Mode map on the GL backend: the CPU builds the sun maps (their passes listed), the GL fog
-// pass walks them (render_gl_fog_test.cpp compares the images); no cones, no cone pass.
+// Mode map (and auto) on the GL backend: the CPU builds the sun maps (their passes listed),
+// the GL fog pass walks them (render_gl_fog_test.cpp compares the images); no cones, no cone pass.
 TEST(RenderFogCli, MapDrawsOnTheGlBackendWithTheCpusSunMaps) {
   TempDir dir;
   const std::string scene = write_scene(dir, R"({"mode": "map", "top": 20, "photons": 20000})");
@@ -255,6 +255,12 @@ TEST(RenderFogCli, MapDrawsOnTheGlBackendWithTheCpusSunMaps) {
   EXPECT_NE(r.err.find("fog[FOG_MAP SUN]"), std::string::npos) << describe(r);
   EXPECT_EQ(r.err.find("shadow cones"), std::string::npos) << describe(r);
   EXPECT_TRUE(std::filesystem::exists(dir.file("f.png")));
+  // auto is map on the GL backend (docs/gl-fog.md sec. 2b): the same maps and pass.
+  r = run_sylva({"render", "--spp", "1", scene, "-o", dir.file("f.png"), "--backend", "gl", "--fog-mode", "auto",
+                 "--verbose"});
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.err.find("  sun maps "), std::string::npos) << describe(r);
+  EXPECT_NE(r.err.find("fog[FOG_MAP SUN]"), std::string::npos) << describe(r);
 }
 
 TEST(RenderFogCli, TheConeParametersAreTheFlagsOrTheAutomaticChoiceWithItsReport) {

@@ -104,6 +104,8 @@ TEST(GlFog, TheGlBackendRefusesTheModesItDoesNotImplementSayingWhich) {
   for (FogMode mode : {FogMode::brute, FogMode::medium, FogMode::fast, FogMode::automatic, FogMode::map}) {
     options.fog.mode = mode;
     EXPECT_FALSE(gl_unsupported(s, options)) << fog_mode_name(mode);
+    // map, and auto (map on the GL backend), walk sun maps; the others do not.
+    EXPECT_EQ(gl_fog_walks_maps(mode), mode == FogMode::map || mode == FogMode::automatic) << fog_mode_name(mode);
   }
   for (FogMode mode : {FogMode::refined, FogMode::reference}) {
     options.fog.mode = mode;
