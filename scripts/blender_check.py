@@ -5,7 +5,14 @@ skeleton in the plant nodes' extras. Optionally renders the imported plant with 
 Run by Blender in background mode (Debian's blender 3.4):
 
     blender -b --factory-startup --python-exit-code 1 --python scripts/blender_check.py -- \
-        plant.glb [--render out.png --size 480x360 --samples 16]
+        plant.glb [--render out.png --size 480x360 --samples 16] [--pose-frames F1,F2,... --every N]
+
+A rigged file (`sylva export --rig [--animation]`) is checked too: one armature bone per
+skin joint, one action per animation spanning its keys at the scene's 24 fps, and the
+skinned mesh's first and last frame equal. With --pose-frames, report["rig"]["poses"]
+holds, for every N-th vertex of each skinned mesh, its rest and its evaluated (deformed)
+world position at each frame, in glTF's axes (Y up), for the caller to compare with
+sylva's own pose (tests/app/blender_check_test.cpp).
 
 Prints one line `BLENDER_CHECK {json}` (the report: counts from the file and from Blender,
 the problems found) and exits 1 when there is a problem (tests/app/blender_check_test.cpp).
@@ -229,6 +236,65 @@ def render(out, width, height, samples):
     bpy.ops.render.render(write_still=True)
 
 
+def gltf_axes(v):
+    """A Blender (Z up) world position in glTF's axes (Y up): the importer's (x, -z, y) undone."""
+    return [v[0], v[2], -v[1]]
+
+
+def check_rig(doc, report, problems, pose_frames, every):
+    """The skins and the wind clip: bones, actions, the loop, and the poses asked for."""
+    import bpy
+
+    skins = doc.get("skins", [])
+    if not skins:
+        return
+    scene = bpy.context.scene
+    armatures = [o for o in scene.objects if o.type == "ARMATURE"]
+    rig = {"skin_joints": [len(s["joints"]) for s in skins],
+           "armatures": [{"name": o.name, "bones": len(o.data.bones)} for o in armatures],
+           "actions": [], "poses": []}
+    if sorted(rig["skin_joints"]) != sorted(a["bones"] for a in rig["armatures"]):
+        problems.append(f"skins with {rig['skin_joints']} joints in the file, armatures with "
+                        f"{[a['bones'] for a in rig['armatures']]} bones in Blender")
+    fps = scene.render.fps / scene.render.fps_base
+    for animation in doc.get("animations", []):
+        end = max(doc["accessors"][s["input"]]["max"][0] for s in animation["samplers"])
+        actions = [a for a in bpy.data.actions if a.name.startswith(animation.get("name", ""))]
+        rig["actions"] += [{"name": a.name, "frame_range": list(a.frame_range)} for a in actions]
+        if not any(abs(a.frame_range[0]) < 1e-6 and abs(a.frame_range[1] - end * fps) < 1e-3 for a in actions):
+            problems.append(f"animation {animation.get('name')!r}: no action spans frames 0 to {end * fps:g}")
+    skinned = [o for o in scene.objects if o.type == "MESH" and o.find_armature() is not None]
+    if len(skinned) != len(skins):
+        problems.append(f"{len(skins)} skins in the file, {len(skinned)} skinned meshes in Blender")
+
+    def evaluated(o, frame):
+        scene.frame_set(frame)
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        e = o.evaluated_get(depsgraph)
+        mesh = e.to_mesh()
+        world = [gltf_axes(e.matrix_world @ v.co) for v in mesh.vertices]
+        e.to_mesh_clear()
+        return world
+
+    if doc.get("animations"):
+        last = round(max(a["frame_range"][1] for a in rig["actions"])) if rig["actions"] else 0
+        for o in skinned:
+            first, final = evaluated(o, 0), evaluated(o, last)
+            size = max(max(abs(c) for c in p) for p in first) or 1
+            gap = max(max(abs(a - b) for a, b in zip(p, q)) for p, q in zip(first, final))
+            rig.setdefault("loop_gap", []).append(gap)
+            if gap > 1e-5 * size:
+                problems.append(f"mesh {o.name!r}: frame {last} differs from frame 0 by {gap:g}: the clip does not loop")
+    for frame in pose_frames:
+        for o in skinned:
+            rest = [gltf_axes(v.co) for v in o.data.vertices]  # the file's POSITION, in mesh space
+            posed = evaluated(o, frame)
+            rig["poses"].append({"mesh": o.name, "frame": frame, "time_s": frame / fps,
+                                 "rest": [c for p in rest[::every] for c in p],
+                                 "posed": [c for p in posed[::every] for c in p]})
+    report["rig"] = rig
+
+
 def main(argv):
     import numpy as np
 
@@ -239,7 +305,7 @@ def main(argv):
         print("usage: blender -b --python scripts/blender_check.py -- FILE.glb [--render OUT.png] "
               "[--size WxH] [--samples N]", file=sys.stderr)
         return 2
-    path, out, size, samples = args[0], None, (480, 360), 16
+    path, out, size, samples, pose_frames, every = args[0], None, (480, 360), 16, [], 1
     rest = args[1:]
     while rest:
         flag = rest.pop(0)
@@ -250,11 +316,16 @@ def main(argv):
             size = (int(w), int(h))
         elif flag == "--samples":
             samples = int(rest.pop(0))
+        elif flag == "--pose-frames":
+            pose_frames = [int(f) for f in rest.pop(0).split(",")]
+        elif flag == "--every":
+            every = max(1, int(rest.pop(0)))
         else:
             print(f"blender_check.py: unknown flag {flag}", file=sys.stderr)
             return 2
     problems = []
     report = check(path, problems)
+    check_rig(read_gltf_json(path), report, problems, pose_frames, every)
     report["problems"] = problems
     print("BLENDER_CHECK " + json.dumps(report), flush=True)
     if out:

@@ -52,3 +52,12 @@ if [ ! -f "$tools/node_modules/gltf-validator/package.json" ] || \
   mkdir -p "$tools"
   npm install --silent --no-audit --no-fund --prefix "$tools" "gltf-validator@$validator_version"
 fi
+# three.js (npm), pinned, for tests/app/three_check_test.cpp: its GLTFLoader and
+# AnimationMixer play an exported wind clip (scripts/three_check.mjs).
+three_version=0.187.0
+if [ ! -f "$tools/node_modules/three/package.json" ] || \
+   ! grep -q "\"version\": \"$three_version\"" "$tools/node_modules/three/package.json"; then
+  echo "setup: installing three@$three_version into .tools/node"
+  mkdir -p "$tools"
+  npm install --silent --no-audit --no-fund --prefix "$tools" "three@$three_version"
+fi

@@ -32,6 +32,7 @@ namespace {
 
 void print_export_help() {
   std::cout << "usage: sylva export INPUT -o FILE.gltf|FILE.glb [--mesh] [--segments-around N] [--instancing]\n"
+               "                    [--rig [--max-joints N]] [--animation] [--wind-data]\n"
                "                    [--extras compact|full|none] [--skin smooth|paper]\n"
                "                    [--bark-albedo FILE] [--bark-height FILE] [--relief-depth M]\n"
                "                    [--u-repeat N] [--v-per-metre N]\n"
@@ -49,6 +50,15 @@ void print_export_help() {
                "      --segments-around N  columns around each frustum of the mesh, 3 to 4096 (default 8)\n"
                "      --instancing         repeated identical plants of a scene as one node with\n"
                "                           EXT_mesh_gpu_instancing\n"
+               "      --rig                skin the mesh to a glTF skin for wind (needs --mesh, not with\n"
+               "                           --instancing): joints along the first branch orders, a joint\n"
+               "                           every k internodes, each vertex on at most 2 (docs/gltf.md)\n"
+               "      --max-joints N       the rig's joints per plant, root included, 1 to 1024 (default 128)\n"
+               "      --animation          with --rig: the scene's animation (or the default sway) as one\n"
+               "                           looping clip 'wind' of joint rotations, frequencies rounded to\n"
+               "                           whole cycles per duration_s\n"
+               "      --wind-data          per-vertex wind data for shaders (needs --mesh): TEXCOORD_2 =\n"
+               "                           (pivot x, pivot y), TEXCOORD_3 = (pivot z, level + phase)\n"
                "      --skin S             how chains meet in the mesh and extras' skinning, for every\n"
                "                           plant (over a scene's skin keys): smooth (the default) or\n"
                "                           paper (Bhagvat et al. 2009's mitred chains)\n"
@@ -93,6 +103,11 @@ std::string plant_name(const std::string& path) {
 
 enum class InputKind { grammar, skeleton, scene };
 
+// The wind clip of a scene's `animation` key (docs/animation.md): its sway, duration and fps.
+GltfWindClip wind_clip_of(const SceneAnimation& animation) {
+  return {.sway = sway_parameters_of(animation), .duration_s = animation.duration_s, .fps = animation.fps};
+}
+
 // A finite number from `text`, in (lo, hi] or [lo, hi] (`open_low`); a usage error naming `name`.
 double number_flag(const std::string& name, const std::string& text, double lo, bool open_low) {
   double v = 0;
@@ -133,6 +148,8 @@ int run_export(const std::vector<std::string>& raw_args) {
   Bark bark;                 // from the --bark-* flags
   std::optional<SkinStyle> skin;  // --skin
   bool bark_flags = false;
+  bool animation = false;     // --animation
+  bool max_joints_given = false;
   FlagTable table;
   table.inline_values = InlineValues::value_flags;
   table.leaves_others = true;  // INPUT, -o and the grammar flags: parse_grammar_args's
@@ -155,6 +172,18 @@ int run_export(const std::vector<std::string>& raw_args) {
       set_flag({"--mesh"}, options.mesh),
       skin_flag(skin),
       set_flag({"--instancing"}, options.instancing),
+      set_flag({"--rig"}, options.rig),
+      set_flag({"--animation"}, animation),
+      set_flag({"--wind-data"}, options.wind_data),
+      noting_given(value_flag({"--max-joints"},
+                              [&options](const std::string&, const std::string& v) {
+                                const auto n = parse_u64(v);
+                                if (!n || *n < 1 || *n > kMaxRigJoints)
+                                  throw UsageError{"--max-joints " + v + ": expected an integer from 1 to " +
+                                                   std::to_string(kMaxRigJoints)};
+                                options.max_joints = static_cast<uint32_t>(*n);
+                              }),
+                   max_joints_given),
       value_flag({"--extras"},
                  [&options](const std::string&, const std::string& mode) {
                    if (mode == "compact") options.extras = GltfExtras::compact;
@@ -197,6 +226,15 @@ int run_export(const std::vector<std::string>& raw_args) {
   if (bark_flags && !options.mesh)
     throw UsageError{"--bark-albedo, --bark-height, --relief-depth, --u-repeat and --v-per-metre shape the mesh: "
                      "add --mesh"};
+  if (options.rig && !options.mesh) throw UsageError{"--rig skins the mesh: add --mesh"};
+  if (options.rig && options.instancing)
+    throw UsageError{"--rig and --instancing cannot be combined: glTF instancing (EXT_mesh_gpu_instancing) does not "
+                     "skin"};
+  if (max_joints_given && !options.rig) throw UsageError{"--max-joints sizes the rig: add --rig"};
+  if (animation && !options.rig) throw UsageError{"--animation poses the rig: add --rig"};
+  if (options.wind_data && !options.mesh) throw UsageError{"--wind-data is per mesh vertex: add --mesh"};
+  // The default sway; a scene's own `animation` key replaces it below.
+  if (animation) options.animation = wind_clip_of(SceneAnimation{});
   if (range && !has_seed_placeholder(a.output))
     throw UsageError{"--seed " + std::to_string(range->first) + ".." + std::to_string(range->last) +
                      " writes one file per seed: -o must hold {seed}, e.g. -o out/plant_{seed}.glb"};
@@ -235,6 +273,8 @@ int run_export(const std::vector<std::string>& raw_args) {
     Scene& scene = *read;
     if (skin) override_skin(scene, *skin);
     options.materials = scene.materials;  // one glTF material per entry (docs/materials.md)
+    if (animation && scene.animation) options.animation = wind_clip_of(*scene.animation);
+    if (scene.animation) options.wind_seed = scene.animation->seed;
     // A plant's grammar error: the grammar's place, and a note at the scene key naming it.
     if (Status grown = grow_scene_plants(scene, a.max_modules, {}, &cpu_light_oracle()); !grown) {
       std::cerr << grown.error().format();

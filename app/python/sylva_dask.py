@@ -57,7 +57,7 @@ def output_path(pattern, seed):
     return pattern.replace("{seed}", str(seed))
 
 
-def _seed_task(kind, text, grammar_path, seed, path, steps, defines, mesh, segments_around, extras):
+def _seed_task(kind, text, grammar_path, seed, path, steps, defines, export_options):
     """One seed on a worker: grow, write atomically (the sylva writers), return the path."""
     import sylva  # on the worker
 
@@ -69,19 +69,21 @@ def _seed_task(kind, text, grammar_path, seed, path, steps, defines, mesh, segme
     if kind == "grow":
         skeleton.save(path)
     else:
-        sylva.export_gltf(skeleton, path, mesh=mesh, segments_around=segments_around, extras=extras)
+        sylva.export_gltf(skeleton, path, **export_options)
     return path
 
 
 def batch(client, kind, grammar, seeds, output, *, steps=None, defines=None, mesh=False, segments_around=8,
-          extras="compact"):
+          extras="compact", rig=False, max_joints=128, animation=None, wind_data=False):
     """Grows (``kind="grow"``) or exports (``kind="export"``) every seed of ``grammar`` on the
     workers of ``client`` (a ``dask.distributed.Client``), one task per seed, into
     ``output`` with ``{seed}`` replaced. Returns the paths written, in the order of ``seeds``.
 
     ``steps`` and ``defines`` are ``sylva grow``'s ``-n`` and ``-D``; ``mesh``,
-    ``segments_around`` and ``extras`` are ``sylva export``'s, with its defaults (``extras``
-    is ``"compact"`` here, as ``sylva export --extras``, so the files are the CLI batch's).
+    ``segments_around``, ``extras``, ``rig``, ``max_joints``, ``animation`` (True or a dict of
+    a scene's animation keys) and ``wind_data`` are ``sylva.export_gltf``'s (docs/gltf.md), with
+    its defaults (``extras`` is ``"compact"`` here, as ``sylva export --extras``, so the files
+    are the CLI batch's).
     The grammar is parsed here first, so a bad grammar raises ``sylva.GrammarError`` before
     any task is sent; a task that fails raises its exception here (the files of the seeds
     that finished stay: each is complete).
@@ -109,9 +111,11 @@ def batch(client, kind, grammar, seeds, output, *, steps=None, defines=None, mes
     if defines:
         parsed.grow(steps=0, defines=defines)  # unknown define names, bad values: here too
     paths = [output_path(output, seed) for seed in seeds]
+    export_options = dict(mesh=mesh, segments_around=segments_around, extras=extras, rig=rig,
+                          max_joints=max_joints, animation=animation, wind_data=wind_data)
     futures = client.map(_seed_task, [kind] * len(seeds), [parsed.text] * len(seeds), [parsed.file] * len(seeds),
-                         seeds, paths, [steps] * len(seeds), [defines] * len(seeds), [mesh] * len(seeds),
-                         [segments_around] * len(seeds), [extras] * len(seeds), pure=False)
+                         seeds, paths, [steps] * len(seeds), [defines] * len(seeds), [export_options] * len(seeds),
+                         pure=False)
     return client.gather(futures)
 
 

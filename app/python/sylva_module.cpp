@@ -577,7 +577,8 @@ Bark bark_from_dict(const py::object& value) {
 void python_export_gltf(const py::object& plants, const std::filesystem::path& path, bool mesh, int segments_around,
                         bool instancing, const py::object& names, const py::object& positions,
                         const py::object& rotate_y_deg, const py::object& scales, const py::object& bark,
-                        const std::string& extras, const std::string& skin) {
+                        const std::string& extras, const std::string& skin, bool rig, int max_joints,
+                        const py::object& animation, bool wind_data) {
   const SkinStyle style = skin_style_argument(skin);
   const std::vector<const Skeleton*> skeletons = skeleton_list(plants);
   if (skeletons.empty()) throw py::value_error("export_gltf needs at least one plant");
@@ -629,6 +630,25 @@ void python_export_gltf(const py::object& plants, const std::filesystem::path& p
   options.mesh = mesh;
   options.segments_around = segments_around;
   options.instancing = instancing;
+  options.rig = rig;
+  if (max_joints < 1 || max_joints > static_cast<int>(kMaxRigJoints))
+    throw py::value_error("max_joints must be from 1 to " + std::to_string(kMaxRigJoints));
+  options.max_joints = static_cast<uint32_t>(max_joints);
+  options.wind_data = wind_data;
+  // animation: True for the default sway, or a dict with the keys of a scene's "animation".
+  if (!animation.is_none() && !(py::isinstance<py::bool_>(animation) && !animation.cast<bool>())) {
+    SceneAnimation a;
+    if (py::isinstance<py::dict>(animation)) {
+      const std::string text = py::module_::import("json").attr("dumps")(animation).cast<std::string>();
+      Expected<SceneAnimation> parsed = parse_animation_json(text, "animation");
+      if (!parsed) throw py::value_error(chomp(parsed.error().format()));
+      a = *parsed;
+    } else if (!py::isinstance<py::bool_>(animation)) {
+      throw py::type_error("animation must be True, False, None or a dict of a scene's animation keys");
+    }
+    options.animation = GltfWindClip{.sway = sway_parameters_of(a), .duration_s = a.duration_s, .fps = a.fps};
+    options.wind_seed = a.seed;
+  }
   if (extras == "full") options.extras = GltfExtras::full;
   else if (extras == "compact") options.extras = GltfExtras::compact;
   else if (extras == "none") options.extras = GltfExtras::none;
@@ -874,8 +894,9 @@ and where no light arrived). A grammar without ?E gives an empty (0, 7) array.)d
   m.def("export_gltf", &python_export_gltf, "plants"_a, "path"_a, py::kw_only(), "mesh"_a = false,
         "segments_around"_a = 8, "instancing"_a = false, "names"_a = py::none(), "positions"_a = py::none(),
         "rotate_y_deg"_a = py::none(), "scales"_a = py::none(), "bark"_a = py::none(), "extras"_a = "full",
-        "skin"_a = "smooth",
-        R"doc(export_gltf(plants: Skeleton | Sequence[Skeleton], path: str | os.PathLike, *, mesh: bool = False, segments_around: int = 8, instancing: bool = False, names: Sequence[str] | None = None, positions: Sequence[tuple[float, float, float]] | None = None, rotate_y_deg: Sequence[float] | None = None, scales: Sequence[float] | None = None, bark: dict | None = None, extras: str = "full", skin: str = "smooth") -> None
+        "skin"_a = "smooth", "rig"_a = false, "max_joints"_a = static_cast<int>(kDefaultRigJoints),
+        "animation"_a = py::none(), "wind_data"_a = false,
+        R"doc(export_gltf(plants: Skeleton | Sequence[Skeleton], path: str | os.PathLike, *, mesh: bool = False, segments_around: int = 8, instancing: bool = False, names: Sequence[str] | None = None, positions: Sequence[tuple[float, float, float]] | None = None, rotate_y_deg: Sequence[float] | None = None, scales: Sequence[float] | None = None, bark: dict | None = None, extras: str = "full", skin: str = "smooth", rig: bool = False, max_joints: int = 128, animation: bool | dict | None = None, wind_data: bool = False) -> None
 
 Writes plants to a glTF 2.0 file, binary (.glb) or JSON (.gltf) by extension.
 
@@ -904,6 +925,15 @@ Keyword-only:
                    times smaller: `sylva export`'s default) or "none" (a plain mesh)
   skin             how chains meet in the mesh and extras' skinning: "smooth" (collars,
                    domes, rounded bends) or "paper" (Bhagvat et al. 2009's mitred chains)
+  rig              skin the mesh to a glTF skin for wind (needs mesh=True, not with
+                   instancing): joints along the first branch orders (docs/gltf.md)
+  max_joints       the rig's joints per plant, root included, 1 to 1024
+  animation        with rig=True: True for the default sway, or a dict with the keys of a
+                   scene's "animation" (wind, amplitude_deg, frequency_hz, seed, fps,
+                   duration_s, ...): one looping clip "wind", frequencies rounded to whole
+                   cycles per duration_s; plant i sways as plant i of a scene
+  wind_data        per-vertex wind data for shaders (needs mesh=True): TEXCOORD_2 =
+                   (pivot x, pivot y), TEXCOORD_3 = (pivot z, level + phase)
 The mesh has one material per material index the plants use. The file is written
 atomically; a file that cannot be read or written (a missing texture, a missing folder,
 a FIFO or read-only target) raises OSError, plants beyond the limits (docs/limits.md)

@@ -487,7 +487,7 @@ void StudioApp::watch_file(double now) {
   }
 }
 
-std::optional<std::string> StudioApp::export_gltf_file(const std::string& path, bool mesh) {
+std::optional<std::string> StudioApp::export_gltf_file(const std::string& path, const GltfChoice& choice) {
   if (!plant_) return std::string("no plant to export yet");
   std::vector<GltfPlant> plants;
   const std::optional<SkinStyle> skin = skin_override();
@@ -504,7 +504,14 @@ std::optional<std::string> StudioApp::export_gltf_file(const std::string& path, 
     plants.push_back(std::move(p));
   }
   GltfExportOptions o;
-  o.mesh = mesh;
+  o.mesh = choice.mesh;
+  o.rig = choice.rig;
+  o.max_joints = static_cast<uint32_t>(std::clamp(choice.max_joints, 1, static_cast<int>(kMaxRigJoints)));
+  o.wind_data = choice.wind_data;
+  const SceneAnimation animation = scene_.animation.value_or(SceneAnimation{});
+  o.wind_seed = animation.seed;
+  if (choice.animation)
+    o.animation = GltfWindClip{.sway = sway_parameters_of(animation), .duration_s = animation.duration_s, .fps = animation.fps};
   if (Status exported = export_gltf(plants, path, o); !exported) return one_line(exported.error());
   return std::nullopt;
 }
@@ -1204,7 +1211,24 @@ void StudioApp::draw_file_dialog() {
     export_width_ = std::clamp(export_width_, 1, 16384);
     export_height_ = std::clamp(export_height_, 1, 16384);
   }
-  if (dialog_ == FileDialog::export_gltf) ImGui::Checkbox("mesh (the skinned frusta as triangles)", &export_mesh_);
+  if (dialog_ == FileDialog::export_gltf) {
+    GltfChoice& c = export_gltf_;
+    ImGui::Checkbox("mesh (the skinned frusta as triangles)", &c.mesh);
+    ImGui::BeginDisabled(!c.mesh);
+    ImGui::Checkbox("wind rig (a glTF skin)", &c.rig);
+    ImGui::SameLine();
+    ImGui::SetNextItemWidth(100);
+    ImGui::BeginDisabled(!c.rig);
+    ImGui::InputInt("joints at most", &c.max_joints);
+    c.max_joints = std::clamp(c.max_joints, 1, static_cast<int>(kMaxRigJoints));
+    ImGui::Checkbox(scene_.animation ? "wind clip (the scene's animation, looping)" : "wind clip (the default sway, looping)",
+                    &c.animation);
+    ImGui::EndDisabled();
+    ImGui::Checkbox("wind data for shaders (TEXCOORD_2/3)", &c.wind_data);
+    ImGui::EndDisabled();
+    if (!c.mesh) c.rig = c.wind_data = false;
+    if (!c.rig) c.animation = false;
+  }
   go |= ImGui::Button("OK");
   ImGui::SameLine();
   const bool cancel = ImGui::Button("Cancel") || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape));
@@ -1216,7 +1240,7 @@ void StudioApp::draw_file_dialog() {
         else err = open(dialog_path_);
         break;
       case FileDialog::save_as: err = save_as(dialog_path_); break;
-      case FileDialog::export_gltf: err = export_gltf_file(dialog_path_, export_mesh_); break;
+      case FileDialog::export_gltf: err = export_gltf_file(dialog_path_, export_gltf_); break;
       case FileDialog::export_png:
         err = export_png_file(dialog_path_, static_cast<uint32_t>(export_width_), static_cast<uint32_t>(export_height_));
         break;

@@ -144,7 +144,16 @@ class StudioApp {
   double animate_speed() const { return animate_steps_per_s_; }
   void set_animate_speed(double steps_per_s) { animate_steps_per_s_ = std::clamp(steps_per_s, 0.25, 60.0); }
   void frame_plant();
-  std::optional<std::string> export_gltf_file(const std::string& path, bool mesh);
+  // What the glTF export dialog asks (docs/gltf.md): the mesh, the wind rig and clip (the
+  // scene's `animation` key, or the default sway), per-vertex wind data.
+  struct GltfChoice {
+    bool mesh = true;
+    bool rig = false;
+    int max_joints = 128;
+    bool animation = false;
+    bool wind_data = false;
+  };
+  std::optional<std::string> export_gltf_file(const std::string& path, const GltfChoice& choice);
   std::optional<std::string> export_skeleton_file(const std::string& path);
   std::optional<std::string> export_png_file(const std::string& path, uint32_t width, uint32_t height);
 
@@ -259,7 +268,7 @@ class StudioApp {
   FileDialog dialog_ = FileDialog::none;
   std::string dialog_path_;
   int export_width_ = 1920, export_height_ = 1080;
-  bool export_mesh_ = true;
+  GltfChoice export_gltf_;
   bool show_presets_ = false;
   std::string status_;
   std::map<std::string, WidgetRect> rects_;

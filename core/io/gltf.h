@@ -104,8 +104,10 @@
 #include <string>
 #include <vector>
 
+#include "core/scene/animate.h"
 #include "core/scene/scene.h"
 #include "core/geometry/skeleton.h"
+#include "core/io/gltf_rig.h"
 #include "core/util/diagnostic.h"
 
 namespace sylva {
@@ -133,6 +135,21 @@ enum class GltfExtras {
   none,     // no node extras: a plain mesh, which cannot be read back as a skeleton
 };
 
+// The looping wind clip of a rigged export (docs/gltf.md "Rig and wind clip"): plant i of
+// the list sways as plant_sway_parameters(sway, i) does in the renderer, every frequency
+// rounded to a whole number of cycles per duration_s (looping_frequency_hz); keys every
+// duration_s / ceil(duration_s · fps) seconds, the last one the first's.
+struct GltfWindClip {
+  SwayParameters sway;      // a scene's animation (sway_parameters_of) or the defaults
+  double duration_s = 4;    // (0, 1e6] (as the scene's key)
+  double fps = 24;          // (0, 1000]; at most kMaxWindClipKeys keys in all
+};
+inline constexpr uint64_t kMaxWindClipKeys = 100'000;
+// The clip's key intervals: ceil(duration_s · fps), at least 1 (keys = intervals + 1).
+uint64_t wind_clip_intervals(const GltfWindClip& clip);
+// Why `clip` cannot be written (duration, fps or key count out of range), or nothing.
+std::optional<std::string> wind_clip_problem(const GltfWindClip& clip);
+
 struct GltfExportOptions {
   bool mesh = false;            // also write the tessellated frusta as a triangle mesh
   int segments_around = 8;      // columns around each frustum for the mesh (>= 3)
@@ -141,6 +158,16 @@ struct GltfExportOptions {
                                 // with EXT_mesh_gpu_instancing (listed in extensionsUsed)
   std::map<uint32_t, SceneMaterial> materials = {};  // the scene's table (with `mesh`)
   GltfExtras extras = GltfExtras::full;  // how node extras.sylva holds the skeleton (above)
+  // The wind rig (needs `mesh`, excludes `instancing`): a glTF skin per plant along its
+  // first branch orders (gltf_rig.h), at most max_joints joints (1 .. kMaxRigJoints).
+  bool rig = false;
+  uint32_t max_joints = kDefaultRigJoints;
+  std::optional<GltfWindClip> animation = {};  // the looping wind clip (needs `rig`)
+  // Per-vertex wind data for shaders (needs `mesh`; docs/gltf.md "Wind data for shaders"):
+  // TEXCOORD_2 = (pivot.x, pivot.y), TEXCOORD_3 = (pivot.z, level + phase), TEXCOORD_1
+  // then always present (TEXCOORD_0's values where no texture needs its own).
+  bool wind_data = false;
+  uint64_t wind_seed = 0;  // the sway seed the phases come from (a scene animation's `seed`)
 };
 
 // Writes `plants` to `path` (.glb or .gltf by extension). An error is a Diagnostic naming

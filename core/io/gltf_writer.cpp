@@ -48,6 +48,7 @@ using namespace gltf_format;
 
 constexpr uint32_t kComponentFloat = 5126;
 constexpr uint32_t kComponentUint32 = 5125;
+constexpr uint32_t kComponentUint16 = 5123;
 constexpr int kTargetArrayBuffer = 34962;
 constexpr int kTargetElementArrayBuffer = 34963;
 constexpr int kModeLines = 1;
@@ -88,6 +89,24 @@ class BufferBuilder {
       a.max[k] = std::max(a.max[k], static_cast<double>(values[i]));
     }
     a.view = add_view(values.data(), values.size() * sizeof(float), target);
+    accessors_.push_back(std::move(a));
+    return accessors_.size() - 1;
+  }
+
+  // Appends `values` (count × components unsigned shorts: JOINTS_0) with their min/max.
+  size_t add_u16s(const std::vector<uint16_t>& values, int components, const char* type, int target) {
+    const size_t n = static_cast<size_t>(components);
+    Accessor a;
+    a.component = kComponentUint16;
+    a.type = type;
+    a.count = values.size() / n;
+    a.min.assign(n, 65535);
+    a.max.assign(n, 0);
+    for (size_t i = 0; i < values.size(); ++i) {
+      a.min[i % n] = std::min(a.min[i % n], static_cast<double>(values[i]));
+      a.max[i % n] = std::max(a.max[i % n], static_cast<double>(values[i]));
+    }
+    a.view = add_view(values.data(), values.size() * sizeof(uint16_t), target);
     accessors_.push_back(std::move(a));
     return accessors_.size() - 1;
   }
@@ -613,9 +632,137 @@ std::vector<PlantGroup> group_plants(const std::vector<GltfPlant>& plants, const
 struct GltfDocument {
   BufferBuilder buffer;
   MaterialTable table;
-  std::vector<std::string> meshes, nodes;
+  std::vector<std::string> meshes, nodes, skins;
+  std::vector<size_t> roots;  // the scene's nodes
   bool any_instancing = false;
+  // The wind clip (GltfExportOptions::animation): its key times' accessor, written once,
+  // and its samplers and channels (JSON objects), every plant's.
+  std::optional<size_t> clip_times;
+  std::vector<std::string> clip_samplers, clip_channels;
 };
+
+// A plant's rig and the skeleton it was built on (the mesh's weights come from both).
+struct PlantRig {
+  const Rig& rig;
+  const Skeleton& skeleton;
+};
+
+// JOINTS_0 (unsigned short) and WEIGHTS_0 (float) of `weights`, one per vertex, as the
+// text `,"JOINTS_0":a,"WEIGHTS_0":b` to add to an open attributes object. Unused slots
+// hold joint 0 with weight 0.
+std::string skin_attributes(const std::vector<RigWeights>& weights, BufferBuilder& buffer) {
+  std::vector<uint16_t> joints;
+  std::vector<float> w;
+  joints.reserve(weights.size() * 4);
+  w.reserve(weights.size() * 4);
+  for (const RigWeights& v : weights) {
+    for (size_t i = 0; i < 4; ++i) {
+      const bool used = i < static_cast<size_t>(v.count);
+      joints.push_back(used ? static_cast<uint16_t>(v.joints[i]) : 0);
+      w.push_back(used ? v.weights[i] : 0.0f);
+    }
+  }
+  const size_t j = buffer.add_u16s(joints, 4, "VEC4", kTargetArrayBuffer);
+  const size_t k = buffer.add_floats(w, 4, "VEC4", kTargetArrayBuffer);
+  return ",\"JOINTS_0\":" + std::to_string(j) + ",\"WEIGHTS_0\":" + std::to_string(k);
+}
+
+// Each vertex's frustum: that of the first triangle using it; UINT32_MAX for a vertex
+// on no triangle (a collapsed tip's spare, tessellate.h).
+std::vector<uint32_t> vertex_frusta(const TriangleMesh& tm) {
+  std::vector<uint32_t> frustum_of(tm.positions.size(), UINT32_MAX);
+  for (size_t t = 0; t < tm.triangle_count(); ++t)
+    for (size_t k = 0; k < 3; ++k) {
+      uint32_t& f = frustum_of[tm.indices[3 * t + k]];
+      if (f == UINT32_MAX) f = tm.triangle_frustum[t];
+    }
+  return frustum_of;
+}
+
+// One vertex's wind data (docs/gltf.md "Wind data for shaders"): the point its branch
+// swings about, its level (branch order; a leaf one more than its chain) and its phase
+// in [0, 1) (its chain's flutter draw).
+struct WindVertex {
+  glm::dvec3 pivot_m{0};
+  uint32_t level = 0;
+  double phase = 0;
+};
+
+// What the wind data of a plant's vertices comes from.
+struct WindSource {
+  const Skeleton& skeleton;
+  std::vector<uint32_t> order;  // chain_orders
+  uint64_t seed;                // the plant's own sway seed
+
+  WindVertex on_chain(uint32_t chain, uint32_t level_offset, const glm::dvec3& pivot) const {
+    return {pivot, order[chain] + level_offset, chain_flutter_draw(seed, chain)};
+  }
+  glm::dvec3 joint(uint32_t j) const {
+    return {skeleton.joints[j].position_m[0], skeleton.joints[j].position_m[1], skeleton.joints[j].position_m[2]};
+  }
+};
+
+// TEXCOORD_2 = (pivot.x, pivot.y), TEXCOORD_3 = (pivot.z, level + phase) as the text
+// `,"TEXCOORD_2":a,"TEXCOORD_3":b`. The phase is kept below 1 in float.
+std::string wind_attributes(const std::vector<WindVertex>& wind, BufferBuilder& buffer) {
+  std::vector<float> xy, zl;
+  xy.reserve(2 * wind.size());
+  zl.reserve(2 * wind.size());
+  for (const WindVertex& w : wind) {
+    xy.insert(xy.end(), {static_cast<float>(w.pivot_m.x), static_cast<float>(w.pivot_m.y)});
+    const float level = static_cast<float>(w.level);
+    zl.insert(zl.end(), {static_cast<float>(w.pivot_m.z),
+                         std::min(level + static_cast<float>(w.phase), std::nextafter(level + 1.0f, level))});
+  }
+  const size_t a = buffer.add_floats(xy, 2, "VEC2", kTargetArrayBuffer);
+  const size_t b = buffer.add_floats(zl, 2, "VEC2", kTargetArrayBuffer);
+  return ",\"TEXCOORD_2\":" + std::to_string(a) + ",\"TEXCOORD_3\":" + std::to_string(b);
+}
+
+// The wind data of the segments' mesh: each vertex on its frustum's chain, pivoting about
+// the chain's first joint.
+std::vector<WindVertex> segment_wind(const TriangleMesh& tm, const SkinnedSkeleton& skinned, const WindSource& source) {
+  const std::vector<uint32_t> frustum_of = vertex_frusta(tm);
+  std::vector<WindVertex> wind(tm.positions.size());
+  for (size_t v = 0; v < tm.positions.size(); ++v) {
+    if (frustum_of[v] == UINT32_MAX) {
+      if (v > 0) wind[v] = wind[v - 1];
+      continue;
+    }
+    const uint32_t c = skinned.frusta[frustum_of[v]].chain;
+    wind[v] = source.on_chain(c, 0, source.joint(source.skeleton.chains[c].first_joint));
+  }
+  return wind;
+}
+
+// The weights of every vertex of the segments' mesh: each vertex at its arc length along
+// the chain of the first triangle that uses it (its projection on that frustum's
+// segment; a vertex shared across a joint has the same arc length on both sides).
+std::vector<RigWeights> segment_vertex_weights(const TriangleMesh& tm, const SkinnedSkeleton& skinned,
+                                               const PlantRig& plant) {
+  const Skeleton& sk = plant.skeleton;
+  const std::vector<uint32_t> frustum_of = vertex_frusta(tm);
+  std::vector<RigWeights> weights(tm.positions.size());
+  for (size_t v = 0; v < tm.positions.size(); ++v) {
+    if (frustum_of[v] == UINT32_MAX) {  // on no triangle (a collapsed tip's spare): never drawn, it
+      if (v > 0) weights[v] = weights[v - 1];  // moves with the vertex before it, its frustum's
+      continue;
+    }
+    const Frustum& f = skinned.frusta[frustum_of[v]];
+    const Chain& chain = sk.chains[f.chain];
+    const uint32_t lower = chain.first_joint + f.segment;
+    double arc = plant.rig.arc_m[lower];
+    if (f.segment + 1 < chain.joint_count) {
+      const glm::dvec3 a(sk.joints[lower].position_m[0], sk.joints[lower].position_m[1], sk.joints[lower].position_m[2]);
+      const glm::dvec3 b(sk.joints[lower + 1].position_m[0], sk.joints[lower + 1].position_m[1],
+                         sk.joints[lower + 1].position_m[2]);
+      const double length = glm::length(b - a);
+      if (length > 0) arc += std::clamp(glm::dot(tm.positions[v] - a, b - a) / length, 0.0, length);
+    }
+    weights[v] = rig_weights(plant.rig, sk, f.chain, arc);
+  }
+  return weights;
+}
 
 // The primitives of one plant's mesh: a JSON array, open while they are added, and how
 // many it holds.
@@ -668,7 +815,7 @@ std::vector<float> scaled_uvs(const TriangleMesh& tm, double u_repeat, double v_
 // object left open (a primitive may add its TEXCOORD_1): POSITION, NORMAL, TANGENT with
 // a normal map (`tangents`), TEXCOORD_0 in the bark's repeats.
 std::string open_segment_attributes(const TriangleMesh& tm, const SkinnedSkeleton& skinned, const Bark& bark,
-                                    bool tangents, BufferBuilder& buffer) {
+                                    bool tangents, BufferBuilder& buffer, size_t* texcoord_0) {
   std::vector<float> positions, normals;
   positions.reserve(tm.positions.size() * 3);
   normals.reserve(tm.normals.size() * 3);
@@ -686,14 +833,15 @@ std::string open_segment_attributes(const TriangleMesh& tm, const SkinnedSkeleto
   attributes.key("NORMAL").integer(normal_accessor);
   if (tangents)
     attributes.key("TANGENT").integer(buffer.add_floats(vertex_tangents(tm, skinned), 4, "VEC4", kTargetArrayBuffer));
-  attributes.key("TEXCOORD_0").integer(buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer));
+  *texcoord_0 = buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer);
+  attributes.key("TEXCOORD_0").integer(*texcoord_0);
   return attributes.take();
 }
 
 // The segments of `skinned` tessellated (tessellate.h), one primitive per material index
 // in increasing order, with the bark's textures on the wood.
 Status add_segment_mesh(const SkinnedSkeleton& skinned, const Bark& bark, const GltfExportOptions& options,
-                        GltfDocument& doc, MeshPrimitives& primitives) {
+                        const PlantRig* rig, const WindSource* wind, GltfDocument& doc, MeshPrimitives& primitives) {
   TessellateOptions to;
   to.segments_around = options.segments_around;
   const TriangleMesh tm = tessellate(skinned, to);
@@ -709,9 +857,14 @@ Status add_segment_mesh(const SkinnedSkeleton& skinned, const Bark& bark, const 
   if (!normal_map) return std::move(normal_map.error());
   const std::optional<size_t> normal_texture = *normal_map;
 
-  const std::string open_attributes =
-      open_segment_attributes(tm, skinned, bark, normal_texture.has_value(), doc.buffer);
-  const std::string shared_attributes = open_attributes + "}";
+  size_t texcoord_0 = 0;
+  std::string open_attributes =
+      open_segment_attributes(tm, skinned, bark, normal_texture.has_value(), doc.buffer, &texcoord_0);
+  if (rig) open_attributes += skin_attributes(segment_vertex_weights(tm, skinned, *rig), doc.buffer);
+  // Wind data in TEXCOORD_2/3 needs a TEXCOORD_1 (glTF numbers the sets without gaps).
+  const std::string wind_text = wind ? wind_attributes(segment_wind(tm, skinned, *wind), doc.buffer) : std::string();
+  const std::string shared_attributes =
+      open_attributes + (wind ? ",\"TEXCOORD_1\":" + std::to_string(texcoord_0) + wind_text : std::string()) + "}";
   // A table image repeating otherwise than the bark reads TEXCOORD_1, its own
   // (u · u_repeat, v_m · v_per_metre); one accessor per distinct pair of repeats.
   std::map<std::pair<double, double>, std::string> attributes_with_texcoord_1;
@@ -728,7 +881,7 @@ Status add_segment_mesh(const SkinnedSkeleton& skinned, const Bark& bark, const 
         const size_t accessor =
             doc.buffer.add_floats(scaled_uvs(tm, repeat.first, repeat.second), 2, "VEC2", kTargetArrayBuffer);
         it = attributes_with_texcoord_1
-                 .emplace(repeat, open_attributes + ",\"TEXCOORD_1\":" + std::to_string(accessor) + "}")
+                 .emplace(repeat, open_attributes + ",\"TEXCOORD_1\":" + std::to_string(accessor) + wind_text + "}")
                  .first;
       }
       primitive_attributes = &it->second;
@@ -753,8 +906,8 @@ Status add_segment_mesh(const SkinnedSkeleton& skinned, const Bark& bark, const 
 // primitive per material index in increasing order, double-sided materials;
 // TEXCOORD_0 = (u, 1 − v) of leaf_uvs (glTF's t runs down the image: an image drawn
 // upright, petiole at its bottom row, covers the leaf as the renderers map it).
-Status add_leaf_mesh(const Skeleton& sk, const GltfExportOptions& options, GltfDocument& doc,
-                     MeshPrimitives& primitives) {
+Status add_leaf_mesh(const Skeleton& sk, const GltfExportOptions& options, const PlantRig* rig,
+                     const WindSource* wind, GltfDocument& doc, MeshPrimitives& primitives) {
   LeafMesh leaves;
   append_leaves(leaves, sk, 0);
   std::vector<float> positions, normals, texcoords;
@@ -769,12 +922,34 @@ Status add_leaf_mesh(const Skeleton& sk, const GltfExportOptions& options, GltfD
   attributes.begin_object();
   attributes.key("POSITION").integer(doc.buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer));
   attributes.key("NORMAL").integer(doc.buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer));
-  attributes.key("TEXCOORD_0").integer(doc.buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer));
-  attributes.end_object();
+  const size_t texcoord_0 = doc.buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer);
+  attributes.key("TEXCOORD_0").integer(texcoord_0);
+  std::string attribute_text = attributes.take();
+  if (wind) {  // each leaf pivots about its joint, one level above its chain
+    std::vector<WindVertex> data;
+    data.reserve(leaves.vertex_leaf.size());
+    for (size_t v = 0; v < leaves.vertex_leaf.size(); ++v) {
+      const Leaf& leaf = sk.leaves[leaves.leaves[leaves.vertex_leaf[v]].leaf];
+      if (leaf.joint)
+        data.push_back(wind->on_chain(leaf.joint->chain, 1,
+                                      wind->joint(sk.chains[leaf.joint->chain].first_joint + leaf.joint->joint)));
+      else  // a leaf before the first segment: about its first vertex, level 1, phase 0
+        data.push_back({{leaf.vertices_m[0][0], leaf.vertices_m[0][1], leaf.vertices_m[0][2]}, 1, 0});
+    }
+    attribute_text += ",\"TEXCOORD_1\":" + std::to_string(texcoord_0) + wind_attributes(data, doc.buffer);
+  }
+  if (rig) {  // each leaf rides as its joint does
+    std::vector<RigWeights> weights;
+    weights.reserve(leaves.vertex_leaf.size());
+    for (uint32_t l : leaves.vertex_leaf)
+      weights.push_back(rig_weights_at_joint(rig->rig, sk, sk.leaves[leaves.leaves[l].leaf].joint));
+    attribute_text += skin_attributes(weights, doc.buffer);
+  }
+  attribute_text += "}";
   for (const auto& [material, indices] : triangles_of) {
     JsonWriter& json = primitives.json;
     json.begin_object();
-    json.key("attributes").raw(attributes.text());
+    json.key("attributes").raw(attribute_text);
     json.key("indices").integer(doc.buffer.add_indices(indices));
     Expected<std::optional<size_t>> texture = doc.table.leaf_texture(material);
     if (!texture) return std::move(texture.error());
@@ -851,25 +1026,152 @@ void write_node_extras(JsonWriter& node, const std::vector<GltfPlant>& plants, c
   }
 }
 
-// The mesh (where it has primitives) and the node of one group of plants, added to `doc`.
+// The rotation about the unit `axis` by angle_rad as a glTF quaternion (x, y, z, w).
+std::array<float, 4> axis_quaternion(const glm::dvec3& axis, double angle_rad) {
+  const double s = std::sin(0.5 * angle_rad);
+  return {static_cast<float>(axis.x * s), static_cast<float>(axis.y * s), static_cast<float>(axis.z * s),
+          static_cast<float>(std::cos(0.5 * angle_rad))};
+}
+
+// The wind clip's channels for one plant's rig (joint j is node base + j): each joint's
+// local rotation at every key, R(φ_j − φ_parent) about the sway axis (gltf_rig.h
+// pose_rig), the last key a copy of the first. Joints that never turn get no channel.
+void add_clip_channels(GltfDocument& doc, const Skeleton& sk, const Rig& rig, size_t base, const GltfWindClip& clip,
+                       const SwayParameters& sway) {
+  const std::optional<glm::dvec3> axis = sway_axis(sway);
+  if (!axis) return;
+  const uint64_t intervals = wind_clip_intervals(clip);
+  if (!doc.clip_times) {
+    std::vector<float> times;
+    for (uint64_t i = 0; i <= intervals; ++i)
+      times.push_back(static_cast<float>(clip.duration_s * static_cast<double>(i) / static_cast<double>(intervals)));
+    doc.clip_times = doc.buffer.add_floats(times, 1, "SCALAR", 0);
+  }
+  // local[j][i]: joint j's local angle at key i.
+  std::vector<std::vector<double>> local(rig.joints.size(), std::vector<double>(intervals + 1, 0.0));
+  for (uint64_t i = 0; i < intervals; ++i) {
+    const double t_s = clip.duration_s * static_cast<double>(i) / static_cast<double>(intervals);
+    const std::vector<double> angle = sway_joint_angles(sk, t_s, sway);
+    for (size_t j = 1; j < rig.joints.size(); ++j) {
+      const RigJoint& joint = rig.joints[j];
+      const double parent = joint.parent == 0 ? 0.0 : angle[rig.joints[joint.parent].skeleton_joint];
+      local[j][i] = angle[joint.skeleton_joint] - parent;
+    }
+  }
+  for (size_t j = 1; j < rig.joints.size(); ++j) {
+    local[j][intervals] = local[j][0];
+    if (std::all_of(local[j].begin(), local[j].end(), [](double a) { return a == 0; })) continue;
+    std::vector<float> quaternions;
+    quaternions.reserve(4 * local[j].size());
+    for (double a : local[j]) {
+      const std::array<float, 4> q = axis_quaternion(*axis, a);
+      quaternions.insert(quaternions.end(), q.begin(), q.end());
+    }
+    const size_t output = doc.buffer.add_floats(quaternions, 4, "VEC4", 0);
+    JsonWriter sampler;
+    sampler.begin_object().key("input").integer(*doc.clip_times).key("interpolation").string("LINEAR");
+    sampler.key("output").integer(output).end_object();
+    JsonWriter channel;
+    channel.begin_object().key("sampler").integer(doc.clip_samplers.size());
+    channel.key("target").begin_object().key("node").integer(base + j).key("path").string("rotation").end_object();
+    channel.end_object();
+    doc.clip_samplers.push_back(sampler.take());
+    doc.clip_channels.push_back(channel.take());
+  }
+}
+
+// The rig of one plant (gltf_rig.h) as glTF: its joints as nodes base, base + 1, … (the
+// root, named NAME_rig, a child of the plant's node; joint j named NAME_joint_j with its
+// rest offset from its parent and extras {"sylva_rig": {"chain", "joint"}}, the skeleton
+// joint it sits on), the skin with inverse bind matrices (the rest positions' inverse
+// translations, in the plant's frame), and a scene root node NAME_skin drawing the
+// skinned `primitives` (glTF ignores a skinned mesh node's transform; the placement
+// reaches the mesh through the joints under the plant's node).
+void add_rig_nodes(GltfDocument& doc, const GltfPlant& plant, const Rig& rig, const MeshPrimitives& primitives) {
+  const size_t base = doc.nodes.size();
+  std::vector<std::vector<size_t>> children(rig.joints.size());
+  for (size_t j = 1; j < rig.joints.size(); ++j) children[rig.joints[j].parent].push_back(j);
+  std::vector<float> inverse_bind;
+  inverse_bind.reserve(16 * rig.joints.size());
+  for (size_t j = 0; j < rig.joints.size(); ++j) {
+    const RigJoint& joint = rig.joints[j];
+    JsonWriter node;
+    node.begin_object();
+    node.key("name").string(j == 0 ? plant.name + "_rig" : plant.name + "_joint_" + std::to_string(j));
+    if (!children[j].empty()) {
+      node.key("children").begin_array();
+      for (size_t c : children[j]) node.integer(base + c);
+      node.end_array();
+    }
+    if (j > 0) {
+      const glm::dvec3 offset = joint.position_m - rig.joints[joint.parent].position_m;
+      if (offset != glm::dvec3(0)) write_vec3(node.key("translation"), offset);
+      node.key("extras").begin_object().key("sylva_rig").begin_object();
+      node.key("chain").integer(joint.chain);
+      node.key("joint").integer(joint.skeleton_joint - plant.skeleton.chains[joint.chain].first_joint);
+      node.end_object().end_object();
+    }
+    node.end_object();
+    doc.nodes.push_back(node.take());
+    const float column_major[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, static_cast<float>(-joint.position_m.x),
+                                    static_cast<float>(-joint.position_m.y), static_cast<float>(-joint.position_m.z), 1};
+    inverse_bind.insert(inverse_bind.end(), std::begin(column_major), std::end(column_major));
+  }
+  JsonWriter skin;
+  skin.begin_object();
+  skin.key("inverseBindMatrices").integer(doc.buffer.add_floats(inverse_bind, 16, "MAT4", 0));
+  skin.key("joints").begin_array();
+  for (size_t j = 0; j < rig.joints.size(); ++j) skin.integer(base + j);
+  skin.end_array();
+  skin.key("name").string(plant.name);
+  skin.key("skeleton").integer(base);
+  skin.end_object();
+  doc.skins.push_back(skin.take());
+  if (primitives.count == 0) return;
+  JsonWriter mesh;
+  mesh.begin_object().key("name").string(plant.name + "_skin").key("primitives").raw(primitives.json.text()).end_object();
+  doc.meshes.push_back(mesh.take());
+  JsonWriter node;
+  node.begin_object().key("mesh").integer(doc.meshes.size() - 1).key("name").string(plant.name + "_skin");
+  node.key("skin").integer(doc.skins.size() - 1).end_object();
+  doc.roots.push_back(doc.nodes.size());
+  doc.nodes.push_back(node.take());
+}
+
+// The mesh (where it has primitives) and the node of one group of plants, added to `doc`;
+// with `rig` (a group of one plant, plants[group.plants.front()]) the triangles are
+// skinned to it instead (add_rig_nodes) and, with options.animation, sway in the clip.
 Status add_plant_group(GltfDocument& doc, const std::vector<GltfPlant>& plants, const PlantGroup& group,
-                       const GltfExportOptions& options) {
+                       const GltfExportOptions& options, const Rig* rig) {
   const GltfPlant& plant = plants[group.plants.front()];
   const Skeleton& sk = plant.skeleton;
   const SkinnedSkeleton skinned = skin_skeleton(sk, SkinOptions{}.styled(plant.skin));
+  const std::optional<PlantRig> plant_rig = rig ? std::optional<PlantRig>(PlantRig{*rig, sk}) : std::nullopt;
+  const PlantRig* weights = plant_rig ? &*plant_rig : nullptr;
+  const std::optional<WindSource> wind_source =
+      options.wind_data ? std::optional<WindSource>(WindSource{
+                              sk, chain_orders(sk),
+                              plant_sway_parameters(SwayParameters{.seed = options.wind_seed}, group.plants.front()).seed})
+                        : std::nullopt;
+  const WindSource* wind = wind_source ? &*wind_source : nullptr;
 
-  MeshPrimitives primitives;
+  MeshPrimitives primitives, skinned_primitives;
   primitives.json.begin_array();
+  skinned_primitives.json.begin_array();
+  MeshPrimitives& surface = rig ? skinned_primitives : primitives;
   if (sk.segment_count() > 0) add_skeleton_lines(sk, doc.buffer, primitives);
   if (options.mesh && !skinned.frusta.empty())
-    if (Status added = add_segment_mesh(skinned, plant.bark, options, doc, primitives); !added) return added;
+    if (Status added = add_segment_mesh(skinned, plant.bark, options, weights, wind, doc, surface); !added) return added;
   if (options.mesh && !sk.leaves.empty())
-    if (Status added = add_leaf_mesh(sk, options, doc, primitives); !added) return added;
+    if (Status added = add_leaf_mesh(sk, options, weights, wind, doc, surface); !added) return added;
   primitives.json.end_array();
+  skinned_primitives.json.end_array();
 
+  const size_t plant_node = doc.nodes.size();
   JsonWriter node;
   node.begin_object();
   node.key("name").string(plant.name);
+  if (rig) node.key("children").begin_array().integer(plant_node + 1).end_array();
   if (primitives.count > 0) {
     JsonWriter mesh;
     mesh.begin_object();
@@ -887,7 +1189,16 @@ Status add_plant_group(GltfDocument& doc, const std::vector<GltfPlant>& plants, 
   }
   write_node_extras(node, plants, group, skinned, options.extras, doc.buffer);
   node.end_object();
+  doc.roots.push_back(plant_node);
   doc.nodes.push_back(node.take());
+  if (rig) {
+    add_rig_nodes(doc, plant, *rig, skinned_primitives);
+    if (options.animation) {
+      SwayParameters sway = plant_sway_parameters(options.animation->sway, group.plants.front());
+      sway.loop_period_s = options.animation->duration_s;
+      add_clip_channels(doc, sk, *rig, plant_node + 1, *options.animation, sway);
+    }
+  }
   return {};
 }
 
@@ -961,7 +1272,7 @@ std::string document_json(GltfDocument& doc, bool glb) {
   }
   json.key("scene").integer(0);
   json.key("scenes").begin_array().begin_object().key("nodes").begin_array();
-  for (size_t i = 0; i < doc.nodes.size(); ++i) json.integer(i);
+  for (size_t i : doc.roots) json.integer(i);
   json.end_array().end_object().end_array();
   json.key("nodes").begin_array();
   for (const std::string& node : doc.nodes) json.raw(node);
@@ -970,6 +1281,22 @@ std::string document_json(GltfDocument& doc, bool glb) {
     json.key("meshes").begin_array();
     for (const std::string& mesh : doc.meshes) json.raw(mesh);
     json.end_array();
+  }
+  if (!doc.skins.empty()) {
+    json.key("skins").begin_array();
+    for (const std::string& skin : doc.skins) json.raw(skin);
+    json.end_array();
+  }
+  if (!doc.clip_channels.empty()) {
+    json.key("animations").begin_array().begin_object();
+    json.key("channels").begin_array();
+    for (const std::string& channel : doc.clip_channels) json.raw(channel);
+    json.end_array();
+    json.key("name").string("wind");
+    json.key("samplers").begin_array();
+    for (const std::string& sampler : doc.clip_samplers) json.raw(sampler);
+    json.end_array();
+    json.end_object().end_array();
   }
   if (!doc.table.materials().empty()) {
     json.key("materials").begin_array();
@@ -1010,6 +1337,20 @@ Expected<std::string> glb_file(const std::string& text, const std::string& bin, 
 
 }  // namespace
 
+uint64_t wind_clip_intervals(const GltfWindClip& clip) {
+  return std::max<uint64_t>(1, static_cast<uint64_t>(std::ceil(clip.duration_s * clip.fps - 1e-9)));
+}
+
+std::optional<std::string> wind_clip_problem(const GltfWindClip& clip) {
+  if (!(clip.duration_s > 0 && clip.duration_s <= 1e6))
+    return "the wind clip's duration must be a number of seconds in (0, 1e6]";
+  if (!(clip.fps > 0 && clip.fps <= 1000)) return "the wind clip's fps must be a number in (0, 1000]";
+  if (clip.duration_s * clip.fps > static_cast<double>(kMaxWindClipKeys))
+    return "the wind clip would have more than " + std::to_string(kMaxWindClipKeys) +
+           " keys (duration_s x fps): shorten it or lower fps";
+  return std::nullopt;
+}
+
 Status check_bark_textures(const Bark& bark) {
   if (bark.albedo_texture) {
     Expected<EmbeddedImage> image = read_albedo_image(*bark.albedo_texture);
@@ -1035,11 +1376,37 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
     return file_diagnostic(path, "segments around must be an integer from 3 to 4096");
   for (size_t i = 0; i < plants.size(); ++i)
     if (auto problem = plant_problem(plants[i], i)) return file_diagnostic(path, *problem);
+  if (options.rig && !options.mesh) return file_diagnostic(path, "a rig skins the mesh: export the mesh too");
+  if (options.rig && options.instancing)
+    return file_diagnostic(path, "a rig cannot be instanced (EXT_mesh_gpu_instancing does not skin): export one or "
+                                 "the other");
+  if (options.rig && (options.max_joints < 1 || options.max_joints > kMaxRigJoints))
+    return file_diagnostic(path, "the rig's joints must be from 1 to " + std::to_string(kMaxRigJoints));
+  if (options.animation && !options.rig) return file_diagnostic(path, "the wind clip poses the rig: export the rig too");
+  if (options.wind_data && !options.mesh) return file_diagnostic(path, "wind data is per mesh vertex: export the mesh too");
+  if (options.animation)
+    if (auto problem = wind_clip_problem(*options.animation)) return file_diagnostic(path, *problem);
+  // The rigs first: a plant that cannot be rigged writes nothing.
+  std::vector<Rig> rigs;
+  if (options.rig)
+    for (size_t i = 0; i < plants.size(); ++i) {
+      Expected<Rig> rig = build_rig(plants[i].skeleton, {.max_joints = options.max_joints});
+      if (!rig)
+        return file_diagnostic(path, "plant " + std::to_string(i) + " (" + json_excerpt(plants[i].name) +
+                                         "): " + rig.error().message);
+      rigs.push_back(std::move(*rig));
+    }
   GltfDocument doc;
   if (options.mesh)
     if (Status loaded = doc.table.load(plants, options.materials); !loaded) return loaded;
   for (const PlantGroup& group : group_plants(plants, options))
-    if (Status added = add_plant_group(doc, plants, group, options); !added) return added;
+    if (Status added = add_plant_group(doc, plants, group, options, options.rig ? &rigs[group.plants.front()] : nullptr);
+        !added)
+      return added;
+  if (options.animation && doc.clip_channels.empty())
+    return file_diagnostic(path, "the wind clip moves no joint (the wind has no horizontal part, both amplitudes "
+                                 "are 0, or the rig's only joints sit at the base, where the sway does not turn: "
+                                 "allow more joints): nothing to animate");
   const std::string text = document_json(doc, glb);
   if (!glb) return write_file_atomically(path, text);
   Expected<std::string> file = glb_file(text, doc.buffer.bytes(), path);

@@ -29,7 +29,9 @@
 // skeleton's frame (Y up).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -48,14 +50,43 @@ struct SwayParameters {
   double branch_amplitude_deg = 3;     // each lateral chain's swing about its attachment
   double branch_frequency_hz = 1.1;    // mean flutter frequency of the lateral chains
   uint64_t seed = 0;                   // draws each chain's flutter frequency
+  double loop_period_s = 0;            // > 0: every frequency (the sway's and each chain's
+                                       // flutter) is rounded to the nearest positive
+                                       // multiple of 1/loop_period_s (looping_frequency_hz),
+                                       // so the motion repeats exactly after it (the glTF
+                                       // wind clip, docs/gltf.md "Wind clip"); 0: as given
 };
+
+// `frequency_hz` rounded to a whole number of cycles per `period_s`: n/period_s with
+// n = round(frequency_hz·period_s), at least 1 for a frequency > 0; 0 stays 0. period_s
+// not > 0 returns frequency_hz unchanged.
+double looping_frequency_hz(double frequency_hz, double period_s);
+
+// The horizontal axis every sway turns about: up × the wind's unit horizontal part
+// (rotating +Y about it by a positive angle tips it toward the wind); nullopt when the
+// wind has no horizontal part (nothing moves).
+std::optional<glm::dvec3> sway_axis(const SwayParameters& parameters);
+
+// The angle (radians, about sway_axis) by which the segment leaving each joint of `rest`
+// turns at t_s: the bend at the joint's rest height plus its chain's flutter (its
+// parent chains' included). One per joint, all 0 at t = 0. sway_skeleton moves every
+// joint and leaf with these angles; the glTF wind clip poses its rig with them.
+std::vector<double> sway_joint_angles(const Skeleton& rest, double t_s, const SwayParameters& parameters);
 
 // The rest skeleton `rest` (validate_skeleton holds) swayed to time t_s seconds.
 Skeleton sway_skeleton(const Skeleton& rest, double t_s, const SwayParameters& parameters);
 
+// The draw u in [0, 1) that sets chain `chain`'s flutter frequency,
+// branch_frequency_hz · (0.75 + 0.5·u), for a sway with seed `seed` (the glTF wind data's
+// phase, docs/gltf.md "Wind data for shaders").
+double chain_flutter_draw(uint64_t seed, size_t chain);
+
+// Plant p's own sway in a scene: `parameters` with its own seed (from parameters.seed and
+// p) and its sway frequency scaled by a factor in [0.85, 1.15] drawn from that seed.
+SwayParameters plant_sway_parameters(const SwayParameters& parameters, size_t p);
+
 // Sets every plant's skeleton of `scene` to its rest skeleton rest[p] swayed to t_s, the
-// plants out of step: plant p uses `parameters` with its own seed (from parameters.seed
-// and p) and its sway frequency scaled by a factor in [0.85, 1.15] drawn from that seed.
+// plants out of step: plant p uses plant_sway_parameters(parameters, p).
 // Precondition: rest.size() == scene.plants.size().
 void sway_scene_plants(Scene& scene, const std::vector<Skeleton>& rest, double t_s,
                        const SwayParameters& parameters);

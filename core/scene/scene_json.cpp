@@ -639,6 +639,16 @@ Expected<Scene> parse_scene_json(std::string_view text, std::string_view file, c
   }
 }
 
+Expected<SceneAnimation> parse_animation_json(std::string_view text, std::string_view file) {
+  Expected<JsonValue> json = parse_json(text, file);
+  if (!json) return std::move(json.error());
+  try {
+    return read_animation(*json);
+  } catch (const Located& e) {
+    return diagnostic_at(std::string(file), {e.line, e.column}, e.message);
+  }
+}
+
 Expected<Scene> read_scene_file(const std::string& path) {
   Expected<std::string> file = read_text_file(path);
   if (!file) return std::move(file.error());

@@ -23,6 +23,10 @@ Expected<Scene> parse_scene_json(std::string_view text, std::string_view file, c
 // Reads and parses a scene file; paths in it are relative to its folder.
 Expected<Scene> read_scene_file(const std::string& path);
 
+// A scene's `animation` object alone (docs/animation.md), e.g. from Python's export_gltf;
+// errors located in `text` as the scene reader locates them.
+Expected<SceneAnimation> parse_animation_json(std::string_view text, std::string_view file);
+
 // The scene as `.scene.json` text (docs/spec/scene.md) that parse_scene_json(text, file, base_dir)
 // reads back equal to `scene` (but for the places: file, grammar_loc) when its sun
 // direction is one the reader makes (unit_sun_direction; every scene read from a file

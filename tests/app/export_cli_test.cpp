@@ -12,6 +12,7 @@
 
 #include "core/io/gltf.h"
 #include "core/geometry/skeleton.h"
+#include "tests/app/node_script.h"
 #include "tests/support/process.h"
 
 namespace {
@@ -29,20 +30,7 @@ constexpr const char* kSometimesBroken = "derivation length: 1\naxiom: A\nA -> F
 // Runs the validator harness on `files`. Fails the test (never skips) when node or the
 // validator is missing.
 ProcessResult validate(const std::vector<std::string>& files) {
-  const fs::path validator = fs::path(kSource) / ".tools/node/node_modules/gltf-validator/package.json";
-  if (!fs::exists(validator)) {
-    ADD_FAILURE() << "the Khronos glTF validator is not installed (" << validator.string()
-                  << " is missing): run scripts/setup.sh";
-    return {};
-  }
-  std::vector<std::string> argv = {"node", kSource + "/scripts/validate_gltf.mjs"};
-  argv.insert(argv.end(), files.begin(), files.end());
-  try {
-    return run_process(argv, {}, 240);
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "cannot run node (install Node.js with scripts/setup.sh): " << e.what();
-    return {};
-  }
+  return sylva::test::run_node_script("validate_gltf.mjs", "gltf-validator", files);
 }
 
 void expect_valid(const std::vector<std::string>& files) {

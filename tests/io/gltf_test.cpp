@@ -33,10 +33,14 @@
 #include "core/io/normal_map.h"
 #include "core/geometry/skin.h"
 #include "core/geometry/tessellate.h"
+#include "tests/io/tinygltf_read.h"
 #include "tests/support/plants.h"
 
 namespace sylva {
 namespace {
+
+using test::floats_of;
+using test::load_with_tinygltf;
 
 namespace fs = std::filesystem;
 
@@ -556,29 +560,6 @@ Skeleton cylinder(double radius_m, uint32_t segments = 1) {
   for (uint32_t k = 0; k <= segments; ++k) sk.joints.push_back({{0, 2.0 * k / segments, 0}, radius_m, 0});
   sk.chains = {{0, segments + 1, std::nullopt}};
   return sk;
-}
-
-bool load_with_tinygltf(const std::string& path, tinygltf::Model* model) {
-  tinygltf::TinyGLTF loader;
-  std::string err, warn;
-  const bool ok = path.ends_with(".glb") ? loader.LoadBinaryFromFile(model, &err, &warn, path)
-                                         : loader.LoadASCIIFromFile(model, &err, &warn, path);
-  EXPECT_TRUE(ok) << err;
-  EXPECT_TRUE(warn.empty()) << warn;
-  return ok;
-}
-
-// The float components of accessor `index` (tightly packed, as we write them).
-std::vector<float> floats_of(const tinygltf::Model& model, int index) {
-  const tinygltf::Accessor& a = model.accessors.at(static_cast<size_t>(index));
-  EXPECT_EQ(a.componentType, TINYGLTF_COMPONENT_TYPE_FLOAT);
-  const tinygltf::BufferView& view = model.bufferViews.at(static_cast<size_t>(a.bufferView));
-  const std::vector<unsigned char>& data = model.buffers.at(static_cast<size_t>(view.buffer)).data;
-  const size_t n = a.count * static_cast<size_t>(tinygltf::GetNumComponentsInType(static_cast<uint32_t>(a.type)));
-  std::vector<float> out(n);
-  EXPECT_LE(view.byteOffset + a.byteOffset + n * 4, data.size());
-  std::memcpy(out.data(), data.data() + view.byteOffset + a.byteOffset, n * 4);
-  return out;
 }
 
 TEST(GltfExport, BarkTexturesGoToTheWoodMaterialOnlyWithAlbedoNormalMapAndUnitTangents) {

@@ -420,7 +420,7 @@ TEST_F(Fixture, TheSkinControlReSkinsThePlantsAndStartsAtSkinFlag) {
   ui.frames(*app, 2);
   EXPECT_EQ(viewport.skins, std::vector<SkinStyle>{SkinStyle::paper});
   const std::string out = dir.file("tree.gltf");
-  ASSERT_FALSE(app->export_gltf_file(out, false));
+  ASSERT_FALSE(app->export_gltf_file(out, {.mesh = false}));
   const Expected<std::string> written = read_text_file(out);
   ASSERT_TRUE(written.ok());
   EXPECT_NE(written->find("\"skin\":\"paper\""), std::string::npos);
@@ -532,7 +532,7 @@ TEST_F(Fixture, ExportsTheShownPlantThroughTheCliWriters) {
   ASSERT_TRUE(ui.settle(*app));
   ASSERT_EQ(viewport.segments, 7u);
   const std::string glb = dir.file("tree.glb"), skel = dir.file("tree.skel.json");
-  ASSERT_FALSE(app->export_gltf_file(glb, /*mesh=*/true));
+  ASSERT_FALSE(app->export_gltf_file(glb, {.mesh = true}));
   ASSERT_FALSE(app->export_skeleton_file(skel));
   Expected<std::vector<GltfPlant>> back = import_gltf_skeletons(glb);
   ASSERT_TRUE(back.ok()) << back.error().format();
@@ -543,6 +543,16 @@ TEST_F(Fixture, ExportsTheShownPlantThroughTheCliWriters) {
   Expected<Skeleton> read = read_skeleton_file(skel);
   ASSERT_TRUE(read.ok());
   EXPECT_EQ(read->segment_count(), 7u);
+  // The wind rig, its clip and the shader data, as the export dialog offers them.
+  const std::string rigged = dir.file("rigged.glb");
+  ASSERT_FALSE(app->export_gltf_file(rigged, {.mesh = true, .rig = true, .max_joints = 8, .animation = true,
+                                              .wind_data = true}));
+  const std::string bytes = read_text_file(rigged).value();
+  for (const char* key : {"\"skins\"", "\"animations\"", "\"name\":\"wind\"", "\"TEXCOORD_3\"", "\"JOINTS_0\""})
+    EXPECT_NE(bytes.find(key), std::string::npos) << key;
+  EXPECT_EQ(app->export_gltf_file(dir.file("refused.glb"), {.mesh = false, .rig = true}).value_or(""),
+            dir.file("refused.glb") + ": error: a rig skins the mesh: export the mesh too");
+  EXPECT_FALSE(std::filesystem::exists(dir.file("refused.glb")));
   EXPECT_FALSE(app->export_png_file(dir.file("tree.png"), 64, 64).value_or("").empty())
       << "the fake viewport renders nothing: the error comes back, nothing is written";
   EXPECT_FALSE(std::filesystem::exists(dir.file("tree.png")));

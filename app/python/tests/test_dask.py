@@ -58,6 +58,12 @@ def test_export_with_defines_and_a_seed_folder(tmp_path, client, sylva_binary):
                             extras="full")
     assert_same_files(full, [str(tmp_path / "cli/full_3.gltf")])
     assert b'"chains":[{' in pathlib.Path(full[0]).read_bytes().replace(b" ", b"").replace(b"\n", b"")
+    # The rig, the wind clip and the wind data: the CLI batch's files, byte for byte.
+    cli_batch(sylva_binary, "export", "presets/elm.lsys", "--seed", "4", "--mesh", "--rig", "--max-joints", "40",
+              "--animation", "--wind-data", "-o", str(tmp_path / "cli/rig_{seed}.glb"))
+    rigged = sylva_dask.batch(client, "export", "presets/elm.lsys", [4], str(tmp_path / "dask/rig_{seed}.glb"),
+                              mesh=True, rig=True, max_joints=40, animation=True, wind_data=True)
+    assert_same_files(rigged, [str(tmp_path / "cli/rig_4.glb")])
 
 
 def test_bad_batches_are_refused_before_any_task(tmp_path, client):

@@ -192,3 +192,38 @@ def test_extras_none_writes_no_node_extras_and_a_bad_mode_is_a_value_error(sagua
     with pytest.raises(ValueError, match="extras must be"):
         sylva.export_gltf(saguaro, tmp_path / "x.glb", extras="tiny")
     assert not (tmp_path / "x.glb").exists()
+
+
+def test_a_rig_with_a_wind_clip_and_wind_data(saguaro, tmp_path, validate_gltf):
+    path = tmp_path / "windy.glb"
+    sylva.export_gltf(saguaro, path, mesh=True, rig=True, max_joints=16,
+                      animation={"wind": [1, 0, 1], "duration_s": 2, "fps": 10, "seed": 3}, wind_data=True)
+    doc = glb_json(path)
+    assert len(doc["skins"]) == 1 and 2 <= len(doc["skins"][0]["joints"]) <= 16
+    clip = doc["animations"][0]
+    assert clip["name"] == "wind" and clip["channels"]
+    times = doc["accessors"][clip["samplers"][0]["input"]]
+    assert times["count"] == 21 and times["max"] == [2]
+    skinned = [n for n in doc["nodes"] if "skin" in n]
+    attributes = doc["meshes"][skinned[0]["mesh"]]["primitives"][0]["attributes"]
+    assert {"JOINTS_0", "WEIGHTS_0", "TEXCOORD_1", "TEXCOORD_2", "TEXCOORD_3"} <= set(attributes)
+    validate_gltf(path)
+    # True: the default sway (4 s at 24 fps).
+    sylva.export_gltf(saguaro, path, mesh=True, rig=True, animation=True)
+    doc = glb_json(path)
+    assert doc["accessors"][doc["animations"][0]["samplers"][0]["input"]]["count"] == 97
+
+
+def test_rig_arguments_are_checked_and_nothing_is_written(saguaro, tmp_path):
+    path = tmp_path / "refused.glb"
+    with pytest.raises(ValueError, match="export the mesh too"):
+        sylva.export_gltf(saguaro, path, rig=True)
+    with pytest.raises(ValueError, match="max_joints must be from 1 to 1024"):
+        sylva.export_gltf(saguaro, path, mesh=True, rig=True, max_joints=0)
+    with pytest.raises(ValueError, match="export the rig too"):
+        sylva.export_gltf(saguaro, path, mesh=True, animation=True)
+    with pytest.raises(ValueError, match="animation.fps"):
+        sylva.export_gltf(saguaro, path, mesh=True, rig=True, animation={"fps": -1})
+    with pytest.raises(TypeError, match="animation must be"):
+        sylva.export_gltf(saguaro, path, mesh=True, rig=True, animation="breezy")
+    assert not path.exists()
