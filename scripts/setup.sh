@@ -10,6 +10,7 @@ packages=(
   libnanoflann-dev  # kd-tree of the shadow-cone clustering (core/light/shadow_cones.cpp)
   # The design card's libraries; later stages link them (render, GUI, export).
   libglm-dev libglfw3-dev libimgui-dev libopenimageio-dev libtinygltf-dev
+  libmeshoptimizer-dev  # `sylva export --compress meshopt` (EXT_meshopt_compression)
   # The Python module (built for /usr/bin/python3) and its tests.
   python3 python3-dev pybind11-dev python3-numpy python3-pytest
   python3-distributed  # sylva_dask: batches of seeds on a dask.distributed cluster

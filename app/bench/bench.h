@@ -20,6 +20,8 @@ int run_bench_gpu(const std::vector<std::string>& args);
 int run_bench_fog(const std::vector<std::string>& args);
 // `sylva bench spp` (bench_spp.cpp).
 int run_bench_spp(const std::vector<std::string>& args);
+// `sylva bench export` (bench_export.cpp).
+int run_bench_export(const std::vector<std::string>& args);
 // `sylva bench light` (bench_light.cpp).
 int run_bench_light(const std::vector<std::string>& args);
 

@@ -105,7 +105,8 @@ int run_bench(const std::vector<std::string>& args) {
                  "                       [--csv FILE] [--plot FILE] [--quick]\n"
                  "       sylva bench fog SCENE [--photons LIST] [--seeds N] [--csv FILE] [--quick]\n"
                  "       sylva bench spp [INPUT...] [--spp LIST] [--backends cpu,gl] [--csv FILE] [--quick]\n"
-                 "       sylva bench light [--threads N] [--csv FILE] [--plot FILE] [--quick]\n\n"
+                 "       sylva bench light [--threads N] [--csv FILE] [--plot FILE] [--quick]\n"
+                 "       sylva bench export [INPUT...] [--scatter N] [--csv FILE] [--quick]\n\n"
                  "Derivation throughput (modules produced per second, one thread) for ABOP 1.24a,\n"
                  "Honda's tree (ABOP 2.6) and ABOP 1.31a; turtle segments per second; peak bytes\n"
                  "per module; memcpy bandwidth in the same run. --quick uses small sizes (a smoke\n"
@@ -123,7 +124,9 @@ int run_bench(const std::vector<std::string>& args) {
                  "spp: the sampling error (speckle, RMSE) of both backends against the samples per\n"
                  "pixel, at 800x600 on the pine and the elm; `sylva bench spp --help` for details.\n"
                  "light: the ?E light's error against closed forms and time against photons, and one\n"
-                 "answer on the pine and a 10-pine stand; `sylva bench light --help` for details.\n";
+                 "answer on the pine and a 10-pine stand; `sylva bench light --help` for details.\n"
+                 "export: CPU time and bytes of the glTF variants for engines (rig, wind clip, wind\n"
+                 "data, levels of detail) and an instanced scatter; `sylva bench export --help`.\n";
     return args.empty() ? kUsageError : kOk;
   }
   if (args[0] == "raycast") return run_bench_raycast(args);
@@ -132,8 +135,9 @@ int run_bench(const std::vector<std::string>& args) {
   if (args[0] == "fog") return run_bench_fog(args);
   if (args[0] == "spp") return run_bench_spp(args);
   if (args[0] == "light") return run_bench_light(args);
+  if (args[0] == "export") return run_bench_export(args);
   if (args[0] != "lsystem")
-    throw UsageError{"unknown benchmark '" + args[0] + "' (available: lsystem, raycast, geometry, gpu, fog, spp, light)"};
+    throw UsageError{"unknown benchmark '" + args[0] + "' (available: lsystem, raycast, geometry, gpu, fog, spp, light, export)"};
   bool quick = false;
   std::string presets = SYLVA_PRESETS_DIR;
   std::vector<std::string> gb_args = {"sylva-bench"};

@@ -18,6 +18,7 @@
 
 #include "app/front/light.h"
 #include "app/front/batch.h"
+#include "app/front/impostor.h"
 #include "app/cli/cli.h"
 #include "core/grow/grow.h"
 #include "core/io/gltf.h"
@@ -32,7 +33,8 @@ namespace {
 
 void print_export_help() {
   std::cout << "usage: sylva export INPUT -o FILE.gltf|FILE.glb [--mesh] [--segments-around N] [--instancing]\n"
-               "                    [--rig [--max-joints N]] [--animation] [--wind-data]\n"
+               "                    [--rig [--max-joints N]] [--animation] [--wind-data] [--lod N]\n"
+               "                    [--compress meshopt]\n"
                "                    [--extras compact|full|none] [--skin smooth|paper]\n"
                "                    [--bark-albedo FILE] [--bark-height FILE] [--relief-depth M]\n"
                "                    [--u-repeat N] [--v-per-metre N]\n"
@@ -59,6 +61,13 @@ void print_export_help() {
                "                           whole cycles per duration_s\n"
                "      --wind-data          per-vertex wind data for shaders (needs --mesh): TEXCOORD_2 =\n"
                "                           (pivot x, pivot y), TEXCOORD_3 = (pivot z, level + phase)\n"
+               "      --lod N              levels of detail NAME_LOD0 ... NAME_LODN (needs --mesh), N from 1\n"
+               "                           to 6: each re-meshed from the skeleton with about a quarter\n"
+               "                           of the triangles before, the last two crossed impostor cards\n"
+               "                           drawn by the CPU ray caster (docs/gltf.md)\n"
+               "      --compress meshopt   encode the vertex and index data with EXT_meshopt_compression\n"
+               "                           (lossless; then required: three.js, Babylon and glTFast\n"
+               "                           decode it, Blender 3.4 and Godot cannot); default: none\n"
                "      --skin S             how chains meet in the mesh and extras' skinning, for every\n"
                "                           plant (over a scene's skin keys): smooth (the default) or\n"
                "                           paper (Bhagvat et al. 2009's mitred chains)\n"
@@ -175,6 +184,19 @@ int run_export(const std::vector<std::string>& raw_args) {
       set_flag({"--rig"}, options.rig),
       set_flag({"--animation"}, animation),
       set_flag({"--wind-data"}, options.wind_data),
+      value_flag({"--compress"},
+                 [&options](const std::string&, const std::string& v) {
+                   if (v == "meshopt") options.compress = GltfCompression::meshopt;
+                   else if (v == "none") options.compress = GltfCompression::none;
+                   else throw UsageError{"--compress " + v + ": expected meshopt or none"};
+                 }),
+      value_flag({"--lod"},
+                 [&options](const std::string&, const std::string& v) {
+                   const auto n = parse_u64(v);
+                   if (!n || *n < 1 || *n > kMaxLodLevels)
+                     throw UsageError{"--lod " + v + ": expected an integer from 1 to " + std::to_string(kMaxLodLevels)};
+                   options.lod = static_cast<uint32_t>(*n);
+                 }),
       noting_given(value_flag({"--max-joints"},
                               [&options](const std::string&, const std::string& v) {
                                 const auto n = parse_u64(v);
@@ -233,6 +255,8 @@ int run_export(const std::vector<std::string>& raw_args) {
   if (max_joints_given && !options.rig) throw UsageError{"--max-joints sizes the rig: add --rig"};
   if (animation && !options.rig) throw UsageError{"--animation poses the rig: add --rig"};
   if (options.wind_data && !options.mesh) throw UsageError{"--wind-data is per mesh vertex: add --mesh"};
+  if (options.lod > 0 && !options.mesh) throw UsageError{"--lod re-meshes the plant: add --mesh"};
+  if (options.lod > 0) options.card_renderer = cpu_card_renderer({});
   // The default sway; a scene's own `animation` key replaces it below.
   if (animation) options.animation = wind_clip_of(SceneAnimation{});
   if (range && !has_seed_placeholder(a.output))
@@ -275,6 +299,7 @@ int run_export(const std::vector<std::string>& raw_args) {
     options.materials = scene.materials;  // one glTF material per entry (docs/materials.md)
     if (animation && scene.animation) options.animation = wind_clip_of(*scene.animation);
     if (scene.animation) options.wind_seed = scene.animation->seed;
+    if (options.lod > 0) options.card_renderer = cpu_card_renderer(scene.materials);
     // A plant's grammar error: the grammar's place, and a note at the scene key naming it.
     if (Status grown = grow_scene_plants(scene, a.max_modules, {}, &cpu_light_oracle()); !grown) {
       std::cerr << grown.error().format();

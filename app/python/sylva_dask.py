@@ -74,14 +74,14 @@ def _seed_task(kind, text, grammar_path, seed, path, steps, defines, export_opti
 
 
 def batch(client, kind, grammar, seeds, output, *, steps=None, defines=None, mesh=False, segments_around=8,
-          extras="compact", rig=False, max_joints=128, animation=None, wind_data=False):
+          extras="compact", rig=False, max_joints=128, animation=None, wind_data=False, lod=0, compress="none"):
     """Grows (``kind="grow"``) or exports (``kind="export"``) every seed of ``grammar`` on the
     workers of ``client`` (a ``dask.distributed.Client``), one task per seed, into
     ``output`` with ``{seed}`` replaced. Returns the paths written, in the order of ``seeds``.
 
     ``steps`` and ``defines`` are ``sylva grow``'s ``-n`` and ``-D``; ``mesh``,
     ``segments_around``, ``extras``, ``rig``, ``max_joints``, ``animation`` (True or a dict of
-    a scene's animation keys) and ``wind_data`` are ``sylva.export_gltf``'s (docs/gltf.md), with
+    a scene's animation keys), ``wind_data``, ``lod`` and ``compress`` are ``sylva.export_gltf``'s (docs/gltf.md), with
     its defaults (``extras`` is ``"compact"`` here, as ``sylva export --extras``, so the files
     are the CLI batch's).
     The grammar is parsed here first, so a bad grammar raises ``sylva.GrammarError`` before
@@ -112,7 +112,8 @@ def batch(client, kind, grammar, seeds, output, *, steps=None, defines=None, mes
         parsed.grow(steps=0, defines=defines)  # unknown define names, bad values: here too
     paths = [output_path(output, seed) for seed in seeds]
     export_options = dict(mesh=mesh, segments_around=segments_around, extras=extras, rig=rig,
-                          max_joints=max_joints, animation=animation, wind_data=wind_data)
+                          max_joints=max_joints, animation=animation, wind_data=wind_data, lod=lod,
+                          compress=compress)
     futures = client.map(_seed_task, [kind] * len(seeds), [parsed.text] * len(seeds), [parsed.file] * len(seeds),
                          seeds, paths, [steps] * len(seeds), [defines] * len(seeds), [export_options] * len(seeds),
                          pure=False)

@@ -25,6 +25,7 @@
 #include <utility>
 #include <vector>
 
+#include "app/front/impostor.h"
 #include "app/front/light.h"
 #include "core/scene/scene_json.h"
 #include "app/python/sylva_python.h"
@@ -578,7 +579,7 @@ void python_export_gltf(const py::object& plants, const std::filesystem::path& p
                         bool instancing, const py::object& names, const py::object& positions,
                         const py::object& rotate_y_deg, const py::object& scales, const py::object& bark,
                         const std::string& extras, const std::string& skin, bool rig, int max_joints,
-                        const py::object& animation, bool wind_data) {
+                        const py::object& animation, bool wind_data, int lod, const std::string& compress) {
   const SkinStyle style = skin_style_argument(skin);
   const std::vector<const Skeleton*> skeletons = skeleton_list(plants);
   if (skeletons.empty()) throw py::value_error("export_gltf needs at least one plant");
@@ -635,6 +636,12 @@ void python_export_gltf(const py::object& plants, const std::filesystem::path& p
     throw py::value_error("max_joints must be from 1 to " + std::to_string(kMaxRigJoints));
   options.max_joints = static_cast<uint32_t>(max_joints);
   options.wind_data = wind_data;
+  if (lod < 0 || lod > static_cast<int>(kMaxLodLevels))
+    throw py::value_error("lod must be from 0 (none) to " + std::to_string(kMaxLodLevels));
+  options.lod = static_cast<uint32_t>(lod);
+  if (lod > 0) options.card_renderer = cpu_card_renderer({});
+  if (compress == "meshopt") options.compress = GltfCompression::meshopt;
+  else if (compress != "none") throw py::value_error("compress must be \"none\" or \"meshopt\", got \"" + compress + "\"");
   // animation: True for the default sway, or a dict with the keys of a scene's "animation".
   if (!animation.is_none() && !(py::isinstance<py::bool_>(animation) && !animation.cast<bool>())) {
     SceneAnimation a;
@@ -895,8 +902,8 @@ and where no light arrived). A grammar without ?E gives an empty (0, 7) array.)d
         "segments_around"_a = 8, "instancing"_a = false, "names"_a = py::none(), "positions"_a = py::none(),
         "rotate_y_deg"_a = py::none(), "scales"_a = py::none(), "bark"_a = py::none(), "extras"_a = "full",
         "skin"_a = "smooth", "rig"_a = false, "max_joints"_a = static_cast<int>(kDefaultRigJoints),
-        "animation"_a = py::none(), "wind_data"_a = false,
-        R"doc(export_gltf(plants: Skeleton | Sequence[Skeleton], path: str | os.PathLike, *, mesh: bool = False, segments_around: int = 8, instancing: bool = False, names: Sequence[str] | None = None, positions: Sequence[tuple[float, float, float]] | None = None, rotate_y_deg: Sequence[float] | None = None, scales: Sequence[float] | None = None, bark: dict | None = None, extras: str = "full", skin: str = "smooth", rig: bool = False, max_joints: int = 128, animation: bool | dict | None = None, wind_data: bool = False) -> None
+        "animation"_a = py::none(), "wind_data"_a = false, "lod"_a = 0, "compress"_a = "none",
+        R"doc(export_gltf(plants: Skeleton | Sequence[Skeleton], path: str | os.PathLike, *, mesh: bool = False, segments_around: int = 8, instancing: bool = False, names: Sequence[str] | None = None, positions: Sequence[tuple[float, float, float]] | None = None, rotate_y_deg: Sequence[float] | None = None, scales: Sequence[float] | None = None, bark: dict | None = None, extras: str = "full", skin: str = "smooth", rig: bool = False, max_joints: int = 128, animation: bool | dict | None = None, wind_data: bool = False, lod: int = 0, compress: str = "none") -> None
 
 Writes plants to a glTF 2.0 file, binary (.glb) or JSON (.gltf) by extension.
 
@@ -934,6 +941,12 @@ Keyword-only:
                    cycles per duration_s; plant i sways as plant i of a scene
   wind_data        per-vertex wind data for shaders (needs mesh=True): TEXCOORD_2 =
                    (pivot x, pivot y), TEXCOORD_3 = (pivot z, level + phase)
+  lod              levels of detail NAME_LOD0 ... NAME_LODn (needs mesh=True), 0 (none) to
+                   6: each re-meshed with about a quarter of the triangles before, the last
+                   crossed impostor cards drawn by the CPU ray caster
+  compress         "none" (default) or "meshopt": the vertex and index data encoded with
+                   EXT_meshopt_compression (lossless, then required; three.js, Babylon and
+                   glTFast decode it, Blender 3.4 and Godot cannot)
 The mesh has one material per material index the plants use. The file is written
 atomically; a file that cannot be read or written (a missing texture, a missing folder,
 a FIFO or read-only target) raises OSError, plants beyond the limits (docs/limits.md)

@@ -1,6 +1,8 @@
 // studio_app.cpp — see studio_app.h.
 #include "app/studio/studio_app.h"
 
+#include "app/front/impostor.h"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -508,6 +510,9 @@ std::optional<std::string> StudioApp::export_gltf_file(const std::string& path, 
   o.rig = choice.rig;
   o.max_joints = static_cast<uint32_t>(std::clamp(choice.max_joints, 1, static_cast<int>(kMaxRigJoints)));
   o.wind_data = choice.wind_data;
+  o.lod = static_cast<uint32_t>(std::clamp(choice.lod, 0, static_cast<int>(kMaxLodLevels)));
+  if (o.lod > 0) o.card_renderer = cpu_card_renderer(scene_.materials);
+  if (choice.meshopt) o.compress = GltfCompression::meshopt;
   const SceneAnimation animation = scene_.animation.value_or(SceneAnimation{});
   o.wind_seed = animation.seed;
   if (choice.animation)
@@ -1225,8 +1230,13 @@ void StudioApp::draw_file_dialog() {
                     &c.animation);
     ImGui::EndDisabled();
     ImGui::Checkbox("wind data for shaders (TEXCOORD_2/3)", &c.wind_data);
+    ImGui::SetNextItemWidth(100);
+    ImGui::InputInt("levels of detail (0: none; the last are impostor cards)", &c.lod);
+    c.lod = std::clamp(c.lod, 0, static_cast<int>(kMaxLodLevels));
     ImGui::EndDisabled();
-    if (!c.mesh) c.rig = c.wind_data = false;
+    ImGui::Checkbox("compress (EXT_meshopt_compression: three.js, Babylon, Unity; not Blender 3.4, Godot)",
+                    &c.meshopt);
+    if (!c.mesh) c.rig = c.wind_data = false, c.lod = 0;
     if (!c.rig) c.animation = false;
   }
   go |= ImGui::Button("OK");

@@ -152,6 +152,8 @@ class StudioApp {
     int max_joints = 128;
     bool animation = false;
     bool wind_data = false;
+    int lod = 0;  // levels of detail beyond LOD0, the last impostor cards (0: none)
+    bool meshopt = false;  // EXT_meshopt_compression (then required)
   };
   std::optional<std::string> export_gltf_file(const std::string& path, const GltfChoice& choice);
   std::optional<std::string> export_skeleton_file(const std::string& path);

@@ -101,12 +101,14 @@
 // warnings (checked in CI by scripts/validate_gltf.mjs).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "core/scene/animate.h"
 #include "core/scene/scene.h"
 #include "core/geometry/skeleton.h"
+#include "core/io/gltf_lod.h"
 #include "core/io/gltf_rig.h"
 #include "core/util/diagnostic.h"
 
@@ -150,6 +152,26 @@ uint64_t wind_clip_intervals(const GltfWindClip& clip);
 // Why `clip` cannot be written (duration, fps or key count out of range), or nothing.
 std::optional<std::string> wind_clip_problem(const GltfWindClip& clip);
 
+// An impostor card's image (LOD, gltf_lod.h): RGBA, 8 bits, sRGB colour, straight alpha,
+// rows from the top.
+struct CardImage {
+  uint32_t width = 0, height = 0;
+  std::vector<uint8_t> rgba;
+};
+// Renders `plant` (its skeleton in its own frame, its bark) as seen on `card`, from the
+// side card.normal points to, the image's right along card.right, width × height pixels
+// covering the card exactly. The front end supplies it (app/front/impostor.h: the CPU ray
+// caster); core/io renders nothing itself.
+using CardRenderer = std::function<Expected<CardImage>(const GltfPlant& plant, const ImpostorCard& card,
+                                                       uint32_t width, uint32_t height)>;
+
+// How the file's buffers are stored (docs/gltf.md "Compression").
+enum class GltfCompression {
+  none,     // plain: no extension required (Blender 3.4, Godot and every viewer read it)
+  meshopt,  // EXT_meshopt_compression (required then): the accessors' views encoded by
+            // meshoptimizer's lossless codecs; three.js, Babylon and glTFast decode it
+};
+
 struct GltfExportOptions {
   bool mesh = false;            // also write the tessellated frusta as a triangle mesh
   int segments_around = 8;      // columns around each frustum for the mesh (>= 3)
@@ -168,6 +190,13 @@ struct GltfExportOptions {
   // then always present (TEXCOORD_0's values where no texture needs its own).
   bool wind_data = false;
   uint64_t wind_seed = 0;  // the sway seed the phases come from (a scene animation's `seed`)
+  // Levels of detail (needs `mesh`; gltf_lod.h): 0 none; N in 1 .. kMaxLodLevels writes
+  // nodes NAME_LOD0 … NAME_LOD(N−1) re-meshed from the skeleton and NAME_LODN, the
+  // impostor cards, card_pixels tall, drawn by card_renderer (required then).
+  uint32_t lod = 0;
+  uint32_t card_pixels = 256;
+  CardRenderer card_renderer = {};
+  GltfCompression compress = GltfCompression::none;
 };
 
 // Writes `plants` to `path` (.glb or .gltf by extension). An error is a Diagnostic naming

@@ -25,6 +25,7 @@
 #include <utility>
 
 #include <OpenImageIO/imageio.h>
+#include <meshoptimizer.h>
 
 #include <glm/geometric.hpp>
 
@@ -57,10 +58,19 @@ constexpr int kFilterLinear = 9729;
 constexpr int kFilterLinearMipmapLinear = 9987;
 constexpr int kWrapRepeat = 10497;
 
+// How EXT_meshopt_compression may encode a bufferView (none: never, it stays as it is).
+enum class MeshoptMode { none, attributes, triangles, indices };
+
 struct BufferView {
   size_t offset = 0;
   size_t length = 0;
   int target = 0;  // 0: none (instancing attributes)
+  MeshoptMode meshopt = MeshoptMode::none;
+  size_t stride = 0;  // bytes an element (meshopt modes)
+  // After BufferBuilder::compress_meshopt, for an encoded view: where its bytes are in the
+  // fallback buffer 1 (offset, length) and its encoding in buffer 0.
+  bool compressed = false;
+  size_t encoded_offset = 0, encoded_length = 0;
 };
 
 struct Accessor {
@@ -89,6 +99,7 @@ class BufferBuilder {
       a.max[k] = std::max(a.max[k], static_cast<double>(values[i]));
     }
     a.view = add_view(values.data(), values.size() * sizeof(float), target);
+    set_meshopt(a.view, MeshoptMode::attributes, sizeof(float) * static_cast<size_t>(components));
     accessors_.push_back(std::move(a));
     return accessors_.size() - 1;
   }
@@ -107,11 +118,13 @@ class BufferBuilder {
       a.max[i % n] = std::max(a.max[i % n], static_cast<double>(values[i]));
     }
     a.view = add_view(values.data(), values.size() * sizeof(uint16_t), target);
+    set_meshopt(a.view, MeshoptMode::attributes, sizeof(uint16_t) * n);
     accessors_.push_back(std::move(a));
     return accessors_.size() - 1;
   }
 
-  size_t add_indices(const std::vector<uint32_t>& indices) {
+  // Indices of a primitive: `triangles` for a triangle list, else (LINES) any sequence.
+  size_t add_indices(const std::vector<uint32_t>& indices, bool triangles = true) {
     Accessor a;
     a.component = kComponentUint32;
     a.count = indices.size();
@@ -120,6 +133,8 @@ class BufferBuilder {
     a.min = {static_cast<double>(lo)};
     a.max = {static_cast<double>(hi)};
     a.view = add_view(indices.data(), indices.size() * sizeof(uint32_t), kTargetElementArrayBuffer);
+    set_meshopt(a.view, triangles && indices.size() % 3 == 0 ? MeshoptMode::triangles : MeshoptMode::indices,
+                sizeof(uint32_t));
     accessors_.push_back(std::move(a));
     return accessors_.size() - 1;
   }
@@ -134,6 +149,59 @@ class BufferBuilder {
     return add_view(values.data(), values.size() * sizeof(T), 0, 8);
   }
 
+  // EXT_meshopt_compression (`--compress meshopt`): every view an accessor reads is encoded
+  // (vertex codec for attributes, index codec version 1 for triangle lists, the index
+  // sequence codec for other indices) into buffer 0; its plain bytes move to the fallback
+  // buffer 1, which the file does not hold. Views without a codec (images, compact
+  // extras) stay in buffer 0 as they are, aligned as they were.
+  void compress_meshopt() {
+    meshopt_encodeIndexVersion(1);
+    std::string out, encoded;
+    fallback_length_ = 0;
+    for (BufferView& v : views_) {
+      const unsigned char* data = reinterpret_cast<const unsigned char*>(bytes_.data()) + v.offset;
+      if (v.meshopt == MeshoptMode::none || v.length == 0) {
+        const size_t alignment = v.target == 0 && v.meshopt == MeshoptMode::none ? 8 : 4;
+        while (out.size() % alignment != 0) out.push_back('\0');
+        const size_t offset = out.size();
+        out.append(reinterpret_cast<const char*>(data), v.length);
+        v.offset = offset;
+        continue;
+      }
+      const size_t count = v.length / v.stride;
+      if (v.meshopt == MeshoptMode::attributes) {
+        encoded.resize(meshopt_encodeVertexBufferBound(count, v.stride));
+        encoded.resize(meshopt_encodeVertexBuffer(reinterpret_cast<unsigned char*>(encoded.data()), encoded.size(), data,
+                                                  count, v.stride));
+      } else {
+        std::vector<unsigned int> indices(count);
+        std::memcpy(indices.data(), data, v.length);
+        const size_t vertices = indices.empty() ? 0 : *std::max_element(indices.begin(), indices.end()) + 1;
+        encoded.resize(v.meshopt == MeshoptMode::triangles ? meshopt_encodeIndexBufferBound(count, vertices)
+                                                            : meshopt_encodeIndexSequenceBound(count, vertices));
+        encoded.resize(v.meshopt == MeshoptMode::triangles
+                           ? meshopt_encodeIndexBuffer(reinterpret_cast<unsigned char*>(encoded.data()), encoded.size(),
+                                                       indices.data(), count)
+                           : meshopt_encodeIndexSequence(reinterpret_cast<unsigned char*>(encoded.data()),
+                                                         encoded.size(), indices.data(), count));
+      }
+      while (out.size() % 4 != 0) out.push_back('\0');
+      v.encoded_offset = out.size();
+      v.encoded_length = encoded.size();
+      out += encoded;
+      while (fallback_length_ % 4 != 0) ++fallback_length_;
+      v.offset = fallback_length_;
+      fallback_length_ += v.length;
+      v.compressed = true;
+    }
+    bytes_ = std::move(out);
+  }
+  size_t fallback_length() const { return fallback_length_; }
+  bool has_meshopt_views() const {
+    return std::any_of(views_.begin(), views_.end(),
+                       [](const BufferView& v) { return v.meshopt != MeshoptMode::none && v.length > 0; });
+  }
+
   const std::string& bytes() const { return bytes_; }
   const std::vector<BufferView>& views() const { return views_; }
   const std::vector<Accessor>& accessors() const { return accessors_; }
@@ -146,9 +214,15 @@ class BufferBuilder {
     return views_.size() - 1;
   }
 
+  void set_meshopt(size_t view, MeshoptMode mode, size_t stride) {
+    views_[view].meshopt = mode;
+    views_[view].stride = stride;
+  }
+
   std::string bytes_;
   std::vector<BufferView> views_;
   std::vector<Accessor> accessors_;
+  size_t fallback_length_ = 0;
 };
 
 void write_vec3(JsonWriter& w, const glm::dvec3& v) {
@@ -568,6 +642,12 @@ class MaterialTable {
   }
   const LeafImages* leaf_images() const { return leaf_images_.get(); }
 
+  // An image made here (an impostor card's PNG), embedded once per key.
+  size_t png_texture(const std::string& key, std::string png) {
+    if (auto it = image_of_.find(key); it != image_of_.end()) return it->second;
+    return add_image(key, {std::move(png), "image/png"});
+  }
+
   // The index of a material, written once however many plants use it.
   size_t material(const std::string& json) {
     auto [it, inserted] = material_of_.emplace(json, materials_.size());
@@ -635,6 +715,7 @@ struct GltfDocument {
   std::vector<std::string> meshes, nodes, skins;
   std::vector<size_t> roots;  // the scene's nodes
   bool any_instancing = false;
+  bool compress_meshopt = false;  // GltfExportOptions::compress == meshopt
   // The wind clip (GltfExportOptions::animation): its key times' accessor, written once,
   // and its samplers and channels (JSON objects), every plant's.
   std::optional<size_t> clip_times;
@@ -703,8 +784,10 @@ struct WindSource {
 };
 
 // TEXCOORD_2 = (pivot.x, pivot.y), TEXCOORD_3 = (pivot.z, level + phase) as the text
-// `,"TEXCOORD_2":a,"TEXCOORD_3":b`. The phase is kept below 1 in float.
-std::string wind_attributes(const std::vector<WindVertex>& wind, BufferBuilder& buffer) {
+// `,"TEXCOORD_2":a,"TEXCOORD_3":b`, preceded by `,"TEXCOORD_1":texcoord_1` when given
+// (glTF numbers the sets without gaps). The phase is kept below 1 in float.
+std::string wind_attributes(const std::vector<WindVertex>& wind, BufferBuilder& buffer,
+                            std::optional<size_t> texcoord_1 = std::nullopt) {
   std::vector<float> xy, zl;
   xy.reserve(2 * wind.size());
   zl.reserve(2 * wind.size());
@@ -716,7 +799,21 @@ std::string wind_attributes(const std::vector<WindVertex>& wind, BufferBuilder& 
   }
   const size_t a = buffer.add_floats(xy, 2, "VEC2", kTargetArrayBuffer);
   const size_t b = buffer.add_floats(zl, 2, "VEC2", kTargetArrayBuffer);
-  return ",\"TEXCOORD_2\":" + std::to_string(a) + ",\"TEXCOORD_3\":" + std::to_string(b);
+  return (texcoord_1 ? ",\"TEXCOORD_1\":" + std::to_string(*texcoord_1) : std::string()) + ",\"TEXCOORD_2\":" +
+         std::to_string(a) + ",\"TEXCOORD_3\":" + std::to_string(b);
+}
+
+// POSITION, NORMAL and TEXCOORD_0 (its accessor in *texcoord_0) of flat geometry (leaves,
+// cards) as the text of a JSON object left open for the skin and wind attributes.
+std::string open_flat_attributes(const std::vector<float>& positions, const std::vector<float>& normals,
+                                 const std::vector<float>& texcoords, BufferBuilder& buffer, size_t* texcoord_0) {
+  JsonWriter attributes;
+  attributes.begin_object();
+  attributes.key("POSITION").integer(buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer));
+  attributes.key("NORMAL").integer(buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer));
+  *texcoord_0 = buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer);
+  attributes.key("TEXCOORD_0").integer(*texcoord_0);
+  return attributes.take();
 }
 
 // The wind data of the segments' mesh: each vertex on its frustum's chain, pivoting about
@@ -792,7 +889,7 @@ void add_skeleton_lines(const Skeleton& sk, BufferBuilder& buffer, MeshPrimitive
   }
   const size_t pos = buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer);
   const size_t rad = buffer.add_floats(radii, 1, "SCALAR", kTargetArrayBuffer);
-  const size_t idx = buffer.add_indices(pairs);
+  const size_t idx = buffer.add_indices(pairs, /*triangles=*/false);
   JsonWriter& json = primitives.json;
   json.begin_object();
   json.key("attributes").begin_object().key("POSITION").integer(pos).key("_RADIUS").integer(rad).end_object();
@@ -918,13 +1015,8 @@ Status add_leaf_mesh(const Skeleton& sk, const GltfExportOptions& options, const
   const std::map<uint32_t, std::vector<uint32_t>> triangles_of = triangles_by_material(
       leaves.indices, leaves.triangle_count(), [&](size_t t) { return leaves.leaves[leaves.triangle_leaf[t]].material; });
   if (triangles_of.empty()) return {};
-  JsonWriter attributes;
-  attributes.begin_object();
-  attributes.key("POSITION").integer(doc.buffer.add_floats(positions, 3, "VEC3", kTargetArrayBuffer));
-  attributes.key("NORMAL").integer(doc.buffer.add_floats(normals, 3, "VEC3", kTargetArrayBuffer));
-  const size_t texcoord_0 = doc.buffer.add_floats(texcoords, 2, "VEC2", kTargetArrayBuffer);
-  attributes.key("TEXCOORD_0").integer(texcoord_0);
-  std::string attribute_text = attributes.take();
+  size_t texcoord_0 = 0;
+  std::string attribute_text = open_flat_attributes(positions, normals, texcoords, doc.buffer, &texcoord_0);
   if (wind) {  // each leaf pivots about its joint, one level above its chain
     std::vector<WindVertex> data;
     data.reserve(leaves.vertex_leaf.size());
@@ -932,17 +1024,18 @@ Status add_leaf_mesh(const Skeleton& sk, const GltfExportOptions& options, const
       const Leaf& leaf = sk.leaves[leaves.leaves[leaves.vertex_leaf[v]].leaf];
       if (leaf.joint)
         data.push_back(wind->on_chain(leaf.joint->chain, 1,
-                                      wind->joint(sk.chains[leaf.joint->chain].first_joint + leaf.joint->joint)));
+                                      wind->joint(wind->skeleton.chains[leaf.joint->chain].first_joint +
+                                                  leaf.joint->joint)));
       else  // a leaf before the first segment: about its first vertex, level 1, phase 0
         data.push_back({{leaf.vertices_m[0][0], leaf.vertices_m[0][1], leaf.vertices_m[0][2]}, 1, 0});
     }
-    attribute_text += ",\"TEXCOORD_1\":" + std::to_string(texcoord_0) + wind_attributes(data, doc.buffer);
+    attribute_text += wind_attributes(data, doc.buffer, texcoord_0);
   }
   if (rig) {  // each leaf rides as its joint does
     std::vector<RigWeights> weights;
     weights.reserve(leaves.vertex_leaf.size());
     for (uint32_t l : leaves.vertex_leaf)
-      weights.push_back(rig_weights_at_joint(rig->rig, sk, sk.leaves[leaves.leaves[l].leaf].joint));
+      weights.push_back(rig_weights_at_joint(rig->rig, rig->skeleton, sk.leaves[leaves.leaves[l].leaf].joint));
     attribute_text += skin_attributes(weights, doc.buffer);
   }
   attribute_text += "}";
@@ -1087,7 +1180,8 @@ void add_clip_channels(GltfDocument& doc, const Skeleton& sk, const Rig& rig, si
 // translations, in the plant's frame), and a scene root node NAME_skin drawing the
 // skinned `primitives` (glTF ignores a skinned mesh node's transform; the placement
 // reaches the mesh through the joints under the plant's node).
-void add_rig_nodes(GltfDocument& doc, const GltfPlant& plant, const Rig& rig, const MeshPrimitives& primitives) {
+void add_rig_nodes(GltfDocument& doc, const GltfPlant& plant, const Rig& rig,
+                   const std::vector<std::pair<std::string, MeshPrimitives>>& surfaces) {
   const size_t base = doc.nodes.size();
   std::vector<std::vector<size_t>> children(rig.joints.size());
   for (size_t j = 1; j < rig.joints.size(); ++j) children[rig.joints[j].parent].push_back(j);
@@ -1127,51 +1221,160 @@ void add_rig_nodes(GltfDocument& doc, const GltfPlant& plant, const Rig& rig, co
   skin.key("skeleton").integer(base);
   skin.end_object();
   doc.skins.push_back(skin.take());
-  if (primitives.count == 0) return;
-  JsonWriter mesh;
-  mesh.begin_object().key("name").string(plant.name + "_skin").key("primitives").raw(primitives.json.text()).end_object();
-  doc.meshes.push_back(mesh.take());
-  JsonWriter node;
-  node.begin_object().key("mesh").integer(doc.meshes.size() - 1).key("name").string(plant.name + "_skin");
-  node.key("skin").integer(doc.skins.size() - 1).end_object();
-  doc.roots.push_back(doc.nodes.size());
-  doc.nodes.push_back(node.take());
+  for (const auto& [name, primitives] : surfaces) {
+    if (primitives.count == 0) continue;
+    JsonWriter mesh;
+    mesh.begin_object().key("name").string(name).key("primitives").raw(primitives.json.text()).end_object();
+    doc.meshes.push_back(mesh.take());
+    JsonWriter node;
+    node.begin_object().key("mesh").integer(doc.meshes.size() - 1).key("name").string(name);
+    node.key("skin").integer(doc.skins.size() - 1).end_object();
+    doc.roots.push_back(doc.nodes.size());
+    doc.nodes.push_back(node.take());
+  }
+}
+
+// The surface of one skeleton (the plant, or a level of detail of it: its chains and
+// joints indexed as the plant's): the tessellated segments and the leaves.
+Status add_surface(const Skeleton& sk, const SkinnedSkeleton& skinned, const Bark& bark,
+                   const GltfExportOptions& options, const PlantRig* rig, const WindSource* wind, GltfDocument& doc,
+                   MeshPrimitives& primitives) {
+  if (options.mesh && !skinned.frusta.empty())
+    if (Status added = add_segment_mesh(skinned, bark, options, rig, wind, doc, primitives); !added) return added;
+  if (options.mesh && !sk.leaves.empty())
+    if (Status added = add_leaf_mesh(sk, options, rig, wind, doc, primitives); !added) return added;
+  return {};
+}
+
+// The impostor cards (gltf_lod.h) of `plant` as one primitive each: a double-sided,
+// cut-out quad textured with card_renderer's image; on the rig's root, the wind data's
+// pivot at the plant's origin (level 0, phase 0).
+Status add_impostor_cards(const GltfPlant& plant, size_t plant_index, const GltfExportOptions& options,
+                          const PlantRig* rig, const WindSource* wind, GltfDocument& doc, MeshPrimitives& primitives) {
+  const std::optional<std::vector<ImpostorCard>> cards = impostor_cards(plant.skeleton);
+  if (!cards) return {};
+  for (size_t i = 0; i < cards->size(); ++i) {
+    const ImpostorCard& card = (*cards)[i];
+    const uint32_t height = options.card_pixels;
+    const uint32_t width = static_cast<uint32_t>(
+        std::clamp(std::lround(height * card.half_width_m / card.half_height_m), 1L, 4L * height));
+    Expected<CardImage> image = options.card_renderer(plant, card, width, height);
+    if (!image) return std::move(image.error());
+    if (image->width == 0 || image->height == 0 || image->rgba.size() != size_t{4} * image->width * image->height)
+      return file_diagnostic("", "the impostor card renderer gave " + plant.name + " an image of the wrong size");
+    std::optional<std::string> png = encode_png_in_memory(image->width, image->height, 4, image->rgba);
+    if (!png) return file_diagnostic("", "cannot encode the impostor card of " + plant.name + " as PNG");
+    const size_t texture =
+        doc.table.png_texture("card:" + std::to_string(plant_index) + ":" + std::to_string(i), std::move(*png));
+    JsonWriter material;
+    material.begin_object();
+    material.key("alphaCutoff").number(0.5).key("alphaMode").string("MASK").key("doubleSided").boolean(true);
+    material.key("name").string(plant.name + "_card_" + std::to_string(i));
+    material.key("pbrMetallicRoughness").begin_object();
+    material.key("baseColorTexture").begin_object().key("index").integer(texture).end_object();
+    material.key("metallicFactor").number(0).key("roughnessFactor").number(1).end_object();
+    material.end_object();
+    // The quad: image rows from the top (glTF's t runs down the image).
+    const glm::dvec3 up(0, 1, 0);
+    const glm::dvec3 corner[4] = {card.centre_m - card.half_width_m * card.right + card.half_height_m * up,
+                                  card.centre_m + card.half_width_m * card.right + card.half_height_m * up,
+                                  card.centre_m + card.half_width_m * card.right - card.half_height_m * up,
+                                  card.centre_m - card.half_width_m * card.right - card.half_height_m * up};
+    std::vector<float> positions, normals, texcoords = {0, 0, 1, 0, 1, 1, 0, 1};
+    for (const glm::dvec3& c : corner) append_float3(positions, c), append_unit_float3(normals, card.normal);
+    size_t texcoord_0 = 0;
+    std::string text = open_flat_attributes(positions, normals, texcoords, doc.buffer, &texcoord_0);
+    if (rig) text += skin_attributes(std::vector<RigWeights>(4), doc.buffer);
+    if (wind) text += wind_attributes(std::vector<WindVertex>(4), doc.buffer, texcoord_0);
+    text += "}";
+    // Counter-clockwise seen from the side the normal points to.
+    const glm::dvec3 turn = glm::cross(corner[1] - corner[0], corner[3] - corner[0]);
+    const std::vector<uint32_t> indices = glm::dot(turn, card.normal) < 0 ? std::vector<uint32_t>{0, 3, 2, 0, 2, 1}
+                                                                           : std::vector<uint32_t>{0, 1, 2, 0, 2, 3};
+    JsonWriter& json = primitives.json;
+    json.begin_object();
+    json.key("attributes").raw(text);
+    json.key("indices").integer(doc.buffer.add_indices(indices));
+    json.key("material").integer(doc.table.material(material.take()));
+    json.key("mode").integer(kModeTriangles);
+    json.end_object();
+    ++primitives.count;
+  }
+  return {};
 }
 
 // The mesh (where it has primitives) and the node of one group of plants, added to `doc`;
 // with `rig` (a group of one plant, plants[group.plants.front()]) the triangles are
-// skinned to it instead (add_rig_nodes) and, with options.animation, sway in the clip.
+// skinned to it instead (add_rig_nodes) and, with options.animation, sway in the clip;
+// with options.lod the triangles are levels of detail NAME_LOD0 … NAME_LODN (children of
+// the plant's node, or skinned scene roots with a rig).
 Status add_plant_group(GltfDocument& doc, const std::vector<GltfPlant>& plants, const PlantGroup& group,
                        const GltfExportOptions& options, const Rig* rig) {
-  const GltfPlant& plant = plants[group.plants.front()];
+  const size_t plant_index = group.plants.front();
+  const GltfPlant& plant = plants[plant_index];
   const Skeleton& sk = plant.skeleton;
-  const SkinnedSkeleton skinned = skin_skeleton(sk, SkinOptions{}.styled(plant.skin));
+  const SkinOptions skin_options = SkinOptions{}.styled(plant.skin);
+  const SkinnedSkeleton skinned = skin_skeleton(sk, skin_options);
   const std::optional<PlantRig> plant_rig = rig ? std::optional<PlantRig>(PlantRig{*rig, sk}) : std::nullopt;
   const PlantRig* weights = plant_rig ? &*plant_rig : nullptr;
   const std::optional<WindSource> wind_source =
       options.wind_data ? std::optional<WindSource>(WindSource{
                               sk, chain_orders(sk),
-                              plant_sway_parameters(SwayParameters{.seed = options.wind_seed}, group.plants.front()).seed})
+                              plant_sway_parameters(SwayParameters{.seed = options.wind_seed}, plant_index).seed})
                         : std::nullopt;
   const WindSource* wind = wind_source ? &*wind_source : nullptr;
 
-  MeshPrimitives primitives, skinned_primitives;
+  MeshPrimitives primitives;  // the plant node's mesh
   primitives.json.begin_array();
-  skinned_primitives.json.begin_array();
-  MeshPrimitives& surface = rig ? skinned_primitives : primitives;
   if (sk.segment_count() > 0) add_skeleton_lines(sk, doc.buffer, primitives);
-  if (options.mesh && !skinned.frusta.empty())
-    if (Status added = add_segment_mesh(skinned, plant.bark, options, weights, wind, doc, surface); !added) return added;
-  if (options.mesh && !sk.leaves.empty())
-    if (Status added = add_leaf_mesh(sk, options, weights, wind, doc, surface); !added) return added;
+  // The surfaces drawn by nodes of their own: the skinned mesh, or the levels of detail.
+  std::vector<std::pair<std::string, MeshPrimitives>> surfaces;
+  if (options.mesh && options.lod > 0) {
+    for (uint32_t level = 0; level <= options.lod; ++level) {
+      MeshPrimitives& level_primitives =
+          surfaces.emplace_back(plant.name + "_LOD" + std::to_string(level), MeshPrimitives{}).second;
+      level_primitives.json.begin_array();
+      if (level == options.lod) {
+        if (Status added = add_impostor_cards(plant, plant_index, options, weights, wind, doc, level_primitives);
+            !added)
+          return added;
+      } else if (level == 0) {
+        if (Status added = add_surface(sk, skinned, plant.bark, options, weights, wind, doc, level_primitives); !added)
+          return added;
+      } else {
+        GltfExportOptions level_options = options;
+        level_options.segments_around = lod_columns(options.segments_around, level);
+        const Skeleton coarse = lod_skeleton(sk, level, options.segments_around);
+        if (Status added = add_surface(coarse, skin_skeleton(coarse, skin_options), plant.bark, level_options, weights,
+                                       wind, doc, level_primitives);
+            !added)
+          return added;
+      }
+      level_primitives.json.end_array();
+    }
+  } else if (rig) {
+    MeshPrimitives& skinned_primitives = surfaces.emplace_back(plant.name + "_skin", MeshPrimitives{}).second;
+    skinned_primitives.json.begin_array();
+    if (Status added = add_surface(sk, skinned, plant.bark, options, weights, wind, doc, skinned_primitives); !added)
+      return added;
+    skinned_primitives.json.end_array();
+  } else {
+    if (Status added = add_surface(sk, skinned, plant.bark, options, weights, wind, doc, primitives); !added)
+      return added;
+  }
   primitives.json.end_array();
-  skinned_primitives.json.end_array();
 
   const size_t plant_node = doc.nodes.size();
   JsonWriter node;
   node.begin_object();
   node.key("name").string(plant.name);
-  if (rig) node.key("children").begin_array().integer(plant_node + 1).end_array();
+  if (rig) {
+    node.key("children").begin_array().integer(plant_node + 1).end_array();
+  } else if (!surfaces.empty()) {  // the levels of detail, placed with the plant
+    node.key("children").begin_array();
+    for (size_t i = 0; i < surfaces.size(); ++i) node.integer(plant_node + 1 + i);
+    node.end_array();
+  }
   if (primitives.count > 0) {
     JsonWriter mesh;
     mesh.begin_object();
@@ -1192,11 +1395,27 @@ Status add_plant_group(GltfDocument& doc, const std::vector<GltfPlant>& plants, 
   doc.roots.push_back(plant_node);
   doc.nodes.push_back(node.take());
   if (rig) {
-    add_rig_nodes(doc, plant, *rig, skinned_primitives);
+    add_rig_nodes(doc, plant, *rig, surfaces);
     if (options.animation) {
-      SwayParameters sway = plant_sway_parameters(options.animation->sway, group.plants.front());
+      SwayParameters sway = plant_sway_parameters(options.animation->sway, plant_index);
       sway.loop_period_s = options.animation->duration_s;
       add_clip_channels(doc, sk, *rig, plant_node + 1, *options.animation, sway);
+    }
+  } else {
+    for (size_t i = 0; i < surfaces.size(); ++i) {
+      const auto& [name, level_primitives] = surfaces[i];
+      JsonWriter child;
+      child.begin_object();
+      if (level_primitives.count > 0) {
+        JsonWriter mesh;
+        mesh.begin_object().key("name").string(name).key("primitives").raw(level_primitives.json.text()).end_object();
+        doc.meshes.push_back(mesh.take());
+        child.key("mesh").integer(doc.meshes.size() - 1);
+      }
+      child.key("name").string(name);
+      if (group.plants.size() > 1) write_instancing(child, plants, group, doc.buffer);
+      child.end_object();
+      doc.nodes.push_back(child.take());
     }
   }
   return {};
@@ -1246,14 +1465,30 @@ void write_buffer_layout(JsonWriter& json, const BufferBuilder& buffer, bool glb
     json.key("bufferViews").begin_array();
     for (const BufferView& v : buffer.views()) {
       json.begin_object();
-      json.key("buffer").integer(0).key("byteOffset").integer(v.offset).key("byteLength").integer(v.length);
+      json.key("buffer").integer(v.compressed ? 1 : 0).key("byteOffset").integer(v.offset);
+      json.key("byteLength").integer(v.length);
       if (v.target) json.key("target").integer(v.target);
+      if (v.compressed) {
+        static constexpr const char* kMode[] = {"", "ATTRIBUTES", "TRIANGLES", "INDICES"};
+        json.key("extensions").begin_object().key("EXT_meshopt_compression").begin_object();
+        json.key("buffer").integer(0).key("byteOffset").integer(v.encoded_offset);
+        json.key("byteLength").integer(v.encoded_length).key("byteStride").integer(v.stride);
+        json.key("count").integer(v.length / v.stride).key("mode").string(kMode[static_cast<int>(v.meshopt)]);
+        json.end_object().end_object();
+      }
       json.end_object();
     }
     json.end_array();
     json.key("buffers").begin_array().begin_object().key("byteLength").integer(bin.size());
     if (!glb) json.key("uri").string("data:application/octet-stream;base64," + base64(bin));
-    json.end_object().end_array();
+    json.end_object();
+    if (buffer.fallback_length() > 0) {  // the encoded views' plain bytes: not in the file
+      json.begin_object().key("byteLength").integer(buffer.fallback_length());
+      json.key("extensions").begin_object().key("EXT_meshopt_compression").begin_object();
+      json.key("fallback").boolean(true).end_object().end_object();
+      json.end_object();
+    }
+    json.end_array();
   }
 }
 
@@ -1266,9 +1501,18 @@ std::string document_json(GltfDocument& doc, bool glb) {
   // The instances' placements exist only in the extension (the node has no fallback
   // transform per instance): a viewer without it would show one plant at the origin, so
   // the extension is required, not merely used (glTF 2.0 sec. 3.12).
-  if (doc.any_instancing) {
-    json.key("extensionsUsed").begin_array().string("EXT_mesh_gpu_instancing").end_array();
-    json.key("extensionsRequired").begin_array().string("EXT_mesh_gpu_instancing").end_array();
+  std::vector<const char*> required;
+  if (doc.any_instancing) required.push_back("EXT_mesh_gpu_instancing");
+  // Compressed views have no plain bytes in the file: a reader must decode them.
+  const bool meshopt = doc.compress_meshopt && doc.buffer.has_meshopt_views();
+  if (meshopt) required.push_back("EXT_meshopt_compression");
+  if (!required.empty()) {
+    json.key("extensionsUsed").begin_array();
+    for (const char* e : required) json.string(e);
+    json.end_array();
+    json.key("extensionsRequired").begin_array();
+    for (const char* e : required) json.string(e);
+    json.end_array();
   }
   json.key("scene").integer(0);
   json.key("scenes").begin_array().begin_object().key("nodes").begin_array();
@@ -1304,6 +1548,7 @@ std::string document_json(GltfDocument& doc, bool glb) {
     json.end_array();
   }
   if (!doc.table.images().empty()) write_textures(json, doc.table, glb, doc.buffer);
+  if (meshopt) doc.buffer.compress_meshopt();
   write_buffer_layout(json, doc.buffer, glb);
   json.end_object();
   return json.take() + "\n";
@@ -1384,6 +1629,13 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
     return file_diagnostic(path, "the rig's joints must be from 1 to " + std::to_string(kMaxRigJoints));
   if (options.animation && !options.rig) return file_diagnostic(path, "the wind clip poses the rig: export the rig too");
   if (options.wind_data && !options.mesh) return file_diagnostic(path, "wind data is per mesh vertex: export the mesh too");
+  if (options.lod > kMaxLodLevels)
+    return file_diagnostic(path, "levels of detail must be from 1 to " + std::to_string(kMaxLodLevels));
+  if (options.lod > 0 && !options.mesh) return file_diagnostic(path, "levels of detail re-mesh the plant: export the mesh too");
+  if (options.lod > 0 && !options.card_renderer)
+    return file_diagnostic(path, "levels of detail end in impostor cards: give a card renderer");
+  if (options.lod > 0 && (options.card_pixels < 8 || options.card_pixels > 4096))
+    return file_diagnostic(path, "impostor cards must be 8 to 4096 pixels tall");
   if (options.animation)
     if (auto problem = wind_clip_problem(*options.animation)) return file_diagnostic(path, *problem);
   // The rigs first: a plant that cannot be rigged writes nothing.
@@ -1397,6 +1649,7 @@ Status export_gltf(const std::vector<GltfPlant>& plants, const std::string& path
       rigs.push_back(std::move(*rig));
     }
   GltfDocument doc;
+  doc.compress_meshopt = options.compress == GltfCompression::meshopt;
   if (options.mesh)
     if (Status loaded = doc.table.load(plants, options.materials); !loaded) return loaded;
   for (const PlantGroup& group : group_plants(plants, options))

@@ -2,6 +2,8 @@
 // (A smoke test on small sizes: speed targets live in the benchmark, never in tests.)
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "tests/support/process.h"
 
 namespace {
@@ -49,7 +51,7 @@ TEST(BenchLsystem, PipedOutputHasNoColourCodes) {
 
 // Every benchmark answers --help with its own usage on stdout and exit 0, doing no work.
 TEST(BenchHelp, EveryBenchmarkPrintsItsUsage) {
-  for (const char* name : {"lsystem", "raycast", "geometry", "gpu", "fog", "spp", "studio"}) {
+  for (const char* name : {"lsystem", "raycast", "geometry", "gpu", "fog", "spp", "studio", "export"}) {
     for (const char* flag : {"--help", "-h"}) {
       auto r = run_process({SYLVA_BINARY, "bench", name, flag}, SYLVA_SOURCE_DIR);
       ASSERT_FALSE(crashed(r)) << name << " " << flag << "\n" << describe(r);
@@ -80,6 +82,26 @@ TEST(BenchFlags, BadSizesAndFiltersAreUsageErrors) {
   ASSERT_FALSE(crashed(r)) << describe(r);
   EXPECT_EQ(r.exit_code, 2) << describe(r);
   EXPECT_NE(r.err.find("no benchmark matches"), std::string::npos) << describe(r);
+}
+
+// `sylva bench export --quick`: every variant on the elm and a small instanced scatter,
+// each row with its size, its triangles per level falling, its joints where rigged, and
+// the CSV holding the same rows.
+TEST(BenchExport, QuickRunExportsEveryVariantAndTheScatter) {
+  TempDir dir;
+  const std::string csv = dir.file("export.csv");
+  auto r = run_process({SYLVA_BINARY, "bench", "export", "--quick", "--scatter", "4", "--csv", csv}, SYLVA_SOURCE_DIR, 240);
+  ASSERT_FALSE(crashed(r)) << describe(r);
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  for (const char* variant : {"mesh", "rig", "rig+animation", "wind-data", "lod3", "all", "all+meshopt", "instanced+lod3"})
+    EXPECT_NE(r.out.find(std::string(" ") + variant + " "), std::string::npos) << variant << "\n" << r.out;
+  const std::string text = read_file(csv);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 9) << text;  // header + 8 rows
+  EXPECT_NE(text.find("elm,all,"), std::string::npos) << text;
+  EXPECT_NE(text.find(",101,55680/12612/3702/4"), std::string::npos) << text;  // joints, falling levels
+  EXPECT_NE(text.find("scatter4,instanced+lod3,"), std::string::npos) << text;
+  auto bad = run_process({SYLVA_BINARY, "bench", "export", "--scatter", "x"}, SYLVA_SOURCE_DIR);
+  EXPECT_EQ(bad.exit_code, 2) << describe(bad);
 }
 
 }  // namespace

@@ -147,6 +147,38 @@ TEST(BlenderCheck, AFileBlenderReadsOtherwiseThanItSaysIsAProblem) {
   EXPECT_EQ(report.find(R"("problems": [])"), std::string::npos) << report;
 }
 
+// The levels of detail in Blender: one object a level, each with every triangle of its
+// mesh, the counts falling strictly, the last two textured cut-out cards.
+TEST(BlenderCheck, TheElmsLevelsOfDetailImportWithFallingTriangleCounts) {
+  if (!have_blender()) SYLVA_SKIP_WITHOUT_TOOL("blender is not installed (scripts/setup.sh installs it)");
+  TempDir dir;
+  const std::string glb = dir.file("elm_lod.glb");
+  ProcessResult exported = run_sylva({"export", kSource + "/presets/elm_in_leaf.lsys", "--mesh", "--lod", "3", "-o", glb},
+                                     {}, 120);
+  ASSERT_EQ(exported.exit_code, 0) << describe(exported);
+  std::string report;
+  ProcessResult r = blender_check(glb, &report);
+  ASSERT_EQ(r.exit_code, 0) << describe(r, 20000);
+  EXPECT_NE(report.find(R"("problems": [])"), std::string::npos) << report;
+  long before = -1;
+  for (int level = 0; level <= 3; ++level) {
+    const std::regex mesh("\"name\": \"elm_in_leaf_LOD" + std::to_string(level) +
+                          R"(", "triangles_file": (\d+), "triangles_blender": (\d+))");
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(report, m, mesh)) << "level " << level << ": " << report.substr(0, 3000);
+    const long triangles = std::stol(m[2]);
+    EXPECT_EQ(std::stol(m[1]), triangles);
+    if (before >= 0) {
+      EXPECT_LT(triangles, before) << "level " << level;
+    }
+    before = triangles;
+  }
+  EXPECT_EQ(before, 4);
+  EXPECT_NE(report.find(R"("name": "elm_in_leaf_card_0", "double_sided": true, "blend_method": "CLIP", "textured": true)"),
+            std::string::npos)
+      << report.substr(0, 4000);
+}
+
 // The wind rig in Blender: one armature with the rig's joints, the clip an action of its
 // length, and the deformed vertices at three frames where sylva's own pose puts them
 // (placement included), the last frame the first.

@@ -60,11 +60,32 @@ TEST(ExportRig, EveryRiggedVariantPassesTheKhronosValidator) {
   exported({"export", kLeafy, "--rig", "--animation", "--extras", "none"}, "leafy.glb");
   exported({"export", kLeafy, "--wind-data"}, "leafy_wind_data.glb");
   exported({"export", kLeafy, "--wind-data", "--rig", "--animation"}, "leafy_wind_data_rig.gltf");
+  exported({"export", kElm, "--lod", "3"}, "elm_lod.glb");
+  exported({"export", kLeafy, "--lod", "2", "--rig", "--animation", "--wind-data"}, "leafy_lod_rig.glb");
+  exported({"export", scene, "--lod", "1", "--wind-data"}, "scene_lod.gltf");
+  const std::string forest = dir.write("forest.scene.json", R"({"format":"sylva-scene","version":1,"plants":[
+    {"grammar":")" + kLeafy + R"(","seed":1,"position":[0,0,0]},
+    {"grammar":")" + kLeafy + R"(","seed":1,"position":[3,0,0],"rotate_y_deg":90}]})");
+  exported({"export", forest, "--lod", "2", "--instancing"}, "forest_lod_instanced.glb");
+  // The elm's LINES hold 3538 indices, not a multiple of 3: the index-sequence codec.
+  exported({"export", kElm, "--rig", "--animation", "--wind-data", "--lod", "3", "--compress", "meshopt"},
+           "elm_all_meshopt.glb");
+  exported({"export", forest, "--instancing", "--compress", "meshopt"}, "forest_meshopt.gltf");
   exported({"export", scene, "--rig", "--animation"}, "scene.glb");
   exported({"export", scene, "--rig", "--animation", "--extras", "full"}, "scene.gltf");
   ProcessResult r = run_node_script("validate_gltf.mjs", "gltf-validator", files);
   EXPECT_EQ(r.exit_code, 0) << describe(r, 20000);
   for (const std::string& f : files) EXPECT_NE(r.out.find(f + ": 0 errors, 0 warnings"), std::string::npos) << r.out;
+  // three.js loads the levels of a rigged plant, each a skinned mesh, and plays the clip.
+  ProcessResult three = run_node_script("three_check.mjs", "three", {dir.file("leafy_lod_rig.glb"), "--times", "0,1", "--every", "1000"});
+  ASSERT_EQ(three.exit_code, 0) << describe(three, 20000);
+  Expected<JsonValue> report = report_after(three.out, "THREE_CHECK ");
+  ASSERT_TRUE(report);
+  std::vector<std::string> names;
+  for (const JsonValue& m : report->find("skinned_meshes")->elements) names.push_back(m.find("name")->text);
+  for (const char* level : {"LOD0", "LOD1", "LOD2"})
+    EXPECT_TRUE(std::any_of(names.begin(), names.end(), [&](const std::string& n) { return n.find(level) != std::string::npos; }))
+        << level;
 }
 
 TEST(ExportRig, ThreeJsPlaysTheWindClipAsSylvaPosesTheRig) {
@@ -143,6 +164,10 @@ TEST(ExportRig, UsageErrorsExitTwoAndAClipThatMovesNothingExitsOneWritingNothing
   usage({"--mesh", "--max-joints", "8"}, "add --rig");
   usage({"--mesh", "--animation"}, "add --rig");
   usage({"--wind-data"}, "add --mesh");
+  usage({"--lod", "2"}, "add --mesh");
+  usage({"--mesh", "--lod", "0"}, "from 1 to 6");
+  usage({"--mesh", "--lod", "7"}, "from 1 to 6");
+  usage({"--mesh", "--compress", "zstd"}, "expected meshopt or none");
   const std::string still = placed_scene(dir, kElm, R"({"wind":[0,1,0]})");
   ProcessResult r = run_sylva({"export", still, "--mesh", "--rig", "--animation", "-o", out});
   EXPECT_EQ(r.exit_code, 1) << describe(r);
@@ -153,6 +178,54 @@ TEST(ExportRig, UsageErrorsExitTwoAndAClipThatMovesNothingExitsOneWritingNothing
   EXPECT_EQ(r.exit_code, 1) << describe(r);
   EXPECT_NE(r.err.find("allow more joints"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
+}
+
+// --compress meshopt: smaller, the extension required, and three.js (its WebAssembly
+// MeshoptDecoder) decodes exactly the plain file's geometry and plays the same clip; the
+// skeleton in extras reads back unchanged.
+TEST(ExportCompress, MeshoptIsSmallerAndDecodesInThreeJsToThePlainFilesVertices) {
+  TempDir dir;
+  const std::string plain = dir.file("plain.glb"), packed = dir.file("packed.glb");
+  const std::vector<std::string> flags = {"--mesh", "--segments-around", "5", "--rig", "--animation", "--lod", "2"};
+  std::vector<std::string> args = {"export", kLeafy, "-o", plain};
+  args.insert(args.end(), flags.begin(), flags.end());
+  expect_ok(run_sylva(args));
+  args[3] = packed;
+  args.insert(args.end(), {"--compress", "meshopt"});
+  expect_ok(run_sylva(args));
+  const uintmax_t plain_bytes = fs::file_size(plain), packed_bytes = fs::file_size(packed);
+  EXPECT_LT(packed_bytes, plain_bytes * 7 / 10) << plain_bytes << " -> " << packed_bytes;
+  const std::string text = read_file(packed);
+  EXPECT_NE(text.find(R"("extensionsRequired":["EXT_meshopt_compression"])"), std::string::npos);
+  EXPECT_EQ(read_file(plain).find("EXT_meshopt_compression"), std::string::npos);
+
+  std::vector<JsonValue> reports;
+  for (const std::string& file : {plain, packed}) {
+    ProcessResult r = run_node_script("three_check.mjs", "three", {file, "--times", "0,1.25", "--every", "7"});
+    ASSERT_EQ(r.exit_code, 0) << describe(r, 20000);
+    Expected<JsonValue> report = report_after(r.out, "THREE_CHECK ");
+    ASSERT_TRUE(report);
+    reports.push_back(std::move(*report));
+  }
+  const JsonValue& a = *reports[0].find("meshes");
+  const JsonValue& b = *reports[1].find("meshes");
+  ASSERT_EQ(a.elements.size(), b.elements.size());
+  ASSERT_GT(a.elements.size(), 3u);
+  for (size_t m = 0; m < a.elements.size(); ++m) {
+    EXPECT_EQ(a.elements[m].find("name")->text, b.elements[m].find("name")->text);
+    EXPECT_EQ(a.elements[m].find("indices")->number, b.elements[m].find("indices")->number);
+    EXPECT_EQ(numbers_of(*a.elements[m].find("positions")), numbers_of(*b.elements[m].find("positions")))
+        << a.elements[m].find("name")->text;
+  }
+  for (size_t f = 0; f < 2; ++f)
+    EXPECT_EQ(numbers_of(reports[0].find("frames")->elements[f].find("meshes")->elements[0]),
+              numbers_of(reports[1].find("frames")->elements[f].find("meshes")->elements[0]))
+        << "frame " << f;
+  Expected<std::vector<GltfPlant>> back = import_gltf_skeletons(packed);
+  ASSERT_TRUE(back) << back.error().format();
+  Expected<std::vector<GltfPlant>> plain_back = import_gltf_skeletons(plain);
+  ASSERT_TRUE(plain_back);
+  EXPECT_EQ(back->front().skeleton, plain_back->front().skeleton);
 }
 
 }  // namespace

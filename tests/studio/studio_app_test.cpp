@@ -546,9 +546,10 @@ TEST_F(Fixture, ExportsTheShownPlantThroughTheCliWriters) {
   // The wind rig, its clip and the shader data, as the export dialog offers them.
   const std::string rigged = dir.file("rigged.glb");
   ASSERT_FALSE(app->export_gltf_file(rigged, {.mesh = true, .rig = true, .max_joints = 8, .animation = true,
-                                              .wind_data = true}));
+                                              .wind_data = true, .lod = 2, .meshopt = true}));
   const std::string bytes = read_text_file(rigged).value();
-  for (const char* key : {"\"skins\"", "\"animations\"", "\"name\":\"wind\"", "\"TEXCOORD_3\"", "\"JOINTS_0\""})
+  for (const char* key : {"\"skins\"", "\"animations\"", "\"name\":\"wind\"", "\"TEXCOORD_3\"", "\"JOINTS_0\"",
+                          "\"tree_LOD2\"", "\"tree_card_1\"", "\"EXT_meshopt_compression\""})
     EXPECT_NE(bytes.find(key), std::string::npos) << key;
   EXPECT_EQ(app->export_gltf_file(dir.file("refused.glb"), {.mesh = false, .rig = true}).value_or(""),
             dir.file("refused.glb") + ": error: a rig skins the mesh: export the mesh too");

@@ -60,9 +60,10 @@ def test_export_with_defines_and_a_seed_folder(tmp_path, client, sylva_binary):
     assert b'"chains":[{' in pathlib.Path(full[0]).read_bytes().replace(b" ", b"").replace(b"\n", b"")
     # The rig, the wind clip and the wind data: the CLI batch's files, byte for byte.
     cli_batch(sylva_binary, "export", "presets/elm.lsys", "--seed", "4", "--mesh", "--rig", "--max-joints", "40",
-              "--animation", "--wind-data", "-o", str(tmp_path / "cli/rig_{seed}.glb"))
+              "--animation", "--wind-data", "--lod", "2", "--compress", "meshopt", "-o", str(tmp_path / "cli/rig_{seed}.glb"))
     rigged = sylva_dask.batch(client, "export", "presets/elm.lsys", [4], str(tmp_path / "dask/rig_{seed}.glb"),
-                              mesh=True, rig=True, max_joints=40, animation=True, wind_data=True)
+                              mesh=True, rig=True, max_joints=40, animation=True, wind_data=True, lod=2,
+                              compress="meshopt")
     assert_same_files(rigged, [str(tmp_path / "cli/rig_4.glb")])
 
 

@@ -227,3 +227,27 @@ def test_rig_arguments_are_checked_and_nothing_is_written(saguaro, tmp_path):
     with pytest.raises(TypeError, match="animation must be"):
         sylva.export_gltf(saguaro, path, mesh=True, rig=True, animation="breezy")
     assert not path.exists()
+
+
+def test_levels_of_detail_end_in_textured_cards(saguaro, tmp_path, validate_gltf):
+    path = tmp_path / "lod.glb"
+    sylva.export_gltf(saguaro, path, mesh=True, lod=2)
+    doc = glb_json(path)
+    names = [n["name"] for n in doc["nodes"]]
+    assert {"saguaro_LOD0", "saguaro_LOD1", "saguaro_LOD2"} <= set(names)
+    assert len(doc["images"]) == 2  # the two cards
+    validate_gltf(path)
+    with pytest.raises(ValueError, match="lod must be from 0"):
+        sylva.export_gltf(saguaro, tmp_path / "x.glb", mesh=True, lod=7)
+
+
+def test_meshopt_compression_is_required_and_smaller(saguaro, tmp_path):
+    plain, packed = tmp_path / "plain.glb", tmp_path / "packed.glb"
+    sylva.export_gltf(saguaro, plain, mesh=True)
+    sylva.export_gltf(saguaro, packed, mesh=True, compress="meshopt")
+    doc = glb_json(packed)
+    assert doc["extensionsRequired"] == ["EXT_meshopt_compression"]
+    assert packed.stat().st_size < 0.8 * plain.stat().st_size
+    assert "extensionsRequired" not in glb_json(plain)
+    with pytest.raises(ValueError, match="compress must be"):
+        sylva.export_gltf(saguaro, tmp_path / "x.glb", mesh=True, compress="zip")
