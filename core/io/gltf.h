@@ -96,6 +96,18 @@
 // The reader takes an array-valued "chains" as "full" (files written before "compact"
 // existed), an object-valued one as "compact".
 // Vertex i of the LINES primitive is joint i of the skeleton.
+// For engines (docs/gltf.md; each needs `mesh`):
+//   - `rig`: the triangles leave the plant's mesh for a skinned mesh NAME_skin on a scene
+//     root node; the joints (gltf_rig.h) are nodes NAME_rig (a child of the plant's node),
+//     NAME_joint_j; JOINTS_0 unsigned short, WEIGHTS_0 float, at most two used;
+//   - `animation`: one animation "wind", LINEAR rotation channels on the joints;
+//   - `wind_data`: TEXCOORD_1 (TEXCOORD_0's accessor unless a texture has its own),
+//     TEXCOORD_2 = (pivot.x, pivot.y), TEXCOORD_3 = (pivot.z, level + phase);
+//   - `lod`: nodes NAME_LOD0 … NAME_LODN (gltf_lod.h) instead of the plant's triangles,
+//     children of its node (or skinned roots with `rig`), the last two cards with
+//     materials NAME_card_i (MASK, double-sided, an embedded PNG);
+//   - `compress` meshopt: the accessors' bufferViews encoded (EXT_meshopt_compression,
+//     required), their plain bytes in a fallback buffer 1 the file does not hold.
 // Files are written atomically; .glb is binary glTF, .gltf is JSON with the buffer
 // embedded as a data URI. Every file passes the Khronos glTF validator with no errors or
 // warnings (checked in CI by scripts/validate_gltf.mjs).
