@@ -11,6 +11,7 @@
 
 #include "core/cpu/render_cpu.h"
 #include "core/util/color.h"
+#include "core/util/math.h"
 
 namespace sylva {
 
@@ -25,7 +26,7 @@ CardRenderer cpu_card_renderer(std::map<uint32_t, SceneMaterial> materials, uint
     scene.camera.eye = card.centre_m + distance * card.normal;
     scene.camera.target = card.centre_m;
     scene.camera.up = {0, 1, 0};
-    scene.camera.fov_y_deg = 2 * std::atan(card.half_height_m / distance) * 180 / 3.14159265358979323846;
+    scene.camera.fov_y_deg = 2 * std::atan(card.half_height_m / distance) / kRadPerDeg;
     scene.sun.direction = unit_sun_direction(card.normal + glm::dvec3(0.3, 1, 0.2));
     ScenePlant sp;
     sp.skeleton = plant.skeleton;

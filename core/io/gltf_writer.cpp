@@ -818,8 +818,8 @@ std::string open_flat_attributes(const std::vector<float>& positions, const std:
 
 // The wind data of the segments' mesh: each vertex on its frustum's chain, pivoting about
 // the chain's first joint.
-std::vector<WindVertex> segment_wind(const TriangleMesh& tm, const SkinnedSkeleton& skinned, const WindSource& source) {
-  const std::vector<uint32_t> frustum_of = vertex_frusta(tm);
+std::vector<WindVertex> segment_wind(const TriangleMesh& tm, const std::vector<uint32_t>& frustum_of,
+                                     const SkinnedSkeleton& skinned, const WindSource& source) {
   std::vector<WindVertex> wind(tm.positions.size());
   for (size_t v = 0; v < tm.positions.size(); ++v) {
     if (frustum_of[v] == UINT32_MAX) {
@@ -835,10 +835,9 @@ std::vector<WindVertex> segment_wind(const TriangleMesh& tm, const SkinnedSkelet
 // The weights of every vertex of the segments' mesh: each vertex at its arc length along
 // the chain of the first triangle that uses it (its projection on that frustum's
 // segment; a vertex shared across a joint has the same arc length on both sides).
-std::vector<RigWeights> segment_vertex_weights(const TriangleMesh& tm, const SkinnedSkeleton& skinned,
-                                               const PlantRig& plant) {
+std::vector<RigWeights> segment_vertex_weights(const TriangleMesh& tm, const std::vector<uint32_t>& frustum_of,
+                                               const SkinnedSkeleton& skinned, const PlantRig& plant) {
   const Skeleton& sk = plant.skeleton;
-  const std::vector<uint32_t> frustum_of = vertex_frusta(tm);
   std::vector<RigWeights> weights(tm.positions.size());
   for (size_t v = 0; v < tm.positions.size(); ++v) {
     if (frustum_of[v] == UINT32_MAX) {  // on no triangle (a collapsed tip's spare): never drawn, it
@@ -957,9 +956,12 @@ Status add_segment_mesh(const SkinnedSkeleton& skinned, const Bark& bark, const 
   size_t texcoord_0 = 0;
   std::string open_attributes =
       open_segment_attributes(tm, skinned, bark, normal_texture.has_value(), doc.buffer, &texcoord_0);
-  if (rig) open_attributes += skin_attributes(segment_vertex_weights(tm, skinned, *rig), doc.buffer);
+  // Each vertex's frustum, once for the skin weights and the wind data.
+  const std::vector<uint32_t> frustum_of = rig || wind ? vertex_frusta(tm) : std::vector<uint32_t>();
+  if (rig) open_attributes += skin_attributes(segment_vertex_weights(tm, frustum_of, skinned, *rig), doc.buffer);
   // Wind data in TEXCOORD_2/3 needs a TEXCOORD_1 (glTF numbers the sets without gaps).
-  const std::string wind_text = wind ? wind_attributes(segment_wind(tm, skinned, *wind), doc.buffer) : std::string();
+  const std::string wind_text =
+      wind ? wind_attributes(segment_wind(tm, frustum_of, skinned, *wind), doc.buffer) : std::string();
   const std::string shared_attributes =
       open_attributes + (wind ? ",\"TEXCOORD_1\":" + std::to_string(texcoord_0) + wind_text : std::string()) + "}";
   // A table image repeating otherwise than the bark reads TEXCOORD_1, its own
