@@ -99,7 +99,8 @@
 // For engines (docs/gltf.md; each needs `mesh`):
 //   - `rig`: the triangles leave the plant's mesh for a skinned mesh NAME_skin on a scene
 //     root node; the joints (gltf_rig.h) are nodes NAME_rig (a child of the plant's node),
-//     NAME_joint_j; JOINTS_0 unsigned short, WEIGHTS_0 float, at most two used;
+//     NAME_joint_j; JOINTS_0 unsigned byte (short past 256 joints), WEIGHTS_0
+//     normalized unsigned short summing to exactly 1, at most two used;
 //   - `animation`: one animation "wind", LINEAR rotation channels on the joints;
 //   - `wind_data`: TEXCOORD_1 (TEXCOORD_0's accessor unless a texture has its own),
 //     TEXCOORD_2 = (pivot.x, pivot.y), TEXCOORD_3 = (pivot.z, level + phase);

@@ -22,6 +22,7 @@
 #include <map>
 #include <numbers>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 
 #include <OpenImageIO/imageio.h>
@@ -50,6 +51,7 @@ using namespace gltf_format;
 constexpr uint32_t kComponentFloat = 5126;
 constexpr uint32_t kComponentUint32 = 5125;
 constexpr uint32_t kComponentUint16 = 5123;
+constexpr uint32_t kComponentUint8 = 5121;
 constexpr int kTargetArrayBuffer = 34962;
 constexpr int kTargetElementArrayBuffer = 34963;
 constexpr int kModeLines = 1;
@@ -78,7 +80,9 @@ struct Accessor {
   uint32_t component = kComponentFloat;
   size_t count = 0;
   const char* type = "SCALAR";
-  std::vector<double> min, max;  // per component, exact values of the stored elements
+  std::vector<double> min, max;  // per component, exact values of the stored elements;
+                                 // empty: not written (normalized weights)
+  bool normalized = false;
 };
 
 // The binary buffer and the views/accessors describing it.
@@ -104,21 +108,29 @@ class BufferBuilder {
     return accessors_.size() - 1;
   }
 
-  // Appends `values` (count × components unsigned shorts: JOINTS_0) with their min/max.
-  size_t add_u16s(const std::vector<uint16_t>& values, int components, const char* type, int target) {
+  // Appends `values` (count × components unsigned integers, T = uint8_t or uint16_t:
+  // JOINTS_0, WEIGHTS_0) with their min/max, or `normalized` (WEIGHTS_0: read as
+  // value / max of T) without bounds.
+  template <class T>
+  size_t add_unsigned(const std::vector<T>& values, int components, const char* type, int target,
+                      bool normalized = false) {
+    static_assert(std::is_same_v<T, uint8_t> || std::is_same_v<T, uint16_t>);
     const size_t n = static_cast<size_t>(components);
     Accessor a;
-    a.component = kComponentUint16;
+    a.component = sizeof(T) == 1 ? kComponentUint8 : kComponentUint16;
     a.type = type;
     a.count = values.size() / n;
-    a.min.assign(n, 65535);
-    a.max.assign(n, 0);
-    for (size_t i = 0; i < values.size(); ++i) {
-      a.min[i % n] = std::min(a.min[i % n], static_cast<double>(values[i]));
-      a.max[i % n] = std::max(a.max[i % n], static_cast<double>(values[i]));
+    a.normalized = normalized;
+    if (!normalized) {
+      a.min.assign(n, static_cast<double>(std::numeric_limits<T>::max()));
+      a.max.assign(n, 0);
+      for (size_t i = 0; i < values.size(); ++i) {
+        a.min[i % n] = std::min(a.min[i % n], static_cast<double>(values[i]));
+        a.max[i % n] = std::max(a.max[i % n], static_cast<double>(values[i]));
+      }
     }
-    a.view = add_view(values.data(), values.size() * sizeof(uint16_t), target);
-    set_meshopt(a.view, MeshoptMode::attributes, sizeof(uint16_t) * n);
+    a.view = add_view(values.data(), values.size() * sizeof(T), target);
+    set_meshopt(a.view, MeshoptMode::attributes, sizeof(T) * n);
     accessors_.push_back(std::move(a));
     return accessors_.size() - 1;
   }
@@ -728,23 +740,33 @@ struct PlantRig {
   const Skeleton& skeleton;
 };
 
-// JOINTS_0 (unsigned short) and WEIGHTS_0 (float) of `weights`, one per vertex, as the
-// text `,"JOINTS_0":a,"WEIGHTS_0":b` to add to an open attributes object. Unused slots
-// hold joint 0 with weight 0.
-std::string skin_attributes(const std::vector<RigWeights>& weights, BufferBuilder& buffer) {
-  std::vector<uint16_t> joints;
-  std::vector<float> w;
+// JOINTS_0 (unsigned byte for rigs of at most 256 joints, else unsigned short) and
+// WEIGHTS_0 (normalized unsigned short: the second weight rounded to 1/65535, the first
+// the rest, so that every vertex's weights sum to exactly 1) of `weights`, one per
+// vertex, as the text `,"JOINTS_0":a,"WEIGHTS_0":b` to add to an open attributes object.
+// Unused slots hold joint 0 with weight 0. 12 bytes a vertex (8 with byte joints) where
+// floats took 24.
+std::string skin_attributes(const std::vector<RigWeights>& weights, size_t rig_joints, BufferBuilder& buffer) {
+  std::vector<uint16_t> joints, w;
   joints.reserve(weights.size() * 4);
   w.reserve(weights.size() * 4);
   for (const RigWeights& v : weights) {
+    const uint16_t second =
+        v.count == 2 ? static_cast<uint16_t>(std::clamp(std::lround(v.weights[1] * 65535.0), 1L, 65534L)) : 0;
     for (size_t i = 0; i < 4; ++i) {
       const bool used = i < static_cast<size_t>(v.count);
       joints.push_back(used ? static_cast<uint16_t>(v.joints[i]) : 0);
-      w.push_back(used ? v.weights[i] : 0.0f);
+      w.push_back(i == 0 ? static_cast<uint16_t>(65535 - second) : i == 1 ? second : 0);
     }
   }
-  const size_t j = buffer.add_u16s(joints, 4, "VEC4", kTargetArrayBuffer);
-  const size_t k = buffer.add_floats(w, 4, "VEC4", kTargetArrayBuffer);
+  size_t j;
+  if (rig_joints <= 256) {
+    const std::vector<uint8_t> bytes(joints.begin(), joints.end());
+    j = buffer.add_unsigned(bytes, 4, "VEC4", kTargetArrayBuffer);
+  } else {
+    j = buffer.add_unsigned(joints, 4, "VEC4", kTargetArrayBuffer);
+  }
+  const size_t k = buffer.add_unsigned(w, 4, "VEC4", kTargetArrayBuffer, /*normalized=*/true);
   return ",\"JOINTS_0\":" + std::to_string(j) + ",\"WEIGHTS_0\":" + std::to_string(k);
 }
 
@@ -958,7 +980,9 @@ Status add_segment_mesh(const SkinnedSkeleton& skinned, const Bark& bark, const 
       open_segment_attributes(tm, skinned, bark, normal_texture.has_value(), doc.buffer, &texcoord_0);
   // Each vertex's frustum, once for the skin weights and the wind data.
   const std::vector<uint32_t> frustum_of = rig || wind ? vertex_frusta(tm) : std::vector<uint32_t>();
-  if (rig) open_attributes += skin_attributes(segment_vertex_weights(tm, frustum_of, skinned, *rig), doc.buffer);
+  if (rig)
+    open_attributes +=
+        skin_attributes(segment_vertex_weights(tm, frustum_of, skinned, *rig), rig->rig.joints.size(), doc.buffer);
   // Wind data in TEXCOORD_2/3 needs a TEXCOORD_1 (glTF numbers the sets without gaps).
   const std::string wind_text =
       wind ? wind_attributes(segment_wind(tm, frustum_of, skinned, *wind), doc.buffer) : std::string();
@@ -1038,7 +1062,7 @@ Status add_leaf_mesh(const Skeleton& sk, const GltfExportOptions& options, const
     weights.reserve(leaves.vertex_leaf.size());
     for (uint32_t l : leaves.vertex_leaf)
       weights.push_back(rig_weights_at_joint(rig->rig, rig->skeleton, sk.leaves[leaves.leaves[l].leaf].joint));
-    attribute_text += skin_attributes(weights, doc.buffer);
+    attribute_text += skin_attributes(weights, rig->rig.joints.size(), doc.buffer);
   }
   attribute_text += "}";
   for (const auto& [material, indices] : triangles_of) {
@@ -1286,7 +1310,7 @@ Status add_impostor_cards(const GltfPlant& plant, size_t plant_index, const Gltf
     for (const glm::dvec3& c : corner) append_float3(positions, c), append_unit_float3(normals, card.normal);
     size_t texcoord_0 = 0;
     std::string text = open_flat_attributes(positions, normals, texcoords, doc.buffer, &texcoord_0);
-    if (rig) text += skin_attributes(std::vector<RigWeights>(4), doc.buffer);
+    if (rig) text += skin_attributes(std::vector<RigWeights>(4), rig->rig.joints.size(), doc.buffer);
     if (wind) text += wind_attributes(std::vector<WindVertex>(4), doc.buffer, texcoord_0);
     text += "}";
     // Counter-clockwise seen from the side the normal points to.
@@ -1456,9 +1480,12 @@ void write_buffer_layout(JsonWriter& json, const BufferBuilder& buffer, bool glb
     for (const Accessor& a : buffer.accessors()) {
       json.begin_object();
       json.key("bufferView").integer(a.view).key("componentType").integer(a.component).key("count").integer(a.count);
+      if (a.normalized) json.key("normalized").boolean(true);
       json.key("type").string(a.type);
-      json.key("min").numbers(a.min.data(), a.min.size());
-      json.key("max").numbers(a.max.data(), a.max.size());
+      if (!a.min.empty()) {
+        json.key("min").numbers(a.min.data(), a.min.size());
+        json.key("max").numbers(a.max.data(), a.max.size());
+      }
       json.end_object();
     }
     json.end_array();

@@ -261,23 +261,26 @@ TEST(GltfRig, TheWindClipPosesTheRiggedJointsAsTheRendererSwaysThem) {
   EXPECT_LT(worst, 0.01 * height) << "worst " << worst << " m of " << height << " m";
   RecordProperty("rig_joint_error_over_height", std::to_string(worst / height));
 
-  // Every vertex's weights: at most two used, normalised, no joint twice.
+  // Every vertex's weights: at most two used, normalised exactly (unsigned shorts summing
+  // to 65535), no joint twice; joints as bytes (101 joints).
   const tinygltf::Primitive& prim = model.meshes.at(static_cast<size_t>(model.nodes.at(static_cast<size_t>(roots[1])).mesh))
                                         .primitives.at(0);
-  const std::vector<uint16_t> joints = u16s_of(model, prim.attributes.at("JOINTS_0"));
-  const std::vector<float> weights = floats_of(model, prim.attributes.at("WEIGHTS_0"));
+  const tinygltf::Accessor& weight_accessor = model.accessors.at(static_cast<size_t>(prim.attributes.at("WEIGHTS_0")));
+  EXPECT_TRUE(weight_accessor.normalized);
+  const std::vector<uint8_t> joints =
+      test::components_of<uint8_t>(model, prim.attributes.at("JOINTS_0"), TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE);
+  const std::vector<uint16_t> weights = u16s_of(model, prim.attributes.at("WEIGHTS_0"));
   ASSERT_EQ(joints.size(), weights.size());
   for (size_t v = 0; v < joints.size(); v += 4) {
-    float sum = 0;
+    uint32_t sum = 0;
     for (size_t k = 0; k < 4; ++k) {
-      EXPECT_GE(weights[v + k], 0);
       EXPECT_LT(joints[v + k], rig->joints.size());
       sum += weights[v + k];
       if (k >= 2) {
         EXPECT_EQ(weights[v + k], 0);
       }
     }
-    EXPECT_NEAR(sum, 1, 2e-7);
+    EXPECT_EQ(sum, 65535u);
     if (weights[v + 1] > 0) {
       EXPECT_NE(joints[v], joints[v + 1]);
     }
