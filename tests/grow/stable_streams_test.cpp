@@ -17,6 +17,8 @@
 #include "core/geometry/skeleton.h"
 #include "core/grow/turtle.h"
 #include "core/grow/grow.h"
+#include "lsystem/derive.h"
+#include "lsystem/word.h"
 
 namespace sylva {
 namespace {
@@ -163,6 +165,45 @@ TEST(StableStreams, DefineOverrideIsRecordedInTheSkeletonSource) {
   EXPECT_EQ(skeleton.source.defines, (std::map<std::string, double>{{"BN", 5}}));
   EXPECT_EQ(skeleton.source.seed, 7u);
   EXPECT_EQ(skeleton.source.steps, 14);
+}
+
+// What the keys promise, exactly (docs/grammar-notes.md "Random numbers"): a module's key
+// is its lineage — its place in the axiom, then its place in each successor that made it.
+// Modules added after it, or anything another production draws, leave its numbers alone;
+// a module inserted before it in the axiom (or in its own successor) gives it another
+// place, hence other numbers — the "F(2) before Crown(0)" edit the README warns about.
+std::string derived_word(const std::string& axiom, const std::string& extra_productions = {}) {
+  const std::string text = "seed: 3\nderivation length: 6\naxiom: " + axiom +
+                           "\nA(n) : n < 6 -> F(uniform(0.5, 1)) [+(uniform(10, 50)) A(n+1)] A(n+1) : 0.5\n"
+                           "A(n) : n < 6 -> F(uniform(0.5, 1)) A(n+1) : 0.5\n" +
+                           extra_productions;
+  sylva::Expected<lsys::Grammar> grammar = lsys::parse_grammar(text, "crown.lsys");
+  if (!grammar.ok()) {
+    ADD_FAILURE() << grammar.error().format();
+    return {};
+  }
+  sylva::Expected<lsys::Word> word = lsys::derive(*grammar);
+  if (!word.ok()) {
+    ADD_FAILURE() << word.error().format();
+    return {};
+  }
+  return lsys::print_word(*word, grammar->symbols);
+}
+
+TEST(StableStreams, ModulesAfterAndOtherProductionsLeaveAModuleAloneAModuleBeforeItMovesItsKey) {
+  const std::string crown = derived_word("A(0)");
+  ASSERT_GT(crown.size(), 40u);
+  // Appended after the crown, with and without a random production of its own.
+  const std::string appended = derived_word("A(0) G(2)");
+  EXPECT_TRUE(appended.starts_with(crown)) << appended;
+  const std::string other_rule = derived_word("A(0) G(2)", "G(x) -> G(x) F(uniform(0, 1))\n");
+  EXPECT_TRUE(other_rule.starts_with(crown)) << other_rule;
+  EXPECT_NE(other_rule, appended);  // G's rule did draw
+  // Inserted before it: the crown's place in the axiom, and so its numbers, change.
+  const std::string inserted = derived_word("G(2) A(0)");
+  EXPECT_FALSE(inserted.ends_with(crown)) << inserted;
+  // Not a different shape by accident of the rule: the crown's own words differ.
+  EXPECT_NE(inserted.substr(inserted.find('F')), crown.substr(crown.find('F')));
 }
 
 }  // namespace
