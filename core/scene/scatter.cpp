@@ -90,6 +90,18 @@ double scatter_area_m2(const SceneScatter& s) {
   return std::abs(twice) / 2;
 }
 
+double scatter_weighted_area_m2(const SceneScatter& s) {
+  if (!s.disc_centre || !(s.disc_fade > 0)) return scatter_area_m2(s);
+  const double r = s.disc_radius, f = s.disc_fade;
+  return std::numbers::pi * (r * r - r * f + f * f / 3);
+}
+
+double scatter_rim_weight(const SceneScatter& s, glm::dvec2 xz) {
+  if (!s.disc_centre || !(s.disc_fade > 0)) return 1;
+  const double inside_m = s.disc_radius - glm::length(xz - *s.disc_centre);
+  return std::clamp(inside_m / s.disc_fade, 0.0, 1.0);
+}
+
 Expected<std::vector<ScatterPlacement>> place_scatter(const SceneScatter& s) {
   glm::dvec2 lo, hi;
   if (s.disc_centre) {
@@ -122,7 +134,7 @@ Expected<std::vector<ScatterPlacement>> place_scatter(const SceneScatter& s) {
     }
     return bands->inside(p);
   };
-  Rng darts(s.seed), attributes(s.seed ^ 0x5ca77e5eed5ca77eull);
+  Rng darts(s.seed), attributes(s.seed ^ 0x5ca77e5eed5ca77eull), rim(s.seed ^ 0x0f4de0f4de0f4de0ull);
   std::vector<ScatterPlacement> out;
   out.reserve(static_cast<size_t>(s.count));
   // The spacing grid: cells min_spacing wide, keyed by their integer coordinates.
@@ -136,6 +148,7 @@ Expected<std::vector<ScatterPlacement>> place_scatter(const SceneScatter& s) {
   for (uint64_t dart = 0; dart < max_darts && out.size() < s.count; ++dart) {
     const glm::dvec2 p(lo.x + darts.next_double() * (hi.x - lo.x), lo.y + darts.next_double() * (hi.y - lo.y));
     if (!inside(p)) continue;
+    if (const double w = scatter_rim_weight(s, p); w < 1 && !(rim.next_double() < w)) continue;
     if (cell > 0) {
       const auto [ci, cj] = cell_of(p);
       bool free = true;

@@ -4,7 +4,8 @@
 // bounding box, kept when inside the area (a disc, or a simple polygon by the even–odd
 // rule) and at least min_spacing from every plant kept before (a uniform grid of cells
 // min_spacing wide: a candidate checks the 3 × 3 cells around it). At most
-// 30·count + 1000 darts are thrown; an entry that cannot fit its count is an error saying
+// 30·count + 1000 darts are thrown (a disc's faded rim keeps a dart in it with the
+// probability scatter_rim_weight, drawn from a third stream so the darts stay the same); an entry that cannot fit its count is an error saying
 // how many fit. Rotation, scale and each plant's grammar seed come from a second stream,
 // drawn in placement order, so changing a range never moves a plant. Both streams are
 // SplitMix64 from the entry's seed, with floats made from the top 53 bits: the same entry
@@ -59,6 +60,15 @@ inline constexpr double kMaxScatterEdgeTests = 2e10;
 
 // The area of `scatter` in m² (π r², or the polygon's by the shoelace formula).
 double scatter_area_m2(const SceneScatter& scatter);
+
+// The area weighted by the density's fall at a disc's faded rim (docs/scatter.md): a disc
+// of radius R faded over f has π(R² − R·f + f²/3); without a fade, scatter_area_m2.
+// `density` counts plants per m² of this area, so the unfaded inside keeps that density.
+double scatter_weighted_area_m2(const SceneScatter& scatter);
+
+// The probability that a dart at `xz` inside the area is kept before the spacing test:
+// 1 inside, falling linearly from 1 at fade metres inside a disc's rim to 0 at the rim.
+double scatter_rim_weight(const SceneScatter& scatter, glm::dvec2 xz);
 
 // The plants of `scatter` (its count), or why they do not fit: a Diagnostic with the
 // message alone (no file or place: the scene reader reports it at the entry).

@@ -259,6 +259,8 @@ struct SceneScatter {
   std::optional<double> density;           // plants per m², as the file says
   std::optional<glm::dvec2> disc_centre;   // the area: a disc (x, z) with disc_radius ...
   double disc_radius = 0;
+  double disc_fade = 0;                    // metres inside the disc's rim over which the
+                                           //   density falls linearly to 0 (0: a hard edge)
   std::vector<glm::dvec2> polygon;         // ... or a simple polygon (x, z), >= 3 corners
   uint64_t seed = 0;                       // the placement's random stream
   std::optional<std::pair<uint64_t, uint64_t>> plant_seeds;  // each instance's grammar seed

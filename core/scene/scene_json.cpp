@@ -319,7 +319,7 @@ SceneScatter read_scatter(const JsonValue& v, const std::string& base_dir, size_
   if ((disc != nullptr) == (polygon != nullptr)) fail(v, what + " needs exactly one area: \"disc\" or \"polygon\"");
   if (disc) {
     expect_object(*disc, what + ".disc");
-    check_keys(*disc, what + ".disc", {"centre", "radius"});
+    check_keys(*disc, what + ".disc", {"centre", "radius", "fade"});
     glm::dvec2 c(0, 0);
     if (auto* x = disc->find("centre")) {
       if (!x->is_array() || x->elements.size() != 2) fail(*x, what + ".disc.centre must be [x, z]");
@@ -330,6 +330,8 @@ SceneScatter read_scatter(const JsonValue& v, const std::string& base_dir, size_
     const JsonValue* r = disc->find("radius");
     if (!r) fail(*disc, what + ".disc needs a \"radius\"");
     sc.disc_radius = number_in(*r, what + ".disc.radius", 0, 1e9, true, false);
+    if (auto* x = disc->find("fade"))
+      sc.disc_fade = number_in(*x, what + ".disc.fade", 0, sc.disc_radius, false, false);
   } else {
     if (!polygon->is_array() || polygon->elements.size() < 3)
       fail(*polygon, what + ".polygon must be an array of at least 3 corners [x, z]");
@@ -351,9 +353,12 @@ SceneScatter read_scatter(const JsonValue& v, const std::string& base_dir, size_
     sc.count = *n;
   } else {
     sc.density = number_in(*density, what + ".density", 0, 1e6, true, false);
-    const double n = std::round(*sc.density * scatter_area_m2(sc));
+    // Plants per m² where the rim does not fade them: the area weighted by the fade.
+    const double area = scatter_weighted_area_m2(sc);
+    const double n = std::round(*sc.density * area);
     if (!(n >= 1 && n <= static_cast<double>(kMaxScatterPlants)))
-      fail(*density, what + ".density × the area's " + std::to_string(scatter_area_m2(sc)) + " m^2 must give 1 to " +
+      fail(*density, what + ".density × the area's " + std::to_string(area) + " m^2" +
+                         (sc.disc_fade > 0 ? " (its faded rim counted by its weight)" : "") + " must give 1 to " +
                          limit + " plants");
     sc.count = static_cast<uint64_t>(n);
   }
@@ -824,6 +829,7 @@ void write_scatter(JsonWriter& w, const SceneScatter& sc, const std::string& bas
     const double c[2] = {sc.disc_centre->x, sc.disc_centre->y};
     w.key("centre").numbers(c, 2);
     w.key("radius").number(sc.disc_radius);
+    if (sc.disc_fade > 0) w.key("fade").number(sc.disc_fade);
     w.end_object();
   } else {
     w.key("polygon").begin_array(Layout::spaced);

@@ -872,9 +872,79 @@ TEST(SceneScatterKey, APolygonOfEightyThousandCornersPlacesItsPlantsAndAHopeless
   EXPECT_EQ(refused.error().loc.line, 1u);
 }
 
+// Issue 31 §2: a disc's `fade` thins the plants linearly to nothing at its rim. Against the
+// closed form: with radius R faded over f, the share of plants in the band R − f < r ≤ R is
+// (R·f − 2f²/3) / (R² − R·f + f²/3), the outer half of the band holds ∫ r(R − r) over it
+// against the whole band's (at R = 20, f = 8: 0.449 and 0.296 of that), and
+// none stands in the last few centimetres; the darts inside stay where they were.
+TEST(SceneScatterKey, ADiscsFadeThinsItsRimAsTheClosedFormSaysAndLeavesTheInsideAlone) {
+  const double R = 20, f = 8;
+  const size_t n = 20000;
+  auto faded = scene_with_scatter(cactus_entry(
+      R"("count": 20000, "disc": {"centre": [3, -2], "radius": 20, "fade": 8}, "seed": 5)"));
+  ASSERT_TRUE(faded) << faded.error().format();
+  ASSERT_EQ(faded->plants.size(), n);
+  size_t band = 0, outer_half = 0, last_cm = 0;
+  for (const ScenePlant& p : faded->plants) {
+    const double r = std::hypot(p.position.x - 3, p.position.z + 2);
+    ASSERT_LE(r, R);
+    band += r > R - f;
+    outer_half += r > R - f / 2;
+    last_cm += r > R - 0.02;
+  }
+  const double share = (R * f - 2 * f * f / 3) / (R * R - R * f + f * f / 3);
+  const double sigma = std::sqrt(share * (1 - share) / static_cast<double>(n));
+  EXPECT_NEAR(static_cast<double>(band) / n, share, 4 * sigma) << band;
+  // ∫_{R−f/2}^{R} r(R − r) dr / ∫_{R−f}^{R} r(R − r) dr
+  auto integral = [&](double a) { return R * (R * R - a * a) / 2 - (R * R * R - a * a * a) / 3; };
+  const double outer_share = integral(R - f / 2) / integral(R - f);
+  EXPECT_NEAR(static_cast<double>(outer_half) / static_cast<double>(band), outer_share,
+              4 * std::sqrt(outer_share * (1 - outer_share) / static_cast<double>(band)));
+  EXPECT_LT(last_cm, 3u);  // about 0.08 expected
+  // A hard-edged disc of the same seed puts more than twice as many there (0.36 of 20,000).
+  auto hard = scene_with_scatter(cactus_entry(R"("count": 20000, "disc": {"centre": [3, -2], "radius": 20}, "seed": 5)"));
+  ASSERT_TRUE(hard);
+  size_t hard_outer = 0;
+  for (const ScenePlant& p : hard->plants) hard_outer += std::hypot(p.position.x - 3, p.position.z + 2) > R - f / 2;
+  EXPECT_GT(hard_outer, 2 * outer_half);
+  // `fade: 0` is the hard edge, plant for plant.
+  auto zero = scene_with_scatter(
+      cactus_entry(R"("count": 20000, "disc": {"centre": [3, -2], "radius": 20, "fade": 0}, "seed": 5)"));
+  ASSERT_TRUE(zero);
+  EXPECT_EQ(zero->plants, hard->plants);
+  // The darts that land inside the fade are the hard disc's: its first plants inside
+  // R − f are the faded disc's first plants inside R − f, in order.
+  std::vector<glm::dvec3> inner_hard, inner_faded;
+  for (const ScenePlant& p : hard->plants)
+    if (std::hypot(p.position.x - 3, p.position.z + 2) <= R - f) inner_hard.push_back(p.position);
+  for (const ScenePlant& p : faded->plants)
+    if (std::hypot(p.position.x - 3, p.position.z + 2) <= R - f) inner_faded.push_back(p.position);
+  ASSERT_GT(inner_faded.size(), 1000u);
+  for (size_t i = 0; i < std::min(inner_hard.size(), inner_faded.size()); ++i)
+    ASSERT_EQ(inner_hard[i], inner_faded[i]) << i;
+}
+
+TEST(SceneScatterKey, DensityOverAFadedDiscCountsTheRimByItsWeightAndAFadePastTheRadiusIsAnError) {
+  // R = 10, f = 6: π(100 − 60 + 12) = 52π m², 2 plants per m² -> 327 plants (not 628).
+  auto s = scene_with_scatter(cactus_entry(R"("density": 2, "disc": {"radius": 10, "fade": 6})"));
+  ASSERT_TRUE(s) << s.error().format();
+  EXPECT_EQ(s->plants.size(), static_cast<size_t>(std::round(2 * 52 * M_PI)));
+  EXPECT_NEAR(scatter_weighted_area_m2(s->scatter[0]), 52 * M_PI, 1e-9);
+  EXPECT_EQ(scatter_rim_weight(s->scatter[0], {0, 0}), 1);
+  EXPECT_EQ(scatter_rim_weight(s->scatter[0], {7, 0}), 0.5);
+  EXPECT_EQ(scatter_rim_weight(s->scatter[0], {0, -10}), 0);
+  for (const char* bad : {R"("count": 5, "disc": {"radius": 2, "fade": 3})", R"("count": 5, "disc": {"radius": 2, "fade": -1})",
+                          R"("count": 5, "disc": {"radius": 2, "fade": "soft"})"}) {
+    auto r = scene_with_scatter(cactus_entry(bad));
+    ASSERT_FALSE(r) << bad;
+    EXPECT_NE(r.error().message.find("disc.fade must be"), std::string::npos) << r.error().format();
+    EXPECT_GT(r.error().loc.column, 60u) << r.error().format();  // at the value
+  }
+}
+
 TEST(SceneScatterKey, WritesBackAsItsEntryAndReadsBackEqual) {
   auto s = parse_scene_json(R"({"plants": [{"grammar": ")" + kCactusGrammar + R"(", "seed": 2}], "scatter": [)" +
-                                cactus_entry(R"("count": 30, "disc": {"centre": [1, 2], "radius": 6}, "seed": 4,
+                                cactus_entry(R"("count": 30, "disc": {"centre": [1, 2], "radius": 6, "fade": 1.5}, "seed": 4,
                                    "plant_seeds": 8, "rotate_y_deg": 45, "scale": [1, 1.5], "min_spacing": 0.5,
                                    "steps": 3, "defines": {"HEIGHT": 1.1})") +
                                 "," + cactus_entry(R"("density": 0.5, "polygon": [[0, 0], [4, 0], [0, 4]])") + "]}",
