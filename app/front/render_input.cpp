@@ -1,11 +1,17 @@
 // render_input.cpp — see render_input.h.
 #include "app/front/render_input.h"
 
+#include <cerrno>
 #include <chrono>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <glm/common.hpp>
 #include <iostream>
 #include <limits>
+#include <map>
+#include <memory>
+#include <set>
 
 #include "core/io/gltf.h"
 #include "core/scene/render_common.h"
@@ -14,11 +20,110 @@
 #include "core/util/json.h"
 #include "core/grow/grow.h"
 #include "core/util/clock.h"
+#include "core/util/file_io.h"
 #include "app/front/light.h"
 
 namespace sylva::cli {
 
 bool is_grammar_input(const std::string& path) { return lsys::is_grammar_path(path); }
+
+namespace {
+
+// A private folder under the temporary directory, removed with everything in it when the
+// last scene holding it goes.
+class ScratchFolder {
+ public:
+  static Expected<std::shared_ptr<ScratchFolder>> make() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "sylva-gltf-XXXXXX").string();
+    if (!::mkdtemp(pattern.data()))
+      return file_diagnostic(pattern, std::string("cannot make a folder for the file's images: ") + std::strerror(errno));
+    return std::make_shared<ScratchFolder>(pattern);
+  }
+  explicit ScratchFolder(std::string path) : path_(std::move(path)) {}
+  ~ScratchFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  ScratchFolder(const ScratchFolder&) = delete;
+  ScratchFolder& operator=(const ScratchFolder&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+// The bark height map a glTF's material names (the path `sylva export` was given): as
+// given (absolute, or from the working folder), else beside the glTF file; none if neither
+// is a file.
+std::optional<std::string> find_height_map(const std::string& given, const std::string& gltf_path) {
+  std::error_code e;
+  const std::filesystem::path as_given(given);
+  if (std::filesystem::is_regular_file(as_given, e)) return given;
+  if (as_given.is_relative()) {
+    const std::filesystem::path beside = std::filesystem::path(gltf_path).parent_path() / as_given;
+    if (std::filesystem::is_regular_file(beside, e)) return beside.string();
+    const std::filesystem::path by_name = std::filesystem::path(gltf_path).parent_path() / as_given.filename();
+    if (std::filesystem::is_regular_file(by_name, e)) return by_name.string();
+  }
+  return std::nullopt;
+}
+
+// Gives the plants of a glTF file the looks the file carries (GltfLook, core/io/gltf.h):
+// each plant's bark (its albedo image written to a scratch folder the scene holds, its
+// height map where the path the export was given still leads to one) and the scene's
+// materials (the first plant that uses an index sets it). Warns on stderr for a height map
+// that cannot be found: the plant is drawn without relief.
+Status apply_gltf_looks(const std::vector<GltfPlant>& imported, const std::string& input, Scene& scene) {
+  std::shared_ptr<ScratchFolder> folder;
+  std::map<const std::string*, std::string> written;  // image bytes -> its file
+  auto file_of = [&](const GltfLook::Image& image) -> Expected<std::string> {
+    if (auto found = written.find(image.bytes.get()); found != written.end()) return found->second;
+    if (!folder) {
+      Expected<std::shared_ptr<ScratchFolder>> made = ScratchFolder::make();
+      if (!made) return std::move(made.error());
+      folder = *made;
+      scene.files_held = folder;
+    }
+    const std::string file = folder->path() + "/image" + std::to_string(written.size()) +
+                             (image.mime == "image/jpeg" ? ".jpg" : ".png");
+    if (Status saved = write_file_atomically(file, *image.bytes); !saved) return std::move(saved.error());
+    return written.emplace(image.bytes.get(), file).first->second;
+  };
+  std::set<std::string> missing_heights;
+  for (size_t i = 0; i < imported.size(); ++i) {
+    if (!imported[i].look) continue;
+    const GltfLook& look = *imported[i].look;
+    Bark& bark = scene.plants[i].bark;
+    bark = look.bark;
+    if (look.bark_albedo) {
+      Expected<std::string> file = file_of(*look.bark_albedo);
+      if (!file) return std::move(file.error());
+      bark.albedo_texture = *file;
+      bark.albedo_rgb.reset();
+    }
+    if (look.bark_height) {
+      bark.height_texture = find_height_map(*look.bark_height, input);
+      if (!bark.height_texture) missing_heights.insert(*look.bark_height);
+    }
+    for (const GltfLook::Material& m : look.materials) {
+      if (scene.materials.count(m.index)) continue;
+      SceneMaterial material = m.material;
+      if (m.image) {
+        Expected<std::string> file = file_of(*m.image);
+        if (!file) return std::move(file.error());
+        material.albedo_image = *file;
+      }
+      scene.materials.emplace(m.index, std::move(material));
+    }
+  }
+  for (const std::string& height : missing_heights)
+    std::cerr << input << ": warning: the bark's height map '" << height
+              << "' (the file holds only the normal map baked from it) is neither where the export found it nor "
+                 "beside the file: the bark is drawn without relief\n";
+  return {};
+}
+
+}  // namespace
 
 bool is_render_input(const std::string& path) {
   return path.ends_with(".scene.json") || path.ends_with(".skel.json") || is_grammar_input(path) ||
@@ -85,6 +190,10 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
     }
     scene.ground.height = lowest;
     scene.camera = framing_camera(lo, hi, w, h);
+    if (Status looks = apply_gltf_looks(*imported, input, scene); !looks) {
+      std::cerr << looks.error().format();
+      return kInputError;
+    }
     passes.push_back({"read glTF", seconds_since(start), std::to_string(scene.plants.size()) + " plants"});
   } else {
     Skeleton skeleton;

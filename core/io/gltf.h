@@ -115,6 +115,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -132,6 +133,31 @@ namespace sylva {
 // (each instance is a copy of its skeleton; docs/limits.md "Inputs"): about 2 GiB.
 inline constexpr uint64_t kMaxImportedJoints = 50'000'000;
 
+// How a plant's mesh looked in a file `sylva export --mesh` wrote (its materials
+// "sylva_material_k" / "sylva_leaf_material_k" and their extras.sylva), read back so that
+// `render plant.glb` draws what the file carries (issue 31 §6). Images are the file's
+// embedded PNG or JPEG bytes, shared between the instances that use them.
+struct GltfLook {
+  struct Image {
+    std::string mime;                          // "image/png" or "image/jpeg"
+    std::shared_ptr<const std::string> bytes;  // the encoded file
+  };
+  // The wood (material 0): u_repeat, v_per_metre, relief_depth_m and an albedo colour as
+  // the material's extras give them; no paths (below).
+  Bark bark;
+  std::optional<Image> bark_albedo;       // material 0's baseColorTexture
+  std::optional<std::string> bark_height; // extras "height": the path the export was given
+                                          //   (the file holds only the normal map baked from it)
+  struct Material {
+    uint32_t index = 0;                   // the material index k >= 1
+    SceneMaterial material;               // colour (baseColorFactor), specular, two_sided,
+                                          //   segment repeats; no image paths (below)
+    std::optional<Image> image;           // its baseColorTexture: a leaf image (RGBA, the
+                                          //   alpha its cut-out) or the segments' image
+  };
+  std::vector<Material> materials;        // in increasing index
+};
+
 struct GltfPlant {
   std::string name;             // node name, e.g. "elm" (from the grammar file's stem)
   Skeleton skeleton;            // in the plant's own frame, metres
@@ -141,6 +167,8 @@ struct GltfPlant {
   Bark bark = {};               // textures and relief of the mesh (used with `mesh` only)
   SkinStyle skin = SkinStyle::smooth;  // how its chains meet (the frusta of the mesh and of
                                        //   extras' "skinning"; docs/spec/scene.md "Skin")
+  std::optional<GltfLook> look = {};   // read back only: the look of the mesh drawn for it
+                                       //   (none: the file has no sylva material on it)
 };
 
 // How a node's extras.sylva holds the skeleton (docs/gltf.md "Skeleton in extras").
@@ -233,7 +261,11 @@ double bark_reference_radius_m(const Skeleton& skeleton, SkinStyle skin = SkinSt
 // file, not a crash; a bad value is located in the JSON. For "compact" the binary buffer
 // is read too (the GLB's BIN chunk, or a .gltf's base64 data URI; no other URI is ever
 // resolved), and every bufferView index, offset and length is checked against it and
-// against the counts before anything is allocated.
+// against the counts before anything is allocated. Each plant's `look` comes from the
+// triangles drawn for its node (its own mesh, else the node NAME_LOD0 or NAME_skin the
+// export adds) — the materials sylva wrote, their embedded images (bufferViews of buffer 0
+// or data URIs) and their extras; a material or image that is not sylva's shape leaves
+// the look without it, an index past its array is an error at its place.
 Expected<std::vector<GltfPlant>> import_gltf_skeletons(const std::string& path);
 
 // The same from the file's bytes already in memory (`path` names it in messages): the

@@ -1,8 +1,9 @@
 // gltf_reader.cpp — sylva's skeletons read back from a glTF 2.0 file (core/io/gltf.h).
 //
 // json.h's reader: strict, located, depth-limited. Only the JSON is read and, for
-// "compact" extras, the bufferViews they name; meshes and images are never read and no
-// URI is ever resolved. Every count and index is checked before use.
+// "compact" extras, the bufferViews they name, and for a plant's look its materials'
+// embedded images (bytes, not decoded); vertices are never read and no URI other than a
+// data URI is ever resolved. Every count and index is checked before use.
 #include "core/io/gltf.h"
 
 #include <algorithm>
@@ -211,6 +212,174 @@ class BinaryViews {
   std::string_view data_;
 };
 
+// The looks of the plants (GltfLook, gltf.h): the materials sylva wrote on the triangles
+// drawn for a plant's node, their extras and embedded images. Each image is decoded from
+// the file once and shared.
+class LookReader {
+ public:
+  LookReader(const std::string& path, const JsonValue& root, BinaryViews& views)
+      : path_(path), root_(root), views_(views) {}
+
+  // The look of the plant whose extras sit on `node` (named `name`): none where no
+  // triangles with a sylva material are drawn for it.
+  Expected<std::optional<GltfLook>> look_of(const JsonValue& node, const std::string& name) {
+    const JsonValue* mesh = mesh_of(node, name);
+    if (!mesh) return std::optional<GltfLook>();
+    const JsonValue* primitives = mesh->find("primitives");
+    if (!primitives || !primitives->is_array()) return std::optional<GltfLook>();
+    GltfLook look;
+    bool any = false;
+    std::map<uint32_t, GltfLook::Material> materials;
+    for (const JsonValue& primitive : primitives->elements) {
+      const JsonValue* index = primitive.is_object() ? primitive.find("material") : nullptr;
+      if (!index) continue;
+      Expected<const JsonValue*> material = element("materials", *index);
+      if (!material) return std::move(material.error());
+      const JsonValue* extras = (*material)->find("extras");
+      const JsonValue* sylva = extras && extras->is_object() ? extras->find("sylva") : nullptr;
+      const JsonValue* k_value = sylva && sylva->is_object() ? sylva->find("material_index") : nullptr;
+      const std::optional<uint64_t> k = k_value ? k_value->as_uint64() : std::nullopt;
+      if (!k || *k > UINT32_MAX) continue;
+      any = true;
+      const JsonValue* pbr = (*material)->find("pbrMetallicRoughness");
+      const JsonValue* texture = pbr && pbr->is_object() ? pbr->find("baseColorTexture") : nullptr;
+      std::optional<GltfLook::Image> image;
+      if (texture && texture->is_object()) {
+        Expected<std::optional<GltfLook::Image>> read = image_of(*texture);
+        if (!read) return std::move(read.error());
+        image = std::move(*read);
+      }
+      const std::optional<glm::dvec3> factor = pbr && pbr->is_object() ? rgb(pbr->find("baseColorFactor")) : std::nullopt;
+      const JsonValue* leaf = sylva->find("leaf");
+      const bool is_leaf = leaf && leaf->kind == JsonValue::Kind::Bool && leaf->boolean;
+      if (*k == 0 && !is_leaf) {
+        look.bark.u_repeat = positive(sylva->find("u_repeat")).value_or(1);
+        look.bark.v_per_metre = positive(sylva->find("v_per_metre")).value_or(1);
+        if (const JsonValue* depth = sylva->find("relief_depth_m"); depth && depth->is_number() && depth->number >= 0)
+          look.bark.relief_depth_m = depth->number;
+        look.bark.albedo_rgb = rgb(sylva->find("albedo"));
+        if (const JsonValue* height = sylva->find("height"); height && height->is_string()) look.bark_height = height->text;
+        look.bark_albedo = std::move(image);
+        continue;
+      }
+      GltfLook::Material& m = materials[static_cast<uint32_t>(*k)];
+      m.index = static_cast<uint32_t>(*k);
+      if (image && (is_leaf || !m.image)) m.image = std::move(image);
+      else if (!image && factor && !m.material.albedo_rgb) m.material.albedo_rgb = factor;
+      if (const JsonValue* specular = sylva->find("specular"); specular && specular->is_number())
+        m.material.specular = std::clamp(specular->number, 0.0, 1.0);
+      if (is_leaf) {
+        const JsonValue* two_sided = (*material)->find("doubleSided");
+        m.material.two_sided = two_sided && two_sided->kind == JsonValue::Kind::Bool && two_sided->boolean;
+      }
+      if (const JsonValue* segment = sylva->find("segment_texture"); segment && segment->is_object())
+        m.material.segment_repeat = SegmentRepeat{positive(segment->find("u_repeat")).value_or(1),
+                                                  positive(segment->find("v_per_metre")).value_or(1)};
+    }
+    for (auto& [k, m] : materials) look.materials.push_back(std::move(m));
+    return any ? std::optional<GltfLook>(std::move(look)) : std::nullopt;
+  }
+
+ private:
+  // The mesh drawn for the node: its own, else that of the node NAME_LOD0 (levels of
+  // detail) or NAME_skin (a rig) that the export adds.
+  const JsonValue* mesh_of(const JsonValue& node, const std::string& name) {
+    auto mesh_at = [&](const JsonValue& n) -> const JsonValue* {
+      const JsonValue* index = n.find("mesh");
+      if (!index) return nullptr;
+      Expected<const JsonValue*> mesh = element("meshes", *index);
+      return mesh ? *mesh : nullptr;
+    };
+    if (const JsonValue* own = mesh_at(node)) {
+      const JsonValue* primitives = own->find("primitives");
+      if (primitives && primitives->is_array())
+        for (const JsonValue& p : primitives->elements)
+          if (p.is_object() && p.find("material")) return own;  // not only the skeleton's lines
+    }
+    if (!named_) {  // the nodes by name, once
+      named_.emplace();
+      if (const JsonValue* nodes = root_.find("nodes"); nodes && nodes->is_array())
+        for (const JsonValue& other : nodes->elements)
+          if (const JsonValue* n = other.is_object() ? other.find("name") : nullptr; n && n->is_string())
+            named_->emplace(n->text, &other);
+    }
+    for (const char* suffix : {"_LOD0", "_skin"})
+      if (auto found = named_->find(name + suffix); found != named_->end())
+        if (const JsonValue* mesh = mesh_at(*found->second)) return mesh;
+    return nullptr;
+  }
+
+  // Element `index` of the top-level array `key`, or an error at the index.
+  Expected<const JsonValue*> element(const char* key, const JsonValue& index) {
+    const JsonValue* array = root_.find(key);
+    const size_t count = array && array->is_array() ? array->elements.size() : 0;
+    const std::optional<uint64_t> i = index.as_uint64();
+    if (!i || *i >= count || !array->elements[*i].is_object())
+      return error_at(path_, index, std::string("must be the index of one of the file's ") + std::to_string(count) +
+                                        " " + key);
+    return &array->elements[*i];
+  }
+
+  // The image a textureInfo ({"index": t}) shows: PNG or JPEG, embedded; none otherwise.
+  Expected<std::optional<GltfLook::Image>> image_of(const JsonValue& info) {
+    const JsonValue* t = info.find("index");
+    if (!t) return std::optional<GltfLook::Image>();
+    Expected<const JsonValue*> texture = element("textures", *t);
+    if (!texture) return std::move(texture.error());
+    const JsonValue* source = (*texture)->find("source");
+    if (!source) return std::optional<GltfLook::Image>();
+    Expected<const JsonValue*> image = element("images", *source);
+    if (!image) return std::move(image.error());
+    const uint64_t key = *source->as_uint64();
+    if (auto found = images_.find(key); found != images_.end()) return std::optional<GltfLook::Image>(found->second);
+    GltfLook::Image out;
+    if (const JsonValue* uri = (*image)->find("uri"); uri && uri->is_string()) {
+      for (const char* mime : {"image/png", "image/jpeg"}) {
+        const std::string prefix = std::string("data:") + mime + ";base64,";
+        if (uri->text.compare(0, prefix.size(), prefix) != 0) continue;
+        std::optional<std::string> decoded = decode_base64(std::string_view(uri->text).substr(prefix.size()));
+        if (!decoded) return error_at(path_, *uri, "an image's data URI is not valid base64");
+        out = {mime, std::make_shared<const std::string>(std::move(*decoded))};
+      }
+    } else if (const JsonValue* view = (*image)->find("bufferView")) {
+      const JsonValue* mime = (*image)->find("mimeType");
+      if (!mime || !mime->is_string() || (mime->text != "image/png" && mime->text != "image/jpeg"))
+        return std::optional<GltfLook::Image>();
+      Expected<const JsonValue*> view_object = element("bufferViews", *view);
+      if (!view_object) return std::move(view_object.error());
+      const JsonValue* length = (*view_object)->find("byteLength");
+      const std::optional<uint64_t> bytes = length ? length->as_uint64() : std::nullopt;
+      if (!bytes) return error_at(path_, **view_object, "an image's bufferView needs a byteLength");
+      Expected<std::vector<char>> read = views_.read<char>(*view, *bytes, "images[" + std::to_string(key) + "]");
+      if (!read) return std::move(read.error());
+      out = {mime->text, std::make_shared<const std::string>(read->begin(), read->end())};
+    }
+    if (!out.bytes) return std::optional<GltfLook::Image>();  // an external URI: never resolved
+    images_.emplace(key, out);
+    return std::optional<GltfLook::Image>(std::move(out));
+  }
+
+  static std::optional<glm::dvec3> rgb(const JsonValue* v) {
+    if (!v || !v->is_array() || v->elements.size() < 3) return std::nullopt;
+    glm::dvec3 c;
+    for (int i = 0; i < 3; ++i) {
+      if (!v->elements[i].is_number() || !(v->elements[i].number >= 0 && v->elements[i].number <= 1e6))
+        return std::nullopt;
+      c[i] = v->elements[i].number;
+    }
+    return c;
+  }
+  static std::optional<double> positive(const JsonValue* v) {
+    return v && v->is_number() && v->number > 0 && v->number < 1e9 ? std::optional<double>(v->number) : std::nullopt;
+  }
+
+  const std::string& path_;
+  const JsonValue& root_;
+  BinaryViews& views_;
+  std::map<uint64_t, GltfLook::Image> images_;
+  std::optional<std::multimap<std::string, const JsonValue*>> named_;
+};
+
 // One plant's placement as extras.sylva.instances gives it.
 struct Placement {
   std::string name;
@@ -341,7 +510,7 @@ Status read_compact_instances(const std::string& path, const JsonValue& instance
 
 // One node's extras.sylva back into plants (one per instance), "full" or "compact".
 Status read_sylva_extras(const std::string& path, const JsonValue& node, size_t node_index, const JsonValue& sylva,
-                         BinaryViews& views, std::vector<GltfPlant>* plants) {
+                         BinaryViews& views, LookReader& looks, std::vector<GltfPlant>* plants) {
   const JsonValue* name_value = node.find("name");
   const std::string node_name = name_value && name_value->is_string() ? name_value->text : "";
   const std::string where = "node " + std::to_string(node_index) +
@@ -450,8 +619,11 @@ Status read_sylva_extras(const std::string& path, const JsonValue& node, size_t 
     p.scale = scale->number;
     placements.push_back(std::move(p));
   }
+  Expected<std::optional<GltfLook>> look = looks.look_of(node, node_name);
+  if (!look) return std::move(look.error());
   for (Placement& placement : placements) {
     GltfPlant p;
+    p.look = *look;
     p.name = std::move(placement.name);
     p.skeleton = *read;
     std::copy(placement.position_m, placement.position_m + 3, p.position_m);
@@ -487,13 +659,14 @@ Expected<std::vector<GltfPlant>> parse_gltf_skeletons(const std::string& bytes, 
     return error_at(path, *nodes, std::string("\"nodes\" is ") + nodes->kind_name() + ", expected an array");
   std::vector<GltfPlant> plants;
   BinaryViews views(path, bytes, root);
+  LookReader looks(path, root, views);
   for (size_t n = 0; nodes && n < nodes->elements.size(); ++n) {
     const JsonValue& node = nodes->elements[n];
     if (!node.is_object()) continue;
     const JsonValue* extras = node.find("extras");
     const JsonValue* sylva = extras && extras->is_object() ? extras->find("sylva") : nullptr;
     if (!sylva) continue;
-    if (Status read = read_sylva_extras(path, node, n, *sylva, views, &plants); !read) return std::move(read.error());
+    if (Status read = read_sylva_extras(path, node, n, *sylva, views, looks, &plants); !read) return std::move(read.error());
   }
   if (plants.empty())
     return file_diagnostic(path, "no sylva skeleton in this glTF file (no node has extras.sylva; "

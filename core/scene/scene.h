@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -292,6 +293,9 @@ struct Scene {
   std::string file = {};           // the file it was read from, for messages ("" if made
                                    //   in code); like ScenePlant::grammar_loc, a place, not
                                    //   part of what the scene describes (not written)
+  std::shared_ptr<const void> files_held = {};  // keeps alive files the paths above name
+                                   //   that exist only while the scene does (a glTF's
+                                   //   images written out for the renderers); not written
   bool operator==(const Scene&) const = default;  // field by field, places included
 };
 

@@ -371,6 +371,65 @@ TEST(RenderCli, ReliefScenePresetsRenderAndSayWhatRan) {
   EXPECT_NE(plain.err.find("none"), std::string::npos) << plain.err;
 }
 
+// Issue 31 §6: `render plant.glb` draws the bark and materials the file carries — the
+// picture of the exported scene itself, not the bare default look — and leaves no file
+// of the images it wrote out behind; a height map no longer where the export found it is
+// a warning, and the bark is drawn flat.
+std::vector<float> rgb_pixels(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) return {};
+  std::vector<float> v(static_cast<size_t>(in->spec().width) * in->spec().height * 3);
+  if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, v.data())) return {};
+  return v;
+}
+double mean_abs_difference(const std::vector<float>& a, const std::vector<float>& b) {
+  if (a.size() != b.size() || a.empty()) return 1e9;
+  double sum = 0;
+  for (size_t i = 0; i < a.size(); ++i) sum += std::abs(a[i] - b[i]);
+  return sum / static_cast<double>(a.size());
+}
+
+TEST(RenderCli, AGltfFileRendersWithTheBarkAndMaterialsItCarries) {
+  TempDir dir;
+  const std::string textures = std::string(SYLVA_SOURCE_DIR) + "/presets/textures/";
+  std::filesystem::copy_file(textures + "bark_height.png", dir.file("height.png"));
+  const std::string elm = std::string(SYLVA_SOURCE_DIR) + "/presets/elm.lsys";
+  dir.write("elm.scene.json", R"({"plants": [{"grammar": ")" + elm + R"(", "bark": {"albedo": ")" + textures +
+                                  R"(bark.png", "height": "height.png", "u_repeat": 2, "relief_depth": 0.03}}],
+                                  "materials": [{"index": 1, "albedo": [0.7, 0.1, 0.05], "specular": 0.2}]})");
+  dir.write("bare.scene.json", R"({"plants": [{"grammar": ")" + elm + R"("}]})");
+  for (const char* name : {"elm", "bare"}) {
+    ProcessResult e = run_sylva({"export", dir.file(std::string(name) + ".scene.json"), "-o",
+                                 dir.file(std::string(name) + ".glb"), "--mesh"});
+    ASSERT_EQ(e.exit_code, 0) << describe(e);
+  }
+  const std::filesystem::path scratch = dir.file("tmp");
+  std::filesystem::create_directory(scratch);
+  setenv("TMPDIR", scratch.c_str(), 1);
+  auto render = [&](const std::string& input, const std::string& out) {
+    ProcessResult r = run_sylva({"render", input, "-o", dir.file(out), "--eye", "1.5,3,4", "--target", "0,2.5,0", "--sun", "0.5,1,0.3", "--fov", "35",
+                                 "--width", "96", "--height", "72", "--backend", "cpu"});
+    EXPECT_EQ(r.exit_code, 0) << describe(r);
+    return r;
+  };
+  render(dir.file("elm.glb"), "glb.png");
+  render(dir.file("elm.scene.json"), "scene.png");
+  render(dir.file("bare.glb"), "bare.png");
+  EXPECT_TRUE(std::filesystem::is_empty(scratch));  // the images written out are gone
+  const std::vector<float> glb = rgb_pixels(dir.file("glb.png")), scene = rgb_pixels(dir.file("scene.png")),
+                           bare = rgb_pixels(dir.file("bare.png"));
+  const double same = mean_abs_difference(glb, scene), apart = mean_abs_difference(bare, scene);
+  EXPECT_LT(same, 0.002) << "the glTF drew another look than the scene it was exported from";
+  EXPECT_GT(apart, 10 * same + 0.002) << "the bare elm should look different";
+  // The height map moved away: a warning naming it, exit 0, the bark flat.
+  std::filesystem::remove(dir.file("height.png"));
+  ProcessResult moved = render(dir.file("elm.glb"), "flat.png");
+  EXPECT_NE(moved.err.find("warning: the bark's height map"), std::string::npos) << describe(moved);
+  EXPECT_NE(moved.err.find("height.png"), std::string::npos) << describe(moved);
+  EXPECT_GT(mean_abs_difference(rgb_pixels(dir.file("flat.png")), glb), 0);
+  unsetenv("TMPDIR");
+}
+
 TEST(RenderCli, UsageErrors) {
   TempDir dir;
   EXPECT_EQ(run_sylva({"render", kSaguaro}).exit_code, 2);                                  // no -o
