@@ -133,7 +133,8 @@ void print_render_help() {
          "                         (all: 0 to its derivation length), seen by the last frame's\n"
          "                         camera; so does a scene without an animation key, every\n"
          "                         plant that grows from a grammar in lockstep, in the scene's\n"
-         "                         light. Each frame is written atomically as it finishes\n"
+         "                         light (all stops at the first frame that shows the grown\n"
+         "                         plants). Each frame is written atomically as it finishes\n"
          "      --fps F            frames per second of the video (and of a scene's time):\n"
          "                         default the scene's animation fps, 4 for a grammar\n"
          "      --video VIDEO      also encode the PNG frames into VIDEO (.mp4, .mkv, .webm,\n"
@@ -410,6 +411,7 @@ int run_render_frames(const RenderArgs& a) {
   // The scene whose plants move, or the grammar's last frame (its camera and ground frame
   // every frame, so the plant grows in a still view).
   GrammarArgs last_args = a.grammar;
+  const bool all_frames = range.all;  // growth stops at the first frame that is the last's
   if (grammar_growth) {
     int code = kOk;
     const std::optional<lsys::Grammar> g = load_grammar_for(a.grammar, &code);
@@ -506,6 +508,18 @@ int run_render_frames(const RenderArgs& a) {
 
   std::vector<Skeleton> rest;
   for (const ScenePlant& p : base.plants) rest.push_back(*p.skeleton);
+  // `--frames all` of a growth: the frames after the first whose plants have the last
+  // frame's shapes would repeat its picture (a plant that has stopped growing), so they
+  // are left out (docs/animation.md).
+  auto grown_out = [&](const Scene& scene) {
+    if (!growth || !all_frames || scene.plants.size() != rest.size()) return false;
+    for (size_t i = 0; i < rest.size(); ++i) {
+      const Skeleton& s = *scene.plants[i].skeleton;
+      if (s.joints != rest[i].joints || s.chains != rest[i].chains || s.leaves != rest[i].leaves) return false;
+    }
+    return true;
+  };
+  std::optional<uint64_t> stopped_at;
   const SwayParameters sway = base.animation ? sway_parameters_of(*base.animation) : SwayParameters{};
   auto programs = std::make_shared<GlProgramCache>();
   std::unique_ptr<GlRenderer> renderer;  // the moving scene's, made at its first frame
@@ -575,7 +589,14 @@ int run_render_frames(const RenderArgs& a) {
     std::cerr << "sylva render: [" << done << "/" << range.count() << "] frame " << f << ": " << *path << " ("
               << seconds_text(seconds_since(frame_start))
               << (done < range.count() ? "; about " + seconds_text(left) + " left)" : ")") << "\n";
+    if (f < range.last && grown_out(scene)) {
+      stopped_at = f;
+      std::cerr << "sylva render: frame " << f << " already shows the grown plants: frames " << f + 1 << ".."
+                << range.last << " would repeat it and are left out\n";
+      break;
+    }
   }
+  if (stopped_at) range.last = *stopped_at;  // what was asked for is written
   if (done < range.count()) {
     std::cerr << "sylva render: interrupted after " << done << " of " << range.count()
               << " frames (the frames written stay; the frame in progress was not written"

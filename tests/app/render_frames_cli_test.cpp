@@ -143,6 +143,29 @@ TEST(RenderFrames, AGrammarGrowsOneDerivationStepPerFrameSeenByTheLastFramesCame
   EXPECT_TRUE(fs::exists(dir.file("a_0000.png")));
 }
 
+// Issue 31 §3: `--frames all` stops at the first frame that already shows the grown plant
+// (here step 3 of 8: A stops rewriting itself), so a growth movie has no static tail; an
+// explicit range is rendered whole.
+TEST(RenderFrames, AllFramesOfAGrowthStopWhenThePlantHasStoppedGrowing) {
+  TempDir dir;
+  dir.write("stops.lsys", "derivation length: 8\naxiom: A(0)\nA(n) : n < 3 -> F(1) A(n+1)\n");
+  ProcessResult all = run_sylva({"render", "--spp", "1", dir.file("stops.lsys"), "--frames", "all", "-o",
+                                 dir.file("all/g_{frame}.png"), "--width", "24", "--height", "18", "--backend", "cpu"});
+  ASSERT_EQ(all.exit_code, 0) << describe(all);
+  EXPECT_EQ(list_dir(dir.file("all")),
+            (std::vector<std::string>{"g_0000.png", "g_0001.png", "g_0002.png", "g_0003.png"}));
+  EXPECT_NE(all.err.find("frame 3 already shows the grown plants: frames 4..8 would repeat it and are left out"),
+            std::string::npos)
+      << all.err;
+  EXPECT_NE(all.err.find("4 frames in"), std::string::npos) << all.err;
+  ProcessResult range = run_sylva({"render", "--spp", "1", dir.file("stops.lsys"), "--frames", "0..8", "-o",
+                                   dir.file("range/g_{frame}.png"), "--width", "24", "--height", "18", "--backend",
+                                   "cpu"});
+  ASSERT_EQ(range.exit_code, 0) << describe(range);
+  EXPECT_EQ(list_dir(dir.file("range")).size(), 9u);
+  EXPECT_EQ(mean_abs_difference(pixels(dir.file("range/g_0008.png")), pixels(dir.file("all/g_0003.png"))), 0.0);
+}
+
 TEST(RenderFrames, ASceneWithoutAnimationGrowsItsPlantsInLockstepInItsLight) {
   // docs/animation.md: frame k is every plant grown min(k, its derivation length) steps,
   // all in lockstep in the scene's light (light.md), seen by the scene's camera. Two
