@@ -324,6 +324,24 @@ void GlViewport::set_fog_cones(std::shared_ptr<const ConeSet> cones) {
   asked_view_.clear();  // the next image() asks for the picture with them
 }
 
+ImTextureID GlViewport::make_texture(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) {
+  if (width == 0 || height == 0 || rgba.size() != size_t{width} * height * 4) return nullptr;
+  GLuint texture = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &texture);
+  glTextureStorage2D(texture, 1, GL_RGBA8, static_cast<GLsizei>(width), static_cast<GLsizei>(height));
+  glTextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(texture, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTextureSubImage2D(texture, 0, 0, 0, static_cast<GLsizei>(width), static_cast<GLsizei>(height), GL_RGBA,
+                      GL_UNSIGNED_BYTE, rgba.data());
+  return reinterpret_cast<ImTextureID>(static_cast<intptr_t>(texture));
+}
+
+void GlViewport::free_texture(ImTextureID texture) {
+  const GLuint name = static_cast<GLuint>(reinterpret_cast<intptr_t>(texture));
+  if (name) glDeleteTextures(1, &name);
+}
+
 bool GlViewport::busy() const {
   std::lock_guard<std::mutex> lock(shared_->mutex);
   return shared_->working || shared_->plants || shared_->view || shared_->picture || shared_->cones || shared_->maps;

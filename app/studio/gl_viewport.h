@@ -51,6 +51,8 @@ class GlViewport : public Viewport {
   void set_fog_cones(std::shared_ptr<const ConeSet> cones) override;
   void set_fog_maps(std::shared_ptr<const std::vector<SunDepthMap>> maps) override;
   bool busy() const override;
+  ImTextureID make_texture(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) override;
+  void free_texture(ImTextureID texture) override;
   std::optional<std::string> write_image(const Scene& scene, const RenderOptions& options,
                                          const std::string& path) override;
 

@@ -91,7 +91,11 @@ StudioApp::StudioApp(StudioOptions options, Viewport* viewport)
   sun_elevation_deg_ = static_cast<float>(std::asin(d.y) / kRadPerDeg);
 }
 
-StudioApp::~StudioApp() = default;
+StudioApp::~StudioApp() {
+  thumbnails_.reset();
+  if (viewport_)
+    for (const auto& [path, texture] : thumbnail_textures_) viewport_->free_texture(texture);
+}
 
 std::string StudioApp::display_name() const { return path_.empty() ? "untitled" : base_name(path_); }
 
@@ -103,7 +107,8 @@ bool StudioApp::dirty() const { return text_ != saved_text_; }
 
 bool StudioApp::wants_frames() const {
   return worker_->busy() || worker_->result_waiting() || cones_->busy() || edited_at_ || unsnapped_at_ || animating_ ||
-         view_half_res_ || latency_start_ || (viewport_ && viewport_->busy());
+         view_half_res_ || latency_start_ || (viewport_ && viewport_->busy()) ||
+         (show_presets_ && thumbnails_ && !thumbnails_->idle());
 }
 
 std::optional<WidgetRect> StudioApp::rect(const std::string& name) const {
@@ -1163,33 +1168,80 @@ void StudioApp::draw_view() {
   if (!latencies_.empty()) ImGui::TextDisabled("last regrow: %.0f ms edit to picture", latencies_.back() * 1e3);
 }
 
+// Thumbnails the worker finished, made into textures (the viewport's GL, on this thread).
+void StudioApp::take_thumbnails() {
+  if (!thumbnails_) return;
+  for (auto& [path, t] : thumbnails_->take_finished()) {
+    if (!t.error.empty()) {
+      thumbnail_errors_[path] = t.error;
+      continue;
+    }
+    if (ImTextureID texture = viewport_ ? viewport_->make_texture(t.width, t.height, t.rgba) : nullptr)
+      thumbnail_textures_[path] = texture;
+  }
+}
+
 void StudioApp::draw_presets() {
-  ImGui::SetNextWindowSize(ImVec2(360, 420), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(520, 560), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowPos(ImVec2(60, 60), ImGuiCond_FirstUseEver);
   if (!ImGui::Begin("Presets", &show_presets_, ImGuiWindowFlags_NoSavedSettings)) {
     ImGui::End();
     return;
   }
-  std::vector<std::string> files;
-  std::error_code ec;
-  for (const char* sub : {"", "scenes"}) {
-    const std::filesystem::path dir = std::filesystem::path(options_.presets_dir) / sub;
-    for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
-      const std::string p = e.path().string();
-      if (p.ends_with(".lsys") || p.ends_with(".scene.json")) files.push_back(p);
+  if (!presets_) {  // listed once, not every frame; thumbnails asked for in list order
+    presets_ = list_presets(options_.presets_dir);
+    if (!options_.thumbnail_cache.empty() && !presets_->empty()) {
+      thumbnails_ = std::make_unique<ThumbnailWorker>(options_.thumbnail_cache, kThumbnailWidth, kThumbnailHeight);
+      for (const PresetEntry& e : *presets_) thumbnails_->request(e.path);
     }
   }
-  std::sort(files.begin(), files.end());
-  if (files.empty()) ImGui::TextDisabled("no presets in %s", options_.presets_dir.c_str());
-  for (const std::string& f : files) {
-    const std::string label = std::filesystem::relative(f, options_.presets_dir, ec).string();
-    const bool chosen = ImGui::Selectable(label.c_str(), f == path_ || f == scene_path_);
-    keep("preset:" + label);
+  take_thumbnails();
+  if (presets_->empty()) ImGui::TextDisabled("no presets in %s", options_.presets_dir.c_str());
+  const ImVec2 thumb(static_cast<float>(kThumbnailWidth), static_cast<float>(kThumbnailHeight));
+  for (const PresetEntry& e : *presets_) {
+    ImGui::PushID(e.path.c_str());
+    if (thumbnails_) {
+      auto texture = thumbnail_textures_.find(e.path);
+      if (texture != thumbnail_textures_.end()) {
+        ImGui::Image(texture->second, thumb);
+      } else {
+        auto error = thumbnail_errors_.find(e.path);
+        ImGui::BeginChild("##thumb", thumb, true, ImGuiWindowFlags_NoScrollbar);
+        ImGui::TextDisabled("%s", error != thumbnail_errors_.end() ? "no picture" : "drawing...");
+        ImGui::EndChild();
+      }
+      keep("thumbnail:" + e.label);
+      ImGui::SameLine();
+    }
+    ImGui::BeginGroup();
+    const bool chosen = ImGui::Selectable(e.label.c_str(), e.path == path_ || e.path == scene_path_, 0,
+                                          ImVec2(ImGui::CalcTextSize(e.label.c_str()).x, 0));
+    keep("preset:" + e.label);
+    if (!e.description.empty() && ImGui::IsItemHovered()) {
+      ImGui::BeginTooltip();
+      ImGui::PushTextWrapPos(ImGui::GetFontSize() * 32);
+      ImGui::TextUnformatted(e.description.c_str());
+      ImGui::PopTextWrapPos();
+      ImGui::EndTooltip();
+    }
+    if (!e.title.empty()) {
+      if (thumbnails_) {  // under the label, wrapped beside the thumbnail
+        ImGui::PushTextWrapPos(0);
+        ImGui::TextDisabled("%s", e.title.c_str());
+        ImGui::PopTextWrapPos();
+      } else {  // one line a preset
+        ImGui::SameLine();
+        ImGui::TextDisabled("%s", e.title.c_str());
+      }
+      keep("preset title:" + e.label);
+    }
+    ImGui::EndGroup();
+    ImGui::PopID();
     if (chosen) {
       if (dirty()) {
-        open_after_prompt_ = f;
+        open_after_prompt_ = e.path;
         close_prompt_ = true;
-      } else if (auto err = open(f)) {
+      } else if (auto err = open(e.path)) {
         status_ = *err;
       }
     }

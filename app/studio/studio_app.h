@@ -30,6 +30,7 @@
 #include "app/studio/grow_worker.h"
 #include "app/studio/light_overlay.h"
 #include "app/studio/orbit_camera.h"
+#include "app/studio/preset_catalog.h"
 #include "app/studio/undo_history.h"
 #include "app/studio/viewport.h"
 #include "core/scene/render_types.h"
@@ -40,6 +41,8 @@ namespace sylva::studio {
 
 struct StudioOptions {
   std::string presets_dir;        // the preset browser's folder
+  std::string thumbnail_cache;    // where the browser keeps its thumbnails (preset_catalog.h);
+                                  //   empty: the browser shows none (the headless tests)
   double debounce_s = 0.15;       // a pause in typing before the text is grown again
   double snapshot_s = 0.8;        // a pause in typing before an undo step is taken
   double autosave_s = 3;          // how often an edited document is autosaved
@@ -60,6 +63,9 @@ struct WidgetRect {
   ImVec2 min{0, 0}, max{0, 0};
   ImVec2 centre() const { return ImVec2((min.x + max.x) * 0.5f, (min.y + max.y) * 0.5f); }
 };
+
+// The preset browser's thumbnails, in pixels.
+inline constexpr uint32_t kThumbnailWidth = 96, kThumbnailHeight = 72;
 
 class StudioApp {
  public:
@@ -187,6 +193,7 @@ class StudioApp {
   void draw_light();
   void update_cones();  // the fog's cones for the plants and sun on screen (cone_worker.h)
   void draw_presets();
+  void take_thumbnails();
   void draw_modals();
   void draw_file_dialog();
   void keep(const std::string& name);  // records the last item's rect under `name`
@@ -272,6 +279,10 @@ class StudioApp {
   int export_width_ = 1920, export_height_ = 1080;
   GltfChoice export_gltf_;
   bool show_presets_ = false;
+  std::optional<std::vector<PresetEntry>> presets_;  // listed when the browser first opens
+  std::unique_ptr<ThumbnailWorker> thumbnails_;
+  std::map<std::string, ImTextureID> thumbnail_textures_;  // by preset path
+  std::map<std::string, std::string> thumbnail_errors_;    // by preset path
   std::string status_;
   std::map<std::string, WidgetRect> rects_;
   std::map<std::string, std::string> field_text_;  // typed fields being edited

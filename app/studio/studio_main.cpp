@@ -224,6 +224,11 @@ int run_studio(const std::vector<std::string>& raw_args) {
     StudioOptions options;
     const char* presets = std::getenv("SYLVA_PRESETS");
     options.presets_dir = presets ? presets : SYLVA_PRESETS_DIR;
+    // The preset browser's thumbnails: rendered once, kept in the user's cache folder.
+    if (const char* cache = std::getenv("XDG_CACHE_HOME"); cache && *cache)
+      options.thumbnail_cache = std::string(cache) + "/sylva/thumbnails";
+    else if (const char* home = std::getenv("HOME"); home && *home)
+      options.thumbnail_cache = std::string(home) + "/.cache/sylva/thumbnails";
     options.skin = a.skin;
     StudioApp app(options, viewport_ptr.get());
     app.worker().on_result([] { glfwPostEmptyEvent(); });

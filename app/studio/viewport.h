@@ -64,6 +64,14 @@ class Viewport {
   virtual void set_fog_cones(std::shared_ptr<const ConeSet> cones) = 0;
   // The same for fog mode map's sun maps (the cone worker builds them for mode map).
   virtual void set_fog_maps(std::shared_ptr<const std::vector<SunDepthMap>> maps) = 0;
+  // A texture of `rgba` (width × height, sRGB-encoded, top row first) for the UI to draw
+  // (the preset browser's thumbnails), or null where the viewport makes none; freed with
+  // free_texture.
+  virtual ImTextureID make_texture(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) {
+    (void)width, (void)height, (void)rgba;
+    return nullptr;
+  }
+  virtual void free_texture(ImTextureID texture) { (void)texture; }
   // Whether a picture is being made (the UI keeps drawing frames to show it when done).
   virtual bool busy() const { return false; }
   // Renders `scene` at its width × height with `options` through the same renderer as

@@ -52,6 +52,17 @@ class FakeViewport : public Viewport {
   std::optional<std::string> write_image(const Scene&, const RenderOptions&, const std::string&) override {
     return std::string("no renderer in the headless tests");
   }
+  ImTextureID make_texture(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) override {
+    textures.push_back({width, height, rgba.size()});
+    return reinterpret_cast<ImTextureID>(static_cast<intptr_t>(100 + textures.size()));
+  }
+  void free_texture(ImTextureID) override { ++freed_textures; }
+  struct Texture {
+    uint32_t width, height;
+    size_t bytes;
+  };
+  std::vector<Texture> textures;  // every make_texture, in order
+  int freed_textures = 0;
   int set_plants_calls = 0, renders = 0, last_plants = -1, fog_cones_calls = 0, fog_maps_calls = 0;
   std::shared_ptr<const ConeSet> last_cones;
   std::shared_ptr<const std::vector<SunDepthMap>> last_maps;
