@@ -52,8 +52,8 @@ for grammar in presets/*.lsys; do
   printf "%-24s %s  (%.1f s)\n" "$name" "${label/|/, }" "$(echo "$(date +%s.%N) - $t0" | bc)"
   sheet+=("$out/$name.png" "$name|$label")
 done
-# The paper's plants dressed by their scenes; rendered at the sheet's size.
-for scene in pine_dense coconut_palm saguaro; do
+# The paper's plants and the fir dressed by their scenes; rendered at the sheet's size.
+for scene in pine_dense coconut_palm saguaro fir; do
   t0=$(date +%s.%N)
   "$sylva" render "presets/scenes/$scene.scene.json" -o "$out/scene_$scene.png" --width "$width" \
     --height "$height" --spp "$spp" --backend "$backend" 2>/dev/null

@@ -69,6 +69,8 @@ const Preset kPresets[] = {
     // Synthetic topiary (Prusinkiewicz, James and Měch 1994): apices that query their
     // position (?P) and are cut outside a ball.
     {"topiary", 21576, std::nullopt, 33723},
+    // A fir (Abies): Massart's model, whorls of flat sprays, needles drawn as tufts.
+    {"fir", 20342, std::nullopt},
 };
 
 fs::path presets_dir() { return fs::path(SYLVA_SOURCE_DIR) / "presets"; }
