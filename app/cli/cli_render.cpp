@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <map>
 
 #include "app/front/batch.h"
 #include "app/front/camera_flags.h"
@@ -29,6 +30,7 @@
 #include "app/front/render.h"
 #include "core/gl/render_gl.h"
 #include "core/grow/grow.h"
+#include "core/grow/growth_tween.h"
 #include "core/scene/scene.h"
 #include "core/util/clock.h"
 
@@ -135,6 +137,9 @@ void print_render_help() {
          "                         plant that grows from a grammar in lockstep, in the scene's\n"
          "                         light (all stops at the first frame that shows the grown\n"
          "                         plants). Each frame is written atomically as it finishes\n"
+         "      --substeps K       a growth's frames from one derivation step to the next\n"
+         "                         (1 to 100, default 1): frame k is step k/K, what grows\n"
+         "                         between two steps growing out smoothly (docs/animation.md)\n"
          "      --fps F            frames per second of the video (and of a scene's time):\n"
          "                         default the scene's animation fps, 4 for a grammar\n"
          "      --video VIDEO      also encode the PNG frames into VIDEO (.mp4, .mkv, .webm,\n"
@@ -163,6 +168,7 @@ struct RenderArgs {
   bool grammar_flags = false;  // -n, --seed, -D or --max-modules given
   std::optional<std::string> frames;  // --frames, as given
   std::optional<double> fps;          // --fps
+  uint32_t substeps = 1;              // --substeps: frames from one derivation step to the next
   std::optional<std::string> video;   // --video
   std::optional<SkinStyle> skin;      // --skin: every plant's, over the scene's keys
   std::optional<glm::dvec3> sun;      // --sun: toward the sun, over the scene's sun.direction
@@ -292,6 +298,14 @@ RenderArgs parse_render_args(const std::vector<std::string>& args) {
                      throw UsageError{"--fps " + v + ": expected a number of frames per second in (0, 1000]"};
                    out.fps = fps;
                  }),
+      value_flag({"--substeps"},
+                 [&out](const std::string&, const std::string& v) {
+                   char* end = nullptr;
+                   const long k = std::strtol(v.c_str(), &end, 10);
+                   if (v.empty() || *end != '\0' || k < 1 || k > 100)
+                     throw UsageError{"--substeps " + v + ": expected an integer from 1 to 100"};
+                   out.substeps = static_cast<uint32_t>(k);
+                 }),
       value_flag({"--video"}, [&out](const std::string&, const std::string& v) { out.video = v; }),
       value_flag({"--eye"},
                  [&out](const std::string& spelled, const std::string& v) {
@@ -416,8 +430,8 @@ int run_render_frames(const RenderArgs& a) {
     int code = kOk;
     const std::optional<lsys::Grammar> g = load_grammar_for(a.grammar, &code);
     if (!g) return code;
-    if (range.all) range = {0, static_cast<uint64_t>(std::max<int64_t>(0, g->steps)), false};
-    last_args.steps = static_cast<int64_t>(range.last);
+    if (range.all) range = {0, static_cast<uint64_t>(std::max<int64_t>(0, g->steps)) * a.substeps, false};
+    last_args.steps = static_cast<int64_t>((range.last + a.substeps - 1) / a.substeps);
   }
   auto loaded = load_render_input(last_args, a.width, a.height, passes, Progress(&g_interrupted));
   if (auto* code = std::get_if<ExitCode>(&loaded)) {
@@ -436,7 +450,12 @@ int run_render_frames(const RenderArgs& a) {
   if (!growth && !base.animation)
     throw UsageError{"--frames: " + input + " has no animation key and no plant that grows from a grammar: "
                      "nothing moves or grows (docs/animation.md)"};
-  if (scene_growth && range.all) range = {0, static_cast<uint64_t>(scene_length), false};
+  if (!growth && a.substeps != 1)
+    throw UsageError{"--substeps applies to a growth (a grammar, or a scene without an animation key)"};
+  if (scene_growth && range.all) range = {0, static_cast<uint64_t>(scene_length) * a.substeps, false};
+  if (range.count() > kMaxAnimationFrames)
+    throw UsageError{"--substeps " + std::to_string(a.substeps) + ": " + std::to_string(range.count()) +
+                     " frames, more than the limit of " + std::to_string(kMaxAnimationFrames) + " in one command"};
   // --fps is a scene's time step too (docs/animation.md): frame k at k / fps seconds, and
   // `all` the frames of its duration at that rate.
   if (!growth && a.fps) {
@@ -520,6 +539,22 @@ int run_render_frames(const RenderArgs& a) {
     return true;
   };
   std::optional<uint64_t> stopped_at;
+  // A growth's scenes by step, the last two kept: the frames between two steps need both.
+  std::map<uint64_t, Scene> grown;
+  auto grown_to = [&](uint64_t step, std::optional<ExitCode>& failed) -> const Scene* {
+    if (auto found = grown.find(step); found != grown.end()) return &found->second;
+    GrammarArgs args = a.grammar;
+    if (grammar_growth) args.steps = static_cast<int64_t>(step);
+    std::vector<RenderPass> ignored;
+    auto loaded = load_render_input(args, a.width, a.height, ignored, Progress(&g_interrupted),
+                                    scene_growth ? std::optional<int64_t>(static_cast<int64_t>(step)) : std::nullopt);
+    if (auto* code = std::get_if<ExitCode>(&loaded)) {
+      failed = *code;
+      return nullptr;
+    }
+    while (grown.size() >= 2) grown.erase(grown.begin());
+    return &grown.emplace(step, std::move(std::get<Scene>(loaded))).first->second;
+  };
   const SwayParameters sway = base.animation ? sway_parameters_of(*base.animation) : SwayParameters{};
   auto programs = std::make_shared<GlProgramCache>();
   std::unique_ptr<GlRenderer> renderer;  // the moving scene's, made at its first frame
@@ -530,17 +565,20 @@ int run_render_frames(const RenderArgs& a) {
     if (g_interrupted.load()) break;
     const auto frame_start = std::chrono::steady_clock::now();
     Scene scene = base;
+    const uint64_t step_below = f / a.substeps;
+    const double alpha = static_cast<double>(f % a.substeps) / a.substeps;  // 0: a whole step
     if (growth) {
-      GrammarArgs step = a.grammar;
-      if (grammar_growth) step.steps = static_cast<int64_t>(f);
-      std::vector<RenderPass> ignored;
-      auto grown = load_render_input(step, a.width, a.height, ignored, Progress(&g_interrupted),
-                                     scene_growth ? std::optional<int64_t>(static_cast<int64_t>(f)) : std::nullopt);
-      if (auto* code = std::get_if<ExitCode>(&grown)) {
-        if (*code == kInterrupted) break;  // said below, with the frames kept
-        return *code;
+      std::optional<ExitCode> failed;
+      const Scene* before = grown_to(step_below, failed);
+      const Scene* after = before && alpha > 0 ? grown_to(step_below + 1, failed) : before;
+      if (failed) {
+        if (*failed == kInterrupted) break;  // said below, with the frames kept
+        return *failed;
       }
-      scene = std::move(std::get<Scene>(grown));
+      scene = *after;
+      if (alpha > 0)  // between two steps: what grows grows out (growth_tween.h)
+        for (size_t i = 0; i < scene.plants.size() && i < before->plants.size(); ++i)
+          scene.plants[i].skeleton = tween_growth(*before->plants[i].skeleton, *after->plants[i].skeleton, alpha);
       apply_scene_flags(a, scene);
       scene.camera = base.camera;
       scene.ground = base.ground;
@@ -589,7 +627,7 @@ int run_render_frames(const RenderArgs& a) {
     std::cerr << "sylva render: [" << done << "/" << range.count() << "] frame " << f << ": " << *path << " ("
               << seconds_text(seconds_since(frame_start))
               << (done < range.count() ? "; about " + seconds_text(left) + " left)" : ")") << "\n";
-    if (f < range.last && grown_out(scene)) {
+    if (f < range.last && alpha == 0 && grown_out(scene)) {
       stopped_at = f;
       std::cerr << "sylva render: frame " << f << " already shows the grown plants: frames " << f + 1 << ".."
                 << range.last << " would repeat it and are left out\n";

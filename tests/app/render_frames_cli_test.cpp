@@ -166,6 +166,43 @@ TEST(RenderFrames, AllFramesOfAGrowthStopWhenThePlantHasStoppedGrowing) {
   EXPECT_EQ(mean_abs_difference(pixels(dir.file("range/g_0008.png")), pixels(dir.file("all/g_0003.png"))), 0.0);
 }
 
+// Issue 31 §3: --substeps K puts K frames between two derivation steps; frame K·n is step
+// n's picture exactly, the frames between show the new internode growing out.
+TEST(RenderFrames, SubstepsGrowWhatIsNewOutBetweenTwoSteps) {
+  TempDir dir;
+  dir.write("stops.lsys", "derivation length: 8\naxiom: A(0)\nA(n) : n < 3 -> F(1) A(n+1)\n");
+  auto render = [&](const std::string& folder, const std::vector<std::string>& more) {
+    std::vector<std::string> args = {"render", "--spp", "1", dir.file("stops.lsys"), "-o",
+                                     dir.file(folder + "/g_{frame}.png"), "--width", "96", "--height", "72",
+                                     "--backend", "cpu", "--frames"};
+    args.insert(args.end(), more.begin(), more.end());
+    return run_sylva(args);
+  };
+  ProcessResult halves = render("halves", {"all", "--substeps", "2"});
+  ASSERT_EQ(halves.exit_code, 0) << describe(halves);
+  EXPECT_EQ(list_dir(dir.file("halves")).size(), 7u) << "steps 0..3 at two frames a step, then grown";
+  ProcessResult whole = render("whole", {"all"});
+  ASSERT_EQ(whole.exit_code, 0) << describe(whole);
+  for (int step = 0; step <= 3; ++step) {
+    const std::string a = dir.file("halves/g_000" + std::to_string(2 * step) + ".png");
+    const std::string b = dir.file("whole/g_000" + std::to_string(step) + ".png");
+    EXPECT_EQ(mean_abs_difference(pixels(a), pixels(b)), 0.0) << step;
+  }
+  for (int k : {1, 3, 5}) {  // half-way frames: neither step
+    const std::vector<float> mid = pixels(dir.file("halves/g_000" + std::to_string(k) + ".png"));
+    EXPECT_GT(mean_abs_difference(mid, pixels(dir.file("halves/g_000" + std::to_string(k - 1) + ".png"))), 0.0) << k;
+    EXPECT_GT(mean_abs_difference(mid, pixels(dir.file("halves/g_000" + std::to_string(k + 1) + ".png"))), 0.0) << k;
+  }
+  // Only a growth has steps; out of range is a usage error.
+  const std::string dancing = std::string(SYLVA_SOURCE_DIR) + "/presets/scenes/dancing_cacti.scene.json";
+  ProcessResult moving = run_sylva({"render", dancing, "-o", dir.file("d/f_{frame}.png"), "--frames", "0..1",
+                                    "--substeps", "2", "--backend", "cpu", "--width", "16", "--height", "12"});
+  EXPECT_EQ(moving.exit_code, 2) << describe(moving);
+  EXPECT_NE(moving.err.find("--substeps applies to a growth"), std::string::npos) << describe(moving);
+  EXPECT_EQ(render("bad", {"all", "--substeps", "0"}).exit_code, 2);
+  EXPECT_EQ(render("bad", {"all", "--substeps", "101"}).exit_code, 2);
+}
+
 TEST(RenderFrames, ASceneWithoutAnimationGrowsItsPlantsInLockstepInItsLight) {
   // docs/animation.md: frame k is every plant grown min(k, its derivation length) steps,
   // all in lockstep in the scene's light (light.md), seen by the scene's camera. Two
