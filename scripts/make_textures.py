@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""make_textures.py — synthesises the bundled bark, cactus, stone and roof-tile textures (presets/textures/).
+"""make_textures.py — synthesises the bundled bark, cactus, aloe, stone and roof-tile textures (presets/textures/).
 
     /usr/bin/python3 scripts/make_textures.py [OUTPUT_DIR]      (default presets/textures)
 
@@ -25,6 +25,7 @@ BARK_SEED = 20240611
 CACTUS_SEED = 20240612
 STONE_SEED = 20261202
 TILES_SEED = 20261203
+ALOE_SEED = 20261204
 
 
 # --- PNG ------------------------------------------------------------------------------
@@ -238,6 +239,43 @@ def make_cactus(n):
     return to_u8(srgb_encode(colour)), to_u16(height)
 
 
+# --- aloe -----------------------------------------------------------------------------
+
+ALOE_FLECKS = 90  # pale flecks per repeat
+
+
+def make_aloe(n):
+    """Aloe vera skin (presets/aloe_vera.lsys): a glaucous grey-green with faint streaks
+    along t (the leaf's length), scattered pale whitish flecks elongated along t (as on a
+    young aloe vera leaf), each a soft ellipse about 1/23 of the repeat across and 1/14
+    along, of varying size and brightness, placed at random with wrap-around so the
+    texture tiles. Albedo only (no height)."""
+    rng = np.random.default_rng(ALOE_SEED)
+    s = (np.arange(n)[None, :] + 0.5) / n
+    t = (np.arange(n)[:, None] + 0.5) / n
+    streaks = spectral_noise(rng, n, (4.0, 80.0), 0.9, 8.0)     # fine streaks along t
+    blotch = spectral_noise(rng, n, (1.0, 6.0), 1.2, 1.0)       # broad tint
+    fine = spectral_noise(rng, n, (40.0, 200.0), 0.4, 1.0)
+    wobble = spectral_noise(rng, n, (6.0, 30.0), 1.0, 1.0)      # ragged fleck edges
+    fleck = np.zeros((n, n))
+    for _ in range(ALOE_FLECKS):
+        cs, ct = rng.uniform(), rng.uniform()
+        size = rng.uniform(0.6, 1.3)
+        ds = s - cs
+        ds -= np.round(ds)                                       # periodic
+        dt = t - ct
+        dt -= np.round(dt)
+        r2 = (ds / (0.022 * size)) ** 2 + (dt / (0.036 * size)) ** 2
+        fleck = np.maximum(fleck, rng.uniform(0.6, 1.0) * (1 - smoothstep(0.55, 1.0, r2 + 0.25 * wobble)))
+    skin = np.array([0.150, 0.235, 0.140])
+    glaucous = np.array([0.185, 0.265, 0.190])   # the bloom: greyer, bluer
+    pale = np.array([0.50, 0.56, 0.46])
+    colour = mix(skin, glaucous, smoothstep(-1.5, 1.5, blotch))
+    colour *= (1.0 + 0.06 * streaks + 0.03 * fine)[..., None]
+    colour = mix(colour, pale * (1.0 + 0.05 * fine)[..., None], fleck)
+    return to_u8(srgb_encode(colour))
+
+
 # --- the well's stone and roof tiles (Bhagvat et al. 2009 fig. 10) --------------------------------
 
 STONE_COURSES = 8        # courses of blocks per repeat along t
@@ -307,8 +345,10 @@ def main():
     cactus_albedo, cactus_height = make_cactus(SIZE)
     stone_albedo, stone_height = make_stone(SIZE)
     tiles_albedo, tiles_height = make_tiles(SIZE)
+    aloe_albedo = make_aloe(SIZE)
     for name, pixels in (("bark.png", bark_albedo), ("bark_height.png", bark_height),
                          ("cactus.png", cactus_albedo), ("cactus_height.png", cactus_height),
+                         ("aloe.png", aloe_albedo),
                          ("stone.png", stone_albedo), ("stone_height.png", stone_height),
                          ("tiles.png", tiles_albedo), ("tiles_height.png", tiles_height)):
         path = os.path.join(out_dir, name)

@@ -53,12 +53,16 @@ for grammar in presets/*.lsys; do
   sheet+=("$out/$name.png" "$name|$label")
 done
 # The paper's plants and the fir dressed by their scenes; rendered at the sheet's size.
-for scene in pine_dense coconut_palm saguaro fir; do
+for scene in pine_dense coconut_palm saguaro aloe_vera fir; do
   t0=$(date +%s.%N)
   "$sylva" render "presets/scenes/$scene.scene.json" -o "$out/scene_$scene.png" --width "$width" \
     --height "$height" --spp "$spp" --backend "$backend" 2>/dev/null
   printf "%-24s %s  (%.1f s)\n" "scenes/$scene" "scene" "$(echo "$(date +%s.%N) - $t0" | bc)"
-  sheet+=("$out/scene_$scene.png" "$scene.scene.json|bark relief on wood|(material 0) only")
+  case $scene in
+    aloe_vera) note="flecked skin on the leaves|(materials table)" ;;
+    *) note="bark relief on wood|(material 0) only" ;;
+  esac
+  sheet+=("$out/scene_$scene.png" "$scene.scene.json|$note")
 done
 /usr/bin/python3 scripts/contact_sheet.py docs/images/presets.png 5 "${sheet[@]}"
 echo "docs/images/presets.png: $((${#sheet[@]} / 2)) pictures of ${width}x${height}, $spp spp, $backend backend," \

@@ -55,7 +55,7 @@ const Preset kPresets[] = {
     {"abop_2_8_ternary", 1457, std::nullopt},
     // The plants of Bhagvat et al. 2009, modelled for sylva; Table 1 gives their segment counts.
     {"saguaro", 30, 30},
-    {"aloe_vera", 229, 229, 456},  // a keel of frusta under two blade halves a segment
+    {"aloe_vera", 229, 229, 912},  // a fat keel of frusta under four polygons a segment
     {"elm", 1769, 1833},           // leaves of frusta (the grove scenes' elm)
     {"elm_in_leaf", 1872, 1833, 10627},  // the wood is the segments; leaves are polygons
     {"coconut_palm", 3626, 3713, 3024},  // three blades over each leaflet's frusta
