@@ -12,8 +12,8 @@
 #
 # The CPU ray caster is the default: on the shared 2-core machine without a GPU it is the
 # faster backend (the pine at 320 x 240: 3.4 s on the CPU, 17 s on llvmpipe, load 11);
-# BACKEND=gl uses OpenGL where there is a GPU. The whole sheet took 42 s on the CPU here
-# (24 pictures, load 11 to 13; 308 s at load 15 to 18). The sheet is written by scripts/contact_sheet.py (numpy only).
+# BACKEND=gl uses OpenGL where there is a GPU. The whole sheet took 25 s on the CPU here
+# (29 pictures, load 1.7; 42 s for 24 pictures at load 11 to 13). The sheet is written by scripts/contact_sheet.py (numpy only).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
