@@ -34,7 +34,10 @@ namespace {
 class ScratchFolder {
  public:
   static Expected<std::shared_ptr<ScratchFolder>> make() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "sylva-gltf-XXXXXX").string();
+    std::error_code ec;  // $TMPDIR naming no folder: /tmp, as mkdtemp(3) users expect
+    std::filesystem::path base = std::filesystem::temp_directory_path(ec);
+    if (ec) base = "/tmp";
+    std::string pattern = (base / "sylva-gltf-XXXXXX").string();
     if (!::mkdtemp(pattern.data()))
       return file_diagnostic(pattern, std::string("cannot make a folder for the file's images: ") + std::strerror(errno));
     return std::make_shared<ScratchFolder>(pattern);

@@ -427,6 +427,10 @@ TEST(RenderCli, AGltfFileRendersWithTheBarkAndMaterialsItCarries) {
   EXPECT_NE(moved.err.find("warning: the bark's height map"), std::string::npos) << describe(moved);
   EXPECT_NE(moved.err.find("height.png"), std::string::npos) << describe(moved);
   EXPECT_GT(mean_abs_difference(rgb_pixels(dir.file("flat.png")), glb), 0);
+  // $TMPDIR naming a file, not a folder: the images go under /tmp, the render still runs.
+  setenv("TMPDIR", dir.file("elm.scene.json").c_str(), 1);
+  render(dir.file("elm.glb"), "other_tmp.png");
+  EXPECT_TRUE(std::filesystem::exists(dir.file("other_tmp.png")));
   unsetenv("TMPDIR");
 }
 
