@@ -16,9 +16,9 @@ constexpr uint32_t kNone = UINT32_MAX;
 
 // The same point up to rounding: the turtle reaches an old joint through a longer word
 // the next step, and its position may differ in the last bits.
-bool same_position(const Joint& a, const Joint& b) {
+bool same_point(const double* a, const double* b) {
   for (int k = 0; k < 3; ++k)
-    if (!(std::abs(a.position_m[k] - b.position_m[k]) <= 1e-9 * (1 + std::abs(a.position_m[k])))) return false;
+    if (!(std::abs(a[k] - b[k]) <= 1e-9 * (1 + std::abs(a[k])))) return false;
   return true;
 }
 
@@ -63,7 +63,7 @@ Skeleton tween_growth(const Skeleton& before, const Skeleton& after, double alph
           const uint32_t b = siblings->second[next];
           const Chain& bc = before.chains[b];
           const bool same_start = a.joint_count < 2 || bc.joint_count < 2 ||
-                                  same_position(after.joints[a.first_joint + 1], before.joints[bc.first_joint + 1]);
+                                  same_point(after.joints[a.first_joint + 1].position_m, before.joints[bc.first_joint + 1].position_m);
           if (same_start) {
             candidate = b;
             ++next;
@@ -120,12 +120,8 @@ Skeleton tween_growth(const Skeleton& before, const Skeleton& after, double alph
     if (found == before_leaves.end()) return false;
     for (const Leaf* lb : found->second) {
       bool same = lb->vertices_m.size() == la.vertices_m.size();
-      for (size_t v = 0; same && v < la.vertices_m.size(); ++v) {
-        Joint a{}, b{};
-        std::copy(la.vertices_m[v].begin(), la.vertices_m[v].end(), a.position_m);
-        std::copy(lb->vertices_m[v].begin(), lb->vertices_m[v].end(), b.position_m);
-        same = same_position(a, b);
-      }
+      for (size_t v = 0; same && v < la.vertices_m.size(); ++v)
+        same = same_point(la.vertices_m[v].data(), lb->vertices_m[v].data());
       if (same) return true;
     }
     return false;
