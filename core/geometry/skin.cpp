@@ -431,14 +431,20 @@ void add_knuckle(SkinnedSkeleton& out, const dvec3& center, const dvec3& axis, d
 // stacked along `axis` from the end joint, their profile inscribed in the ball of the end
 // radius (vertices on it), so the first starts at exactly the chain's end radius (no step)
 // and the last ends in a tip on the axis. The chain's flat cap lies under it.
+// Its u and v go on from the chain's last frustum (u_offset, and v_m from v_end_m), so that
+// where the dome shows (beside a continuation that keeps its flat cap) the bark does too.
 void add_dome(SkinnedSkeleton& out, const dvec3& centre, const dvec3& axis, double radius,
-              int count, uint32_t chain, uint32_t joint, uint32_t material, int64_t parent) {
+              int count, uint32_t chain, uint32_t joint, uint32_t material, int64_t parent,
+              double u_offset, double v_end_m) {
   for (int i = 0; i < count; ++i) {
     double b0 = 0.5 * kPi * i / count, b1 = 0.5 * kPi * (i + 1) / count;
-    out.frusta.push_back(knuckle_piece(centre + radius * std::sin(b0) * axis, axis,
-                                       radius * (std::sin(b1) - std::sin(b0)), radius * std::cos(b0),
-                                       i + 1 == count ? 0.0 : radius * std::cos(b1), chain, joint,
-                                       material, parent));
+    Frustum f = knuckle_piece(centre + radius * std::sin(b0) * axis, axis,
+                              radius * (std::sin(b1) - std::sin(b0)), radius * std::cos(b0),
+                              i + 1 == count ? 0.0 : radius * std::cos(b1), chain, joint, material, parent);
+    f.u_offset = u_offset;
+    f.v_lower_m = v_end_m + radius * std::sin(b0);
+    f.v_upper_m = v_end_m + radius * std::sin(b1);
+    out.frusta.push_back(f);
   }
 }
 
@@ -598,7 +604,92 @@ int64_t frustum_at_joint(const std::vector<int64_t>& first_frustum_of_chain,
   return first_frustum_of_chain[chain] + best;
 }
 
+// The u = 0 direction of a frustum (⊥ its axis): raw angle u_offset in axis_frame.
+dvec3 u_direction(const Frustum& f) {
+  AxisFrame frame = axis_frame(f.shape.axis);
+  double angle = 2 * kPi * f.u_offset;
+  return std::cos(angle) * frame.e0 + std::sin(angle) * frame.e1;
+}
+
+// `radial` (⊥ `from`) carried onto `to` by the rotation that takes `from` to `to` (the
+// parallel transport of the chain's u = 0 line across a bend); `fallback` is the rotation
+// axis where the two are antiparallel.
+dvec3 transport(const dvec3& radial, const dvec3& from, const dvec3& to, const dvec3& fallback = dvec3(0)) {
+  dvec3 k = glm::cross(from, to);
+  double sin_a = glm::length(k);
+  double angle = std::atan2(sin_a, glm::dot(from, to));
+  dvec3 out = rotate(radial, sin_a > 1e-12 ? k / sin_a : fallback, angle);
+  return glm::normalize(out - glm::dot(out, to) * to);
+}
+
+// A chain's polyline as skin_skeleton skins it: zero-length segments dropped, bends
+// rounded, its first segment shaped by its attachment.
+ChainPath prepared_path(const Skeleton& sk, uint32_t c, const SkinOptions& options,
+                        const std::vector<Attachment>& joins, uint64_t& skipped) {
+  ChainPath path = chain_path(sk, sk.chains[c], skipped);
+  if (options.round_bends_over_deg < 180) {
+    path = round_bends(path, deg_to_rad(options.round_bends_over_deg), deg_to_rad(options.round_piece_deg));
+  }
+  if (options.collars) shape_attachment(path, sk, c, joins, options.collar_flare);
+  return path;
+}
+
+// The plane in which a continuation (its prepared `child` path) meets `last`, its parent's
+// last frustum: the interior joint's construction, where it needs no split and keeps
+// `last` proper and the child's first segment proper under it even with a perpendicular
+// cut at its far end (which the child then falls back to); none otherwise.
+std::optional<Plane> continuation_mitre(const FrustumShape& last, const ChainPath& child, double max_tilt_deg) {
+  if (child.points.size() < 2) return std::nullopt;
+  const dvec3 end = last.base + last.length * last.axis;
+  if (!(glm::length(child.points[0] - end) <= 1e-9 * (1 + glm::length(end)))) return std::nullopt;
+  const dvec3 d = child.points[1] - child.points[0];
+  const double length = glm::length(d);
+  const dvec3 axis = d / length;
+  JointSide below{last.radius0, last.radius1, last.length};
+  JointSide above{child.radii[1], child.radii[0], length};
+  JointCut cut = cutting_plane_at_joint(child.points[0], last.axis, below, axis, above, deg_to_rad(max_tilt_deg));
+  if (cut.split) return std::nullopt;
+  FrustumShape parent = last;
+  parent.upper = cut.plane;
+  parent.cap_upper = false;
+  FrustumShape first;
+  first.base = child.points[0];
+  first.axis = axis;
+  first.length = length;
+  first.radius0 = child.radii[0];
+  first.radius1 = child.radii[1];
+  first.lower = cut.plane;
+  first.upper = plane_through(child.points[1], axis);
+  if (!cuts_are_proper(parent, max_tilt_deg) || !cuts_are_proper(first, max_tilt_deg)) return std::nullopt;
+  return cut.plane;
+}
+
+// The frustum a continuation goes on from: its parent's last segment frustum, when chain
+// `c` is the continuation of its parent (attachments) and starts at that frustum's end;
+// else -1.
+int64_t continued_from(const Skeleton& sk, uint32_t c, const std::vector<Attachment>& at,
+                             const std::vector<int64_t>& first_frustum_of_chain,
+                             const std::vector<std::vector<uint32_t>>& segment_lower_joint,
+                             const SkinnedSkeleton& out, const dvec3& start) {
+  const Chain& ch = sk.chains[c];
+  if (!ch.parent || at[ch.parent->chain].continuation != int64_t(c)) return -1;
+  int64_t f = frustum_at_joint(first_frustum_of_chain, segment_lower_joint, ch.parent->chain, ch.parent->joint);
+  if (f < 0) return -1;
+  const Frustum& pf = out.frusta[size_t(f)];
+  if (pf.kind != FrustumKind::segment || pf.chain != ch.parent->chain) return -1;
+  dvec3 end = pf.shape.base + pf.shape.length * pf.shape.axis;
+  if (!(glm::length(end - start) <= 1e-9 * (1 + glm::length(start)))) return -1;
+  return f;
+}
+
 }  // namespace
+
+std::vector<int64_t> continuation_children(const Skeleton& sk) {
+  std::vector<int64_t> out;
+  out.reserve(sk.chains.size());
+  for (const Attachment& a : attachments(sk)) out.push_back(a.continuation);
+  return out;
+}
 
 SkinnedSkeleton skin_skeleton(const Skeleton& sk, const SkinOptions& options) {
   Expected<SkinnedSkeleton> skinned = skin_skeleton(sk, options, Progress{});
@@ -616,6 +707,8 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
   std::vector<int64_t> first_frustum_of_chain(sk.chains.size(), -1);
   std::vector<std::vector<uint32_t>> segment_lower_joint(sk.chains.size());
   const std::vector<Attachment> joins = options.collars ? attachments(sk) : std::vector<Attachment>(sk.chains.size());
+  std::vector<std::optional<Plane>> mitre_below(sk.chains.size());  // a continuation's first plane
+  uint64_t lookahead_skipped = 0;  // counted again when the continuation is skinned
 
   for (uint32_t c = 0; c < sk.chains.size(); ++c) {
     if ((c & kProgressChunkMask) == 0 && c != 0) {  // between chunks of chains
@@ -623,12 +716,7 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
       progress.report(static_cast<double>(c) / static_cast<double>(sk.chains.size()), "skin");
     }
     const Chain& chain = sk.chains[c];
-    ChainPath path = chain_path(sk, chain, out.zero_length_skipped);
-    if (options.round_bends_over_deg < 180) {
-      path = round_bends(path, deg_to_rad(options.round_bends_over_deg),
-                         deg_to_rad(options.round_piece_deg));
-    }
-    if (options.collars) shape_attachment(path, sk, c, joins, options.collar_flare);
+    const ChainPath path = prepared_path(sk, c, options, joins, out.zero_length_skipped);
     const size_t n = path.points.size() < 2 ? 0 : path.points.size() - 1;  // segments
     if (n == 0) continue;
     std::vector<dvec3> axis(n);
@@ -644,10 +732,15 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
     std::vector<double> radius_lower(n);  // radius0 per segment (minor-axis fit may move it)
     std::vector<bool> clamped(n + 1, false);
     std::vector<dvec3> bend_normal(n + 1, dvec3(0));
+    // A continuation (docs/joints.md "Continuations") carries its parent's u and v on, and
+    // meets the parent's last frustum in the mitred plane its parent chose (if it did).
+    const int64_t continued = continued_from(sk, c, joins, first_frustum_of_chain,
+                                             segment_lower_joint, out, path.points[0]);
+    const std::optional<Plane> inherited_lower = continued >= 0 ? mitre_below[c] : std::nullopt;
     for (int pass = 0;; ++pass) {
       assert(pass <= int(n) + 1);
       for (size_t s = 0; s < n; ++s) radius_lower[s] = path.radii[s];
-      planes[0] = plane_through(path.points[0], axis[0]);
+      planes[0] = inherited_lower ? *inherited_lower : plane_through(path.points[0], axis[0]);
       planes[n] = plane_through(path.points[n], axis[n - 1]);
       for (size_t i = 1; i < n; ++i) {
         clamped[i] = false;
@@ -717,6 +810,8 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
         if (cuts_are_proper(shape, options.max_tilt_deg)) continue;
         // Split the more tilted interior end; a segment with both ends perpendicular is
         // always proper (parallel planes length apart), so this terminates.
+        // A continuation's mitred start stays (its parent is already emitted): its next
+        // joint is split instead, which its parent checked keeps it proper.
         double tilt_lower = s > 0 && !split[s] ? 1 - glm::dot(shape.lower.normal, shape.axis) : -1;
         double tilt_upper =
             s + 1 < n && !split[s + 1] ? 1 - glm::dot(shape.upper.normal, shape.axis) : -1;
@@ -736,15 +831,15 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
         }
         dvec3 transported = axis_frame(axis[0]).e0;  // u = 0 direction carried along
         double arc = 0;
+        if (continued >= 0) {  // u and v go on from the parent's last frustum
+          const Frustum& pf = out.frusta[size_t(continued)];
+          transported = transport(u_direction(pf), pf.shape.axis, axis[0]);
+          arc = pf.v_upper_m;
+        }
         std::vector<size_t> segment_frustum(n);
         for (size_t s = 0; s < n; ++s) {
           if (s > 0) {
-            dvec3 k = glm::cross(axis[s - 1], axis[s]);
-            double sin_a = glm::length(k);
-            double angle = std::atan2(sin_a, glm::dot(axis[s - 1], axis[s]));
-            dvec3 k_unit = sin_a > 1e-12 ? k / sin_a : bend_normal[s];
-            transported = rotate(transported, k_unit, angle);
-            transported = glm::normalize(transported - glm::dot(transported, axis[s]) * axis[s]);
+            transported = transport(transported, axis[s - 1], axis[s], bend_normal[s]);
           }
           Frustum f;
           f.chain = c;
@@ -758,7 +853,7 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
           f.shape.radius1 = path.radii[s + 1];
           f.shape.lower = lower_plane(s);
           f.shape.upper = upper_plane(s);
-          f.shape.cap_lower = (s == 0 || split[s]) && f.shape.radius0 > 0;
+          f.shape.cap_lower = ((s == 0 && !inherited_lower) || split[s]) && f.shape.radius0 > 0;
           f.shape.cap_upper = (s + 1 == n || split[s + 1]) && f.shape.radius1 > 0;
           f.u_offset = raw_u(axis[s], transported);
           f.twist_rad_per_m = options.twist_rad_per_m;
@@ -781,9 +876,27 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
             ++out.clamped_joints;
           }
         }
-        if (joins[c].ends_with_children && path.radii[n] > 0) {
+        // The continuation's start: mitred onto this chain's end where the plane keeps
+        // both frusta proper, and then no dome (the two tubes hold the ball of the end
+        // radius; a dome inscribed in it would stick out where the continuation tapers).
+        bool mitred = false;
+        if (joins[c].continuation >= 0) {
+          Frustum& last = out.frusta[segment_frustum[n - 1]];
+          std::optional<Plane> mitre = continuation_mitre(
+              last.shape, prepared_path(sk, uint32_t(joins[c].continuation), options, joins, lookahead_skipped),
+              options.max_tilt_deg);
+          if (mitre) {
+            last.shape.upper = *mitre;
+            last.shape.cap_upper = false;
+            mitre_below[size_t(joins[c].continuation)] = mitre;
+            mitred = true;
+          }
+        }
+        if (joins[c].ends_with_children && path.radii[n] > 0 && !mitred) {
+          const Frustum& last = out.frusta[segment_frustum[n - 1]];
           add_dome(out, path.points[n], axis[n - 1], path.radii[n], std::max(2, options.knuckle_frusta / 2), c,
-                   path.joint_index[n], path.materials[n], int64_t(segment_frustum[n - 1]));
+                   path.joint_index[n], path.materials[n], int64_t(segment_frustum[n - 1]), last.u_offset,
+                   last.v_upper_m);
         }
         break;
       }

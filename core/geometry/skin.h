@@ -161,6 +161,12 @@ SkinnedSkeleton skin_skeleton(const Skeleton& skeleton, const SkinOptions& optio
 Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& skeleton, const SkinOptions& options,
                                         const Progress& progress);
 
+// For each chain, the child chain that carries its axis on (docs/joints.md
+// "Continuations"): of the children attached at its last joint (which must have a radius),
+// the one most in line with it, within 45°; -1 where there is none. skin_skeleton's smooth
+// skin mitres that child onto its parent where it can and carries u and v on into it.
+std::vector<int64_t> continuation_children(const Skeleton& skeleton);
+
 // The fixed frame around an axis from which raw u is measured (Duff et al. 2017, "Building
 // an orthonormal basis, revisited"): e0 is u = 0, e1 = axis × e0. The GPU rebuilds it
 // from the axis with the same formula, so it is never stored.

@@ -95,7 +95,9 @@ TriangleMesh tessellate(const SkinnedSkeleton& skinned, const TessellateOptions&
     const uint32_t first = static_cast<uint32_t>(mesh.positions.size());
     const double twist_turns_per_m = fr.twist_rad_per_m / kTwoPi;
     const Frustum* below = fr.parent >= 0 ? &skinned.frusta[static_cast<size_t>(fr.parent)] : nullptr;
-    const bool shares_cut = below && below->chain == fr.chain && below->kind == FrustumKind::segment &&
+    // (`below` is the frustum under it in its chain, or the last of the chain its
+    // continuation goes on from, skin.h: mitred onto it, the same plane.)
+    const bool shares_cut = below && below->kind == FrustumKind::segment &&
                             fr.kind == FrustumKind::segment && below->shape.upper.normal == s.lower.normal &&
                             below->shape.upper.offset == s.lower.offset &&
                             !top_rows[static_cast<size_t>(fr.parent)].empty();

@@ -8,6 +8,9 @@
 
 #include <glm/geometric.hpp>
 
+#include "core/geometry/skin.h"
+#include "core/geometry/tessellate.h"
+
 namespace sylva {
 
 namespace {
@@ -41,18 +44,28 @@ std::vector<bool> kept_chains(const Skeleton& sk, uint32_t level, int level0_col
     if (root_a != root_b) return root_a;  // the root chains first, always kept
     return size[a] > size[b];
   });
-  auto segments = [&](size_t c) { return static_cast<double>(sk.chains[c].joint_count - 1); };
-  double estimate = 0;
-  for (size_t c = 0; c < chains; ++c) estimate += segments(c) * 2 * level0_columns;
+  // A chain's cost at a level: the triangles of its frusta (collars, rounded bends, domes
+  // and caps included) tessellated with that level's columns.
+  const SkinnedSkeleton skinned = skin_skeleton(sk);
+  auto chain_triangles = [&](int columns) {
+    TessellateOptions options;
+    options.segments_around = columns;
+    std::vector<double> out(chains, 0);
+    const TriangleMesh mesh = tessellate(skinned, options);
+    for (uint32_t f : mesh.triangle_frustum) out[skinned.frusta[f].chain] += 1;
+    return out;
+  };
+  const std::vector<double> level0 = chain_triangles(level0_columns);
+  double estimate = std::accumulate(level0.begin(), level0.end(), 0.0);
   std::vector<bool> kept(chains, true);
   for (uint32_t k = 1; k <= level; ++k) {
     const double target = estimate / 4;
-    const double per_segment = 2.0 * lod_columns(level0_columns, k);
+    const std::vector<double> cost_of = chain_triangles(lod_columns(level0_columns, k));
     std::vector<bool> next(chains, false);
     double used = 0;
     for (size_t c : by_size) {
       if (!kept[c]) continue;
-      const double cost = segments(c) * per_segment;
+      const double cost = cost_of[c];
       if (sk.chains[c].parent && used + cost > target) break;  // sizes only fall from here
       next[c] = true;
       used += cost;

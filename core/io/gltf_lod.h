@@ -6,8 +6,9 @@
 //   - columns around each frustum halved (at least 3);
 //   - chains dropped by size: each chain's size is its first joint's radius, capped by its
 //     parent's size (so a kept chain's parent is kept); the largest chains are kept, in
-//     decreasing size, while the wood's estimated triangles (2 · columns a segment) stay
-//     within a quarter of level k − 1's; the root chains are always kept. A dropped chain
+//     decreasing size, while the wood's estimated triangles (each chain's frusta in the
+//     whole plant's skin, tessellated with level k's columns) stay within a quarter of
+//     level k − 1's estimate; the root chains are always kept. A dropped chain
 //     keeps its first joint only (no segment), so chain and joint indices of the kept
 //     chains are those of the full skeleton (the rig's weights and the wind data apply
 //     unchanged);

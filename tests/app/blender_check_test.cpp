@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <optional>
 #include <regex>
@@ -224,7 +225,11 @@ TEST(BlenderCheck, TheRiggedElmSwaysInBlenderAsSylvaPosesIt) {
   };
   std::map<std::tuple<long long, long long, long long>, std::vector<size_t>> grid;
   for (size_t v = 0; v < rest.size() / 3; ++v) grid[cell(rest[3 * v], rest[3 * v + 1], rest[3 * v + 2])].push_back(v);
-  auto vertex_near = [&](const glm::dvec3& p) -> std::optional<size_t> {
+  // Every file vertex at Blender's rest position: where two rings meet (a chain and its
+  // continuation share their cut curve) two vertices of different weights sit at one
+  // position, and Blender's vertex is one of them.
+  auto vertices_near = [&](const glm::dvec3& p) {
+    std::vector<size_t> out;
     const auto [cx, cy, cz] = cell(p.x, p.y, p.z);
     for (long long dx = -1; dx <= 1; ++dx)
       for (long long dy = -1; dy <= 1; ++dy)
@@ -232,9 +237,9 @@ TEST(BlenderCheck, TheRiggedElmSwaysInBlenderAsSylvaPosesIt) {
           const auto it = grid.find(std::tuple(cx + dx, cy + dy, cz + dz));
           if (it == grid.end()) continue;
           for (size_t v : it->second)
-            if (glm::length(glm::dvec3(rest[3 * v], rest[3 * v + 1], rest[3 * v + 2]) - p) < 1e-6) return v;
+            if (glm::length(glm::dvec3(rest[3 * v], rest[3 * v + 1], rest[3 * v + 2]) - p) < 1e-6) out.push_back(v);
         }
-    return std::nullopt;
+    return out;
   };
 
   const JsonValue& poses = *rig.find("poses");
@@ -248,11 +253,15 @@ TEST(BlenderCheck, TheRiggedElmSwaysInBlenderAsSylvaPosesIt) {
     ASSERT_EQ(blender_rest.size(), posed.size());
     for (size_t i = 0; i + 2 < posed.size(); i += 3) {
       const glm::dvec3 p0(blender_rest[i], blender_rest[i + 1], blender_rest[i + 2]);
-      const std::optional<size_t> v = vertex_near(p0);
-      ASSERT_TRUE(v) << "Blender's vertex " << i / 3 << " is at no rest position of the file";
-      const glm::dvec3 expected = sylva.posed(pose, test::weights_of(skin, *v), p0);
-      worst = std::max(worst, glm::length(glm::dvec3(posed[i], posed[i + 1], posed[i + 2]) - expected));
-      moved = std::max(moved, glm::length(expected - sylva.placed(p0)));
+      const std::vector<size_t> candidates = vertices_near(p0);
+      ASSERT_FALSE(candidates.empty()) << "Blender's vertex " << i / 3 << " is at no rest position of the file";
+      double nearest = std::numeric_limits<double>::infinity();
+      for (size_t v : candidates) {
+        const glm::dvec3 expected = sylva.posed(pose, test::weights_of(skin, v), p0);
+        nearest = std::min(nearest, glm::length(glm::dvec3(posed[i], posed[i + 1], posed[i + 2]) - expected));
+        moved = std::max(moved, glm::length(expected - sylva.placed(p0)));
+      }
+      worst = std::max(worst, nearest);
       ++compared;
     }
   }

@@ -169,24 +169,61 @@ TEST(SkinJoints, ALateralStartsWithAFlaredCollarWhoseCapStaysInsideItsParent) {
   for (const Frustum& f : skin.frusta) EXPECT_TRUE(cuts_are_proper(f.shape, 60));
 }
 
-TEST(SkinJoints, AnEndWithChildrenIsADomeAndTheChildInLineGoesOnAtItsRadius) {
+TEST(SkinJoints, AnEndIsMitredOntoItsContinuationWhichGoesOnAtItsRadiusWithItsUAndV) {
+  // docs/joints.md "Continuations": the child in line shares one plane with the parent's
+  // last frustum (no caps, no dome) and carries its u and v on.
   Skeleton sk;
   sk.joints = {joint({0, 0, 0}, 0.3), joint({0, 1.5, 0}, 0.3),        // ends at joint 1
                joint({0, 1.5, 0}, 0.2), joint({0.1, 3, 0}, 0.18),     // in line: goes on
                joint({0, 1.5, 0}, 0.15), joint({1.0, 2.1, 0}, 0.12)}; // a lateral
   sk.chains = {Chain{0, 2, std::nullopt}, Chain{2, 2, ChainParent{0, 1}}, Chain{4, 2, ChainParent{0, 1}}};
+  EXPECT_EQ(continuation_children(sk), (std::vector<int64_t>{1, -1, -1}));
+  SkinnedSkeleton skin = skin_skeleton(sk);
+  ASSERT_EQ(skin.frusta.size(), 1 + 1 + 2u);  // no dome under the mitre
+  const Frustum& end = skin.frusta[0];
+  const Frustum& goes_on = skin.frusta[1];
+  EXPECT_EQ(goes_on.chain, 1u);
+  EXPECT_EQ(goes_on.parent, 0);
+  EXPECT_EQ(goes_on.shape.radius0, 0.3);  // no radius step
+  EXPECT_EQ(goes_on.shape.radius1, 0.18);
+  EXPECT_EQ(end.shape.upper.normal, goes_on.shape.lower.normal);  // one plane
+  EXPECT_EQ(end.shape.upper.offset, goes_on.shape.lower.offset);
+  EXPECT_LT(glm::dot(end.shape.upper.normal, end.shape.axis), 1.0);  // tilted: a mitre
+  EXPECT_FALSE(end.shape.cap_upper);
+  EXPECT_FALSE(goes_on.shape.cap_lower);
+  EXPECT_LT(seam_error(end, goes_on), 0.01 * 0.3);  // the cut curves meet
+  EXPECT_DOUBLE_EQ(goes_on.v_lower_m, end.v_upper_m);  // v goes on
+  for (int i = 0; i < 16; ++i) {  // u goes on: the same u on both sides of the cut
+    const dvec3 p = cut_point(end.shape, end.shape.upper, i / 16.0);
+    const double du = std::abs(surface_uv(end, p).u - surface_uv(goes_on, p).u);
+    EXPECT_LT(std::min(du, 1 - du), 2e-3) << i;
+    EXPECT_NEAR(surface_uv(end, p).v_m, surface_uv(goes_on, p).v_m, 1e-4) << i;  // within the seam error
+  }
+  for (const Frustum& f : skin.frusta) EXPECT_TRUE(cuts_are_proper(f.shape, 60));
+  // The paper's skin keeps each chain to itself: flat caps, the child's v from 0.
+  SkinnedSkeleton paper = skin_skeleton(sk, SkinOptions::paper());
+  EXPECT_TRUE(paper.frusta[0].shape.cap_upper);
+  EXPECT_EQ(paper.frusta[1].v_lower_m, 0.0);
+}
+
+TEST(SkinJoints, AnEndWithChildrenAndNoContinuationIsADomeThatCarriesItsUAndV) {
+  Skeleton sk;
+  sk.joints = {joint({0, 0, 0}, 0.3), joint({0, 1.5, 0}, 0.3),          // ends at joint 1
+               joint({0, 1.5, 0}, 0.15), joint({1.0, 2.1, 0}, 0.12),    // two laterals,
+               joint({0, 1.5, 0}, 0.15), joint({-1.0, 2.1, 0}, 0.12)};  // none in line
+  sk.chains = {Chain{0, 2, std::nullopt}, Chain{2, 2, ChainParent{0, 1}}, Chain{4, 2, ChainParent{0, 1}}};
+  EXPECT_EQ(continuation_children(sk), (std::vector<int64_t>{-1, -1, -1}));
   SkinnedSkeleton skin = skin_skeleton(sk);
   const size_t dome = size_t(SkinOptions{}.knuckle_frusta / 2);
-  ASSERT_EQ(skin.frusta.size(), 1 + dome + 1 + 2);
+  ASSERT_EQ(skin.frusta.size(), 1 + dome + 2 + 2);
   EXPECT_EQ(skin.frusta[0].shape.radius1, 0.3);
+  EXPECT_TRUE(skin.frusta[0].shape.cap_upper);
   const Frustum& dome_base = skin.frusta[1];
   EXPECT_EQ(dome_base.kind, FrustumKind::knuckle);
   EXPECT_NEAR(dome_base.shape.radius0, 0.3, 1e-15);  // no rim
-  EXPECT_EQ(skin.frusta[dome].shape.radius1, 0.0);  // a tip
-  const Frustum& goes_on = skin.frusta[1 + dome];
-  EXPECT_EQ(goes_on.chain, 1u);
-  EXPECT_EQ(goes_on.shape.radius0, 0.3);  // no radius step
-  EXPECT_EQ(goes_on.shape.radius1, 0.18);
+  EXPECT_EQ(skin.frusta[dome].shape.radius1, 0.0);   // a tip
+  EXPECT_EQ(dome_base.u_offset, skin.frusta[0].u_offset);  // the bark goes on over it
+  EXPECT_EQ(dome_base.v_lower_m, skin.frusta[0].v_upper_m);
   for (const Frustum& f : skin.frusta) EXPECT_TRUE(cuts_are_proper(f.shape, 60));
 }
 

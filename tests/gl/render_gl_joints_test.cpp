@@ -54,5 +54,22 @@ TEST(RenderGlJoints, ThePapersSkinByTheScenesKeyMatchesTheCpu) {
   }
 }
 
+TEST(RenderGlJoints, BarkGoesOnAcrossEveryContinuationWithoutARing) {
+  // tests/cpu/render_joints_test.cpp's measure and limit on GL's uv and id AOVs: GL draws
+  // the same mitred continuations with the same u and v.
+  SYLVA_REQUIRE_GL();
+  RenderOptions o;
+  o.aovs = kAovUv | kAovId;
+  o.spp = 1;
+  for (const test::JointCloseUp& c : test::joint_close_ups()) {
+    if (c.name != "continuation" && c.name != "y_fork") continue;
+    const test::UvContinuity d = test::uv_continuity(c.scene, gl_test::gl_render(c.scene, o).image);
+    std::printf("[ joints ] %-12s GL uv: %s\n", c.name.c_str(), d.describe().c_str());
+    EXPECT_GT(d.pairs, 20u) << c.name;
+    EXPECT_LT(d.worst_v, 3) << c.name << ": " << d.describe();
+    EXPECT_LT(d.worst_u, 3) << c.name << ": " << d.describe();
+  }
+}
+
 }  // namespace
 }  // namespace sylva

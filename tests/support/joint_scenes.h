@@ -19,8 +19,10 @@
 #include <glm/vec3.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "core/geometry/skin.h"
 #include "core/scene/render_common.h"
 #include "core/scene/render_types.h"
 #include "core/scene/scene.h"
@@ -56,9 +58,10 @@ inline Scene close_up(const Skeleton& sk, glm::dvec3 eye, glm::dvec3 target, dou
   return s;
 }
 
-// The four close-ups: an elm-like crown (three limbs from the end of the trunk), an axis
-// that goes on thinner past a branch, a lateral at 45° from the side of its parent, and a
-// 60° elbow seen from its outer side.
+// The close-ups: an elm-like crown (three limbs from the end of the trunk), an axis that
+// goes on thinner past a branch, a lateral at 45° from the side of its parent, the elm's
+// first fork (the axis goes on bent, a limb leaves beside it), and a 60° elbow seen from
+// its outer side.
 inline std::vector<JointCloseUp> joint_close_ups() {
   std::vector<JointCloseUp> out;
   {
@@ -83,6 +86,16 @@ inline std::vector<JointCloseUp> joint_close_ups() {
     add_chain(sk, {{0, 0, 0}, {0, 1, 0}, {0, 2, 0}}, {0.3, 0.28, 0.25}, std::nullopt);
     add_chain(sk, {{0, 1, 0}, {0.85, 1.85, 0}}, {0.15, 0.12}, ChainParent{0, 1});
     out.push_back({"fork", close_up(sk, {0.5, 1.6, 2.8}, {0.2, 1.2, 0}, 35)});
+  }
+  {
+    // The elm's first fork (presets/elm.lsys): the trunk ends, its axis goes on bent 30°
+    // toward -z, and a limb of nearly its radius leaves the same joint 35° the other way.
+    Skeleton sk;
+    add_chain(sk, {{0, 0, 0}, {0, 1.6, 0}, {0, 3.2, 0}}, {0.336, 0.32, 0.294}, std::nullopt);
+    add_chain(sk, {{0, 3.2, 0}, {0.05, 4.32, -0.54}, {0.44, 5.27, -1.11}}, {0.2436, 0.2436, 0.18},
+              ChainParent{0, 2});
+    add_chain(sk, {{0, 3.2, 0}, {-0.1, 4.2, 0.7}, {-0.3, 5.1, 1.3}}, {0.22, 0.2, 0.16}, ChainParent{0, 2});
+    out.push_back({"y_fork", close_up(sk, {1.9, 3.5, 0.4}, {0, 3.3, 0}, 40)});
   }
   {
     Skeleton sk;
@@ -198,6 +211,82 @@ inline SurfaceDefects surface_defects(const Scene& scene, const RenderImage& ima
     }
   }
   return d;
+}
+
+// How continuous u and v are across the boundary between a chain and the child that
+// carries its axis on (continuation_children, docs/joints.md "Continuations"), from the uv
+// and id AOVs: for each pair of neighbouring pixels that see the parent and that child, the
+// jump in v (metres) and in u (turns, the shorter way round) against the local step — the
+// largest change between either pixel and a 4-neighbour on its own chain. Seamless
+// bark has jumps of about one step; a ring has jumps of many.
+struct UvContinuity {
+  uint64_t pairs = 0;      // boundary pairs with a local step on at least one side
+  double worst_v = 0;      // largest jump / local step in v
+  double worst_u = 0;      // ... in u
+  int x = -1, y = -1;      // where the worst (v or u) is
+  std::string describe() const {
+    return std::to_string(pairs) + " boundary pairs, worst jump " + std::to_string(worst_v) + " steps in v, " +
+           std::to_string(worst_u) + " in u (at pixel " + std::to_string(x) + ", " + std::to_string(y) + ")";
+  }
+};
+
+inline UvContinuity uv_continuity(const Scene& scene, const RenderImage& image) {
+  const int w = static_cast<int>(image.width), h = static_cast<int>(image.height);
+  std::vector<std::vector<int64_t>> continuation;  // per plant
+  for (const ScenePlant& plant : scene.plants) {
+    continuation.push_back(plant.skeleton ? continuation_children(*plant.skeleton) : std::vector<int64_t>{});
+  }
+  const auto at = [&](int x, int y) { return static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x); };
+  const auto plant_of = [&](int x, int y) { return image.id[3 * at(x, y)]; };
+  const auto chain_of = [&](int x, int y) { return image.id[3 * at(x, y) + 1]; };
+  const auto inside = [&](int x, int y) { return x >= 0 && y >= 0 && x < w && y < h; };
+  const auto same_chain = [&](int ax, int ay, int bx, int by) {
+    return inside(ax, ay) && inside(bx, by) && plant_of(ax, ay) == plant_of(bx, by) && chain_of(ax, ay) == chain_of(bx, by);
+  };
+  const auto u_diff = [](double a, double b) {
+    const double d = std::abs(a - b);
+    return std::min(d, 1 - d);
+  };
+  const auto is_continuation = [&](float plant, float parent, float child) {
+    if (plant < 0 || parent < 0 || child < 0 || static_cast<size_t>(plant) >= continuation.size()) return false;
+    const std::vector<int64_t>& c = continuation[static_cast<size_t>(plant)];
+    return static_cast<size_t>(parent) < c.size() && c[static_cast<size_t>(parent)] == static_cast<int64_t>(child);
+  };
+  UvContinuity out;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int dir = 0; dir < 2; ++dir) {
+        const int dx = dir == 0 ? 1 : 0, dy = dir == 1 ? 1 : 0;
+        const int qx = x + dx, qy = y + dy;
+        if (!inside(qx, qy) || plant_of(x, y) < 0 || plant_of(x, y) != plant_of(qx, qy)) continue;
+        const float a = chain_of(x, y), b = chain_of(qx, qy);
+        if (!is_continuation(plant_of(x, y), a, b) && !is_continuation(plant_of(x, y), b, a)) continue;
+        const auto u = [&](int px, int py) { return double(image.uv[2 * at(px, py)]); };
+        const auto v = [&](int px, int py) { return double(image.uv[2 * at(px, py) + 1]); };
+        // The local step: the largest change to a 4-neighbour of the same chain, around
+        // either pixel of the pair (its gradient's size, not just along the pair).
+        double step_u = 0, step_v = 0;
+        bool stepped = false;
+        for (const auto& [px, py] : {std::pair{x, y}, std::pair{qx, qy}}) {
+          for (const auto& [ox, oy] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+            if (!same_chain(px, py, px + ox, py + oy)) continue;
+            step_u = std::max(step_u, u_diff(u(px, py), u(px + ox, py + oy)));
+            step_v = std::max(step_v, std::abs(v(px, py) - v(px + ox, py + oy)));
+            stepped = true;
+          }
+        }
+        if (!stepped) continue;
+        ++out.pairs;
+        // Floors: a step of 1e-4 (turns, metres) is flat bark at any scale these close-ups use.
+        const double jv = std::abs(v(x, y) - v(qx, qy)) / std::max(step_v, 1e-4);
+        const double ju = u_diff(u(x, y), u(qx, qy)) / std::max(step_u, 1e-4);
+        if (jv > out.worst_v || ju > out.worst_u) out.x = x, out.y = y;
+        out.worst_v = std::max(out.worst_v, jv);
+        out.worst_u = std::max(out.worst_u, ju);
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace sylva::test
