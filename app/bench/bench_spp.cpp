@@ -164,7 +164,7 @@ DisplayErrors display_errors(const RenderImage& reference, const RenderImage& im
     int worst = 0;
     for (int c = 0; c < 3; ++c) {
       const auto encode = [&](const RenderImage& im) {
-        return static_cast<int>(std::lround(linear_to_srgb(im.beauty[4 * p + c]) * 255.0f));
+        return static_cast<int>(linear_to_srgb8(im.beauty[4 * p + c]));
       };
       const int d = std::abs(encode(image) - encode(reference));
       sum_squares += static_cast<double>(d) * d;

@@ -56,8 +56,7 @@ CardRenderer cpu_card_renderer(std::map<uint32_t, SceneMaterial> materials, uint
       if (!std::isfinite(image.depth[p])) continue;
       ++covered;
       for (size_t k = 0; k < 3; ++k) {
-        const float srgb = linear_to_srgb(std::clamp(image.beauty[4 * p + k], 0.0f, 1.0f));
-        out.rgba[4 * p + k] = static_cast<uint8_t>(std::lround(std::clamp(srgb, 0.0f, 1.0f) * 255));
+        out.rgba[4 * p + k] = linear_to_srgb8(image.beauty[4 * p + k]);
         mean[k] += out.rgba[4 * p + k];
       }
       out.rgba[4 * p + 3] = 255;

@@ -1,11 +1,12 @@
 // bench_studio.cpp — `sylva bench studio [--quick]`: the studio's speed targets (issue
 // "The studio", recorded in docs/benchmarks.md, never timed tests), measured on the app
-// the window runs — StudioApp, its worker and the GL viewport — with an ImGui context
+// the window runs — StudioApp, its worker and the GL and CPU viewports — with an ImGui context
 // and a window-less EGL context instead of a window (no display needed). What the
 // window adds per frame (ImGui's own GL draw, the swap) is not in these figures.
 //   latency  a define moved (as a slider release does) until the first frame whose
 //            viewport shows the regrown plant: worker (parse, derive, interpret, turtle),
-//            skin + upload, render, all on this machine (llvmpipe without a GPU)
+//            skin + upload, render, all on this machine (llvmpipe without a GPU); once
+//            with the GL viewport, once with the CPU one (the studio's choice on llvmpipe)
 //   frames   UI frame times while a ~15 M-module derivation runs on the worker
 //   memory   resident memory over many regrows of the same grammar
 #include <unistd.h>
@@ -15,12 +16,14 @@
 #include <cstdio>
 #include <fstream>
 #include <functional>
+#include <initializer_list>
 #include <iostream>
 #include <thread>
 
 #include <imgui.h>
 
 #include "app/front/args.h"
+#include "app/studio/cpu_viewport.h"
 #include "app/studio/gl_viewport.h"
 #include "app/studio/studio.h"
 #include "app/studio/studio_app.h"
@@ -81,7 +84,7 @@ double percentile(std::vector<double> v, double p) {
 }
 
 // Moves `define` between two values `runs` times; prints the latencies.
-bool latency(Ui& ui, GlViewport& viewport, const std::string& presets, const std::string& grammar,
+bool latency(Ui& ui, Viewport& viewport, const std::string& presets, const std::string& grammar,
              const std::string& define, double a, double b, int runs) {
   StudioOptions o;
   o.presets_dir = presets;
@@ -109,13 +112,13 @@ bool latency(Ui& ui, GlViewport& viewport, const std::string& presets, const std
     full.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - edited).count());
     render.push_back(viewport.stats().render_ms);
   }
-  std::printf("latency %-10s %6llu segments %7.1f ms median, %7.1f ms p90, %7.1f ms max  (worker %.1f, skin+upload %.1f, "
-              "render %.1f ms median; %dx%d viewport, %d runs)\n",
-              grammar.c_str(), static_cast<unsigned long long>(app.plant()->segments), percentile(total, 0.5),
+  std::printf("latency %-10s %-4s %6llu segments %7.1f ms median, %7.1f ms p90, %7.1f ms max  (worker %.1f, skin+upload "
+              "%.1f, render %.1f ms median; %dx%d viewport, %d runs)\n",
+              grammar.c_str(), dynamic_cast<CpuViewport*>(&viewport) ? "cpu" : "gl", static_cast<unsigned long long>(app.plant()->segments), percentile(total, 0.5),
               percentile(total, 0.9), percentile(total, 1.0), percentile(worker, 0.5), percentile(upload, 0.5),
               percentile(render, 0.5), app.scene().width, app.scene().height, runs);
-  std::printf("         %zu of %d first pictures were previews (half size, small shadow map); the full picture "
-              "%.1f ms median, %.1f ms p90 after the edit\n",
+  std::printf("         %zu of %d first pictures were previews (GL: half size, small shadow map; CPU: the coarse "
+              "steps); the finest picture %.1f ms median, %.1f ms p90 after the edit\n",
               previews, runs, percentile(full, 0.5), percentile(full, 0.9));
   std::printf("         UI frames meanwhile: %zu, %.2f ms median, %.2f ms max (the picture is made on the render "
               "thread)\n",
@@ -154,9 +157,15 @@ int run_bench_studio(const std::vector<std::string>& args) {
   Ui ui;
   GlViewport viewport;  // its pictures on its own thread; the texture in `gl`
 
-  // 1. Edit-to-picture latency.
-  if (!latency(ui, viewport, presets, "elm.lsys", "TRUNK_H", 3.2, 3.3, quick ? 4 : 20)) return cli::kInternalError;
-  if (!latency(ui, viewport, presets, "pine.lsys", "BR_LEN", 4.2, 4.3, quick ? 2 : 10)) return cli::kInternalError;
+  // 1. Edit-to-picture latency, with the GL viewport and with the CPU one (the studio's
+  // choice where GL is a software rasteriser: --backend auto).
+  {
+    CpuViewport cpu;
+    for (Viewport* v : std::initializer_list<Viewport*>{&viewport, &cpu}) {
+      if (!latency(ui, *v, presets, "elm.lsys", "TRUNK_H", 3.2, 3.3, quick ? 4 : 20)) return cli::kInternalError;
+      if (!latency(ui, *v, presets, "pine.lsys", "BR_LEN", 4.2, 4.3, quick ? 2 : 10)) return cli::kInternalError;
+    }
+  }
 
   // 2. Frames while a long derivation runs (Fibonacci words: F(36) = 14,930,352 modules).
   {

@@ -1,6 +1,8 @@
 // gl_viewport.cpp — see gl_viewport.h.
 #include "app/studio/gl_viewport.h"
 
+#include "app/studio/view_picture.h"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -22,18 +24,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
-// Everything a picture depends on besides the plants.
-std::vector<double> view_key(const Scene& s) {
-  const Camera& c = s.camera;
-  return {c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.up.x, c.up.y, c.up.z, c.fov_y_deg,
-          static_cast<double>(s.width), static_cast<double>(s.height), s.sun.direction.x, s.sun.direction.y,
-          s.sun.direction.z, s.sun.angular_radius_deg, s.sun.radiance.x, s.sun.radiance.y, s.sun.radiance.z,
-          s.sky.x, s.sky.y, s.sky.z, s.ground.height, s.ground.albedo.x, s.ground.albedo.y, s.ground.albedo.z,
-          s.fog ? 1.0 : 0.0, s.fog ? s.fog->sigma_s : 0, s.fog ? s.fog->sigma_a : 0, s.fog ? s.fog->g : 0,
-          s.fog ? s.fog->height_falloff : 0, s.fog ? s.fog->top : 0, s.fog ? static_cast<double>(s.fog->mode) : 0,
-          s.fog ? static_cast<double>(s.fog->steps) : 0};
-}
-
 // The scene the renderer draws: a cone mode without cones yet (mode map without maps) is
 // drawn brute (the same fog, slower) until the cone worker's first cones (maps) arrive.
 Scene drawable(const Scene& scene, bool have_cones, bool have_maps) {
@@ -43,15 +33,6 @@ Scene drawable(const Scene& scene, bool have_cones, bool have_maps) {
   s.fog->mode = FogMode::brute;
   return s;
 }
-
-struct Picture {
-  uint32_t width = 0, height = 0;
-  std::vector<uint8_t> rgba;  // sRGB-encoded, rows top-down
-  uint64_t plants_version = 0;
-  std::vector<RenderPass> passes;
-  double render_ms = 0;
-  bool preview = false;
-};
 
 constexpr uint32_t kPreviewShadowTexels = 512;
 
@@ -71,12 +52,12 @@ Scene preview_of(const Scene& scene) {
 // AOVs, no float beauty. The rows stay bottom-up as GL's (the view shows them flipped).
 // The render thread has its own context (a slow software frame never stalls the UI), so
 // the bytes cross to the window's context as an upload rather than a shared texture.
-Picture present(GlRenderer& renderer, const Scene& scene, std::unique_ptr<GlTextureTarget>& target) {
+ViewPicture present(GlRenderer& renderer, const Scene& scene, std::unique_ptr<GlTextureTarget>& target) {
   const auto start = Clock::now();
   if (!target) target = std::make_unique<GlTextureTarget>(scene.width, scene.height, GlTextureTarget::Format::rgba8);
   else target->resize(scene.width, scene.height);
   renderer.draw(scene, target->target());
-  Picture p;
+  ViewPicture p;
   p.width = scene.width;
   p.height = scene.height;
   p.rgba.resize(static_cast<size_t>(p.width) * p.height * 4);
@@ -90,46 +71,20 @@ Picture present(GlRenderer& renderer, const Scene& scene, std::unique_ptr<GlText
 
 }  // namespace
 
-// What the UI thread and the render thread share, under `mutex`.
-struct GlViewport::Shared {
-  std::mutex mutex;
-  std::condition_variable wake;
-  bool quit = false;
-  bool working = false;
+// The mailbox (view_picture.h) and what only the GL render thread needs.
+struct GlViewport::Shared : PictureMailbox {
   // Set by set_plants while a renderer is being built: newer plants make the skinning in
   // flight stop (GlRenderer checks it every 1024 chains) instead of finishing for nothing.
   std::atomic<bool> cancel_build{false};
-  std::function<void()> on_picture;
   double preview_above_ms = 1000;  // see the constructor
-  uint64_t previews = 0;         // made so far
-  // Requests (latest wins).
-  struct Plants {
-    Scene scene;
-    RenderOptions options;
-    uint64_t version;
-  };
-  std::optional<Plants> plants;
-  struct View {
-    Scene scene;
-    uint64_t version;
-  };
-  std::optional<View> view;
   std::function<void(GlRenderer*, const RenderOptions&, bool, bool)> task;  // an export, run and waited for
-  std::shared_ptr<const ConeSet> cones;  // newer fog cones, not yet taken
-  std::shared_ptr<const std::vector<SunDepthMap>> maps;  // newer sun maps, not yet taken
-  // Results.
-  std::optional<Picture> picture;
-  uint64_t built_version = 0;  // the plants the render thread's renderer holds
-  std::string error;           // why there is no renderer / no picture
-  uint64_t frusta = 0;
-  double upload_ms = 0;
   std::string renderer_name;
   bool started = false;
   std::string start_error;
 };
 
 GlViewport::GlViewport(std::function<void()> on_picture, double preview_above_ms)
-    : shared_(std::make_unique<Shared>()) {
+    : PictureViewport(std::make_unique<Shared>(), /*flip_v=*/true), shared_(static_cast<Shared*>(&mailbox())) {
   shared_->on_picture = std::move(on_picture);
   shared_->preview_above_ms = preview_above_ms;
   thread_ = std::thread([this] { run(); });
@@ -150,7 +105,6 @@ GlViewport::~GlViewport() {
   }
   shared_->wake.notify_all();
   if (thread_.joinable()) thread_.join();
-  if (texture_) glDeleteTextures(1, &texture_);
 }
 
 void GlViewport::run() {
@@ -178,8 +132,8 @@ void GlViewport::run() {
   std::shared_ptr<const std::vector<SunDepthMap>> maps;  // the same for the sun maps
   bool maps_applied = false;
   for (;;) {
-    std::optional<Shared::Plants> plants;
-    std::optional<Shared::View> view;
+    std::optional<PictureMailbox::Plants> plants;
+    std::optional<PictureMailbox::View> view;
     std::function<void(GlRenderer*, const RenderOptions&, bool, bool)> task;
     {
       std::unique_lock<std::mutex> lock(sh.mutex);
@@ -245,7 +199,7 @@ void GlViewport::run() {
     }
     if (task) task(renderer.get(), options, cones_applied, maps_applied);
     // Hands a picture (or the error) to the UI thread; `last`: the render thread is done.
-    auto publish = [&](std::optional<Picture> picture, bool last) {
+    auto publish = [&](std::optional<ViewPicture> picture, bool last) {
       const bool any = picture || !error.empty();
       {
         std::lock_guard<std::mutex> lock(sh.mutex);
@@ -262,7 +216,7 @@ void GlViewport::run() {
       }
       if (any && sh.on_picture) sh.on_picture();
     };
-    std::optional<Picture> picture;
+    std::optional<ViewPicture> picture;
     if (view && renderer && view->version == version) {
       try {
         // New plants on a slow renderer: a quick preview first, so the edit shows at once;
@@ -270,7 +224,7 @@ void GlViewport::run() {
         bool newer_waiting = false;
         if (unshown_plants && last_full_ms > sh.preview_above_ms) {
           renderer->set_shadow_map_texels(kPreviewShadowTexels);
-          Picture quick = present(*renderer, preview_of(drawable(view->scene, cones_applied, maps_applied)), target);
+          ViewPicture quick = present(*renderer, preview_of(drawable(view->scene, cones_applied, maps_applied)), target);
           renderer->set_shadow_map_texels(0);
           quick.plants_version = version;
           quick.preview = true;
@@ -296,14 +250,10 @@ void GlViewport::run() {
   programs.reset();  // while the context is current
 }
 
-void GlViewport::set_plants(const Scene& scene, const RenderOptions& options) {
-  ++plants_version_;
-  {
-    std::lock_guard<std::mutex> lock(shared_->mutex);
-    shared_->plants = Shared::Plants{scene, options, plants_version_};
-    if (shared_->working) shared_->cancel_build = true;
-  }
-  shared_->wake.notify_all();
+void GlViewport::set_plants(const Scene& scene, const RenderOptions& options) { post_plants(scene, options); }
+
+void GlViewport::interrupt(bool new_plants) {
+  if (new_plants && shared_->working) shared_->cancel_build = true;
 }
 
 void GlViewport::set_fog_maps(std::shared_ptr<const std::vector<SunDepthMap>> maps) {
@@ -312,7 +262,7 @@ void GlViewport::set_fog_maps(std::shared_ptr<const std::vector<SunDepthMap>> ma
     shared_->maps = std::move(maps);
   }
   shared_->wake.notify_all();
-  asked_view_.clear();  // the next image() asks for the picture with them
+  ask_again();  // the next image() asks for the picture with them
 }
 
 void GlViewport::set_fog_cones(std::shared_ptr<const ConeSet> cones) {
@@ -321,86 +271,12 @@ void GlViewport::set_fog_cones(std::shared_ptr<const ConeSet> cones) {
     shared_->cones = std::move(cones);
   }
   shared_->wake.notify_all();
-  asked_view_.clear();  // the next image() asks for the picture with them
-}
-
-ImTextureID GlViewport::make_texture(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) {
-  if (width == 0 || height == 0 || rgba.size() != size_t{width} * height * 4) return nullptr;
-  GLuint texture = 0;
-  glCreateTextures(GL_TEXTURE_2D, 1, &texture);
-  glTextureStorage2D(texture, 1, GL_RGBA8, static_cast<GLsizei>(width), static_cast<GLsizei>(height));
-  glTextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTextureParameteri(texture, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTextureSubImage2D(texture, 0, 0, 0, static_cast<GLsizei>(width), static_cast<GLsizei>(height), GL_RGBA,
-                      GL_UNSIGNED_BYTE, rgba.data());
-  return reinterpret_cast<ImTextureID>(static_cast<intptr_t>(texture));
-}
-
-void GlViewport::free_texture(ImTextureID texture) {
-  const GLuint name = static_cast<GLuint>(reinterpret_cast<intptr_t>(texture));
-  if (name) glDeleteTextures(1, &name);
+  ask_again();  // the next image() asks for the picture with them
 }
 
 bool GlViewport::busy() const {
   std::lock_guard<std::mutex> lock(shared_->mutex);
   return shared_->working || shared_->plants || shared_->view || shared_->picture || shared_->cones || shared_->maps;
-}
-
-void GlViewport::take_picture() {
-  std::optional<Picture> p;
-  {
-    std::lock_guard<std::mutex> lock(shared_->mutex);
-    p = std::move(shared_->picture);
-    shared_->picture.reset();
-    stats_.error = shared_->error;
-    stats_.frusta = shared_->frusta;
-    stats_.upload_ms = shared_->upload_ms;
-    stats_.previews = shared_->previews;
-  }
-  if (!p) return;
-  if (!texture_ || texture_w_ != p->width || texture_h_ != p->height) {
-    if (texture_) glDeleteTextures(1, &texture_);
-    glCreateTextures(GL_TEXTURE_2D, 1, &texture_);
-    glTextureStorage2D(texture_, 1, GL_RGBA8, static_cast<GLsizei>(p->width), static_cast<GLsizei>(p->height));
-    glTextureParameteri(texture_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(texture_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(texture_, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(texture_, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    texture_w_ = p->width;
-    texture_h_ = p->height;
-  }
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTextureSubImage2D(texture_, 0, 0, 0, static_cast<GLsizei>(p->width), static_cast<GLsizei>(p->height), GL_RGBA,
-                      GL_UNSIGNED_BYTE, p->rgba.data());
-  shown_version_ = p->plants_version;
-  stats_.passes = std::move(p->passes);
-  stats_.render_ms = p->render_ms;
-  stats_.preview = p->preview;
-}
-
-ViewImage GlViewport::image(const Scene& scene) {
-  take_picture();
-  std::vector<double> key = view_key(scene);
-  if (key != asked_view_ || asked_version_ != plants_version_) {
-    {
-      std::lock_guard<std::mutex> lock(shared_->mutex);
-      shared_->view = Shared::View{scene, plants_version_};
-    }
-    shared_->wake.notify_all();
-    asked_view_ = std::move(key);
-    asked_version_ = plants_version_;
-  }
-  if (!texture_) return {};
-  bool current = shown_version_ == plants_version_;
-  {
-    // New plants that cannot be drawn (no segments or leaves, an error): nothing newer will come.
-    std::lock_guard<std::mutex> lock(shared_->mutex);
-    if (shared_->built_version == plants_version_ && !shared_->error.empty() && !shared_->working && !shared_->view)
-      current = true;
-  }
-  return ViewImage{reinterpret_cast<ImTextureID>(static_cast<intptr_t>(texture_)), true, texture_w_, texture_h_,
-                   current};
 }
 
 std::optional<std::string> GlViewport::write_image(const Scene& scene, const RenderOptions& options,
@@ -435,7 +311,7 @@ std::optional<std::string> GlViewport::write_image(const Scene& scene, const Ren
     };
   }
   shared_->wake.notify_all();
-  asked_view_.clear();  // the targets were resized: ask for the view again
+  ask_again();  // the targets were resized: ask for the view again
   return result.get();
 }
 

@@ -26,11 +26,12 @@
 #include <thread>
 #include <vector>
 
+#include "app/studio/view_picture.h"
 #include "app/studio/viewport.h"
 
 namespace sylva::studio {
 
-class GlViewport : public Viewport {
+class GlViewport : public PictureViewport {
  public:
   // `on_picture` is called on the render thread when a picture is ready (the window loop
   // wakes itself with it). New plants are first shown as a preview (half the pixels a side,
@@ -46,30 +47,19 @@ class GlViewport : public Viewport {
   GlViewport& operator=(const GlViewport&) = delete;
 
   void set_plants(const Scene& scene, const RenderOptions& options) override;
-  ViewImage image(const Scene& scene) override;
-  const ViewStats& stats() const override { return stats_; }
   void set_fog_cones(std::shared_ptr<const ConeSet> cones) override;
   void set_fog_maps(std::shared_ptr<const std::vector<SunDepthMap>> maps) override;
   bool busy() const override;
-  ImTextureID make_texture(uint32_t width, uint32_t height, const std::vector<uint8_t>& rgba) override;
-  void free_texture(ImTextureID texture) override;
   std::optional<std::string> write_image(const Scene& scene, const RenderOptions& options,
                                          const std::string& path) override;
 
  private:
   struct Shared;
-  void run();              // the render thread
-  void take_picture();     // UI thread: a finished picture into the texture
+  void run();  // the render thread
+  void interrupt(bool new_plants) override;
 
-  std::unique_ptr<Shared> shared_;
+  Shared* shared_;  // the mailbox, extended (owned by PictureViewport)
   std::thread thread_;
-  unsigned texture_ = 0;   // GLuint, in the UI thread's context
-  uint32_t texture_w_ = 0, texture_h_ = 0;
-  uint64_t plants_version_ = 0;     // set_plants calls
-  uint64_t shown_version_ = 0;      // the plants the texture shows
-  std::vector<double> asked_view_;  // the last picture asked for
-  uint64_t asked_version_ = 0;
-  ViewStats stats_;
 };
 
 }  // namespace sylva::studio

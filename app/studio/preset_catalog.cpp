@@ -10,9 +10,9 @@
 #include <variant>
 
 #include "app/front/render_input.h"
+#include "app/studio/view_picture.h"
 #include "core/cpu/render_cpu.h"
 #include "core/scene/scene_json.h"
-#include "core/util/color.h"
 #include "core/util/file_io.h"
 #include "core/util/image_io.h"
 
@@ -143,11 +143,7 @@ Thumbnail render_thumbnail(const std::string& path, uint32_t width, uint32_t hei
   const RenderResult r = render_cpu(scene, options);
   t.width = r.image.width;
   t.height = r.image.height;
-  t.rgba.resize(static_cast<size_t>(t.width) * t.height * 4);
-  for (size_t i = 0; i < t.rgba.size(); ++i) {
-    const float v = (i % 4 == 3) ? r.image.beauty[i] : linear_to_srgb(r.image.beauty[i]);
-    t.rgba[i] = static_cast<uint8_t>(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
-  }
+  t.rgba = srgb8_rgba(r.image);
   return t;
 }
 

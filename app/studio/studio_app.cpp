@@ -827,17 +827,20 @@ void StudioApp::draw_viewport(ImVec2 size) {
   }
   // Under the picture: what it is and what it cost.
   if (plant_) {
+    // GL pictures say their GPU time; the CPU viewport's (no GPU passes) its render time.
     double gpu_ms = 0;
+    bool gpu = false;
     if (viewport_)
       for (const RenderPass& p : viewport_->stats().passes)
-        if (p.name.find("(GPU)") != std::string::npos) gpu_ms += p.seconds * 1e3;
+        if (p.name.find("(GPU)") != std::string::npos) gpu_ms += p.seconds * 1e3, gpu = true;
+    if (viewport_ && !gpu) gpu_ms = viewport_->stats().render_ms;
     char leaves[32] = "";
     if (plant_->leaves > 0)
       std::snprintf(leaves, sizeof leaves, "  %llu leaves", static_cast<unsigned long long>(plant_->leaves));
-    ImGui::Text("%llu segments%s  step %lld/%lld  %llu modules  GPU %.1f ms  frame %.1f ms",
+    ImGui::Text("%llu segments%s  step %lld/%lld  %llu modules  %s %.1f ms  frame %.1f ms",
                 static_cast<unsigned long long>(plant_->segments), leaves, static_cast<long long>(plant_->shown_step),
-                static_cast<long long>(plant_->steps), static_cast<unsigned long long>(plant_->modules), gpu_ms,
-                io.DeltaTime * 1e3);
+                static_cast<long long>(plant_->steps), static_cast<unsigned long long>(plant_->modules),
+                gpu ? "GPU" : "CPU", gpu_ms, io.DeltaTime * 1e3);
   }
   ImGui::EndChild();
 }
@@ -1152,15 +1155,18 @@ void StudioApp::draw_view() {
   if (skin) plants_changed();
   if (viewport_) {
     const ViewStats& st = viewport_->stats();
+    // The GPU passes of a GL picture; every pass of a CPU one (none says "(GPU)").
+    bool gpu = false;
+    for (const RenderPass& p : st.passes) gpu |= p.name.find("(GPU)") != std::string::npos;
     std::string passes;
     for (const RenderPass& p : st.passes)
-      if (p.name.find("(GPU)") != std::string::npos) {
+      if (!gpu || p.name.find("(GPU)") != std::string::npos) {
         char b[96];
         std::snprintf(b, sizeof b, "%s%s %.2f ms", passes.empty() ? "" : ", ", p.name.substr(0, p.name.find(" (")).c_str(),
                       p.seconds * 1e3);
         passes += b;
       }
-    ImGui::TextDisabled("GPU: %s", passes.empty() ? "-" : passes.c_str());
+    ImGui::TextDisabled("%s: %s", gpu || passes.empty() ? "GPU" : "CPU", passes.empty() ? "-" : passes.c_str());
     ImGui::TextDisabled("%llu frusta, render %.1f ms, skin+upload %.1f ms%s%s",
                         static_cast<unsigned long long>(st.frusta), st.render_ms, st.upload_ms,
                         st.renderer.empty() ? "" : ", ", st.renderer.c_str());

@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <thread>
 
@@ -27,9 +28,11 @@
 #include <imgui.h>
 
 #include "app/front/args.h"
+#include "app/studio/cpu_viewport.h"
 #include "app/studio/gl_viewport.h"
 #include "app/studio/studio.h"
 #include "app/studio/studio_app.h"
+#include "core/gl/gl_context.h"
 #include "core/util/image_io.h"
 
 namespace sylva::studio {
@@ -37,7 +40,8 @@ namespace sylva::studio {
 namespace {
 
 void print_help() {
-  std::cout << "usage: sylva studio [INPUT] [--size WxH] [--skin smooth|paper] [--screenshot OUT.png [--frames N]]\n\n"
+  std::cout << "usage: sylva studio [INPUT] [--size WxH] [--skin smooth|paper] [--backend auto|gl|cpu]\n"
+               "                    [--screenshot OUT.png [--frames N]]\n\n"
                "Opens the studio: edit a grammar and watch the plant regrow. INPUT is a .lsys grammar\n"
                "or a .scene.json scene (the editor shows its first plant's grammar); without one, the\n"
                "preset browser opens. Needs a display (on a machine without one: xvfb-run -a sylva studio ...).\n\n"
@@ -45,6 +49,10 @@ void print_help() {
                "  --skin S            how chains meet, for every plant (over the scene's skin keys):\n"
                "                      smooth or paper (Bhagvat et al. 2009's mitred chains); the view's\n"
                "                      skin control starts there\n"
+               "  --backend B         what draws the viewport: auto (default): OpenGL, but the CPU ray\n"
+               "                      caster, drawn coarse to fine, where the window's GL is a software\n"
+               "                      rasteriser (Mesa's llvmpipe: the CPU is several times faster);\n"
+               "                      gl: OpenGL always; cpu: the CPU ray caster always\n"
                "  --screenshot FILE   grow the plant, draw N frames after it is on screen, write the\n"
                "                      window's pixels to FILE (PNG, atomically) and exit 0; exit 1 with\n"
                "                      the located error, writing nothing, if INPUT does not parse\n"
@@ -62,6 +70,7 @@ struct StudioArgs {
   int width = 1280, height = 800;
   bool help = false;
   std::optional<SkinStyle> skin;
+  std::string backend = "auto";
 };
 
 StudioArgs parse_args(const std::vector<std::string>& args) {
@@ -71,6 +80,12 @@ StudioArgs parse_args(const std::vector<std::string>& args) {
       cli::help_flag(a.help),
       cli::text_flag({"--screenshot"}, a.screenshot),
       cli::skin_flag(a.skin),
+      cli::value_flag({"--backend"},
+                      [&a](const std::string&, const std::string& v) {
+                        a.backend = v;
+                        if (v != "auto" && v != "gl" && v != "cpu")
+                          throw cli::UsageError{"--backend " + v + ": expected auto, gl or cpu"};
+                      }),
       cli::value_flag({"--frames"},
                       [&a](const std::string&, const std::string& v) {
                         auto n = cli::parse_u64(v);
@@ -214,12 +229,23 @@ int run_studio(const std::vector<std::string>& raw_args) {
 
   int code = cli::kOk;
   {
-    std::unique_ptr<GlViewport> viewport_ptr;
-    try {
-      viewport_ptr = std::make_unique<GlViewport>([] { glfwPostEmptyEvent(); });
-    } catch (const std::exception& e) {
-      std::cerr << "sylva studio: error: " << e.what() << "\n";
-      code = cli::kInputError;
+    // --backend auto: the CPU ray caster where the window's GL is a software rasteriser.
+    std::unique_ptr<Viewport> viewport_ptr;
+    const char* gl_renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    const bool software = gl_renderer && is_software_renderer(gl_renderer);
+    if (a.backend == "cpu" || (a.backend == "auto" && software)) {
+      const std::string why = a.backend == "cpu" ? "--backend cpu"
+                                                 : std::string(gl_renderer) + " is a software rasteriser; --backend gl forces it";
+      // A screenshot waits for the finest picture, however long it takes.
+      viewport_ptr = std::make_unique<CpuViewport>([] { glfwPostEmptyEvent(); }, why,
+                                                   a.screenshot.empty() ? 1500.0 : std::numeric_limits<double>::infinity());
+    } else {
+      try {
+        viewport_ptr = std::make_unique<GlViewport>([] { glfwPostEmptyEvent(); });
+      } catch (const std::exception& e) {
+        std::cerr << "sylva studio: error: " << e.what() << "\n";
+        code = cli::kInputError;
+      }
     }
     StudioOptions options;
     const char* presets = std::getenv("SYLVA_PRESETS");
@@ -290,7 +316,8 @@ int run_studio(const std::vector<std::string>& raw_args) {
           code = cli::kInputError;
           break;
         }
-        if (app.plant_drawn() && !app.worker().busy()) ++frames_after_plant;
+        // The finished picture: the plant drawn, and nothing finer on its way.
+        if (app.plant_drawn() && !app.worker().busy() && !(viewport_ptr && viewport_ptr->busy())) ++frames_after_plant;
         if (frames_after_plant >= a.frames) {
           if (auto err = write_screenshot(a.screenshot, fw, fh)) {
             std::cerr << *err << "\n";

@@ -127,6 +127,11 @@ std::string gl_string(GLenum name) {
 
 }  // namespace
 
+bool is_software_renderer(std::string_view renderer) {
+  return renderer.find("llvmpipe") != std::string_view::npos || renderer.find("softpipe") != std::string_view::npos ||
+         renderer.find("swrast") != std::string_view::npos;
+}
+
 std::string GlContextInfo::describe() const {
   return renderer + ", OpenGL " + version + ", " + platform + (software ? " (software rasteriser)" : "");
 }
@@ -184,9 +189,7 @@ GlContextResult create_headless_gl_context() {
     info.vendor = gl_string(GL_VENDOR);
     info.renderer = gl_string(GL_RENDERER);
     info.version = gl_string(GL_VERSION);
-    info.software = info.renderer.find("llvmpipe") != std::string::npos ||
-                    info.renderer.find("softpipe") != std::string::npos ||
-                    info.renderer.find("swrast") != std::string::npos;
+    info.software = is_software_renderer(info.renderer);
 #ifndef NDEBUG
     glEnable(GL_DEBUG_OUTPUT);
     glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);

@@ -23,6 +23,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace sylva {
 
@@ -38,6 +39,10 @@ struct GlError : std::runtime_error {
 struct GlCancelled : std::runtime_error {
   GlCancelled() : std::runtime_error("cancelled") {}
 };
+
+// Whether GL_RENDERER `renderer` names a software rasteriser (llvmpipe, softpipe, swrast):
+// timings are the CPU's, and the CPU ray caster is faster (docs/spec/cli.md --backend auto).
+bool is_software_renderer(std::string_view renderer);
 
 struct GlContextInfo {
   std::string platform;  // "EGL device 0 (hardware)", "EGL surfaceless (Mesa)", ...

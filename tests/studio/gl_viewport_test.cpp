@@ -1,14 +1,19 @@
-// gl_viewport_test.cpp — the studio's GL viewport (app/studio/gl_viewport.h) on a headless
-// context standing in for the window's: the first picture of a document is full size; new
-// plants on a slow renderer show first as a preview (half the pixels a side), then in full;
-// a fast renderer shows them in full at once. No window, no X.
+// gl_viewport_test.cpp — the studio's viewports on a headless context standing in for the
+// window's. GL (app/studio/gl_viewport.h): the first picture of a document is full size;
+// new plants on a slow renderer show first as a preview (half the pixels a side), then in
+// full; a fast renderer shows them in full at once. CPU (app/studio/cpu_viewport.h): each
+// view coarse to fine, ending in exactly the CPU renderer's picture; nothing re-rendered
+// while nothing changes; the newest plants win. No window, no X.
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <thread>
 
 #include "app/studio/cone_worker.h"
+#include "app/studio/cpu_viewport.h"
 #include "app/studio/gl_viewport.h"
+#include "core/cpu/render_cpu.h"
+#include "core/gl/gl_api.h"
 #include "core/gl/gl_context.h"
 #include "core/grow/grow.h"
 #include "core/scene/scene.h"
@@ -30,7 +35,7 @@ Scene saguaro(uint32_t width, uint32_t height) {
 }
 
 // Asks for `scene`'s picture until the viewport is idle; the last image asked.
-ViewImage settle(GlViewport& viewport, const Scene& scene) {
+ViewImage settle(Viewport& viewport, const Scene& scene) {
   ViewImage image;
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   do {
@@ -138,6 +143,74 @@ TEST_F(Viewports, FogInAConeModeDrawsBruteUntilTheConesComeThenWithThem) {
   settle(viewport, scene);
   EXPECT_EQ(pass_detail(viewport, "fog (GPU)").rfind("medium, 8 steps", 0), 0u) << pass_detail(viewport, "fog (GPU)");
   EXPECT_TRUE(viewport.stats().error.empty()) << viewport.stats().error;
+}
+
+// The bytes of a viewport's texture (RGBA8, as uploaded: the CPU's rows top-down).
+std::vector<uint8_t> texture_bytes(const ViewImage& image) {
+  std::vector<uint8_t> out(size_t{image.width} * image.height * 4);
+  const GLuint name = static_cast<GLuint>(reinterpret_cast<intptr_t>(image.texture));
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(name, 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(out.size()), out.data());
+  return out;
+}
+
+std::vector<uint8_t> cpu_picture(const Scene& scene, uint32_t spp) {
+  RenderOptions o;
+  o.spp = spp;
+  return srgb8_rgba(render_cpu(scene, o).image);
+}
+
+TEST_F(Viewports, TheCpuViewportDrawsCoarseToFineEndingInTheCpuRenderersPicture) {
+  CpuViewport viewport({}, "test", /*refine_below_ms=*/1e9);
+  EXPECT_EQ(viewport.stats().renderer, "CPU ray caster (test)");
+  Scene scene = saguaro(96, 64);
+  viewport.set_plants(scene, RenderOptions{});
+  const ViewImage image = settle(viewport, scene);
+  ASSERT_TRUE(image.texture);
+  EXPECT_EQ(image.width, 96u);
+  EXPECT_EQ(image.height, 64u);
+  EXPECT_FALSE(image.flip_v) << "the CPU's rows are top-down";
+  EXPECT_EQ(viewport.stats().previews, 3u) << "a quarter, a half, then full at 1 sample";
+  EXPECT_FALSE(viewport.stats().preview) << "then the antialiased picture";
+  EXPECT_EQ(texture_bytes(image), cpu_picture(scene, 4));
+  EXPECT_TRUE(viewport.stats().error.empty()) << viewport.stats().error;
+
+  // Nothing changed: the cached picture, no work.
+  EXPECT_EQ(viewport.image(scene).texture, image.texture);
+  EXPECT_FALSE(viewport.busy());
+  // The camera moved: drawn again, coarse to fine.
+  scene.camera.eye.x += 0.5;
+  const ViewImage moved = settle(viewport, scene);
+  EXPECT_EQ(viewport.stats().previews, 6u);
+  EXPECT_EQ(texture_bytes(moved), cpu_picture(scene, 4));
+}
+
+TEST_F(Viewports, TheCpuViewportSkipsTheRefinementWhenTheFullPictureIsSlow) {
+  CpuViewport viewport({}, "test", /*refine_below_ms=*/0);
+  Scene scene = saguaro(96, 64);
+  viewport.set_plants(scene, RenderOptions{});
+  const ViewImage image = settle(viewport, scene);
+  EXPECT_EQ(viewport.stats().previews, 2u) << "a quarter and a half, then full at 1 sample: the last";
+  EXPECT_FALSE(viewport.stats().preview);
+  EXPECT_EQ(texture_bytes(image), cpu_picture(scene, 1));
+}
+
+TEST_F(Viewports, TheCpuViewportShowsTheNewestPlantsAndSaysWhyAnEmptyOneIsNotDrawn) {
+  CpuViewport viewport({}, "test", 1e9);
+  Scene scene = saguaro(96, 64);
+  viewport.set_plants(scene, RenderOptions{});
+  viewport.image(scene);
+  scene.plants[0].position.x += 0.4;  // newer plants at once: the older picture is dropped
+  viewport.set_plants(scene, RenderOptions{});
+  const ViewImage image = settle(viewport, scene);
+  EXPECT_TRUE(image.current);
+  EXPECT_EQ(texture_bytes(image), cpu_picture(scene, 4));
+
+  Scene empty = scene;
+  empty.plants[0].skeleton = Skeleton{};
+  viewport.set_plants(empty, RenderOptions{});
+  settle(viewport, empty);
+  EXPECT_EQ(viewport.stats().error, "the plant has no segments or leaves");
 }
 
 }  // namespace
