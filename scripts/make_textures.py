@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""make_textures.py — synthesises the bundled bark, cactus, aloe, stone and roof-tile textures (presets/textures/).
+"""make_textures.py — synthesises the bundled bark, pine bark, cactus, aloe, stone and roof-tile textures
+(presets/textures/).
 
     /usr/bin/python3 scripts/make_textures.py [OUTPUT_DIR]      (default presets/textures)
 
@@ -26,6 +27,7 @@ CACTUS_SEED = 20240612
 STONE_SEED = 20261202
 TILES_SEED = 20261203
 ALOE_SEED = 20261204
+PINE_SEED = 20261207
 
 
 # --- PNG ------------------------------------------------------------------------------
@@ -337,6 +339,33 @@ def make_tiles(n):
     return to_u8(srgb_encode(colour)), to_u16(height)
 
 
+# --- the upper bark of a Scots pine -----------------------------------------------------
+
+def make_pine_bark(n):
+    """The thin upper bark of a Scots pine (presets/scots_pine.lsys, material 2): a fox-red
+    to orange skin peeling in papery flakes that are wider around the stem (s) than along
+    it (t), paler where a flake has lifted, with a dark hairline where its edge casts a
+    shadow, and a fine grain. Albedo only (no height): the scene's materials table lays it
+    on the segments (u_repeat, v_per_metre; docs/materials.md)."""
+    rng = np.random.default_rng(PINE_SEED)
+    flakes = spectral_noise(rng, n, (2.0, 24.0), 1.4, 0.35)       # papery plates, long around
+    tint = spectral_noise(rng, n, (1.0, 6.0), 1.0, 1.0)          # broad redder / browner areas
+    grain = spectral_noise(rng, n, (30.0, 200.0), 0.4, 0.3)      # fine grain, across
+    # A flake's edge: where the plate field crosses the level of a lifted flake (0.25) or
+    # of an older, darker layer beneath (-0.8), a thin shadow line.
+    edge = np.maximum(np.exp(-((flakes - 0.25) / 0.04) ** 2), 0.6 * np.exp(-((flakes + 0.8) / 0.05) ** 2))
+    orange = np.array([0.42, 0.15, 0.06])
+    pale = np.array([0.52, 0.25, 0.11])
+    brown = np.array([0.26, 0.12, 0.06])
+    shadow = np.array([0.10, 0.045, 0.025])
+    colour = mix(orange, brown, smoothstep(0.6, 2.0, -tint) * 0.7)
+    colour = mix(colour, pale, smoothstep(0.25, 0.6, flakes) * 0.6)
+    colour = mix(colour, brown, smoothstep(-0.8, -1.1, flakes) * 0.5)
+    colour = mix(colour, shadow, 0.6 * edge)
+    colour *= (1.0 + 0.05 * grain)[..., None]
+    return to_u8(srgb_encode(colour))
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     out_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "..", "presets", "textures")
@@ -346,9 +375,10 @@ def main():
     stone_albedo, stone_height = make_stone(SIZE)
     tiles_albedo, tiles_height = make_tiles(SIZE)
     aloe_albedo = make_aloe(SIZE)
+    pine_albedo = make_pine_bark(SIZE)
     for name, pixels in (("bark.png", bark_albedo), ("bark_height.png", bark_height),
                          ("cactus.png", cactus_albedo), ("cactus_height.png", cactus_height),
-                         ("aloe.png", aloe_albedo),
+                         ("aloe.png", aloe_albedo), ("pine_bark.png", pine_albedo),
                          ("stone.png", stone_albedo), ("stone_height.png", stone_height),
                          ("tiles.png", tiles_albedo), ("tiles_height.png", tiles_height)):
         path = os.path.join(out_dir, name)

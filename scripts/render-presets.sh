@@ -52,14 +52,15 @@ for grammar in presets/*.lsys; do
   printf "%-24s %s  (%.1f s)\n" "$name" "${label/|/, }" "$(echo "$(date +%s.%N) - $t0" | bc)"
   sheet+=("$out/$name.png" "$name|$label")
 done
-# The paper's plants and the fir dressed by their scenes; rendered at the sheet's size.
-for scene in pine_dense coconut_palm saguaro aloe_vera fir; do
+# The paper's plants, the fir and the Scots pine dressed by their scenes; rendered at the sheet's size.
+for scene in pine_dense coconut_palm saguaro aloe_vera fir scots_pine; do
   t0=$(date +%s.%N)
   "$sylva" render "presets/scenes/$scene.scene.json" -o "$out/scene_$scene.png" --width "$width" \
     --height "$height" --spp "$spp" --backend "$backend" 2>/dev/null
   printf "%-24s %s  (%.1f s)\n" "scenes/$scene" "scene" "$(echo "$(date +%s.%N) - $t0" | bc)"
   case $scene in
     aloe_vera) note="flecked skin on the leaves|(materials table)" ;;
+    scots_pine) note="orange upper bark|(materials table)" ;;
     *) note="bark relief on wood|(material 0) only" ;;
   esac
   sheet+=("$out/scene_$scene.png" "$scene.scene.json|$note")

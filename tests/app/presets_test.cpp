@@ -71,6 +71,9 @@ const Preset kPresets[] = {
     {"topiary", 21576, std::nullopt, 33723},
     // A fir (Abies): Massart's model, whorls of flat sprays, needles drawn as tufts.
     {"fir", 20342, std::nullopt},
+    // A Scots pine (Pinus sylvestris): Rauh's model, a high open crown of tufted limbs on a
+    // clear bole, needles in pairs; the count depends on the seed (missing limbs, cones).
+    {"scots_pine", 23090, std::nullopt},
 };
 
 fs::path presets_dir() { return fs::path(SYLVA_SOURCE_DIR) / "presets"; }
