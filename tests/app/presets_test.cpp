@@ -61,8 +61,9 @@ const Preset kPresets[] = {
     {"coconut_palm", 3626, 3713, 3024},  // three blades over each leaflet's frusta
     {"pine", 17468, 16997},        // needles of true size (the benchmarks' pine)
     {"pine_dense", 17509, 16997},  // needles drawn as tufts, twice the fascicles
-    // A small cactus for the dancing-cacti scene (Bhagvat et al. 2009, Figure 8).
-    {"cactus", 25, std::nullopt},
+    // A small cactus for the dancing-cacti scene (Bhagvat et al. 2009, Figure 8); its flower's
+    // corolla and throat are polygons (2 x 10 petals of three pieces, and an octagon).
+    {"cactus", 25, std::nullopt, 61},
     // The well of Bhagvat et al. 2009, Figure 10, one part per PART (presets/scenes/well.scene.json
     // holds all four: 8 segments, tests/grow/paper_scenes_test.cpp); PART 0 is the wall.
     {"well", 1, std::nullopt},
