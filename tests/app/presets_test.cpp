@@ -58,7 +58,7 @@ const Preset kPresets[] = {
     {"aloe_vera", 229, 229, 912},  // a fat keel of frusta under four polygons a segment
     {"elm", 1769, 1833},           // leaves of frusta (the grove scenes' elm)
     {"elm_in_leaf", 1872, 1833, 10627},  // the wood is the segments; leaves are polygons
-    {"coconut_palm", 3626, 3713, 3024},  // three blades over each leaflet's frusta
+    {"coconut_palm", 3626, 3713, 8280},  // a frustum and three blades a leaflet, 92 leaflets a frond
     {"pine", 17468, 16997},        // needles of true size (the benchmarks' pine)
     {"pine_dense", 17509, 16997},  // needles drawn as tufts, twice the fascicles
     // A small cactus for the dancing-cacti scene (Bhagvat et al. 2009, Figure 8); its flower's
