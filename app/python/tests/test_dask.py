@@ -119,6 +119,9 @@ def small_dancing_scene(tmp_path, repo):
         plant["grammar"] = str((repo / "presets/scenes" / plant["grammar"]).resolve())
     for entry in scene.get("scatter", []):
         entry["grammar"] = str((repo / "presets/scenes" / entry["grammar"]).resolve())
+    for material in scene.get("materials", []):  # image files, relative to the scene
+        if isinstance(material.get("albedo"), str):
+            material["albedo"] = str((repo / "presets/scenes" / material["albedo"]).resolve())
     path = tmp_path / "dancing.scene.json"
     path.write_text(json.dumps(scene))
     return str(path)
