@@ -13,6 +13,7 @@
 #include <imgui_stdlib.h>
 
 #include "core/grow/grow.h"
+#include "core/grow/growth_tween.h"
 #include "core/gl/render_gl.h"
 #include "core/io/gltf.h"
 #include "core/geometry/skeleton.h"
@@ -106,7 +107,7 @@ std::string StudioApp::title() const {
 bool StudioApp::dirty() const { return text_ != saved_text_; }
 
 bool StudioApp::wants_frames() const {
-  return worker_->busy() || worker_->result_waiting() || cones_->busy() || edited_at_ || unsnapped_at_ || animating_ ||
+  return worker_->busy() || worker_->result_waiting() || cones_->busy() || edited_at_ || unsnapped_at_ || animating_ || tween_ ||
          view_half_res_ || latency_start_ || (viewport_ && viewport_->busy()) ||
          (show_presets_ && thumbnails_ && !thumbnails_->idle());
 }
@@ -352,6 +353,21 @@ void StudioApp::apply_outcome(GrowOutcome outcome) {
     return;
   }
   error_.reset();
+  // Animate with substeps: the next step grows out of the one on screen.
+  tween_.reset();
+  if (animating_ && animate_substeps_ > 1 && plant_ && outcome.shown_step == plant_->shown_step + 1 &&
+      outcome.skeletons.size() == edited_plants_.size()) {
+    Tween t;
+    for (size_t k = 0; k < edited_plants_.size(); ++k) {
+      const std::optional<Skeleton>& old = scene_.plants[edited_plants_[k]].skeleton;
+      if (!old) break;
+      t.before.push_back(*old);
+    }
+    if (t.before.size() == edited_plants_.size()) {
+      t.after = outcome.skeletons;
+      tween_ = std::move(t);
+    }
+  }
   for (size_t k = 0; k < edited_plants_.size() && k < outcome.skeletons.size(); ++k)
     scene_.plants[edited_plants_[k]].skeleton = std::move(outcome.skeletons[k]);
   outcome.skeletons.clear();
@@ -371,6 +387,21 @@ void StudioApp::apply_outcome(GrowOutcome outcome) {
   }
   plant_ = std::move(outcome);
   ++plants_applied_;
+  if (tween_) {
+    tween_->shown = 1;  // the first substep at once
+    animate_stepped_at_ = now_;
+    show_tween();
+  } else {
+    plants_changed();
+  }
+}
+
+void StudioApp::show_tween() {
+  const double alpha = static_cast<double>(tween_->shown) / animate_substeps_;
+  for (size_t k = 0; k < edited_plants_.size(); ++k) {
+    scene_.plants[edited_plants_[k]].skeleton =
+        tween_->shown >= animate_substeps_ ? tween_->after[k] : tween_growth(tween_->before[k], tween_->after[k], alpha);
+  }
   plants_changed();
 }
 
@@ -382,10 +413,19 @@ void StudioApp::poll_worker() {
     if (ok) latency_start_ = submitted;
     else latency_start_.reset();
   }
-  if (animating_ && !worker_->busy() && plant_ && !error_) {
+  // Substeps: each 1 / (speed · K) seconds the plant grows a K-th further into the step;
+  // stopped (Stop, Step, an edit...) mid-step, it shows the whole step.
+  if (tween_ && (!animating_ || now_ - animate_stepped_at_ >= 1.0 / (animate_steps_per_s_ * animate_substeps_))) {
+    tween_->shown = animating_ ? tween_->shown + 1 : animate_substeps_;
+    animate_stepped_at_ = now_;
+    show_tween();
+    if (tween_->shown >= animate_substeps_) tween_.reset();
+  }
+  const double step_s = 1.0 / (animate_steps_per_s_ * (animate_substeps_ > 1 ? animate_substeps_ : 1));
+  if (animating_ && !tween_ && !worker_->busy() && plant_ && !error_) {
     if (plant_->shown_step >= plant_->steps) {
       animating_ = false;
-    } else if (now_ - animate_stepped_at_ >= 1.0 / animate_steps_per_s_) {
+    } else if (now_ - animate_stepped_at_ >= step_s) {
       animate_stepped_at_ = now_;
       show_step_ = plant_->shown_step + 1;
       submit_regrow();
@@ -961,6 +1001,10 @@ void StudioApp::draw_derivation() {
   ImGui::SetNextItemWidth(90);
   ImGui::SliderFloat("##speed", &animate_steps_per_s_, 0.25f, 60, "%.2g steps/s", ImGuiSliderFlags_Logarithmic);
   keep("slider:animate_speed");
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(70);
+  ImGui::SliderInt("##substeps", &animate_substeps_, 1, 16, animate_substeps_ == 1 ? "whole steps" : "%d substeps");
+  keep("slider:animate_substeps");
   ImGui::SameLine();
   if (worker_->busy()) {
     if (ImGui::Button("Cancel")) worker_->cancel(), animating_ = false;

@@ -149,6 +149,13 @@ class StudioApp {
   void animate();  // from the axiom, animate_speed() steps a second (as fast as they grow, at most)
   double animate_speed() const { return animate_steps_per_s_; }
   void set_animate_speed(double steps_per_s) { animate_steps_per_s_ = std::clamp(steps_per_s, 0.25, 60.0); }
+  // Animate's substeps (issue 31 §3, docs/animation.md): each step shown as K pictures, the
+  // plant growing from the last step's into the new one (core/grow/growth_tween.h, what
+  // `render --frames all --substeps K` draws), the step still taking 1 / animate_speed()
+  // seconds. 1 (the default): steps as they come.
+  int animate_substeps() const { return animate_substeps_; }
+  bool animating() const { return animating_; }
+  void set_animate_substeps(int k) { animate_substeps_ = std::clamp(k, 1, 16); }
   void frame_plant();
   // What the glTF export dialog asks (docs/gltf.md): the mesh, the wind rig and clip (the
   // scene's `animation` key, or the default sway), per-vertex wind data.
@@ -240,7 +247,16 @@ class StudioApp {
   std::vector<Chord> chords_;          // queue_chord's, not yet handled
   bool chords_from_callbacks_ = false;
   float animate_steps_per_s_ = 4;    // the Animate speed control
-  double animate_stepped_at_ = 0;    // now_ when the animation last took a step
+  int animate_substeps_ = 1;         // the Animate substeps control
+  double animate_stepped_at_ = 0;    // now_ when the animation last took a step (or substep)
+  // A step being shown in substeps: the edited plants' skeletons of the step before and
+  // of the new one, and how many of the K pictures were put on screen.
+  struct Tween {
+    std::vector<Skeleton> before, after;
+    int shown = 0;
+  };
+  std::optional<Tween> tween_;
+  void show_tween();  // the edited plants at tween_'s current substep, to the viewport
   bool camera_set_ = false;
   OrbitCamera orbit_;
   RenderOptions render_options_;

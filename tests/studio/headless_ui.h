@@ -6,6 +6,7 @@
 #pragma once
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -26,9 +27,19 @@ class FakeViewport : public Viewport {
   void set_plants(const Scene& scene, const RenderOptions&) override {
     ++set_plants_calls;
     segments = 0;
+    wood_m = 0;
     skins.clear();
     for (const ScenePlant& p : scene.plants) {
-      if (p.skeleton) segments += p.skeleton->segment_count();
+      if (p.skeleton) {
+        segments += p.skeleton->segment_count();
+        for (const Chain& c : p.skeleton->chains)
+          for (uint32_t j = 1; j < c.joint_count; ++j) {
+            const Joint& a = p.skeleton->joints[c.first_joint + j - 1];
+            const Joint& b = p.skeleton->joints[c.first_joint + j];
+            wood_m += std::hypot(b.position_m[0] - a.position_m[0], b.position_m[1] - a.position_m[1],
+                                 b.position_m[2] - a.position_m[2]);
+          }
+      }
       skins.push_back(p.skin);
     }
   }
@@ -67,6 +78,7 @@ class FakeViewport : public Viewport {
   std::shared_ptr<const ConeSet> last_cones;
   std::shared_ptr<const std::vector<SunDepthMap>> last_maps;
   uint64_t segments = 0;
+  double wood_m = 0;  // the plants' segment lengths summed, at the last set_plants
   std::vector<SkinStyle> skins;  // each plant's, as the last set_plants saw them
   std::vector<double> last_key;
   ViewStats stats_;

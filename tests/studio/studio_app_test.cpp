@@ -465,6 +465,33 @@ TEST_F(Fixture, AnimateTakesItsStepsAtTheChosenSpeed) {
   EXPECT_EQ(app->animate_speed(), 60) << "clamped";
 }
 
+// Issue 31 §3: with substeps, Animate grows each step out of the one before it
+// (growth_tween.h): K pictures a step, more wood in each, the last the step itself, and
+// the steps still at the chosen speed.
+TEST_F(Fixture, AnimateSubstepsGrowEachStepOutOfTheOneBefore) {
+  auto app = opened();
+  ASSERT_TRUE(app->rect("slider:animate_substeps"));
+  const double whole = viewport.wood_m;  // step 4, as opened
+  app->set_animate_speed(2);
+  app->set_animate_substeps(4);
+  app->animate();
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plant()->shown_step == 0 && !app->worker().busy(); }));
+  std::vector<double> wood{viewport.wood_m};  // on screen after each set_plants
+  int calls = viewport.set_plants_calls, frames = 0;
+  ASSERT_TRUE(ui.until(*app, [&] {
+    ++frames;
+    if (viewport.set_plants_calls != calls) calls = viewport.set_plants_calls, wood.push_back(viewport.wood_m);
+    return !app->animating() && !app->worker().busy() && !app->wants_frames();
+  }));
+  EXPECT_EQ(app->plant()->shown_step, 4);
+  ASSERT_EQ(wood.size(), 1 + 4 * 4u) << "the axiom, then 4 pictures for each of 4 steps";
+  for (size_t i = 1; i < wood.size(); ++i) EXPECT_GT(wood[i], wood[i - 1] + 1e-9) << "picture " << i;
+  EXPECT_DOUBLE_EQ(wood.back(), whole) << "the last picture is the step itself";
+  EXPECT_GE(frames, 4 * 30 - 8) << "4 steps at 2 a second, 60 frames a second";
+  app->set_animate_substeps(100);
+  EXPECT_EQ(app->animate_substeps(), 16) << "clamped";
+}
+
 TEST_F(Fixture, SixtyRapidEditsPutOnlyTheLastPlantOnScreen) {
   StudioOptions o;
   o.debounce_s = 0;  // every keystroke goes to the worker
