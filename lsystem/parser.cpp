@@ -1690,7 +1690,7 @@ LineKind classify(const LogicalLine& line) {
 constexpr const char* kCpfgModuleNames[] = {
     "@Gc", "@Ge", "@Gr", "@Gs", "@Gt", "@L",  "@O",  "@PC", "@PD", "@PS", "@T",  "@Td", "@Tf", "@Tp", "@Ts",
     "@Tx", "@Ti", "@bc", "@bo", "@c",  "@o",  "@v",  "@M",  "@m",  "@R",  "@D",  "@Di", "@Dd", "@;",  "@,",  "?P",
-    "?H",  "?L",  "?U",  "?E"};
+    "?H",  "?L",  "?U",  "?E",  "@!",  "@#"};
 
 void Parser::parse(const std::string& text) {
   validate_text(text);

@@ -40,6 +40,35 @@ struct TurtleState {
   // A cpfg file's elasticity of each view-file tropism (by id − 1): @Ti, @Td, @Ts change it
   // for the rest of the branch.
   std::array<double, lsys::kMaxViewTropisms> elasticity{};
+  // A cpfg file's generalized cylinder (CPFG manual 6.7.3; docs/cpfg.md): the open one's
+  // index in build_skeleton's pool, or -1 (a branch draws on a copy, as cpfg's spline
+  // stack); whether f and F set its control points ({(type)) or not (@Gs); and the
+  // Hermite tangent coefficients @Gt sets.
+  int32_t cylinder = -1;
+  bool cylinder_moves = false;
+  double tangent_start = 1.2, tangent_end = 1.2;
+};
+
+// A control point of a generalized cylinder: where the turtle was, its heading, width and
+// colour.
+struct ControlPoint {
+  dvec3 position{0}, heading{0, 1, 0};
+  double radius = 0;
+  uint32_t material = 0;
+};
+
+// An open generalized cylinder: a Hermite curve through its control points (tangents along
+// the turtle's heading, length × the @Gt coefficients) or a uniform cubic B-spline over
+// them, open or closed, drawn as one chain of frusta, `strips` a segment.
+struct GenCylinder {
+  bool bspline = false, closed = false;
+  int default_strips = 1;               // per segment when the point gives none
+  std::optional<ChainParent> parent;    // the joint the turtle stood on when it started
+  std::array<ControlPoint, 3> last{};   // the newest control points (Hermite: 1, B-spline: 3)
+  int count = 0;
+  std::array<ControlPoint, 3> first{};  // a closed curve's first points, drawn again at its end
+  int first_count = 0;
+  int64_t chain = -1, joint = -1;       // the chain drawn so far and its last joint
 };
 
 // A polygon between `{` and `}` (docs/spec/grammar.md, ABOP 1.10 and 5.1; cpfg): the joint the
@@ -257,7 +286,8 @@ std::vector<SourceLoc> places_writing(const lsys::Grammar& g, lsys::SymbolId sym
 // What the turtle makes of a cpfg file's own symbols (CPFG manual 6; docs/cpfg.md).
 enum class CpfgKind : uint8_t {
   kNone, kDraw, kMove, kColorUp, kColorDown, kWidthUp, kWidthDown, kLevel, kSetPosition, kSetHeading, kCircle, kSphere,
-  kScaleSet, kScaleUp, kScaleDown, kForceTwist, kElasticityUp, kElasticityDown, kElasticitySet, kUnsupported
+  kScaleSet, kScaleUp, kScaleDown, kForceTwist, kElasticityUp, kElasticityDown, kElasticitySet,
+  kCylinderStart, kCylinderPoint, kCylinderEnd, kCylinderTangents, kCylinderSides, kCylinderContour, kUnsupported
 };
 
 struct CpfgSymbols {
@@ -291,8 +321,13 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
   set("@Ti", CpfgKind::kElasticityUp);
   set("@Td", CpfgKind::kElasticityDown);
   set("@Ts", CpfgKind::kElasticitySet);
-  for (const char* name : {"~", "@o", "@Gs", "@Gc", "@Ge", "@Gr", "@Gt",
-                           "@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc"})
+  set("@Gs", CpfgKind::kCylinderStart);
+  set("@Gc", CpfgKind::kCylinderPoint);
+  set("@Ge", CpfgKind::kCylinderEnd);
+  set("@Gt", CpfgKind::kCylinderTangents);
+  set("@!", CpfgKind::kCylinderSides);
+  set("@#", CpfgKind::kCylinderContour);
+  for (const char* name : {"~", "@o", "@Gr", "@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc"})
     set(name, CpfgKind::kUnsupported);
   return out;
 }
@@ -300,13 +335,18 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
 // @c's polygon and @O's frusta (docs/cpfg.md): a 24-gon's area is 1.1 % short of the
 // circle's; 16 frusta inscribed in the sphere's profile hold 99.0 % of its volume.
 constexpr int kCircleSides = 24;
+// Generalized cylinders: the strips a piece gets from f and F ({(type)'s default, cpfg's
+// DEFAULT_RINGS), and the most one piece may ask for.
+constexpr int kDefaultCylinderRings = 4;
+constexpr int kMaxCylinderStrips = 10000;
 constexpr int kSphereSegments = 16;
 
 // The feature a cpfg symbol sylva does not draw yet belongs to, for its error.
 std::string cpfg_feature(const std::string& name) {
   if (name == "~") return "a predefined surface, CPFG manual 6.7.1";
   if (name == "@o") return "a circle in the plane of the screen, CPFG manual 6.6: it turns with the camera, which a skeleton cannot; @c draws one in the HL plane";
-  if (name.rfind("@G", 0) == 0) return "a generalized cylinder, CPFG manual 6.7.3";
+  if (name == "@Gr") return "a generalized cylinder's radius tangents, CPFG manual 6.7.3; widths change linearly between control points";
+  if (name == "@#") return "a view-file contour for generalized cylinders, CPFG manual 6.7.3 and 8.1.5; the default circle is @#(0)";
   if (name.rfind("@T", 0) == 0) return "a view-file tropism, CPFG manual 6.8";
   if (name == "@;" || name == "@,") return "a back-side colour, CPFG manual 6.3";
   if (name.rfind("@P", 0) == 0 || name.rfind("@b", 0) == 0) return "a B-spline surface patch, CPFG manual 6.7.2";
@@ -362,6 +402,75 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   const CpfgSymbols cpfg = cpfg_symbols(g);
   std::vector<OpenPolygon> polygons;  // a stack: polygons nest
   std::vector<Leaf> leaves;
+  // Generalized cylinders (cpfg files): the pool TurtleState::cylinder indexes. '[' gives
+  // the branch a copy of the open one (cpfg's PushSpline) and ']' drops what the branch
+  // added to the pool, so it never outgrows the open cylinders of the branches open.
+  std::vector<GenCylinder> cylinders;
+  std::vector<size_t> cylinder_marks;  // the pool's size at each '[' still open
+  // Appends one piece of a cylinder's curve to its chain: `strips` joints at curve(k /
+  // strips), radii from r0 to r1, in the colour of the piece's start. A new chain where
+  // there is none yet or where the chain went on meanwhile (a branch drew from this point).
+  auto cylinder_piece = [&](GenCylinder& c, const dvec3& start, double r0, double r1, uint32_t material, int strips,
+                            const auto& curve) {
+    if (c.chain < 0 || c.joint + 1 != static_cast<int64_t>(chain_joint_count[static_cast<size_t>(c.chain)])) {
+      if (chain_joint_count.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many chains"};
+      const std::optional<ChainParent> parent =
+          c.chain < 0 ? c.parent : ChainParent{static_cast<uint32_t>(c.chain), static_cast<uint32_t>(c.joint)};
+      const uint32_t id = static_cast<uint32_t>(chain_joint_count.size());
+      chain_joint_count.push_back(1);
+      chain_parent.push_back(parent);
+      joints.push_back({id, Joint{{start.x, start.y, start.z}, r0, material}});
+      c.chain = id;
+      c.joint = 0;
+    }
+    for (int k = 1; k <= strips; ++k) {
+      const double tau = static_cast<double>(k) / strips;
+      const dvec3 v = curve(tau);
+      check_position(v);
+      uint32_t& count = chain_joint_count[static_cast<size_t>(c.chain)];
+      if (count == 0xFFFFFFFFu) throw TurtleFailure{"a chain has too many joints"};
+      joints.push_back({static_cast<uint32_t>(c.chain), Joint{{v.x, v.y, v.z}, r0 + (r1 - r0) * tau, material}});
+      ++count;
+      ++c.joint;
+    }
+  };
+  // A control point `cp` of cylinder `c`, and the piece it ends: Hermite (manual 6.7.3:
+  // tangents along the two points' headings, the chord's length times @Gt's start and end
+  // coefficients) or the uniform cubic B-spline piece of the last four points.
+  auto cylinder_control = [&](GenCylinder& c, const ControlPoint& cp, int strips, double t_start, double t_end) {
+    if (!c.bspline) {
+      if (c.count == 0) {
+        c.last[0] = cp;
+        c.count = 1;
+        return;
+      }
+      const ControlPoint a = c.last[0];
+      c.last[0] = cp;
+      const double len = glm::length(cp.position - a.position);
+      if (!(len > 0)) return;  // coincident points: no piece (cpfg draws none)
+      const dvec3 ta = a.heading * (len * t_start), tb = cp.heading * (len * t_end);
+      cylinder_piece(c, a.position, a.radius, cp.radius, a.material, strips, [&](double u) {
+        const double u2 = u * u, u3 = u2 * u;
+        return (2 * u3 - 3 * u2 + 1) * a.position + (u3 - 2 * u2 + u) * ta + (3 * u2 - 2 * u3) * cp.position +
+               (u3 - u2) * tb;
+      });
+      return;
+    }
+    if (c.count < 3) {
+      c.last[static_cast<size_t>(c.count++)] = cp;
+      return;
+    }
+    const ControlPoint p0 = c.last[0], p1 = c.last[1], p2 = c.last[2];
+    c.last = {p1, p2, cp};
+    const auto b = [&](double u) {
+      const double u2 = u * u, u3 = u2 * u, v = 1 - u;
+      return (v * v * v * p0.position + (3 * u3 - 6 * u2 + 4) * p1.position +
+              (-3 * u3 + 3 * u2 + 3 * u + 1) * p2.position + u3 * cp.position) / 6.0;
+    };
+    const dvec3 start = b(0);
+    if (!(glm::length(b(1) - start) > 0)) return;
+    cylinder_piece(c, start, p1.radius, p2.radius, p1.material, strips, b);
+  };
   const size_t n = word.size();
   const Turn default_turn = turn_of(d.angle_deg);
   const Turn default_turn_back = turn_of(-d.angle_deg);
@@ -375,6 +484,49 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   auto rotated = [&](TurtleState& s) {
     if ((++rotations & 15u) == 0) orthonormalize(s);
     else s.up = glm::cross(s.heading, s.left);
+  };
+  // Strips of a piece: the parameter (at least 1, cpfg's clamp), else the cylinder's default.
+  auto strips_of = [&](const Module& m, const double* p) {
+    if (m.param_count == 0) return 0;
+    if (!std::isfinite(p[0]) || p[0] > kMaxCylinderStrips)
+      throw TurtleFailure{"a generalized cylinder's strips must be finite and at most " +
+                          std::to_string(kMaxCylinderStrips)};
+    return std::max(1, static_cast<int>(p[0]));
+  };
+  // The turtle's open cylinder leaves the pool when it is the pool's last entry and this
+  // branch's own (a finished or replaced one): sequences of cylinders do not pile up.
+  auto cylinder_release = [&] {
+    const size_t at = static_cast<size_t>(t.cylinder);
+    if (t.cylinder >= 0 && at + 1 == cylinders.size() && (cylinder_marks.empty() || at >= cylinder_marks.back()))
+      cylinders.pop_back();
+  };
+  auto cylinder_start = [&](bool bspline, bool closed, int default_strips, bool moves) {
+    cylinder_release();  // a cylinder started while one is open replaces it (cpfg)
+    GenCylinder c;
+    c.bspline = bspline;
+    c.closed = closed;
+    c.default_strips = default_strips;
+    if (t.chain >= 0) c.parent = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
+    cylinders.push_back(c);
+    t.cylinder = static_cast<int32_t>(cylinders.size() - 1);
+    t.cylinder_moves = moves;
+  };
+  // The turtle's place as the open cylinder's next control point (0 strips: the default).
+  auto cylinder_point = [&](int strips) {
+    GenCylinder& c = cylinders[static_cast<size_t>(t.cylinder)];
+    const ControlPoint cp{t.position, t.heading, t.radius, t.material};
+    if (c.closed && c.first_count < (c.bspline ? 3 : 1)) c.first[static_cast<size_t>(c.first_count++)] = cp;
+    cylinder_control(c, cp, strips > 0 ? strips : c.default_strips, t.tangent_start, t.tangent_end);
+  };
+  auto cylinder_end = [&] {
+    GenCylinder& c = cylinders[static_cast<size_t>(t.cylinder)];
+    // A closed curve ends where it began: its first points again (cpfg's FinishSpline).
+    const std::array<ControlPoint, 3> first = c.first;
+    for (int k = 0; c.closed && k < c.first_count; ++k)
+      cylinder_control(c, first[static_cast<size_t>(k)], c.default_strips, t.tangent_start, t.tangent_end);
+    cylinder_release();
+    t.cylinder = -1;
+    t.cylinder_moves = false;
   };
   {
     size_t moves = 0;
@@ -391,14 +543,29 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
       const Module& m = word.modules[i];
       const double* p = word.params_of(m);
       const bool has = m.param_count > 0;
+      if (m.symbol == sym_open && g.cpfg && has && p[0] != 0) {
+        // {(type, strips): a generalized cylinder whose control points f and F set (manual 6.7.3).
+        if (!(p[0] >= 1 && p[0] <= 4 && p[0] == std::floor(p[0])))
+          throw TurtleFailure{"a generalized cylinder's type must be 1 to 4 (Hermite, closed Hermite, B-spline, closed B-spline)"};
+        const int type = static_cast<int>(p[0]);
+        const int strips = m.param_count >= 2 ? strips_of(Module{m.symbol, 1, 0}, p + 1) : 0;
+        cylinder_start(type >= 3, type % 2 == 0, strips > 0 ? strips : kDefaultCylinderRings, true);
+        continue;
+      }
+      if (m.symbol == sym_close && g.cpfg && has && p[0] != 0) {
+        if (t.cylinder < 0) throw TurtleFailure{"'}(type)' without an open generalized cylinder"};
+        cylinder_end();
+        continue;
+      }
       if (m.symbol == sym_open) {
         std::optional<ChainParent> joint;
         if (t.chain >= 0) joint = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
         polygons.push_back({i, joint, t.position, {}});
         continue;
       }
-      if (m.symbol == sym_vertex) {  // outside a polygon a '.' records nothing (as in cpfg)
+      if (m.symbol == sym_vertex) {  // outside a polygon or cylinder a '.' records nothing (as in cpfg)
         if (!polygons.empty()) record_vertex(polygons.back(), t.position);
+        else if (t.cylinder >= 0) cylinder_point(strips_of(m, p));  // .(strips) is @Gc(strips)
         continue;
       }
       if (m.symbol == sym_close) {
@@ -529,6 +696,32 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
             }
             continue;
           }
+          case CpfgKind::kCylinderStart:  // @Gs: a Hermite cylinder from here ({(1) with this point)
+            cylinder_start(false, false, 1, false);
+            cylinder_point(0);
+            continue;
+          case CpfgKind::kCylinderPoint:  // @Gc(strips): a control point (starting a cylinder if none is open)
+          case CpfgKind::kCylinderEnd: {  // @Ge(strips): the last one
+            if (t.cylinder < 0) cylinder_start(false, false, 1, false);
+            cylinder_point(strips_of(m, p));
+            if (cpfg.kind[symbol] == CpfgKind::kCylinderEnd) cylinder_end();
+            continue;
+          }
+          case CpfgKind::kCylinderTangents:  // @Gt(start, end): Hermite tangent coefficients (one: both)
+            if (has) {
+              const double a = p[0], b = m.param_count > 1 ? p[1] : p[0];
+              if (!std::isfinite(a) || !std::isfinite(b) || std::abs(a) > 1e6 || std::abs(b) > 1e6)
+                throw TurtleFailure{"@Gt's tangent coefficients must be finite and at most 1e6"};
+              t.tangent_start = a;
+              t.tangent_end = b;
+            }
+            continue;
+          case CpfgKind::kCylinderSides:  // @!(n): polygons around a cylinder; frusta are round
+            continue;
+          case CpfgKind::kCylinderContour:  // @#(id): 0 (or none) is the default circle
+            if (has && p[0] != 0)
+              throw TurtleFailure{"'@#' (" + cpfg_feature("@#") + ") is not supported yet (docs/cpfg.md)"};
+            continue;
           case CpfgKind::kUnsupported:
             throw TurtleFailure{"'" + g.symbols.name(m.symbol) + "' (" + cpfg_feature(g.symbols.name(m.symbol)) +
                                 ") is not supported yet (docs/cpfg.md)"};
@@ -634,11 +827,22 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
         case kSymPush:
           stack.push_back(t);
           t.branch_pending = true;
+          if (g.cpfg) {
+            cylinder_marks.push_back(cylinders.size());
+            if (t.cylinder >= 0) {  // the branch draws on a copy of the open cylinder
+              cylinders.push_back(cylinders[static_cast<size_t>(t.cylinder)]);
+              t.cylinder = static_cast<int32_t>(cylinders.size() - 1);
+            }
+          }
           break;
         case kSymPop:
           if (stack.empty()) throw TurtleFailure{"']' without matching '['"};
           t = stack.back();
           stack.pop_back();
+          if (g.cpfg && !cylinder_marks.empty()) {
+            cylinders.resize(cylinder_marks.back());
+            cylinder_marks.pop_back();
+          }
           break;
         case kSymWidth:
           if (has) t.radius = p[0];
@@ -684,6 +888,9 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
         default:
           break;  // carried through, ignored by the turtle
       }
+      // Inside {(type) ... }(type) every f and F (not g, G) is also a control point.
+      if (t.cylinder >= 0 && t.cylinder_moves && (symbol == kSymF || symbol == kSymf) && symbol == m.symbol)
+        cylinder_point(0);
     }
     if (!polygons.empty()) {
       i = polygons.back().module;

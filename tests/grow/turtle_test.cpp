@@ -20,6 +20,9 @@
 #include <string_view>
 #include <vector>
 
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
 namespace sylva {
 namespace {
 
@@ -991,7 +994,8 @@ TEST(TurtleCpfg, AtDScalesLengthsAndWidthsAndBracketsKeepTheScale) {
 
 TEST(TurtleCpfg, SymbolsSylvaDoesNotDrawYetAreErrorsNamingTheFeature) {
   const std::pair<const char*, const char*> cases[] = {
-      {"F@o(2)", "plane of the screen"}, {"F~l(1)", "surface"}, {"@Gs F @Ge", "generalized cylinder"},
+      {"F@o(2)", "plane of the screen"}, {"F~l(1)", "surface"}, {"@Gs F @Gr(30,1) @Ge", "radius tangents"},
+      {"@#(2) @Gs F @Ge", "contour"},
       {"F@PS(1)F", "patch"}, {"F@;F", "back-side colour"}};
   for (const auto& [axiom, feature] : cases) {
     const std::string message = grow_error(cpfg(axiom));
@@ -999,6 +1003,138 @@ TEST(TurtleCpfg, SymbolsSylvaDoesNotDrawYetAreErrorsNamingTheFeature) {
     EXPECT_NE(message.find("not supported yet"), std::string::npos) << axiom << ": " << message;
     EXPECT_NE(message.find("test.lsys:2:1"), std::string::npos) << axiom << ": " << message;  // at the axiom
   }
+}
+
+// ---- generalized cylinders (CPFG manual 6.7.3, docs/cpfg.md) ---------------------------
+
+glm::dvec3 at(const Skeleton& sk, size_t chain, size_t joint) {
+  const Position q = position_at(sk, chain, joint);
+  return {q[0], q[1], q[2]};
+}
+
+// The Hermite piece from a to b with tangents ta, tb, at u (the test's own formula).
+glm::dvec3 hermite(glm::dvec3 a, glm::dvec3 ta, glm::dvec3 b, glm::dvec3 tb, double u) {
+  const double h00 = 2 * u * u * u - 3 * u * u + 1, h10 = u * u * u - 2 * u * u + u;
+  const double h01 = -2 * u * u * u + 3 * u * u, h11 = u * u * u - u * u;
+  return h00 * a + h10 * ta + h01 * b + h11 * tb;
+}
+
+TEST(TurtleCpfg, AGeneralizedCylinderIsAHermiteCurveThroughItsControlPointsAlongTheHeadings) {
+  // Figure 3 of the manual: @Gs -(45) f -(45) @Ge(n). The turtle starts at the origin heading
+  // +y; - turns right (toward +x), so the curve leaves at 45° and arrives heading 90° right.
+  const Skeleton sk = skeleton_of(cpfg("@Gs-(45)f(1)-(45)@Ge(8)"));
+  ASSERT_EQ(sk.chains.size(), 1u);
+  ASSERT_EQ(sk.chains[0].joint_count, 9u);
+  EXPECT_FALSE(sk.chains[0].parent);
+  const double h = std::sqrt(0.5);
+  // @Gs's point is where the turtle stood (heading +y), @Ge's where f took it (heading (h, h)).
+  const glm::dvec3 a(0, 0, 0), b(h, h, 0), ha(0, 1, 0), hb(1, 0, 0);
+  const double len = 1, c = 1.2;  // the default tangent coefficients
+  for (int k = 0; k <= 8; ++k)
+    EXPECT_LT(glm::length(at(sk, 0, size_t(k)) - hermite(a, c * len * ha, b, c * len * hb, k / 8.0)), 1e-12) << k;
+  // Tangent at both ends: the first piece leaves along +y, the last arrives along +x.
+  const Skeleton fine = skeleton_of(cpfg("@Gs-(45)f(1)-(45)@Ge(200)"));
+  const glm::dvec3 first = glm::normalize(at(fine, 0, 1) - at(fine, 0, 0));
+  const glm::dvec3 last = glm::normalize(at(fine, 0, 200) - at(fine, 0, 199));
+  EXPECT_GT(glm::dot(first, ha), std::cos(std::numbers::pi / 180));
+  EXPECT_GT(glm::dot(last, hb), std::cos(std::numbers::pi / 180));
+  for (const Joint& j : sk.joints) EXPECT_EQ(j.radius_m, sk.joints[0].radius_m);  // one width
+}
+
+TEST(TurtleCpfg, GtScalesTheTangentsAndWidthsChangeLinearlyBetweenControlPoints) {
+  // The farthest point from the chord bulges more with longer tangents.
+  auto bulge = [](const std::string& axiom) {  // the farthest joint from the chord
+    const Skeleton sk = skeleton_of(cpfg(axiom));
+    const glm::dvec3 a = at(sk, 0, 0), chord = glm::normalize(at(sk, 0, sk.joints.size() - 1) - a);
+    double most = 0;
+    for (size_t k = 0; k < sk.joints.size(); ++k) {
+      const glm::dvec3 d = at(sk, 0, k) - a;
+      most = std::max(most, glm::length(d - glm::dot(d, chord) * chord));
+    }
+    return most;
+  };
+  // The curve leaves 30° left of its chord and arrives 30° left of it: an S-free arc.
+  const double plain = bulge("+(30)@Gs-(30)f(1)-(30)@Ge(32)");
+  const double longer = bulge("+(30)@Gs-(30)f(1)-(30)@Gt(3,3)@Ge(32)");
+  EXPECT_GT(plain, 0.01);
+  EXPECT_GT(longer, 1.5 * plain);
+  // #(w) between the control points: the radius goes linearly from one width to the next.
+  const Skeleton sk = skeleton_of(cpfg("#(2)@Gs f(1) #(6) @Ge(4)"));
+  ASSERT_EQ(sk.joints.size(), 5u);
+  const double r0 = sk.joints[0].radius_m, r4 = sk.joints[4].radius_m;
+  EXPECT_NEAR(r4, 3 * r0, 1e-12);
+  for (int k = 0; k <= 4; ++k) EXPECT_NEAR(sk.joints[size_t(k)].radius_m, r0 + (r4 - r0) * k / 4.0, 1e-12) << k;
+}
+
+TEST(TurtleCpfg, ControlPointsComeFromGcDotAndFromEveryFAndfInsideABraceWithAType) {
+  // @Gc(strips) and .(strips) each add a control point; the pieces have their strips.
+  const Skeleton gc = skeleton_of(cpfg("@Gs f(1) @Gc(3) f(1) .(2) f(1) @Ge(5)"));
+  ASSERT_EQ(gc.chains.size(), 1u);
+  EXPECT_EQ(gc.chains[0].joint_count, 1u + 3 + 2 + 5);
+  EXPECT_TRUE(near(position_at(gc, 0, 3), {0, 1, 0}));
+  EXPECT_TRUE(near(position_at(gc, 0, 5), {0, 2, 0}));
+  EXPECT_TRUE(near(position_at(gc, 0, 10), {0, 3, 0}));
+  // {(1) ... }(1): f and F set the points (4 strips each, cpfg's default); F also draws its
+  // own segment, as in cpfg, so there are two chains.
+  const Skeleton brace = skeleton_of(cpfg("{(1)f(1)F(1)f(1)}(1)"));
+  ASSERT_EQ(brace.chains.size(), 2u);
+  EXPECT_EQ(brace.chains[0].joint_count, 2u);  // F's own segment
+  EXPECT_EQ(brace.chains[1].joint_count, 1u + 4 + 4);
+  EXPECT_TRUE(near(position_at(brace, 1, 0), {0, 1, 0}));
+  EXPECT_TRUE(near(position_at(brace, 1, 8), {0, 3, 0}));
+}
+
+TEST(TurtleCpfg, BSplineCylindersFollowTheUniformCubicBasisAndClosedCurvesEndWhereTheyBegan) {
+  // {(3): an open B-spline over the points f sets; it starts at (c0 + 4 c1 + c2) / 6.
+  const Skeleton open = skeleton_of(cpfg("{(3,2)f(1)+(90)f(1)+(90)f(1)-(90)f(1)}(3)"));
+  ASSERT_EQ(open.chains.size(), 1u);
+  // c0 = (0,1), c1 = (-1,1), c2 = (-1,0), c3 = (-2,0) (+ turns toward -x): one piece.
+  const glm::dvec3 c0(0, 1, 0), c1(-1, 1, 0), c2(-1, 0, 0), c3(-2, 0, 0);
+  ASSERT_EQ(open.chains[0].joint_count, 3u);
+  EXPECT_LT(glm::length(at(open, 0, 0) - (c0 + 4.0 * c1 + c2) / 6.0), 1e-12);
+  EXPECT_LT(glm::length(at(open, 0, 2) - (c1 + 4.0 * c2 + c3) / 6.0), 1e-12);
+  // {(2): a closed Hermite curve around a square comes back to its first point.
+  const Skeleton loop = skeleton_of(cpfg("{(2)f(1)+(90)f(1)+(90)f(1)+(90)f(1)+(90)}(2)"));
+  ASSERT_EQ(loop.chains.size(), 1u);
+  EXPECT_LT(glm::length(at(loop, 0, loop.chains[0].joint_count - 1) - at(loop, 0, 0)), 1e-12);
+  // {(4): the closed B-spline too.
+  const Skeleton ring = skeleton_of(cpfg("{(4)f(1)+(90)f(1)+(90)f(1)+(90)f(1)+(90)}(4)"));
+  ASSERT_EQ(ring.chains.size(), 1u);
+  EXPECT_LT(glm::length(at(ring, 0, ring.chains[0].joint_count - 1) - at(ring, 0, 0)), 1e-12);
+}
+
+TEST(TurtleCpfg, ABranchDrawsOnACopyOfTheOpenCylinderFromItsLastPoint) {
+  // [ gives the branch the cylinder as it stands (cpfg's spline stack): the branch's piece
+  // leaves from the last control point as a lateral of the cylinder's chain.
+  const Skeleton sk = skeleton_of(cpfg("@Gs f(1) @Gc(2) [+(45) f(1) @Ge(2)] -(45) f(1) @Ge(2)"));
+  ASSERT_EQ(sk.chains.size(), 2u);
+  EXPECT_EQ(sk.chains[0].joint_count, 1u + 2 + 2);
+  ASSERT_TRUE(sk.chains[1].parent);
+  EXPECT_EQ(*sk.chains[1].parent, (ChainParent{0, 2}));
+  EXPECT_TRUE(near(position_at(sk, 1, 0), {0, 1, 0}));
+  EXPECT_EQ(sk.chains[1].joint_count, 1u + 2);
+  // @! sets cpfg's polygons around (frusta are round: nothing changes); @#(0) is the circle.
+  const Skeleton plain = skeleton_of(cpfg("@Gs f(1) @Ge(4)"));
+  const Skeleton sides = skeleton_of(cpfg("@!(12)@#(0)@Gs f(1) @Ge(4)"));
+  EXPECT_EQ(plain.joints, sides.joints);
+  EXPECT_NE(grow_error(cpfg("{(5)f}(5)")).find("type must be 1 to 4"), std::string::npos);
+  EXPECT_NE(grow_error(cpfg("f}(1)")).find("without an open generalized cylinder"), std::string::npos);
+}
+
+// The manual's generalized-cylinder object (vlab's GeneralizedCylinder/fractal.l, written
+// again here): a Koch-like curve of control points drawn as one cylinder.
+TEST(TurtleCpfg, TheManualsFractalCylinderGrowsAsOneChain) {
+  const std::string text =
+      "#define STEPS 2\n#define WID 0.8\n#define TANG 1.2\n#define NR 10\n#define SEC 50\n"
+      "Lsystem: 1\nderivation length: STEPS\n"
+      "Axiom: #(WID) @!(SEC) @Gt(TANG,1.5) @Gs X--f--X--f-- @Ge(NR)\n"
+      "X --> X+f+X--f--X+f+X\nhomomorphism\nX --> @Gc(NR)\nendlsystem\n";
+  const Skeleton sk = skeleton_of(text);
+  ASSERT_EQ(sk.chains.size(), 1u);
+  // 2 steps: X becomes 16 X's and 4 more f's... every X is a control point: 2 · 16 points,
+  // plus @Gs's, NR strips between each.
+  EXPECT_GT(sk.chains[0].joint_count, 100u);
+  EXPECT_EQ((sk.chains[0].joint_count - 1) % 10, 0u);
 }
 
 }  // namespace
