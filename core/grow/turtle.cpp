@@ -491,7 +491,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
     if (!std::isfinite(p[0]) || p[0] > kMaxCylinderStrips)
       throw TurtleFailure{"a generalized cylinder's strips must be finite and at most " +
                           std::to_string(kMaxCylinderStrips)};
-    return std::max(1, static_cast<int>(p[0]));
+    return p[0] < 1 ? 1 : static_cast<int>(p[0]);  // below 1: 1, as cpfg clamps
   };
   // The turtle's open cylinder leaves the pool when it is the pool's last entry and this
   // branch's own (a finished or replaced one): sequences of cylinders do not pile up.

@@ -1118,6 +1118,8 @@ TEST(TurtleCpfg, ABranchDrawsOnACopyOfTheOpenCylinderFromItsLastPoint) {
   const Skeleton sides = skeleton_of(cpfg("@!(12)@#(0)@Gs f(1) @Ge(4)"));
   EXPECT_EQ(plain.joints, sides.joints);
   EXPECT_NE(grow_error(cpfg("{(5)f}(5)")).find("type must be 1 to 4"), std::string::npos);
+  EXPECT_NE(grow_error(cpfg("@Gs f @Ge(1e9)")).find("at most 10000"), std::string::npos);
+  EXPECT_EQ(skeleton_of(cpfg("@Gs f(1) @Ge(-1e300)")).joints.size(), 2u) << "strips below 1 are 1";
   EXPECT_NE(grow_error(cpfg("f}(1)")).find("without an open generalized cylinder"), std::string::npos);
 }
 
