@@ -8,6 +8,7 @@
 // would shrink and break that.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -98,6 +99,33 @@ TEST(GrowthTween, NewLeavesGrowAboutTheirJointAndTheOldOnesStay) {
     EXPECT_GT(a, last);
     last = a;
   }
+}
+
+TEST(GrowthTween, TheElmInLeafsTrunkThickensWhileTheCrownGrows) {
+  // Secondary growth (presets/elm_in_leaf.lsys W(r, a)): the trunk's first internode is
+  // NEW_WOOD = 0.45 of its full radius R_TRUNK·0.8 when it is made (step 1) and gains
+  // 0.55/THICKEN of it every step until THICKEN = 20 steps old; a grammar that sets the
+  // radius once (elm.lsys) keeps it from step 1 on.
+  const double full = 0.42 * 0.8;
+  double last = 0;
+  for (int64_t n = 1; n <= 28; ++n) {
+    const Skeleton s = grown("elm_in_leaf.lsys", n);
+    ASSERT_FALSE(s.chains.empty()) << n;
+    const double r = s.joints[s.chains[0].first_joint + 1].radius_m;
+    const double age = double(n - 1);
+    EXPECT_NEAR(r, full * (0.45 + 0.55 * std::min(1.0, age / 20)), 1e-12) << "step " << n;
+    if (n <= 21) {
+      EXPECT_GT(r, last) << "step " << n;
+    }
+    last = r;
+  }
+  // Between two steps the tween thickens the old wood linearly as well.
+  const Skeleton before = grown("elm_in_leaf.lsys", 8), after = grown("elm_in_leaf.lsys", 9);
+  const double rb = before.joints[1].radius_m, ra = after.joints[1].radius_m;
+  ASSERT_GT(ra, rb);
+  EXPECT_NEAR(tween_growth(before, after, 0.25).joints[1].radius_m, rb + 0.25 * (ra - rb), 1e-12);
+  const Skeleton elm1 = grown("elm.lsys", 4), elm2 = grown("elm.lsys", 20);
+  EXPECT_EQ(elm1.joints[1].radius_m, elm2.joints[1].radius_m);
 }
 
 TEST(GrowthTween, AChainThatIsNotTheOldOnesGrowsOutOfWhereItStarts) {
