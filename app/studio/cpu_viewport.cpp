@@ -102,7 +102,7 @@ void CpuViewport::run() {
       {
         std::lock_guard<std::mutex> lock(sh.mutex);
         if (last) sh.working = false;
-        if (plants && (new_plants || picture)) {
+        if (plants && (new_plants || picture || !error.empty())) {  // an error of a new view too
           sh.built_version = plants->version;
           sh.error = error;
           if (frusta) sh.frusta = frusta;

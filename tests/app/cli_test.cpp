@@ -137,6 +137,11 @@ const std::vector<UsageCase>& usage_cases() {
       // '..' undoes the folder the placeholder names: three seeds onto one file (issue 32).
       {"GrowSeedsFoldedOntoOneFile", {"grow", "{G}", "--seed", "1..3", "-o", "out/{seed}/../same.skel.json"}},
       {"ExportSeedsFoldedOntoOneFile", {"export", "{G}", "--seed", "1..3", "-o", "{seed}/../same.glb"}},
+      // The backend flag is one table for render and studio: a bad value is a usage
+      // error before any window or context is made.
+      {"RenderBackendUnknown", {"render", "{G}", "--backend", "BAD", "-o", "x.png"}},
+      {"StudioBackendUnknown", {"studio", "{G}", "--backend", "BAD"}},
+      {"StudioBackendEmpty", {"studio", "{G}", "--backend", ""}},
       {"FramesFoldedOntoOneFile",
        {"render", "{G}", "--frames", "1..3", "-o", "f/{frame}/../same.png", "--width", "8", "--height", "8"}},
   };

@@ -213,5 +213,27 @@ TEST_F(Viewports, TheCpuViewportShowsTheNewestPlantsAndSaysWhyAnEmptyOneIsNotDra
   EXPECT_EQ(viewport.stats().error, "the plant has no segments or leaves");
 }
 
+TEST_F(Viewports, TheCpuViewportSaysWhyAViewOfPlantsItHadShownCannotBeDrawn) {
+  CpuViewport viewport({}, "test", 1e9);
+  Scene scene = saguaro(96, 64);
+  viewport.set_plants(scene, RenderOptions{});
+  ASSERT_TRUE(settle(viewport, scene).texture);
+  ASSERT_TRUE(viewport.stats().error.empty()) << viewport.stats().error;
+  // The same plants under a new view whose materials name an image that is not there:
+  // render_cpu throws, and the viewport says so instead of keeping the old picture mute.
+  Scene broken = scene;
+  broken.camera.eye.x += 0.3;
+  SceneMaterial wood;
+  wood.albedo_image = "/nonexistent/sylva/bark.png";
+  wood.segment_repeat = SegmentRepeat{};
+  broken.materials[0] = wood;
+  settle(viewport, broken);
+  EXPECT_NE(viewport.stats().error.find("bark.png"), std::string::npos) << viewport.stats().error;
+  // A view that can be drawn again clears it.
+  scene.camera.eye.x -= 0.3;
+  settle(viewport, scene);
+  EXPECT_TRUE(viewport.stats().error.empty()) << viewport.stats().error;
+}
+
 }  // namespace
 }  // namespace sylva::studio
