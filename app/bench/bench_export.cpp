@@ -82,8 +82,9 @@ std::string level_triangles(const Skeleton& sk, uint32_t lod) {
     return tessellate(skin_skeleton(s), options).triangle_count() + leaves.triangle_count();
   };
   std::string out = std::to_string(count(sk, 8));
+  const std::vector<Skeleton> levels = lod > 1 ? lod_skeletons(sk, lod - 1, 8) : std::vector<Skeleton>();
   for (uint32_t level = 1; level < lod; ++level)
-    out += "/" + std::to_string(count(lod_skeleton(sk, level, 8), lod_columns(8, level)));
+    out += "/" + std::to_string(count(levels[level - 1], lod_columns(8, level)));
   if (lod > 0) out += "/4";
   return out;
 }

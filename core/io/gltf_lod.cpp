@@ -29,8 +29,10 @@ glm::dvec3 newell(const Leaf& leaf) {
 
 double leaf_area(const Leaf& leaf) { return 0.5 * glm::length(newell(leaf)); }
 
-// Which chains level `level` keeps (lod_skeleton's rule).
-std::vector<bool> kept_chains(const Skeleton& sk, uint32_t level, int level0_columns) {
+// Which chains each level 1 … `levels` keeps (lod_skeleton's rule): one skin, and one
+// tessellation per level for the chains' costs.
+std::vector<std::vector<bool>> kept_chains(const Skeleton& sk, uint32_t levels, int level0_columns,
+                                           const SkinOptions& skin) {
   const size_t chains = sk.chains.size();
   std::vector<double> size(chains, 0);
   for (size_t c = 0; c < chains; ++c) {
@@ -46,7 +48,7 @@ std::vector<bool> kept_chains(const Skeleton& sk, uint32_t level, int level0_col
   });
   // A chain's cost at a level: the triangles of its frusta (collars, rounded bends, domes
   // and caps included) tessellated with that level's columns.
-  const SkinnedSkeleton skinned = skin_skeleton(sk);
+  const SkinnedSkeleton skinned = skin_skeleton(sk, skin);
   auto chain_triangles = [&](int columns) {
     TessellateOptions options;
     options.segments_around = columns;
@@ -58,7 +60,8 @@ std::vector<bool> kept_chains(const Skeleton& sk, uint32_t level, int level0_col
   const std::vector<double> level0 = chain_triangles(level0_columns);
   double estimate = std::accumulate(level0.begin(), level0.end(), 0.0);
   std::vector<bool> kept(chains, true);
-  for (uint32_t k = 1; k <= level; ++k) {
+  std::vector<std::vector<bool>> out;
+  for (uint32_t k = 1; k <= levels; ++k) {
     const double target = estimate / 4;
     const std::vector<double> cost_of = chain_triangles(lod_columns(level0_columns, k));
     std::vector<bool> next(chains, false);
@@ -71,9 +74,10 @@ std::vector<bool> kept_chains(const Skeleton& sk, uint32_t level, int level0_col
       used += cost;
     }
     kept = std::move(next);
+    out.push_back(kept);
     estimate = used;
   }
-  return kept;
+  return out;
 }
 
 }  // namespace
@@ -84,8 +88,10 @@ int lod_columns(int level0_columns, uint32_t level) {
   return columns;
 }
 
-Skeleton lod_skeleton(const Skeleton& sk, uint32_t level, int level0_columns) {
-  const std::vector<bool> kept = kept_chains(sk, level, level0_columns);
+namespace {
+
+// `sk` with only the chains `kept` keeps, and its leaves merged for `level`.
+Skeleton coarsened(const Skeleton& sk, uint32_t level, const std::vector<bool>& kept) {
   Skeleton out;
   out.source = sk.source;
   out.chains = sk.chains;
@@ -130,6 +136,21 @@ Skeleton lod_skeleton(const Skeleton& sk, uint32_t level, int level0_columns) {
     out.leaves.push_back(std::move(leaf));
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<Skeleton> lod_skeletons(const Skeleton& sk, uint32_t levels, int level0_columns, const SkinOptions& skin) {
+  const std::vector<std::vector<bool>> kept = kept_chains(sk, levels, level0_columns, skin);
+  std::vector<Skeleton> out;
+  out.reserve(levels);
+  for (uint32_t k = 1; k <= levels; ++k) out.push_back(coarsened(sk, k, kept[k - 1]));
+  return out;
+}
+
+Skeleton lod_skeleton(const Skeleton& sk, uint32_t level, int level0_columns, const SkinOptions& skin) {
+  if (level == 0) return coarsened(sk, 0, std::vector<bool>(sk.chains.size(), true));
+  return coarsened(sk, level, kept_chains(sk, level, level0_columns, skin).back());
 }
 
 std::optional<std::vector<ImpostorCard>> impostor_cards(const Skeleton& sk) {

@@ -29,14 +29,22 @@
 #include <glm/vec3.hpp>
 
 #include "core/geometry/skeleton.h"
+#include "core/geometry/skin.h"
 
 namespace sylva {
 
 inline constexpr uint32_t kMaxLodLevels = 6;  // `--lod N`: N from 1 to this
 
 // Level k (1 ≤ k) of `skeleton` re-meshed at `columns` around (the columns of level k,
-// lod_columns), as above.
-Skeleton lod_skeleton(const Skeleton& skeleton, uint32_t level, int level0_columns);
+// lod_columns), as above; the chains' costs are those of `skin` (the plant's own skin:
+// smooth or paper, SkinOptions::styled).
+Skeleton lod_skeleton(const Skeleton& skeleton, uint32_t level, int level0_columns, const SkinOptions& skin = {});
+
+// Levels 1 … `levels` at once (element k − 1 is level k, equal to lod_skeleton's): one skin
+// and one tessellation a level, where calling lod_skeleton for each level would tessellate
+// levels(levels + 1)/2 times.
+std::vector<Skeleton> lod_skeletons(const Skeleton& skeleton, uint32_t levels, int level0_columns,
+                                    const SkinOptions& skin = {});
 
 // The columns around of level k: level0_columns halved k times, at least 3.
 int lod_columns(int level0_columns, uint32_t level);

@@ -1356,6 +1356,7 @@ Status add_plant_group(GltfDocument& doc, const std::vector<GltfPlant>& plants, 
   // The surfaces drawn by nodes of their own: the skinned mesh, or the levels of detail.
   std::vector<std::pair<std::string, MeshPrimitives>> surfaces;
   if (options.mesh && options.lod > 0) {
+    const std::vector<Skeleton> coarse_levels = lod_skeletons(sk, options.lod - 1, options.segments_around, skin_options);
     for (uint32_t level = 0; level <= options.lod; ++level) {
       MeshPrimitives& level_primitives =
           surfaces.emplace_back(plant.name + "_LOD" + std::to_string(level), MeshPrimitives{}).second;
@@ -1370,7 +1371,7 @@ Status add_plant_group(GltfDocument& doc, const std::vector<GltfPlant>& plants, 
       } else {
         GltfExportOptions level_options = options;
         level_options.segments_around = lod_columns(options.segments_around, level);
-        const Skeleton coarse = lod_skeleton(sk, level, options.segments_around);
+        const Skeleton& coarse = coarse_levels[level - 1];
         if (Status added = add_surface(coarse, skin_skeleton(coarse, skin_options), plant.bark, level_options, weights,
                                        wind, doc, level_primitives);
             !added)

@@ -86,6 +86,31 @@ TEST(GltfLod, EachLevelIsAValidSkeletonWithAboutAQuarterOfTheTrianglesBefore) {
   }
 }
 
+TEST(GltfLod, AllLevelsAtOnceAreTheLevelsOneByOneAndThePlantsSkinCounts) {
+  // lod_skeletons (the export's: one skin, one tessellation a level) gives each level
+  // exactly as lod_skeleton does; level 0 is the plant itself.
+  const Skeleton sk = test::grow_preset("elm");
+  const std::vector<Skeleton> all = lod_skeletons(sk, 3, 8);
+  ASSERT_EQ(all.size(), 3u);
+  for (uint32_t level = 1; level <= 3; ++level) EXPECT_EQ(all[level - 1], lod_skeleton(sk, level, 8)) << level;
+  EXPECT_EQ(lod_skeleton(sk, 0, 8).chains, sk.chains);
+  EXPECT_TRUE(lod_skeletons(sk, 0, 8).empty());
+  // The chains' costs are the plant's own skin's: the paper skin (no collars, domes or
+  // rounded bends: fewer frusta) keeps at least as many chains within the same budget.
+  const SkinOptions paper = SkinOptions::paper();
+  auto kept = [](const Skeleton& s) {
+    size_t n = 0;
+    for (const Chain& c : s.chains) n += c.joint_count > 1;
+    return n;
+  };
+  const std::vector<Skeleton> as_paper = lod_skeletons(sk, 3, 8, paper);
+  for (uint32_t level = 1; level <= 3; ++level) {
+    EXPECT_EQ(as_paper[level - 1], lod_skeleton(sk, level, 8, paper)) << level;
+    EXPECT_TRUE(validate_skeleton(as_paper[level - 1]).ok()) << level;
+  }
+  EXPECT_NE(kept(as_paper[0]), kept(all[0])) << "the skin changes the estimate";
+}
+
 TEST(GltfLod, ColumnsHalveDownToThree) {
   EXPECT_EQ(lod_columns(8, 0), 8);
   EXPECT_EQ(lod_columns(8, 1), 4);
