@@ -77,7 +77,11 @@ std::vector<LogicalLine> physical_to_logical(const std::string& text, uint32_t f
     const bool backslash = keep > 0 && phys[keep - 1] == '\\' && !last;
     const bool in_comment = line_no <= joined.size() && joined[line_no - 1] && !last;
     current.pieces.push_back({current.text.size(), line_no, 1, file});
-    current.text.append(phys.substr(0, backslash ? keep - 1 : phys.size()));
+    // A doubled backslash before the newline (`#define f(x) \\`, as vlab's models write
+    // it) joins too; cpp would leave the first one, which cpfg's reader skips.
+    size_t cut = backslash ? keep - 1 : phys.size();
+    if (backslash && cut > 0 && phys[cut - 1] == '\\') --cut;
+    current.text.append(phys.substr(0, cut));
     if (in_comment) current.text += ' ';
     if (!backslash && !in_comment) {
       lines.push_back(std::move(current));
@@ -107,6 +111,7 @@ void append_source(LogicalLine& out, const LogicalLine& in, size_t a, size_t b) 
 
 struct Macro {
   bool function_like = false;
+  bool predefined = false;  // ParseOptions::predefined_macros: a #define may replace it
   std::vector<std::string> params;
   std::string body;
   SourceLoc loc;
@@ -127,6 +132,12 @@ class Preprocessor {
     std::error_code ec;
     std::filesystem::path main = std::filesystem::weakly_canonical(main_file_, ec);
     if (ec) main.clear();
+    for (const auto& [name, body] : options_.predefined_macros) {
+      Macro m;
+      m.body = body;
+      m.predefined = true;
+      macros_[name] = std::move(m);
+    }
     process(text, 0, main);
     for (const auto& [name, value] : options_.define_overrides)
       if (!overridable_.count(name)) fail({0, 0}, "-D " + name + ": the grammar has no '#define " + name + " <number>'");
@@ -140,18 +151,34 @@ class Preprocessor {
     std::vector<uint8_t> joined;
     const std::string clean = blank_comments(text, file, joined);
     const size_t conditions_before = conditions_.size();
+    // Whether the line cpp would write before this one is blank (a directive, a line of a
+    // group left out and a blank line are; a file's first line follows a line marker).
+    bool after_blank = true;
     for (const LogicalLine& line : physical_to_logical(clean, file, joined)) {
       size_t i = 0;
       while (i < line.text.size() && is_space(line.text[i])) ++i;
-      if (i < line.text.size() && line.text[i] == '#') {
+      // A `#` followed by a name (or nothing: the null directive) starts a directive; one
+      // followed by anything else is the model's line-width module at the start of a line
+      // (`\t#(0.06) f(0.1)`, a successor going on), which cpfg's preprocessing keeps.
+      size_t after_hash = i + 1;
+      while (after_hash < line.text.size() && is_space(line.text[after_hash])) ++after_hash;
+      const bool directive_line = i < line.text.size() && line.text[i] == '#' &&
+                                  (after_hash == line.text.size() || is_ident_start(line.text[after_hash]));
+      if (directive_line) {
         directive(line, i + 1);
+        after_blank = true;
         continue;
       }
-      if (!active()) continue;
+      if (!active()) {
+        after_blank = true;
+        continue;
+      }
       LogicalLine expanded;
       expand_line(line, expanded);
       bool blank = true;
       for (char c : expanded.text) blank = blank && is_space(c);
+      expanded.continues_previous = !blank && !after_blank && !line.text.empty() && line.text[0] == '\t';
+      after_blank = blank;
       if (!blank) out_.lines.push_back(std::move(expanded));
     }
     if (conditions_.size() > conditions_before)
@@ -258,7 +285,8 @@ class Preprocessor {
     }
     while (p < end && is_space(t[p])) ++p;
     m.body = t.substr(p, end - p);
-    if (auto it = macros_.find(name); it != macros_.end() && (it->second.body != m.body || it->second.params != m.params))
+    if (auto it = macros_.find(name);
+        it != macros_.end() && !it->second.predefined && (it->second.body != m.body || it->second.params != m.params))
       fail(loc, "'" + name + "' is defined twice (first at line " + std::to_string(it->second.loc.line) + ")");
     if (!m.function_like) number_define(name, m, line.loc(p));
     macros_[name] = std::move(m);
@@ -631,6 +659,7 @@ class Preprocessor {
 
 bool is_cpfg_text(std::string_view text) {
   bool in_comment = false;
+  bool in_directive = false;  // the lines a preprocessor line's trailing `\` joins to it
   size_t pos = 0;
   if (text.substr(0, 3) == "\xEF\xBB\xBF") pos = 3;
   while (pos < text.size()) {
@@ -654,7 +683,14 @@ bool is_cpfg_text(std::string_view text) {
     }
     size_t i = 0;
     while (i < kept.size() && is_space(kept[i])) ++i;
-    if (i == kept.size() || kept[i] == '#') continue;  // blank, comment or preprocessor line
+    size_t last = kept.size();
+    while (last > 0 && is_space(kept[last - 1])) --last;
+    const bool joins_next = last > 0 && kept[last - 1] == '\\';
+    if (in_directive || (i < kept.size() && kept[i] == '#')) {
+      in_directive = joins_next;  // a preprocessor line, or one its `\` carried on
+      continue;
+    }
+    if (i == kept.size()) continue;  // blank or comment
     std::string head = lower_ascii(std::string_view(kept).substr(i, 7));
     if (head != "lsystem") return false;
     i += 7;

@@ -67,7 +67,7 @@ class Rewriter {
       if (by_symbol_[s].empty()) continue;
       const Production& p = productions_[by_symbol_[s][0]];
       if (!p.has_context() && p.condition.kind == Expr::Kind::kNone && !p.has_statements() &&
-          p.probability.kind == Expr::Kind::kNone && p.successor.all_constant)
+          p.probability.kind == Expr::Kind::kNone && p.successor.all_constant && p.predecessor_tail.empty())
         direct_[s] = &p;
     }
     for (const std::vector<uint32_t>& rules : by_symbol_)
@@ -118,6 +118,7 @@ class Rewriter {
       } else {
         apply(*chosen, i, rng, keyed);
         if (active_out) active_out->resize(out.size(), 1);
+        i += chosen->predecessor_tail.size();  // a cpfg predecessor's further modules are rewritten too
       }
       if (uses_new_left_) extend_left_tables(out);
     }
@@ -530,6 +531,14 @@ class Rewriter {
   // the predecessor's place in a forward pass, after it in a backward one; it never wraps.
   bool matches(const Production& p, size_t i, const Module& m) {
     bind(p.predecessor, in_->params_of(m));
+    // A cpfg predecessor's further modules: the very next ones, same symbol and count.
+    for (size_t k = 0; k < p.predecessor_tail.size(); ++k) {
+      const PatternModule& pm = p.predecessor_tail[k];
+      if (i + 1 + k >= in_->size()) return false;
+      const Module& next = in_->modules[i + 1 + k];
+      if (next.symbol != pm.symbol || next.param_count != pm.arity) return false;
+      bind(pm, in_->params_of(next));
+    }
     if (!p.left_context.empty()) {
       const bool ok = p.new_left ? match_left(p.left_context, *out_, new_skip_left_, out_->size(), false)
                                  : match_left(p.left_context, *in_, skip_left_, i, g_.ring);
@@ -545,7 +554,7 @@ class Rewriter {
               : match_right(p.right_context,
                             RightView{in_, &match_, &skip_ignored_, &skip_right_, &branch_end_, in_->size(), false,
                                       g_.ring},
-                            i + 1);
+                            i + 1 + p.predecessor_tail.size());
       if (!ok) return false;
     }
     return true;
@@ -581,7 +590,9 @@ class Rewriter {
       candidates_.push_back({&p, w});
       total += w;
     }
-    if (!arity_seen) {
+    // A module no production of its symbol takes with its parameter count: an error in
+    // sylva's format; in a cpfg file no match, as cpfg's PredDiff compares the counts.
+    if (!arity_seen && !g_.cpfg) {
       const Production& p = productions_[rules[0]];
       current_production = &p;
       throw DeriveFailure{p.loc, "parameter count: module has " + std::to_string(m.param_count) +
@@ -920,7 +931,7 @@ Status Derivation::start() {
     try {
       for (const SuccessorModule& sm : g.axiom_successor->modules)
         for (uint16_t a = 0; a < sm.arg_count; ++a)
-          m.cur.params[k++] = g.program.eval(g.axiom_successor->args[sm.first_arg + a], nullptr, &rng);
+          m.cur.params[k++] = g.program.eval(g.axiom_successor->args[sm.first_arg + a], nullptr, &rng, &m.context);
     } catch (const EvalError& e) {
       return g.error_at(e.loc, e.message + " (in the axiom)");
     }

@@ -12,6 +12,109 @@ namespace sylva::lsys {
 
 namespace {
 
+void print_to_stderr(std::string_view text) { std::fwrite(text.data(), 1, text.size(), stderr); }
+PrintSink print_sink_ = print_to_stderr;
+
+// One conversion of a printf format: [flags][width][.precision][length]conversion.
+struct Conversion {
+  size_t end = 0;        // one past it
+  std::string spec;      // "%-8.3" without length modifiers or the conversion
+  char conversion = 0;
+};
+
+// The conversion starting at format[i] == '%' (not "%%"); conversion 0 with an error.
+Conversion parse_conversion(std::string_view format, size_t i, std::string* error) {
+  Conversion c;
+  size_t k = i + 1;
+  c.spec = "%";
+  while (k < format.size() && std::strchr("-+ #0", format[k])) c.spec += format[k++];
+  while (k < format.size() && format[k] >= '0' && format[k] <= '9') c.spec += format[k++];
+  if (k < format.size() && format[k] == '.') {
+    c.spec += format[k++];
+    while (k < format.size() && format[k] >= '0' && format[k] <= '9') c.spec += format[k++];
+  }
+  while (k < format.size() && std::strchr("hlLqjzt", format[k])) ++k;  // a double is printed either way
+  if (k >= format.size()) {
+    *error = "a '%' at the end of the format";
+    return c;
+  }
+  if (c.spec.size() > 12) {
+    *error = "a conversion's width or precision is too long";
+    return c;
+  }
+  const char conv = format[k];
+  if (!std::strchr("diuoxXceEfFgG", conv)) {
+    *error = conv == 's' ? "printf's %s: sylva's values are numbers, it has no strings"
+                         : conv == '*' ? "printf's '*' width: give the width in the format"
+                                       : std::string("printf's %") + conv + " is not a conversion sylva can print";
+    return c;
+  }
+  c.conversion = conv;
+  c.end = k + 1;
+  return c;
+}
+
+}  // namespace
+
+PrintSink set_print_sink(PrintSink sink) {
+  PrintSink old = print_sink_;
+  print_sink_ = sink ? sink : print_to_stderr;
+  return old;
+}
+
+FormatCheck check_format(std::string_view format) {
+  FormatCheck out;
+  for (size_t i = 0; i < format.size(); ++i) {
+    if (format[i] != '%') continue;
+    if (i + 1 < format.size() && format[i + 1] == '%') {
+      ++i;
+      continue;
+    }
+    Conversion c = parse_conversion(format, i, &out.error);
+    if (!c.conversion) return out;
+    ++out.values;
+    i = c.end - 1;
+  }
+  return out;
+}
+
+std::string apply_format(std::string_view format, const double* values) {
+  std::string out;
+  char buffer[512];
+  std::string error;
+  for (size_t i = 0; i < format.size(); ++i) {
+    if (format[i] != '%') {
+      out += format[i];
+      continue;
+    }
+    if (i + 1 < format.size() && format[i + 1] == '%') {
+      out += '%';
+      ++i;
+      continue;
+    }
+    Conversion c = parse_conversion(format, i, &error);
+    if (!c.conversion) break;  // check_format refused it when it was compiled
+    const double v = *values++;
+    if (std::strchr("diuoxXc", c.conversion)) {
+      // C converts to an integer; a value beyond one prints as the nearest one.
+      const double clamped = std::isnan(v) ? 0.0 : std::clamp(v, -9.2e18, 9.2e18);
+      const auto n = static_cast<long long>(clamped);
+      const char conv = c.conversion == 'i' ? 'd' : c.conversion;
+      const std::string f = c.spec + (conv == 'c' ? "c" : std::string("ll") + conv);
+      if (conv == 'c') std::snprintf(buffer, sizeof buffer, f.c_str(), static_cast<int>(n & 0xFF));
+      else std::snprintf(buffer, sizeof buffer, f.c_str(), n);
+    } else {
+      const std::string f = c.spec + c.conversion;
+      std::snprintf(buffer, sizeof buffer, f.c_str(), v);
+    }
+    out += buffer;
+    i = c.end - 1;
+  }
+  return out;
+}
+
+namespace {
+
 const FuncInfo kFuncs[] = {
     {"sin", 1, false},   {"cos", 1, false},   {"tan", 1, false},   {"asin", 1, false},
     {"acos", 1, false},  {"atan", 1, false},  {"atan2", 2, false}, {"sqrt", 1, false},
@@ -20,6 +123,7 @@ const FuncInfo kFuncs[] = {
     {"clamp", 3, false}, {"rand", 0, true},   {"uniform", 2, true}, {"gauss", 2, true},
     {"fabs", 1, false},  {"trunc", 1, false}, {"sign", 1, false},  {"ran", 1, true},
     {"nran", 2, true},   {"bran", 2, true},   {"biran", 2, true},  {"srand", 1, true},
+    {"func", 2, false},
 };
 
 // The largest n biran(n, p) draws for (n uniform draws: bounded time, docs/cpfg.md).
@@ -125,6 +229,15 @@ double Program::run(const Expr& e, double* slots, Rng* rng, EvalContext* context
       case Op::kAdd: --sp; stack[sp - 1] = check(stack[sp - 1] + stack[sp]); break;
       case Op::kSub: --sp; stack[sp - 1] = check(stack[sp - 1] - stack[sp]); break;
       case Op::kMul: --sp; stack[sp - 1] = check(stack[sp - 1] * stack[sp]); break;
+      case Op::kRem: {
+        --sp;
+        // As cpfg's Eval: both made C ints (truncated toward zero), then C's remainder.
+        auto to_int = [](double v) { return std::isnan(v) ? 0LL : static_cast<long long>(std::clamp(v, -2147483648.0, 2147483647.0)); };
+        const long long a = to_int(stack[sp - 1]), d = to_int(stack[sp]);
+        if (d == 0) fail(locs[pc], "remainder by zero ('%' of a value whose whole part is 0)");
+        stack[sp - 1] = static_cast<double>(a % d);
+        break;
+      }
       case Op::kDiv:
         --sp;
         if (stack[sp] == 0.0) fail(locs[pc], "division by zero");
@@ -166,6 +279,13 @@ double Program::run(const Expr& e, double* slots, Rng* rng, EvalContext* context
         break;
       case Op::kPop: --sp; break;
       case Op::kDup: stack[sp] = stack[sp - 1]; ++sp; break;
+      case Op::kPrint: {
+        sp -= in.pad;
+        const std::string text = apply_format(formats[in.arg], stack + sp);
+        print_sink_(text);
+        stack[sp++] = 0.0;
+        break;
+      }
       case Op::kArrayIndex: {
         const ArrayInfo& a = arrays[in.arg];
         const size_t rank = a.dims.size();
@@ -242,6 +362,17 @@ double Program::run(const Expr& e, double* slots, Rng* rng, EvalContext* context
             *rng = Rng(mix_pair(seed, 0x5EEDULL));
             if (context) context->reseeded = true, context->reseed = seed;
             r = 0;
+            break;
+          }
+          case Func::kFunc: {
+            // func(id, x) (CPFG manual 5.5): the view file's function id, 1-based.
+            if (!(a[0] >= 1) || a[0] != std::floor(a[0]) || a[0] > static_cast<double>(functions.size()))
+              fail(locs[pc], "func(" + index_text(a[0]) + ", x): " +
+                                 (functions.empty() ? std::string("this model has no functions (a vlab object's view "
+                                                                  "file names them: 'function: file.func', docs/cpfg.md)")
+                                                    : "the function id is 1 to " + std::to_string(functions.size()) +
+                                                          " (the view file's functions, in order)"));
+            r = functions[static_cast<size_t>(a[0]) - 1].value(a[1]);
             break;
           }
           case Func::kBiran: {

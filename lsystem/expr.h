@@ -10,10 +10,12 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/util/diagnostic.h"
 #include "core/util/random.h"
+#include "lsystem/spline_function.h"
 
 namespace sylva::lsys {
 
@@ -39,6 +41,8 @@ enum class Op : uint8_t {
   kLoadAt,      // pop an index; push globals[index]
   kStoreAt,     // pop a value, pop an index; globals[index] = value
   kDup,         // push the top again
+  kPrint,       // cpfg's printf: pop `pad` values, write formats[arg] with them (print_sink); push 0
+  kRem,         // cpfg's %: pop b, pop a; push (int)a % (int)b, C's remainder
 };
 
 enum class Func : uint8_t {
@@ -46,7 +50,8 @@ enum class Func : uint8_t {
   kFloor, kCeil, kMin, kMax, kClamp, kRand, kUniform, kGauss,
   // The CPFG manual's chapter 5 (docs/cpfg.md): available in every grammar.
   kFabs, kTrunc, kSign, kRan, kNran, kBran, kBiran,
-  kSrand  // srand(s): restarts the random stream from s (EvalContext::reseed); returns 0
+  kSrand,  // srand(s): restarts the random stream from s (EvalContext::reseed); returns 0
+  kFunc    // func(id, x): the grammar's user-defined function id at x (Program::functions)
 };
 
 struct Instr {
@@ -104,6 +109,8 @@ struct Program {
   std::vector<double> consts;
   std::vector<SourceLoc> locs;  // parallel to code: the place of each operation
   std::vector<ArrayInfo> arrays;
+  std::vector<SplineFunction> functions;  // func(id, x)'s, id − 1 (a vlab object's view file)
+  std::vector<std::string> formats;       // printf's format strings (checked when compiled)
 
   // Evaluates `e` with formal parameters `slots` and random stream `rng` (only touched
   // by rand/uniform/gauss). Throws EvalError on division by zero or a non-finite result.
@@ -120,6 +127,22 @@ struct Program {
  private:
   double run(const Expr& e, double* slots, Rng* rng, EvalContext* context) const;
 };
+
+// Where cpfg's printf statements write (CPFG manual 3.2; docs/cpfg.md): standard error by
+// default (standard output carries `sylva derive`'s word). Tests replace it.
+using PrintSink = void (*)(std::string_view text);
+PrintSink set_print_sink(PrintSink sink);  // returns the one it replaces
+
+// A printf format string's conversions (%d %i %u %o %x %X %c %e %E %f %F %g %G with flags,
+// width and precision, and %%): how many values it takes, or an error message for one sylva
+// cannot print (%s, %*d, an unknown conversion).
+struct FormatCheck {
+  int values = 0;
+  std::string error;  // empty when the format is good
+};
+FormatCheck check_format(std::string_view format);
+// The format with `values` put in (check_format said it takes that many).
+std::string apply_format(std::string_view format, const double* values);
 
 // Trigonometry in degrees, exact at multiples of 90° (sin_deg(180) == 0, not 1.2e-16),
 // so ABOP's right-angle grammars give exact coordinates.

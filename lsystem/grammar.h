@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/util/diagnostic.h"
+#include "lsystem/cpfg_surface.h"
 #include "lsystem/expr.h"
 #include "lsystem/word.h"
 
@@ -48,6 +49,9 @@ struct Production {
   std::string label;        // "p1", or empty
   std::string text;         // the production as written (for messages)
   PatternModule predecessor;
+  // A cpfg file's strict predecessor of several modules (docs/cpfg.md): the modules after
+  // the first, matched in the word right after it, no module passed over; empty elsewhere.
+  std::vector<PatternModule> predecessor_tail;
   std::vector<PatternModule> left_context;   // in reading order
   std::vector<PatternModule> right_context;  // may contain [ and ]
   uint32_t slot_count = 0;                   // formal parameters in all patterns, then locals
@@ -73,6 +77,10 @@ struct ViewTropism {
   double angle_deg = 0;
   double elasticity = 0;  // E: the initial elasticity
   double step = 0;        // S: @Ti and @Td's step without a value
+  // A `torque:` line (CPFG manual 8.1.8): it twists the turtle about its heading, its up
+  // vector turned with the projection of `vector` (docs/cpfg.md), and does not bend it.
+  // Torques and tropisms share the ids, in the view file's order.
+  bool torque = false;
 };
 inline constexpr size_t kMaxViewTropisms = 8;
 
@@ -122,6 +130,20 @@ struct Grammar {
   std::shared_ptr<const std::string> text;   // the source, for caret lines
   // A cpfg model file (is_cpfg_text; docs/cpfg.md): the turtle reads cpfg's symbols.
   bool cpfg = false;
+  // A vlab object's predefined surfaces (its view file's `surface:` lines): `~X` draws them.
+  std::vector<CpfgSurface> surfaces;
+  // A vlab object whose environmental program (`cpfg -e file.e`) is vlab's honda81: its `?E`
+  // queries are answered by that program's rule (docs/cpfg.md "Environmental programs"), not
+  // by light. radius: the spec file's; three_d: its `3d case: on` (else x and z are
+  // compared); position_formats: the .e file's `turtle position:` conversions, which round
+  // the positions as cpfg writes them to a program it talks to through files or pipes (none
+  // through memory).
+  struct DensityField {
+    double radius = 0;
+    bool three_d = false;
+    std::vector<std::string> position_formats;
+  };
+  std::optional<DensityField> density_field;
   std::vector<IncludedFile> includes;        // SourceLoc::file k > 0 is includes[k - 1]
   // A cpfg file's global variables (assigned in its blocks) and its blocks (CPFG manual 4.1):
   // Start before the axiom, StartEach and EndEach around every step, End after the last.
@@ -183,6 +205,12 @@ struct ParseOptions {
   // -D overrides: replace the value of a #define. A name the grammar does not define
   // is an error (a typo must not be ignored silently).
   std::map<std::string, double> define_overrides;
+  // A vlab object's user-defined functions, from its view file's `function:` and `function
+  // set:` lines (docs/cpfg.md "Functions"): func(id, x) reads them (Program::functions).
+  std::vector<SplineFunction> functions;
+  // Object-like macros defined before a cpfg model is preprocessed, as cpfg passes cpp
+  // `-DNAME=id` for each function of a function set; the model may define them again.
+  std::vector<std::pair<std::string, std::string>> predefined_macros;
 };
 
 // Work done by parse_grammar on this thread, for the tests that hold docs/limits.md's

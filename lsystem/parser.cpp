@@ -81,7 +81,7 @@ using namespace detail;  // NOLINT: the parser is the detail's main user
 
 constexpr int kMaxNesting = 128;     // parentheses / unary operators / calls
 constexpr int64_t kMaxSteps = 1000000;
-constexpr int kMaxDepthLimit = 1000;
+constexpr int kMaxDepthLimit = 100000;
 constexpr size_t kMaxPasses = 255;  // derive.cpp keys a pass's random streams by its index below 256
 
 std::string quote_char(char c) {
@@ -205,7 +205,7 @@ using Scope = std::unordered_map<std::string, uint32_t>;
 
 class Parser {
  public:
-  Parser(Grammar& g, const ParseOptions& options) : g_(g), options_(options) {}
+  Parser(Grammar& g, const ParseOptions& options) : g_(g), options_(options) { g_.program.functions = options.functions; }
 
   void parse(const std::string& text);
   Word parse_word_line(const LogicalLine& line);
@@ -290,6 +290,7 @@ class Parser {
   std::unordered_map<std::string, uint32_t> global_index_;  // cpfg: global variables by name
   std::unordered_map<std::string, uint32_t> array_index_;   // cpfg: arrays by name (Program::arrays)
   void define_arrays(Cursor value);
+  void parse_printf(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc loc);
   void parse_array_element(Cursor& c, ExprBuild& b, const Scope* scope, uint32_t array, SourceLoc loc);
   bool globals_visible_ = false;  // compiling a production or a block: globals may be read
 };
@@ -363,8 +364,87 @@ void Parser::parse_logical(Cursor& c, ExprBuild& b, const Scope* scope, char sym
   }
 }
 
+// cpfg's printf("format", values...) (CPFG manual 3.2: C's printf in statements): the format a
+// string literal with C's escapes, its conversions those check_format takes, one value each.
+// It writes when evaluated (never folded into a constant) and is 0 as a value.
+void Parser::parse_printf(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc loc) {
+  ++c.pos;  // '('
+  c.skip_spaces();
+  if (c.peek() != '"') fail(c.loc(), "printf needs a format string first: printf(\"x = %g\\n\", x)");
+  const SourceLoc format_loc = c.loc();
+  ++c.pos;
+  std::string format;
+  for (;;) {
+    if (c.at_end()) fail(format_loc, "the format string is not closed ('\"')");
+    const char ch = c.peek();
+    ++c.pos;
+    if (ch == '"') break;
+    if (ch != '\\') {
+      format += ch;
+      continue;
+    }
+    if (c.at_end()) fail(format_loc, "the format string is not closed ('\"')");
+    const char e = c.peek();
+    ++c.pos;
+    switch (e) {
+      case 'n': format += '\n'; break;
+      case 't': format += '\t'; break;
+      case '"': format += '"'; break;
+      case '\\': format += '\\'; break;
+      default: format += '\\', format += e; break;
+    }
+    if (format.size() > 4096) fail(format_loc, "a format string of more than 4096 characters");
+  }
+  const FormatCheck check = check_format(format);
+  if (!check.error.empty()) fail(format_loc, check.error);
+  int values = 0;
+  for (;;) {
+    c.skip_spaces();
+    if (c.peek() == ')') {
+      ++c.pos;
+      break;
+    }
+    if (c.peek() != ',') fail(c.loc(), "expected ',' or ')' in printf's arguments");
+    ++c.pos;
+    if (++b.nesting > kMaxNesting) fail(loc, "expression nested too deeply");
+    parse_or(c, b, scope);
+    --b.nesting;
+    ++values;
+  }
+  if (values != check.values)
+    fail(loc, "printf's format takes " + std::to_string(check.values) + (check.values == 1 ? " value" : " values") +
+                  ", it was given " + std::to_string(values));
+  b.uses_slot = true;  // a side effect: evaluated every time, never folded
+  g_.program.formats.push_back(std::move(format));
+  g_.program.code.push_back(Instr{Op::kPrint, Func{}, static_cast<uint16_t>(values),
+                                  static_cast<uint32_t>(g_.program.formats.size() - 1)});
+  g_.program.locs.push_back(loc);
+  b.depth += 1 - values;
+  b.max_depth = std::max(b.max_depth, b.depth);
+}
+
 void Parser::parse_or(Cursor& c, ExprBuild& b, const Scope* scope) {
   parse_logical(c, b, scope, '|', Op::kOrJump, &Parser::parse_and);
+  // cpfg's conditional `c ? a : b` (its reader has C's `?` and `:` in expressions), right
+  // associative, only the chosen branch evaluated. Not in sylva's own format.
+  if (!g_.cpfg) return;
+  c.skip_spaces();
+  if (c.peek() != '?') return;
+  const SourceLoc loc = c.loc();
+  ++c.pos;
+  if (++b.nesting > kMaxNesting) fail(loc, "expression nested too deeply");
+  const size_t to_else = g_.program.code.size();
+  emit(b, Op::kJumpIfZero, 0, loc, -1);
+  parse_or(c, b, scope);
+  c.skip_spaces();
+  if (c.peek() != ':') fail(c.loc(), "expected ':' in the conditional 'c ? a : b'");
+  ++c.pos;
+  const size_t to_end = g_.program.code.size();
+  emit(b, Op::kJump, 0, loc, -1);  // the else branch pushes its own value
+  g_.program.code[to_else].arg = static_cast<uint32_t>(g_.program.code.size());
+  parse_or(c, b, scope);
+  g_.program.code[to_end].arg = static_cast<uint32_t>(g_.program.code.size());
+  --b.nesting;
 }
 
 void Parser::parse_and(Cursor& c, ExprBuild& b, const Scope* scope) {
@@ -421,11 +501,12 @@ void Parser::parse_multiplicative(Cursor& c, ExprBuild& b, const Scope* scope) {
   for (;;) {
     c.skip_spaces();
     char ch = c.peek();
-    if (ch != '*' && ch != '/') return;
+    // cpfg's `%`: C's remainder of the operands made integers (its Eval); not in sylva's format.
+    if (ch != '*' && ch != '/' && !(ch == '%' && g_.cpfg)) return;
     SourceLoc loc = c.loc();
     ++c.pos;
     parse_unary(c, b, scope);
-    emit(b, ch == '*' ? Op::kMul : Op::kDiv, 0, loc, -1);
+    emit(b, ch == '*' ? Op::kMul : ch == '/' ? Op::kDiv : Op::kRem, 0, loc, -1);
   }
 }
 
@@ -512,6 +593,7 @@ void Parser::parse_primary(Cursor& c, ExprBuild& b, const Scope* scope) {
     std::string name = c.line->text.substr(start, c.pos - start);
     size_t after = c.pos;
     c.skip_spaces();
+    if (c.peek() == '(' && name == "printf" && g_.cpfg) return parse_printf(c, b, scope, loc);
     if (c.peek() == '(') {
       Func fn;
       if (!find_func(name, &fn)) fail(loc, "unknown function '" + name + "'");
@@ -635,6 +717,12 @@ std::vector<Parser::ParsedModule> Parser::parse_modules(Cursor c, const char* wh
     SymbolId id = g_.symbols.intern(name, &ok);
     if (!ok) fail(loc, "too many different module names (more than 65535)");
     ParsedModule m{id, loc, {}};
+    if (g_.cpfg) {
+      // cpfg's reader skips blanks between tokens: `\ (90)` is `\(90)` (cpfg/lsys_input.l).
+      const size_t before = c.pos;
+      c.skip_spaces();
+      if (c.peek() != '(') c.pos = before;
+    }
     if (c.peek() == '(') {
       SourceLoc open = c.loc();
       ++c.pos;
@@ -644,8 +732,16 @@ std::vector<Parser::ParsedModule> Parser::parse_modules(Cursor c, const char* wh
       bool closed = false;
       while (!c.at_end()) {
         char a = c.peek();
-        if (a == '(') {
+        if (a == '"' && g_.cpfg) {  // @L's text: commas and parentheses inside do not count
+          const size_t close = c.line->text.find('"', c.pos + 1);
+          if (close == std::string::npos || close >= c.end) fail(c.loc(), "the string is not closed ('\"')");
+          c.pos = close + 1;
+          continue;
+        }
+        if (a == '(' || (a == '[' && g_.cpfg)) {  // an array's `G[i, j]` keeps its comma
           ++depth;
+        } else if (a == ']' && g_.cpfg && depth > 0) {
+          --depth;
         } else if (a == ')') {
           if (depth == 0) {
             m.args.push_back(c.sub(arg_start, c.pos));
@@ -662,6 +758,13 @@ std::vector<Parser::ParsedModule> Parser::parse_modules(Cursor c, const char* wh
       }
       if (!closed) fail(open, "'(' is never closed: expected ')'");
       if (m.args.size() > 65535) fail(open, "too many arguments (more than 65535)");
+      // cpfg's label @L("format", values) (manual 6.10) is text in cpfg's window: sylva keeps
+      // the values and drops the text, and draws nothing for it (docs/cpfg.md).
+      if (g_.cpfg && name == "@L" && !m.args.empty()) {
+        Cursor first = m.args.front();
+        first.skip_spaces();
+        if (first.peek() == '"') m.args.erase(m.args.begin());
+      }
     }
     out.push_back(std::move(m));
   }
@@ -685,7 +788,11 @@ void Parser::check_brackets(const std::vector<ParsedModule>& ms, const char* wha
 // The modules whose parameter count is part of their meaning (light.md): a light query
 // has 1 or 4 parameters, a turtle query 2 or 3, a tropism vector 3.
 void Parser::check_builtin_arity(const ParsedModule& m) {
-  if (m.symbol == kSymLightQuery && m.args.size() != 1 && m.args.size() != 4)
+  // A cpfg file's ?E carries what its environmental program reads (honda81: vigor and
+  // index): at least one parameter, the answer in the first (docs/cpfg.md).
+  if (m.symbol == kSymLightQuery && g_.cpfg && m.args.empty())
+    fail(m.loc, "?E needs a parameter for its answer: ?E(q)");
+  if (m.symbol == kSymLightQuery && !g_.cpfg && m.args.size() != 1 && m.args.size() != 4)
     fail(m.loc, "?E takes 1 parameter, ?E(q), or 4, ?E(q, x, y, z), not " + std::to_string(m.args.size()) +
                     " (light.md)");
   if (is_turtle_query(m.symbol) && m.args.size() != 2 && m.args.size() != 3)
@@ -727,6 +834,9 @@ Successor Parser::compile_successor(Cursor c, const Scope& scope, const char* wh
 Word Parser::evaluate_constant_word(const Successor& s) {
   Word w;
   Rng rng = axiom_rng(g_.seed);
+  std::vector<double> globals = g_.global_initial;  // a cpfg axiom's globals, before Start runs
+  globals.push_back(0.0);
+  EvalContext context{globals.data()};
   for (const SuccessorModule& sm : s.modules) {
     w.modules.push_back(Module{sm.symbol, sm.arg_count, static_cast<uint32_t>(w.params.size())});
     for (uint32_t k = 0; k < sm.arg_count; ++k) {
@@ -736,7 +846,7 @@ Word Parser::evaluate_constant_word(const Successor& s) {
       double v = e.kind == Expr::Kind::kConst ? e.value : 0.0;
       if (e.kind != Expr::Kind::kConst) {
         try {
-          v = g_.program.eval(e, nullptr, &rng);
+          v = g_.program.eval(e, nullptr, &rng, &context);
         } catch (const EvalError& err) {
           fail(err.loc, err.message);
         }
@@ -834,6 +944,9 @@ void Parser::set_ignore(Cursor c) {
   if (consider_) fail(c.loc(), "'consider:' and 'ignore:' cannot both be given");
   for (const ParsedModule& m : ms) {
     if (!m.args.empty()) fail(m.loc, "the ignore list takes module names without parameters");
+    // cpfg's reader takes them and its context matching walks branches all the same: a
+    // cpfg file's ignored brackets change nothing (docs/cpfg.md).
+    if ((m.symbol == kSymPush || m.symbol == kSymPop) && g_.cpfg) continue;
     if (m.symbol == kSymPush || m.symbol == kSymPop)
       fail(m.loc, "brackets cannot be ignored: they delimit branches");
     if (g_.ignored.size() <= m.symbol) g_.ignored.resize(m.symbol + 1u, 0);
@@ -934,12 +1047,16 @@ bool Parser::try_directive(const LogicalLine& line) {
     } else if (d == "maximum depth") {
       double n = constant_expression(value, "maximum depth");
       if (n < 0 || n != std::floor(n) || n > kMaxDepthLimit)
-        fail(value.loc(), "maximum depth must be an integer from 0 to 1000");
+        fail(value.loc(), "maximum depth must be an integer from 0 to 100000");
       (section_ == Section::kDecomposition ? g_.decomposition_depth : g_.max_depth) = static_cast<int>(n);
     } else {  // axiom / ω
       if (have_axiom_) fail(loc, "the axiom is given twice");
       have_axiom_ = true;
+      // A cpfg axiom may read the globals its Start block set (cpfg evaluates it after Start).
+      const bool visible = globals_visible_;
+      globals_visible_ = g_.cpfg;
       Successor s = compile_successor(value, Scope{}, "the axiom");
+      globals_visible_ = visible;
       if (!s.all_constant) {
         g_.axiom = evaluate_constant_word(s);
         g_.axiom_successor = std::move(s);
@@ -1067,11 +1184,16 @@ void Parser::parse_production(const LogicalLine& line) {
     t.skip_spaces();
     if (t.at_end()) fail(t.loc(), "expected a predecessor module before '->'");
     std::vector<PatternModule> pm = compile_pattern(pred, scope, "the predecessor");
-    if (pm.size() != 1)
-      fail(t.loc(), "the predecessor must be one module (use '<' and '>' for context)");
-    if (pm[0].symbol == kSymPush || pm[0].symbol == kSymPop)
-      fail(t.loc(), "brackets cannot be rewritten");
+    // cpfg's reader takes a strict predecessor of several modules (`f?E(x) --> ...`, its
+    // PredDiff): they match consecutive modules of the word and are rewritten together.
+    if (pm.size() != 1 && !(g_.cpfg && section_ == Section::kProductions && !pm.empty()))
+      fail(t.loc(), g_.cpfg ? "a predecessor of several modules is not supported yet in a homomorphism or a "
+                              "decomposition (docs/cpfg.md)"
+                            : "the predecessor must be one module (use '<' and '>' for context)");
+    for (const PatternModule& m : pm)
+      if (m.symbol == kSymPush || m.symbol == kSymPop) fail(t.loc(), "brackets cannot be rewritten");
     p.predecessor = pm[0];
+    p.predecessor_tail.assign(pm.begin() + 1, pm.end());
   }
   p.left_context = compile_pattern(lctx, scope, "the left context");
   for (const PatternModule& m : p.left_context)
@@ -1517,7 +1639,12 @@ void Parser::define_arrays(Cursor c) {
       if (total + size > kMaxArrayElements)
         fail(at, "the arrays hold more than " + std::to_string(kMaxArrayElements) + " elements (docs/limits.md)");
       c.pos = end + 1;
-      if (c.line->text[end] == ']') break;
+      if (c.line->text[end] == ']') {
+        // C's form of a further dimension, `a[M][N]`, as cpfg's reader takes it.
+        c.skip_spaces();
+        if (c.peek() != '[') break;
+        ++c.pos;
+      }
     }
     total += size;
     a.base = static_cast<uint32_t>(g_.global_names.size());
@@ -1603,6 +1730,12 @@ void Parser::collect_globals(const std::vector<LogicalLine>& lines) {
     if (!block) continue;
     const std::string& t = line.text;
     for (size_t i = 0; i < t.size(); ++i) {
+      if (t[i] == '"') {  // a printf format: no assignments inside
+        const size_t close = t.find('"', i + 1);
+        if (close == std::string::npos) break;
+        i = close;
+        continue;
+      }
       if (!is_ident_start(t[i]) || (i > 0 && (is_ident_char(t[i - 1]) || t[i - 1] == '.'))) continue;
       size_t e = i;
       while (e < t.size() && is_ident_char(t[e])) ++e;
@@ -1629,8 +1762,14 @@ void Parser::collect_globals(const std::vector<LogicalLine>& lines) {
 std::vector<LogicalLine> Parser::join_statement_lines(std::vector<LogicalLine> lines) {
   std::vector<LogicalLine> out;
   int depth = 0;
+  bool counts_braces = false;  // whether the logical line being built may open statement braces
   for (LogicalLine& line : lines) {
-    const bool continuing = depth > 0;
+    // A line that begins with a tab goes on the line before it (cpfg/lsys_input.l reads a
+    // newline and a tab as a space). Its braces are statements' while the production it
+    // continues has not reached its arrow yet.
+    const bool tab_joined = depth == 0 && line.continues_previous && !out.empty();
+    if (tab_joined && out.back().text.find("->") != std::string::npos) counts_braces = false;
+    const bool continuing = depth > 0 || tab_joined;
     size_t end = line.text.size();
     if (size_t arrow = line.text.find("->"); arrow != std::string::npos) end = arrow;
     // Where statement braces may stand: a block's, or a production's after its ':' (an
@@ -1644,6 +1783,9 @@ std::vector<LogicalLine> Parser::join_statement_lines(std::vector<LogicalLine> l
       from = colon == std::string::npos || colon >= end ? end : colon + 1;
       for (const char* header : {"axiom", "seed", "derivation", "ignore", "consider", "maximum", "lsystem"})
         if (folded.compare(k, std::strlen(header), header) == 0) from = end;
+      counts_braces = from < line.text.size() && end == line.text.size();
+    } else if (depth == 0 && !counts_braces) {
+      from = end;
     }
     for (size_t i = from; i < end; ++i) {
       if (line.text[i] == '{') ++depth;

@@ -63,6 +63,10 @@ struct LogicalLine {
   };
   std::string text;
   std::vector<Piece> pieces;  // by offset; at least one
+  // A cpfg model's line that begins with a tab right after a line that is not blank: cpfg's
+  // reader takes a newline followed by a tab as a space (cpfg/lsys_input.l), so the line goes
+  // on the one before it (docs/cpfg.md).
+  bool continues_previous = false;
 
   // The source place of text[p]; text.size() (or more): the place just past the end.
   SourceLoc loc(size_t p) const {

@@ -10,6 +10,7 @@
 
 #include "core/util/file_io.h"
 #include "lsystem/source_text.h"
+#include "lsystem/spline_function.h"
 
 namespace sylva::lsys {
 
@@ -75,6 +76,157 @@ int option_arguments(const std::string& option) {
   return -1;
 }
 
+// The view file's user-defined functions (CPFG manual 8.1.6), in order: `function: file [n]`
+// and `function set: file` (a set replaces the functions before it, as cpfg's reader does, and
+// its names become macros NAME = id for the model, as cpfg's -D). Files are in the object's
+// folder. Read before the model is preprocessed, since the model may use those names.
+Status read_view_functions(const std::string& view, const std::string& folder, ParseOptions& options) {
+  namespace fs = std::filesystem;
+  Expected<std::string> text = read_text_file(view);
+  if (!text) return std::move(text.error());
+  const std::string clean = without_comments(std::move(*text));
+  bool from_set = false;
+  std::optional<Diagnostic> failure;
+  for_each_physical_line(clean, [&](uint32_t line_no, std::string_view line, bool) {
+    if (failure) return;
+    const size_t colon = line.find(':');
+    if (colon == std::string_view::npos) return;
+    std::string name = lower_ascii(line.substr(0, colon));
+    while (!name.empty() && is_space(name.back())) name.pop_back();
+    while (!name.empty() && is_space(name.front())) name.erase(name.begin());
+    if (name != "function" && name != "function set") return;
+    const std::vector<Token> values = tokens_of(line.substr(colon + 1));
+    const uint32_t base = static_cast<uint32_t>(colon + 1);
+    if (values.empty()) return void(failure = error_in(view, line, line_no, base + 1, "'" + name + ":' needs a file name"));
+    const std::string file = (fs::path(folder) / values[0].text).string();
+    auto fail_file = [&](Diagnostic inner) {
+      Diagnostic d = error_in(view, line, line_no, base + values[0].column, "cannot read the function file '" + values[0].text + "'");
+      d.notes.push_back(std::move(inner));
+      failure = std::move(d);
+    };
+    if (name == "function set") {
+      auto set = read_function_set(file);
+      if (!set) return fail_file(std::move(set.error()));
+      options.functions = std::move(*set);
+      from_set = true;
+      return;
+    }
+    double samples = 0;
+    if (values.size() >= 2 && (!number(values[1].text, &samples) || samples != std::floor(samples) || samples < 0 ||
+                               samples > kMaxFunctionSamples))
+      return void(failure = error_in(view, line, line_no, base + values[1].column,
+                                     "the number of samples is a whole number from 0 to " + std::to_string(kMaxFunctionSamples)));
+    auto f = read_function_file(file, static_cast<int>(samples));
+    if (!f) return fail_file(std::move(f.error()));
+    if (f->name == file) f->name = fs::path(values[0].text).stem().string();
+    options.functions.push_back(std::move(*f));
+  });
+  if (failure) return std::move(*failure);
+  if (from_set)
+    for (size_t i = 0; i < options.functions.size(); ++i) {
+      const std::string& n = options.functions[i].name;
+      if (!n.empty() && is_ident_start(n[0]) && std::all_of(n.begin(), n.end(), [](char c) { return is_ident_char(c); }))
+        options.predefined_macros.emplace_back(n, std::to_string(i + 1));
+    }
+  return {};
+}
+
+// The environment file `path` of `cpfg -e` (vlab's environment manual: `executable: program
+// args`, `communication type:`, `turtle position:` ...). For vlab's honda81 its specification
+// file (`radius:`, `3d case:`, `verbose:`) is read too. Another program: `*program` is its
+// name and the error is where the file names it; an unreadable file leaves `*program` empty.
+Expected<Grammar::DensityField> read_density_environment(const std::string& path, const std::string& folder,
+                                                          std::string* program) {
+  namespace fs = std::filesystem;
+  program->clear();
+  Expected<std::string> text = read_text_file(path);
+  if (!text) return std::move(text.error());
+  std::string spec, communication = "memory", formats_line;
+  uint32_t executable_line = 0, formats_line_no = 0;
+  std::string executable_text;
+  for_each_physical_line(*text, [&](uint32_t line_no, std::string_view line, bool) {
+    const size_t colon = line.find(':');
+    if (colon == std::string_view::npos) return;
+    std::string name = lower_ascii(line.substr(0, colon));
+    while (!name.empty() && is_space(name.back())) name.pop_back();
+    const std::vector<Token> values = tokens_of(line.substr(colon + 1));
+    if (name == "executable" && !values.empty()) {
+      *program = fs::path(values[0].text).filename().string();
+      executable_line = line_no;
+      executable_text = std::string(line);
+      // honda81 [-e environment_file] specification_file: the last word is its spec file.
+      if (values.size() >= 2) spec = values.back().text;
+    } else if (name == "communication type" && !values.empty()) {
+      communication = lower_ascii(values[0].text);
+    } else if (name == "turtle position") {
+      formats_line = std::string(line.substr(colon + 1));
+      formats_line_no = line_no;
+    }
+  });
+  if (program->empty()) return file_diagnostic(path, "no 'executable:' line naming the environmental program");
+  if (*program != "honda81")
+    return error_in(path, executable_text, executable_line, 1, "the environmental program is '" + *program + "'");
+  Grammar::DensityField field;
+  // "turtle position:P:%.4f %.4f %.0f": the position is sent, written with these conversions
+  // when the program reads files or pipes.
+  if (formats_line_no == 0)
+    return file_diagnostic(path, "honda81 needs the turtle's position: a line 'turtle position:P:%g %g %g'");
+  size_t p = formats_line.find("P:");  // the field's tag, which older files leave out
+  p = p == std::string::npos ? 0 : p + 2;
+  if (communication == "files" || communication == "pipes") {
+    for (const Token& t : tokens_of(std::string_view(formats_line).substr(p))) {
+      const FormatCheck check = check_format(t.text);
+      if (!check.error.empty() || check.values != 1)
+        return error_in(path, formats_line, formats_line_no, static_cast<uint32_t>(p + t.column + 16),
+                        "expected one number's conversion for each coordinate ('%.4f')");
+      field.position_formats.push_back(t.text);
+    }
+    if (field.position_formats.size() != 3)
+      return error_in(path, formats_line, formats_line_no, 1, "expected three conversions, x y z ('%.4f %.4f %.4f')");
+  }
+  if (spec.empty()) return error_in(path, executable_text, executable_line, 1, "honda81 needs its specification file: 'executable: honda81 file.spec'");
+  const std::string spec_path = (fs::path(folder) / spec).string();
+  Expected<std::string> spec_text = read_text_file(spec_path);
+  if (!spec_text) return std::move(spec_text.error());
+  std::optional<Diagnostic> failure;
+  for_each_physical_line(*spec_text, [&](uint32_t line_no, std::string_view line, bool) {
+    if (failure) return;
+    const size_t colon = line.find(':');
+    if (colon == std::string_view::npos) return;
+    std::string name = lower_ascii(line.substr(0, colon));
+    while (!name.empty() && is_space(name.back())) name.pop_back();
+    const std::vector<Token> values = tokens_of(line.substr(colon + 1));
+    if (values.empty()) return;
+    if (name == "radius") {
+      double r = 0;
+      if (!number(values[0].text, &r) || r < 0)
+        failure = error_in(spec_path, line, line_no, static_cast<uint32_t>(colon + 1 + values[0].column),
+                           "honda81's radius is a number, not negative");
+      field.radius = r;
+    } else if (name == "3d case") {
+      field.three_d = lower_ascii(values[0].text) == "on";
+    }
+    // verbose: and anything else honda81 skips with a message: read and ignored.
+  });
+  if (failure) return std::move(*failure);
+  return field;
+}
+
+// A movement's words with each "K:value" split into "K:" and "value" (cpfg's reader splits
+// them at ':', cpfg/movements.c: `tropism: T: 0 1 0 A:90`).
+std::vector<Token> split_keys(const std::vector<Token>& words) {
+  std::vector<Token> out;
+  for (const Token& w : words) {
+    if (w.text.size() > 2 && is_ident_start(w.text[0]) && w.text[1] == ':') {
+      out.push_back({w.text.substr(0, 2), w.column});
+      out.push_back({w.text.substr(2), w.column + 2});
+    } else {
+      out.push_back(w);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 bool is_grammar_path(const std::string& path) {
@@ -98,7 +250,7 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
     std::string name = lower_ascii(line.substr(0, colon));
     while (!name.empty() && is_space(name.back())) name.pop_back();
     while (!name.empty() && is_space(name.front())) name.erase(name.begin());
-    const std::vector<Token> values = tokens_of(line.substr(colon + 1));
+    std::vector<Token> values = tokens_of(line.substr(colon + 1));
     const uint32_t value_column = static_cast<uint32_t>(colon + 2);
     auto fail_here = [&](uint32_t column, std::string message) {
       failure = error_in(path, line, line_no, column, std::move(message));
@@ -123,8 +275,9 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
       line_width = v;
       if (values.size() > 1) {
         const std::string style = lower_ascii(values[1].text);
-        if (style == "p" || style == "pixels") world_units = false;
-        else if (style == "s" || style == "shaded") world_units = true;
+        // cpfg reads the word's first letter (interpret.c): `pixel`, `pnts`, `shaded` ...
+        if (style[0] == 'p') world_units = false;
+        else if (style[0] == 's') world_units = true;
         else return fail_here(values[1].column + value_column - 1, "expected 'p', 'pixels', 's' or 'shaded' as the line style");
       }
     } else if (name == "line width increment") {
@@ -137,9 +290,10 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
     } else if (name == "line style") {
       if (values.empty()) return fail_here(value_column, "'line style:' needs pixel, polygon or cylinder");
       const std::string style = lower_ascii(values[0].text);
-      if (style == "pixel") world_units = false;
-      else if (style == "polygon" || style == "cylinder") world_units = true;
-      else fail_here(values[0].column + value_column - 1, "expected pixel, polygon or cylinder as the line style");
+      // cpfg's names or their numbers 1 to 3; any other word keeps the style as it was,
+      // as cpfg does ("Invalid line style ... Default used!", interpret.c).
+      if (style == "pixel" || style == "1") world_units = false;
+      else if (style == "polygon" || style == "cylinder" || style == "2" || style == "3") world_units = true;
     } else if (name == "initial color") {
       if (value(0, &v)) {
         if (v < 0 || v != std::floor(v)) return fail_here(values[0].column + value_column - 1, "a colour index is a whole number from 0");
@@ -150,14 +304,33 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
         if (v < 0 || v != std::floor(v)) return fail_here(values[0].column + value_column - 1, "a colour increment is a whole number from 0");
         t.color_increment = static_cast<uint32_t>(v);
       }
-    } else if (name == "torque") {
-      return fail_here(1, "a torque (a twist toward a vector, CPFG manual 8.1.8) is not supported yet (docs/cpfg.md)");
-    } else if (name == "tropism") {
+    } else if (name == "surface") {
+      // "surface: id file size [s t [texture]]" (CPFG manual 8.1.5): the id is one character,
+      // a size not above 0 is 1 (as cpfg's reader), s and t the cells a patch is cut into.
+      if (values.size() < 3) return fail_here(value_column, "a surface needs 'surface: id file.s size [s t]'");
+      if (values[0].text.size() != 1)
+        return fail_here(values[0].column + value_column - 1, "a surface's id is one character ('~" + values[0].text.substr(0, 1) + "' draws it)");
+      double size = 0, cells[2] = {0, 0};
+      if (!number(values[2].text, &size)) return fail_here(values[2].column + value_column - 1, "a surface's size is a number");
+      if (!(size > 0)) size = 1;
+      for (size_t k = 0; k < 2 && 3 + k < values.size(); ++k)
+        if (!number(values[3 + k].text, &cells[k]) || cells[k] != std::floor(cells[k]) || cells[k] < 0 || cells[k] > 1e6)
+          return fail_here(values[3 + k].column + value_column - 1, "a surface's cells across and along are whole numbers");
+      const std::string file = (std::filesystem::path(path).parent_path() / values[1].text).string();
+      auto surface = read_cpfg_surface(file, values[0].text[0], size, static_cast<int>(cells[0]), static_cast<int>(cells[1]));
+      if (!surface) {
+        fail_here(values[1].column + value_column - 1, "cannot read the surface file '" + values[1].text + "'");
+        failure->notes.push_back(std::move(surface.error()));
+        return;
+      }
+      grammar.surfaces.push_back(std::move(*surface));
+    } else if (name == "tropism" || name == "torque") {
       // "T: x y z A: angle I: intensity E: elasticity S: step" (manual 8.1.8).
       if (t.view_tropisms.size() >= lsys::kMaxViewTropisms)
-        return fail_here(1, "more than " + std::to_string(lsys::kMaxViewTropisms) + " tropisms");
+        return fail_here(1, "more than " + std::to_string(lsys::kMaxViewTropisms) + " tropisms and torques");
       double vec[3] = {0, 0, 0}, intensity = 1, elasticity = 0, angle = 0, step = 0;
       bool has_vector = false;
+      values = split_keys(values);
       for (size_t k = 0; k < values.size(); ++k) {
         const std::string key = values[k].text;
         auto read = [&](double* out) { return value(k + 1, out) && (++k, true); };
@@ -184,9 +357,10 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
       const double factor = std::clamp(intensity / length, -1.0, 1.0);
       lsys::ViewTropism tropism;
       for (int k = 0; k < 3; ++k) tropism.vector[k] = vec[k] * factor;
-      tropism.angle_deg = angle;
+      tropism.angle_deg = name == "torque" ? 0 : angle;  // a torque ignores A: (manual 8.1.8)
       tropism.elasticity = elasticity;
       tropism.step = step;
+      tropism.torque = name == "torque";
       t.view_tropisms.push_back(tropism);
     }
     // Every other command only changes cpfg's window, its lights, textures or fonts: read
@@ -208,6 +382,12 @@ Expected<Grammar> load_vlab_object(const std::string& folder, const ParseOptions
                                    "'specifications' file naming its cpfg command)");
   std::optional<Diagnostic> failure;
   std::string model, view;
+  struct EnvironmentOption {
+    std::string file;
+    uint32_t line = 0, column = 0;
+    std::string text;
+  };
+  std::optional<EnvironmentOption> environment;  // cpfg -e file.e
   uint32_t command_line = 0;
   std::string command_text;
   for_each_physical_line(*text, [&](uint32_t line_no, std::string_view line, bool) {
@@ -225,13 +405,10 @@ Expected<Grammar> load_vlab_object(const std::string& folder, const ParseOptions
       }
       const int count = option_arguments(w.text);
       if (count < 0) return void(failure = error_in(specifications, line, line_no, w.column, "unknown cpfg option '" + w.text + "'"));
-      if (w.text == "-e")
-        return void(failure = error_in(specifications, line, line_no, w.column,
-                                       "an environmental program (cpfg -e) is not supported: sylva answers ?E queries "
-                                       "itself, with a scene's environment (docs/cpfg.md)"));
       if (count > 0 && k + static_cast<size_t>(count) >= words.size())
         return void(failure = error_in(specifications, line, line_no, w.column, "cpfg option '" + w.text + "' needs " +
                                                                                     std::to_string(count) + " argument(s)"));
+      if (w.text == "-e") environment = {words[k + 1].text, line_no, w.column, std::string(line)};
       k += static_cast<size_t>(count);
     }
     if (files.size() < 2)
@@ -244,8 +421,33 @@ Expected<Grammar> load_vlab_object(const std::string& folder, const ParseOptions
   if (model.empty())
     return file_diagnostic(specifications, "no cpfg command: a vlab object of cpfg names it on a line "
                                            "'cpfg [options] model.l view.v' (is this object for another program?)");
-  Expected<Grammar> g = load_grammar(model, options);
+  ParseOptions with_functions = options;
+  if (Status s = read_view_functions(view, folder, with_functions); !s) return std::move(s.error());
+  std::optional<Grammar::DensityField> field;
+  if (environment) {
+    // cpfg -e: vlab's honda81 is built in; any other program is not (docs/cpfg.md).
+    std::string program;
+    auto read = read_density_environment((fs::path(folder) / environment->file).string(), folder, &program);
+    if (!read && program == "honda81") return std::move(read.error());
+    if (!read && program.empty()) {
+      Diagnostic d = error_in(specifications, environment->text, environment->line, environment->column,
+                              "cannot read the environment file '" + environment->file + "' (cpfg -e)");
+      d.notes.push_back(std::move(read.error()));
+      return d;
+    }
+    if (!read) {
+      Diagnostic d = error_in(specifications, environment->text, environment->line, environment->column,
+                              "the environmental program '" + program + "' (cpfg -e " + environment->file +
+                                  ") is not supported: sylva answers ?E with its own light (docs/light.md), or "
+                                  "with vlab's honda81, which it has built in (docs/cpfg.md)");
+      d.notes.push_back(std::move(read.error()));
+      return d;
+    }
+    field = std::move(*read);
+  }
+  Expected<Grammar> g = load_grammar(model, with_functions);
   if (!g) return g;
+  g->density_field = std::move(field);
   if (Status s = apply_view_file(view, *g); !s) return std::move(s.error());
   return g;
 }

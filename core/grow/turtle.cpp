@@ -202,6 +202,32 @@ void adjust_up_and_left(TurtleState& t, const dvec3& old_heading) {
   t.left = glm::cross(t.up, t.heading);
 }
 
+// The view file's torques (CPFG manual 8.1.8) after its tropisms, as cpfg's movement_adjust
+// twists (cpfg/movements.c, rotate_to_vector): with D the torques' Σ e·T, not along H, the
+// desired direction is |D| times D's part across H, of length sin(H, D), and the up vector
+// turns about H by |U × desired| (at most 1) radians. cpfg's own up vector turns away from
+// the desired direction (its quaternion's sign; its comment says "towards"); cpfg's up is
+// sylva's reversed (cpfg starts with U = −z), so sylva's turns toward it and comes to rest
+// along T's projection. The heading stays; left = up × heading; this frame becomes the last
+// segment's for later turns, as in cpfg.
+void cpfg_twist(TurtleState& t, const dvec3& twist) {
+  const double length = glm::length(twist);
+  if (!(length > 0)) return;
+  const dvec3 across = glm::cross(t.heading, twist / length);
+  if (!(glm::dot(across, across) > 1e-8)) return;  // D along H: no twist
+  const dvec3 desired = glm::cross(across, t.heading) * length;
+  const dvec3 axis = glm::cross(t.up, desired);
+  double angle = glm::length(axis);
+  if (angle < 1e-7) return;
+  const dvec3 k = axis / angle;
+  angle = std::min(angle, 1.0);
+  t.up = glm::normalize(rotate_about(t.up, k, angle));
+  t.up = glm::normalize(t.up - glm::dot(t.up, t.heading) * t.heading);
+  t.left = glm::cross(t.up, t.heading);
+  t.prev_heading = t.heading;
+  t.prev_up = t.up;
+}
+
 // The view file's tropisms (CPFG manual 8.1.8) as cpfg's movement_adjust applies them before
 // every F, G, f and g (cpfg/movements.c): one desired direction V, the sum over tropisms i of
 // cos(A_i)·e_i·T_i and, where A_i is not 0, sin(A_i)·e_i·T_i × (H × T_i) / |H × T_i| (H × T_i
@@ -210,8 +236,13 @@ void adjust_up_and_left(TurtleState& t, const dvec3& old_heading) {
 // tropism's vector is the turtle's (t.tropism: @Tp(x, y, z) sets it).
 void cpfg_bend(TurtleState& t, const std::vector<lsys::ViewTropism>& tropisms) {
   dvec3 desired(0, 0, 0);
+  dvec3 twist(0, 0, 0);  // the torques' sum of elasticity × T
   for (size_t i = 0; i < tropisms.size(); ++i) {
     const lsys::ViewTropism& tr = tropisms[i];
+    if (tr.torque) {
+      twist += t.elasticity[i] * dvec3(tr.vector[0], tr.vector[1], tr.vector[2]);
+      continue;
+    }
     const dvec3 T = i == 0 ? t.tropism : dvec3(tr.vector[0], tr.vector[1], tr.vector[2]);  // @Tp sets the first
     const double e = t.elasticity[i];
     const double a = tr.angle_deg;
@@ -226,10 +257,12 @@ void cpfg_bend(TurtleState& t, const std::vector<lsys::ViewTropism>& tropisms) {
   }
   const dvec3 rot = glm::cross(t.heading, desired);
   const double len = glm::length(rot);
-  if (!(len >= 1e-6)) return;
-  const dvec3 old_heading = t.heading;
-  t.heading = glm::normalize(rotate_about(t.heading, rot / len, std::min(len, 1.0)));
-  adjust_up_and_left(t, old_heading);
+  if (len >= 1e-6) {
+    const dvec3 old_heading = t.heading;
+    t.heading = glm::normalize(rotate_about(t.heading, rot / len, std::min(len, 1.0)));
+    adjust_up_and_left(t, old_heading);
+  }
+  cpfg_twist(t, twist);
 }
 
 // @R(hx, hy[, hz]) and @R(hx, hy, hz, ux, uy, uz) (CPFG manual 6.2, as cpfg does it): the
@@ -287,7 +320,8 @@ std::vector<SourceLoc> places_writing(const lsys::Grammar& g, lsys::SymbolId sym
 enum class CpfgKind : uint8_t {
   kNone, kDraw, kMove, kColorUp, kColorDown, kWidthUp, kWidthDown, kLevel, kSetPosition, kSetHeading, kCircle, kSphere,
   kScaleSet, kScaleUp, kScaleDown, kForceTwist, kElasticityUp, kElasticityDown, kElasticitySet,
-  kCylinderStart, kCylinderPoint, kCylinderEnd, kCylinderTangents, kCylinderSides, kCylinderContour, kUnsupported
+  kCylinderStart, kCylinderPoint, kCylinderEnd, kCylinderTangents, kCylinderSides, kCylinderContour, kSurface,
+  kUnsupported
 };
 
 struct CpfgSymbols {
@@ -313,6 +347,8 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
   set("@R", CpfgKind::kSetHeading);
   set("@c", CpfgKind::kCircle);
   set("@O", CpfgKind::kSphere);
+  set("@o", CpfgKind::kSphere);  // a disc facing the camera: a sphere shows one from everywhere
+  set("~", CpfgKind::kSurface);
   set("@D", CpfgKind::kScaleSet);
   set("@Di", CpfgKind::kScaleUp);
   set("@Dd", CpfgKind::kScaleDown);
@@ -327,7 +363,7 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
   set("@Gt", CpfgKind::kCylinderTangents);
   set("@!", CpfgKind::kCylinderSides);
   set("@#", CpfgKind::kCylinderContour);
-  for (const char* name : {"~", "@o", "@Gr", "@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc"})
+  for (const char* name : {"@Gr", "@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc"})
     set(name, CpfgKind::kUnsupported);
   return out;
 }
@@ -343,8 +379,6 @@ constexpr int kSphereSegments = 16;
 
 // The feature a cpfg symbol sylva does not draw yet belongs to, for its error.
 std::string cpfg_feature(const std::string& name) {
-  if (name == "~") return "a predefined surface, CPFG manual 6.7.1";
-  if (name == "@o") return "a circle in the plane of the screen, CPFG manual 6.6: it turns with the camera, which a skeleton cannot; @c draws one in the HL plane";
   if (name == "@Gr") return "a generalized cylinder's radius tangents, CPFG manual 6.7.3; widths change linearly between control points";
   if (name == "@#") return "a view-file contour for generalized cylinders, CPFG manual 6.7.3 and 8.1.5; the default circle is @#(0)";
   if (name.rfind("@T", 0) == 0) return "a view-file tropism, CPFG manual 6.8";
@@ -590,8 +624,12 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           case CpfgKind::kMove: symbol = kSymf; break;   // g: move without drawing, no vertex
           case CpfgKind::kColorUp:
           case CpfgKind::kColorDown: {
-            double next = has ? p[0] : static_cast<double>(t.material) +
+            // A parameter is truncated toward zero, as cpfg's (int) cast; an index that steps
+            // past either end of the 256-entry colour map comes round once (interpret.c).
+            double next = has ? std::trunc(p[0]) : static_cast<double>(t.material) +
                                            (cpfg.kind[symbol] == CpfgKind::kColorUp ? 1.0 : -1.0) * d.color_increment;
+            if (cpfg.kind[symbol] == CpfgKind::kColorUp && next > 255) next -= 256;
+            else if (cpfg.kind[symbol] == CpfgKind::kColorDown && next < 0) next += 256;
             if (!(next >= 0) || next != std::floor(next) || next > 4294967295.0)
               throw TurtleFailure{"a colour index must be an integer from 0 to 4294967295"};
             t.material = static_cast<uint32_t>(next);
@@ -662,9 +700,9 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           case CpfgKind::kSphere: {  // @O(d): a sphere of diameter d
             // Diameter: the parameter, else the current line width (the drawn diameter).
             const double radius = has ? 0.5 * p[0] * t.scale : t.radius;
-            if (!(radius >= 0) || !std::isfinite(radius) || radius > kMaxCoordinateM)
-              throw TurtleFailure{"a diameter must be finite, not negative and at most 2e12 m"};
-            if (radius == 0) continue;
+            if (!std::isfinite(radius) || radius > kMaxCoordinateM)
+              throw TurtleFailure{"a diameter must be finite and at most 2e12 m"};
+            if (!(radius > 0)) continue;  // 0 or negative: nothing drawn (cpfg draws no sphere)
             std::optional<ChainParent> at;
             if (t.chain >= 0) at = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
             if (cpfg.kind[symbol] == CpfgKind::kCircle) {
@@ -722,6 +760,55 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
             if (has && p[0] != 0)
               throw TurtleFailure{"'@#' (" + cpfg_feature("@#") + ") is not supported yet (docs/cpfg.md)"};
             continue;
+          case CpfgKind::kSurface: {
+            // ~X(s) or ~X(sx, sy, sz) (CPFG manual 6.7.1): the view file's surface X at the
+            // turtle, its x along L, y along H, z along cpfg's up, scaled by s and
+            // the turtle's scale; one polygon leaf per grid cell (two triangles where the
+            // cell is not flat). The module after `~` names the surface and carries the
+            // scale; a surface the view file does not define draws nothing, as in cpfg.
+            if (i + 1 >= n) continue;
+            const Module& id_module = word.modules[++i];
+            const double* q = word.params_of(id_module);
+            const std::string& id_name = g.symbols.name(id_module.symbol);
+            const lsys::CpfgSurface* surface = nullptr;
+            for (const lsys::CpfgSurface& candidate : g.surfaces)
+              if (id_name.size() == 1 && id_name[0] == candidate.id) surface = &candidate;
+            if (!surface) continue;
+            dvec3 size(1, 1, 1);
+            if (id_module.param_count >= 3) size = dvec3(q[0], q[1], q[2]);
+            else if (id_module.param_count >= 1) size = dvec3(q[0]);
+            size *= t.scale;
+            if (!std::isfinite(size.x) || !std::isfinite(size.y) || !std::isfinite(size.z) ||
+                std::max({std::abs(size.x), std::abs(size.y), std::abs(size.z)}) > kMaxCoordinateM)
+              throw TurtleFailure{"a surface's scale must be finite and at most 2e12"};
+            if (size.x == 0 || size.y == 0 || size.z == 0) continue;  // cpfg draws nothing
+            // cpfg's frame is sylva's with the up vector reversed (cpfg starts with U = −z,
+            // sylva with +z; their left and heading agree): x along L, z along cpfg's U = −U.
+            auto place = [&](const std::array<double, 3>& v) {
+              const dvec3 w = t.position + size.x * v[0] * t.left + size.y * v[1] * t.heading - size.z * v[2] * t.up;
+              check_position(w);
+              return std::array<double, 3>{w.x, w.y, w.z};
+            };
+            std::optional<ChainParent> at;
+            if (t.chain >= 0) at = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
+            const int columns = surface->t_cells + 1;
+            for (const auto& grid : surface->patches)
+              for (int a = 0; a < surface->s_cells; ++a)
+                for (int b = 0; b < surface->t_cells; ++b) {
+                  const auto corner = [&](int da, int db) { return place(grid[static_cast<size_t>((a + da) * columns + b + db)]); };
+                  std::vector<std::array<double, 3>> quad = {corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)};
+                  if (leaves.size() + 2 >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
+                  if (!leaf_polygon_problem(quad)) {
+                    leaves.push_back(Leaf{at, t.material, std::move(quad)});
+                    continue;
+                  }
+                  // Not flat (or a collapsed edge): two triangles, each kept when it has area.
+                  for (std::vector<std::array<double, 3>> tri : {std::vector{quad[0], quad[1], quad[2]},
+                                                                 std::vector{quad[0], quad[2], quad[3]}})
+                    if (!leaf_polygon_problem(tri)) leaves.push_back(Leaf{at, t.material, std::move(tri)});
+                }
+            continue;
+          }
           case CpfgKind::kUnsupported:
             throw TurtleFailure{"'" + g.symbols.name(m.symbol) + "' (" + cpfg_feature(g.symbols.name(m.symbol)) +
                                 ") is not supported yet (docs/cpfg.md)"};

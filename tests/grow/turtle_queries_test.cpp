@@ -7,10 +7,14 @@
 #include <array>
 #include <functional>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
 #include "core/grow/grow.h"
+#include "lsystem/vlab_object.h"
 
 namespace sylva {
 namespace {
@@ -38,6 +42,95 @@ std::vector<double> params_of(const lsys::Word& word, lsys::SymbolId symbol, siz
   for (const lsys::Module& m : word.modules)
     if (m.symbol == symbol && n-- == 0) return {word.params_of(m), word.params_of(m) + m.param_count};
   return {};
+}
+
+// A vlab object in a fresh folder whose environmental program is vlab's honda81 (its
+// ENVIRO/honda81): `axiom` as the model, `environment` as field.e, `spec` as density.spec.
+std::string grown_in_honda81(const std::string& axiom, const std::string& environment, const std::string& spec) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("sylva_honda81_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "specifications") << "generate:\n\tcpfg -m plant.map -e field.e plant.l plant.v\n";
+  std::ofstream(dir / "plant.l") << "Lsystem: 1\nderivation length: 1\nAxiom: " << axiom << "\nendlsystem\n";
+  std::ofstream(dir / "plant.v") << "angle increment: 90\n";
+  std::ofstream(dir / "field.e") << environment;
+  std::ofstream(dir / "density.spec") << spec;
+  auto g = lsys::load_grammar(dir.string());
+  std::string out;
+  if (!g) {
+    out = "error: " + g.error().format();
+  } else {
+    auto w = derived_word(*g, 1);
+    out = w ? lsys::print_word(*w, g->symbols) : "error: " + w.error().message;
+  }
+  fs::remove_all(dir);
+  return out;
+}
+
+// honda81 answers ?E(vigor[, index]) with 0 where another query of the same index and at
+// least its vigor lies within the radius, else 1 (in x, y and z with `3d case: on`, else in x
+// and z); cpfg writes positions with the .e file's conversions when it talks through files.
+TEST(TurtleQueries, Honda81AnswersEByTheQueriesWithinItsRadius) {
+  const std::string memory = "executable: honda81 density.spec\ncommunication type: memory\nturtle position:P:%g %g %g\n";
+  // At y = 0 and 0.3 (vigor 1): each sees the other, 0. At y = 1.3 (vigor 2): none as
+  // vigorous, 1. Index 1 at x = -0.1 beside it: alone in its index, 1.
+  EXPECT_EQ(grown_in_honda81("?E(1)f(0.3)?E(1)f(1)?E(2)[+f(0.1)?E(1,1)]", memory, "radius: 0.5\n3d case: on\n"),
+            "?E(0)f(0.3)?E(0)f(1)?E(1)[+f(0.1)?E(1,1)]");
+  // Written through files as "%.0f": 0.4 and 0.6 are sent as 0 and 1, farther than 0.5.
+  const std::string files = "executable: honda81 density.spec\ncommunication type: files\nturtle position:P:%.0f %.0f %.0f\n";
+  EXPECT_EQ(grown_in_honda81("f(0.4)?E(1)f(0.2)?E(1)", memory, "radius: 0.5\n3d case: on\n"), "f(0.4)?E(0)f(0.2)?E(0)");
+  EXPECT_EQ(grown_in_honda81("f(0.4)?E(1)f(0.2)?E(1)", files, "radius: 0.5\n3d case: on\n"), "f(0.4)?E(1)f(0.2)?E(1)");
+  // Without `3d case: on` only x and z count: 5 apart along y is no distance.
+  EXPECT_EQ(grown_in_honda81("?E(1)f(5)?E(1)", memory, "radius: 0.5\n3d case: on\n"), "?E(1)f(5)?E(1)");
+  EXPECT_EQ(grown_in_honda81("?E(1)f(5)?E(1)", memory, "radius: 0.5\n"), "?E(0)f(5)?E(0)");
+  // Another program is an error at the -e, the program named; honda81's own mistakes at theirs.
+  const std::string chiba = grown_in_honda81("?E(1)", "executable: chiba -e x.e light.spec\n", "");
+  EXPECT_NE(chiba.find("specifications:2:20"), std::string::npos) << chiba;
+  EXPECT_NE(chiba.find("'chiba'"), std::string::npos) << chiba;
+  const std::string radius = grown_in_honda81("?E(1)", memory, "radius: -1\n");
+  EXPECT_NE(radius.find("density.spec:1:9"), std::string::npos) << radius;
+  EXPECT_NE(grown_in_honda81("?E(1)", "executable: honda81 density.spec\n", "radius: 1\n").find("turtle's position"),
+            std::string::npos);
+}
+
+// The word a vlab object of `model` and `view` derives in `steps` steps.
+std::string grown_object(const std::string& model, const std::string& view, int64_t steps = 1) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("sylva_object_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "specifications") << "generate:\n\tcpfg plant.l plant.v\n";
+  std::ofstream(dir / "plant.l") << model;
+  std::ofstream(dir / "plant.v") << view;
+  auto g = lsys::load_grammar(dir.string());
+  fs::remove_all(dir);
+  if (!g) return "error: " + g.error().format();
+  auto w = derived_word(*g, steps);
+  return w ? lsys::print_word(*w, g->symbols) : "error: " + w.error().message;
+}
+
+// A view file's torque (CPFG manual 8.1.8, cpfg's movement_adjust) twists the turtle about its
+// heading before every move: the up vector turns by |U × D'| (at most 1 radian) toward D', the
+// torque's e·T across H, and comes to rest along it; the heading never changes. From U = +z
+// with T = +x and E 1: after one F, U = (sin 1, 0, cos 1); after three, along +x.
+TEST(TurtleQueries, CpfgTorqueTwistsTheUpVectorTowardItsVectorAcrossTheHeading) {
+  const std::string model = "Lsystem: 1\nderivation length: 1\nAxiom: F ?U(0,0,0) F F ?U(0,0,0) ?H(0,0,0)\nendlsystem\n";
+  std::string turned = "?U(";
+  lsys::append_shortest_double(turned, std::sin(1.0));
+  turned += ",0,";
+  lsys::append_shortest_double(turned, std::cos(1.0));
+  turned += ")";
+  const std::string word = grown_object(model, "torque: T: 1 0 0 E: 1\n");
+  EXPECT_EQ(word.substr(0, 1 + turned.size()), "F" + turned) << word;
+  // After three moves: within 1e-4 of +x (the angle to it falls 90° → 32.7° → 1.7° → 0.0005°).
+  const size_t second = word.find("?U(", word.find("?U(") + 1);
+  ASSERT_NE(second, std::string::npos) << word;
+  EXPECT_NEAR(std::stod(word.substr(second + 3)), 1, 1e-4) << word;
+  EXPECT_NE(word.find("?H(0,1,0)"), std::string::npos) << word;  // the heading never turns
+  // No elasticity, no twist; @Ts sets a torque's elasticity by its id, shared with tropisms.
+  EXPECT_EQ(grown_object(model, "torque: T: 1 0 0\n").substr(0, 12), "F?U(0,0,1)FF");
+  const std::string by_id = grown_object("Lsystem: 1\nderivation length: 1\nAxiom: @Ts(2, 1) F ?U(0,0,0)\nendlsystem\n",
+                                         "tropism: T: 0 1 0\ntorque: T: 1 0 0\n");
+  EXPECT_EQ(by_id, "@Ts(2,1)F" + turned) << "the torque is id 2";
 }
 
 TEST(TurtleQueries, PositionIsFilledAfterEveryStepAndReadByTheNextStep) {

@@ -7,12 +7,16 @@
 // involves other angles is compared with a tolerance of 1e-12.
 #include "core/grow/turtle.h"
 #include "core/grow/grow.h"
+#include "lsystem/vlab_object.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <cstdint>
 #include <numbers>
 #include <optional>
@@ -892,7 +896,13 @@ TEST(TurtleCpfg, SemicolonAndCommaStepTheColourIndexOrSetIt) {
   ASSERT_EQ(sk.joints.size(), 7u);
   const uint32_t expected[] = {0, 0, 1, 3, 2, 7, 2};  // a joint has the material of the segment ending at it
   for (size_t k = 0; k < 7; ++k) EXPECT_EQ(sk.joints[k].material, expected[k]) << k;
-  EXPECT_NE(grow_error(cpfg(",F")).find("colour index"), std::string::npos);
+  // As cpfg's interpret.c: a parameter is truncated toward zero, and an index stepped past
+  // either end of the 256-entry colour map comes round once.
+  const Skeleton wrap = skeleton_of(cpfg("F,F;(255)F;F;(256.9)F;(7.6)F,(-1.5)F"));
+  ASSERT_EQ(wrap.joints.size(), 8u);
+  const uint32_t wrapped[] = {0, 255, 255, 0, 0, 7, 255};
+  for (size_t k = 0; k < 7; ++k) EXPECT_EQ(wrap.joints[k + 1].material, wrapped[k]) << k;
+  EXPECT_NE(grow_error(cpfg(";(-300)F")).find("colour index"), std::string::npos);
 }
 
 TEST(TurtleCpfg, HashAndBangStepTheLineWidthOrSetItAndARadiusIsWidthTimesTheScale) {
@@ -966,7 +976,15 @@ TEST(TurtleCpfg, AtCDrawsADiscAndAtOASphereWhereTheTurtleStands) {
   for (uint32_t k = 0; k < small.joint_count; ++k) widest_small = std::max(widest_small, sk.joints[small.first_joint + k].radius_m);
   EXPECT_NEAR(widest_small, 0.05, 1e-12);
   EXPECT_TRUE(near(position_at(sk, 2, 0), {0.05, 2, 0}));  // + turned H from +y to −x; the pole behind is +x
-  EXPECT_NE(grow_error(cpfg("F@O(-1)")).find("diameter"), std::string::npos);
+  // A diameter of 0 or below draws nothing, as in cpfg (a rounding error's -1e-7 included);
+  // one that is not finite is an error. @o (a disc facing the camera) is a sphere: it shows
+  // as a disc of its diameter from every camera.
+  EXPECT_EQ(skeleton_of(cpfg("F@O(-1e-7)F")).chains.size(), 1u);
+  EXPECT_NE(grow_error(cpfg("F@O(1e300)")).find("diameter"), std::string::npos);
+  const Skeleton screen = skeleton_of(cpfg("F(1)@o(1)"));
+  const Skeleton ball = skeleton_of(cpfg("F(1)@O(1)"));
+  EXPECT_EQ(screen.chains.size(), 2u);
+  EXPECT_EQ(screen.joints, ball.joints);
 }
 
 // The turtle's scale (CPFG manual 6.3, as cpfg's interpret.c and blackbox.c apply it): @D(s)
@@ -994,7 +1012,7 @@ TEST(TurtleCpfg, AtDScalesLengthsAndWidthsAndBracketsKeepTheScale) {
 
 TEST(TurtleCpfg, SymbolsSylvaDoesNotDrawYetAreErrorsNamingTheFeature) {
   const std::pair<const char*, const char*> cases[] = {
-      {"F@o(2)", "plane of the screen"}, {"F~l(1)", "surface"}, {"@Gs F @Gr(30,1) @Ge", "radius tangents"},
+      {"@Gs F @Gr(30,1) @Ge", "radius tangents"},
       {"@#(2) @Gs F @Ge", "contour"},
       {"F@PS(1)F", "patch"}, {"F@;F", "back-side colour"}};
   for (const auto& [axiom, feature] : cases) {
@@ -1003,6 +1021,90 @@ TEST(TurtleCpfg, SymbolsSylvaDoesNotDrawYetAreErrorsNamingTheFeature) {
     EXPECT_NE(message.find("not supported yet"), std::string::npos) << axiom << ": " << message;
     EXPECT_NE(message.find("test.lsys:2:1"), std::string::npos) << axiom << ": " << message;  // at the axiom
   }
+}
+
+// ---- predefined surfaces (CPFG manual 6.7.1, 8.1.5; docs/cpfg.md "Surfaces") -----------
+
+// A vlab object in a fresh folder: `plant.l` with `axiom`, its view file `view`, and `leaf.s`,
+// one flat Bézier patch over the unit square (control points at thirds), its contact point at
+// the middle of its bottom edge, heading +y, up +z, SIZE 1.
+sylva::Expected<GrowResult> grow_with_surface(const std::string& axiom, const std::string& view) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("sylva_surface_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "specifications") << "generate:\n\tcpfg plant.l plant.v\n";
+  std::ofstream(dir / "plant.l") << "Lsystem: 1\nAxiom: " << axiom << "\nendlsystem\n";
+  std::ofstream(dir / "plant.v") << view;
+  std::string s = "0 1 0 1 0 0\nCONTACT POINT  X: 0.5 Y: 0 Z: 0\nEND POINT  X: 0.5 Y: 1 Z: 0\n"
+                  "HEADING  X: 0 Y: 1 Z: 0\nUP  X: 0 Y: 0 Z: 1\nSIZE: 1\nmiddle\n"
+                  "TOP COLOR: 0 DIFFUSE: 0.5 BOTTOM COLOR: 0 DIFFUSE: 0.5\nAL: ~ A: ~ AR: ~\nL: ~ R: ~\nBL: ~ B: ~ BR: ~\n";
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) s += std::to_string(j / 3.0) + " " + std::to_string(i / 3.0) + " 0  ";
+    s += "\n";
+  }
+  std::ofstream(dir / "leaf.s") << s;
+  auto g = lsys::load_grammar(dir.string());
+  fs::remove_all(dir);
+  if (!g.ok()) return g.error();
+  return grow(*g, {}, "plant", {});
+}
+
+double polygon_area(const Leaf& leaf) {
+  glm::dvec3 sum(0);
+  const auto& v = leaf.vertices_m;
+  for (size_t k = 0; k < v.size(); ++k) {
+    const auto& a = v[k];
+    const auto& b = v[(k + 1) % v.size()];
+    sum += glm::cross(glm::dvec3(a[0], a[1], a[2]), glm::dvec3(b[0], b[1], b[2]));
+  }
+  return 0.5 * glm::length(sum);
+}
+
+// `~l(s)` draws the view file's surface `l` where the turtle stands: the file's SIZE made the
+// view file's size, times s; its x along cpfg's left (H × U: +x for the first turtle), y along
+// H, z along U; one leaf per cell of the s × t grid a patch is cut into.
+TEST(TurtleCpfg, TildeDrawsTheViewFilesSurfaceAsLeavesWhereTheTurtleStands) {
+  auto grown = grow_with_surface("F(1);(3)~l(1.5)", "surface: l leaf.s 2 4 3\n");
+  ASSERT_TRUE(grown.ok()) << grown.error().format();
+  const Skeleton& sk = grown->skeleton;
+  ASSERT_EQ(sk.leaves.size(), 12u);  // 4 × 3 cells, each flat: one quad
+  double area = 0, lo[3] = {1e9, 1e9, 1e9}, hi[3] = {-1e9, -1e9, -1e9};
+  for (const Leaf& leaf : sk.leaves) {
+    EXPECT_EQ(leaf.material, 3u);
+    ASSERT_TRUE(leaf.joint);
+    EXPECT_EQ(*leaf.joint, (ChainParent{0, 1}));
+    area += polygon_area(leaf);
+    for (const auto& v : leaf.vertices_m)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
+  }
+  // The unit square, scaled by size 2 / SIZE 1 and by 1.5: 3 × 3, from the contact point at
+  // the turtle (0, 1, 0) up along H, centred on it across.
+  EXPECT_NEAR(area, 9, 1e-9);
+  EXPECT_NEAR(lo[0], -1.5, 1e-9);
+  EXPECT_NEAR(hi[0], 1.5, 1e-9);
+  EXPECT_NEAR(lo[1], 1, 1e-9);
+  EXPECT_NEAR(hi[1], 4, 1e-9);
+  EXPECT_NEAR(lo[2], 0, 1e-9);
+  EXPECT_NEAR(hi[2], 0, 1e-9);
+  // Three parameters scale x, y and z apart; the file's cells are cpfg's 5 × 5 without counts;
+  // a surface the view file does not name draws nothing, as in cpfg.
+  auto stretched = grow_with_surface("~l(1,2,1)~q(1)", "surface: l leaf.s 1\n");
+  ASSERT_TRUE(stretched.ok()) << stretched.error().format();
+  ASSERT_EQ(stretched->skeleton.leaves.size(), 25u);
+  double stretched_area = 0, top = 0;
+  for (const Leaf& leaf : stretched->skeleton.leaves) {
+    stretched_area += polygon_area(leaf);
+    for (const auto& v : leaf.vertices_m) top = std::max(top, v[1]);
+  }
+  EXPECT_NEAR(stretched_area, 2, 1e-9);
+  EXPECT_NEAR(top, 2, 1e-9);
+  // A surface file that cannot be read is an error at the view file's line, the file's own
+  // error in a note.
+  auto missing = grow_with_surface("~l", "angle factor: 8\nsurface: l nothing.s 1\n");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.error().loc.line, 2u);
+  EXPECT_NE(missing.error().message.find("surface file 'nothing.s'"), std::string::npos) << missing.error().format();
+  EXPECT_FALSE(missing.error().notes.empty());
 }
 
 // ---- generalized cylinders (CPFG manual 6.7.3, docs/cpfg.md) ---------------------------

@@ -280,6 +280,111 @@ TEST(CpfgModel, TheChapterSixModuleNamesAreOneModuleEach) {
   EXPECT_EQ(w->size(), 1u);
 }
 
+// cpfg's reader takes a newline followed by a tab as a space (cpfg/lsys_input.l): vlab's
+// models write long successors, and a production's condition and its arrow, over lines that
+// begin with a tab. After a blank line a tab-led line is a line of its own.
+TEST(CpfgModel, ALineBeginningWithATabGoesOnTheLineBefore) {
+  // A(1): the condition on the first line, the arrow and successor on tab lines; B: a
+  // precondition block, then the arrow on the next line. The axiom goes on too.
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: A(1)\n\tB\n"
+                        "A(x) : x > 0 -->\n\tF(x)\n\t[+F]\n\tA(x - 1)\n"
+                        "B : {y = 2;}\n\t--> C(y)\nendlsystem\n"),
+            "F(1)[+F]A(0)C(2)");
+  // `#(0.06)` leading a tab line is the line-width module, not a directive; cpfg skips the
+  // blanks between a module and its arguments.
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: A\nA --> F\t// a comment\n\t#(0.06) \\ (90) f(1)\n"
+                        "endlsystem\n"),
+            "F#(0.06)\\(90)f(1)");
+  // After a blank line, a tab-led production is one of its own.
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: A B\nA --> C\n\n\tB --> D\nendlsystem\n"), "CD");
+  // sylva's own format is unchanged: a tab-led line there is a line.
+  EXPECT_EQ(derive_text("axiom: A B\nA -> C\n\tB -> D\nsteps: 1\n"), "CD");
+}
+
+// A preprocessor line that a trailing backslash carries on (vlab's models write it doubled,
+// `\\`, which cpfg's reader skips) is one directive: the model is still a cpfg file.
+TEST(CpfgPreprocessor, ABackslashCarriesADirectiveOnToTheNextLine) {
+  const char* model = "#define twice(x) \\\\\n\t(2 * x)\n#define sum(a, b) (a + \\\n b)\n"
+                      "Lsystem: 1\nderivation length: 1\nAxiom: A(3)\nA(y) --> B(twice(y), sum(y, 1))\nendlsystem\n";
+  EXPECT_TRUE(is_cpfg_text(model));
+  EXPECT_EQ(derive_text(model), "B(6,4)");
+}
+
+// C's conditional `c ? a : b` in a cpfg file's expressions and statements (cpfg's reader has
+// `?` and `:`), right associative; only the branch chosen is evaluated.
+TEST(CpfgStatements, TheConditionalOperatorChoosesOneBranch) {
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: A(1) A(-1) A(5)\n"
+                        "A(x) : * {c = x > 0 ? 3 : 4;} --> B(c, x < 0 ? -1 : x > 2 ? 2 : 1, x > -2 ? 1 : 1 / (x + 1))\n"
+                        "endlsystem\n"),
+            "B(3,1,1)B(4,-1,1)B(3,2,1)");
+  EXPECT_EQ(derive_text("Lsystem: 1\nAxiom: F(1 ? 2 : 1 / 0)\nendlsystem\n"), "F(2)");
+  expect_located({"Lsystem: 1\nAxiom: F(1 ? 2)\nendlsystem\n", 2, 15, "expected ':' in the conditional"});
+  EXPECT_FALSE(parse_error("axiom: F(1 ? 2 : 3)\n").message.empty()) << "not in sylva's own format";
+}
+
+// cpfg's strict predecessor may be several modules (its PredDiff): they match consecutive
+// modules of the word, no module passed over, with their parameter counts, and are rewritten
+// together; the right context starts after the last of them.
+TEST(CpfgModel, APredecessorOfSeveralModulesRewritesConsecutiveModulesTogether) {
+  // X F(3): A(3). X G: no match, X and G copied. F(2) F(1): 2 > 1, B(1). The last X alone.
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: X F(3) X G F(2) F(1) X\n"
+                        "XF(x) --> A(x)\nF(a) F(b) : a > b --> B(a - b)\nendlsystem\n"),
+            "A(3)XGB(1)X");
+  // Contexts around the pair: Q < Y Z > W.
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: Q Y Z W Y Z V\nQ < Y Z > W --> U\nY Z > V --> T\n"
+                        "endlsystem\n"),
+            "QUWTV");
+  expect_located({"Lsystem: 1\nAxiom: A B\nhomomorphism\nA B --> C\nendlsystem\n", 4, 1, "not supported yet"});
+  expect_located({"axiom: A B\nA B -> C\n", 2, 1, "the predecessor must be one module"});
+}
+
+// cpfg compares parameter counts when it matches (PredDiff): a module that no production of
+// its symbol takes with its count is copied; sylva's own format says so as an error.
+TEST(CpfgModel, AModuleNoProductionTakesWithItsParameterCountIsCopied) {
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: G(0.25) G\nG --> I\nendlsystem\n"), "G(0.25)I");
+  DeriveOptions one;
+  one.steps = 1;
+  auto w = derive(parse_ok("axiom: G(1)\nG -> I\n"), one);
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.error().message.find("parameter count"), std::string::npos) << w.error().message;
+}
+
+// cpfg's printf in statements (C's, as cpfg passes it on): the format with its values,
+// written where print_sink says (standard error by default); its mistakes are located.
+std::string printed_text;
+void capture(std::string_view text) { printed_text += text; }
+
+TEST(CpfgStatements, PrintfWritesItsFormatWithItsValues) {
+  printed_text.clear();
+  const PrintSink before = set_print_sink(capture);
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 2\nStart: {printf(\"n=%d x=%5.2f %%\\n\", 3.7, 0.5);}\n"
+                        "Axiom: A(1)\nA(x) : * {printf(\"[%g;%x]\", x, 255);} --> A(x + 1)\nendlsystem\n"),
+            "A(3)");
+  set_print_sink(before);
+  EXPECT_EQ(printed_text, "n=3 x= 0.50 %\n[1;ff][2;ff]");
+  expect_located({"Lsystem: 1\nStart: {printf(\"%s\", 1);}\nAxiom: F\nendlsystem\n", 2, 16, "%s"});
+  expect_located({"Lsystem: 1\nStart: {printf(\"%g %g\", 1);}\nAxiom: F\nendlsystem\n", 2, 9, "takes 2 values"});
+  expect_located({"Lsystem: 1\nStart: {printf(x);}\nAxiom: F\nendlsystem\n", 2, 16, "format string"});
+  EXPECT_NE(parse_error("axiom: F(printf(\"%g\", 1))\n").message.find("unknown function 'printf'"), std::string::npos);
+}
+
+// What cpfg's reader takes and sylva's own format does not: `%` (C's remainder of the values
+// made ints), an axiom reading the globals Start set, `a[M][N]` arrays, @L's text dropped,
+// brackets in the ignore list.
+TEST(CpfgModel, RemainderAxiomGlobalsArraysLabelsAndIgnoredBrackets) {
+  // 7 % 3 = 1; -7.9 % 3: -7 % 3 = -1 (C truncates); 5 % 2.5: 5 % 2 = 1.
+  EXPECT_EQ(derive_text("Lsystem: 1\nAxiom: F(7 % 3, -7.9 % 3, 5 % 2.5)\nendlsystem\n"), "F(1,-1,1)");
+  expect_located({"Lsystem: 1\nAxiom: F(7 % 0.5)\nendlsystem\n", 2, 12, "remainder by zero"});
+  EXPECT_FALSE(parse_error("axiom: F(7 % 3)\n").message.empty()) << "not in sylva's own format";
+  EXPECT_EQ(derive_text("Lsystem: 1\nStart: {x0 = 2; y0 = x0 * 3;}\nAxiom: A(x0, y0 + 1)\nendlsystem\n"), "A(2,7)");
+  EXPECT_EQ(derive_text("#define M 2\n#define N 3\nLsystem: 1\ndefine: {\n\tarray a[M][N] = {1, 2, 3,\n\t\t4, 5, 6};\n\t}\n"
+                        "derivation length: 1\nAxiom: A\nA --> B(a[1][2], a[0, 1])\nendlsystem\n"),
+            "B(6,2)");
+  EXPECT_EQ(derive_text("Lsystem: 1\nAxiom: F @L(\"n = %g, (%d)\", 3, 4) F\nendlsystem\n"), "F@L(3,4)F");
+  // A < B ignores + and, in a cpfg file, the brackets of the list change nothing.
+  EXPECT_EQ(derive_text("Lsystem: 1\nignore: [+]\nderivation length: 1\nAxiom: A + B\nA < B --> C\nendlsystem\n"), "A+C");
+}
+
 TEST(CpfgModel, WhatSylvaCannotReadYetIsAnErrorAtItsPlaceNamingTheFeature) {
   const LocatedError cases[] = {
       {"Lsystem: 1\nAxiom: F\nendlsystem\nLsystem: 2\nAxiom: G\nendlsystem\n", 4, 1, "sub-L-systems"},
@@ -599,7 +704,7 @@ TEST(VlabObject, WhatSylvaCannotFollowIsAnErrorAtItsPlace) {
     const char* says;
   };
   const Case cases[] = {
-      {"run:\n\tcpfg -e field.e plant.l plant.v\n", "angle factor: 8\n", "specifications", 2, 7, "environmental program"},
+      {"run:\n\tcpfg -e field.e plant.l plant.v\n", "angle factor: 8\n", "specifications", 2, 7, "environment file 'field.e'"},
       {"run:\n\tcpfg -Q plant.l plant.v\n", "angle factor: 8\n", "specifications", 2, 7, "unknown cpfg option '-Q'"},
       {"run:\n\tcpfg plant.l\n", "angle factor: 8\n", "specifications", 2, 2, "the model and the view file"},
       {"run:\n\tcpfg -w 400\n", "angle factor: 8\n", "specifications", 2, 7, "needs 2 argument"},
@@ -608,7 +713,6 @@ TEST(VlabObject, WhatSylvaCannotFollowIsAnErrorAtItsPlace) {
       {"run:\n\tcpfg plant.l plant.v\n", "initial line width: wide\n", "plant.v", 1, 21, "needs a number"},
       {"run:\n\tcpfg plant.l plant.v\n", "tropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\ntropism: T: 0 1 0\n", "plant.v", 9, 1, "more than 8 tropisms"},
       {"run:\n\tcpfg plant.l plant.v\n", "scale multiplier: 0\n", "plant.v", 1, 19, "must be a non-zero number"},
-      {"run:\n\tcpfg plant.l plant.v\n", "torque: T: 0 1 0 E: 0.1\n", "plant.v", 1, 1, "a torque"},
       {"run:\n\tcpfg plant.l plant.v\n", "tropism: T: 0 0 0 E: 0.1\n", "plant.v", 1, 9, "must not be 0"},
       {"run:\n\tcpfg plant.l missing.v\n", "", "missing.v", 0, 0, "cannot open"},
   };
@@ -627,6 +731,90 @@ TEST(VlabObject, WhatSylvaCannotFollowIsAnErrorAtItsPlace) {
   auto none = load_grammar(empty.dir().string());
   ASSERT_FALSE(none.ok());
   EXPECT_NE(none.error().message.find("not a vlab object"), std::string::npos) << none.error().format();
+}
+
+// The view file's functions (CPFG manual 5.5, 8.1.6; docs/cpfg.md "Functions"): func(id, x)
+// is the curve's y where its x is x, x clamped to [0, 1]. The S curve below has control points
+// (0, 0), (1/3, 0), (2/3, 1), (1, 1): a cubic Bézier (four points of cpfg's open B-spline)
+// with x(t) = t and y(t) = 3t² − 2t³, so y(0.25) = 0.15625, y(0.5) = 0.5.
+const char* const kSCurve = "0 0\n0.3333333333 0\n0.6666666667 1\n1 1\n";
+
+TEST(VlabObject, TheViewFilesFunctionsAnswerFunc) {
+  ModelFolder folder;
+  folder.write("specifications", "generate:\n\tcpfg plant.l plant.v\n");
+  folder.write("curve.func", std::string("fver 1 1\nname: curve\nsamples: 0\nflip: off\npoints: 4\n") + kSCurve);
+  // The older format takes the view file's samples: 3 values, at 0, 0.5 and 1, joined by lines.
+  folder.write("old.func", std::string("range: 0 1\npoints: 4\n") + kSCurve);
+  folder.write("plant.v", "angle factor: 8\nfunction: curve.func\nfunction: old.func 3\n");
+  folder.write("plant.l", "Lsystem: 1\nderivation length: 1\nAxiom: A(0.25)\n"
+                          "A(x) --> B(func(1, x), func(1, 0.5), func(2, x), func(1, -3), func(1, 7))\nendlsystem\n");
+  auto g = load_grammar(folder.dir().string());
+  ASSERT_TRUE(g.ok()) << g.error().format();
+  auto w = derive(*g);
+  ASSERT_TRUE(w.ok());
+  ASSERT_EQ(w->size(), 1u);
+  const double* p = w->params_of(w->modules[0]);
+  EXPECT_NEAR(p[0], 0.15625, 2e-3);  // within cpfg's bisection tolerance of 0.001 in x
+  EXPECT_NEAR(p[1], 0.5, 2e-3);
+  EXPECT_NEAR(p[2], 0.25, 2e-3);     // the table's line between y(0) = 0 and y(0.5) = 0.5
+  EXPECT_NEAR(p[3], 0, 2e-3);        // x below 0 is 0
+  EXPECT_NEAR(p[4], 1, 2e-3);        // x above 1 is 1
+  // A function set names its functions: each name is a macro for its id (cpfg's -D), which
+  // the model may define again. A control point's third number repeats it.
+  folder.write("shapes.fset", std::string("funcgalleryver 1 1\nitems: 2\n") +
+                                  "fver 1 1\nname: LINE\nsamples: 0\nflip: off\npoints: 4\n0 0 2\n0.5 0.5\n1 1\n1 1\n" +
+                                  "fver 1 1\nname: S\nsamples: 0\nflip: off\npoints: 4\n" + kSCurve);
+  folder.write("plant.v", "function set: shapes.fset\n");
+  folder.write("plant.l", "#define LINE 1\nLsystem: 1\nderivation length: 1\nAxiom: A(0.25)\n"
+                          "A(x) --> B(func(S, x), func(LINE, x))\nendlsystem\n");
+  auto set = load_grammar(folder.dir().string());
+  ASSERT_TRUE(set.ok()) << set.error().format();
+  ASSERT_EQ(set->program.functions.size(), 2u);
+  EXPECT_EQ(set->program.functions[1].name, "S");
+  EXPECT_EQ(set->program.functions[0].x.size(), 5u);  // (0, 0) twice
+  auto sw = derive(*set);
+  ASSERT_TRUE(sw.ok());
+  EXPECT_NEAR(sw->params_of(sw->modules[0])[0], 0.15625, 2e-3);
+  // An id no function has, a file that cannot be read, a malformed one: errors at their place.
+  folder.write("plant.l", "Lsystem: 1\nderivation length: 1\nAxiom: A(0.25)\nA(x) --> B(func(3, x))\nendlsystem\n");
+  auto three = load_grammar(folder.dir().string());
+  ASSERT_TRUE(three.ok()) << three.error().format();
+  auto bad = derive(*three);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("the function id is 1 to 2"), std::string::npos) << bad.error().message;
+  EXPECT_EQ(bad.error().loc.line, 4u);
+  folder.write("plant.v", "angle factor: 8\n\nfunction: missing.func 10\n");
+  auto missing = load_grammar(folder.dir().string());
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.error().loc.line, 3u);
+  EXPECT_NE(missing.error().message.find("cannot read the function file 'missing.func'"), std::string::npos);
+  folder.write("few.func", "fver 1 1\nname: few\nsamples: 10\nflip: off\npoints: 3\n0 0\n0.5 0.5\n1 1\n");
+  folder.write("plant.v", "function: few.func\n");
+  auto few = load_grammar(folder.dir().string());
+  ASSERT_FALSE(few.ok());
+  ASSERT_EQ(few.error().notes.size(), 1u);
+  EXPECT_NE(few.error().notes[0].file.find("few.func"), std::string::npos);
+  EXPECT_EQ(few.error().notes[0].loc.line, 5u);
+  EXPECT_NE(few.error().notes[0].message.find("at least 4"), std::string::npos);
+  // Without a vlab object's view file there are no functions.
+  EXPECT_NE(parse_error("Lsystem: 1\nAxiom: F(func(1, 0.5))\nendlsystem\n").message.find("has no functions"), std::string::npos);
+}
+
+// What the view file says as cpfg's reader reads it: `A:90` is `A: 90` (its tokens split at
+// ':'), a line style cpfg does not know keeps the style, `pixel` is `p`, and a homomorphism
+// may be as deep as vlab's models ask (`maximum depth: 3000`).
+TEST(VlabObject, TheViewFileIsReadAsCpfgReadsIt) {
+  ModelFolder folder;
+  folder.write("specifications", "generate:\n\tcpfg plant.l plant.v\n");
+  folder.write("plant.l", "Lsystem: 1\nderivation length: 1\nAxiom: A\nhomomorphism\nmaximum depth: 3000\nendlsystem\n");
+  folder.write("plant.v", "tropism: T: 1 0 0 A:90 E:0.1\ninitial line width: 2 pixel\nline style: wireframe\n");
+  auto g = load_grammar(folder.dir().string());
+  ASSERT_TRUE(g.ok()) << g.error().format();
+  ASSERT_EQ(g->turtle.view_tropisms.size(), 1u);
+  EXPECT_EQ(g->turtle.view_tropisms[0].angle_deg, 90);
+  EXPECT_EQ(g->turtle.view_tropisms[0].elasticity, 0.1);
+  EXPECT_DOUBLE_EQ(g->turtle.width, 2 * 0.05);  // pixels, kept by the unknown line style
+  EXPECT_EQ(g->max_depth, 3000);
 }
 
 // ---- chapter 5 functions ----
