@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/util/diagnostic.h"
+#include "lsystem/cpfg_contour.h"
 #include "lsystem/cpfg_surface.h"
 #include "lsystem/expr.h"
 #include "lsystem/word.h"
@@ -108,6 +109,9 @@ struct TurtleDefaults {
   // bends by all of them before every move, as cpfg does (docs/cpfg.md). sylva's own
   // `tropism:` header (has_tropism) stands for one orthotropism in a cpfg file without them.
   std::vector<ViewTropism> view_tropisms;
+  // The points around a contour (a view file's `contour sides:`, or 2^(n + 1) for its
+  // `polygonization level: n`; cpfg's default 8); @!(n) sets it for the turtle.
+  int contour_sides = 8;
 };
 
 // A file a cpfg grammar read with #include (lsystem/cpfg_preprocessor.h).
@@ -132,6 +136,8 @@ struct Grammar {
   bool cpfg = false;
   // A vlab object's predefined surfaces (its view file's `surface:` lines): `~X` draws them.
   std::vector<CpfgSurface> surfaces;
+  // Its contours (the view file's `contour:` lines): `@#(id)` sweeps them along cylinders.
+  std::vector<CpfgContour> contours;
   // A vlab object whose environmental program (`cpfg -e file.e`) is vlab's honda81: its `?E`
   // queries are answered by that program's rule (docs/cpfg.md "Environmental programs"), not
   // by light. radius: the spec file's; three_d: its `3d case: on` (else x and z are

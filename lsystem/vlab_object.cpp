@@ -255,6 +255,13 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
     auto fail_here = [&](uint32_t column, std::string message) {
       failure = error_in(path, line, line_no, column, std::move(message));
     };
+    // A file the view file names (beside it) and the error where one cannot be read: at its
+    // name, the file's own error as a note.
+    auto beside = [&](const Token& name) { return (std::filesystem::path(path).parent_path() / name.text).string(); };
+    auto fail_file = [&](const Token& name, const char* what, Diagnostic inner) {
+      fail_here(name.column + value_column - 1, std::string("cannot read the ") + what + " file '" + name.text + "'");
+      failure->notes.push_back(std::move(inner));
+    };
     auto value = [&](size_t k, double* out) {
       if (k < values.size() && number(values[k].text, out)) return true;
       fail_here(k < values.size() ? values[k].column + value_column - 1 : value_column,
@@ -304,6 +311,22 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
         if (v < 0 || v != std::floor(v)) return fail_here(values[0].column + value_column - 1, "a colour increment is a whole number from 0");
         t.color_increment = static_cast<uint32_t>(v);
       }
+    } else if (name == "contour") {
+      // "contour: id file.con" (CPFG manual 8.1.5): @#(id) selects it.
+      double id = 0;
+      if (values.size() < 2 || !number(values[0].text, &id) || id != std::floor(id) || id < 1 || id > 1e6)
+        return fail_here(value_column, "a contour needs 'contour: id file.con', the id a whole number from 1");
+      auto contour = read_cpfg_contour(beside(values[1]), static_cast<int>(id));
+      if (!contour) return fail_file(values[1], "contour", std::move(contour.error()));
+      grammar.contours.push_back(std::move(*contour));
+    } else if (name == "contour sides" || name == "polygonization level") {
+      // cpfg's points around a contour: n, or 2^(n + 1) for the level (interpret.c), at least 3.
+      if (!value(0, &v)) return;
+      const double sides = name == "contour sides" ? v : std::round(std::pow(2.0, std::min(v, 20.0) + 1));
+      if (!(sides >= 1) || sides != std::floor(sides) || sides > lsys::kMaxContourSides)
+        return fail_here(values[0].column + value_column - 1,
+                         "the sides around a contour are a whole number up to " + std::to_string(lsys::kMaxContourSides));
+      t.contour_sides = std::max(3, static_cast<int>(sides));
     } else if (name == "surface") {
       // "surface: id file size [s t [texture]]" (CPFG manual 8.1.5): the id is one character,
       // a size not above 0 is 1 (as cpfg's reader), s and t the cells a patch is cut into.
@@ -316,13 +339,9 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
       for (size_t k = 0; k < 2 && 3 + k < values.size(); ++k)
         if (!number(values[3 + k].text, &cells[k]) || cells[k] != std::floor(cells[k]) || cells[k] < 0 || cells[k] > 1e6)
           return fail_here(values[3 + k].column + value_column - 1, "a surface's cells across and along are whole numbers");
-      const std::string file = (std::filesystem::path(path).parent_path() / values[1].text).string();
-      auto surface = read_cpfg_surface(file, values[0].text[0], size, static_cast<int>(cells[0]), static_cast<int>(cells[1]));
-      if (!surface) {
-        fail_here(values[1].column + value_column - 1, "cannot read the surface file '" + values[1].text + "'");
-        failure->notes.push_back(std::move(surface.error()));
-        return;
-      }
+      auto surface = read_cpfg_surface(beside(values[1]), values[0].text[0], size, static_cast<int>(cells[0]),
+                                       static_cast<int>(cells[1]));
+      if (!surface) return fail_file(values[1], "surface", std::move(surface.error()));
       grammar.surfaces.push_back(std::move(*surface));
     } else if (name == "tropism" || name == "torque") {
       // "T: x y z A: angle I: intensity E: elasticity S: step" (manual 8.1.8).

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/util/limits.h"
@@ -47,14 +48,55 @@ struct TurtleState {
   int32_t cylinder = -1;
   bool cylinder_moves = false;
   double tangent_start = 1.2, tangent_end = 1.2;
+  // The contour @#(id) selects for the cylinders (0: the circle, drawn as frusta) and the
+  // points around one @!(n) sets (-1: the view file's `contour sides:`).
+  int contour = 0;
+  int contour_sides = -1;
+  // @Gr's radius tangents, at a piece's start and end ((0, 0): the radius changes linearly),
+  // and whether they are stretched by the piece's length (@Gr(flag)).
+  std::array<glm::dvec2, 2> radius_tangent{};
+  bool scale_radius_tangents = false;
 };
 
 // A control point of a generalized cylinder: where the turtle was, its heading, width and
 // colour.
 struct ControlPoint {
-  dvec3 position{0}, heading{0, 1, 0};
+  dvec3 position{0}, heading{0, 1, 0}, up{0, 0, 1};
   double radius = 0;
   uint32_t material = 0;
+  int contour = 0;  // TurtleState::contour
+  int sides = 8;    // the points around its contour
+  std::array<glm::dvec2, 2> radius_tangent{};  // TurtleState's
+  bool scale_radius_tangents = false;
+};
+
+// A piece's radius along it (CPFG manual 6.7.3 @Gr, cpfg's interpolate_connection): with its
+// start and end radius tangents (t, r) — a's second and b's first, the r parts times the
+// piece's length where b asks — the pair (curve parameter, radius) is a Hermite curve in the
+// piece's fraction s from (0, r0) to (1, r1); a zero tangent is (1, r1 − r0), so without @Gr
+// the parameter is s and the radius linear in it.
+struct RadiusProfile {
+  double c[4][2] = {};  // cubic coefficients in s of the parameter and the radius
+  RadiusProfile(const ControlPoint& a, const ControlPoint& b, double length) {
+    const double r0 = a.radius, dr = b.radius - a.radius;
+    glm::dvec2 ta = a.radius_tangent[1], tb = b.radius_tangent[0];
+    if (b.scale_radius_tangents) ta.y *= length, tb.y *= length;
+    if (ta == glm::dvec2(0)) ta = {1, dr};
+    if (tb == glm::dvec2(0)) tb = {1, dr};
+    const double start[2] = {0, r0}, delta[2] = {1, dr}, t0[2] = {ta.x, ta.y}, t1[2] = {tb.x, tb.y};
+    for (int k = 0; k < 2; ++k) {
+      c[0][k] = start[k];
+      c[1][k] = t0[k];
+      c[2][k] = 3 * delta[k] - 2 * t0[k] - t1[k];
+      c[3][k] = -2 * delta[k] + t0[k] + t1[k];
+    }
+  }
+  // (curve parameter clamped to [0, 1], radius not below 0) at fraction s.
+  std::pair<double, double> at(double s) const {
+    const double u = ((c[3][0] * s + c[2][0]) * s + c[1][0]) * s + c[0][0];
+    const double r = ((c[3][1] * s + c[2][1]) * s + c[1][1]) * s + c[0][1];
+    return {std::clamp(u, 0.0, 1.0), std::max(r, 0.0)};
+  }
 };
 
 // An open generalized cylinder: a Hermite curve through its control points (tangents along
@@ -320,7 +362,7 @@ std::vector<SourceLoc> places_writing(const lsys::Grammar& g, lsys::SymbolId sym
 enum class CpfgKind : uint8_t {
   kNone, kDraw, kMove, kColorUp, kColorDown, kWidthUp, kWidthDown, kLevel, kSetPosition, kSetHeading, kCircle, kSphere,
   kScaleSet, kScaleUp, kScaleDown, kForceTwist, kElasticityUp, kElasticityDown, kElasticitySet,
-  kCylinderStart, kCylinderPoint, kCylinderEnd, kCylinderTangents, kCylinderSides, kCylinderContour, kSurface,
+  kCylinderStart, kCylinderPoint, kCylinderEnd, kCylinderTangents, kCylinderSides, kCylinderContour, kSurface, kRadiusTangents,
   kUnsupported
 };
 
@@ -361,9 +403,10 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
   set("@Gc", CpfgKind::kCylinderPoint);
   set("@Ge", CpfgKind::kCylinderEnd);
   set("@Gt", CpfgKind::kCylinderTangents);
+  set("@Gr", CpfgKind::kRadiusTangents);
   set("@!", CpfgKind::kCylinderSides);
   set("@#", CpfgKind::kCylinderContour);
-  for (const char* name : {"@Gr", "@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc"})
+  for (const char* name : {"@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc"})
     set(name, CpfgKind::kUnsupported);
   return out;
 }
@@ -379,8 +422,6 @@ constexpr int kSphereSegments = 16;
 
 // The feature a cpfg symbol sylva does not draw yet belongs to, for its error.
 std::string cpfg_feature(const std::string& name) {
-  if (name == "@Gr") return "a generalized cylinder's radius tangents, CPFG manual 6.7.3; widths change linearly between control points";
-  if (name == "@#") return "a view-file contour for generalized cylinders, CPFG manual 6.7.3 and 8.1.5; the default circle is @#(0)";
   if (name.rfind("@T", 0) == 0) return "a view-file tropism, CPFG manual 6.8";
   if (name == "@;" || name == "@,") return "a back-side colour, CPFG manual 6.3";
   if (name.rfind("@P", 0) == 0 || name.rfind("@b", 0) == 0) return "a B-spline surface patch, CPFG manual 6.7.2";
@@ -444,8 +485,9 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   // Appends one piece of a cylinder's curve to its chain: `strips` joints at curve(k /
   // strips), radii from r0 to r1, in the colour of the piece's start. A new chain where
   // there is none yet or where the chain went on meanwhile (a branch drew from this point).
-  auto cylinder_piece = [&](GenCylinder& c, const dvec3& start, double r0, double r1, uint32_t material, int strips,
-                            const auto& curve) {
+  auto cylinder_piece = [&](GenCylinder& c, const dvec3& start, const RadiusProfile& profile, uint32_t material,
+                            int strips, const auto& curve) {
+    const double r0 = profile.at(0).second;
     if (c.chain < 0 || c.joint + 1 != static_cast<int64_t>(chain_joint_count[static_cast<size_t>(c.chain)])) {
       if (chain_joint_count.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many chains"};
       const std::optional<ChainParent> parent =
@@ -458,14 +500,110 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
       c.joint = 0;
     }
     for (int k = 1; k <= strips; ++k) {
-      const double tau = static_cast<double>(k) / strips;
+      const auto [tau, radius] = profile.at(static_cast<double>(k) / strips);
       const dvec3 v = curve(tau);
       check_position(v);
       uint32_t& count = chain_joint_count[static_cast<size_t>(c.chain)];
       if (count == 0xFFFFFFFFu) throw TurtleFailure{"a chain has too many joints"};
-      joints.push_back({static_cast<uint32_t>(c.chain), Joint{{v.x, v.y, v.z}, r0 + (r1 - r0) * tau, material}});
+      joints.push_back({static_cast<uint32_t>(c.chain), Joint{{v.x, v.y, v.z}, radius, material}});
       ++count;
       ++c.joint;
+    }
+  };
+  // A piece whose ends have contours (docs/cpfg.md "Contours"): instead of frusta, the
+  // contour swept along the curve as cpfg's make_contour places it — ring k at curve(k /
+  // strips), the contour interpolated from a's to b's, times the radius, its x along cpfg's
+  // up (sylva's −U) and y along −L, the frame carried along the curve from a's by the least
+  // rotation between the tangents — and polygon leaves between neighbouring rings.
+  auto contour_points = [&](int id, int sides) {
+    if (id == 0) {  // cpfg's default contour: the unit circle, closed
+      std::vector<std::array<double, 3>> circle;
+      for (int i = 0; i <= sides; ++i) {
+        const double a = 2 * kPi * (i % sides) / sides;
+        circle.push_back({std::cos(a), std::sin(a), 0.0});
+      }
+      return circle;
+    }
+    for (const lsys::CpfgContour& c : g.contours)
+      if (c.id == id) return c.sample(sides);
+    throw TurtleFailure{"@#(" + std::to_string(id) + ") names no contour of the view file ('contour: " +
+                        std::to_string(id) + " file.con')"};
+  };
+  auto contour_piece = [&](const GenCylinder& c, const ControlPoint& a, const ControlPoint& b,
+                           const RadiusProfile& profile, int strips, const auto& curve) {
+    const int sides = a.sides;
+    const auto ca = contour_points(a.contour, sides), cb = contour_points(b.contour, sides);
+    if (ca.size() != cb.size())
+      throw TurtleFailure{"a generalized cylinder changes from an open contour to a closed one (cpfg cannot mix them)"};
+    auto tangent = [&](double u) {
+      const double e = 1e-4;
+      const dvec3 d = curve(std::min(1.0, u + e)) - curve(std::max(0.0, u - e));
+      const double l = glm::length(d);
+      return l > 0 ? d / l : dvec3(0);
+    };
+    // The frames along the piece: the up vector carried by the least rotation between the
+    // tangents, then turned about them by the share s of the twist that brings it to b's up
+    // at the end (cpfg's twist_angle × t), so that pieces meet without a step.
+    struct Frame {
+      dvec3 position, heading, up;
+      double radius, s;
+    };
+    std::vector<Frame> frames;
+    frames.reserve(static_cast<size_t>(strips) + 1);
+    dvec3 heading = a.heading, up = a.up;
+    for (int k = 0; k <= strips; ++k) {
+      const double s_k = static_cast<double>(k) / strips;
+      const auto [u, r] = profile.at(s_k);
+      const dvec3 p = curve(u);
+      check_position(p);
+      const dvec3 h = tangent(u);
+      if (glm::length(h) > 0) {
+        const dvec3 axis = glm::cross(heading, h);
+        const double sin_a = glm::length(axis);
+        if (sin_a > 1e-12) up = rotate_about(up, axis / sin_a, std::atan2(sin_a, glm::dot(heading, h)));
+        heading = h;
+        up = up - glm::dot(up, heading) * heading;
+        const double ul = glm::length(up);
+        if (ul > 1e-12) up /= ul;
+      }
+      frames.push_back({p, heading, up, r, s_k});
+    }
+    double twist = 0;
+    {
+      const Frame& end = frames.back();
+      dvec3 target = b.up - glm::dot(b.up, end.heading) * end.heading;
+      if (glm::length(target) > 1e-9) {
+        target = glm::normalize(target);
+        twist = std::atan2(glm::dot(glm::cross(end.up, target), end.heading), glm::dot(end.up, target));
+      }
+    }
+    std::vector<std::array<double, 3>> previous;
+    for (int k = 0; k <= strips; ++k) {
+      const Frame& f = frames[static_cast<size_t>(k)];
+      const double s_k = f.s, r = f.radius;
+      const dvec3 p = f.position, heading = f.heading;
+      const dvec3 up = twist != 0 ? rotate_about(f.up, heading, twist * s_k) : f.up;
+      const dvec3 left = glm::cross(up, heading);
+      std::vector<std::array<double, 3>> ring;
+      ring.reserve(ca.size());
+      for (size_t i = 0; i < ca.size(); ++i) {
+        const double x = ca[i][0] + (cb[i][0] - ca[i][0]) * s_k, y = ca[i][1] + (cb[i][1] - ca[i][1]) * s_k;
+        const dvec3 v = p + r * (-x * up - y * left);
+        check_position(v);
+        ring.push_back({v.x, v.y, v.z});
+      }
+      for (size_t i = 0; k > 0 && i + 1 < ring.size(); ++i) {
+        std::vector<std::array<double, 3>> quad = {previous[i], previous[i + 1], ring[i + 1], ring[i]};
+        if (leaves.size() + 2 >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
+        if (!leaf_polygon_problem(quad)) {
+          leaves.push_back(Leaf{c.parent, a.material, std::move(quad)});
+          continue;
+        }
+        for (std::vector<std::array<double, 3>> tri :
+             {std::vector{quad[0], quad[1], quad[2]}, std::vector{quad[0], quad[2], quad[3]}})
+          if (!leaf_polygon_problem(tri)) leaves.push_back(Leaf{c.parent, a.material, std::move(tri)});
+      }
+      previous = std::move(ring);
     }
   };
   // A control point `cp` of cylinder `c`, and the piece it ends: Hermite (manual 6.7.3:
@@ -483,11 +621,14 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
       const double len = glm::length(cp.position - a.position);
       if (!(len > 0)) return;  // coincident points: no piece (cpfg draws none)
       const dvec3 ta = a.heading * (len * t_start), tb = cp.heading * (len * t_end);
-      cylinder_piece(c, a.position, a.radius, cp.radius, a.material, strips, [&](double u) {
+      const auto hermite = [&](double u) {
         const double u2 = u * u, u3 = u2 * u;
         return (2 * u3 - 3 * u2 + 1) * a.position + (u3 - 2 * u2 + u) * ta + (3 * u2 - 2 * u3) * cp.position +
                (u3 - u2) * tb;
-      });
+      };
+      const RadiusProfile profile(a, cp, len);
+      if (a.contour != 0 || cp.contour != 0) contour_piece(c, a, cp, profile, strips, hermite);
+      else cylinder_piece(c, a.position, profile, a.material, strips, hermite);
       return;
     }
     if (c.count < 3) {
@@ -503,7 +644,9 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
     };
     const dvec3 start = b(0);
     if (!(glm::length(b(1) - start) > 0)) return;
-    cylinder_piece(c, start, p1.radius, p2.radius, p1.material, strips, b);
+    const RadiusProfile profile(p1, p2, glm::length(b(1) - start));
+    if (p1.contour != 0 || p2.contour != 0) contour_piece(c, p1, p2, profile, strips, b);
+    else cylinder_piece(c, start, profile, p1.material, strips, b);
   };
   const size_t n = word.size();
   const Turn default_turn = turn_of(d.angle_deg);
@@ -548,7 +691,9 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   // The turtle's place as the open cylinder's next control point (0 strips: the default).
   auto cylinder_point = [&](int strips) {
     GenCylinder& c = cylinders[static_cast<size_t>(t.cylinder)];
-    const ControlPoint cp{t.position, t.heading, t.radius, t.material};
+    const ControlPoint cp{t.position, t.heading, t.up, t.radius, t.material, t.contour,
+                          t.contour_sides > 0 ? t.contour_sides : d.contour_sides, t.radius_tangent,
+                          t.scale_radius_tangents};
     if (c.closed && c.first_count < (c.bspline ? 3 : 1)) c.first[static_cast<size_t>(c.first_count++)] = cp;
     cylinder_control(c, cp, strips > 0 ? strips : c.default_strips, t.tangent_start, t.tangent_end);
   };
@@ -745,6 +890,20 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
             if (cpfg.kind[symbol] == CpfgKind::kCylinderEnd) cylinder_end();
             continue;
           }
+          case CpfgKind::kRadiusTangents: {  // @Gr(flag) or @Gr(angle, length[, angle2, length2]) (manual 6.7.3)
+            if (m.param_count == 1) {
+              t.scale_radius_tangents = p[0] != 0;
+            } else if (m.param_count >= 2) {
+              for (uint32_t k = 0; k < std::min<uint32_t>(m.param_count, 4); ++k)
+                if (!std::isfinite(p[k]) || std::abs(p[k]) > 1e12) throw TurtleFailure{"@Gr's angles and lengths must be finite"};
+              auto tangent = [](double angle, double length) {
+                return glm::dvec2(lsys::cos_deg(angle) * length, lsys::sin_deg(angle) * length);
+              };
+              t.radius_tangent[0] = t.radius_tangent[1] = tangent(p[0], p[1]);
+              if (m.param_count >= 4) t.radius_tangent[1] = tangent(p[2], p[3]);
+            }
+            continue;
+          }
           case CpfgKind::kCylinderTangents:  // @Gt(start, end): Hermite tangent coefficients (one: both)
             if (has) {
               const double a = p[0], b = m.param_count > 1 ? p[1] : p[0];
@@ -754,11 +913,21 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
               t.tangent_end = b;
             }
             continue;
-          case CpfgKind::kCylinderSides:  // @!(n): polygons around a cylinder; frusta are round
+          case CpfgKind::kCylinderSides:  // @!(n): the points around a contour (frusta are round)
+            if (has) {
+              if (!(p[0] >= 3) || !(p[0] <= lsys::kMaxContourSides))
+                throw TurtleFailure{"@!(n) takes 3 to " + std::to_string(lsys::kMaxContourSides) + " sides"};
+              t.contour_sides = static_cast<int>(p[0]);
+            }
             continue;
-          case CpfgKind::kCylinderContour:  // @#(id): 0 (or none) is the default circle
-            if (has && p[0] != 0)
-              throw TurtleFailure{"'@#' (" + cpfg_feature("@#") + ") is not supported yet (docs/cpfg.md)"};
+          case CpfgKind::kCylinderContour:  // @#(id): the view file's contour id; 0 (or none) the circle
+            if (!has || p[0] == 0) {
+              t.contour = 0;
+            } else {
+              if (p[0] != std::floor(p[0]) || std::abs(p[0]) > 1e6) throw TurtleFailure{"@#(id) takes a contour's id, a whole number"};
+              contour_points(static_cast<int>(p[0]), 8);  // names one of the view file's, or an error here
+              t.contour = static_cast<int>(p[0]);
+            }
             continue;
           case CpfgKind::kSurface: {
             // ~X(s) or ~X(sx, sy, sz) (CPFG manual 6.7.1): the view file's surface X at the

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
@@ -1012,8 +1013,6 @@ TEST(TurtleCpfg, AtDScalesLengthsAndWidthsAndBracketsKeepTheScale) {
 
 TEST(TurtleCpfg, SymbolsSylvaDoesNotDrawYetAreErrorsNamingTheFeature) {
   const std::pair<const char*, const char*> cases[] = {
-      {"@Gs F @Gr(30,1) @Ge", "radius tangents"},
-      {"@#(2) @Gs F @Ge", "contour"},
       {"F@PS(1)F", "patch"}, {"F@;F", "back-side colour"}};
   for (const auto& [axiom, feature] : cases) {
     const std::string message = grow_error(cpfg(axiom));
@@ -1025,16 +1024,26 @@ TEST(TurtleCpfg, SymbolsSylvaDoesNotDrawYetAreErrorsNamingTheFeature) {
 
 // ---- predefined surfaces (CPFG manual 6.7.1, 8.1.5; docs/cpfg.md "Surfaces") -----------
 
-// A vlab object in a fresh folder: `plant.l` with `axiom`, its view file `view`, and `leaf.s`,
-// one flat Bézier patch over the unit square (control points at thirds), its contact point at
-// the middle of its bottom edge, heading +y, up +z, SIZE 1.
-sylva::Expected<GrowResult> grow_with_surface(const std::string& axiom, const std::string& view) {
+// A vlab object in a fresh folder: `plant.l` with `axiom`, its view file `view`, and `files`
+// (name, text) beside them.
+sylva::Expected<GrowResult> grow_object(const std::string& axiom, const std::string& view,
+                                        const std::vector<std::pair<std::string, std::string>>& files) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("sylva_surface_" + std::to_string(::getpid()));
+  const fs::path dir = fs::temp_directory_path() / ("sylva_object_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   std::ofstream(dir / "specifications") << "generate:\n\tcpfg plant.l plant.v\n";
   std::ofstream(dir / "plant.l") << "Lsystem: 1\nAxiom: " << axiom << "\nendlsystem\n";
   std::ofstream(dir / "plant.v") << view;
+  for (const auto& [name, text] : files) std::ofstream(dir / name) << text;
+  auto g = lsys::load_grammar(dir.string());
+  fs::remove_all(dir);
+  if (!g.ok()) return g.error();
+  return grow(*g, {}, "plant", {});
+}
+
+// ... with `leaf.s`, one flat Bézier patch over the unit square (control points at thirds),
+// its contact point at the middle of its bottom edge, heading +y, up +z, SIZE 1.
+sylva::Expected<GrowResult> grow_with_surface(const std::string& axiom, const std::string& view) {
   std::string s = "0 1 0 1 0 0\nCONTACT POINT  X: 0.5 Y: 0 Z: 0\nEND POINT  X: 0.5 Y: 1 Z: 0\n"
                   "HEADING  X: 0 Y: 1 Z: 0\nUP  X: 0 Y: 0 Z: 1\nSIZE: 1\nmiddle\n"
                   "TOP COLOR: 0 DIFFUSE: 0.5 BOTTOM COLOR: 0 DIFFUSE: 0.5\nAL: ~ A: ~ AR: ~\nL: ~ R: ~\nBL: ~ B: ~ BR: ~\n";
@@ -1042,11 +1051,7 @@ sylva::Expected<GrowResult> grow_with_surface(const std::string& axiom, const st
     for (int j = 0; j < 4; ++j) s += std::to_string(j / 3.0) + " " + std::to_string(i / 3.0) + " 0  ";
     s += "\n";
   }
-  std::ofstream(dir / "leaf.s") << s;
-  auto g = lsys::load_grammar(dir.string());
-  fs::remove_all(dir);
-  if (!g.ok()) return g.error();
-  return grow(*g, {}, "plant", {});
+  return grow_object(axiom, view, {{"leaf.s", s}});
 }
 
 double polygon_area(const Leaf& leaf) {
@@ -1105,6 +1110,90 @@ TEST(TurtleCpfg, TildeDrawsTheViewFilesSurfaceAsLeavesWhereTheTurtleStands) {
   EXPECT_EQ(missing.error().loc.line, 2u);
   EXPECT_NE(missing.error().message.find("surface file 'nothing.s'"), std::string::npos) << missing.error().format();
   EXPECT_FALSE(missing.error().notes.empty());
+}
+
+// A generalized cylinder with a contour (CPFG manual 6.7.3 @#(id), 8.1.5 `contour:`; cpfg's
+// make_contour): the contour swept along the curve, x along cpfg's up (sylva's −U), times the
+// radius, as polygon leaves between neighbouring rings instead of frusta. An open straight
+// contour along x (control points at −3, −1, 1, 3: its B-spline runs from −1 to 1) makes a flat
+// ribbon in the plane of H and U.
+TEST(TurtleCpfg, AContourIsSweptAlongTheCylinderAsLeaves) {
+  const std::string flat = "cver 1 3\nname: flat\npoints: 4 4\ntype: or\nsamples: 8\n"
+                           "-3 0 0 1\n-1 0 0 1\n1 0 0 1\n3 0 0 1\n";
+  auto grown = grow_object("@#(1) @Gs f(2) @Ge(4)", "initial line width: 1 shaded\ncontour: 1 flat.con\n",
+                           {{"flat.con", flat}});
+  ASSERT_TRUE(grown.ok()) << grown.error().format();
+  const Skeleton& sk = grown->skeleton;
+  EXPECT_TRUE(sk.chains.empty()) << "a contour's cylinder draws no frusta";
+  ASSERT_EQ(sk.leaves.size(), 32u);  // 8 sides (cpfg's default) × 4 strips, each flat
+  double area = 0, lo_z = 1e9, hi_z = -1e9;
+  for (const Leaf& leaf : sk.leaves) {
+    area += polygon_area(leaf);
+    for (const auto& v : leaf.vertices_m) {
+      EXPECT_NEAR(v[0], 0, 1e-9);
+      lo_z = std::min(lo_z, v[2]), hi_z = std::max(hi_z, v[2]);
+    }
+  }
+  // cpfg's partial lengths stop a tenth of a parameter unit before an open contour's end
+  // (general.c: t < segments), so the ribbon runs from x = −1 to 0.8: 0.9 wide, x = −1 at +z.
+  EXPECT_NEAR(area, 2 * 0.9, 1e-9);
+  EXPECT_NEAR(lo_z, -0.4, 1e-9);
+  EXPECT_NEAR(hi_z, 0.5, 1e-9);
+  // `contour sides:` and @!(n) set the points around; @#(0) is the circle: frusta again.
+  auto sides = grow_object("@!(4) @#(1) @Gs f(2) @Ge(4)", "initial line width: 1 shaded\ncontour: 1 flat.con\n",
+                           {{"flat.con", flat}});
+  ASSERT_TRUE(sides.ok());
+  EXPECT_EQ(sides->skeleton.leaves.size(), 16u);
+  auto round = grow_object("@#(1) @#(0) @Gs f(2) @Ge(4)", "contour: 1 flat.con\n", {{"flat.con", flat}});
+  ASSERT_TRUE(round.ok());
+  EXPECT_EQ(round->skeleton.chains.size(), 1u);
+  EXPECT_TRUE(round->skeleton.leaves.empty());
+  // A contour the view file does not name is an error at the module; a malformed file at its line.
+  auto none = grow_object("@#(2) @Gs f(2) @Ge(4)", "contour: 1 flat.con\n", {{"flat.con", flat}});
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.error().message.find("names no contour"), std::string::npos) << none.error().format();
+  auto bad = grow_object("F", "contour: 1 flat.con\n", {{"flat.con", "cver 1 3\nname: x\npoints: 4 4\ntype: or\n1 2\n"}});
+  ASSERT_FALSE(bad.ok());
+  ASSERT_EQ(bad.error().notes.size(), 1u);
+  EXPECT_EQ(bad.error().notes[0].loc.line, 5u);
+}
+
+// A closed contour is sampled by arc length, its first point turned onto +x, its last the first.
+TEST(TurtleCpfg, AClosedContourIsSampledEvenlyByArcLength) {
+  lsys::CpfgContour square;
+  square.closed = true;
+  square.control = {{1, 1, 0}, {-1, 1, 0}, {-1, -1, 0}, {1, -1, 0}};  // a rounded square, symmetric
+  const auto pts = square.sample(16);
+  ASSERT_EQ(pts.size(), 17u);
+  EXPECT_EQ(pts.front(), pts.back());
+  EXPECT_NEAR(pts[0][1], 0, 1e-6);
+  EXPECT_GT(pts[0][0], 0);
+  std::vector<double> steps;
+  for (size_t i = 0; i + 1 < pts.size(); ++i) steps.push_back(std::hypot(pts[i + 1][0] - pts[i][0], pts[i + 1][1] - pts[i][1]));
+  const auto [lo, hi] = std::minmax_element(steps.begin(), steps.end());
+  EXPECT_LT(*hi / *lo, 1.05) << "chords of equal arcs on a symmetric curve";
+}
+
+// @Gr (CPFG manual 6.7.3, cpfg's interpolate_connection): the radius and the curve's parameter
+// along a piece follow a Hermite curve with the radius tangents (angle, length); without them
+// the radius changes linearly. Tangents at 45° of length 1 and equal end radii r: the radius
+// is r + t·s − 3t·s² + 2t·s³ with t = sin 45°, r + 0.0663 at a quarter of the piece.
+TEST(TurtleCpfg, GrBendsTheRadiusAlongAPieceByItsTangents) {
+  const Skeleton plain = skeleton_of(cpfg("!(2)@Gs f(2) @Ge(4)"));
+  const Skeleton bent = skeleton_of(cpfg("!(2)@Gr(45,1)@Gs f(2) @Ge(4)"));
+  ASSERT_EQ(plain.joints.size(), 5u);
+  ASSERT_EQ(bent.joints.size(), 5u);
+  const double r = 0.1, t = std::sqrt(0.5);
+  for (const Joint& j : plain.joints) EXPECT_DOUBLE_EQ(j.radius_m, r);
+  auto radius = [&](double s) { return r + t * s + (-3 * t) * s * s + (2 * t) * s * s * s; };
+  auto parameter = [&](double s) { return t * s + (3 - 3 * t) * s * s + (-2 + 2 * t) * s * s * s; };
+  // The straight Hermite piece from y = 0 to 2, tangents 2 × 1.2 along +y: y(u) = 0.8u³ − 1.2u² + 2.4u.
+  auto along = [](double u) { return 0.8 * u * u * u - 1.2 * u * u + 2.4 * u; };
+  for (int k = 0; k <= 4; ++k) {
+    EXPECT_NEAR(bent.joints[static_cast<size_t>(k)].radius_m, radius(k / 4.0), 1e-12) << k;
+    EXPECT_NEAR(bent.joints[static_cast<size_t>(k)].position_m[1], along(parameter(k / 4.0)), 1e-12) << k;
+  }
+  EXPECT_NEAR(bent.joints[1].radius_m, r + 0.0663, 1e-4);
 }
 
 // ---- generalized cylinders (CPFG manual 6.7.3, docs/cpfg.md) ---------------------------
