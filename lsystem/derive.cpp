@@ -62,6 +62,7 @@ class Rewriter {
     uint32_t slots = 0;
     for (const Production& p : productions_) slots = std::max(slots, p.slot_count);
     slots_.assign(slots + 1, 0.0);
+    has_rest_of_branch_ = g_.cpfg && g_.symbols.find("=", &rest_of_branch_);
     direct_.assign(by_symbol_.size(), nullptr);
     for (size_t s = 0; s < by_symbol_.size(); ++s) {
       if (by_symbol_[s].empty()) continue;
@@ -501,6 +502,14 @@ class Rewriter {
         ++j;
         continue;
       }
+      if (has_rest_of_branch_ && pm.symbol == rest_of_branch_ && pm.arity == 0) {
+        // cpfg's `=` in a right context (generate.c: skipright): the rest of the branch the
+        // pattern is in, whatever it holds, up to its `]`.
+        const size_t close = !entered_.empty() ? v.get(*v.match, entered_.back()) : v.get(*v.branch_end, j);
+        if (close >= n) return false;
+        j = close;
+        continue;
+      }
       if (pm.symbol == kSymPop) {
         if (v.get(*v.skip_ignored, j) >= n) return false;
         size_t close;
@@ -672,6 +681,8 @@ class Rewriter {
   uint64_t seed_;
   uint64_t max_modules_;
   EvalContext* context_;  // the L-system's global variables (cpfg); null-free: never null
+  SymbolId rest_of_branch_ = 0;  // a cpfg file's `=` (match_right), when has_rest_of_branch_
+  bool has_rest_of_branch_ = false;
   bool uses_context_ = false;
   const Word* in_ = nullptr;
   Word* out_ = nullptr;

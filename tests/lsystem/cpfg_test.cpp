@@ -385,6 +385,20 @@ TEST(CpfgModel, RemainderAxiomGlobalsArraysLabelsAndIgnoredBrackets) {
   EXPECT_EQ(derive_text("Lsystem: 1\nignore: [+]\nderivation length: 1\nAxiom: A + B\nA < B --> C\nendlsystem\n"), "A+C");
 }
 
+// cpfg's `=` in a right context (generate.c's skipright) stands for the rest of the branch the
+// pattern is in: the pipe models of vlab's Borchert–Slade and Lilac read a lateral's first
+// module whatever follows it. I(1) sees [I(2) ...] and then I(3): I(6). sylva's own format has
+// no such symbol (there `=` would be a module).
+TEST(CpfgModel, AnEqualsSignInARightContextIsTheRestOfTheBranch) {
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: I(1) [I(2) X Y] I(3)\n"
+                        "I(a) > [I(b)=]I(c) --> I(a + b + c)\nendlsystem\n"),
+            "I(6)[I(2)XY]I(3)");
+  // `=` over nothing (the branch ends at once) still matches; nothing after the branch: none.
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: I(1) [I(2)] I(3) [I(4) X]\n"
+                        "I(a) > [I(b)=]I(c) --> I(a + b + c)\nendlsystem\n"),
+            "I(6)[I(2)]I(3)[I(4)X]");
+}
+
 TEST(CpfgModel, WhatSylvaCannotReadYetIsAnErrorAtItsPlaceNamingTheFeature) {
   const LocatedError cases[] = {
       {"Lsystem: 1\nAxiom: F\nendlsystem\nLsystem: 2\nAxiom: G\nendlsystem\n", 4, 1, "sub-L-systems"},
