@@ -222,7 +222,8 @@ Status answer_density(LightJob& job) {
   const double r2 = field.radius * field.radius;
   const double cell = field.radius > 0 ? field.radius : 1.0;
   auto key_of = [&](const glm::dvec3& p, int dx, int dy, int dz) {
-    auto c = [&](double v, int d) { return static_cast<int64_t>(std::floor(v / cell)) + d; };
+    // Clamped: a tiny radius over a far position must not overflow the cast.
+    auto c = [&](double v, int d) { return static_cast<int64_t>(std::clamp(std::floor(v / cell), -4e18, 4e18)) + d; };
     const uint64_t a = static_cast<uint64_t>(c(p.x, dx)), b = static_cast<uint64_t>(c(p.y, dy)),
                    z = static_cast<uint64_t>(c(p.z, dz));
     return mix_pair(mix_pair(a, b), z);

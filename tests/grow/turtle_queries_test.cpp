@@ -83,6 +83,8 @@ TEST(TurtleQueries, Honda81AnswersEByTheQueriesWithinItsRadius) {
   // Without `3d case: on` only x and z count: 5 apart along y is no distance.
   EXPECT_EQ(grown_in_honda81("?E(1)f(5)?E(1)", memory, "radius: 0.5\n3d case: on\n"), "?E(1)f(5)?E(1)");
   EXPECT_EQ(grown_in_honda81("?E(1)f(5)?E(1)", memory, "radius: 0.5\n"), "?E(0)f(5)?E(0)");
+  // A radius far below the positions' scale (the neighbour grid's cells stay in range).
+  EXPECT_EQ(grown_in_honda81("?E(1)f(1e9)?E(1)", memory, "radius: 1e-300\n3d case: on\n"), "?E(1)f(1e+09)?E(1)");
   // Another program is an error at the -e, the program named; honda81's own mistakes at theirs.
   const std::string chiba = grown_in_honda81("?E(1)", "executable: chiba -e x.e light.spec\n", "");
   EXPECT_NE(chiba.find("specifications:2:20"), std::string::npos) << chiba;
