@@ -76,6 +76,18 @@ int option_arguments(const std::string& option) {
   return -1;
 }
 
+// A view, environment or specification file's command line "name: values": the name in lower
+// case without the blanks around it, and where its colon is; nullopt for a line without one
+// (blank or stray: cpfg skips it).
+std::optional<size_t> command_of(std::string_view line, std::string* name) {
+  const size_t colon = line.find(':');
+  if (colon == std::string_view::npos) return std::nullopt;
+  *name = lower_ascii(line.substr(0, colon));
+  while (!name->empty() && is_space(name->back())) name->pop_back();
+  while (!name->empty() && is_space(name->front())) name->erase(name->begin());
+  return colon;
+}
+
 // The view file's user-defined functions (CPFG manual 8.1.6), in order: `function: file [n]`
 // and `function set: file` (a set replaces the functions before it, as cpfg's reader does, and
 // its names become macros NAME = id for the model, as cpfg's -D). Files are in the object's
@@ -89,11 +101,10 @@ Status read_view_functions(const std::string& view, const std::string& folder, P
   std::optional<Diagnostic> failure;
   for_each_physical_line(clean, [&](uint32_t line_no, std::string_view line, bool) {
     if (failure) return;
-    const size_t colon = line.find(':');
-    if (colon == std::string_view::npos) return;
-    std::string name = lower_ascii(line.substr(0, colon));
-    while (!name.empty() && is_space(name.back())) name.pop_back();
-    while (!name.empty() && is_space(name.front())) name.erase(name.begin());
+    std::string name;
+    const std::optional<size_t> found = command_of(line, &name);
+    if (!found) return;  // not a command: cpfg skips it
+    const size_t colon = *found;
     if (name != "function" && name != "function set") return;
     const std::vector<Token> values = tokens_of(line.substr(colon + 1));
     const uint32_t base = static_cast<uint32_t>(colon + 1);
@@ -145,10 +156,10 @@ Expected<Grammar::DensityField> read_density_environment(const std::string& path
   uint32_t executable_line = 0, formats_line_no = 0;
   std::string executable_text;
   for_each_physical_line(*text, [&](uint32_t line_no, std::string_view line, bool) {
-    const size_t colon = line.find(':');
-    if (colon == std::string_view::npos) return;
-    std::string name = lower_ascii(line.substr(0, colon));
-    while (!name.empty() && is_space(name.back())) name.pop_back();
+    std::string name;
+    const std::optional<size_t> found = command_of(line, &name);
+    if (!found) return;  // not a command: cpfg skips it
+    const size_t colon = *found;
     const std::vector<Token> values = tokens_of(line.substr(colon + 1));
     if (name == "executable" && !values.empty()) {
       *program = fs::path(values[0].text).filename().string();
@@ -191,10 +202,10 @@ Expected<Grammar::DensityField> read_density_environment(const std::string& path
   std::optional<Diagnostic> failure;
   for_each_physical_line(*spec_text, [&](uint32_t line_no, std::string_view line, bool) {
     if (failure) return;
-    const size_t colon = line.find(':');
-    if (colon == std::string_view::npos) return;
-    std::string name = lower_ascii(line.substr(0, colon));
-    while (!name.empty() && is_space(name.back())) name.pop_back();
+    std::string name;
+    const std::optional<size_t> found = command_of(line, &name);
+    if (!found) return;  // not a command: cpfg skips it
+    const size_t colon = *found;
     const std::vector<Token> values = tokens_of(line.substr(colon + 1));
     if (values.empty()) return;
     if (name == "radius") {
@@ -245,11 +256,10 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
   std::optional<Diagnostic> failure;
   for_each_physical_line(clean, [&](uint32_t line_no, std::string_view line, bool) {
     if (failure) return;
-    const size_t colon = line.find(':');
-    if (colon == std::string_view::npos) return;  // not a command (a blank or stray line): cpfg skips it
-    std::string name = lower_ascii(line.substr(0, colon));
-    while (!name.empty() && is_space(name.back())) name.pop_back();
-    while (!name.empty() && is_space(name.front())) name.erase(name.begin());
+    std::string name;
+    const std::optional<size_t> found = command_of(line, &name);
+    if (!found) return;  // not a command: cpfg skips it
+    const size_t colon = *found;
     std::vector<Token> values = tokens_of(line.substr(colon + 1));
     const uint32_t value_column = static_cast<uint32_t>(colon + 2);
     auto fail_here = [&](uint32_t column, std::string message) {

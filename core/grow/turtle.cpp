@@ -2,6 +2,7 @@
 #include "core/grow/turtle.h"
 
 #include <algorithm>
+#include <map>
 #include <chrono>
 #include <cmath>
 #include <glm/geometric.hpp>
@@ -515,24 +516,47 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   // strips), the contour interpolated from a's to b's, times the radius, its x along cpfg's
   // up (sylva's −U) and y along −L, the frame carried along the curve from a's by the least
   // rotation between the tangents — and polygon leaves between neighbouring rings.
-  auto contour_points = [&](int id, int sides) {
-    if (id == 0) {  // cpfg's default contour: the unit circle, closed
-      std::vector<std::array<double, 3>> circle;
-      for (int i = 0; i <= sides; ++i) {
-        const double a = 2 * kPi * (i % sides) / sides;
-        circle.push_back({std::cos(a), std::sin(a), 0.0});
-      }
-      return circle;
+  // One cell of a surface or a swept contour (quad: its corners in order) as polygon leaves:
+  // the quad where it is flat, else its two triangles, each kept only where it has area.
+  auto add_cell = [&](const std::optional<ChainParent>& at, uint32_t material, std::vector<std::array<double, 3>> quad) {
+    if (leaves.size() + 2 >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
+    if (!leaf_polygon_problem(quad)) {
+      leaves.push_back(Leaf{at, material, std::move(quad)});
+      return;
     }
-    for (const lsys::CpfgContour& c : g.contours)
-      if (c.id == id) return c.sample(sides);
+    for (std::vector<std::array<double, 3>> tri :
+         {std::vector{quad[0], quad[1], quad[2]}, std::vector{quad[0], quad[2], quad[3]}})
+      if (!leaf_polygon_problem(tri)) leaves.push_back(Leaf{at, material, std::move(tri)});
+  };
+  // A view-file contour's id, checked (0 is cpfg's default circle).
+  auto check_contour = [&](int id) {
+    if (id == 0 || std::any_of(g.contours.begin(), g.contours.end(), [&](const lsys::CpfgContour& c) { return c.id == id; }))
+      return;
     throw TurtleFailure{"@#(" + std::to_string(id) + ") names no contour of the view file ('contour: " +
                         std::to_string(id) + " file.con')"};
+  };
+  // Contour `id` sampled to `sides` points, once per (id, sides) for the whole word.
+  std::map<std::pair<int, int>, std::vector<std::array<double, 3>>> sampled_contours;
+  auto contour_points = [&](int id, int sides) -> const std::vector<std::array<double, 3>>& {
+    auto [it, added] = sampled_contours.try_emplace({id, sides});
+    if (!added) return it->second;
+    if (id == 0) {  // cpfg's default contour: the unit circle, closed
+      for (int i = 0; i <= sides; ++i) {
+        const double a = 2 * kPi * (i % sides) / sides;
+        it->second.push_back({std::cos(a), std::sin(a), 0.0});
+      }
+      return it->second;
+    }
+    check_contour(id);
+    for (const lsys::CpfgContour& c : g.contours)
+      if (c.id == id) it->second = c.sample(sides);
+    return it->second;
   };
   auto contour_piece = [&](const GenCylinder& c, const ControlPoint& a, const ControlPoint& b,
                            const RadiusProfile& profile, int strips, const auto& curve) {
     const int sides = a.sides;
-    const auto ca = contour_points(a.contour, sides), cb = contour_points(b.contour, sides);
+    const auto& ca = contour_points(a.contour, sides);
+    const auto& cb = contour_points(b.contour, sides);
     if (ca.size() != cb.size())
       throw TurtleFailure{"a generalized cylinder changes from an open contour to a closed one (cpfg cannot mix them)"};
     auto tangent = [&](double u) {
@@ -592,17 +616,8 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
         check_position(v);
         ring.push_back({v.x, v.y, v.z});
       }
-      for (size_t i = 0; k > 0 && i + 1 < ring.size(); ++i) {
-        std::vector<std::array<double, 3>> quad = {previous[i], previous[i + 1], ring[i + 1], ring[i]};
-        if (leaves.size() + 2 >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
-        if (!leaf_polygon_problem(quad)) {
-          leaves.push_back(Leaf{c.parent, a.material, std::move(quad)});
-          continue;
-        }
-        for (std::vector<std::array<double, 3>> tri :
-             {std::vector{quad[0], quad[1], quad[2]}, std::vector{quad[0], quad[2], quad[3]}})
-          if (!leaf_polygon_problem(tri)) leaves.push_back(Leaf{c.parent, a.material, std::move(tri)});
-      }
+      for (size_t i = 0; k > 0 && i + 1 < ring.size(); ++i)
+        add_cell(c.parent, a.material, {previous[i], previous[i + 1], ring[i + 1], ring[i]});
       previous = std::move(ring);
     }
   };
@@ -925,7 +940,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
               t.contour = 0;
             } else {
               if (p[0] != std::floor(p[0]) || std::abs(p[0]) > 1e6) throw TurtleFailure{"@#(id) takes a contour's id, a whole number"};
-              contour_points(static_cast<int>(p[0]), 8);  // names one of the view file's, or an error here
+              check_contour(static_cast<int>(p[0]));  // one of the view file's, or an error here
               t.contour = static_cast<int>(p[0]);
             }
             continue;
@@ -965,16 +980,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
               for (int a = 0; a < surface->s_cells; ++a)
                 for (int b = 0; b < surface->t_cells; ++b) {
                   const auto corner = [&](int da, int db) { return place(grid[static_cast<size_t>((a + da) * columns + b + db)]); };
-                  std::vector<std::array<double, 3>> quad = {corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)};
-                  if (leaves.size() + 2 >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
-                  if (!leaf_polygon_problem(quad)) {
-                    leaves.push_back(Leaf{at, t.material, std::move(quad)});
-                    continue;
-                  }
-                  // Not flat (or a collapsed edge): two triangles, each kept when it has area.
-                  for (std::vector<std::array<double, 3>> tri : {std::vector{quad[0], quad[1], quad[2]},
-                                                                 std::vector{quad[0], quad[2], quad[3]}})
-                    if (!leaf_polygon_problem(tri)) leaves.push_back(Leaf{at, t.material, std::move(tri)});
+                  add_cell(at, t.material, {corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)});
                 }
             continue;
           }
