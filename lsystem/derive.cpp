@@ -112,6 +112,7 @@ class Rewriter {
         progress.report(static_cast<double>(i) / static_cast<double>(n), stage);
       }
       Rng rng;
+      tail_ = TailView{&in, i + 1, 1, n - i - 1, active_in, 0};
       const Production* chosen = (!active_in || (*active_in)[i]) ? select(in, i, stream, rng) : nullptr;
       if (!chosen) {
         copy_module(in, i, out);
@@ -159,6 +160,7 @@ class Rewriter {
       }
       const size_t i = n - 1 - done;
       Rng rng;
+      tail_ = TailView{};  // a cpfg predecessor's further modules: cpfg has no backward passes
       const Production* chosen = select(in, i, stream, rng);
       if (!chosen) {
         copy_module(in, i, rev);
@@ -212,6 +214,7 @@ class Rewriter {
       stack_depth_.clear();
       copy_module(in, i, stack_);
       stack_depth_.push_back(1);
+      size_t consumed = 0;  // modules of `in` after i that a predecessor took with it
       while (!stack_.modules.empty()) {
         const size_t t = stack_.size() - 1;
         const Module m = stack_.modules[t];
@@ -222,6 +225,10 @@ class Rewriter {
         const bool has_rules = !by_symbol_[m.symbol].empty();
         if (has_rules && d <= max_depth) {
           in_ = &stack_;
+          // A cpfg predecessor's further modules (CPFG generate.c, ApplyRecursiveProductions):
+          // at depth 1 the word's next modules, deeper the rest of the same successor, which
+          // lies below t on the stack at the same depth.
+          tail_ = d == 1 ? TailView{&in, i + 1, 1, n - i - 1, nullptr, 0} : TailView{&stack_, t - 1, -1, t, nullptr, d};
           const Production* direct = direct_[m.symbol];
           if (direct && direct->predecessor.arity == m.param_count) {
             chosen = direct;
@@ -242,6 +249,8 @@ class Rewriter {
         apply(*chosen, t, rng, keyed);
         out_ = &out;
         pop(t);
+        if (d == 1) consumed = chosen->predecessor_tail.size();
+        else for (size_t k = 0; k < chosen->predecessor_tail.size(); ++k) pop(stack_.size() - 1);
         // A failure while pushing names the production, not a module (t is gone).
         current_production = chosen;
         current = SIZE_MAX;
@@ -251,6 +260,7 @@ class Rewriter {
           stack_depth_.push_back(d + 1);
         }
       }
+      i += consumed;
     }
   }
 
@@ -540,13 +550,16 @@ class Rewriter {
   // the predecessor's place in a forward pass, after it in a backward one; it never wraps.
   bool matches(const Production& p, size_t i, const Module& m) {
     bind(p.predecessor, in_->params_of(m));
-    // A cpfg predecessor's further modules: the very next ones, same symbol and count.
+    // A cpfg predecessor's further modules: the very next ones (tail_), same symbol and count.
     for (size_t k = 0; k < p.predecessor_tail.size(); ++k) {
       const PatternModule& pm = p.predecessor_tail[k];
-      if (i + 1 + k >= in_->size()) return false;
-      const Module& next = in_->modules[i + 1 + k];
+      if (k >= tail_.count) return false;
+      const size_t j = tail_.first + static_cast<size_t>(tail_.step * static_cast<ptrdiff_t>(k));
+      if (tail_.active && !(*tail_.active)[j]) return false;
+      if (tail_.depth && stack_depth_[j] != tail_.depth) return false;
+      const Module& next = tail_.word->modules[j];
       if (next.symbol != pm.symbol || next.param_count != pm.arity) return false;
-      bind(pm, in_->params_of(next));
+      bind(pm, tail_.word->params_of(next));
     }
     if (!p.left_context.empty()) {
       const bool ok = p.new_left ? match_left(p.left_context, *out_, new_skip_left_, out_->size(), false)
@@ -691,6 +704,18 @@ class Rewriter {
   std::vector<uint32_t> match_;
   std::vector<uint32_t> open_;
   std::vector<uint32_t> entered_;
+  // Where matches() looks for a cpfg predecessor's further modules: the k-th (k < count) is
+  // word->modules[first + step * k]; with `active`, only a module flagged there; with
+  // `depth` (expand()'s stack), only one of that depth, of the same successor.
+  struct TailView {
+    const Word* word = nullptr;
+    size_t first = 0;
+    ptrdiff_t step = 1;
+    size_t count = 0;
+    const std::vector<uint8_t>* active = nullptr;
+    int depth = 0;
+  };
+  TailView tail_;
   std::vector<uint32_t> skip_ignored_, skip_right_, branch_end_;
   std::vector<uint32_t> skip_left_;
   bool uses_left_context_ = false, uses_right_context_ = false;  // old context (the word before the pass)

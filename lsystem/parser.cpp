@@ -1097,9 +1097,9 @@ void Parser::parse_production(const LogicalLine& line) {
   Cursor left = all.sub(all.pos, arrow);
   Cursor right = all.sub(arrow + arrow_len, line.text.size());
 
-  // Label "p<digits>:".
+  // Label "p<digits>:" (sylva's format; cpfg has none: "AXIOM : c" is five modules and a condition).
   left.skip_spaces();
-  {
+  if (!g_.cpfg) {
     size_t q = left.pos;
     while (q < left.end && is_ident_char(line.text[q])) ++q;
     size_t r = q;
@@ -1186,10 +1186,8 @@ void Parser::parse_production(const LogicalLine& line) {
     std::vector<PatternModule> pm = compile_pattern(pred, scope, "the predecessor");
     // cpfg's reader takes a strict predecessor of several modules (`f?E(x) --> ...`, its
     // PredDiff): they match consecutive modules of the word and are rewritten together.
-    if (pm.size() != 1 && !(g_.cpfg && section_ == Section::kProductions && !pm.empty()))
-      fail(t.loc(), g_.cpfg ? "a predecessor of several modules is not supported yet in a homomorphism or a "
-                              "decomposition (docs/cpfg.md)"
-                            : "the predecessor must be one module (use '<' and '>' for context)");
+    if (pm.size() != 1 && !(g_.cpfg && !pm.empty()))
+      fail(t.loc(), "the predecessor must be one module (use '<' and '>' for context)");
     for (const PatternModule& m : pm)
       if (m.symbol == kSymPush || m.symbol == kSymPop) fail(t.loc(), "brackets cannot be rewritten");
     p.predecessor = pm[0];

@@ -334,8 +334,32 @@ TEST(CpfgModel, APredecessorOfSeveralModulesRewritesConsecutiveModulesTogether) 
   EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: Q Y Z W Y Z V\nQ < Y Z > W --> U\nY Z > V --> T\n"
                         "endlsystem\n"),
             "QUWTV");
-  expect_located({"Lsystem: 1\nAxiom: A B\nhomomorphism\nA B --> C\nendlsystem\n", 4, 1, "not supported yet"});
   expect_located({"axiom: A B\nA B -> C\n", 2, 1, "the predecessor must be one module"});
+}
+
+// In a homomorphism or a decomposition too (generate.c's ApplyRecursiveProductions): at the
+// first depth the word's consecutive modules, deeper the rest of the same successor only.
+// cpfg has no labels: "AXIOM : c" is five modules and a condition (vlab's Lilac), "Sl :" two.
+TEST(CpfgModel, APredecessorOfSeveralModulesWorksInAHomomorphismAndADecomposition) {
+  // Homomorphism: L becomes S l T; "S l" is rewritten at depth 2, "l T" never (S l went first).
+  const std::string homo = "Lsystem: 0\nderivation length: 0\nAxiom: L F L\nhomomorphism\nmaximum depth: 3\n"
+                           "L --> S l T\nSl : 1 --> [G]\nl T --> X\nT --> +\nendlsystem\n";
+  auto g = parse_grammar(homo, "h.l");
+  ASSERT_TRUE(g.ok()) << g.error().message;
+  EXPECT_EQ(drawn_text(*g), "[G]+F[G]+");
+  // Depth 1 reads the word: A B together; a B that ended another successor is not taken.
+  const std::string pair = "Lsystem: 0\nderivation length: 0\nAxiom: A B A C\nhomomorphism\nmaximum depth: 3\n"
+                           "A B --> F\nC --> A\nA --> G\nendlsystem\n";
+  auto h = parse_grammar(pair, "p.l");
+  ASSERT_TRUE(h.ok()) << h.error().message;
+  EXPECT_EQ(drawn_text(*h), "FGG");
+  // Decomposition of the axiom, five modules with a condition; its result stays in the word.
+  EXPECT_EQ(derive_text("#define SW 2\nLsystem: 1\nderivation length: 0\nAxiom: AXIOM\ndecomposition\n"
+                        "maximum depth: 10\nAXIOM : SW == 1 --> F\nAXIOM : SW == 2 --> K(2)\nendlsystem\n"),
+            "K(2)");
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: Q\nQ --> Q Y Z\ndecomposition\n"
+                        "maximum depth: 10\nY Z --> W(1)\nendlsystem\n"),
+            "QW(1)");
 }
 
 // cpfg compares parameter counts when it matches (PredDiff): a module that no production of
