@@ -921,7 +921,7 @@ struct Derivation::Impl {
 
   const Grammar& g;
   const DeriveOptions& options;
-  const int64_t steps;
+  int64_t steps;  // the derivation length; a stop() (CPFG manual 5.6) shortens it
   uint64_t seed;
   // A cpfg file's global variables, 0 until a block or a production assigns them.
   std::vector<double> globals;
@@ -976,12 +976,13 @@ Status Derivation::start() {
     m.cur.lineage.resize(m.cur.size());
     for (size_t i = 0; i < m.cur.size(); ++i) m.cur.lineage[i] = mix_pair(kAxiomKeyBase, i);
   }
-  if (g.uses_cut) apply_cut(m.cur);
+  const bool cut_now = g.uses_cut && !g.cpfg;  // a cpfg file's % cuts when the next step reads it
+  if (cut_now) apply_cut(m.cur);
   m.reset_rewriters();
   if (m.decomposer) {
     try {
       m.decompose(0);
-      if (g.uses_cut) apply_cut(m.cur);
+      if (cut_now) apply_cut(m.cur);
     } catch (const DeriveCancelled&) {
       return cancelled_diagnostic();
     } catch (const DeriveFailure& f) {
@@ -991,6 +992,7 @@ Status Derivation::start() {
     }
   }
   m.peak = m.cur.capacity_bytes();
+  if (m.context.stop) m.steps = 0;  // stop() in the Start block or the axiom's decomposition
   if (m.options.on_step && !m.options.on_step(0, m.cur)) return m.stopped_at(0);
   m.failed = false;
   return {};
@@ -1013,6 +1015,9 @@ Status Derivation::advance() {
     const double share = 1.0 / static_cast<double>(m.steps) / static_cast<double>(pass_count);
     for (size_t k = 0; k < pass_count; ++k) {
       m.active = &m.passes[k];
+      // cpfg (generate.c's ApplyProd): a % of the word before the step, which no production
+      // rewrites, drops itself and the rest of its branch as the step reads it.
+      if (g.uses_cut && g.cpfg) apply_cut(m.cur);
       const uint64_t before = m.cur.size();
       m.next.clear();
       reserve_for_growth(m.next, m.cur.size(), m.growth, m.options.max_modules);
@@ -1022,7 +1027,7 @@ Status Derivation::advance() {
       // Pass 0 keeps the streams a one-pass grammar always had: the step's number.
       const uint64_t stream = static_cast<uint64_t>(step) | (static_cast<uint64_t>(k) << 56);
       m.passes[k].rewrite(m.cur, m.next, stream, nullptr, nullptr, pass_progress, "derive", g.passes[k].backward);
-      if (g.uses_cut) apply_cut(m.next);
+      if (g.uses_cut && !g.cpfg) apply_cut(m.next);
       if (step < m.steps || k + 1 < pass_count) pass_progress.report(1, "derive");  // the last 1 is the whole's
       m.peak = std::max<uint64_t>(m.peak, m.cur.capacity_bytes() + m.next.capacity_bytes());
       m.growth = before ? std::max(1.0, static_cast<double>(m.next.size()) / static_cast<double>(before)) : 2.0;
@@ -1031,10 +1036,11 @@ Status Derivation::advance() {
     m.active = &m.passes[0];
     if (m.decomposer) {
       m.decompose(step);
-      if (g.uses_cut) apply_cut(m.cur);
+      if (g.uses_cut && !g.cpfg) apply_cut(m.cur);
     }
     m.reset_rewriters();
     run_block(g, Block::kEndEach, step, &m.seed, m.context);
+    if (m.context.stop) m.steps = step;  // stop() (CPFG manual 5.6): this step is the last
     if (m.options.on_step && !m.options.on_step(step, m.cur)) return m.stopped_at(step);
   } catch (const DeriveCancelled&) {
     return cancelled_diagnostic();

@@ -123,7 +123,7 @@ const FuncInfo kFuncs[] = {
     {"clamp", 3, false}, {"rand", 0, true},   {"uniform", 2, true}, {"gauss", 2, true},
     {"fabs", 1, false},  {"trunc", 1, false}, {"sign", 1, false},  {"ran", 1, true},
     {"nran", 2, true},   {"bran", 2, true},   {"biran", 2, true},  {"srand", 1, true},
-    {"func", 2, false},
+    {"func", 2, false},  {"stop", 1, false},
 };
 
 // The largest n biran(n, p) draws for (n uniform draws: bounded time, docs/cpfg.md).
@@ -364,6 +364,10 @@ double Program::run(const Expr& e, double* slots, Rng* rng, EvalContext* context
             r = 0;
             break;
           }
+          case Func::kStop:
+            if (context) context->stop = true;
+            r = 0;
+            break;
           case Func::kFunc: {
             // func(id, x) (CPFG manual 5.5): the view file's function id, 1-based.
             if (!(a[0] >= 1) || a[0] != std::floor(a[0]) || a[0] > static_cast<double>(functions.size()))

@@ -51,7 +51,8 @@ enum class Func : uint8_t {
   // The CPFG manual's chapter 5 (docs/cpfg.md): available in every grammar.
   kFabs, kTrunc, kSign, kRan, kNran, kBran, kBiran,
   kSrand,  // srand(s): restarts the random stream from s (EvalContext::reseed); returns 0
-  kFunc    // func(id, x): the grammar's user-defined function id at x (Program::functions)
+  kFunc,   // func(id, x): the grammar's user-defined function id at x (Program::functions)
+  kStop    // stop(n) (CPFG manual 5.6): the derivation ends after this step (EvalContext::stop); returns 0
 };
 
 struct Instr {
@@ -90,6 +91,7 @@ struct EvalContext {
   double* globals = nullptr;
   bool reseeded = false;
   uint64_t reseed = 0;
+  bool stop = false;  // a stop() was evaluated: the derivation ends after the current step
 };
 
 // The evaluation stack's size in values: Program::run's fixed stack, and the depth the

@@ -112,6 +112,9 @@ struct TurtleDefaults {
   // The points around a contour (a view file's `contour sides:`, or 2^(n + 1) for its
   // `polygonization level: n`; cpfg's default 8); @!(n) sets it for the turtle.
   int contour_sides = 8;
+  // A view file's `interpretation past %:` (CPFG manual 8.1.1, on by default): a % left in
+  // the word is passed over; off, the turtle skips the rest of its branch.
+  bool interpret_past_cut = true;
 };
 
 // A file a cpfg grammar read with #include (lsystem/cpfg_preprocessor.h).
@@ -138,18 +141,43 @@ struct Grammar {
   std::vector<CpfgSurface> surfaces;
   // Its contours (the view file's `contour:` lines): `@#(id)` sweeps them along cylinders.
   std::vector<CpfgContour> contours;
-  // A vlab object whose environmental program (`cpfg -e file.e`) is vlab's honda81: its `?E`
+  // A vlab object whose environmental program (`cpfg -e file.e`) sylva has built in: its `?E`
   // queries are answered by that program's rule (docs/cpfg.md "Environmental programs"), not
-  // by light. radius: the spec file's; three_d: its `3d case: on` (else x and z are
-  // compared); position_formats: the .e file's `turtle position:` conversions, which round
-  // the positions as cpfg writes them to a program it talks to through files or pipes (none
-  // through memory).
-  struct DensityField {
+  // by light (core/grow/vlab_enviro.h answers them).
+  // honda81: radius, the spec file's; three_d, its `3d case: on` (else x and z are compared).
+  struct Honda81 {
     double radius = 0;
     bool three_d = false;
+  };
+  // chiba (Chiba et al. 1994's light on leaf balls), from its spec file: light from the
+  // `source direction: x y z intensity` lines, or else from a sky of `number of samples:`
+  // directions (rounded up to 8 * 4^k, k < kMaxLevel), the lower hemisphere's weighted
+  // `lower to upper ratio:` against the upper's 1, or the CIE overcast sky (`use CIE
+  // formula: yes`); each ball met dims it by `transmittance:`.
+  struct Chiba {
+    static constexpr int kMaxLevel = 7;  // 8 * 4^6 = 32768 sky directions at most
+    struct Source {
+      double direction[3] = {0, 1, 0};
+      double intensity = 1;
+    };
+    std::vector<Source> sources;
+    double samples = 20;
+    double lower_to_upper = 0.7;
+    bool cie_sky = false;
+    double transmittance = 0.6;
+    double radius = 25;          // a ball's radius where ?E(r) has r <= 0
+    double beam_radius = 0;      // the ray's width, in the asking ball's radii (1 with estimate_area, as chiba sets it)
+    bool estimate_area = false;  // `estimate intersection area: on`: dim by the discs' overlap
+  };
+  struct Environment {
+    std::string program;  // "honda81" or "chiba"
+    Honda81 honda81;
+    Chiba chiba;
+    // The .e file's `turtle position:` conversions: cpfg writes the positions with them to a
+    // program it talks to through files or pipes (none through memory), so they are rounded so.
     std::vector<std::string> position_formats;
   };
-  std::optional<DensityField> density_field;
+  std::optional<Environment> environment;
   std::vector<IncludedFile> includes;        // SourceLoc::file k > 0 is includes[k - 1]
   // A cpfg file's global variables (assigned in its blocks) and its blocks (CPFG manual 4.1):
   // Start before the axiom, StartEach and EndEach around every step, End after the last.
@@ -194,7 +222,10 @@ struct Grammar {
   std::vector<std::vector<uint32_t>> decomposition_by_symbol;
   bool uses_random = false;   // any stochastic production or random function
   bool uses_context = false;  // any production with left or right context
-  bool uses_cut = false;      // % appears in a successor or the axiom
+  // % appears in a successor or the axiom. In sylva's format the cut is made as the word is
+  // written; in a cpfg file the % stays in the word and cuts when the next step reads it, as
+  // cpfg's generate.c does (docs/cpfg.md).
+  bool uses_cut = false;
   bool ring = false;          // a cpfg 'ring lsystem': context wraps from the word's end to its start (manual 3.1.1)
 
   // The physical source line at `loc` (in its file) without its newline, for messages.

@@ -626,6 +626,7 @@ void Parser::parse_primary(Cursor& c, ExprBuild& b, const Scope* scope) {
                       (info.arity == 1 ? " argument" : " arguments") + ", got " +
                       std::to_string(args));
       if (info.random) b.uses_random = true;
+      if (fn == Func::kStop) b.uses_slot = true;  // its effect is the call: never folded
       emit(b, Op::kCall, 0, loc, 1 - args, fn);
       return;
     }

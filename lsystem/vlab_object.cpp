@@ -143,11 +143,12 @@ Status read_view_functions(const std::string& view, const std::string& folder, P
 }
 
 // The environment file `path` of `cpfg -e` (vlab's environment manual: `executable: program
-// args`, `communication type:`, `turtle position:` ...). For vlab's honda81 its specification
-// file (`radius:`, `3d case:`, `verbose:`) is read too. Another program: `*program` is its
-// name and the error is where the file names it; an unreadable file leaves `*program` empty.
-Expected<Grammar::DensityField> read_density_environment(const std::string& path, const std::string& folder,
-                                                          std::string* program) {
+// args`, `communication type:`, `turtle position:` ...). For a program sylva has built in
+// (honda81, chiba) its specification file, the executable's last word, is read too. Another
+// program: `*program` is its name and the error is where the file names it; an unreadable
+// file leaves `*program` empty.
+Expected<Grammar::Environment> read_environment(const std::string& path, const std::string& folder,
+                                                std::string* program) {
   namespace fs = std::filesystem;
   program->clear();
   Expected<std::string> text = read_text_file(path);
@@ -165,7 +166,7 @@ Expected<Grammar::DensityField> read_density_environment(const std::string& path
       *program = fs::path(values[0].text).filename().string();
       executable_line = line_no;
       executable_text = std::string(line);
-      // honda81 [-e environment_file] specification_file: the last word is its spec file.
+      // program [-e environment_file] specification_file: the last word is its spec file.
       if (values.size() >= 2) spec = values.back().text;
     } else if (name == "communication type" && !values.empty()) {
       communication = lower_ascii(values[0].text);
@@ -175,13 +176,14 @@ Expected<Grammar::DensityField> read_density_environment(const std::string& path
     }
   });
   if (program->empty()) return file_diagnostic(path, "no 'executable:' line naming the environmental program");
-  if (*program != "honda81")
+  if (*program != "honda81" && *program != "chiba")
     return error_in(path, executable_text, executable_line, 1, "the environmental program is '" + *program + "'");
-  Grammar::DensityField field;
+  Grammar::Environment env;
+  env.program = *program;
   // "turtle position:P:%.4f %.4f %.0f": the position is sent, written with these conversions
   // when the program reads files or pipes.
   if (formats_line_no == 0)
-    return file_diagnostic(path, "honda81 needs the turtle's position: a line 'turtle position:P:%g %g %g'");
+    return file_diagnostic(path, *program + " needs the turtle's position: a line 'turtle position:P:%g %g %g'");
   size_t p = formats_line.find("P:");  // the field's tag, which older files leave out
   p = p == std::string::npos ? 0 : p + 2;
   if (communication == "files" || communication == "pipes") {
@@ -190,16 +192,19 @@ Expected<Grammar::DensityField> read_density_environment(const std::string& path
       if (!check.error.empty() || check.values != 1)
         return error_in(path, formats_line, formats_line_no, static_cast<uint32_t>(p + t.column + 16),
                         "expected one number's conversion for each coordinate ('%.4f')");
-      field.position_formats.push_back(t.text);
+      env.position_formats.push_back(t.text);
     }
-    if (field.position_formats.size() != 3)
+    if (env.position_formats.size() != 3)
       return error_in(path, formats_line, formats_line_no, 1, "expected three conversions, x y z ('%.4f %.4f %.4f')");
   }
-  if (spec.empty()) return error_in(path, executable_text, executable_line, 1, "honda81 needs its specification file: 'executable: honda81 file.spec'");
+  if (spec.empty())
+    return error_in(path, executable_text, executable_line, 1,
+                    *program + " needs its specification file: 'executable: " + *program + " file.spec'");
   const std::string spec_path = (fs::path(folder) / spec).string();
   Expected<std::string> spec_text = read_text_file(spec_path);
   if (!spec_text) return std::move(spec_text.error());
   std::optional<Diagnostic> failure;
+  Grammar::Chiba& chiba = env.chiba;
   for_each_physical_line(*spec_text, [&](uint32_t line_no, std::string_view line, bool) {
     if (failure) return;
     std::string name;
@@ -208,19 +213,66 @@ Expected<Grammar::DensityField> read_density_environment(const std::string& path
     const size_t colon = *found;
     const std::vector<Token> values = tokens_of(line.substr(colon + 1));
     if (values.empty()) return;
-    if (name == "radius") {
-      double r = 0;
-      if (!number(values[0].text, &r) || r < 0)
-        failure = error_in(spec_path, line, line_no, static_cast<uint32_t>(colon + 1 + values[0].column),
-                           "honda81's radius is a number, not negative");
-      field.radius = r;
-    } else if (name == "3d case") {
-      field.three_d = lower_ascii(values[0].text) == "on";
+    auto fail_at = [&](size_t k, const std::string& message) {
+      failure = error_in(spec_path, line, line_no, static_cast<uint32_t>(colon + 1 + values[k].column), message);
+    };
+    // The k-th value as a number in [low, high]; else an error there saying `what`.
+    auto read = [&](size_t k, double low, double high, double* out, const std::string& what) {
+      double v = 0;
+      if (k >= values.size()) {
+        failure = error_in(spec_path, line, line_no, static_cast<uint32_t>(line.size() + 1), what);
+        return false;
+      }
+      if (!number(values[k].text, &v) || v < low || v > high) {
+        fail_at(k, what);
+        return false;
+      }
+      *out = v;
+      return true;
+    };
+    const std::string word = lower_ascii(values[0].text);
+    if (*program == "honda81") {
+      if (name == "radius") read(0, 0, 1e12, &env.honda81.radius, "honda81's radius is a number, not negative");
+      else if (name == "3d case") env.honda81.three_d = word == "on";
+      // verbose: and anything else honda81 skips with a message: read and ignored.
+      return;
     }
-    // verbose: and anything else honda81 skips with a message: read and ignored.
+    // chiba's keywords (ENVIRO/chiba/chiba.c); `grid size:` sizes its voxel grid, which
+    // sylva sizes itself (the answers do not depend on it), `verbose:` its messages.
+    if (name == "lower to upper ratio") {
+      read(0, 0, 1e6, &chiba.lower_to_upper, "the lower to upper ratio is a number, not negative");
+    } else if (name == "transmittance") {
+      read(0, 0, 1, &chiba.transmittance, "the transmittance is a number from 0 to 1");
+    } else if (name == "number of samples") {
+      read(0, 1, 1e9, &chiba.samples, "the number of samples is a number from 1");
+    } else if (name == "radius") {
+      read(0, 0, 1e12, &chiba.radius, "chiba's radius is a number, not negative");
+    } else if (name == "beam radius") {
+      read(0, 0, 1e6, &chiba.beam_radius, "the beam radius is a number, not negative");
+    } else if (name == "estimate intersection area") {
+      chiba.estimate_area = word == "on";
+    } else if (name == "use cie formula") {
+      chiba.cie_sky = word == "yes";
+    } else if (name == "source direction") {
+      if (chiba.sources.size() >= 100) return fail_at(0, "chiba takes at most 100 light sources");
+      Grammar::Chiba::Source src;
+      for (size_t k = 0; k < 3; ++k)
+        if (!read(k, -1e12, 1e12, &src.direction[k], "a source direction is 'x y z intensity', numbers")) return;
+      if (src.direction[0] == 0 && src.direction[1] == 0 && src.direction[2] == 0)
+        return fail_at(0, "a source's direction must not be zero");
+      if (values.size() > 3 && !read(3, 0, 1e12, &src.intensity, "a source's intensity is a number, not negative")) return;
+      chiba.sources.push_back(src);
+    }
   });
   if (failure) return std::move(*failure);
-  return field;
+  if (*program == "chiba") {
+    double total = 0;
+    for (const auto& src : chiba.sources) total += src.intensity;
+    if (!chiba.sources.empty() && !(total > 0))
+      return file_diagnostic(spec_path, "chiba's light sources have no intensity (they sum to 0)");
+    if (chiba.estimate_area) chiba.beam_radius = 1;  // as chiba sets it
+  }
+  return env;
 }
 
 // A movement's words with each "K:value" split into "K:" and "value" (cpfg's reader splits
@@ -329,6 +381,9 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
       auto contour = read_cpfg_contour(beside(values[1]), static_cast<int>(id));
       if (!contour) return fail_file(values[1], "contour", std::move(contour.error()));
       grammar.contours.push_back(std::move(*contour));
+    } else if (name == "interpretation past %") {
+      // On unless the word is "off" (interpret.c reads its first three letters).
+      if (!values.empty()) t.interpret_past_cut = lower_ascii(values[0].text).rfind("off", 0) != 0;
     } else if (name == "contour sides" || name == "polygonization level") {
       // cpfg's points around a contour: n, or 2^(n + 1) for the level (interpret.c), at least 3.
       if (!value(0, &v)) return;
@@ -452,12 +507,12 @@ Expected<Grammar> load_vlab_object(const std::string& folder, const ParseOptions
                                            "'cpfg [options] model.l view.v' (is this object for another program?)");
   ParseOptions with_functions = options;
   if (Status s = read_view_functions(view, folder, with_functions); !s) return std::move(s.error());
-  std::optional<Grammar::DensityField> field;
+  std::optional<Grammar::Environment> field;
   if (environment) {
-    // cpfg -e: vlab's honda81 is built in; any other program is not (docs/cpfg.md).
+    // cpfg -e: vlab's honda81 and chiba are built in; any other program is not (docs/cpfg.md).
     std::string program;
-    auto read = read_density_environment((fs::path(folder) / environment->file).string(), folder, &program);
-    if (!read && program == "honda81") return std::move(read.error());
+    auto read = read_environment((fs::path(folder) / environment->file).string(), folder, &program);
+    if (!read && (program == "honda81" || program == "chiba")) return std::move(read.error());
     if (!read && program.empty()) {
       Diagnostic d = error_in(specifications, environment->text, environment->line, environment->column,
                               "cannot read the environment file '" + environment->file + "' (cpfg -e)");
@@ -468,7 +523,7 @@ Expected<Grammar> load_vlab_object(const std::string& folder, const ParseOptions
       Diagnostic d = error_in(specifications, environment->text, environment->line, environment->column,
                               "the environmental program '" + program + "' (cpfg -e " + environment->file +
                                   ") is not supported: sylva answers ?E with its own light (docs/light.md), or "
-                                  "with vlab's honda81, which it has built in (docs/cpfg.md)");
+                                  "with vlab's honda81 or chiba, which it has built in (docs/cpfg.md)");
       d.notes.push_back(std::move(read.error()));
       return d;
     }
@@ -476,7 +531,7 @@ Expected<Grammar> load_vlab_object(const std::string& folder, const ParseOptions
   }
   Expected<Grammar> g = load_grammar(model, with_functions);
   if (!g) return g;
-  g->density_field = std::move(field);
+  g->environment = std::move(field);
   if (Status s = apply_view_file(view, *g); !s) return std::move(s.error());
   return g;
 }

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/grow/vlab_enviro.h"
 #include "core/util/clock.h"
 #include "core/util/parallel.h"
 #include "core/util/random.h"
@@ -195,77 +196,60 @@ glm::dvec3 as_sent(const glm::dvec3& p, const std::vector<std::string>& formats)
   return out;
 }
 
-// vlab's honda81 (its ENVIRO/honda81/honda81.c): every ?E(vigor[, index]) of the job's word
-// answers 1 unless another query of the same index and at least its vigor lies within the
-// radius (in x, y, z, or in x and z without `3d case: on`); then 0. Positions in the plant's
-// frame, as the turtle sends them. A grid of cells one radius wide finds the neighbours.
-Status answer_density(LightJob& job) {
-  const lsys::Grammar::DensityField& field = *job.grammar->density_field;
+// A vlab object's built-in environmental program (vlab_enviro.h) answers the ?E queries of
+// the job's word where the turtle meets them (positions in the plant's frame, rounded as
+// cpfg sends them): honda81 each ?E(vigor[, index]), chiba each ?E(r) and ?E(r, x, y, z) (the
+// light reaching a ball of radius r there, and with four parameters the brightest
+// direction); a query the program does not read is left as it is.
+Status answer_environment(LightJob& job) {
+  const lsys::Grammar::Environment& env = *job.grammar->environment;
   std::vector<glm::dvec3> positions;
   if (auto sk = turtle_now(job, &positions, nullptr); !sk) return sk.error();
   lsys::Word& word = job.derivation->word();
-  struct Query {
-    glm::dvec3 p;
-    double vigor, index;
-    double* answer;
-  };
-  std::vector<Query> queries;
+  std::vector<double*> params;
+  std::vector<uint16_t> counts;
+  std::vector<glm::dvec3> at;
   size_t next = 0;
   for (const lsys::Module& m : word.modules) {
     if (m.symbol != lsys::kSymLightQuery) continue;
-    double* p = word.params.data() + m.param_begin;
-    glm::dvec3 q = as_sent(positions[next++], field.position_formats);
-    if (!field.three_d) q = glm::dvec3(q.x, q.z, 0);
-    if (m.param_count == 0) continue;  // honda81 skips a query without its vigor, unanswered
-    queries.push_back({q, p[0], m.param_count > 1 ? p[1] : 0.0, p});
+    const glm::dvec3 q = as_sent(positions[next++], env.position_formats);
+    // honda81 skips a query without its vigor; chiba one of two or three parameters.
+    if (m.param_count == 0 || (env.program == "chiba" && m.param_count > 1 && m.param_count < 4)) continue;
+    params.push_back(word.params.data() + m.param_begin);
+    counts.push_back(m.param_count);
+    at.push_back(q);
   }
-  const double r2 = field.radius * field.radius;
-  const double cell = field.radius > 0 ? field.radius : 1.0;
-  auto key_of = [&](const glm::dvec3& p, int dx, int dy, int dz) {
-    // Clamped: a tiny radius over a far position must not overflow the cast.
-    auto c = [&](double v, int d) { return static_cast<int64_t>(std::clamp(std::floor(v / cell), -4e18, 4e18)) + d; };
-    const uint64_t a = static_cast<uint64_t>(c(p.x, dx)), b = static_cast<uint64_t>(c(p.y, dy)),
-                   z = static_cast<uint64_t>(c(p.z, dz));
-    return mix_pair(mix_pair(a, b), z);
-  };
-  std::unordered_map<uint64_t, std::vector<uint32_t>> grid;
-  for (size_t i = 0; i < queries.size(); ++i) grid[key_of(queries[i].p, 0, 0, 0)].push_back(static_cast<uint32_t>(i));
-  std::vector<double> answers(queries.size(), 1.0);
-  for (size_t i = 0; i < queries.size(); ++i) {
-    const Query& a = queries[i];
-    for (int dx = -1; dx <= 1 && answers[i] == 1.0; ++dx)
-      for (int dy = -1; dy <= 1 && answers[i] == 1.0; ++dy)
-        for (int dz = -1; dz <= 1 && answers[i] == 1.0; ++dz) {
-          auto it = grid.find(key_of(a.p, dx, dy, dz));
-          if (it == grid.end()) continue;
-          for (uint32_t j : it->second) {
-            const Query& b = queries[j];
-            if (j == i || b.index != a.index || a.vigor > b.vigor) continue;
-            const glm::dvec3 d = a.p - b.p;
-            if (d.x * d.x + d.y * d.y + d.z * d.z <= r2) {
-              answers[i] = 0.0;
-              break;
-            }
-          }
-        }
+  if (env.program == "honda81") {
+    std::vector<Honda81Query> queries(at.size());
+    for (size_t i = 0; i < at.size(); ++i) queries[i] = {at[i], params[i][0], counts[i] > 1 ? params[i][1] : 0.0};
+    const std::vector<double> answers = honda81_answers(env.honda81, queries);
+    for (size_t i = 0; i < at.size(); ++i) params[i][0] = answers[i];
+    return {};
   }
-  for (size_t i = 0; i < queries.size(); ++i) *queries[i].answer = answers[i];
+  std::vector<ChibaBall> balls(at.size());
+  for (size_t i = 0; i < at.size(); ++i) balls[i] = {at[i], params[i][0] > 0 ? params[i][0] : env.chiba.radius};
+  const std::vector<ChibaAnswer> answers = chiba_answers(env.chiba, balls);
+  for (size_t i = 0; i < at.size(); ++i) {
+    params[i][0] = answers[i].light;
+    if (counts[i] >= 4)
+      for (int k = 0; k < 3; ++k) params[i][1 + k] = answers[i].brightest[k];
+  }
   return {};
 }
 
 // Answers every query of every job's current word at once, writing q (clamped to
 // [0, 1]) and the direction into each `?E`'s parameters. Nothing is traced without queries.
-// A job whose grammar has a density field (a vlab object's honda81) answers its own.
+// A job whose grammar has a built-in environmental program (a vlab object's) answers its own.
 std::optional<JobFailure> answer_queries(std::vector<LightJob>& jobs, std::span<const Skeleton> fixed,
                                          const Scene& scene, const LightOracle* oracle, int64_t step,
                                          LightGrowthStats* stats) {
   size_t total = 0;
   for (size_t k = 0; k < jobs.size(); ++k) {
     LightJob& j = jobs[k];
-    if (!j.grammar->density_field) {
+    if (!j.grammar->environment) {
       total += count_queries(j.derivation->word());
     } else if (count_queries(j.derivation->word()) > 0) {
-      if (Status s = answer_density(j); !s) return JobFailure{k, s.error()};
+      if (Status s = answer_environment(j); !s) return JobFailure{k, s.error()};
     }
   }
   if (total == 0) return std::nullopt;
@@ -274,7 +258,7 @@ std::optional<JobFailure> answer_queries(std::vector<LightJob>& jobs, std::span<
   std::vector<Skeleton> plants(fixed.begin(), fixed.end());
   std::vector<glm::dvec3> sensors;
   for (size_t k = 0; k < jobs.size(); ++k) {
-    if (jobs[k].grammar->density_field) continue;
+    if (jobs[k].grammar->environment) continue;
     auto sk = placed_now(jobs[k], sensors);
     if (!sk) return JobFailure{k, sk.error()};
     plants.push_back(std::move(*sk));
@@ -284,7 +268,7 @@ std::optional<JobFailure> answer_queries(std::vector<LightJob>& jobs, std::span<
   if (!answers) return JobFailure{0, answers.error()};
   size_t next = 0;
   for (LightJob& j : jobs) {
-    if (j.grammar->density_field) continue;
+    if (j.grammar->environment) continue;
     lsys::Word& word = j.derivation->word();
     for (const lsys::Module& m : word.modules) {
       if (m.symbol != lsys::kSymLightQuery) continue;
@@ -474,8 +458,8 @@ Expected<lsys::Word> derive_word(const lsys::Grammar& g, const lsys::DeriveOptio
     if (auto f = derive_stepped(jobs, {}, Scene{}, nullptr, stats)) return f->error;
     return jobs[0].derivation->finish(derive_stats);
   }
-  if (g.density_field && !light.scene) {
-    // A vlab object's honda81 (docs/cpfg.md): its queries answered from its own positions.
+  if (g.environment && !light.scene) {
+    // A vlab object's honda81 or chiba (docs/cpfg.md): its queries answered by that program.
     std::vector<LightJob> jobs(1);
     jobs[0].grammar = &g;
     jobs[0].options = options;

@@ -1086,6 +1086,18 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           }
           break;
         }
+        case kSymCut:
+          // A % left in a cpfg file's word (cpfg cuts one step later, docs/cpfg.md): passed
+          // over, or with the view file's `interpretation past %: off` the rest of its branch.
+          if (g.cpfg && !d.interpret_past_cut) {
+            int depth = 0;
+            for (; i + 1 < n; ++i) {
+              const SymbolId s = word.modules[i + 1].symbol;
+              if (s == kSymPush) ++depth;
+              else if (s == kSymPop && depth-- == 0) break;
+            }
+          }
+          break;
         case kSymPush:
           stack.push_back(t);
           t.branch_pending = true;

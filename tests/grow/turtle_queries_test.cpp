@@ -86,12 +86,37 @@ TEST(TurtleQueries, Honda81AnswersEByTheQueriesWithinItsRadius) {
   // A radius far below the positions' scale (the neighbour grid's cells stay in range).
   EXPECT_EQ(grown_in_honda81("?E(1)f(1e9)?E(1)", memory, "radius: 1e-300\n3d case: on\n"), "?E(1)f(1e+09)?E(1)");
   // Another program is an error at the -e, the program named; honda81's own mistakes at theirs.
-  const std::string chiba = grown_in_honda81("?E(1)", "executable: chiba -e x.e light.spec\n", "");
-  EXPECT_NE(chiba.find("specifications:2:20"), std::string::npos) << chiba;
-  EXPECT_NE(chiba.find("'chiba'"), std::string::npos) << chiba;
+  const std::string clover = grown_in_honda81("?E(1)", "executable: clover -e x.e light.spec\n", "");
+  EXPECT_NE(clover.find("specifications:2:20"), std::string::npos) << clover;
+  EXPECT_NE(clover.find("'clover'"), std::string::npos) << clover;
   const std::string radius = grown_in_honda81("?E(1)", memory, "radius: -1\n");
   EXPECT_NE(radius.find("density.spec:1:9"), std::string::npos) << radius;
   EXPECT_NE(grown_in_honda81("?E(1)", "executable: honda81 density.spec\n", "radius: 1\n").find("turtle's position"),
+            std::string::npos);
+}
+
+// chiba answers ?E(r) with the light reaching a ball of radius r where the turtle meets it,
+// and ?E(r, x, y, z) with the brightest direction too; other counts are left as they are.
+// Straight up through three balls of radius 0.9 one apart, transmittance 0.25 and no beam:
+// each ball above dims by 0.25^(1.8 / 1.8).
+TEST(TurtleQueries, ChibaAnswersEWithTheLightReachingItsBall) {
+  const std::string memory = "executable: chiba -e field.e density.spec\ncommunication type: memory\n"
+                             "turtle position:P:%g %g %g\n";
+  const std::string spec = "grid size: 32x32x32\ntransmittance: 0.25\nsource direction: 0 100 0 4\n";
+  EXPECT_EQ(grown_in_honda81("?E(0.9)f(1)?E(0.9,0,0,0)f(1)?E(0.9)?E(1,1)", memory, spec),
+            "?E(0.0625)f(1)?E(0.25,0,1,0)f(1)?E(1)?E(1,1)");
+  // A radius of 0 is the spec's (`radius:`): 0.1, too small for the ray straight up to meet
+  // a ball 0.3 beside it; by default 25, each dims the other's light by the part of the ray
+  // inside it, 0.25^(25.998 / 50) and 0.25^(23.998 / 50). (The answer stays in the query as
+  // the next step's radius: the production asks with 0 again.)
+  const std::string again = "?E(0)f(1)+f(0.3)?E(0)\n?E(r) --> ?E(0)";
+  EXPECT_EQ(grown_in_honda81(again, memory, spec + "radius: 0.1\n"), "?E(1)f(1)+f(0.3)?E(1)");
+  const std::string wide = grown_in_honda81(again, memory, spec);
+  EXPECT_EQ(wide.substr(0, 8), "?E(0.486") << wide;
+  EXPECT_NE(wide.find("?E(0.514"), std::string::npos) << wide;
+  const std::string bad = grown_in_honda81("?E(1)", memory, "transmittance: 2\n");
+  EXPECT_NE(bad.find("density.spec:1:16"), std::string::npos) << bad;
+  EXPECT_NE(grown_in_honda81("?E(1)", memory, "source direction: 0 0 0 1\n").find("must not be zero"),
             std::string::npos);
 }
 

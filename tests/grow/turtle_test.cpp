@@ -892,6 +892,25 @@ TEST(TurtleCpfg, GDrawsLikeFAndgMovesLikef) {
   EXPECT_EQ(leaf.leaves[0].vertices_m.size(), 3u);
 }
 
+// A % left in a cpfg word (cpfg cuts it a step later) is passed over, as cpfg's default
+// `interpretation past %: on`; off, the turtle skips the rest of its branch.
+TEST(TurtleCpfg, APercentLeftInTheWordIsPassedOverUnlessInterpretationPastCutIsOff) {
+  auto unstepped = [](std::string_view axiom) {
+    return "Lsystem: 1\nderivation length: 0\nAxiom: " + std::string(axiom) + "\nendlsystem\n";
+  };
+  const std::string text = unstepped("F[+F%F(2)[F]F]F(3)");
+  const Skeleton past = skeleton_of(text), all = skeleton_of(unstepped("F[+FF(2)[F]F]F(3)"));
+  EXPECT_TRUE(past.joints == all.joints && past.chains == all.chains);
+  auto g = lsys::parse_grammar(text, "test.l", {});
+  ASSERT_TRUE(g.ok()) << g.error().format();
+  g->turtle.interpret_past_cut = false;
+  auto off = grow(*g, {}, "test.l", {});
+  ASSERT_TRUE(off.ok()) << off.error().format();
+  const Skeleton cut = skeleton_of(unstepped("F[+F]F(3)"));  // the branch's F(2)[F]F after % are cut
+  EXPECT_TRUE(off->skeleton.joints == cut.joints && off->skeleton.chains == cut.chains);
+  EXPECT_LT(off->skeleton.joints.size(), past.joints.size());
+}
+
 TEST(TurtleCpfg, SemicolonAndCommaStepTheColourIndexOrSetIt) {
   const Skeleton sk = skeleton_of(cpfg("F;F;;F,F;(7)F,(2)F"));
   ASSERT_EQ(sk.joints.size(), 7u);

@@ -337,6 +337,38 @@ TEST(CpfgModel, APredecessorOfSeveralModulesRewritesConsecutiveModulesTogether) 
   expect_located({"axiom: A B\nA B -> C\n", 2, 1, "the predecessor must be one module"});
 }
 
+// cpfg's cut (generate.c's ApplyProd): a % a production writes stays in the word, and cuts
+// itself and the rest of its branch when the next step reads it; what follows it is still
+// rewritten meanwhile. sylva's own format cuts as the word is written.
+TEST(CpfgModel, APercentCutsTheRestOfItsBranchWhenTheNextStepReadsIt) {
+  const std::string model = "Lsystem: 1\nderivation length: %d\nAxiom: A[XBD]C\nX --> %\nB --> E\nendlsystem\n";
+  auto with_steps = [&](int n) {
+    std::string t = model;
+    t.replace(t.find("%d"), 2, std::to_string(n));
+    return derive_text(t);
+  };
+  EXPECT_EQ(with_steps(1), "A[%ED]C");
+  EXPECT_EQ(with_steps(2), "A[]C");
+  EXPECT_EQ(derive_text("axiom: A[XBD]C\nX -> %\nB -> E\n"), "A[]C") << "sylva's own format";
+  // vlab's canalization model: the florets of the step before are rewritten behind the %.
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 3\nAxiom: M\nM --> MX[A]\nX --> %\nA --> B\nendlsystem\n"),
+            "MX[A]%[B]");
+  // The axiom's % waits for the first step too.
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 0\nAxiom: F%F\nendlsystem\n"), "F%F");
+}
+
+// stop(n) (CPFG manual 5.6) ends the derivation after the step that calls it: the word is
+// that step's, and the End block still runs.
+TEST(CpfgStatements, StopEndsTheDerivationAfterTheCurrentStep) {
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 10\nStart: {n=0;}\nEndEach: {n=n+1; if (n==3) {stop(1);}}\n"
+                        "End: {printf(\"\");}\nAxiom: A\nA --> AB\nendlsystem\n"),
+            "ABBB");
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 10\nAxiom: A(0)\nA(n) : n == 1 {stop(0);} --> A(n+1)\n"
+                        "A(n) --> A(n+1)\nendlsystem\n"),
+            "A(2)");
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 10\nStart: {stop(1);}\nAxiom: A\nA --> AB\nendlsystem\n"), "A");
+}
+
 // In a homomorphism or a decomposition too (generate.c's ApplyRecursiveProductions): at the
 // first depth the word's consecutive modules, deeper the rest of the same successor only.
 // cpfg has no labels: "AXIOM : c" is five modules and a condition (vlab's Lilac), "Sl :" two.
