@@ -63,6 +63,7 @@ class Rewriter {
     for (const Production& p : productions_) slots = std::max(slots, p.slot_count);
     slots_.assign(slots + 1, 0.0);
     has_rest_of_branch_ = g_.cpfg && g_.symbols.find("=", &rest_of_branch_);
+    sub_lsystems_ = g_.has_sub_lsystems() && g_.symbols.find("?", &sub_call_);
     direct_.assign(by_symbol_.size(), nullptr);
     for (size_t s = 0; s < by_symbol_.size(); ++s) {
       if (by_symbol_[s].empty()) continue;
@@ -100,6 +101,7 @@ class Rewriter {
     in_ = &in;
     out_ = &out;
     const bool keyed = !in.lineage.empty();
+    enter_word();
     if (uses_context_) compute_brackets(in);
     if (uses_new_left_) {
       new_skip_left_.clear();
@@ -117,9 +119,12 @@ class Rewriter {
       if (!chosen) {
         copy_module(in, i, out);
         if (active_out) active_out->push_back(0);
+        if (sub_lsystems_) track_lsystem(in, i);
       } else {
         apply(*chosen, i, rng, keyed);
         if (active_out) active_out->resize(out.size(), 1);
+        if (sub_lsystems_)
+          for (size_t k = 0; k <= chosen->predecessor_tail.size(); ++k) track_lsystem(in, i + k);
         i += chosen->predecessor_tail.size();  // a cpfg predecessor's further modules are rewritten too
       }
       if (uses_new_left_) extend_left_tables(out);
@@ -132,7 +137,7 @@ class Rewriter {
     const Module& m = in.modules[i];
     if (by_symbol_[m.symbol].empty()) return nullptr;
     const Production* direct = direct_[m.symbol];
-    if (direct && direct->predecessor.arity == m.param_count) return direct;
+    if (direct && direct->predecessor.arity == m.param_count && direct->lsystem == lsystem_) return direct;
     if (!in.lineage.empty()) rng = Rng(mix_pair(mix_pair(seed_, in.lineage[i]), stream));
     return choose(i, m, rng);
   }
@@ -142,6 +147,7 @@ class Rewriter {
   // (its last module first), so that its context tables grow by appending, then turned round.
   void rewrite_backward(const Word& in, Word& out, uint64_t stream, const Progress& progress, const char* stage) {
     in_ = &in;
+    enter_word();  // (a cpfg file has no backward passes: its sub-L-systems are never tracked here)
     Word& rev = reversed_;
     rev.clear();
     out_ = &rev;
@@ -182,7 +188,7 @@ class Rewriter {
   // True if some production of m's symbol takes m's parameter count (only those could apply).
   bool has_rule_of_arity(const Module& m) const {
     for (uint32_t k : by_symbol_[m.symbol])
-      if (productions_[k].predecessor.arity == m.param_count) return true;
+      if (productions_[k].predecessor.arity == m.param_count && productions_[k].lsystem == lsystem_) return true;
     return false;
   }
 
@@ -201,6 +207,7 @@ class Rewriter {
     *deepest_applied = 0;
     *left_expandable = 0;
     work_budget_ = work_budget;
+    enter_word();
     for (size_t i = 0; i < n; ++i) {
       if ((i & kProgressChunkMask) == 0 && i != 0) {
         if (progress.cancelled()) throw DeriveCancelled{};
@@ -208,6 +215,7 @@ class Rewriter {
       }
       if (by_symbol_[in.modules[i].symbol].empty()) {
         copy_module(in, i, out);  // the common case: nothing to expand, no stack
+        if (sub_lsystems_) track_lsystem(in, i);
         continue;
       }
       stack_.clear();
@@ -230,7 +238,7 @@ class Rewriter {
           // lies below t on the stack at the same depth.
           tail_ = d == 1 ? TailView{&in, i + 1, 1, n - i - 1, nullptr, 0} : TailView{&stack_, t - 1, -1, t, nullptr, d};
           const Production* direct = direct_[m.symbol];
-          if (direct && direct->predecessor.arity == m.param_count) {
+          if (direct && direct->predecessor.arity == m.param_count && direct->lsystem == lsystem_) {
             chosen = direct;
           } else {
             if (keyed) rng = Rng(mix_pair(mix_pair(seed_, stack_.lineage[t]), stream_base + static_cast<uint64_t>(d)));
@@ -260,6 +268,9 @@ class Rewriter {
           stack_depth_.push_back(d + 1);
         }
       }
+      // The module's L-system served its whole expansion; the word's ?( and $ change it after.
+      if (sub_lsystems_)
+        for (size_t k = 0; k <= consumed; ++k) track_lsystem(in, i + k);
       i += consumed;
     }
   }
@@ -590,6 +601,7 @@ class Rewriter {
     double total = 0;
     for (uint32_t r : rules) {
       const Production& p = productions_[r];
+      if (p.lsystem != lsystem_) continue;  // another L-system's (sub-L-systems)
       if (p.predecessor.arity != m.param_count) continue;
       arity_seen = true;
       if (!matches(p, i, m)) continue;
@@ -614,7 +626,7 @@ class Rewriter {
     }
     // A module no production of its symbol takes with its parameter count: an error in
     // sylva's format; in a cpfg file no match, as cpfg's PredDiff compares the counts.
-    if (!arity_seen && !g_.cpfg) {
+    if (!arity_seen && !g_.cpfg && !sub_lsystems_) {
       const Production& p = productions_[rules[0]];
       current_production = &p;
       throw DeriveFailure{p.loc, "parameter count: module has " + std::to_string(m.param_count) +
@@ -716,6 +728,57 @@ class Rewriter {
     int depth = 0;
   };
   TailView tail_;
+  // Sub-L-systems (CPFG manual 7.2; cpfg's CheckPred): the L-system whose productions apply
+  // now (its index in Grammar::lsystem_labels), and the ones a $ returns to.
+  bool sub_lsystems_ = false;
+  SymbolId sub_call_ = 0;  // `?`, as in ?(label, s)
+  uint32_t lsystem_ = 0;
+  std::vector<uint32_t> lsystem_stack_;
+
+  // A word is read from its start in the main L-system.
+  void enter_word() {
+    lsystem_ = 0;
+    lsystem_stack_.clear();
+  }
+
+  // After module i of `w` is read: ?(label, s) makes L-system `label` current; $ returns to
+  // the one before (at the top level it stays the main one, as cpfg warns and goes on).
+  void track_lsystem(const Word& w, size_t i) {
+    const Module& m = w.modules[i];
+    if (m.symbol == sub_call_ && m.param_count >= 1) {
+      const double label = w.params_of(m)[0];
+      const auto& labels = g_.lsystem_labels;
+      size_t k = 0;
+      while (k < labels.size() && static_cast<double>(labels[k]) != label) ++k;
+      if (k == labels.size()) {
+        current = i;
+        in_ = &w;  // the message names the module in this word
+        current_production = nullptr;
+        throw DeriveFailure{{}, "?(" + module_number(label) + ", ...) calls an L-system the file does not define "
+                                "(its labels: " + label_list() + ")"};
+      }
+      lsystem_stack_.push_back(lsystem_);
+      lsystem_ = static_cast<uint32_t>(k);
+    } else if (m.symbol == kSymLevel) {
+      if (!lsystem_stack_.empty()) {
+        lsystem_ = lsystem_stack_.back();
+        lsystem_stack_.pop_back();
+      } else {
+        lsystem_ = 0;
+      }
+    }
+  }
+  std::string label_list() const {
+    std::string out;
+    for (int64_t l : g_.lsystem_labels)
+      if (l >= 0) out += (out.empty() ? "" : ", ") + std::to_string(l);
+    return out;
+  }
+  static std::string module_number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+  }
   std::vector<uint32_t> skip_ignored_, skip_right_, branch_end_;
   std::vector<uint32_t> skip_left_;
   bool uses_left_context_ = false, uses_right_context_ = false;  // old context (the word before the pass)
@@ -733,19 +796,26 @@ class Rewriter {
   std::vector<std::vector<double>> candidate_slots_;  // by candidate, for those with statements
 };
 
-// Removes, for each %, the rest of its branch up to (not including) the closing ']'.
-void apply_cut(Word& w) {
+// Removes, for each %, the rest of its branch up to (not including) the closing ']' — or,
+// in a cpfg file with sub-L-systems, the $ that ends the sub-L-system it is in (cpfg's
+// SkipCutPart).
+void apply_cut(Word& w, const Grammar& g) {
   const size_t n = w.size();
   const bool keyed = !w.lineage.empty();
+  SymbolId call = 0;
+  const bool subs = g.has_sub_lsystems() && g.symbols.find("?", &call);
   size_t out = 0, out_param = 0;
   for (size_t i = 0; i < n;) {
     if (w.modules[i].symbol == kSymCut) {
-      int depth = 0;
+      int depth = 0, sub = 0;
       size_t j = i + 1;
       for (; j < n; ++j) {
-        SymbolId s = w.modules[j].symbol;
+        const Module& m = w.modules[j];
+        const SymbolId s = m.symbol;
         if (s == kSymPush) ++depth;
         else if (s == kSymPop && depth-- == 0) break;
+        else if (subs && s == call && m.param_count > 0) ++sub;
+        else if (subs && s == kSymLevel && sub-- == 0) break;
       }
       i = j;
       continue;
@@ -977,12 +1047,12 @@ Status Derivation::start() {
     for (size_t i = 0; i < m.cur.size(); ++i) m.cur.lineage[i] = mix_pair(kAxiomKeyBase, i);
   }
   const bool cut_now = g.uses_cut && !g.cpfg;  // a cpfg file's % cuts when the next step reads it
-  if (cut_now) apply_cut(m.cur);
+  if (cut_now) apply_cut(m.cur, g);
   m.reset_rewriters();
   if (m.decomposer) {
     try {
       m.decompose(0);
-      if (cut_now) apply_cut(m.cur);
+      if (cut_now) apply_cut(m.cur, g);
     } catch (const DeriveCancelled&) {
       return cancelled_diagnostic();
     } catch (const DeriveFailure& f) {
@@ -1017,7 +1087,7 @@ Status Derivation::advance() {
       m.active = &m.passes[k];
       // cpfg (generate.c's ApplyProd): a % of the word before the step, which no production
       // rewrites, drops itself and the rest of its branch as the step reads it.
-      if (g.uses_cut && g.cpfg) apply_cut(m.cur);
+      if (g.uses_cut && g.cpfg) apply_cut(m.cur, g);
       const uint64_t before = m.cur.size();
       m.next.clear();
       reserve_for_growth(m.next, m.cur.size(), m.growth, m.options.max_modules);
@@ -1027,7 +1097,7 @@ Status Derivation::advance() {
       // Pass 0 keeps the streams a one-pass grammar always had: the step's number.
       const uint64_t stream = static_cast<uint64_t>(step) | (static_cast<uint64_t>(k) << 56);
       m.passes[k].rewrite(m.cur, m.next, stream, nullptr, nullptr, pass_progress, "derive", g.passes[k].backward);
-      if (g.uses_cut && !g.cpfg) apply_cut(m.next);
+      if (g.uses_cut && !g.cpfg) apply_cut(m.next, g);
       if (step < m.steps || k + 1 < pass_count) pass_progress.report(1, "derive");  // the last 1 is the whole's
       m.peak = std::max<uint64_t>(m.peak, m.cur.capacity_bytes() + m.next.capacity_bytes());
       m.growth = before ? std::max(1.0, static_cast<double>(m.next.size()) / static_cast<double>(before)) : 2.0;
@@ -1036,7 +1106,7 @@ Status Derivation::advance() {
     m.active = &m.passes[0];
     if (m.decomposer) {
       m.decompose(step);
-      if (g.uses_cut && !g.cpfg) apply_cut(m.cur);
+      if (g.uses_cut && !g.cpfg) apply_cut(m.cur, g);
     }
     m.reset_rewriters();
     run_block(g, Block::kEndEach, step, &m.seed, m.context);

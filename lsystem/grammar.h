@@ -66,6 +66,7 @@ struct Production {
   // forward pass, `>>` only in a backward one.
   bool new_left = false, new_right = false;
   uint32_t pass = 0;                         // the pass it belongs to (Grammar::passes)
+  uint32_t lsystem = 0;                      // a cpfg file's L-system it belongs to (Grammar::lsystem_labels)
   bool has_context() const { return !left_context.empty() || !right_context.empty(); }
   bool has_statements() const { return before.kind != Expr::Kind::kNone || after.kind != Expr::Kind::kNone; }
 };
@@ -227,6 +228,14 @@ struct Grammar {
   // cpfg's generate.c does (docs/cpfg.md).
   bool uses_cut = false;
   bool ring = false;          // a cpfg 'ring lsystem': context wraps from the word's end to its start (manual 3.1.1)
+  // A cpfg file's L-systems by their labels (`Lsystem: 2`), in file order: the first is the
+  // main one (its axiom, derivation length and blocks count), the others sub-L-systems
+  // (CPFG manual 7.2). Reading the word, a module ?(label, s) makes L-system `label` the
+  // one whose productions, decomposition and homomorphism apply to the modules after it,
+  // up to its $ (docs/cpfg.md "Sub-L-systems"); -1 for a label that is no whole number
+  // (`Lsystem: plant`), which nothing can call. Empty for sylva's own format.
+  std::vector<int64_t> lsystem_labels;
+  bool has_sub_lsystems() const { return lsystem_labels.size() > 1; }
 
   // The physical source line at `loc` (in its file) without its newline, for messages.
   std::string_view source_line(SourceLoc loc) const;

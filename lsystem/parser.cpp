@@ -284,7 +284,8 @@ class Parser {
   bool explicit_pass_ = false;         // a 'pass:' line started the current pass
   bool pass_line(const Cursor& c, std::string_view rest);
   bool seen_lsystem_ = false;  // cpfg: the 'Lsystem:' line was read
-  bool seen_end_ = false;      // cpfg: the 'endlsystem' line was read
+  bool seen_end_ = false;      // cpfg: the 'endlsystem' line was read (of the L-system being read)
+  uint32_t lsystem_ = 0;       // cpfg: the L-system being read (Grammar::lsystem_labels), 0 the main one
   bool consider_ = false;      // cpfg: a 'consider:' list names the modules context sees
   std::vector<uint8_t> considered_;  // by symbol id
   std::unordered_map<std::string, uint32_t> global_index_;  // cpfg: global variables by name
@@ -976,6 +977,11 @@ bool Parser::try_directive(const LogicalLine& line) {
     SourceLoc loc = c.loc();
     if (d == "module") {
       // handled in the first pass
+    } else if (lsystem_ > 0 && (d == "derivation length" || d == "steps" || d == "seed")) {
+      // A sub-L-system's own derivation length: the main L-system's counts (CPFG manual 7.2).
+      constant_expression(value, d.c_str());
+    } else if (lsystem_ > 0 && d == "ignore") {
+      fail(loc, "'ignore:' in a sub-L-system is not supported yet (docs/cpfg.md)");
     } else if (d == "ignore") {
       set_ignore(value);
     } else if (d == "angle") {
@@ -1049,7 +1055,18 @@ bool Parser::try_directive(const LogicalLine& line) {
       double n = constant_expression(value, "maximum depth");
       if (n < 0 || n != std::floor(n) || n > kMaxDepthLimit)
         fail(value.loc(), "maximum depth must be an integer from 0 to 100000");
-      (section_ == Section::kDecomposition ? g_.decomposition_depth : g_.max_depth) = static_cast<int>(n);
+      int& depth = section_ == Section::kDecomposition ? g_.decomposition_depth : g_.max_depth;
+      if (lsystem_ > 0 && static_cast<int>(n) != depth)
+        fail(value.loc(), "a sub-L-system's maximum depth must be the main L-system's (" + std::to_string(depth) +
+                              "): sylva applies one (docs/cpfg.md)");
+      depth = static_cast<int>(n);
+    } else if (lsystem_ > 0) {
+      // A sub-L-system's axiom is read and not used: it runs when ?(label, s) calls it
+      // (CPFG manual 7.2: "the axiom is ignored when it is called as a sub-L-system").
+      const bool visible = globals_visible_;
+      globals_visible_ = true;
+      compile_successor(value, Scope{}, "the axiom");
+      globals_visible_ = visible;
     } else {  // axiom / ω
       if (have_axiom_) fail(loc, "the axiom is given twice");
       have_axiom_ = true;
@@ -1258,6 +1275,7 @@ void Parser::parse_production(const LogicalLine& line) {
   p.slot_count = static_cast<uint32_t>(scope.size());  // the formal parameters, then the locals
   for (const Expr& e : p.successor.args)
     if (e.uses_random) g_.uses_random = true;
+  p.lsystem = lsystem_;
   (section_ == Section::kHomomorphism    ? g_.homomorphism
    : section_ == Section::kDecomposition ? g_.decomposition
                                           : g_.productions)
@@ -1286,11 +1304,34 @@ bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest) {
   };
   Cursor value = c;
   if (keyword("lsystem", false, &value)) {
-    if (seen_lsystem_) unsupported("a second L-system (sub-L-systems, CPFG manual 7.2)");
+    // "Lsystem: label" (CPFG manual 2, 7.2): the label, a whole number (0 without one), names
+    // the L-system for ?(label, s); each after the first is a sub-L-system.
+    value.skip_spaces();
+    std::string_view text = value.rest();
+    while (!text.empty() && is_space(text.back())) text.remove_suffix(1);
+    int64_t label = 0;
+    if (!text.empty()) {
+      auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), label);
+      if (ec != std::errc() || ptr != text.data() + text.size() || label < 0)
+        label = -1;  // a name ("Lsystem: plant"): no ?(label, s) can call it
+    }
+    if (seen_lsystem_) {
+      if (!seen_end_) fail(c.loc(), "an L-system starts before the one above ends: 'endlsystem' first");
+      if (label >= 0 && std::find(g_.lsystem_labels.begin(), g_.lsystem_labels.end(), label) != g_.lsystem_labels.end())
+        fail(value.loc(), "a second L-system with the label " + std::to_string(label));
+      lsystem_ = static_cast<uint32_t>(g_.lsystem_labels.size());
+      seen_end_ = false;
+      section_ = Section::kProductions;
+    }
+    g_.lsystem_labels.push_back(label);
     seen_lsystem_ = true;
-    return true;  // its label names the L-system for sub-L-systems only
+    return true;
   }
-  if (seen_end_) unsupported("text after 'endlsystem' (sub-L-systems, CPFG manual 7.2)");
+  if (seen_end_) fail(c.loc(), "expected a sub-L-system's 'Lsystem:' line or nothing after 'endlsystem'");
+  // What a sub-L-system may not hold (sylva keeps one of each for the whole file).
+  auto main_only = [&](const std::string& what) {
+    if (lsystem_ > 0) unsupported(what + " in a sub-L-system");
+  };
   if (folded == "endlsystem") {
     seen_end_ = true;
     return true;
@@ -1327,11 +1368,13 @@ bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest) {
     for (char ch : folded)
       if (!is_space(ch)) words += ch;
     if (words != "ringlsystem" && words != "ringlsystem:") fail(c.loc(), "expected 'ring lsystem' (CPFG manual 3.1.1)");
+    main_only("'ring lsystem'");
     if (have_axiom_) fail(c.loc(), "'ring lsystem' must come before the axiom (CPFG manual 3.1.1)");
     g_.ring = true;
     return true;
   }
   if (keyword("consider", false, &value)) {
+    main_only("'consider:'");
     set_consider(value);
     return true;
   }
@@ -1341,6 +1384,7 @@ bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest) {
   for (const auto& [block, expr] : blocks) {
     if (!keyword(block, false, &value)) continue;
     const std::string name(rest.substr(0, std::strlen(block)));
+    main_only("a '" + name + ":' block");
     if (expr->kind != Expr::Kind::kNone) fail(c.loc(), "the '" + name + ":' block is given twice");
     *expr = compile_statements(value, nullptr);
     value.skip_spaces();

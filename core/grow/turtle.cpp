@@ -364,7 +364,7 @@ enum class CpfgKind : uint8_t {
   kNone, kDraw, kMove, kColorUp, kColorDown, kWidthUp, kWidthDown, kLevel, kSetPosition, kSetHeading, kCircle, kSphere,
   kScaleSet, kScaleUp, kScaleDown, kForceTwist, kElasticityUp, kElasticityDown, kElasticitySet,
   kCylinderStart, kCylinderPoint, kCylinderEnd, kCylinderTangents, kCylinderSides, kCylinderContour, kSurface, kRadiusTangents,
-  kUnsupported
+  kSubCall, kSubEnd, kUnsupported
 };
 
 struct CpfgSymbols {
@@ -392,6 +392,8 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
   set("@O", CpfgKind::kSphere);
   set("@o", CpfgKind::kSphere);  // a disc facing the camera: a sphere shows one from everywhere
   set("~", CpfgKind::kSurface);
+  set("?", CpfgKind::kSubCall);  // ?(label, s): a sub-L-system, drawn s times larger
+  set("$", CpfgKind::kSubEnd);   // its end (cpfg's $ is no roll: @v levels the turtle)
   set("@D", CpfgKind::kScaleSet);
   set("@Di", CpfgKind::kScaleUp);
   set("@Dd", CpfgKind::kScaleDown);
@@ -483,6 +485,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   // added to the pool, so it never outgrows the open cylinders of the branches open.
   std::vector<GenCylinder> cylinders;
   std::vector<size_t> cylinder_marks;  // the pool's size at each '[' still open
+  std::vector<double> sub_scales;      // cpfg: the scale of each sub-L-system entered and not left
   // Appends one piece of a cylinder's curve to its chain: `strips` joints at curve(k /
   // strips), radii from r0 to r1, in the colour of the piece's start. A new chain where
   // there is none yet or where the chain went on meanwhile (a branch drew from this point).
@@ -839,6 +842,26 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
             t.prev_heading = t.heading;
             t.prev_up = t.up;
             continue;
+          case CpfgKind::kSubCall:  // ?(label, s) (CPFG manual 7.2; interpret.c's UpdateCurrentLsystem)
+          case CpfgKind::kSubEnd: {  // $: back to the scale before the call; an unmatched $ is ignored
+            const bool call = cpfg.kind[symbol] == CpfgKind::kSubCall;
+            if (call && !has) continue;  // a bare ? is no call
+            if (!call && sub_scales.empty()) continue;
+            const double before = sub_scales.empty() ? d.initial_scale : sub_scales.back();
+            if (call) {
+              const double next = m.param_count >= 2 ? before * p[1] : before;
+              if (!std::isfinite(next) || std::abs(next) > kMaxCoordinateM)
+                throw TurtleFailure{"the turtle's scale must be finite and at most 1e12"};
+              sub_scales.push_back(next);
+            } else {
+              sub_scales.pop_back();
+            }
+            // cpfg's turtle takes the stack's scale, and its line width in proportion.
+            const double now = sub_scales.empty() ? d.initial_scale : sub_scales.back();
+            if (before != 0) t.radius = t.radius * now / before;
+            t.scale = now;
+            continue;
+          }
           case CpfgKind::kScaleSet:    // @D(s): the scale is s (CPFG manual 6.3)
           case CpfgKind::kScaleUp:     // @Di(s): times s, else times the view file's scale multiplier
           case CpfgKind::kScaleDown: {  // @Dd(s): over s, else over the multiplier

@@ -911,6 +911,20 @@ TEST(TurtleCpfg, APercentLeftInTheWordIsPassedOverUnlessInterpretationPastCutIsO
   EXPECT_LT(off->skeleton.joints.size(), past.joints.size());
 }
 
+// ?(label, s) draws the sub-L-system's modules s times larger, widths too, up to its $ (cpfg's
+// interpret.c); the scale stacks with nested calls and an unmatched $ changes nothing.
+TEST(TurtleCpfg, ASubLSystemCallScalesTheTurtleUpToItsEnd) {
+  const Skeleton sk = skeleton_of(
+      "Lsystem: 1\nderivation length: 0\nAxiom: #(2)F(1)?(2,0.5)F(1)?(2,0.5)F(1)$F(1)$F(1)$F(1)\nendlsystem\n"
+      "Lsystem: 2\nAxiom: F\nendlsystem\n");
+  ASSERT_EQ(sk.joints.size(), 7u);
+  const double y[] = {0, 1, 1.5, 1.75, 2.25, 3.25, 4.25};
+  for (size_t k = 0; k < 7; ++k) EXPECT_NEAR(sk.joints[k].position_m[1], y[k], 1e-12) << k;
+  EXPECT_NEAR(sk.joints[2].radius_m, sk.joints[1].radius_m * 0.5, 1e-15);
+  EXPECT_NEAR(sk.joints[3].radius_m, sk.joints[1].radius_m * 0.25, 1e-15);
+  EXPECT_NEAR(sk.joints[6].radius_m, sk.joints[1].radius_m, 1e-15);
+}
+
 TEST(TurtleCpfg, SemicolonAndCommaStepTheColourIndexOrSetIt) {
   const Skeleton sk = skeleton_of(cpfg("F;F;;F,F;(7)F,(2)F"));
   ASSERT_EQ(sk.joints.size(), 7u);

@@ -337,6 +337,42 @@ TEST(CpfgModel, APredecessorOfSeveralModulesRewritesConsecutiveModulesTogether) 
   expect_located({"axiom: A B\nA B -> C\n", 2, 1, "the predecessor must be one module"});
 }
 
+// Sub-L-systems (CPFG manual 7.2; cpfg's CheckPred): reading the word, ?(label, s) makes
+// L-system `label` the one whose productions (and homomorphism) apply, up to its $. A
+// sub-L-system's axiom and derivation length are not used.
+TEST(CpfgModel, SubLSystemsRewriteTheModulesBetweenTheirCallAndItsEnd) {
+  const std::string text =
+      "Lsystem: 1\nderivation length: 2\nAxiom: A\nA --> F?(2,0.5)B(1)$A\nB(x) --> X\nhomomorphism\nA --> K\n"
+      "endlsystem\nLsystem: 2\nderivation length: 9\nAxiom: B(5)\nB(x) --> F(x)B(x+1)\nhomomorphism\nB(x) --> G(x)\n"
+      "endlsystem\n";
+  // Step 1: A. Step 2: B(1) inside ?(2, ...) ... $ by L-system 2's production, not the main's.
+  EXPECT_EQ(derive_text(text), "F?(2,0.5)F(1)B(2)$F?(2,0.5)B(1)$A");
+  auto g = parse_grammar(text, "s.l");
+  ASSERT_TRUE(g.ok()) << g.error().format();
+  EXPECT_EQ(drawn_text(*g), "F?(2,0.5)F(1)G(2)$F?(2,0.5)G(1)$K");
+  // Nested calls return to the caller's L-system; a stray $ at the top leaves the main one.
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: $B?(2)B?(1)B$B$B\nB --> M\nendlsystem\n"
+                        "Lsystem: 2\nAxiom: B\nB --> S\nendlsystem\n"),
+            "$M?(2)S?(1)M$S$M");
+  // A cut inside a sub-L-system ends at its $ (cpfg's SkipCutPart).
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: ?(2)A%B[C]$D\nendlsystem\nLsystem: 2\nAxiom: B\n"
+                        "endlsystem\n"),
+            "?(2)A$D");
+  // What the file does not define, and what a sub-L-system may not hold yet.
+  auto unknown = derive_text("Lsystem: 1\nAxiom: ?(7,1)B$\nendlsystem\nLsystem: 2\nAxiom: B\nendlsystem\n",
+                             [] { DeriveOptions o; o.steps = 1; return o; }());
+  EXPECT_NE(unknown.find("?(7, ...) calls an L-system the file does not define (its labels: 1, 2)"), std::string::npos)
+      << unknown;
+  expect_located({"Lsystem: 1\nAxiom: A\nendlsystem\nLsystem: 2\nAxiom: B\nignore: F\nendlsystem\n", 6, 1,
+                  "'ignore:' in a sub-L-system is not supported yet"});
+  expect_located({"Lsystem: 1\nAxiom: A\nendlsystem\nLsystem: 1\nAxiom: B\nendlsystem\n", 4, 10,
+                  "a second L-system with the label 1"});
+  expect_located({"Lsystem: 1\nAxiom: A\nendlsystem\nF --> G\n", 4, 1, "expected a sub-L-system's 'Lsystem:' line"});
+  expect_located({"Lsystem: 1\nAxiom: A\nLsystem: 2\nendlsystem\n", 3, 1, "'endlsystem' first"});
+  expect_located({"Lsystem: 1\nAxiom: A\nhomomorphism\nmaximum depth: 3\nendlsystem\nLsystem: 2\nAxiom: B\n"
+                  "homomorphism\nmaximum depth: 2\nendlsystem\n", 9, 16, "must be the main L-system's (3)"});
+}
+
 // cpfg's cut (generate.c's ApplyProd): a % a production writes stays in the word, and cuts
 // itself and the rest of its branch when the next step reads it; what follows it is still
 // rewritten meanwhile. sylva's own format cuts as the word is written.
@@ -457,7 +493,8 @@ TEST(CpfgModel, AnEqualsSignInARightContextIsTheRestOfTheBranch) {
 
 TEST(CpfgModel, WhatSylvaCannotReadYetIsAnErrorAtItsPlaceNamingTheFeature) {
   const LocatedError cases[] = {
-      {"Lsystem: 1\nAxiom: F\nendlsystem\nLsystem: 2\nAxiom: G\nendlsystem\n", 4, 1, "sub-L-systems"},
+      {"Lsystem: 1\nAxiom: F\nendlsystem\nLsystem: 2\nAxiom: G\nStart: {x = 1;}\nendlsystem\n", 6, 1,
+       "a 'Start:' block in a sub-L-system"},
   };
   for (const LocatedError& c : cases) {
     expect_located(c);
