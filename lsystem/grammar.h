@@ -179,6 +179,16 @@ struct Grammar {
     std::vector<std::string> position_formats;
   };
   std::optional<Environment> environment;
+  // A vlab object's colours (docs/cpfg.md "Colours"): its colour map (`cpfg -m`, 256 sRGB
+  // triples) or material file (`-M`: each record's diffuse colour, and its specular's
+  // brightest channel as the lobe's weight), by colour index, which is the turtle's material
+  // index. Empty: none given (the scene's table, then sylva's defaults).
+  struct Colour {
+    uint32_t index = 0;
+    double srgb[3] = {0, 0, 0};  // 0..1, sRGB-encoded as the files store them
+    double specular = 1;         // the Blinn–Phong lobe's weight (a colour map's: sylva's default)
+  };
+  std::vector<Colour> colours;
   std::vector<IncludedFile> includes;        // SourceLoc::file k > 0 is includes[k - 1]
   // A cpfg file's global variables (assigned in its blocks) and its blocks (CPFG manual 4.1):
   // Start before the axiom, StartEach and EndEach around every step, End after the last.

@@ -275,6 +275,47 @@ Expected<Grammar::Environment> read_environment(const std::string& path, const s
   return env;
 }
 
+// cpfg's colour map (`-m`; irisGL.c's load_in_colormaps): 256 RGB byte triples, one for
+// each colour index.
+Expected<std::vector<Grammar::Colour>> read_colour_map(const std::string& path) {
+  Expected<std::string> bytes = read_text_file(path, 4096);
+  if (!bytes) return std::move(bytes.error());
+  if (bytes->size() != 768)
+    return file_diagnostic(path, "a colour map holds 256 RGB triples, 768 bytes; this file has " +
+                                     std::to_string(bytes->size()));
+  std::vector<Grammar::Colour> out(256);
+  for (uint32_t i = 0; i < 256; ++i) {
+    out[i].index = i;
+    for (int c = 0; c < 3; ++c) out[i].srgb[c] = static_cast<unsigned char>((*bytes)[3 * i + c]) / 255.0;
+  }
+  return out;
+}
+
+// cpfg's material file (`-M`, medit's; irisGL.c's load_in_materials): records of 15 bytes,
+// the colour index, then transparency, ambient RGB, diffuse RGB, emissive RGB, specular RGB
+// and shininess. sylva takes the diffuse colour and the specular's brightest channel as its
+// lobe's weight.
+Expected<std::vector<Grammar::Colour>> read_material_file(const std::string& path) {
+  Expected<std::string> bytes = read_text_file(path, 256 * 15 * 16);
+  if (!bytes) return std::move(bytes.error());
+  if (bytes->empty() || bytes->size() % 15 != 0)
+    return file_diagnostic(path, "a material file holds records of 15 bytes (medit's); this file has " +
+                                     std::to_string(bytes->size()) + " bytes");
+  std::vector<Grammar::Colour> out;
+  for (size_t r = 0; r + 15 <= bytes->size(); r += 15) {
+    auto byte = [&](size_t k) { return static_cast<unsigned char>((*bytes)[r + k]); };
+    Grammar::Colour c;
+    c.index = byte(0);
+    for (int k = 0; k < 3; ++k) c.srgb[k] = byte(5 + k) / 255.0;
+    c.specular = std::max({byte(11), byte(12), byte(13)}) / 255.0;
+    // A later record of the same index replaces the earlier, as cpfg's table does.
+    auto same = std::find_if(out.begin(), out.end(), [&](const Grammar::Colour& o) { return o.index == c.index; });
+    if (same != out.end()) *same = c;
+    else out.push_back(c);
+  }
+  return out;
+}
+
 // A movement's words with each "K:value" split into "K:" and "value" (cpfg's reader splits
 // them at ':', cpfg/movements.c: `tropism: T: 0 1 0 A:90`).
 std::vector<Token> split_keys(const std::vector<Token>& words) {
@@ -342,13 +383,11 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
       if (!value(0, &v)) return;
       if (v < 0) return fail_here(values[0].column + value_column - 1, "a line width must not be negative");
       line_width = v;
-      if (values.size() > 1) {
-        const std::string style = lower_ascii(values[1].text);
-        // cpfg reads the word's first letter (interpret.c): `pixel`, `pnts`, `shaded` ...
-        if (style[0] == 'p') world_units = false;
-        else if (style[0] == 's') world_units = true;
-        else return fail_here(values[1].column + value_column - 1, "expected 'p', 'pixels', 's' or 'shaded' as the line style");
-      }
+      // cpfg's reader (interpret.c) makes the style polygon, world units, and then reads the
+      // next word's first letter: `p...` (pixels, pnts) is pixels, `s...` (shaded) cylinders,
+      // anything else or nothing stays polygon. (The manual's table says pixels without a
+      // word; cpfg's source draws world units, and so does sylva: docs/cpfg.md.)
+      world_units = values.size() < 2 || lower_ascii(values[1].text)[0] != 'p';
     } else if (name == "line width increment") {
       if (value(0, &v)) width_increment = v;
     } else if (name == "initial scale" || name == "scale multiplier") {
@@ -364,6 +403,12 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
       if (style == "pixel" || style == "1") world_units = false;
       else if (style == "polygon" || style == "cylinder" || style == "2" || style == "3") world_units = true;
     } else if (name == "initial color") {
+      double back = 0;
+      // A second number turns cpfg's double-sided surfaces on: a back side with its own colour.
+      if (values.size() >= 2 && number(values[1].text, &back))
+        return fail_here(values[1].column + value_column - 1,
+                         "a back side's colour ('initial color: front back', double-sided surfaces) is not supported "
+                         "yet (docs/cpfg.md)");
       if (value(0, &v)) {
         if (v < 0 || v != std::floor(v)) return fail_here(values[0].column + value_column - 1, "a colour index is a whole number from 0");
         t.initial_color = static_cast<uint32_t>(v);
@@ -457,7 +502,12 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
   return {};
 }
 
-Expected<Grammar> load_vlab_object(const std::string& folder, const ParseOptions& options) {
+namespace {
+
+// load_vlab_object, and parse_vlab_object with the model's text given (`model_text`), or
+// `*model_file` only: the model file's path, nothing parsed.
+Expected<Grammar> read_vlab_object(const std::string& folder, const ParseOptions& options,
+                                   const std::string* model_text, std::string* model_file) {
   namespace fs = std::filesystem;
   const std::string specifications = (fs::path(folder) / "specifications").string();
   Expected<std::string> text = read_text_file(specifications);
@@ -472,6 +522,7 @@ Expected<Grammar> load_vlab_object(const std::string& folder, const ParseOptions
     std::string text;
   };
   std::optional<EnvironmentOption> environment;  // cpfg -e file.e
+  std::optional<EnvironmentOption> colour_file, map_file;  // cpfg -M file.mat, -m file.map
   uint32_t command_line = 0;
   std::string command_text;
   for_each_physical_line(*text, [&](uint32_t line_no, std::string_view line, bool) {
@@ -493,6 +544,10 @@ Expected<Grammar> load_vlab_object(const std::string& folder, const ParseOptions
         return void(failure = error_in(specifications, line, line_no, w.column, "cpfg option '" + w.text + "' needs " +
                                                                                     std::to_string(count) + " argument(s)"));
       if (w.text == "-e") environment = {words[k + 1].text, line_no, w.column, std::string(line)};
+      // The colours: a material file, else the first colour map (-m or -m1; -m2 ... colour
+      // indices from 256, which sylva's colour steps never reach, are read by nobody).
+      if (w.text == "-M") colour_file = {words[k + 1].text, line_no, w.column, std::string(line)};
+      if ((w.text == "-m" || w.text == "-m1") && !map_file) map_file = {words[k + 1].text, line_no, w.column, std::string(line)};
       k += static_cast<size_t>(count);
     }
     if (files.size() < 2)
@@ -505,6 +560,10 @@ Expected<Grammar> load_vlab_object(const std::string& folder, const ParseOptions
   if (model.empty())
     return file_diagnostic(specifications, "no cpfg command: a vlab object of cpfg names it on a line "
                                            "'cpfg [options] model.l view.v' (is this object for another program?)");
+  if (model_file) {
+    *model_file = model;
+    if (!model_text) return Grammar{};
+  }
   ParseOptions with_functions = options;
   if (Status s = read_view_functions(view, folder, with_functions); !s) return std::move(s.error());
   std::optional<Grammar::Environment> field;
@@ -529,11 +588,91 @@ Expected<Grammar> load_vlab_object(const std::string& folder, const ParseOptions
     }
     field = std::move(*read);
   }
-  Expected<Grammar> g = load_grammar(model, with_functions);
+  Expected<Grammar> g = model_text ? parse_grammar(*model_text, model, with_functions) : load_grammar(model, with_functions);
   if (!g) return g;
   g->environment = std::move(field);
   if (Status s = apply_view_file(view, *g); !s) return std::move(s.error());
+  if (const auto& file = colour_file ? colour_file : map_file;
+      file && fs::exists(fs::path(folder) / file->file)) {  // none there: cpfg's defaults, as cpfg goes on
+    const std::string path = (fs::path(folder) / file->file).string();
+    auto colours = colour_file ? read_material_file(path) : read_colour_map(path);
+    if (!colours) {
+      Diagnostic d = error_in(specifications, file->text, file->line, file->column,
+                              std::string("cannot read the ") + (colour_file ? "material file '" : "colour map '") +
+                                  file->file + "'");
+      d.notes.push_back(std::move(colours.error()));
+      return d;
+    }
+    g->colours = std::move(*colours);
+  }
   return g;
+}
+
+}  // namespace
+
+Expected<Grammar> load_vlab_object(const std::string& folder, const ParseOptions& options) {
+  return read_vlab_object(folder, options, nullptr, nullptr);
+}
+
+Expected<std::string> vlab_model_file(const std::string& folder) {
+  std::string file;
+  if (auto read = read_vlab_object(folder, {}, nullptr, &file); !read) return std::move(read.error());
+  return file;
+}
+
+Expected<Grammar> parse_vlab_object(const std::string& folder, const std::string& model_text,
+                                    const ParseOptions& options) {
+  std::string file;
+  return read_vlab_object(folder, options, &model_text, &file);
+}
+
+std::vector<PanelSlider> read_panel_sliders(std::string_view text) {
+  std::vector<PanelSlider> out;
+  // Items are blocks of "key: value" lines, each starting with "type:".
+  std::string type, name, minmax, value, message;
+  auto finish = [&] {
+    if (lower_ascii(type) == "slider") {
+      // message: "d NAME %d scale" — the parameter editor defines NAME as the value / scale.
+      const std::vector<Token> m = tokens_of(message);
+      const std::vector<Token> r = tokens_of(minmax);
+      double lo = 0, hi = 0, scale = 1, v = 0;
+      if (m.size() == 4 && m[0].text == "d" && m[2].text == "%d" && number(m[3].text, &scale) && scale != 0 &&
+          r.size() == 2 && number(r[0].text, &lo) && number(r[1].text, &hi) && lo < hi) {
+        PanelSlider sl;
+        sl.label = name;
+        sl.define = m[1].text;
+        sl.min = lo / scale;
+        sl.max = hi / scale;
+        if (sl.min > sl.max) std::swap(sl.min, sl.max);
+        sl.step = 1 / std::abs(scale);
+        sl.value = number(value, &v) ? v / scale : sl.min;
+        out.push_back(std::move(sl));
+      }
+    }
+    type.clear(), name.clear(), minmax.clear(), value.clear(), message.clear();
+  };
+  for_each_physical_line(text, [&](uint32_t, std::string_view line, bool) {
+    std::string key;
+    const std::optional<size_t> colon = command_of(line, &key);
+    if (!colon) return;
+    std::string_view rest = line.substr(*colon + 1);
+    while (!rest.empty() && is_space(rest.front())) rest.remove_prefix(1);
+    while (!rest.empty() && (is_space(rest.back()) || rest.back() == '\r')) rest.remove_suffix(1);
+    if (key == "type") {
+      finish();
+      type = std::string(rest);
+    } else if (key == "name") {
+      name = std::string(rest);
+    } else if (key == "min/max") {
+      minmax = std::string(rest);
+    } else if (key == "value") {
+      value = std::string(rest);
+    } else if (key == "message") {
+      message = std::string(rest);
+    }
+  });
+  finish();
+  return out;
 }
 
 }  // namespace sylva::lsys

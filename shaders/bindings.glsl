@@ -39,7 +39,7 @@
 
 // Constants.
 #define MAX_BARK_IMAGES 16        // distinct bark images a scene may bind (GL 4.5 guarantees 16 units a stage)
-#define MAX_MATERIALS 16          // shade.frag.glsl's material table (materials.h fills it)
+#define MAX_MATERIALS 256         // shade.frag.glsl's material table (materials.h fills it)
 #define PLANT_INDEX_BITS 24       // G-buffer ids.x: plant | material << PLANT_INDEX_BITS
 #define PLANT_INDEX_MASK 0xFFFFFFu
 #define LEAF_CHAIN 0xFFFFFFFEu    // G-buffer ids.y of a leaf (gl_mesh.h), ids.z its index

@@ -296,15 +296,16 @@ int run_export(const std::vector<std::string>& raw_args) {
     }
     Scene& scene = *read;
     if (skin) override_skin(scene, *skin);
-    options.materials = scene.materials;  // one glTF material per entry (docs/materials.md)
     if (animation && scene.animation) options.animation = wind_clip_of(*scene.animation);
     if (scene.animation) options.wind_seed = scene.animation->seed;
-    if (options.lod > 0) options.card_renderer = cpu_card_renderer(scene.materials);
     // A plant's grammar error: the grammar's place, and a note at the scene key naming it.
     if (Status grown = grow_scene_plants(scene, a.max_modules, {}, &cpu_light_oracle()); !grown) {
       std::cerr << grown.error().format();
       return kInputError;
     }
+    // One glTF material per entry (docs/materials.md), the plants' vlab colours included.
+    options.materials = scene.materials;
+    if (options.lod > 0) options.card_renderer = cpu_card_renderer(scene.materials);
     std::vector<GltfPlant> plants;
     for (ScenePlant& sp : scene.plants) {
       GltfPlant p;
@@ -328,6 +329,9 @@ int run_export(const std::vector<std::string>& raw_args) {
   int code = kOk;
   auto g = load_grammar_for(a, &code);
   if (!g) return code;
+  // A vlab object's colour map or material file: its colours as the glTF materials.
+  add_grammar_colours(g->colours, options.materials);
+  if (options.lod > 0) options.card_renderer = cpu_card_renderer(options.materials);
   // Grows with `one`'s seed and exports to `output`.
   // Grows with `one`'s seed and exports to `output`; the summary line on success.
   auto export_one = [&](const GrammarArgs& one, const std::string& output) -> Expected<std::string> {

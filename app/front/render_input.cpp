@@ -200,6 +200,7 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
     passes.push_back({"read glTF", seconds_since(start), std::to_string(scene.plants.size()) + " plants"});
   } else {
     Skeleton skeleton;
+    std::map<uint32_t, SceneMaterial> colours;
     if (is_skeleton) {
       Expected<Skeleton> read = read_skeleton_file(input);
       if (!read) {
@@ -233,6 +234,7 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
         return kInputError;
       }
       skeleton = std::move(grown->skeleton);
+      add_grammar_colours(g->colours, colours);  // a vlab object's colour map or material file
       passes.push_back({"grow", seconds_since(start), std::to_string(grown->modules) + " modules"});
     }
     if (auto problem = plant_extent_problem(skeleton)) {
@@ -240,6 +242,7 @@ std::variant<Scene, ExitCode> load_render_input(const GrammarArgs& grammar, std:
       return kInputError;
     }
     scene = default_scene_for(skeleton, width.value_or(1024), height.value_or(768));
+    if (!colours.empty()) scene.materials = std::move(colours);
   }
   if (width) scene.width = *width;
   if (height) scene.height = *height;

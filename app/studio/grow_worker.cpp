@@ -15,11 +15,17 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+// The request's text as a grammar: a vlab object's model with its object's files, else the text alone.
+Expected<lsys::Grammar> parse(const GrowRequest& r, const lsys::ParseOptions& po) {
+  return r.object_folder.empty() ? lsys::parse_grammar(r.text, r.file, po)
+                                 : lsys::parse_vlab_object(r.object_folder, r.text, po);
+}
+
 }  // namespace
 
 // What plants[0]'s last derivation left: its key and each step's word.
 struct GrowWorker::Cache {
-  std::string text, file;
+  std::string text, file, object_folder;
   std::map<std::string, double> defines;
   std::optional<uint64_t> seed;
   uint64_t max_modules = 0;
@@ -27,7 +33,8 @@ struct GrowWorker::Cache {
   std::shared_ptr<const lsys::Grammar> grammar;
   std::vector<std::optional<lsys::Word>> words;  // by step; nullopt: not kept (budget)
   bool matches(const GrowRequest& r) const {
-    return grammar && text == r.text && file == r.file && defines == r.plants[0].defines &&
+    return grammar && text == r.text && file == r.file && object_folder == r.object_folder &&
+           defines == r.plants[0].defines &&
            seed == r.plants[0].seed && max_modules == r.max_modules &&
            (!grammar_queries_light(*grammar) || (light.sun == r.light.sun && light.ground == r.light.ground &&
                                                   light.environment == r.light.environment));
@@ -160,12 +167,13 @@ GrowOutcome GrowWorker::grow(const GrowRequest& request, uint64_t gen, bool* can
   if (!cache.matches(request)) {
     lsys::ParseOptions po;
     po.define_overrides = first.defines;
-    auto parsed = lsys::parse_grammar(request.text, request.file, po);
+    auto parsed = parse(request, po);
     if (!parsed) return fail(parsed.error());
     cache.words.clear();
     cache.grammar = std::make_shared<const lsys::Grammar>(std::move(*parsed));
     cache.text = request.text;
     cache.file = request.file;
+    cache.object_folder = request.object_folder;
     cache.defines = first.defines;
     cache.seed = first.seed;
     cache.max_modules = request.max_modules;
@@ -173,6 +181,7 @@ GrowOutcome GrowWorker::grow(const GrowRequest& request, uint64_t gen, bool* can
   }
   const lsys::Grammar& g = *cache.grammar;
   out.defines = g.defines;
+  out.colours = g.colours;
   out.grammar_seed = g.seed;
   out.grammar_steps = g.steps;
   out.steps = first.steps.value_or(g.steps);
@@ -256,7 +265,7 @@ GrowOutcome GrowWorker::grow(const GrowRequest& request, uint64_t gen, bool* can
     const PlantVariant& v = request.plants[p];
     lsys::ParseOptions po;
     po.define_overrides = v.defines;
-    auto parsed = lsys::parse_grammar(request.text, request.file, po);
+    auto parsed = parse(request, po);
     if (!parsed) return fail(parsed.error());
     lsys::DeriveOptions o;
     o.seed = v.seed;

@@ -47,6 +47,9 @@ struct PlantVariant {
 struct GrowRequest {
   std::string text;                  // the grammar text
   std::string file;                  // its name in messages (the path as the user gave it)
+  // A vlab object's folder when `text` is its model (docs/cpfg.md): parsed with the object's
+  // view file, functions, environment and colours (lsys::parse_vlab_object). Empty: none.
+  std::string object_folder;
   std::vector<PlantVariant> plants;  // at least one; plants[0] is the one the panel steps
   std::optional<int64_t> show_step;  // plants[0]: show this step's word, clamped to its
                                      // steps; unset: the last step
@@ -65,6 +68,7 @@ struct GrowOutcome {
                                      //   met them (the plant's frame; none without ?E)
   // plants[0]'s grammar: its defines after overrides, seed and derivation length.
   std::vector<lsys::Define> defines;
+  std::vector<lsys::Grammar::Colour> colours;  // a vlab object's colour map (none: empty)
   uint64_t grammar_seed = 1;
   int64_t grammar_steps = 1;
   int64_t steps = 0;                 // the derivation length used for plants[0]

@@ -136,6 +136,7 @@ std::optional<std::string> StudioApp::open(const std::string& path) {
         break;
       }
     if (grammar.empty()) return path + ": error: the scene has no plant grown from a grammar to edit";
+    const bool object = std::filesystem::is_directory(grammar);
     Scene others = scene;
     for (ScenePlant& p : others.plants)
       if (p.grammar == grammar) p.skeleton = Skeleton{};  // not grown here
@@ -143,9 +144,21 @@ std::optional<std::string> StudioApp::open(const std::string& path) {
     if (Status grown = grow_scene_plants(others, options_.max_modules, {}, &cpu_light_oracle()); !grown) return grown.error().format();
     for (size_t i = 0; i < scene.plants.size(); ++i)
       if (scene.plants[i].grammar != grammar) scene.plants[i].skeleton = std::move(others.plants[i].skeleton);
-    Expected<std::string> r = read_text_file(grammar);
+    Expected<std::string> model = object ? lsys::vlab_model_file(grammar) : Expected<std::string>(grammar);
+    if (!model) return one_line(model.error());
+    Expected<std::string> r = read_text_file(*model);
     if (!r) return one_line(r.error());
-    load_text(grammar, std::move(*r), path, std::move(scene));
+    load_text(*model, std::move(*r), path, std::move(scene), object ? grammar : "");
+    return std::nullopt;
+  }
+  if (std::filesystem::is_directory(path)) {
+    // A vlab object: the editor shows its model; the object's view file, functions,
+    // environment, colours and panel come with it (docs/cpfg.md).
+    Expected<std::string> model = lsys::vlab_model_file(path);
+    if (!model) return one_line(model.error());
+    Expected<std::string> r = read_text_file(*model);
+    if (!r) return one_line(r.error());
+    load_text(*model, std::move(*r), "", Scene{}, path);
     return std::nullopt;
   }
   Expected<std::string> r = read_text_file(path);
@@ -154,16 +167,38 @@ std::optional<std::string> StudioApp::open(const std::string& path) {
   return std::nullopt;
 }
 
-void StudioApp::load_text(const std::string& path, std::string text, const std::string& scene_path, Scene scene) {
+void StudioApp::rescan_defines() {
+  define_lines_ = scan_defines(text_);
+  for (DefineLine& d : define_lines_) {
+    if (d.has_range()) continue;
+    for (const lsys::PanelSlider& p : panel_)
+      if (p.define == d.name) {
+        d.min = p.min;
+        d.max = p.max;
+        d.step = p.step;
+      }
+  }
+}
+
+void StudioApp::load_text(const std::string& path, std::string text, const std::string& scene_path, Scene scene,
+                          std::string object_folder) {
   worker_->cancel();
   path_ = path;
   scene_path_ = scene_path;
+  object_folder_ = std::move(object_folder);
+  panel_.clear();
+  if (!object_folder_.empty()) {
+    // vlab's panel manager reads panel.l beside the model; without one, no sliders from it.
+    if (Expected<std::string> panel = read_text_file((std::filesystem::path(object_folder_) / "panel.l").string());
+        panel)
+      panel_ = lsys::read_panel_sliders(*panel);
+  }
   saved_text_ = text;
   text_ = std::move(text);
   editor_.replace(text_);
   disk_stamp_ = stamp_of(path_);
   autosaved_text_ = text_;
-  define_lines_ = scan_defines(text_);
+  rescan_defines();
   overrides_.clear();
   seed_.reset();
   steps_.reset();
@@ -178,11 +213,11 @@ void StudioApp::load_text(const std::string& path, std::string text, const std::
   edited_plants_.clear();
   if (scene_path_.empty()) {
     scene_.plants.assign(1, ScenePlant{});
-    scene_.plants[0].grammar = path_;
+    scene_.plants[0].grammar = plant_grammar();
     edited_plants_.push_back(0);
   } else {
     for (size_t i = 0; i < scene_.plants.size(); ++i)
-      if (scene_.plants[i].grammar == path_) edited_plants_.push_back(i);
+      if (scene_.plants[i].grammar == plant_grammar()) edited_plants_.push_back(i);
   }
   history_.reset(doc_state());
   restore_ = path_.empty() ? std::nullopt : restorable_autosave(path_, saved_text_);
@@ -219,6 +254,14 @@ std::optional<std::string> StudioApp::save_as(const std::string& path) {
     return err;
   }
   if (!old.empty() && old != path_) remove_autosave(old);
+  // Saved elsewhere, a vlab object's model is a cpfg file of its own: its object's
+  // specifications still name the old file, so its view file no longer applies.
+  if (old != path_ && !object_folder_.empty()) {
+    object_folder_.clear();
+    panel_.clear();
+    rescan_defines();
+    submit_regrow();
+  }
   for (size_t i : edited_plants_) scene_.plants[i].grammar = path_;
   return std::nullopt;
 }
@@ -232,7 +275,7 @@ std::optional<std::string> StudioApp::save_scene(const std::string& path) {
   s.sun.direction = unit_sun_direction(scene_.sun.direction);
   for (ScenePlant& p : s.plants) p.skeleton.reset();  // plants are named, never embedded
   for (size_t i : edited_plants_) {
-    s.plants[i].grammar = path_;
+    s.plants[i].grammar = plant_grammar();
     for (const auto& [name, value] : overrides_) s.plants[i].defines[name] = value;
     if (seed_) s.plants[i].seed = *seed_;
     if (steps_) s.plants[i].steps = *steps_;
@@ -293,7 +336,7 @@ void StudioApp::set_text(std::string text) {
   if (text == text_) return;
   text_ = std::move(text);
   editor_.replace(text_);
-  define_lines_ = scan_defines(text_);
+  rescan_defines();
   edited_at_.reset();
 }
 
@@ -308,6 +351,7 @@ void StudioApp::submit_regrow() {
   GrowRequest r;
   r.text = text_;
   r.file = path_.empty() ? "untitled.lsys" : path_;
+  r.object_folder = object_folder_;
   r.max_modules = options_.max_modules;
   r.show_step = show_step_;
   for (size_t i : edited_plants_) {
@@ -376,6 +420,7 @@ void StudioApp::apply_outcome(GrowOutcome outcome) {
     if (scene_path_.empty()) {
       const Skeleton& sk = *scene_.plants[0].skeleton;
       Scene d = default_scene_for(sk, scene_.width, scene_.height);
+      add_grammar_colours(outcome.colours, d.materials);  // a vlab object's colour map
       d.plants = std::move(scene_.plants);
       scene_ = std::move(d);
       const glm::dvec3 dir = glm::normalize(scene_.sun.direction);
@@ -735,7 +780,7 @@ void StudioApp::draw_editor(ImVec2 size) {
     mark = EditorMark{error_->loc.line, error_->loc.column, token_length(text_, error_->loc.line, error_->loc.column),
                       error_->message};
   if (editor_.draw("editor", text_, mark, size)) {
-    define_lines_ = scan_defines(text_);
+    rescan_defines();
     edited_at_ = now_;
     unsnapped_at_ = now_;  // the undo step comes after a pause in typing
     animating_ = false;

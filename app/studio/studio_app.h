@@ -33,6 +33,7 @@
 #include "app/studio/preset_catalog.h"
 #include "app/studio/undo_history.h"
 #include "app/studio/viewport.h"
+#include "core/grow/grow.h"
 #include "core/scene/render_types.h"
 #include "core/scene/scene.h"
 #include "core/util/diagnostic.h"
@@ -175,7 +176,13 @@ class StudioApp {
  private:
   enum class FileDialog { none, open, save_as, export_gltf, export_png, export_skeleton, save_scene_as };
 
-  void load_text(const std::string& path, std::string text, const std::string& scene_path, Scene scene);
+  void load_text(const std::string& path, std::string text, const std::string& scene_path, Scene scene,
+                 std::string object_folder = "");
+  // The document's define lines, found again in the text; a vlab object's panel sliders give
+  // the ranges the text's own range comments do not.
+  void rescan_defines();
+  // What a scene's plant names for the document: a vlab object's folder, else the grammar file.
+  const std::string& plant_grammar() const { return object_folder_.empty() ? path_ : object_folder_; }
   void submit_regrow();
   void apply_outcome(GrowOutcome outcome);
   void set_text(std::string text);  // from undo/reload/write-to-text: editor follows
@@ -221,6 +228,8 @@ class StudioApp {
   // The document.
   std::string path_;                 // the grammar file; empty: untitled
   std::string scene_path_;           // the scene it came with, if any
+  std::string object_folder_;        // a vlab object's folder when path_ is its model (docs/cpfg.md)
+  std::vector<lsys::PanelSlider> panel_;  // that object's panel.l sliders
   std::string text_;
   std::string saved_text_;           // the text as on disk
   FileStamp disk_stamp_;

@@ -47,7 +47,7 @@ inline constexpr uint32_t kLeafImagesUnit = 22;  // leaf_images.h's layers, one 
 
 // Constants.
 inline constexpr uint32_t kMaxBarkImages = 16;  // GL 4.5 guarantees 16 texture units a stage
-inline constexpr uint32_t kMaxMaterials = 16;   // shade.frag.glsl's u_material_albedo
+inline constexpr uint32_t kMaxMaterials = 256;  // shade.frag.glsl's u_material_albedo: a colour index (8 bits) each
 inline constexpr uint32_t kPlantIndexBits = 24;  // G-buffer ids.x = plant | material << 24
 inline constexpr uint32_t kPlantIndexMask = (1u << kPlantIndexBits) - 1;
 inline constexpr uint32_t kMaxPlants = 1u << kPlantIndexBits;

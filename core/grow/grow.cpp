@@ -16,6 +16,7 @@
 
 #include "core/grow/vlab_enviro.h"
 #include "core/util/clock.h"
+#include "core/util/color.h"
 #include "core/util/parallel.h"
 #include "core/util/random.h"
 
@@ -37,6 +38,16 @@ bool grammar_writes(const lsys::Grammar& g, Pred pred) {
   return false;
 }
 }  // namespace
+
+void add_grammar_colours(const std::vector<lsys::Grammar::Colour>& colours, std::map<uint32_t, SceneMaterial>& table) {
+  for (const lsys::Grammar::Colour& c : colours) {
+    if (c.index >= kMaterialSlots || table.count(c.index)) continue;
+    SceneMaterial m;
+    m.albedo_rgb = glm::dvec3(srgb_to_linear(c.srgb[0]), srgb_to_linear(c.srgb[1]), srgb_to_linear(c.srgb[2]));
+    m.specular = c.specular;
+    table.emplace(c.index, std::move(m));
+  }
+}
 
 bool grammar_queries_light(const lsys::Grammar& g) {
   return grammar_writes(g, [](lsys::SymbolId s) { return s == lsys::kSymLightQuery; });
@@ -551,6 +562,11 @@ Status grow_scene_plants(Scene& scene, uint64_t max_modules, const Progress& pro
     lsys::ParseOptions parse;
     parse.define_overrides = p.defines;
     grammars.emplace(std::move(key), lsys::load_grammar(p.grammar, parse));
+  }
+  for (const ScenePlant& p : scene.plants) {
+    if (p.skeleton) continue;
+    const Expected<lsys::Grammar>& g = grammars.at(Source{p.grammar, p.defines});
+    if (g) add_grammar_colours(g->colours, scene.materials);
   }
   // A grammar that draws no random number (no stochastic production, no rand, uniform or
   // gauss, no random axiom) grows the same shape from every seed: its plants' seed is left

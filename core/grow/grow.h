@@ -9,6 +9,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "core/geometry/skeleton.h"
 #include "core/grow/turtle.h"
@@ -18,6 +19,7 @@
 #include "core/util/progress.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
+#include "lsystem/vlab_object.h"  // vlab objects for the front ends (the studio opens one)
 
 namespace sylva {
 
@@ -90,6 +92,12 @@ Expected<lsys::Word> derive_word(const lsys::Grammar& grammar, const lsys::Deriv
                                  const GrowLight& light = {}, LightGrowthStats* stats = nullptr,
                                  lsys::DeriveStats* derive_stats = nullptr);
 
+// A vlab object's colours (lsys::Grammar::colours, docs/cpfg.md "Colours") as scene
+// materials: each colour index the table does not name yet gets the colour (as a linear
+// albedo) and the specular weight. Indices from kMaterialSlots on are left out (the renderers'
+// table ends there). Nothing for a grammar without colours.
+void add_grammar_colours(const std::vector<lsys::Grammar::Colour>& colours, std::map<uint32_t, SceneMaterial>& table);
+
 // Grows every plant of `scene` that has no skeleton yet from its grammar (with its seed,
 // steps and defines) and stores the skeleton in the plant, untransformed. The first
 // error, for an error with a place in the grammar, is the grammar's own Diagnostic (its
@@ -98,6 +106,8 @@ Expected<lsys::Word> derive_word(const lsys::Grammar& grammar, const lsys::Deriv
 // without (an unreadable grammar, a define it lacks) the error is at that key with the
 // grammar's as a note; a path not ending in .lsys is never quoted (docs/design.md). Progress: one equal share per plant to grow;
 // cancelled: cancelled_diagnostic(), the plants grown so far keep their skeletons.
+// The plants' vlab colour maps fill the materials the scene's table leaves unnamed, the
+// first plant's first (add_grammar_colours).
 // When any plant to grow queries light (`?E`), every plant to grow grows in lockstep in
 // the scene's light (light.md): step k of each is interpreted before step k's queries
 // are answered, so neighbours shade each other; plants that already have skeletons shade

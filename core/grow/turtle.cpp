@@ -2,6 +2,7 @@
 #include "core/grow/turtle.h"
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <chrono>
 #include <cmath>
@@ -364,7 +365,7 @@ enum class CpfgKind : uint8_t {
   kNone, kDraw, kMove, kColorUp, kColorDown, kWidthUp, kWidthDown, kLevel, kSetPosition, kSetHeading, kCircle, kSphere,
   kScaleSet, kScaleUp, kScaleDown, kForceTwist, kElasticityUp, kElasticityDown, kElasticitySet,
   kCylinderStart, kCylinderPoint, kCylinderEnd, kCylinderTangents, kCylinderSides, kCylinderContour, kSurface, kRadiusTangents,
-  kSubCall, kSubEnd, kUnsupported
+  kSubCall, kSubEnd, kPatchInit, kPatchPoint, kPatchDraw, kRing, kBackColour
 };
 
 struct CpfgSymbols {
@@ -409,8 +410,13 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
   set("@Gr", CpfgKind::kRadiusTangents);
   set("@!", CpfgKind::kCylinderSides);
   set("@#", CpfgKind::kCylinderContour);
-  for (const char* name : {"@;", "@,", "@PS", "@PC", "@PD", "@bo", "@bc"})
-    set(name, CpfgKind::kUnsupported);
+  set("@PS", CpfgKind::kPatchInit);
+  set("@PC", CpfgKind::kPatchPoint);
+  set("@PD", CpfgKind::kPatchDraw);
+  set("@bc", CpfgKind::kRing);
+  set("@bo", CpfgKind::kRing);  // a boundary facing the screen: drawn in the HL plane (docs/cpfg.md)
+  set("@;", CpfgKind::kBackColour);
+  set("@,", CpfgKind::kBackColour);
   return out;
 }
 
@@ -423,12 +429,31 @@ constexpr int kDefaultCylinderRings = 4;
 constexpr int kMaxCylinderStrips = 10000;
 constexpr int kSphereSegments = 16;
 
-// The feature a cpfg symbol sylva does not draw yet belongs to, for its error.
-std::string cpfg_feature(const std::string& name) {
-  if (name.rfind("@T", 0) == 0) return "a view-file tropism, CPFG manual 6.8";
-  if (name == "@;" || name == "@,") return "a back-side colour, CPFG manual 6.3";
-  if (name.rfind("@P", 0) == 0 || name.rfind("@b", 0) == 0) return "a B-spline surface patch, CPFG manual 6.7.2";
-  return "a cpfg turtle command, CPFG manual chapter 6";
+// An L-system defined surface patch (CPFG manual 6.7.2, cpfg's patches.c): @PS(id, basis)
+// clears it, @PC(id, r, c) puts control point (r, c) where the turtle stands, @PD(id, s, t)
+// draws it. Bases 1 Bézier, 2 B-spline, 3 Cardinal (patches.c's matrices).
+struct TurtlePatch {
+  int basis = 1;
+  std::array<glm::dvec3, 16> points{};  // row-major: row r (along s), column c (along t)
+  std::array<bool, 16> set{};
+};
+constexpr double kPatchBasis[3][4][4] = {
+    {{-1, 3, -3, 1}, {3, -6, 3, 0}, {-3, 3, 0, 0}, {1, 0, 0, 0}},
+    {{-1. / 6, 3. / 6, -3. / 6, 1. / 6}, {3. / 6, -6. / 6, 3. / 6, 0}, {-3. / 6, 0, 3. / 6, 0}, {1. / 6, 4. / 6, 1. / 6, 0}},
+    {{-0.5, 1.5, -1.5, 0.5}, {1.0, -2.5, 2.0, -0.5}, {-0.5, 0.0, 0.5, 0.0}, {0.0, 1.0, 0.0, 0.0}}};
+constexpr int kPatchMaxPrecision = 10;  // patches.c's S_COUNT and T_COUNT (half of each without @PD's s, t)
+
+// The patch's point at (u, v) in [0, 1]²: [u³ u² u 1] M G Mᵀ [v³ v² v 1]ᵀ, G the control points.
+glm::dvec3 patch_point(const TurtlePatch& patch, double u, double v) {
+  const auto& m = kPatchBasis[patch.basis - 1];
+  const double uu[4] = {u * u * u, u * u, u, 1}, vv[4] = {v * v * v, v * v, v, 1};
+  double a[4] = {0, 0, 0, 0}, b[4] = {0, 0, 0, 0};
+  for (int i = 0; i < 4; ++i)
+    for (int k = 0; k < 4; ++k) a[i] += uu[k] * m[k][i], b[i] += vv[k] * m[k][i];
+  glm::dvec3 out(0.0);
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out += a[r] * b[c] * patch.points[static_cast<size_t>(4 * r + c)];
+  return out;
 }
 
 }  // namespace
@@ -486,6 +511,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   std::vector<GenCylinder> cylinders;
   std::vector<size_t> cylinder_marks;  // the pool's size at each '[' still open
   std::vector<double> sub_scales;      // cpfg: the scale of each sub-L-system entered and not left
+  std::map<double, TurtlePatch> turtle_patches;  // cpfg: the L-system defined surfaces by id
   // Appends one piece of a cylinder's curve to its chain: `strips` joints at curve(k /
   // strips), radii from r0 to r1, in the colour of the piece's start. A new chain where
   // there is none yet or where the chain went on meanwhile (a branch drew from this point).
@@ -1007,9 +1033,76 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
                 }
             continue;
           }
-          case CpfgKind::kUnsupported:
-            throw TurtleFailure{"'" + g.symbols.name(m.symbol) + "' (" + cpfg_feature(g.symbols.name(m.symbol)) +
-                                ") is not supported yet (docs/cpfg.md)"};
+          case CpfgKind::kBackColour:
+            // @; and @, step the back side's colour, which cpfg draws only on double-sided
+            // surfaces (a view file's `initial color: front back`, which sylva refuses at its
+            // place); otherwise the front's colour shows on both sides, as here.
+            continue;
+          case CpfgKind::kPatchInit:
+          case CpfgKind::kPatchPoint:
+          case CpfgKind::kPatchDraw: {
+            const CpfgKind kind = cpfg.kind[symbol];
+            const std::string name = g.symbols.name(m.symbol);
+            if (!has) throw TurtleFailure{name + " needs the surface's id"};
+            TurtlePatch& patch = turtle_patches[p[0]];
+            if (kind == CpfgKind::kPatchInit) {
+              patch = TurtlePatch{};
+              // Its basis: 1 Bézier, 2 B-spline, 3 Cardinal; another (or none) Bézier, as patches.c.
+              if (m.param_count >= 2 && p[1] >= 1 && p[1] <= 3) patch.basis = static_cast<int>(p[1]);
+              continue;
+            }
+            if (kind == CpfgKind::kPatchPoint) {
+              if (m.param_count < 3) throw TurtleFailure{"@PC needs the surface's id, row and column: @PC(id, r, c)"};
+              if (!(p[1] >= 0 && p[1] < 4 && p[2] >= 0 && p[2] < 4))
+                throw TurtleFailure{"@PC's row and column are 0 to 3 (a 4 x 4 patch)"};
+              const size_t k = static_cast<size_t>(4 * static_cast<int>(p[1]) + static_cast<int>(p[2]));
+              patch.points[k] = t.position;
+              patch.set[k] = true;
+              continue;
+            }
+            // @PD(id, s, t): every control point set, else nothing drawn (patches.c warns);
+            // the s x t cells (at most 10 each, 5 without them) are polygon leaves.
+            if (std::find(patch.set.begin(), patch.set.end(), false) != patch.set.end()) continue;
+            int cells[2] = {kPatchMaxPrecision / 2, kPatchMaxPrecision / 2};
+            if (m.param_count >= 3)
+              for (int k = 0; k < 2; ++k) {
+                if (!(p[1 + k] >= 1)) throw TurtleFailure{"@PD's s and t are counts of lines, 1 or more"};
+                cells[k] = static_cast<int>(std::min<double>(p[1 + k], kPatchMaxPrecision));
+              }
+            std::optional<ChainParent> at;
+            if (t.chain >= 0) at = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
+            auto corner = [&](int a, int b) {
+              const dvec3 v = patch_point(patch, static_cast<double>(a) / cells[0], static_cast<double>(b) / cells[1]);
+              check_position(v);
+              return std::array<double, 3>{v.x, v.y, v.z};
+            };
+            for (int a = 0; a < cells[0]; ++a)
+              for (int b = 0; b < cells[1]; ++b)
+                add_cell(at, t.material, {corner(a, b), corner(a + 1, b), corner(a + 1, b + 1), corner(a, b + 1)});
+            continue;
+          }
+          case CpfgKind::kRing: {
+            // @bc(d) (and @bo(d)): a circle's boundary of diameter d (else the line width) in
+            // the plane of H and L, the line as wide as the current line width: a closed chain
+            // of kCircleSides frusta hung from the joint the turtle stands on. It does not move.
+            const double radius = has ? 0.5 * p[0] * t.scale : t.radius;
+            if (!std::isfinite(radius) || radius > kMaxCoordinateM)
+              throw TurtleFailure{"a diameter must be finite and at most 2e12 m"};
+            if (!(radius > 0) || !(t.radius > 0)) continue;  // no circle, or no line width: nothing drawn
+            std::optional<ChainParent> at;
+            if (t.chain >= 0) at = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
+            if (chain_joint_count.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many chains"};
+            const uint32_t c = static_cast<uint32_t>(chain_joint_count.size());
+            chain_joint_count.push_back(kCircleSides + 1);
+            chain_parent.push_back(at);
+            for (int k = 0; k <= kCircleSides; ++k) {
+              const double a = 2 * kPi * (k % kCircleSides) / kCircleSides;
+              const dvec3 v = t.position + radius * (std::cos(a) * t.heading + std::sin(a) * t.left);
+              check_position(v);
+              joints.push_back({c, Joint{{v.x, v.y, v.z}, t.radius, t.material}});
+            }
+            continue;
+          }
           case CpfgKind::kNone: break;
         }
       }

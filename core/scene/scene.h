@@ -210,7 +210,7 @@ std::optional<SegmentTexture> segment_texture(const std::map<uint32_t, SceneMate
 
 // The highest material index the `materials` table may name (the GL shade pass's table
 // holds kMaterialSlots entries; higher indices look like the default table's last).
-constexpr uint32_t kMaterialSlots = 16;
+constexpr uint32_t kMaterialSlots = 256;
 
 // What material `material` looks like (but for bark textures, which the renderers look up
 // themselves on material 0): albedo = `bark`'s colour for material 0 where it has one,

@@ -925,6 +925,56 @@ TEST(TurtleCpfg, ASubLSystemCallScalesTheTurtleUpToItsEnd) {
   EXPECT_NEAR(sk.joints[6].radius_m, sk.joints[1].radius_m, 1e-15);
 }
 
+// L-system defined surfaces (CPFG manual 6.7.2, cpfg's patches.c): @PS(id, basis), a
+// control point per @PC(id, r, c) where the turtle stands, @PD(id, s, t) drawing s x t cells
+// as leaves. Control points on an even grid: Bézier spans the grid (P = (3v, 3u)); a
+// B-spline spans its middle third (P = (1 + v, 1 + u)).
+TEST(TurtleCpfg, AnLSystemDefinedSurfaceIsDrawnFromItsControlPoints) {
+  auto patch = [](int basis, const std::string& draw) {
+    std::string axiom = "@PS(1," + std::to_string(basis) + ")";
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c)
+        axiom += "@M(" + std::to_string(c) + "," + std::to_string(r) + ",0)@PC(1," + std::to_string(r) + "," +
+                 std::to_string(c) + ")";
+    return "Lsystem: 1\nderivation length: 0\nAxiom: " + axiom + draw + "\nendlsystem\n";
+  };
+  const Skeleton bezier = skeleton_of(patch(1, "@PD(1,2,2)"));
+  ASSERT_EQ(bezier.leaves.size(), 4u);
+  const auto& v = bezier.leaves[0].vertices_m;
+  ASSERT_EQ(v.size(), 4u);
+  const double expected[4][2] = {{0, 0}, {0, 1.5}, {1.5, 1.5}, {1.5, 0}};
+  for (size_t k = 0; k < 4; ++k) {
+    EXPECT_NEAR(v[k][0], expected[k][0], 1e-12) << k;
+    EXPECT_NEAR(v[k][1], expected[k][1], 1e-12) << k;
+  }
+  const Skeleton bspline = skeleton_of(patch(2, "@PD(1,1,1)"));
+  ASSERT_EQ(bspline.leaves.size(), 1u);
+  EXPECT_NEAR(bspline.leaves[0].vertices_m[0][0], 1, 1e-12);
+  EXPECT_NEAR(bspline.leaves[0].vertices_m[2][1], 2, 1e-12);
+  EXPECT_EQ(skeleton_of(patch(1, "")).leaves.size(), 0u) << "not drawn without @PD";
+  EXPECT_EQ(skeleton_of(patch(1, "@PD(1)")).leaves.size(), 25u) << "5 x 5 cells by default";
+  EXPECT_EQ(skeleton_of(cpfg("@PS(1)@PC(1,0,0)@PD(1,2,2)")).leaves.size(), 0u) << "points unset: nothing drawn";
+  EXPECT_NE(grow_error(cpfg("@PS(1)@PC(1,4,0)")).find("row and column are 0 to 3"), std::string::npos);
+}
+
+// @bc(d): a circle's boundary in the H-L plane, a closed chain as wide as the line width;
+// the turtle does not move. No line width: nothing drawn.
+TEST(TurtleCpfg, ACircleBoundaryIsAClosedChainAroundTheTurtle) {
+  const Skeleton sk = skeleton_of(cpfg("f(1)#(2)@bc(4)F(1)"));
+  ASSERT_EQ(sk.chains.size(), 2u);
+  ASSERT_EQ(sk.joints.size(), 25u + 2u);
+  for (size_t k = 0; k < 25; ++k) {
+    const Joint& j = sk.joints[k];
+    EXPECT_NEAR(std::hypot(j.position_m[0], j.position_m[1] - 1, j.position_m[2]), 2, 1e-12) << k;
+    EXPECT_NEAR(j.radius_m, 0.1, 1e-15);
+  }
+  EXPECT_EQ(sk.joints[0].position_m[1], sk.joints[24].position_m[1]);
+  EXPECT_NEAR(sk.joints[26].position_m[1], 2, 1e-12) << "F goes on from where the turtle stood";
+  EXPECT_EQ(skeleton_of(cpfg("#(0)@bc(4)")).chains.size(), 0u);
+  // @; and @, (the back side's colour) draw nothing and change nothing drawn.
+  EXPECT_TRUE(skeleton_of(cpfg("F@;F@,(3)F")).joints == skeleton_of(cpfg("FFF")).joints);
+}
+
 TEST(TurtleCpfg, SemicolonAndCommaStepTheColourIndexOrSetIt) {
   const Skeleton sk = skeleton_of(cpfg("F;F;;F,F;(7)F,(2)F"));
   ASSERT_EQ(sk.joints.size(), 7u);
@@ -1042,17 +1092,6 @@ TEST(TurtleCpfg, AtDScalesLengthsAndWidthsAndBracketsKeepTheScale) {
   EXPECT_NEAR(widest, 1.5, 1e-12);
   EXPECT_NE(grow_error(cpfg("F@DF")).find("@D needs the scale"), std::string::npos);
   EXPECT_NE(grow_error(cpfg("F@Di(0)F")).find("must not be 0"), std::string::npos);
-}
-
-TEST(TurtleCpfg, SymbolsSylvaDoesNotDrawYetAreErrorsNamingTheFeature) {
-  const std::pair<const char*, const char*> cases[] = {
-      {"F@PS(1)F", "patch"}, {"F@;F", "back-side colour"}};
-  for (const auto& [axiom, feature] : cases) {
-    const std::string message = grow_error(cpfg(axiom));
-    EXPECT_NE(message.find(feature), std::string::npos) << axiom << ": " << message;
-    EXPECT_NE(message.find("not supported yet"), std::string::npos) << axiom << ": " << message;
-    EXPECT_NE(message.find("test.lsys:2:1"), std::string::npos) << axiom << ": " << message;  // at the axiom
-  }
 }
 
 // ---- predefined surfaces (CPFG manual 6.7.1, 8.1.5; docs/cpfg.md "Surfaces") -----------

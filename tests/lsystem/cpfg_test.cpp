@@ -797,6 +797,70 @@ TEST(VlabObject, AFolderIsReadThroughItsSpecificationsCpfgCommandAndItsViewFile)
   ASSERT_FALSE(zero.ok());
   EXPECT_EQ(zero.error().loc.line, 2u);
   EXPECT_NE(zero.error().message.find("must be a non-zero number"), std::string::npos) << zero.error().message;
+  EXPECT_TRUE(shaded->colours.empty()) << "no plant.map in the folder: cpfg's defaults, as cpfg goes on";
+}
+
+// vlab's panel.l: a slider with "message: d NAME %d scale" sets NAME to value / scale, so its
+// range is min / scale .. max / scale in steps of 1 / scale; other items are left out.
+TEST(VlabObject, PanelSlidersGiveTheirDefinesRanges) {
+  const auto sliders = read_panel_sliders(
+      "target: Lsystem\n\ntype: LABEL\nname: GENERAL\ncolor: 255,255,0\norigin: 129 0\n\n"
+      "type: SLIDER\nname: Steps\ncolors: 255,255,255 255,0,0\norigin: 20 30\nmin/max: 0 800\nvalue: 650\n"
+      "message: d STEPS %d 1\n\ntype: SLIDER\nname: Width\nmin/max: 5 40\nvalue: 10\nmessage: d WIDTH %d 10\n\n"
+      "type: BUTTON\nname: Grid\nvalue: 1\nmessage: d GRID 1 1\n\ntype: SLIDER\nname: Odd\nmin/max: 9 1\n"
+      "message: d ODD %d 1\n");
+  ASSERT_EQ(sliders.size(), 2u);
+  EXPECT_EQ(sliders[0].define, "STEPS");
+  EXPECT_EQ(sliders[0].label, "Steps");
+  EXPECT_EQ(sliders[0].max, 800);
+  EXPECT_EQ(sliders[0].value, 650);
+  EXPECT_EQ(sliders[1].define, "WIDTH");
+  EXPECT_DOUBLE_EQ(sliders[1].min, 0.5);
+  EXPECT_DOUBLE_EQ(sliders[1].max, 4);
+  EXPECT_DOUBLE_EQ(sliders[1].step, 0.1);
+  EXPECT_DOUBLE_EQ(sliders[1].value, 1);
+  EXPECT_TRUE(read_panel_sliders("type: SLIDER\nmin/max: 0 1\nmessage: n 4 1 -1 %d\n").empty());
+}
+
+// The colours (docs/cpfg.md "Colours"): `-m` a colour map of 256 RGB bytes, `-M` a material
+// file of 15-byte records (index, transparency, ambient, diffuse, emissive, specular,
+// shininess); the material file wins. A file of the wrong size is an error at its option.
+TEST(VlabObject, TheColourMapOrMaterialFileGivesTheColours) {
+  ModelFolder folder;
+  folder.write("plant.l", kVlabModel);
+  folder.write("plant.v", "angle factor: 8\n");
+  std::string map(768, '\0');
+  for (int i = 0; i < 256; ++i) map[3 * i] = static_cast<char>(i), map[3 * i + 2] = static_cast<char>(255 - i);
+  folder.write("plant.map", map);
+  folder.write("specifications", "generate:\n\tcpfg -m plant.map plant.l plant.v\n");
+  auto g = load_grammar(folder.dir().string());
+  ASSERT_TRUE(g.ok()) << g.error().format();
+  ASSERT_EQ(g->colours.size(), 256u);
+  EXPECT_EQ(g->colours[51].index, 51u);
+  EXPECT_DOUBLE_EQ(g->colours[51].srgb[0], 0.2);
+  EXPECT_DOUBLE_EQ(g->colours[51].srgb[1], 0.0);
+  EXPECT_DOUBLE_EQ(g->colours[51].srgb[2], 0.8);
+  EXPECT_EQ(g->colours[51].specular, 1);
+  // Two records: index 7 (diffuse 255, 51, 0; specular 0, 102, 0), then 2 (all zero).
+  std::string mat(30, '\0');
+  mat[0] = 7, mat[5] = static_cast<char>(255), mat[6] = 51, mat[12] = 102;
+  mat[15] = 2;
+  folder.write("plant.mat", mat);
+  folder.write("specifications", "generate:\n\tcpfg -m plant.map -M plant.mat plant.l plant.v\n");
+  auto m = load_grammar(folder.dir().string());
+  ASSERT_TRUE(m.ok()) << m.error().format();
+  ASSERT_EQ(m->colours.size(), 2u);
+  EXPECT_EQ(m->colours[0].index, 7u);
+  EXPECT_DOUBLE_EQ(m->colours[0].srgb[0], 1.0);
+  EXPECT_DOUBLE_EQ(m->colours[0].srgb[1], 0.2);
+  EXPECT_DOUBLE_EQ(m->colours[0].specular, 0.4);
+  EXPECT_EQ(m->colours[1].index, 2u);
+  folder.write("plant.mat", mat.substr(0, 29));
+  auto bad = load_grammar(folder.dir().string());
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().loc.line, 2u);
+  EXPECT_EQ(bad.error().loc.column, 20u);  // at -M
+  EXPECT_NE(bad.error().format().find("records of 15 bytes"), std::string::npos) << bad.error().format();
 }
 
 TEST(VlabObject, WhatSylvaCannotFollowIsAnErrorAtItsPlace) {
@@ -922,6 +986,24 @@ TEST(VlabObject, TheViewFileIsReadAsCpfgReadsIt) {
   EXPECT_EQ(g->turtle.view_tropisms[0].elasticity, 0.1);
   EXPECT_DOUBLE_EQ(g->turtle.width, 2 * 0.05);  // pixels, kept by the unknown line style
   EXPECT_EQ(g->max_depth, 3000);
+  // Without a `p...` word cpfg's reader draws the width in world units (a diameter), where
+  // the manual's table says pixels; no line at all: 1 pixel.
+  for (const char* view : {"initial line width: 0.2\n", "initial line width: 0.2 wide\n", "initial line width: 0.2 s\n"}) {
+    folder.write("plant.v", view);
+    auto w = load_grammar(folder.dir().string());
+    ASSERT_TRUE(w.ok()) << w.error().format();
+    EXPECT_DOUBLE_EQ(w->turtle.width, 0.1) << view;
+  }
+  // cpfg's double-sided surfaces (a back colour) are not drawn yet: said at the place.
+  folder.write("plant.v", "initial color: 3 7\n");
+  auto sides = load_grammar(folder.dir().string());
+  ASSERT_FALSE(sides.ok());
+  EXPECT_EQ(sides.error().loc.column, 18u);
+  EXPECT_NE(sides.error().message.find("back side"), std::string::npos) << sides.error().message;
+  folder.write("plant.v", "angle factor: 4\n");
+  auto none = load_grammar(folder.dir().string());
+  ASSERT_TRUE(none.ok()) << none.error().format();
+  EXPECT_DOUBLE_EQ(none->turtle.width, 0.05);
 }
 
 // ---- chapter 5 functions ----

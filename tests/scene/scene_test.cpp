@@ -329,8 +329,8 @@ TEST(SceneMaterials, EveryBadEntryIsAnErrorAtItsKey) {
   };
   const Bad bad[] = {
       {R"({"albedo": [1, 1, 1]})", "materials[0] needs an \"index\"", 16},
-      {R"({"index": 16})", "materials[0].index must be an integer from 0 to 15", 26},
-      {R"({"index": -1})", "materials[0].index must be an integer from 0 to 15", 26},
+      {R"({"index": 256})", "materials[0].index must be an integer from 0 to 255", 26},
+      {R"({"index": -1})", "materials[0].index must be an integer from 0 to 255", 26},
       {R"({"index": 1.5})", "materials[0].index must be an integer", 26},
       {R"({"index": 1, "specular": 1.5})", "materials[0].specular must be in [0, 1]", 41},
       {R"({"index": 1, "albedo": [1, -1, 1]})", "materials[0].albedo components must be >= 0", 43},

@@ -517,6 +517,46 @@ TEST_F(Fixture, OpensAScene) {
   EXPECT_EQ(app->scene().plants.size(), 1u);
 }
 
+// A vlab object folder (docs/cpfg.md): the editor shows its model, the plant grows with the
+// object's view file (angle factor 4: right angles) and colour map, its panel.l sliders give
+// the defines their ranges, and a scene saved from it names the folder.
+TEST_F(Fixture, OpensAVlabObjectWithItsViewFileColoursAndPanel) {
+  const std::string object = dir.file("object");
+  std::filesystem::create_directories(object);
+  const std::string model = "#define N 3\n#define L 10\nLsystem: 1\nderivation length: N\nAxiom: ;(5)A\n"
+                            "A --> F(L/10)[+A]A\nendlsystem\n";
+  ASSERT_TRUE(write_file_atomically(object + "/plant.l", model).ok());
+  ASSERT_TRUE(write_file_atomically(object + "/plant.v", "angle factor: 4\n").ok());
+  std::string map(768, '\0');
+  map[15] = static_cast<char>(255);  // colour 5: red
+  ASSERT_TRUE(write_file_atomically(object + "/plant.map", map).ok());
+  ASSERT_TRUE(write_file_atomically(object + "/specifications", "plant.l\ngenerate:\n\tcpfg -m plant.map plant.l plant.v\n").ok());
+  ASSERT_TRUE(write_file_atomically(object + "/panel.l",
+                                    "target: Lsystem\n\ntype: SLIDER\nname: Length\ncolors: 255,255,255 255,0,0\n"
+                                    "origin: 20 30\nmin/max: 0 40\nvalue: 10\nmessage: d L %d 1\n").ok());
+  auto app = make_app();
+  ASSERT_FALSE(app->open(object));
+  ASSERT_TRUE(ui.until(*app, [&] { return app->plant_drawn(); }));
+  EXPECT_FALSE(app->error());
+  EXPECT_EQ(app->path(), object + "/plant.l");
+  EXPECT_EQ(app->text(), model);
+  EXPECT_EQ(viewport.segments, 7u);  // F[+F[+F]F]F[+F]F and the A between: N = 3
+  ASSERT_TRUE(app->scene().materials.count(5));
+  EXPECT_EQ(app->scene().materials.at(5).albedo_rgb, glm::dvec3(1, 0, 0)) << "the colour map's red, linear";
+  ASSERT_TRUE(app->rect("slider:L")) << "panel.l's slider gives L its range";
+  EXPECT_FALSE(app->rect("slider:N")) << "no panel slider, no range comment: a typed field";
+  // The view file counts: each branch turns a right angle (angle factor 4), so the first
+  // branch's own axis reaches 2 m to the side of the trunk.
+  double widest = 0;
+  for (const Joint& j : app->scene().plants[0].skeleton->joints) widest = std::max(widest, std::abs(j.position_m[0]));
+  EXPECT_NEAR(widest, 2, 1e-9);
+  const std::string scene_path = dir.file("object.scene.json");
+  EXPECT_FALSE(app->save_scene(scene_path));
+  Expected<Scene> read = read_scene_file(scene_path);
+  ASSERT_TRUE(read) << read.error().format();
+  EXPECT_EQ(std::filesystem::weakly_canonical(read->plants[0].grammar), std::filesystem::weakly_canonical(object));
+}
+
 TEST_F(Fixture, SavesTheSceneAsShownAndItReopensSo) {
   auto app = opened();
   app->set_define("N", 3);
