@@ -124,6 +124,7 @@ const FuncInfo kFuncs[] = {
     {"fabs", 1, false},  {"trunc", 1, false}, {"sign", 1, false},  {"ran", 1, true},
     {"nran", 2, true},   {"bran", 2, true},   {"biran", 2, true},  {"srand", 1, true},
     {"func", 2, false},  {"stop", 1, false},
+    {"curveX", 2, false}, {"curveY", 2, false}, {"curveZ", 2, false}, {"curveGAL", 1, false},
 };
 
 // The largest n biran(n, p) draws for (n uniform draws: bounded time, docs/cpfg.md).
@@ -362,6 +363,25 @@ double Program::run(const Expr& e, double* slots, Rng* rng, EvalContext* context
             *rng = Rng(mix_pair(seed, 0x5EEDULL));
             if (context) context->reseeded = true, context->reseed = seed;
             r = 0;
+            break;
+          }
+          case Func::kCurveX:
+          case Func::kCurveY:
+          case Func::kCurveZ:
+          case Func::kCurveGal: {
+            // The view file's curve id, 1-based (CPFG manual 5.5): t a fraction of its length.
+            if (!(a[0] >= 1) || a[0] != std::floor(a[0]) || a[0] > static_cast<double>(curves.size()))
+              fail(locs[pc], std::string(func_info(in.fn).name) + "(" + index_text(a[0]) + ", ...): " +
+                                 (curves.empty() ? std::string("this model has no curves (a vlab object's view file "
+                                                               "names them: 'curve: file.con')")
+                                                 : "the curve id is 1 to " + std::to_string(curves.size()) +
+                                                       " (the view file's curve: lines, in order)"));
+            const CpfgCurve& c = curves[static_cast<size_t>(a[0]) - 1];
+            if (in.fn == Func::kCurveGal) {
+              r = c.length;
+            } else {
+              r = c.at_length(a[1])[in.fn == Func::kCurveX ? 0 : in.fn == Func::kCurveY ? 1 : 2];
+            }
             break;
           }
           case Func::kStop:

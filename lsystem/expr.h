@@ -52,7 +52,9 @@ enum class Func : uint8_t {
   kFabs, kTrunc, kSign, kRan, kNran, kBran, kBiran,
   kSrand,  // srand(s): restarts the random stream from s (EvalContext::reseed); returns 0
   kFunc,   // func(id, x): the grammar's user-defined function id at x (Program::functions)
-  kStop    // stop(n) (CPFG manual 5.6): the derivation ends after this step (EvalContext::stop); returns 0
+  kStop,   // stop(n) (CPFG manual 5.6): the derivation ends after this step (EvalContext::stop); returns 0
+  // curveX/Y/Z(id, t) and curveGAL(id) (CPFG manual 5.5): the view file's curve id (Program::curves)
+  kCurveX, kCurveY, kCurveZ, kCurveGal
 };
 
 struct Instr {
@@ -112,6 +114,7 @@ struct Program {
   std::vector<SourceLoc> locs;  // parallel to code: the place of each operation
   std::vector<ArrayInfo> arrays;
   std::vector<SplineFunction> functions;  // func(id, x)'s, id − 1 (a vlab object's view file)
+  std::vector<CpfgCurve> curves;          // curveX(id, t)'s and curveGAL(id)'s, id − 1 (its `curve:` lines)
   std::vector<std::string> formats;       // printf's format strings (checked when compiled)
 
   // Evaluates `e` with formal parameters `slots` and random stream `rng` (only touched

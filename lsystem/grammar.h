@@ -264,6 +264,9 @@ struct ParseOptions {
   // A vlab object's user-defined functions, from its view file's `function:` and `function
   // set:` lines (docs/cpfg.md "Functions"): func(id, x) reads them (Program::functions).
   std::vector<SplineFunction> functions;
+  // Its contour functions' curves, from the view file's `curve:` lines: curveX(id, t) ...
+  // and curveGAL(id) read them (Program::curves; docs/cpfg.md "Contour functions").
+  std::vector<CpfgCurve> curves;
   // Object-like macros defined before a cpfg model is preprocessed, as cpfg passes cpp
   // `-DNAME=id` for each function of a function set; the model may define them again.
   std::vector<std::pair<std::string, std::string>> predefined_macros;

@@ -205,7 +205,10 @@ using Scope = std::unordered_map<std::string, uint32_t>;
 
 class Parser {
  public:
-  Parser(Grammar& g, const ParseOptions& options) : g_(g), options_(options) { g_.program.functions = options.functions; }
+  Parser(Grammar& g, const ParseOptions& options) : g_(g), options_(options) {
+    g_.program.functions = options.functions;
+    g_.program.curves = options.curves;
+  }
 
   void parse(const std::string& text);
   Word parse_word_line(const LogicalLine& line);

@@ -240,4 +240,139 @@ Expected<std::vector<SplineFunction>> read_function_set(const std::string& path)
   return out;
 }
 
+namespace {
+
+// cpfg's uniform cubic B-spline basis on the integer knots (curveXYZ.cpp's Bi4).
+double uniform_basis(int i, double t, int order) {
+  if (order == 1) return (i <= t && t < i + 1) ? 1.0 : 0.0;
+  const double k = order - 1;
+  return (t - i) / k * uniform_basis(i, t, order - 1) + (i + order - t) / k * uniform_basis(i + 1, t, order - 1);
+}
+
+// Its endpoint-interpolating basis over n control points (Nk4 with uk: 0 0 0 0 1 ... n−3 n−3 n−3 n−3).
+double endpoint_knot(int k, int n) { return k < 4 ? 0.0 : (k > n - 1 ? n - 3.0 : k - 3.0); }
+double endpoint_basis(int k, double u, int order, int n) {
+  if (order == 1) return (endpoint_knot(k, n) <= u && u < endpoint_knot(k + 1, n)) ? 1.0 : 0.0;
+  double out = 0;
+  const double a = endpoint_knot(k + order - 1, n) - endpoint_knot(k, n);
+  const double b = endpoint_knot(k + order, n) - endpoint_knot(k + 1, n);
+  if (a != 0) out += (u - endpoint_knot(k, n)) / a * endpoint_basis(k, u, order - 1, n);
+  if (b != 0) out += (endpoint_knot(k + order, n) - u) / b * endpoint_basis(k + 1, u, order - 1, n);
+  return out;
+}
+
+}  // namespace
+
+std::array<double, 3> CpfgCurve::point(double u) const {
+  std::array<double, 3> p{0, 0, 0};
+  const int n = static_cast<int>(control.size());
+  if (n < 4) return p;
+  auto add = [&](int i, double w) {
+    for (int c = 0; c < 3; ++c) p[c] += w * control[static_cast<size_t>(i)][c];
+  };
+  if (type == Type::kBezier) {
+    // Segments of 4 points sharing their ends, each an endpoint B-spline of 4 (a Bézier).
+    const int segments = 1 + (n - 4) / 3;
+    const int c = static_cast<int>(u / (1.000001 / segments));
+    const int i = c * 3;
+    const double t = (u - c * (1.0 / segments)) * segments / 1.000001;
+    for (int k = 0; k < 4 && i + k < n; ++k) add(i + k, endpoint_basis(k, t, 4, 4));
+    return p;
+  }
+  if (type == Type::kBSplineEndpoint) {
+    const double t = u * (n - 3.000001);
+    for (int k = 0; k < n; ++k) add(k, endpoint_basis(k, t, 4, n));
+    return p;
+  }
+  const int i = 3 + static_cast<int>(u * (n - 3.000001));
+  const double t = 3.0 + u * (n - 3.000001);
+  for (int k = i - 3; k <= i; ++k) add(k, uniform_basis(k, t, 4));
+  return p;
+}
+
+std::array<double, 3> CpfgCurve::at_length(double s) const {
+  s = std::clamp(s, 0.0, 1.0);
+  // The last sample at or below s (curveXYZ.cpp's bisection), then the parameter between it
+  // and the next in proportion.
+  size_t lo = 0, hi = lengths.size() - 1;
+  while (hi - lo > 1) {
+    const size_t mid = (lo + hi) / 2;
+    (lengths[mid] > s ? hi : lo) = mid;
+  }
+  const double span = lengths[hi] - lengths[lo];
+  const double u = (static_cast<double>(lo) + (span > 0 ? (s - lengths[lo]) / span : 0.0)) /
+                   static_cast<double>(lengths.size() - 1);
+  return point(u);
+}
+
+Expected<CpfgCurve> read_cpfg_curve(const std::string& path, int samples) {
+  Expected<std::string> text = read_text_file(path);
+  if (!text) return std::move(text.error());
+  Lines lines(path, *text);
+  if (lines.done()) return lines.at_end("an empty curve file (expected 'version: 1.4')");
+  auto version = numbers_after(lines.take(), "version:");
+  if (!version || version->size() != 1)
+    return lines.error("expected 'version: 1.4' (a curve file of vlab's cuspy; cpfg's contour functions read that format)");
+  CpfgCurve curve;
+  size_t count = 0;
+  // Fields up to `type:`, which comes last before the points; `points:` among them.
+  for (;;) {
+    if (lines.done()) return lines.at_end("expected 'type:' before the control points");
+    const std::string& line = lines.take();
+    if (auto n = numbers_after(line, "points:")) {
+      if (n->size() != 1 || (*n)[0] != std::floor((*n)[0]) || (*n)[0] < 4 || (*n)[0] > 1e6)
+        return lines.error("'points:' needs a whole number of control points, at least 4");
+      count = static_cast<size_t>((*n)[0]);
+      continue;
+    }
+    size_t i = 0;
+    while (i < line.size() && detail::is_space(line[i])) ++i;
+    if (line.compare(i, 5, "type:") != 0) continue;  // contact, end, heading, up, size, range, dimension
+    std::string word = line.substr(i + 5);
+    word.erase(0, word.find_first_not_of(" \t"));
+    word.erase(word.find_last_not_of(" \t\r") + 1);
+    if (word == "bspline") curve.type = CpfgCurve::Type::kBSpline;
+    else if (word == "bsplineclosed") curve.type = CpfgCurve::Type::kBSplineClosed;
+    else if (word == "bsplineendpoint") curve.type = CpfgCurve::Type::kBSplineEndpoint;
+    else if (word == "bsplinephantom") curve.type = CpfgCurve::Type::kBSplinePhantom;
+    else if (word == "bezier") curve.type = CpfgCurve::Type::kBezier;
+    else return lines.error("a curve's type is bspline, bsplineclosed, bsplineendpoint, bsplinephantom or bezier");
+    break;
+  }
+  if (count == 0) return lines.error("expected 'points:' before 'type:'");
+  for (size_t k = 0; k < count; ++k) {
+    if (lines.done()) return lines.at_end("expected " + std::to_string(count) + " control points, found " + std::to_string(k));
+    auto v = numbers_after(lines.take(), "");
+    if (!v || v->size() != 4) return lines.error("expected a control point 'x y z multiplicity'");
+    const double m = (*v)[3];
+    if (m != std::floor(m) || m < 1 || m > 16) return lines.error("a control point's multiplicity is a whole number from 1 to 16");
+    for (int r = 0; r < static_cast<int>(m); ++r) curve.control.push_back({(*v)[0], (*v)[1], (*v)[2]});
+  }
+  // createPPoints: a closed curve repeats its first three points; a phantom one gets mirrored ends.
+  auto& c = curve.control;
+  if (curve.type == CpfgCurve::Type::kBSplineClosed)
+    for (int k = 0; k < 3; ++k) c.push_back(c[static_cast<size_t>(k)]);
+  if (curve.type == CpfgCurve::Type::kBSplinePhantom) {
+    std::array<double, 3> first{}, last{};
+    const size_t n = c.size();
+    for (int a = 0; a < 3; ++a) first[a] = 2 * c[0][a] - c[1][a], last[a] = 2 * c[n - 1][a] - c[n - 2][a];
+    c.insert(c.begin(), first);
+    c.push_back(last);
+  }
+  if (samples < 2 || samples > kMaxCurveSamples)
+    return file_diagnostic(path, "a curve is measured with 2 to " + std::to_string(kMaxCurveSamples) + " samples");
+  // createAPoints: the arc length at each of `samples` points evenly spaced in the parameter.
+  curve.lengths.resize(static_cast<size_t>(samples));
+  std::array<double, 3> before = curve.point(0);
+  for (int i = 1; i < samples; ++i) {
+    const std::array<double, 3> p = curve.point(i / static_cast<double>(samples - 1));
+    curve.length += std::hypot(p[0] - before[0], p[1] - before[1], p[2] - before[2]);
+    curve.lengths[static_cast<size_t>(i)] = curve.length;
+    before = p;
+  }
+  if (!(curve.length > 0)) return file_diagnostic(path, "the curve has no length (its control points coincide)");
+  for (double& l : curve.lengths) l /= curve.length;
+  return curve;
+}
+
 }  // namespace sylva::lsys

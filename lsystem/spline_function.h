@@ -7,6 +7,7 @@
 // evenly spaced x, as cpfg precomputes them.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -41,5 +42,35 @@ Expected<SplineFunction> read_function_file(const std::string& path, int view_sa
 // Reads a function set (`.fset`, vlab's gallery: `funcgalleryver 1 1`, `items: n`, then n
 // functions of format 1.1).
 Expected<std::vector<SplineFunction>> read_function_set(const std::string& path);
+
+// cpfg's contour functions (CPFG manual 5.5: curveX, curveY, curveZ(id, t) and curveGAL(id);
+// the view file's `curve: file [samples]` lines, ids 1, 2, ... in order; docs/cpfg.md
+// "Contour functions"): a curve drawn in vlab's cuspy, read from its `.con` file and measured
+// as cpfg's curveXYZ.cpp measures it: `samples` points evenly spaced in the curve's parameter
+// (100 without the number), the polyline through them its arc length. curveX(id, t) is the
+// curve's point at the fraction t of that length (t clamped to [0, 1]), curveGAL(id) the
+// length.
+struct CpfgCurve {
+  // cuspy's `type:` (cpfg's curveXYZ.h ECURVE): how the control points make the curve.
+  enum class Type { kBSpline, kBSplineClosed, kBSplineEndpoint, kBSplinePhantom, kBezier };
+  Type type = Type::kBSpline;
+  std::vector<std::array<double, 3>> control;  // each repeated by its multiplicity (and closed / phantom's extras)
+  std::vector<double> lengths;                 // the arc length at each sample, normalised to end at 1
+  double length = 0;                           // the sampled polyline's length: curveGAL
+
+  // The point at parameter u in [0, 1] (curveXYZ.cpp's calcPValue).
+  std::array<double, 3> point(double u) const;
+  // The point at the fraction s of the length, s clamped to [0, 1] (calcAValue).
+  std::array<double, 3> at_length(double s) const;
+};
+
+// The most samples a curve may be measured with (a table of 8 MB).
+inline constexpr int kMaxCurveSamples = 1'000'000;
+
+// Reads the curve file `path` (cuspy's `version: 1.4` format: `points: n`, `type:`, then n
+// lines "x y z multiplicity"; the other fields are read and not used) and measures it with
+// `samples` points (2 to kMaxCurveSamples). Errors at their line: a missing or malformed
+// field, fewer than 4 control points, an unknown type.
+Expected<CpfgCurve> read_cpfg_curve(const std::string& path, int samples);
 
 }  // namespace sylva::lsys

@@ -105,16 +105,31 @@ Status read_view_functions(const std::string& view, const std::string& folder, P
     const std::optional<size_t> found = command_of(line, &name);
     if (!found) return;  // not a command: cpfg skips it
     const size_t colon = *found;
-    if (name != "function" && name != "function set") return;
+    if (name != "function" && name != "function set" && name != "curve") return;
     const std::vector<Token> values = tokens_of(line.substr(colon + 1));
     const uint32_t base = static_cast<uint32_t>(colon + 1);
     if (values.empty()) return void(failure = error_in(view, line, line_no, base + 1, "'" + name + ":' needs a file name"));
     const std::string file = (fs::path(folder) / values[0].text).string();
     auto fail_file = [&](Diagnostic inner) {
-      Diagnostic d = error_in(view, line, line_no, base + values[0].column, "cannot read the function file '" + values[0].text + "'");
+      Diagnostic d = error_in(view, line, line_no, base + values[0].column,
+                              std::string("cannot read the ") + (name == "curve" ? "curve" : "function") + " file '" +
+                                  values[0].text + "'");
       d.notes.push_back(std::move(inner));
       failure = std::move(d);
     };
+    if (name == "curve") {
+      // "curve: file [samples]" (CPFG manual 8.1.5): curveX(id, t) ... with ids 1, 2, ... in
+      // order; cpfg measures it with 100 samples without the number (interpret.c).
+      double samples = 100;
+      if (values.size() >= 2 && (!number(values[1].text, &samples) || samples != std::floor(samples) || samples < 2 ||
+                                 samples > kMaxCurveSamples))
+        return void(failure = error_in(view, line, line_no, base + values[1].column,
+                                       "the number of samples is a whole number from 2 to " + std::to_string(kMaxCurveSamples)));
+      auto c = read_cpfg_curve(file, static_cast<int>(samples));
+      if (!c) return fail_file(std::move(c.error()));
+      options.curves.push_back(std::move(*c));
+      return;
+    }
     if (name == "function set") {
       auto set = read_function_set(file);
       if (!set) return fail_file(std::move(set.error()));

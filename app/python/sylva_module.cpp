@@ -164,12 +164,13 @@ PyGrammar::PyGrammar(std::string grammar_text, std::string grammar_file)
 PyGrammar PyGrammar::from_file(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {  // a vlab object (docs/cpfg.md)
+    // Parsed once, with the object's view file (its function sets' names are macros there):
+    // the model's text alone would not parse.
     auto loaded = lsys::load_grammar(path);
     if (!loaded) throw GrammarFailure(loaded.error());
-    PyGrammar g(*loaded->text, loaded->file);
-    g.file = path;
+    std::string text = *loaded->text;
+    PyGrammar g(std::move(text), path, std::make_shared<const lsys::Grammar>(std::move(*loaded)));
     g.vlab_object = true;
-    g.parsed = std::make_shared<const lsys::Grammar>(std::move(*loaded));
     return g;
   }
   Expected<std::string> read = read_text_file(path);

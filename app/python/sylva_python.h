@@ -38,6 +38,9 @@ struct SkeletonFailure : std::runtime_error {
 // overrides apply at parse time) and the grammar parsed without overrides.
 struct PyGrammar {
   PyGrammar(std::string grammar_text, std::string grammar_file);  // throws GrammarFailure
+  // A grammar already parsed (a vlab object's, read with its folder's files).
+  PyGrammar(std::string grammar_text, std::string grammar_file, std::shared_ptr<const lsys::Grammar> grammar)
+      : text(std::move(grammar_text)), file(std::move(grammar_file)), parsed(std::move(grammar)) {}
   static PyGrammar from_file(const std::string& path);            // OSError / GrammarFailure
 
   // The grammar with `defines` applied (the shared parse when there are none). Safe

@@ -800,6 +800,47 @@ TEST(VlabObject, AFolderIsReadThroughItsSpecificationsCpfgCommandAndItsViewFile)
   EXPECT_TRUE(shaded->colours.empty()) << "no plant.map in the folder: cpfg's defaults, as cpfg goes on";
 }
 
+// Contour functions (CPFG manual 5.5; cpfg's curveXYZ.cpp): the view file's `curve: file
+// [samples]` lines, ids in order; curveX/Y/Z(id, t) the point at the fraction t of the
+// curve's sampled length, curveGAL(id) that length. A straight B-spline from (0, 0) to (3, 0)
+// (its ends tripled, as cuspy writes them): length 3, its middle at x = 1.5.
+TEST(VlabObject, ContourFunctionsMeasureTheViewFilesCurves) {
+  ModelFolder folder;
+  folder.write("specifications", "generate:\n\tcpfg plant.l plant.v\n");
+  folder.write("line.con", "version: 1.4\ncontact: 0 0 0\nend: 0 0 0\nheading: 0 1 0\nup: 0 0 -1\nsize: 1\n"
+                           "points: 4\nrange: 0.0 1.0\ndimension: 4\ntype: bspline\n"
+                           "0 0 0 3\n1 0 0 1\n2 0 0 1\n3 0 0 3\n");
+  folder.write("plant.v", "angle factor: 8\ncurve: line.con\ncurve: line.con 2\n");
+  folder.write("plant.l", "Lsystem: 1\nderivation length: 0\nStart: {L = curveGAL(1);}\n"
+                          "Axiom: A(L, curveX(1, 0.5), curveX(1, -1), curveX(1, 7), curveY(1, 0.3), curveGAL(2))\n"
+                          "endlsystem\n");
+  auto g = load_grammar(folder.dir().string());
+  ASSERT_TRUE(g.ok()) << g.error().format();
+  ASSERT_EQ(g->program.curves.size(), 2u);
+  auto w = derive(*g);
+  ASSERT_TRUE(w.ok()) << w.error().message;
+  const double* p = w->params_of(w->modules[0]);
+  EXPECT_NEAR(p[0], 3, 1e-12);
+  EXPECT_NEAR(p[1], 1.5, 2e-3);
+  EXPECT_NEAR(p[2], 0, 1e-12);  // t below 0 is the start
+  EXPECT_NEAR(p[3], 3, 1e-9);   // above 1 the end
+  EXPECT_EQ(p[4], 0);
+  EXPECT_NEAR(p[5], 3, 1e-12) << "two samples: the chord, here the line itself";
+  folder.write("plant.l", "Lsystem: 1\nAxiom: A(curveX(3, 0.5))\nendlsystem\n");
+  auto three = load_grammar(folder.dir().string());
+  std::string message = three.ok() ? "" : three.error().message;
+  if (three.ok()) {
+    auto derived = derive(*three);
+    ASSERT_FALSE(derived.ok());
+    message = derived.error().message;
+  }
+  EXPECT_NE(message.find("the curve id is 1 to 2"), std::string::npos) << message;
+  folder.write("plant.v", "curve: line.con 1\n");
+  auto one = load_grammar(folder.dir().string());
+  ASSERT_FALSE(one.ok());
+  EXPECT_EQ(one.error().loc.column, 17u);
+}
+
 // vlab's panel.l: a slider with "message: d NAME %d scale" sets NAME to value / scale, so its
 // range is min / scale .. max / scale in steps of 1 / scale; other items are left out.
 TEST(VlabObject, PanelSlidersGiveTheirDefinesRanges) {

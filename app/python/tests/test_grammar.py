@@ -55,6 +55,22 @@ def test_grammar_from_file_takes_a_cpfg_model_and_a_vlab_object_folder():
     assert "not a vlab object" in str(info.value)
 
 
+def test_a_vlab_object_whose_model_needs_its_view_file(tmp_path):
+    # Its function set's names are macros only with the view file: the model alone would
+    # not parse (docs/cpfg.md "Functions"); from_file reads the object as a whole.
+    (tmp_path / "specifications").write_text("generate:\n\tcpfg plant.l plant.v\n")
+    (tmp_path / "shapes.fset").write_text(
+        "funcgalleryver 1 1\nitems: 1\nfver 1 1\nname: LINE\nsamples: 0\nflip: off\npoints: 4\n"
+        "0 0\n0.3333 0.3333\n0.6667 0.6667\n1 1\n")
+    (tmp_path / "plant.v").write_text("function set: shapes.fset\nangle factor: 4\n")
+    (tmp_path / "plant.l").write_text("Lsystem: 1\nderivation length: 1\nAxiom: A\n"
+                                      "A --> F(1 + func(LINE, 0.5))\nendlsystem\n")
+    g = sylva.Grammar.from_file(str(tmp_path))
+    assert g.file == str(tmp_path)
+    tip = g.grow().positions.max(axis=0)
+    assert abs(tip[1] - 1.5) < 2e-3  # func(LINE, 0.5) = 0.5, within cpfg's bisection tolerance
+
+
 def test_grammar_from_missing_file_raises_file_not_found():
     with pytest.raises(FileNotFoundError) as info:
         sylva.Grammar.from_file("presets/no_such_plant.lsys")
