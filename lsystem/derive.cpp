@@ -13,6 +13,7 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 
 namespace sylva::lsys {
 
@@ -947,6 +948,13 @@ struct Derivation::Impl {
         seed(o.seed.value_or(grammar.seed)),
         globals(initial_globals(grammar)),
         context{globals.data()} {
+    if (grammar.uses_files) {
+      // fopen writes beside the model (docs/cpfg.md "Output files"); a model of no file has no folder.
+      if (!grammar.file.empty() && grammar.file.front() != '<')
+        files.folder = std::filesystem::path(grammar.file).parent_path().string();
+      if (files.folder.empty() && !grammar.file.empty() && grammar.file.front() != '<') files.folder = ".";
+      context.files = &files;
+    }
     passes.reserve(grammar.passes.size());
     for (const Grammar::Pass& pass : grammar.passes)
       passes.emplace_back(grammar, grammar.productions, pass.by_symbol, seed, o.max_modules, &context);
@@ -996,6 +1004,7 @@ struct Derivation::Impl {
   // A cpfg file's global variables, 0 until a block or a production assigns them.
   std::vector<double> globals;
   EvalContext context;
+  OutputFiles files;                   // what fopen opened (context.files points here)
   std::vector<Rewriter> passes;        // one per pass of a step (Grammar::passes)
   std::optional<Rewriter> decomposer;  // with decomposition productions only
   Rewriter* active = nullptr;          // the one whose production an error names
@@ -1133,6 +1142,9 @@ Expected<Word> Derivation::finish(DeriveStats* stats) {
   try {
     m.reset_rewriters();
     run_block(g, Block::kEnd, m.steps, &m.seed, m.context);
+    // The files a model left open are written now (cpfg's exit closes them).
+    if (const std::string error = m.files.close_all(); !error.empty())
+      return g.error_at({}, "a file the model wrote with fopen: " + error);
   } catch (const DeriveFailure& f) {
     return failure_diagnostic(g, m.passes[0], f.message, f.loc, "step", m.steps + 1);
   } catch (const EvalError& e) {

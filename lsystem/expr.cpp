@@ -1,9 +1,12 @@
 // expr.cpp — the bytecode machine for grammar expressions (see expr.h).
 #include "lsystem/expr.h"
+
+#include "core/util/file_io.h"
 #include "core/util/math.h"
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -125,6 +128,7 @@ const FuncInfo kFuncs[] = {
     {"nran", 2, true},   {"bran", 2, true},   {"biran", 2, true},  {"srand", 1, true},
     {"func", 2, false},  {"stop", 1, false},
     {"curveX", 2, false}, {"curveY", 2, false}, {"curveZ", 2, false}, {"curveGAL", 1, false},
+    {"fflush", 1, false}, {"fclose", 1, false},
 };
 
 // The largest n biran(n, p) draws for (n uniform draws: bounded time, docs/cpfg.md).
@@ -280,6 +284,23 @@ double Program::run(const Expr& e, double* slots, Rng* rng, EvalContext* context
         break;
       case Op::kPop: --sp; break;
       case Op::kDup: stack[sp] = stack[sp - 1]; ++sp; break;
+      case Op::kFileOpen: {
+        if (!context || !context->files) fail(locs[pc], "files are written by a derivation's statements only");
+        double id = 0;
+        const std::string error = context->files->open(formats[in.arg], &id);
+        if (!error.empty()) fail(locs[pc], "fopen: " + error);
+        stack[sp++] = id;
+        break;
+      }
+      case Op::kFilePrint: {
+        if (!context || !context->files) fail(locs[pc], "files are written by a derivation's statements only");
+        sp -= in.pad;
+        const std::string text = apply_format(formats[in.arg], stack + sp);
+        const std::string error = context->files->append(stack[sp - 1], text);
+        if (!error.empty()) fail(locs[pc], "fprintf: " + error);
+        stack[sp - 1] = 0.0;
+        break;
+      }
       case Op::kPrint: {
         sp -= in.pad;
         const std::string text = apply_format(formats[in.arg], stack + sp);
@@ -384,6 +405,14 @@ double Program::run(const Expr& e, double* slots, Rng* rng, EvalContext* context
             }
             break;
           }
+          case Func::kFflush:
+          case Func::kFclose: {
+            if (!context || !context->files) fail(locs[pc], "files are written by a derivation's statements only");
+            const std::string error = context->files->write(a[0], in.fn == Func::kFclose);
+            if (!error.empty()) fail(locs[pc], std::string(func_info(in.fn).name) + ": " + error);
+            r = 0;
+            break;
+          }
           case Func::kStop:
             if (context) context->stop = true;
             r = 0;
@@ -416,6 +445,52 @@ double Program::run(const Expr& e, double* slots, Rng* rng, EvalContext* context
     }
   }
   return stack[sp - 1];
+}
+
+std::string OutputFiles::open(const std::string& name, double* id) {
+  namespace fs = std::filesystem;
+  if (folder.empty()) return "this model was read from no file: it has no folder to write '" + name + "' in";
+  const fs::path relative(name);
+  if (name.empty() || relative.is_absolute() ||
+      std::any_of(relative.begin(), relative.end(), [](const fs::path& part) { return part == ".."; }))
+    return "'" + name + "' is outside the model's folder: a model writes files beside itself only (docs/cpfg.md)";
+  if (files.size() >= kMaxFiles) return "more than " + std::to_string(kMaxFiles) + " files opened";
+  files.push_back(File{(fs::path(folder) / relative).string(), "", true});
+  *id = static_cast<double>(files.size());
+  return "";
+}
+
+namespace {
+// The file of id `id`, or null when no open file has it.
+OutputFiles::File* file_of(std::vector<OutputFiles::File>& files, double id) {
+  if (!(id >= 1) || id != std::floor(id) || id > static_cast<double>(files.size())) return nullptr;
+  OutputFiles::File& f = files[static_cast<size_t>(id) - 1];
+  return f.open ? &f : nullptr;
+}
+}  // namespace
+
+std::string OutputFiles::append(double id, const std::string& text) {
+  File* f = file_of(files, id);
+  if (!f) return index_text(id) + " is no open file (an id fopen returned, before its fclose)";
+  if ((bytes += text.size()) > kMaxOutputBytes)
+    return "the model wrote more than " + std::to_string(kMaxOutputBytes >> 20) + " MiB to its files";
+  f->text += text;
+  return "";
+}
+
+std::string OutputFiles::write(double id, bool close) {
+  File* f = file_of(files, id);
+  if (!f) return index_text(id) + " is no open file (an id fopen returned, before its fclose)";
+  if (Status s = write_file_atomically(f->path, f->text); !s) return s.error().format();
+  if (close) f->open = false;
+  return "";
+}
+
+std::string OutputFiles::close_all() {
+  for (size_t k = 0; k < files.size(); ++k)
+    if (files[k].open)
+      if (std::string e = write(static_cast<double>(k + 1), true); !e.empty()) return e;
+  return "";
 }
 
 }  // namespace sylva::lsys

@@ -43,6 +43,8 @@ enum class Op : uint8_t {
   kDup,         // push the top again
   kPrint,       // cpfg's printf: pop `pad` values, write formats[arg] with them (print_sink); push 0
   kRem,         // cpfg's %: pop b, pop a; push (int)a % (int)b, C's remainder
+  kFileOpen,    // cpfg's fopen(formats[arg], "w"): push the new output file's id (EvalContext::files)
+  kFilePrint,   // cpfg's fprintf: pop `pad` values and a file id, append formats[arg] with them; push 0
 };
 
 enum class Func : uint8_t {
@@ -54,7 +56,9 @@ enum class Func : uint8_t {
   kFunc,   // func(id, x): the grammar's user-defined function id at x (Program::functions)
   kStop,   // stop(n) (CPFG manual 5.6): the derivation ends after this step (EvalContext::stop); returns 0
   // curveX/Y/Z(id, t) and curveGAL(id) (CPFG manual 5.5): the view file's curve id (Program::curves)
-  kCurveX, kCurveY, kCurveZ, kCurveGal
+  kCurveX, kCurveY, kCurveZ, kCurveGal,
+  // fflush(id) and fclose(id) (CPFG manual 5.4): an output file written out (EvalContext::files)
+  kFflush, kFclose
 };
 
 struct Instr {
@@ -89,11 +93,34 @@ inline constexpr uint64_t kMaxLoopIterations = 10000000;
 // What statements read and write besides their own slots: the L-system's global variables,
 // and the seed a srand() asked for (the derivation's, when a Start/StartEach/EndEach block
 // calls it).
+// The files a cpfg model writes with fopen(name, "w") and fprintf (CPFG manual 5.4; docs/cpfg.md
+// "Output files"): only in the model's folder, each kept in memory and written whole and
+// atomically (write_file_atomically, never onto an input) at its fflush, its fclose and, for
+// one left open, at the derivation's end. At most kMaxOutputBytes in all.
+struct OutputFiles {
+  static constexpr uint64_t kMaxOutputBytes = uint64_t{64} << 20;
+  static constexpr size_t kMaxFiles = 256;
+  std::string folder;  // the model's folder; empty: the model came from no file, fopen is an error
+  struct File {
+    std::string path;
+    std::string text;
+    bool open = true;
+  };
+  std::vector<File> files;  // by id − 1
+  uint64_t bytes = 0;
+  // Each returns an error message, empty on success.
+  std::string open(const std::string& name, double* id);
+  std::string append(double id, const std::string& text);
+  std::string write(double id, bool close);
+  std::string close_all();  // writes every file still open
+};
+
 struct EvalContext {
   double* globals = nullptr;
   bool reseeded = false;
   uint64_t reseed = 0;
   bool stop = false;  // a stop() was evaluated: the derivation ends after the current step
+  OutputFiles* files = nullptr;  // a derivation's (fopen); null where statements write no files
 };
 
 // The evaluation stack's size in values: Program::run's fixed stack, and the depth the

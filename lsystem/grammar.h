@@ -233,6 +233,7 @@ struct Grammar {
   std::vector<std::vector<uint32_t>> decomposition_by_symbol;
   bool uses_random = false;   // any stochastic production or random function
   bool uses_context = false;  // any production with left or right context
+  bool uses_files = false;    // a cpfg file's statements call fopen or fprintf (EvalContext::files)
   // % appears in a successor or the axiom. In sylva's format the cut is made as the word is
   // written; in a cpfg file the % stays in the word and cuts when the next step reads it, as
   // cpfg's generate.c does (docs/cpfg.md).

@@ -294,7 +294,9 @@ class Parser {
   std::unordered_map<std::string, uint32_t> global_index_;  // cpfg: global variables by name
   std::unordered_map<std::string, uint32_t> array_index_;   // cpfg: arrays by name (Program::arrays)
   void define_arrays(Cursor value);
-  void parse_printf(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc loc);
+  void parse_printf(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc loc, bool to_file = false);
+  void parse_fopen(Cursor& c, ExprBuild& b, SourceLoc loc);
+  std::string string_literal(Cursor& c, const std::string& missing);
   void parse_array_element(Cursor& c, ExprBuild& b, const Scope* scope, uint32_t array, SourceLoc loc);
   bool globals_visible_ = false;  // compiling a production or a block: globals may be read
 };
@@ -371,10 +373,11 @@ void Parser::parse_logical(Cursor& c, ExprBuild& b, const Scope* scope, char sym
 // cpfg's printf("format", values...) (CPFG manual 3.2: C's printf in statements): the format a
 // string literal with C's escapes, its conversions those check_format takes, one value each.
 // It writes when evaluated (never folded into a constant) and is 0 as a value.
-void Parser::parse_printf(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc loc) {
-  ++c.pos;  // '('
+// A string literal at `c` (C's escapes \n \t \" \\), for printf's and fprintf's formats and
+// fopen's arguments; `missing` is the error when there is none.
+std::string Parser::string_literal(Cursor& c, const std::string& missing) {
   c.skip_spaces();
-  if (c.peek() != '"') fail(c.loc(), "printf needs a format string first: printf(\"x = %g\\n\", x)");
+  if (c.peek() != '"') fail(c.loc(), missing);
   const SourceLoc format_loc = c.loc();
   ++c.pos;
   std::string format;
@@ -399,6 +402,51 @@ void Parser::parse_printf(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc
     }
     if (format.size() > 4096) fail(format_loc, "a format string of more than 4096 characters");
   }
+  return format;
+}
+
+// cpfg's fopen("name", "w") (CPFG manual 5.4): the file's id, a file in the model's folder
+// written when fflush, fclose or the derivation's end comes (OutputFiles). Reading ("r",
+// and fscan) is not supported yet. It opens when evaluated, never folded.
+void Parser::parse_fopen(Cursor& c, ExprBuild& b, SourceLoc loc) {
+  ++c.pos;  // '('
+  std::string name = string_literal(c, "fopen needs the file's name in quotes: fopen(\"out.txt\", \"w\")");
+  c.skip_spaces();
+  if (c.peek() != ',') fail(c.loc(), "expected ',' and the mode after fopen's file name");
+  ++c.pos;
+  c.skip_spaces();
+  const SourceLoc mode_loc = c.loc();
+  const std::string mode = string_literal(c, "fopen needs its mode in quotes: \"w\"");
+  if (mode == "r")
+    fail(mode_loc, "reading files (fopen \"r\", fscan) is not supported yet (docs/cpfg.md)");
+  if (mode != "w") fail(mode_loc, "fopen's mode is \"w\" (writing; \"r\", reading, is not supported yet)");
+  c.skip_spaces();
+  if (c.peek() != ')') fail(c.loc(), "expected ')' after fopen's mode");
+  ++c.pos;
+  b.uses_slot = true;  // a side effect: evaluated every time, never folded
+  g_.program.formats.push_back(std::move(name));
+  g_.program.code.push_back(Instr{Op::kFileOpen, Func{}, 0, static_cast<uint32_t>(g_.program.formats.size() - 1)});
+  g_.program.locs.push_back(loc);
+  b.depth += 1;
+  b.max_depth = std::max(b.max_depth, b.depth);
+}
+
+void Parser::parse_printf(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc loc, bool to_file) {
+  ++c.pos;  // '('
+  const char* what = to_file ? "fprintf" : "printf";
+  if (to_file) {
+    // fprintf(file, "format", values...): the file's id first.
+    if (++b.nesting > kMaxNesting) fail(loc, "expression nested too deeply");
+    parse_or(c, b, scope);
+    --b.nesting;
+    c.skip_spaces();
+    if (c.peek() != ',') fail(c.loc(), "expected ',' and the format after fprintf's file");
+    ++c.pos;
+  }
+  c.skip_spaces();
+  const SourceLoc format_loc = c.loc();
+  std::string format = string_literal(c, to_file ? "fprintf needs a format string after its file: fprintf(f, \"x = %g\\n\", x)"
+                                                 : "printf needs a format string first: printf(\"x = %g\\n\", x)");
   const FormatCheck check = check_format(format);
   if (!check.error.empty()) fail(format_loc, check.error);
   int values = 0;
@@ -408,7 +456,7 @@ void Parser::parse_printf(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc
       ++c.pos;
       break;
     }
-    if (c.peek() != ',') fail(c.loc(), "expected ',' or ')' in printf's arguments");
+    if (c.peek() != ',') fail(c.loc(), std::string("expected ',' or ')' in ") + what + "'s arguments");
     ++c.pos;
     if (++b.nesting > kMaxNesting) fail(loc, "expression nested too deeply");
     parse_or(c, b, scope);
@@ -416,14 +464,15 @@ void Parser::parse_printf(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc
     ++values;
   }
   if (values != check.values)
-    fail(loc, "printf's format takes " + std::to_string(check.values) + (check.values == 1 ? " value" : " values") +
-                  ", it was given " + std::to_string(values));
+    fail(loc, std::string(what) + "'s format takes " + std::to_string(check.values) +
+                  (check.values == 1 ? " value" : " values") + ", it was given " + std::to_string(values));
   b.uses_slot = true;  // a side effect: evaluated every time, never folded
   g_.program.formats.push_back(std::move(format));
-  g_.program.code.push_back(Instr{Op::kPrint, Func{}, static_cast<uint16_t>(values),
+  g_.program.code.push_back(Instr{to_file ? Op::kFilePrint : Op::kPrint, Func{}, static_cast<uint16_t>(values),
                                   static_cast<uint32_t>(g_.program.formats.size() - 1)});
   g_.program.locs.push_back(loc);
-  b.depth += 1 - values;
+  if (to_file) g_.uses_files = true;
+  b.depth += 1 - values - (to_file ? 1 : 0);
   b.max_depth = std::max(b.max_depth, b.depth);
 }
 
@@ -598,6 +647,13 @@ void Parser::parse_primary(Cursor& c, ExprBuild& b, const Scope* scope) {
     size_t after = c.pos;
     c.skip_spaces();
     if (c.peek() == '(' && name == "printf" && g_.cpfg) return parse_printf(c, b, scope, loc);
+    if (c.peek() == '(' && name == "fprintf" && g_.cpfg) return parse_printf(c, b, scope, loc, true);
+    if (c.peek() == '(' && name == "fopen" && g_.cpfg) {
+      g_.uses_files = true;
+      return parse_fopen(c, b, loc);
+    }
+    if (c.peek() == '(' && (name == "fscan" || name == "fscanf") && g_.cpfg)
+      fail(loc, "reading files (fopen \"r\", fscan) is not supported yet (docs/cpfg.md)");
     if (c.peek() == '(') {
       Func fn;
       if (!find_func(name, &fn)) fail(loc, "unknown function '" + name + "'");
@@ -630,7 +686,7 @@ void Parser::parse_primary(Cursor& c, ExprBuild& b, const Scope* scope) {
                       (info.arity == 1 ? " argument" : " arguments") + ", got " +
                       std::to_string(args));
       if (info.random) b.uses_random = true;
-      if (fn == Func::kStop) b.uses_slot = true;  // its effect is the call: never folded
+      if (fn == Func::kStop || fn == Func::kFflush || fn == Func::kFclose) b.uses_slot = true;  // its effect is the call: never folded
       emit(b, Op::kCall, 0, loc, 1 - args, fn);
       return;
     }

@@ -393,6 +393,45 @@ TEST(CpfgModel, APercentCutsTheRestOfItsBranchWhenTheNextStepReadsIt) {
   EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 0\nAxiom: F%F\nendlsystem\n"), "F%F");
 }
 
+// Output files (CPFG manual 5.4; vlab's canalization-file): fopen(name, "w") in the model's
+// folder, fprintf appends, fflush and fclose write the whole file atomically, and a file left
+// open is written when the derivation ends. Outside the folder, reading, an unknown id and a
+// model of no file are errors at their place.
+TEST(CpfgStatements, FopenAndFprintfWriteFilesBesideTheModel) {
+  ModelFolder folder;
+  const std::string model = folder.write(
+      "plant.l", "Lsystem: 1\nderivation length: 3\nStart: {n = 0; f = fopen(\"out.txt\", \"w\"); "
+                 "g = fopen(\"log/open.txt\", \"w\");}\nStartEach: {n = n + 1;}\n"
+                 "EndEach: {fprintf(f, \"step %.0f: %g\\n\", n, n / 2); fflush(f); fprintf(g, \"%.0f \", n);}\n"
+                 "End: {fclose(f);}\nAxiom: A\nA --> AB\nendlsystem\n");
+  std::filesystem::create_directories(folder.dir() / "log");
+  EXPECT_EQ(derive_file(model), "ABBB");
+  auto text = [&](const char* name) {
+    std::ifstream in(folder.dir() / name);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(text("out.txt"), "step 1: 0.5\nstep 2: 1\nstep 3: 1.5\n");
+  EXPECT_EQ(text("log/open.txt"), "1 2 3 ") << "left open: written at the derivation's end";
+  folder.write("bad.l", "Lsystem: 1\nStart: {f = fopen(\"../escape.txt\", \"w\");}\nAxiom: A\nendlsystem\n");
+  const std::string outside = derive_file((folder.dir() / "bad.l").string());
+  EXPECT_NE(outside.find("outside the model's folder"), std::string::npos) << outside;
+  EXPECT_FALSE(std::filesystem::exists(folder.dir().parent_path() / "escape.txt"));
+  expect_located({"Lsystem: 1\nStart: {f = fopen(\"in.txt\", \"r\");}\nAxiom: A\nendlsystem\n", 2, 29,
+                  "reading files (fopen \"r\", fscan) is not supported yet"});
+  expect_located({"Lsystem: 1\nStart: {fscan(1, \"%f\", x);}\nAxiom: A\nendlsystem\n", 2, 9, "not supported yet"});
+  // A model read from no file (Python's Grammar(text), "<string>") has no folder to write in.
+  auto from_text = [](const std::string& text) {
+    auto g = parse_grammar(text, "<string>");
+    if (!g.ok()) return "<parse error: " + g.error().message + ">";
+    auto w = derive(*g);
+    return w.ok() ? print_word(*w, g->symbols) : "<error: " + w.error().message + ">";
+  };
+  const std::string unknown = from_text("Lsystem: 1\nStart: {fprintf(3, \"x\");}\nAxiom: A\nendlsystem\n");
+  EXPECT_NE(unknown.find("3 is no open file"), std::string::npos) << unknown;
+  const std::string nofile = from_text("Lsystem: 1\nStart: {f = fopen(\"x.txt\", \"w\");}\nAxiom: A\nendlsystem\n");
+  EXPECT_NE(nofile.find("read from no file"), std::string::npos) << nofile;
+}
+
 // stop(n) (CPFG manual 5.6) ends the derivation after the step that calls it: the word is
 // that step's, and the End block still runs.
 TEST(CpfgStatements, StopEndsTheDerivationAfterTheCurrentStep) {
