@@ -452,6 +452,9 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
         return fail_here(values[0].column + value_column - 1,
                          "the sides around a contour are a whole number up to " + std::to_string(lsys::kMaxContourSides));
       t.contour_sides = std::max(3, static_cast<int>(sides));
+    } else if (name == "tsurface") {
+      // Triangulated surfaces (cpfg's tsurfaces.c) would change the plant: said, not skipped.
+      return fail_here(1, "'tsurface:' (a surface of triangles for ~) is not supported yet (docs/cpfg.md)");
     } else if (name == "surface") {
       // "surface: id file size [s t [texture]]" (CPFG manual 8.1.5): the id is one character,
       // a size not above 0 is 1 (as cpfg's reader), s and t the cells a patch is cut into.

@@ -1074,6 +1074,11 @@ TEST(VlabObject, TheViewFileIsReadAsCpfgReadsIt) {
     ASSERT_TRUE(w.ok()) << w.error().format();
     EXPECT_DOUBLE_EQ(w->turtle.width, 0.1) << view;
   }
+  folder.write("plant.v", "angle factor: 4\ntsurface: l leaf.tsurface 1\n");
+  auto triangles = load_grammar(folder.dir().string());
+  ASSERT_FALSE(triangles.ok());
+  EXPECT_EQ(triangles.error().loc.line, 2u);
+  EXPECT_NE(triangles.error().message.find("not supported yet"), std::string::npos) << triangles.error().message;
   // cpfg's double-sided surfaces (a back colour) are not drawn yet: said at the place.
   folder.write("plant.v", "initial color: 3 7\n");
   auto sides = load_grammar(folder.dir().string());
