@@ -864,10 +864,13 @@ enum class Block : uint64_t { kStart, kStartEach, kEndEach, kEnd };
 void run_block(const Grammar& g, Block block, int64_t step, uint64_t* seed, EvalContext& context) {
   const Expr* const exprs[] = {&g.start_block, &g.start_each_block, &g.end_each_block, &g.end_block};
   const Expr& e = *exprs[static_cast<size_t>(block)];
-  if (e.kind == Expr::Kind::kNone) return;
+  const std::vector<Expr>& subs = g.sub_blocks[static_cast<size_t>(block)];
+  if (e.kind == Expr::Kind::kNone && subs.empty()) return;
   Rng rng(mix_pair(*seed, kBlockStreamBase + 4 * static_cast<uint64_t>(step) + static_cast<uint64_t>(block)));
   context.reseeded = false;
-  g.program.eval(e, nullptr, &rng, &context);
+  // The main L-system's block, then its sub-L-systems' (cpfg's Evaluate*Statements, in order).
+  if (e.kind != Expr::Kind::kNone) g.program.eval(e, nullptr, &rng, &context);
+  for (const Expr& sub : subs) g.program.eval(sub, nullptr, &rng, &context);
   if (context.reseeded) *seed = context.reseed;
 }
 

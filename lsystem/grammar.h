@@ -195,6 +195,10 @@ struct Grammar {
   std::vector<std::string> global_names;     // a global's index is its place here
   std::vector<double> global_initial;        // their values before the Start block (arrays' initialisers; else 0)
   Expr start_block, start_each_block, end_each_block, end_block;  // kind kNone: none
+  // The sub-L-systems' blocks (CPFG manual 7.2), by kind (Start, StartEach, EndEach, End),
+  // in file order: each kind runs after the main L-system's, as cpfg's Evaluate*Statements
+  // run every L-system's in its list. The globals are one set for the whole file.
+  std::vector<Expr> sub_blocks[4];
   SymbolTable symbols;
   std::vector<Define> defines;
   TurtleDefaults turtle;

@@ -8,6 +8,7 @@
 // reads no formal parameter and draws no random number is evaluated once and stored as a
 // constant. Recursion is bounded (kMaxNesting) so hostile input cannot overflow the stack.
 #include <algorithm>
+#include <array>
 #include <functional>
 #include <numeric>
 #include <charconv>
@@ -289,6 +290,7 @@ class Parser {
   bool seen_lsystem_ = false;  // cpfg: the 'Lsystem:' line was read
   bool seen_end_ = false;      // cpfg: the 'endlsystem' line was read (of the L-system being read)
   uint32_t lsystem_ = 0;       // cpfg: the L-system being read (Grammar::lsystem_labels), 0 the main one
+  std::vector<std::array<bool, 4>> sub_block_seen_;  // by L-system: which of its four blocks were read
   bool consider_ = false;      // cpfg: a 'consider:' list names the modules context sees
   std::vector<uint8_t> considered_;  // by symbol id
   std::unordered_map<std::string, uint32_t> global_index_;  // cpfg: global variables by name
@@ -1440,12 +1442,22 @@ bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest) {
   if (keyword("define", false, nullptr)) return true;  // its arrays: define_arrays, before the productions
   const std::pair<const char*, Expr*> blocks[] = {{"start", &g_.start_block}, {"starteach", &g_.start_each_block},
                                                   {"endeach", &g_.end_each_block}, {"end", &g_.end_block}};
-  for (const auto& [block, expr] : blocks) {
+  for (size_t kind = 0; kind < 4; ++kind) {
+    const auto& [block, main_expr] = blocks[kind];
     if (!keyword(block, false, &value)) continue;
     const std::string name(rest.substr(0, std::strlen(block)));
-    main_only("a '" + name + ":' block");
+    // A sub-L-system's block runs after the main one's (Grammar::sub_blocks).
+    Expr sub;
+    Expr* expr = main_expr;
+    if (lsystem_ > 0) {
+      if (sub_block_seen_.size() <= lsystem_) sub_block_seen_.resize(lsystem_ + 1);
+      if (sub_block_seen_[lsystem_][kind]) fail(c.loc(), "the '" + name + ":' block is given twice");
+      sub_block_seen_[lsystem_][kind] = true;
+      expr = &sub;
+    }
     if (expr->kind != Expr::Kind::kNone) fail(c.loc(), "the '" + name + ":' block is given twice");
     *expr = compile_statements(value, nullptr);
+    if (lsystem_ > 0) g_.sub_blocks[kind].push_back(sub);
     value.skip_spaces();
     if (value.peek() == ';') ++value.pos;  // cpfg writes "Start: { ... };"
     value.skip_spaces();

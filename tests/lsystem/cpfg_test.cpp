@@ -354,6 +354,14 @@ TEST(CpfgModel, SubLSystemsRewriteTheModulesBetweenTheirCallAndItsEnd) {
   EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: $B?(2)B?(1)B$B$B\nB --> M\nendlsystem\n"
                         "Lsystem: 2\nAxiom: B\nB --> S\nendlsystem\n"),
             "$M?(2)S?(1)M$S$M");
+  // A sub-L-system's blocks run after the main one's, over the same globals (cpfg's
+  // Evaluate*Statements): Start n = 1 then 11; each step's EndEach doubles, then adds 1.
+  EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 2\nStart: {n = 1;}\nEndEach: {n = n * 2;}\nAxiom: A\n"
+                        "A --> A B(n)\nendlsystem\nLsystem: 2\nStart: {n = n + 10;}\nEndEach: {n = n + 1;}\nAxiom: B\n"
+                        "endlsystem\n"),
+            "AB(23)B(11)");
+  expect_located({"Lsystem: 1\nAxiom: A\nendlsystem\nLsystem: 2\nStart: {n = 1;}\nStart: {n = 2;}\nAxiom: B\n"
+                  "endlsystem\n", 6, 1, "given twice"});
   // A cut inside a sub-L-system ends at its $ (cpfg's SkipCutPart).
   EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: ?(2)A%B[C]$D\nendlsystem\nLsystem: 2\nAxiom: B\n"
                         "endlsystem\n"),
@@ -532,8 +540,8 @@ TEST(CpfgModel, AnEqualsSignInARightContextIsTheRestOfTheBranch) {
 
 TEST(CpfgModel, WhatSylvaCannotReadYetIsAnErrorAtItsPlaceNamingTheFeature) {
   const LocatedError cases[] = {
-      {"Lsystem: 1\nAxiom: F\nendlsystem\nLsystem: 2\nAxiom: G\nStart: {x = 1;}\nendlsystem\n", 6, 1,
-       "a 'Start:' block in a sub-L-system"},
+      {"Lsystem: 1\nAxiom: F\nendlsystem\nLsystem: 2\nAxiom: G\nconsider: G\nendlsystem\n", 6, 1,
+       "'consider:' in a sub-L-system"},
   };
   for (const LocatedError& c : cases) {
     expect_located(c);
