@@ -65,6 +65,8 @@ class Rewriter {
     slots_.assign(slots + 1, 0.0);
     has_rest_of_branch_ = g_.cpfg && g_.symbols.find("=", &rest_of_branch_);
     sub_lsystems_ = g_.has_sub_lsystems() && g_.symbols.find("?", &sub_call_);
+    uses_tails_ = std::any_of(productions_.begin(), productions_.end(),
+                              [](const Production& p) { return !p.predecessor_tail.empty(); });
     direct_.assign(by_symbol_.size(), nullptr);
     for (size_t s = 0; s < by_symbol_.size(); ++s) {
       if (by_symbol_[s].empty()) continue;
@@ -115,7 +117,7 @@ class Rewriter {
         progress.report(static_cast<double>(i) / static_cast<double>(n), stage);
       }
       Rng rng;
-      tail_ = TailView{&in, i + 1, 1, n - i - 1, active_in, 0};
+      if (uses_tails_) tail_ = TailView{&in, i + 1, 1, n - i - 1, active_in, 0};
       const Production* chosen = (!active_in || (*active_in)[i]) ? select(in, i, stream, rng) : nullptr;
       if (!chosen) {
         copy_module(in, i, out);
@@ -167,7 +169,7 @@ class Rewriter {
       }
       const size_t i = n - 1 - done;
       Rng rng;
-      tail_ = TailView{};  // a cpfg predecessor's further modules: cpfg has no backward passes
+      if (uses_tails_) tail_ = TailView{};  // a cpfg predecessor's further modules: cpfg has no backward passes
       const Production* chosen = select(in, i, stream, rng);
       if (!chosen) {
         copy_module(in, i, rev);
@@ -237,7 +239,8 @@ class Rewriter {
           // A cpfg predecessor's further modules (CPFG generate.c, ApplyRecursiveProductions):
           // at depth 1 the word's next modules, deeper the rest of the same successor, which
           // lies below t on the stack at the same depth.
-          tail_ = d == 1 ? TailView{&in, i + 1, 1, n - i - 1, nullptr, 0} : TailView{&stack_, t - 1, -1, t, nullptr, d};
+          if (uses_tails_)
+            tail_ = d == 1 ? TailView{&in, i + 1, 1, n - i - 1, nullptr, 0} : TailView{&stack_, t - 1, -1, t, nullptr, d};
           const Production* direct = direct_[m.symbol];
           if (direct && direct->predecessor.arity == m.param_count && direct->lsystem == lsystem_) {
             chosen = direct;
@@ -729,6 +732,7 @@ class Rewriter {
     int depth = 0;
   };
   TailView tail_;
+  bool uses_tails_ = false;  // some production has a predecessor of several modules (else tail_ is never read)
   // Sub-L-systems (CPFG manual 7.2; cpfg's CheckPred): the L-system whose productions apply
   // now (its index in Grammar::lsystem_labels), and the ones a $ returns to.
   bool sub_lsystems_ = false;
@@ -952,10 +956,12 @@ struct Derivation::Impl {
         globals(initial_globals(grammar)),
         context{globals.data()} {
     if (grammar.uses_files) {
-      // fopen writes beside the model (docs/cpfg.md "Output files"); a model of no file has no folder.
-      if (!grammar.file.empty() && grammar.file.front() != '<')
-        files.folder = std::filesystem::path(grammar.file).parent_path().string();
-      if (files.folder.empty() && !grammar.file.empty() && grammar.file.front() != '<') files.folder = ".";
+      // fopen writes beside the model (docs/cpfg.md "Output files"); a model of no file
+      // ("<string>") has no folder.
+      if (!grammar.file.empty() && grammar.file.front() != '<') {
+        const std::filesystem::path folder = std::filesystem::path(grammar.file).parent_path();
+        files.folder = folder.empty() ? "." : folder.string();
+      }
       context.files = &files;
     }
     passes.reserve(grammar.passes.size());

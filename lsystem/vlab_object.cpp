@@ -117,15 +117,25 @@ Status read_view_functions(const std::string& view, const std::string& folder, P
       d.notes.push_back(std::move(inner));
       failure = std::move(d);
     };
+    // The line's optional sample count (its second word): `fallback` without one, else a whole
+    // number from `low` to `high`; false after an error at it.
+    auto samples_of = [&](int fallback, int low, int high, int* out) {
+      double v = fallback;
+      if (values.size() >= 2 && (!number(values[1].text, &v) || v != std::floor(v) || v < low || v > high)) {
+        failure = error_in(view, line, line_no, base + values[1].column,
+                           "the number of samples is a whole number from " + std::to_string(low) + " to " +
+                               std::to_string(high));
+        return false;
+      }
+      *out = static_cast<int>(v);
+      return true;
+    };
+    int samples = 0;
     if (name == "curve") {
       // "curve: file [samples]" (CPFG manual 8.1.5): curveX(id, t) ... with ids 1, 2, ... in
       // order; cpfg measures it with 100 samples without the number (interpret.c).
-      double samples = 100;
-      if (values.size() >= 2 && (!number(values[1].text, &samples) || samples != std::floor(samples) || samples < 2 ||
-                                 samples > kMaxCurveSamples))
-        return void(failure = error_in(view, line, line_no, base + values[1].column,
-                                       "the number of samples is a whole number from 2 to " + std::to_string(kMaxCurveSamples)));
-      auto c = read_cpfg_curve(file, static_cast<int>(samples));
+      if (!samples_of(100, 2, kMaxCurveSamples, &samples)) return;
+      auto c = read_cpfg_curve(file, samples);
       if (!c) return fail_file(std::move(c.error()));
       options.curves.push_back(std::move(*c));
       return;
@@ -137,12 +147,8 @@ Status read_view_functions(const std::string& view, const std::string& folder, P
       from_set = true;
       return;
     }
-    double samples = 0;
-    if (values.size() >= 2 && (!number(values[1].text, &samples) || samples != std::floor(samples) || samples < 0 ||
-                               samples > kMaxFunctionSamples))
-      return void(failure = error_in(view, line, line_no, base + values[1].column,
-                                     "the number of samples is a whole number from 0 to " + std::to_string(kMaxFunctionSamples)));
-    auto f = read_function_file(file, static_cast<int>(samples));
+    if (!samples_of(0, 0, kMaxFunctionSamples, &samples)) return;
+    auto f = read_function_file(file, samples);
     if (!f) return fail_file(std::move(f.error()));
     if (f->name == file) f->name = fs::path(values[0].text).stem().string();
     options.functions.push_back(std::move(*f));

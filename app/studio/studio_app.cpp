@@ -122,6 +122,20 @@ void StudioApp::keep(const std::string& name) { rects_[name] = WidgetRect{ImGui:
 
 // ---- documents --------------------------------------------------------------------
 
+namespace {
+// The file the editor shows for a grammar path, and its text: the file itself, or for a vlab
+// object folder the model its specifications name (its view file, functions, environment,
+// colours and panel come with it when it grows: docs/cpfg.md).
+Expected<std::pair<std::string, std::string>> grammar_document(const std::string& grammar) {
+  Expected<std::string> file =
+      std::filesystem::is_directory(grammar) ? lsys::vlab_model_file(grammar) : Expected<std::string>(grammar);
+  if (!file) return std::move(file.error());
+  Expected<std::string> text = read_text_file(*file);
+  if (!text) return std::move(text.error());
+  return std::pair<std::string, std::string>{*file, std::move(*text)};
+}
+}  // namespace
+
 std::optional<std::string> StudioApp::open(const std::string& path) {
   if (path.ends_with(".scene.json")) {
     Expected<Scene> read = read_scene_file(path);
@@ -144,26 +158,15 @@ std::optional<std::string> StudioApp::open(const std::string& path) {
     if (Status grown = grow_scene_plants(others, options_.max_modules, {}, &cpu_light_oracle()); !grown) return grown.error().format();
     for (size_t i = 0; i < scene.plants.size(); ++i)
       if (scene.plants[i].grammar != grammar) scene.plants[i].skeleton = std::move(others.plants[i].skeleton);
-    Expected<std::string> model = object ? lsys::vlab_model_file(grammar) : Expected<std::string>(grammar);
-    if (!model) return one_line(model.error());
-    Expected<std::string> r = read_text_file(*model);
-    if (!r) return one_line(r.error());
-    load_text(*model, std::move(*r), path, std::move(scene), object ? grammar : "");
+    auto document = grammar_document(grammar);
+    if (!document) return one_line(document.error());
+    load_text(document->first, std::move(document->second), path, std::move(scene), object ? grammar : "");
     return std::nullopt;
   }
-  if (std::filesystem::is_directory(path)) {
-    // A vlab object: the editor shows its model; the object's view file, functions,
-    // environment, colours and panel come with it (docs/cpfg.md).
-    Expected<std::string> model = lsys::vlab_model_file(path);
-    if (!model) return one_line(model.error());
-    Expected<std::string> r = read_text_file(*model);
-    if (!r) return one_line(r.error());
-    load_text(*model, std::move(*r), "", Scene{}, path);
-    return std::nullopt;
-  }
-  Expected<std::string> r = read_text_file(path);
-  if (!r) return one_line(r.error());
-  load_text(path, std::move(*r), "", Scene{});
+  auto document = grammar_document(path);
+  if (!document) return one_line(document.error());
+  load_text(document->first, std::move(document->second), "", Scene{},
+            std::filesystem::is_directory(path) ? path : "");
   return std::nullopt;
 }
 

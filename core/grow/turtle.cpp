@@ -512,6 +512,19 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   std::vector<size_t> cylinder_marks;  // the pool's size at each '[' still open
   std::vector<double> sub_scales;      // cpfg: the scale of each sub-L-system entered and not left
   std::map<double, TurtlePatch> turtle_patches;  // cpfg: the L-system defined surfaces by id
+  // The joint the turtle stands on, which what it draws in place (a leaf, a sphere) hangs from.
+  auto standing_on = [](const TurtleState& at) -> std::optional<ChainParent> {
+    if (at.chain < 0) return std::nullopt;
+    return ChainParent{static_cast<uint32_t>(at.chain), static_cast<uint32_t>(at.joint)};
+  };
+  // A new chain of `count` joints hung from `parent`: its id (the joints are the caller's to add).
+  auto new_chain = [&](uint32_t count, const std::optional<ChainParent>& parent) {
+    if (chain_joint_count.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many chains"};
+    const uint32_t c = static_cast<uint32_t>(chain_joint_count.size());
+    chain_joint_count.push_back(count);
+    chain_parent.push_back(parent);
+    return c;
+  };
   // Appends one piece of a cylinder's curve to its chain: `strips` joints at curve(k /
   // strips), radii from r0 to r1, in the colour of the piece's start. A new chain where
   // there is none yet or where the chain went on meanwhile (a branch drew from this point).
@@ -519,12 +532,9 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
                             int strips, const auto& curve) {
     const double r0 = profile.at(0).second;
     if (c.chain < 0 || c.joint + 1 != static_cast<int64_t>(chain_joint_count[static_cast<size_t>(c.chain)])) {
-      if (chain_joint_count.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many chains"};
       const std::optional<ChainParent> parent =
           c.chain < 0 ? c.parent : ChainParent{static_cast<uint32_t>(c.chain), static_cast<uint32_t>(c.joint)};
-      const uint32_t id = static_cast<uint32_t>(chain_joint_count.size());
-      chain_joint_count.push_back(1);
-      chain_parent.push_back(parent);
+      const uint32_t id = new_chain(1, parent);
       joints.push_back({id, Joint{{start.x, start.y, start.z}, r0, material}});
       c.chain = id;
       c.joint = 0;
@@ -727,7 +737,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
     c.bspline = bspline;
     c.closed = closed;
     c.default_strips = default_strips;
-    if (t.chain >= 0) c.parent = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
+    c.parent = standing_on(t);
     cylinders.push_back(c);
     t.cylinder = static_cast<int32_t>(cylinders.size() - 1);
     t.cylinder_moves = moves;
@@ -781,9 +791,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
         continue;
       }
       if (m.symbol == sym_open) {
-        std::optional<ChainParent> joint;
-        if (t.chain >= 0) joint = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
-        polygons.push_back({i, joint, t.position, {}});
+        polygons.push_back({i, standing_on(t), t.position, {}});
         continue;
       }
       if (m.symbol == sym_vertex) {  // outside a polygon or cylinder a '.' records nothing (as in cpfg)
@@ -912,8 +920,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
             if (!std::isfinite(radius) || radius > kMaxCoordinateM)
               throw TurtleFailure{"a diameter must be finite and at most 2e12 m"};
             if (!(radius > 0)) continue;  // 0 or negative: nothing drawn (cpfg draws no sphere)
-            std::optional<ChainParent> at;
-            if (t.chain >= 0) at = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
+            const std::optional<ChainParent> at = standing_on(t);
             if (cpfg.kind[symbol] == CpfgKind::kCircle) {
               // A leaf: kCircleSides vertices around the turtle in the plane of H and L.
               std::vector<std::array<double, 3>> vertices;
@@ -930,10 +937,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
             // A chain of its own, hung from the joint the turtle stands on: kSphereSegments
             // frusta along H through the turtle's position, the profile inscribed in the
             // circle of the radius (tips at both poles). The turtle does not move.
-            if (chain_joint_count.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many chains"};
-            const uint32_t c = static_cast<uint32_t>(chain_joint_count.size());
-            chain_joint_count.push_back(kSphereSegments + 1);
-            chain_parent.push_back(at);
+            const uint32_t c = new_chain(kSphereSegments + 1, at);
             for (int k = 0; k <= kSphereSegments; ++k) {
               const double a = kPi * k / kSphereSegments;
               const dvec3 v = t.position - radius * std::cos(a) * t.heading;
@@ -1022,8 +1026,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
               check_position(w);
               return std::array<double, 3>{w.x, w.y, w.z};
             };
-            std::optional<ChainParent> at;
-            if (t.chain >= 0) at = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
+            const std::optional<ChainParent> at = standing_on(t);
             const int columns = surface->t_cells + 1;
             for (const auto& grid : surface->patches)
               for (int a = 0; a < surface->s_cells; ++a)
@@ -1069,8 +1072,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
                 if (!(p[1 + k] >= 1)) throw TurtleFailure{"@PD's s and t are counts of lines, 1 or more"};
                 cells[k] = static_cast<int>(std::min<double>(p[1 + k], kPatchMaxPrecision));
               }
-            std::optional<ChainParent> at;
-            if (t.chain >= 0) at = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
+            const std::optional<ChainParent> at = standing_on(t);
             auto corner = [&](int a, int b) {
               const dvec3 v = patch_point(patch, static_cast<double>(a) / cells[0], static_cast<double>(b) / cells[1]);
               check_position(v);
@@ -1089,12 +1091,8 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
             if (!std::isfinite(radius) || radius > kMaxCoordinateM)
               throw TurtleFailure{"a diameter must be finite and at most 2e12 m"};
             if (!(radius > 0) || !(t.radius > 0)) continue;  // no circle, or no line width: nothing drawn
-            std::optional<ChainParent> at;
-            if (t.chain >= 0) at = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
-            if (chain_joint_count.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many chains"};
-            const uint32_t c = static_cast<uint32_t>(chain_joint_count.size());
-            chain_joint_count.push_back(kCircleSides + 1);
-            chain_parent.push_back(at);
+            const std::optional<ChainParent> at = standing_on(t);
+            const uint32_t c = new_chain(kCircleSides + 1, at);
             for (int k = 0; k <= kCircleSides; ++k) {
               const double a = 2 * kPi * (k % kCircleSides) / kCircleSides;
               const dvec3 v = t.position + radius * (std::cos(a) * t.heading + std::sin(a) * t.left);
@@ -1131,12 +1129,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           const bool start_chain = t.chain < 0 || t.branch_pending ||
                                    t.joint + 1 != static_cast<int64_t>(chain_joint_count[t.chain]);
           if (start_chain) {
-            if (chain_joint_count.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many chains"};
-            std::optional<ChainParent> parent;
-            if (t.chain >= 0) parent = ChainParent{static_cast<uint32_t>(t.chain), static_cast<uint32_t>(t.joint)};
-            const uint32_t c = static_cast<uint32_t>(chain_joint_count.size());
-            chain_joint_count.push_back(1);
-            chain_parent.push_back(parent);
+            const uint32_t c = new_chain(1, standing_on(t));
             joints.push_back({c, Joint{{t.position.x, t.position.y, t.position.z}, t.radius, t.material}});
             t.chain = c;
             t.joint = 0;
