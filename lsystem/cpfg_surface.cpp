@@ -215,4 +215,57 @@ Expected<CpfgSurface> read_cpfg_surface(const std::string& path, char id, double
   return out;
 }
 
+Expected<CpfgSurface> read_cpfg_tsurface(const std::string& path, char id, double size) {
+  Expected<std::string> text = read_text_file(path);
+  if (!text) return std::move(text.error());
+  CpfgSurface out;
+  out.id = id;
+  std::array<std::array<double, 3>, 3> triangle{};
+  int vertex = -1;  // the vertex being read; -1: between triangles
+  int values = 0;   // the numbers of that vertex read so far
+  SourceLoc started{1, 1};
+  std::optional<Diagnostic> failure;
+  detail::for_each_physical_line(*text, [&](uint32_t line_no, std::string_view line, bool) {
+    if (failure) return;
+    size_t i = 0;
+    while (i < line.size()) {
+      auto delimiter = [](char ch) { return detail::is_space(ch) || ch == ',' || ch == ':'; };
+      while (i < line.size() && delimiter(line[i])) ++i;
+      const size_t start = i;
+      while (i < line.size() && !delimiter(line[i])) ++i;
+      if (i == start) break;
+      const std::string_view word = line.substr(start, i - start);
+      const SourceLoc at{line_no, static_cast<uint32_t>(start + 1)};
+      if (vertex < 0) {
+        if (word.substr(0, 8) != "triangle") continue;  // another word: passed over, as cpfg does
+        if (out.triangles.size() >= kMaxTsurfaceTriangles)
+          return void(failure = diagnostic_at(path, at, "more than " + std::to_string(kMaxTsurfaceTriangles) + " triangles"));
+        vertex = 0;
+        values = 0;
+        started = at;
+        continue;
+      }
+      double v = 0;
+      const char* first = word.data() + (word[0] == '+' ? 1 : 0);
+      auto [ptr, ec] = std::from_chars(first, word.data() + word.size(), v);
+      if (ec != std::errc() || ptr != word.data() + word.size() || !std::isfinite(v))
+        return void(failure = diagnostic_at(path, at, "expected a number: a triangle has three vertices of x y z "
+                                                      "(and the normal, the texture's u v)"));
+      if (values < 3) triangle[static_cast<size_t>(vertex)][static_cast<size_t>(values)] = v * size;
+      if (++values > 8) break;  // the rest of the line is passed over, as cpfg does
+    }
+    if (vertex >= 0 && values >= 3) {
+      values = 0;
+      if (++vertex == 3) {
+        out.triangles.push_back(triangle);
+        vertex = -1;
+      }
+    }
+  });
+  if (failure) return std::move(*failure);
+  if (vertex >= 0) return diagnostic_at(path, started, "this triangle has fewer than three vertices (x y z on each line)");
+  if (out.triangles.empty()) return diagnostic_at(path, {1, 1}, "a tsurface needs at least one 'triangle'");
+  return out;
+}
+
 }  // namespace sylva::lsys

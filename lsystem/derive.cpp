@@ -65,6 +65,8 @@ class Rewriter {
     slots_.assign(slots + 1, 0.0);
     has_rest_of_branch_ = g_.cpfg && g_.symbols.find("=", &rest_of_branch_);
     sub_lsystems_ = g_.has_sub_lsystems() && g_.symbols.find("?", &sub_call_);
+    per_lsystem_context_ = sub_lsystems_ && g_.sub_contexts_differ();
+    tables_.resize(per_lsystem_context_ ? g_.lsystem_labels.size() : 1);
     uses_tails_ = std::any_of(productions_.begin(), productions_.end(),
                               [](const Production& p) { return !p.predecessor_tail.empty(); });
     direct_.assign(by_symbol_.size(), nullptr);
@@ -118,7 +120,9 @@ class Rewriter {
       }
       Rng rng;
       if (uses_tails_) tail_ = TailView{&in, i + 1, 1, n - i - 1, active_in, 0};
-      const Production* chosen = (!active_in || (*active_in)[i]) ? select(in, i, stream, rng) : nullptr;
+      // A recursive pass past this module's L-system's own maximum depth leaves it as it is.
+      const bool within = depth_limits_.empty() || pass_depth_ <= depth_limits_[lsystem_];
+      const Production* chosen = ((!active_in || (*active_in)[i]) && within) ? select(in, i, stream, rng) : nullptr;
       if (!chosen) {
         copy_module(in, i, out);
         if (active_out) active_out->push_back(0);
@@ -221,6 +225,8 @@ class Rewriter {
         if (sub_lsystems_) track_lsystem(in, i);
         continue;
       }
+      // The maximum depth of the L-system the module is in (sub-L-systems have their own).
+      const int limit = depth_limits_.empty() ? max_depth : depth_limits_[lsystem_];
       stack_.clear();
       stack_depth_.clear();
       copy_module(in, i, stack_);
@@ -234,7 +240,7 @@ class Rewriter {
         const Production* chosen = nullptr;
         Rng rng;
         const bool has_rules = !by_symbol_[m.symbol].empty();
-        if (has_rules && d <= max_depth) {
+        if (has_rules && d <= limit) {
           in_ = &stack_;
           // A cpfg predecessor's further modules (CPFG generate.c, ApplyRecursiveProductions):
           // at depth 1 the word's next modules, deeper the rest of the same successor, which
@@ -250,7 +256,7 @@ class Rewriter {
           }
         }
         if (!chosen) {
-          if (has_rules && d > max_depth && g_.depth_warnings && has_rule_of_arity(m)) ++*left_expandable;
+          if (has_rules && d > limit && g_.depth_warnings && has_rule_of_arity(m)) ++*left_expandable;
           copy_module(stack_, t, out);
           pop(t);
           continue;
@@ -291,6 +297,14 @@ class Rewriter {
     budget_what_ = what;
   }
   void set_seed(uint64_t seed) { seed_ = seed; }
+  // A cpfg file's maximum depths by L-system (Grammar::SubLsystem), which a recursive
+  // application (apply_recursively) holds each module to; empty: its max_depth for all.
+  void set_depth_limits(std::vector<int> limits) { depth_limits_ = std::move(limits); }
+  // The pass of a recursive application with context that rewrite() performs (from 1).
+  void set_pass_depth(int d) { pass_depth_ = d; }
+  int deepest_limit(int max_depth) const {
+    return depth_limits_.empty() ? max_depth : *std::max_element(depth_limits_.begin(), depth_limits_.end());
+  }
 
   // Index of the module whose production failed, for messages.
   size_t current = 0;
@@ -336,6 +350,11 @@ class Rewriter {
     for (uint16_t k = 0; k < pm.arity; ++k) slots_[pm.first_slot + k] = p[k];
   }
 
+  // The jump tables of old context (compute_brackets) for one set of ignored modules.
+  struct ContextTables {
+    std::vector<uint32_t> skip_ignored, skip_right, branch_end, skip_left;
+  };
+
   // One pass over the word before a step: bracket partners and the jump tables that let
   // context matching pass over ignored modules, completed branches and the rest of a
   // branch in one step each (ABOP 1.8's walk, without rescanning what it skips). So the
@@ -358,48 +377,56 @@ class Rewriter {
     // the same passing over completed branches too (an unclosed '[' stops it); the
     // ']' that ends the branch j is in (n: the word's end; kNoMatch: an unclosed '['
     // lies in the way).
-    if (uses_right_context_) compute_right_tables(w);
-    if (uses_left_context_) compute_left_table(w);
+    // One set of jump tables per L-system when a sub-L-system passes over other modules
+    // (Grammar::SubLsystem): context is matched with the tables of the L-system whose
+    // production it is.
+    for (uint32_t k = 0; k < tables_.size(); ++k) {
+      const std::vector<uint8_t>& ignored = g_.ignored_in(k);
+      if (uses_right_context_) compute_right_tables(w, ignored, tables_[k]);
+      if (uses_left_context_) compute_left_table(w, ignored, tables_[k]);
+    }
   }
 
-  void compute_right_tables(const Word& w) {
+  void compute_right_tables(const Word& w, const std::vector<uint8_t>& ignored, ContextTables& t) {
     const size_t n = w.size();
-    skip_ignored_.assign(n + 1, static_cast<uint32_t>(n));
-    skip_right_.assign(n + 1, static_cast<uint32_t>(n));
-    branch_end_.assign(n + 1, static_cast<uint32_t>(n));
+    std::vector<uint32_t> &skip_ignored = t.skip_ignored, &skip_right = t.skip_right, &branch_end = t.branch_end;
+    skip_ignored.assign(n + 1, static_cast<uint32_t>(n));
+    skip_right.assign(n + 1, static_cast<uint32_t>(n));
+    branch_end.assign(n + 1, static_cast<uint32_t>(n));
     for (size_t j = n; j-- > 0;) {
       const SymbolId s = w.modules[j].symbol;
       const uint32_t after = static_cast<uint32_t>(j + 1);
-      skip_ignored_[j] = ignored(s) ? skip_ignored_[after] : static_cast<uint32_t>(j);
-      if (ignored(s)) {
-        skip_right_[j] = skip_right_[after];
-        branch_end_[j] = branch_end_[after];
+      skip_ignored[j] = ignored[s] ? skip_ignored[after] : static_cast<uint32_t>(j);
+      if (ignored[s]) {
+        skip_right[j] = skip_right[after];
+        branch_end[j] = branch_end[after];
       } else if (s == kSymPush && match_[j] != kNoMatch) {
-        skip_right_[j] = skip_right_[match_[j] + 1];
-        branch_end_[j] = branch_end_[match_[j] + 1];
+        skip_right[j] = skip_right[match_[j] + 1];
+        branch_end[j] = branch_end[match_[j] + 1];
       } else if (s == kSymPush) {
-        skip_right_[j] = static_cast<uint32_t>(j);
-        branch_end_[j] = kNoMatch;
+        skip_right[j] = static_cast<uint32_t>(j);
+        branch_end[j] = kNoMatch;
       } else if (s == kSymPop) {
-        skip_right_[j] = static_cast<uint32_t>(j);
-        branch_end_[j] = static_cast<uint32_t>(j);
+        skip_right[j] = static_cast<uint32_t>(j);
+        branch_end[j] = static_cast<uint32_t>(j);
       } else {
-        skip_right_[j] = static_cast<uint32_t>(j);
-        branch_end_[j] = branch_end_[after];
+        skip_right[j] = static_cast<uint32_t>(j);
+        branch_end[j] = branch_end[after];
       }
     }
   }
 
   // Going left: the last module at or before j that is not ignored, not a '[' (climbed
   // out of) and not a completed branch; an unmatched ']' stops it; kNoMatch past the start.
-  void compute_left_table(const Word& w) {
+  void compute_left_table(const Word& w, const std::vector<uint8_t>& ignored, ContextTables& t) {
     const size_t n = w.size();
-    skip_left_.assign(n, kNoMatch);
+    std::vector<uint32_t>& skip_left = t.skip_left;
+    skip_left.assign(n, kNoMatch);
     for (size_t j = 0; j < n; ++j) {
       const SymbolId s = w.modules[j].symbol;
-      if (s == kSymPush || ignored(s)) skip_left_[j] = j ? skip_left_[j - 1] : kNoMatch;
-      else if (s == kSymPop && match_[j] != kNoMatch) skip_left_[j] = match_[j] ? skip_left_[match_[j] - 1] : kNoMatch;
-      else skip_left_[j] = static_cast<uint32_t>(j);
+      if (s == kSymPush || ignored[s]) skip_left[j] = j ? skip_left[j - 1] : kNoMatch;
+      else if (s == kSymPop && match_[j] != kNoMatch) skip_left[j] = match_[j] ? skip_left[match_[j] - 1] : kNoMatch;
+      else skip_left[j] = static_cast<uint32_t>(j);
     }
   }
 
@@ -576,9 +603,12 @@ class Rewriter {
       if (next.symbol != pm.symbol || next.param_count != pm.arity) return false;
       bind(pm, tail_.word->params_of(next));
     }
+    // The tables and ring of the L-system whose production this is (sub-L-systems).
+    const ContextTables& t = tables_[per_lsystem_context_ ? lsystem_ : 0];
+    const bool ring = per_lsystem_context_ ? g_.ring_in(lsystem_) : g_.ring;
     if (!p.left_context.empty()) {
       const bool ok = p.new_left ? match_left(p.left_context, *out_, new_skip_left_, out_->size(), false)
-                                 : match_left(p.left_context, *in_, skip_left_, i, g_.ring);
+                                 : match_left(p.left_context, *in_, t.skip_left, i, ring);
       if (!ok) return false;
     }
     if (!p.right_context.empty()) {
@@ -589,8 +619,8 @@ class Rewriter {
                                       reversed_.size(), true, false},
                             0)
               : match_right(p.right_context,
-                            RightView{in_, &match_, &skip_ignored_, &skip_right_, &branch_end_, in_->size(), false,
-                                      g_.ring},
+                            RightView{in_, &match_, &t.skip_ignored, &t.skip_right, &t.branch_end, in_->size(), false,
+                                      ring},
                             i + 1 + p.predecessor_tail.size());
       if (!ok) return false;
     }
@@ -739,6 +769,8 @@ class Rewriter {
   SymbolId sub_call_ = 0;  // `?`, as in ?(label, s)
   uint32_t lsystem_ = 0;
   std::vector<uint32_t> lsystem_stack_;
+  std::vector<int> depth_limits_;  // set_depth_limits
+  int pass_depth_ = 0;
 
   // A word is read from its start in the main L-system.
   void enter_word() {
@@ -784,8 +816,8 @@ class Rewriter {
     std::snprintf(buf, sizeof buf, "%g", v);
     return buf;
   }
-  std::vector<uint32_t> skip_ignored_, skip_right_, branch_end_;
-  std::vector<uint32_t> skip_left_;
+  std::vector<ContextTables> tables_;  // one set, or one per L-system when per_lsystem_context_
+  bool per_lsystem_context_ = false;
   bool uses_left_context_ = false, uses_right_context_ = false;  // old context (the word before the pass)
   bool uses_new_left_ = false, uses_new_right_ = false;          // new context (grammar.h)
   // The new word's context tables (extend_left_tables, extend_right_tables) and a backward
@@ -894,6 +926,7 @@ int apply_recursively(Rewriter& rewriter, const std::vector<Production>& product
                       const std::vector<std::vector<uint32_t>>& by_symbol, Word& cur, Word& next, uint64_t stream_base,
                       int max_depth, uint64_t budget, const Progress& progress, bool count_left, uint64_t* left) {
   *left = 0;
+  max_depth = rewriter.deepest_limit(max_depth);  // sub-L-systems' own depths: the deepest bounds the passes
   const bool context =
       std::any_of(productions.begin(), productions.end(), [](const Production& p) { return p.has_context(); });
   if (!context) {
@@ -915,6 +948,7 @@ int apply_recursively(Rewriter& rewriter, const std::vector<Production>& product
     next_active.clear();
     rewriter.current_production = nullptr;
     rewriter.current_depth = depth;
+    rewriter.set_pass_depth(depth);
     // Passes until nothing expands: each reports within the pass only (how many passes
     // there will be is not known), monotone across passes by the share scheme 1 - 2^-depth.
     const double first = 1 - std::ldexp(1.0, -(depth - 1)), last = 1 - std::ldexp(1.0, -depth);
@@ -938,6 +972,13 @@ uint64_t recursion_budget(uint64_t max_modules) {
   return max_modules > UINT64_MAX / kInterpretBudgetFactor ? UINT64_MAX : max_modules * kInterpretBudgetFactor;
 }
 
+// A maximum depth by L-system: the main one's `main`, each sub-L-system's its own `field`.
+std::vector<int> depths_by_lsystem(const Grammar& g, int Grammar::SubLsystem::*field, int main) {
+  std::vector<int> depths{main};
+  for (const Grammar::SubLsystem& s : g.sub_lsystems) depths.push_back(s.*field);
+  return depths;
+}
+
 // The globals before the Start block: the arrays' initialisers, every other one 0.
 std::vector<double> initial_globals(const Grammar& g) {
   std::vector<double> v = g.global_initial;
@@ -956,7 +997,7 @@ struct Derivation::Impl {
         globals(initial_globals(grammar)),
         context{globals.data()} {
     if (grammar.uses_files) {
-      // fopen writes beside the model (docs/cpfg.md "Output files"); a model of no file
+      // fopen writes and reads beside the model (docs/cpfg.md "Files"); a model of no file
       // ("<string>") has no folder.
       if (!grammar.file.empty() && grammar.file.front() != '<') {
         const std::filesystem::path folder = std::filesystem::path(grammar.file).parent_path();
@@ -971,6 +1012,9 @@ struct Derivation::Impl {
     if (!grammar.decomposition.empty())
       decomposer.emplace(grammar, grammar.decomposition, grammar.decomposition_by_symbol, seed, o.max_modules,
                          &context);
+    if (decomposer && grammar.has_sub_lsystems())
+      decomposer->set_depth_limits(depths_by_lsystem(grammar, &Grammar::SubLsystem::decomposition_depth,
+                                                     grammar.decomposition_depth));
   }
 
   // The decomposition productions applied to `cur` (CPFG manual 4.4), each step's from
@@ -1013,7 +1057,7 @@ struct Derivation::Impl {
   // A cpfg file's global variables, 0 until a block or a production assigns them.
   std::vector<double> globals;
   EvalContext context;
-  OutputFiles files;                   // what fopen opened (context.files points here)
+  ModelFiles files;                    // what fopen opened (context.files points here)
   std::vector<Rewriter> passes;        // one per pass of a step (Grammar::passes)
   std::optional<Rewriter> decomposer;  // with decomposition productions only
   Rewriter* active = nullptr;          // the one whose production an error names
@@ -1193,6 +1237,7 @@ Expected<Word> interpret(const Grammar& g, const Word& word, const DeriveOptions
   std::vector<double> globals = word.globals.size() == g.global_names.size() ? word.globals : initial_globals(g);
   EvalContext eval_context{globals.data()};
   Rewriter rewriter(g, g.homomorphism, g.homomorphism_by_symbol, seed, options.max_modules, &eval_context);
+  if (g.has_sub_lsystems()) rewriter.set_depth_limits(depths_by_lsystem(g, &Grammar::SubLsystem::max_depth, g.max_depth));
   const uint64_t budget = recursion_budget(options.max_modules);
   rewriter.set_work_budget(budget);
   int depth = 0;  // passes performed, as stats report them

@@ -5,6 +5,7 @@
 #include "core/util/math.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <cstdio>
@@ -57,7 +58,62 @@ Conversion parse_conversion(std::string_view format, size_t i, std::string* erro
   return c;
 }
 
+// One conversion of an fscanf format: %[*][width][length]conversion (C's scanf).
+struct ScanConversion {
+  size_t end = 0;          // one past it
+  size_t width = 0;        // 0: none
+  bool suppressed = false; // %*f: read and not stored
+  char conversion = 0;     // '%' for "%%"
+};
+
+// The conversion starting at format[i] == '%'; conversion 0 with an error.
+ScanConversion parse_scan_conversion(std::string_view format, size_t i, std::string* error) {
+  ScanConversion c;
+  size_t k = i + 1;
+  if (k < format.size() && format[k] == '%') {
+    c.conversion = '%';
+    c.end = k + 1;
+    return c;
+  }
+  if (k < format.size() && format[k] == '*') c.suppressed = true, ++k;
+  while (k < format.size() && format[k] >= '0' && format[k] <= '9') {
+    c.width = c.width * 10 + static_cast<size_t>(format[k++] - '0');
+    if (c.width > 4096) {
+      *error = "a conversion's width is too long";
+      return c;
+    }
+  }
+  while (k < format.size() && std::strchr("lL", format[k])) ++k;  // float or double: a number either way
+  if (k >= format.size()) {
+    *error = "a '%' at the end of the format";
+    return c;
+  }
+  const char conv = format[k];
+  if (!std::strchr("eEfFgGaA", conv)) {
+    *error = std::string("fscanf's %") + conv +
+             ": every cpfg variable is a number (CPFG manual 5.4), read it with %f, %e or %g";
+    return c;
+  }
+  c.conversion = conv;
+  c.end = k + 1;
+  return c;
+}
+
+bool is_c_space(char ch) { return ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r' || ch == '\v' || ch == '\f'; }
+
 }  // namespace
+
+FormatCheck check_scan_format(std::string_view format) {
+  FormatCheck out;
+  for (size_t i = 0; i < format.size(); ++i) {
+    if (format[i] != '%') continue;
+    const ScanConversion c = parse_scan_conversion(format, i, &out.error);
+    if (!c.conversion) return out;
+    if (c.conversion != '%' && !c.suppressed) ++out.values;
+    i = c.end - 1;
+  }
+  return out;
+}
 
 PrintSink set_print_sink(PrintSink sink) {
   PrintSink old = print_sink_;
@@ -284,12 +340,28 @@ double Program::run(const Expr& e, double* slots, Rng* rng, EvalContext* context
         break;
       case Op::kPop: --sp; break;
       case Op::kDup: stack[sp] = stack[sp - 1]; ++sp; break;
-      case Op::kFileOpen: {
-        if (!context || !context->files) fail(locs[pc], "files are written by a derivation's statements only");
+      case Op::kFileOpen:
+      case Op::kFileRead: {
+        if (!context || !context->files) fail(locs[pc], "files are opened by a derivation's statements only");
         double id = 0;
-        const std::string error = context->files->open(formats[in.arg], &id);
+        const std::string error = context->files->open(formats[in.arg], in.op == Op::kFileRead, &id);
         if (!error.empty()) fail(locs[pc], "fopen: " + error);
         stack[sp++] = id;
+        break;
+      }
+      case Op::kFileScan: {
+        if (!context || !context->files) fail(locs[pc], "files are read by a derivation's statements only");
+        const Scan& scan = scans[in.arg];
+        sp -= in.pad;
+        std::vector<double> values(in.pad, 0.0);
+        int read = 0;
+        const std::string error = context->files->scan(stack[sp - 1], formats[scan.format], values, &read);
+        if (!error.empty()) fail(locs[pc], "fscanf: " + error);
+        for (int k = 0; k < read; ++k) {
+          const auto target = static_cast<uint32_t>(stack[sp + k]);
+          (scan.local[static_cast<size_t>(k)] ? slots : context->globals)[target] = values[static_cast<size_t>(k)];
+        }
+        stack[sp - 1] = read;
         break;
       }
       case Op::kFilePrint: {
@@ -447,48 +519,126 @@ double Program::run(const Expr& e, double* slots, Rng* rng, EvalContext* context
   return stack[sp - 1];
 }
 
-std::string OutputFiles::open(const std::string& name, double* id) {
+namespace {
+// A file's read or write error as one line of a statement's message: "'path': what failed".
+std::string failed_on(const std::string& path, const Diagnostic& d) { return "'" + path + "': " + d.message; }
+}  // namespace
+
+std::string ModelFiles::open(const std::string& name, bool reading, double* id) {
   namespace fs = std::filesystem;
-  if (folder.empty()) return "this model was read from no file: it has no folder to write '" + name + "' in";
+  if (folder.empty())
+    return "this model was read from no file: it has no folder to " + std::string(reading ? "read '" : "write '") + name +
+           "' in";
   const fs::path relative(name);
   if (name.empty() || relative.is_absolute() ||
       std::any_of(relative.begin(), relative.end(), [](const fs::path& part) { return part == ".."; }))
-    return "'" + name + "' is outside the model's folder: a model writes files beside itself only (docs/cpfg.md)";
+    return "'" + name + "' is outside the model's folder: a model " + (reading ? "reads" : "writes") +
+           " files beside itself only (docs/cpfg.md)";
   if (files.size() >= kMaxFiles) return "more than " + std::to_string(kMaxFiles) + " files opened";
-  files.push_back(File{(fs::path(folder) / relative).string(), "", true});
+  File f{(fs::path(folder) / relative).string(), "", true, reading, 0};
+  if (reading) {
+    const uint64_t left = kMaxInputBytes - std::min(bytes_read, kMaxInputBytes);
+    Expected<std::string> text = read_text_file(f.path, static_cast<size_t>(left));
+    if (!text.ok()) return failed_on(f.path, text.error());
+    f.text = std::move(*text);
+    bytes_read += f.text.size();
+  }
+  files.push_back(std::move(f));
   *id = static_cast<double>(files.size());
   return "";
 }
 
 namespace {
 // The file of id `id`, or null when no open file has it.
-OutputFiles::File* file_of(std::vector<OutputFiles::File>& files, double id) {
+ModelFiles::File* file_of(std::vector<ModelFiles::File>& files, double id) {
   if (!(id >= 1) || id != std::floor(id) || id > static_cast<double>(files.size())) return nullptr;
-  OutputFiles::File& f = files[static_cast<size_t>(id) - 1];
+  ModelFiles::File& f = files[static_cast<size_t>(id) - 1];
   return f.open ? &f : nullptr;
 }
+const char* const kNoOpenFile = " is no open file (an id fopen returned, before its fclose)";
 }  // namespace
 
-std::string OutputFiles::append(double id, const std::string& text) {
+std::string ModelFiles::scan(double id, std::string_view format, std::vector<double>& values, int* read) {
   File* f = file_of(files, id);
-  if (!f) return index_text(id) + " is no open file (an id fopen returned, before its fclose)";
+  if (!f) return index_text(id) + kNoOpenFile;
+  if (!f->reading) return "the file " + index_text(id) + " was opened for writing (\"w\"): fscanf reads one opened with \"r\"";
+  const std::string& t = f->text;
+  size_t& pos = f->pos;
+  int stored = 0, converted = 0;
+  std::string error;
+  auto skip_space = [&] {
+    while (pos < t.size() && is_c_space(t[pos])) ++pos;
+  };
+  // C's result: the values stored, or EOF when the input ended before the first conversion.
+  auto input_failure = [&] { *read = converted ? stored : -1; };
+  *read = 0;
+  for (size_t i = 0; i < format.size(); ++i) {
+    const char ch = format[i];
+    if (is_c_space(ch)) {
+      skip_space();
+      continue;
+    }
+    if (ch != '%') {
+      if (pos >= t.size()) return input_failure(), "";
+      if (t[pos] != ch) return *read = stored, "";  // a matching failure
+      ++pos;
+      continue;
+    }
+    const ScanConversion c = parse_scan_conversion(format, i, &error);
+    if (!c.conversion) return error;  // check_scan_format refused it when it was compiled
+    i = c.end - 1;
+    skip_space();
+    if (pos >= t.size()) return input_failure(), "";
+    if (c.conversion == '%') {
+      if (t[pos] != '%') return *read = stored, "";
+      ++pos;
+      continue;
+    }
+    // The number, as strtod reads one, at most `width` characters; C's '+' sign too.
+    const size_t limit = c.width ? std::min(t.size(), pos + c.width) : t.size();
+    size_t at = pos;
+    if (at < limit && t[at] == '+') ++at;
+    double v = 0;
+    const auto [end, ec] = std::from_chars(t.data() + at, t.data() + limit, v);
+    if (ec == std::errc::invalid_argument || (at > pos && at < limit && t[at] == '-')) return *read = stored, "";
+    if (ec == std::errc::result_out_of_range || !std::isfinite(v))
+      return "fscanf read a number that is not finite in '" + f->path + "' at byte " + std::to_string(pos);
+    pos = static_cast<size_t>(end - t.data());
+    ++converted;
+    if (!c.suppressed) {
+      if (static_cast<size_t>(stored) >= values.size()) return "fscanf's format reads more values than it was given targets";
+      values[static_cast<size_t>(stored++)] = v;
+    }
+  }
+  *read = stored;
+  return "";
+}
+
+std::string ModelFiles::append(double id, const std::string& text) {
+  File* f = file_of(files, id);
+  if (!f) return index_text(id) + kNoOpenFile;
+  if (f->reading) return "the file " + index_text(id) + " was opened for reading (\"r\"): fprintf writes one opened with \"w\"";
   if ((bytes += text.size()) > kMaxOutputBytes)
     return "the model wrote more than " + std::to_string(kMaxOutputBytes >> 20) + " MiB to its files";
   f->text += text;
   return "";
 }
 
-std::string OutputFiles::write(double id, bool close) {
+std::string ModelFiles::write(double id, bool close) {
   File* f = file_of(files, id);
-  if (!f) return index_text(id) + " is no open file (an id fopen returned, before its fclose)";
-  if (Status s = write_file_atomically(f->path, f->text); !s) return s.error().format();
-  if (close) f->open = false;
+  if (!f) return index_text(id) + kNoOpenFile;
+  if (!f->reading)
+    if (Status s = write_file_atomically(f->path, f->text); !s) return failed_on(f->path, s.error());
+  if (close) {
+    f->open = false;
+    if (f->reading) std::string().swap(f->text);
+  }
   return "";
 }
 
-std::string OutputFiles::close_all() {
+std::string ModelFiles::close_all() {
   for (size_t k = 0; k < files.size(); ++k)
-    if (files[k].open)
+    if (files[k].open && !files[k].reading)
       if (std::string e = write(static_cast<double>(k + 1), true); !e.empty()) return e;
   return "";
 }

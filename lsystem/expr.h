@@ -45,6 +45,10 @@ enum class Op : uint8_t {
   kRem,         // cpfg's %: pop b, pop a; push (int)a % (int)b, C's remainder
   kFileOpen,    // cpfg's fopen(formats[arg], "w"): push the new output file's id (EvalContext::files)
   kFilePrint,   // cpfg's fprintf: pop `pad` values and a file id, append formats[arg] with them; push 0
+  kFileRead,    // cpfg's fopen(formats[arg], "r"): push the id of the file, read whole (EvalContext::files)
+  // cpfg's fscanf: pop `pad` targets (Program::scans[arg]) and a file id, read the values into
+  // the targets; push how many were read, or -1 at the file's end
+  kFileScan,
 };
 
 enum class Func : uint8_t {
@@ -93,26 +97,34 @@ inline constexpr uint64_t kMaxLoopIterations = 10000000;
 // What statements read and write besides their own slots: the L-system's global variables,
 // and the seed a srand() asked for (the derivation's, when a Start/StartEach/EndEach block
 // calls it).
-// The files a cpfg model writes with fopen(name, "w") and fprintf (CPFG manual 5.4; docs/cpfg.md
-// "Output files"): only in the model's folder, each kept in memory and written whole and
-// atomically (write_file_atomically, never onto an input) at its fflush, its fclose and, for
-// one left open, at the derivation's end. At most kMaxOutputBytes in all.
-struct OutputFiles {
+// The files a cpfg model opens with fopen (CPFG manual 5.4; docs/cpfg.md "Files"): only in
+// the model's folder. One opened with "w" is kept in memory and written whole and atomically
+// (write_file_atomically, never onto an input) at its fflush, its fclose and, for one left
+// open, at the derivation's end: at most kMaxOutputBytes in all. One opened with "r" is read
+// whole when it opens (at most kMaxInputBytes in all) and fscanf reads on from where it left.
+struct ModelFiles {
   static constexpr uint64_t kMaxOutputBytes = uint64_t{64} << 20;
+  static constexpr uint64_t kMaxInputBytes = uint64_t{64} << 20;
   static constexpr size_t kMaxFiles = 256;
   std::string folder;  // the model's folder; empty: the model came from no file, fopen is an error
   struct File {
     std::string path;
-    std::string text;
+    std::string text;  // written so far, or the whole file read
     bool open = true;
+    bool reading = false;
+    size_t pos = 0;    // reading: where the next fscanf starts
   };
   std::vector<File> files;  // by id − 1
-  uint64_t bytes = 0;
+  uint64_t bytes = 0, bytes_read = 0;
   // Each returns an error message, empty on success.
-  std::string open(const std::string& name, double* id);
+  std::string open(const std::string& name, bool reading, double* id);
   std::string append(double id, const std::string& text);
   std::string write(double id, bool close);
-  std::string close_all();  // writes every file still open
+  // fscanf: the numbers `format` (check_scan_format said it reads `values.size()`) reads from the
+  // file into `values`; *read is C's result: how many were read, or -1 when the file ended
+  // before the first conversion.
+  std::string scan(double id, std::string_view format, std::vector<double>& values, int* read);
+  std::string close_all();  // writes every file still open for writing
 };
 
 struct EvalContext {
@@ -120,7 +132,7 @@ struct EvalContext {
   bool reseeded = false;
   uint64_t reseed = 0;
   bool stop = false;  // a stop() was evaluated: the derivation ends after the current step
-  OutputFiles* files = nullptr;  // a derivation's (fopen); null where statements write no files
+  ModelFiles* files = nullptr;  // a derivation's (fopen); null where statements open no files
 };
 
 // The evaluation stack's size in values: Program::run's fixed stack, and the depth the
@@ -143,6 +155,13 @@ struct Program {
   std::vector<SplineFunction> functions;  // func(id, x)'s, id − 1 (a vlab object's view file)
   std::vector<CpfgCurve> curves;          // curveX(id, t)'s and curveGAL(id)'s, id − 1 (its `curve:` lines)
   std::vector<std::string> formats;       // printf's format strings (checked when compiled)
+  // An fscanf's: its format (formats[format]) and where each value goes, in order: a local
+  // slot, or a global (an array's element is one), whose index the code pushes.
+  struct Scan {
+    uint32_t format = 0;
+    std::vector<uint8_t> local;  // by target: 1 a slot, 0 a global
+  };
+  std::vector<Scan> scans;
 
   // Evaluates `e` with formal parameters `slots` and random stream `rng` (only touched
   // by rand/uniform/gauss). Throws EvalError on division by zero or a non-finite result.
@@ -173,6 +192,10 @@ struct FormatCheck {
   std::string error;  // empty when the format is good
 };
 FormatCheck check_format(std::string_view format);
+// An fscanf format's conversions (%f %e %g %E %G %F %a %A with width, `l` and `*`, and %%;
+// white space and other characters match as in C's scanf): how many values it reads, or an
+// error message for one sylva cannot read (every cpfg variable is a number: no %d, %s, %[).
+FormatCheck check_scan_format(std::string_view format);
 // The format with `values` put in (check_format said it takes that many).
 std::string apply_format(std::string_view format, const double* values);
 

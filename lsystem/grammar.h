@@ -251,6 +251,31 @@ struct Grammar {
   // (`Lsystem: plant`), which nothing can call. Empty for sylva's own format.
   std::vector<int64_t> lsystem_labels;
   bool has_sub_lsystems() const { return lsystem_labels.size() > 1; }
+  // What each sub-L-system has of its own (CPFG manual 7.2; cpfg keeps them per LSYSDATA): the
+  // modules its context passes over (`ignore:`/`consider:`; none unless it says), whether it
+  // is a ring, its homomorphism's and its decomposition's maximum depth (1 unless it says).
+  // Index k - 1 for the L-system k of lsystem_labels; the main one's are the fields above.
+  struct SubLsystem {
+    std::vector<uint8_t> ignored;
+    bool ring = false;
+    int max_depth = 1;
+    int decomposition_depth = 1;
+  };
+  std::vector<SubLsystem> sub_lsystems;
+  // The L-system k's own (k = 0: the main one's fields).
+  const std::vector<uint8_t>& ignored_in(uint32_t k) const { return k ? sub_lsystems[k - 1].ignored : ignored; }
+  bool ring_in(uint32_t k) const { return k ? sub_lsystems[k - 1].ring : ring; }
+  // The tables by symbol id sized for `nsym` symbols (the ignore lists: new symbols are not ignored).
+  void resize_symbol_tables(size_t nsym) {
+    ignored.resize(nsym, 0);
+    for (SubLsystem& s : sub_lsystems) s.ignored.resize(nsym, 0);
+  }
+  // Whether some sub-L-system passes over other modules than the main one, or is a ring.
+  bool sub_contexts_differ() const {
+    for (const SubLsystem& s : sub_lsystems)
+      if (s.ignored != ignored || s.ring != ring) return true;
+    return false;
+  }
 
   // The physical source line at `loc` (in its file) without its newline, for messages.
   std::string_view source_line(SourceLoc loc) const;

@@ -11,6 +11,7 @@
 #include <array>
 #include <functional>
 #include <numeric>
+#include <optional>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -291,15 +292,22 @@ class Parser {
   bool seen_end_ = false;      // cpfg: the 'endlsystem' line was read (of the L-system being read)
   uint32_t lsystem_ = 0;       // cpfg: the L-system being read (Grammar::lsystem_labels), 0 the main one
   std::vector<std::array<bool, 4>> sub_block_seen_;  // by L-system: which of its four blocks were read
-  bool consider_ = false;      // cpfg: a 'consider:' list names the modules context sees
-  std::vector<uint8_t> considered_;  // by symbol id
+  bool sub_axiom_ = false;     // cpfg: the sub-L-system being read has its axiom
+  // cpfg, by L-system: the modules a 'consider:' list names (by symbol id), when it has one:
+  // its context passes over every other.
+  std::vector<std::optional<std::vector<uint8_t>>> considered_{1};
+  // The modules the L-system being read passes over in context (Grammar::ignored_in).
+  std::vector<uint8_t>& ignored_here() { return lsystem_ ? g_.sub_lsystems[lsystem_ - 1].ignored : g_.ignored; }
   std::unordered_map<std::string, uint32_t> global_index_;  // cpfg: global variables by name
   std::unordered_map<std::string, uint32_t> array_index_;   // cpfg: arrays by name (Program::arrays)
   void define_arrays(Cursor value);
   void parse_printf(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc loc, bool to_file = false);
   void parse_fopen(Cursor& c, ExprBuild& b, SourceLoc loc);
+  void parse_fscan(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc loc);
+  void parse_file_argument(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc loc, const char* what);
   std::string string_literal(Cursor& c, const std::string& missing);
-  void parse_array_element(Cursor& c, ExprBuild& b, const Scope* scope, uint32_t array, SourceLoc loc);
+  // An element of array `name` ("a[i][j]" or "a[i, j]" at c): its global index pushed.
+  void parse_array_element(Cursor& c, ExprBuild& b, const Scope* scope, const std::string& name, SourceLoc loc);
   bool globals_visible_ = false;  // compiling a production or a block: globals may be read
 };
 
@@ -407,9 +415,9 @@ std::string Parser::string_literal(Cursor& c, const std::string& missing) {
   return format;
 }
 
-// cpfg's fopen("name", "w") (CPFG manual 5.4): the file's id, a file in the model's folder
-// written when fflush, fclose or the derivation's end comes (OutputFiles). Reading ("r",
-// and fscan) is not supported yet. It opens when evaluated, never folded.
+// cpfg's fopen("name", "w" or "r") (CPFG manual 5.4): the file's id, a file in the model's
+// folder written when fflush, fclose or the derivation's end comes, or read whole as it opens
+// (ModelFiles). It opens when evaluated, never folded.
 void Parser::parse_fopen(Cursor& c, ExprBuild& b, SourceLoc loc) {
   ++c.pos;  // '('
   std::string name = string_literal(c, "fopen needs the file's name in quotes: fopen(\"out.txt\", \"w\")");
@@ -418,33 +426,103 @@ void Parser::parse_fopen(Cursor& c, ExprBuild& b, SourceLoc loc) {
   ++c.pos;
   c.skip_spaces();
   const SourceLoc mode_loc = c.loc();
-  const std::string mode = string_literal(c, "fopen needs its mode in quotes: \"w\"");
-  if (mode == "r")
-    fail(mode_loc, "reading files (fopen \"r\", fscan) is not supported yet (docs/cpfg.md)");
-  if (mode != "w") fail(mode_loc, "fopen's mode is \"w\" (writing; \"r\", reading, is not supported yet)");
+  const std::string mode = string_literal(c, "fopen needs its mode in quotes: \"w\" or \"r\"");
+  if (mode != "w" && mode != "r") fail(mode_loc, "fopen's mode is \"w\" (writing) or \"r\" (reading)");
   c.skip_spaces();
   if (c.peek() != ')') fail(c.loc(), "expected ')' after fopen's mode");
   ++c.pos;
   b.uses_slot = true;  // a side effect: evaluated every time, never folded
   g_.program.formats.push_back(std::move(name));
-  g_.program.code.push_back(Instr{Op::kFileOpen, Func{}, 0, static_cast<uint32_t>(g_.program.formats.size() - 1)});
+  g_.program.code.push_back(Instr{mode == "r" ? Op::kFileRead : Op::kFileOpen, Func{}, 0,
+                                  static_cast<uint32_t>(g_.program.formats.size() - 1)});
   g_.program.locs.push_back(loc);
   b.depth += 1;
   b.max_depth = std::max(b.max_depth, b.depth);
 }
 
+// cpfg's fscanf(file, "format", &a, &b[i], ...) (CPFG manual 5.4, which calls it fscan): reads
+// numbers from a file fopen opened with "r" into variables — a production's parameter or a
+// local it assigned before, a global, an array's element. Its value is C's: how many were
+// read, or -1 at the file's end.
+void Parser::parse_fscan(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc loc) {
+  ++c.pos;  // '('
+  parse_file_argument(c, b, scope, loc, "fscanf");
+  c.skip_spaces();
+  const SourceLoc format_loc = c.loc();
+  std::string format = string_literal(c, "fscanf needs a format string after its file: fscanf(f, \"%f\", &x)");
+  const FormatCheck check = check_scan_format(format);
+  if (!check.error.empty()) fail(format_loc, check.error);
+  Program::Scan scan;
+  for (;;) {
+    c.skip_spaces();
+    if (c.peek() == ')') {
+      ++c.pos;
+      break;
+    }
+    if (c.peek() != ',') fail(c.loc(), "expected ',' or ')' in fscanf's arguments");
+    ++c.pos;
+    c.skip_spaces();
+    const SourceLoc target_loc = c.loc();
+    if (c.peek() != '&') fail(target_loc, "fscanf reads into variables: write '&' and the variable (&x, &a[i])");
+    ++c.pos;
+    c.skip_spaces();
+    const SourceLoc name_loc = c.loc();
+    if (!is_ident_start(c.peek())) fail(name_loc, "expected a variable's name after '&'");
+    const size_t start = c.pos;
+    while (is_ident_char(c.peek())) ++c.pos;
+    const std::string name = c.line->text.substr(start, c.pos - start);
+    c.skip_spaces();
+    if (c.peek() == '[') {
+      if (++b.nesting > kMaxNesting) fail(loc, "expression nested too deeply");
+      parse_array_element(c, b, scope, name, name_loc);  // pushes the element's global index
+      --b.nesting;
+      scan.local.push_back(0);
+      continue;
+    }
+    uint32_t index = 0;
+    if (scope && scope->count(name)) {
+      index = scope->at(name);
+      scan.local.push_back(1);
+    } else if (global_index_.count(name)) {
+      index = global_index_.at(name);
+      scan.local.push_back(0);
+    } else {
+      fail(name_loc, "fscanf reads into a variable: '" + name + "' is no parameter, local assigned before, or global" +
+                         (scope ? " (assign it first: " + name + " = 0;)" : ""));
+    }
+    g_.program.consts.push_back(static_cast<double>(index));
+    emit(b, Op::kConst, static_cast<uint32_t>(g_.program.consts.size() - 1), name_loc, +1);
+  }
+  const int values = static_cast<int>(scan.local.size());
+  if (values != check.values)
+    fail(loc, "fscanf's format reads " + std::to_string(check.values) + (check.values == 1 ? " value" : " values") +
+                  ", it was given " + std::to_string(values) + (values == 1 ? " variable" : " variables"));
+  b.uses_slot = true;  // a side effect: evaluated every time, never folded
+  g_.program.formats.push_back(std::move(format));
+  scan.format = static_cast<uint32_t>(g_.program.formats.size() - 1);
+  g_.program.scans.push_back(std::move(scan));
+  g_.program.code.push_back(Instr{Op::kFileScan, Func{}, static_cast<uint16_t>(values),
+                                  static_cast<uint32_t>(g_.program.scans.size() - 1)});
+  g_.program.locs.push_back(loc);
+  g_.uses_files = true;
+  b.depth += -values;
+  b.max_depth = std::max(b.max_depth, b.depth);
+}
+
+// The file's id, fprintf's or fscanf's (`what`) first argument, and the ',' after it.
+void Parser::parse_file_argument(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc loc, const char* what) {
+  if (++b.nesting > kMaxNesting) fail(loc, "expression nested too deeply");
+  parse_or(c, b, scope);
+  --b.nesting;
+  c.skip_spaces();
+  if (c.peek() != ',') fail(c.loc(), std::string("expected ',' and the format after ") + what + "'s file");
+  ++c.pos;
+}
+
 void Parser::parse_printf(Cursor& c, ExprBuild& b, const Scope* scope, SourceLoc loc, bool to_file) {
   ++c.pos;  // '('
   const char* what = to_file ? "fprintf" : "printf";
-  if (to_file) {
-    // fprintf(file, "format", values...): the file's id first.
-    if (++b.nesting > kMaxNesting) fail(loc, "expression nested too deeply");
-    parse_or(c, b, scope);
-    --b.nesting;
-    c.skip_spaces();
-    if (c.peek() != ',') fail(c.loc(), "expected ',' and the format after fprintf's file");
-    ++c.pos;
-  }
+  if (to_file) parse_file_argument(c, b, scope, loc, what);  // fprintf(file, "format", values...)
   c.skip_spaces();
   const SourceLoc format_loc = c.loc();
   std::string format = string_literal(c, to_file ? "fprintf needs a format string after its file: fprintf(f, \"x = %g\\n\", x)"
@@ -654,8 +732,7 @@ void Parser::parse_primary(Cursor& c, ExprBuild& b, const Scope* scope) {
       g_.uses_files = true;
       return parse_fopen(c, b, loc);
     }
-    if (c.peek() == '(' && (name == "fscan" || name == "fscanf") && g_.cpfg)
-      fail(loc, "reading files (fopen \"r\", fscan) is not supported yet (docs/cpfg.md)");
+    if (c.peek() == '(' && (name == "fscan" || name == "fscanf") && g_.cpfg) return parse_fscan(c, b, scope, loc);
     if (c.peek() == '(') {
       Func fn;
       if (!find_func(name, &fn)) fail(loc, "unknown function '" + name + "'");
@@ -693,9 +770,7 @@ void Parser::parse_primary(Cursor& c, ExprBuild& b, const Scope* scope) {
       return;
     }
     if (c.peek() == '[' && globals_visible_) {
-      auto a = array_index_.find(name);
-      if (a == array_index_.end()) fail(loc, "'" + name + "' is not an array (CPFG manual 2.2.2: 'define: { array " + name + "[n]; }')");
-      parse_array_element(c, b, scope, a->second, loc);
+      parse_array_element(c, b, scope, name, loc);
       b.uses_slot = true;  // not a constant: read when evaluated
       emit(b, Op::kLoadAt, 0, loc, 0);
       return;
@@ -1004,7 +1079,8 @@ void Parser::declare_modules(Cursor c) {
 
 void Parser::set_ignore(Cursor c) {
   std::vector<ParsedModule> ms = parse_modules(c, "the ignore list");
-  if (consider_) fail(c.loc(), "'consider:' and 'ignore:' cannot both be given");
+  if (considered_[lsystem_]) fail(c.loc(), "'consider:' and 'ignore:' cannot both be given");
+  std::vector<uint8_t>& ignored = ignored_here();
   for (const ParsedModule& m : ms) {
     if (!m.args.empty()) fail(m.loc, "the ignore list takes module names without parameters");
     // cpfg's reader takes them and its context matching walks branches all the same: a
@@ -1012,8 +1088,8 @@ void Parser::set_ignore(Cursor c) {
     if ((m.symbol == kSymPush || m.symbol == kSymPop) && g_.cpfg) continue;
     if (m.symbol == kSymPush || m.symbol == kSymPop)
       fail(m.loc, "brackets cannot be ignored: they delimit branches");
-    if (g_.ignored.size() <= m.symbol) g_.ignored.resize(m.symbol + 1u, 0);
-    g_.ignored[m.symbol] = 1;
+    if (ignored.size() <= m.symbol) ignored.resize(m.symbol + 1u, 0);
+    ignored[m.symbol] = 1;
   }
 }
 
@@ -1041,8 +1117,6 @@ bool Parser::try_directive(const LogicalLine& line) {
     } else if (lsystem_ > 0 && (d == "derivation length" || d == "steps" || d == "seed")) {
       // A sub-L-system's own derivation length: the main L-system's counts (CPFG manual 7.2).
       constant_expression(value, d.c_str());
-    } else if (lsystem_ > 0 && d == "ignore") {
-      fail(loc, "'ignore:' in a sub-L-system is not supported yet (docs/cpfg.md)");
     } else if (d == "ignore") {
       set_ignore(value);
     } else if (d == "angle") {
@@ -1116,14 +1190,16 @@ bool Parser::try_directive(const LogicalLine& line) {
       double n = constant_expression(value, "maximum depth");
       if (n < 0 || n != std::floor(n) || n > kMaxDepthLimit)
         fail(value.loc(), "maximum depth must be an integer from 0 to 100000");
-      int& depth = section_ == Section::kDecomposition ? g_.decomposition_depth : g_.max_depth;
-      if (lsystem_ > 0 && static_cast<int>(n) != depth)
-        fail(value.loc(), "a sub-L-system's maximum depth must be the main L-system's (" + std::to_string(depth) +
-                              "): sylva applies one (docs/cpfg.md)");
+      // Each L-system has its own (CPFG manual 7.2; Grammar::SubLsystem).
+      Grammar::SubLsystem* sub = lsystem_ ? &g_.sub_lsystems[lsystem_ - 1] : nullptr;
+      int& depth = section_ == Section::kDecomposition ? (sub ? sub->decomposition_depth : g_.decomposition_depth)
+                                                        : (sub ? sub->max_depth : g_.max_depth);
       depth = static_cast<int>(n);
     } else if (lsystem_ > 0) {
       // A sub-L-system's axiom is read and not used: it runs when ?(label, s) calls it
       // (CPFG manual 7.2: "the axiom is ignored when it is called as a sub-L-system").
+      if (sub_axiom_) fail(loc, "the axiom is given twice");
+      sub_axiom_ = true;
       const bool visible = globals_visible_;
       globals_visible_ = true;
       compile_successor(value, Scope{}, "the axiom");
@@ -1360,9 +1436,6 @@ bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest) {
     if (value) *value = c.sub(c.pos + k, line.text.size());
     return true;
   };
-  auto unsupported = [&](const std::string& what) {
-    fail(c.loc(), what + " is not supported yet (docs/cpfg.md)");
-  };
   Cursor value = c;
   if (keyword("lsystem", false, &value)) {
     // "Lsystem: label" (CPFG manual 2, 7.2): the label, a whole number (0 without one), names
@@ -1382,17 +1455,16 @@ bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest) {
         fail(value.loc(), "a second L-system with the label " + std::to_string(label));
       lsystem_ = static_cast<uint32_t>(g_.lsystem_labels.size());
       seen_end_ = false;
+      sub_axiom_ = false;
       section_ = Section::kProductions;
+      g_.sub_lsystems.emplace_back();
+      considered_.emplace_back();
     }
     g_.lsystem_labels.push_back(label);
     seen_lsystem_ = true;
     return true;
   }
   if (seen_end_) fail(c.loc(), "expected a sub-L-system's 'Lsystem:' line or nothing after 'endlsystem'");
-  // What a sub-L-system may not hold (sylva keeps one of each for the whole file).
-  auto main_only = [&](const std::string& what) {
-    if (lsystem_ > 0) unsupported(what + " in a sub-L-system");
-  };
   if (folded == "endlsystem") {
     seen_end_ = true;
     return true;
@@ -1429,13 +1501,12 @@ bool Parser::cpfg_line(const LogicalLine& line, std::string_view rest) {
     for (char ch : folded)
       if (!is_space(ch)) words += ch;
     if (words != "ringlsystem" && words != "ringlsystem:") fail(c.loc(), "expected 'ring lsystem' (CPFG manual 3.1.1)");
-    main_only("'ring lsystem'");
-    if (have_axiom_) fail(c.loc(), "'ring lsystem' must come before the axiom (CPFG manual 3.1.1)");
-    g_.ring = true;
+    if (lsystem_ ? sub_axiom_ : have_axiom_)
+      fail(c.loc(), "'ring lsystem' must come before the axiom (CPFG manual 3.1.1)");
+    (lsystem_ ? g_.sub_lsystems[lsystem_ - 1].ring : g_.ring) = true;
     return true;
   }
   if (keyword("consider", false, &value)) {
-    main_only("'consider:'");
     set_consider(value);
     return true;
   }
@@ -1497,14 +1568,15 @@ bool Parser::pass_line(const Cursor& c, std::string_view rest) {
 
 void Parser::set_consider(Cursor c) {
   std::vector<ParsedModule> ms = parse_modules(c, "the consider list");
-  if (consider_) fail(c.loc(), "'consider:' is given twice");
-  for (uint8_t ignored : g_.ignored)
+  std::optional<std::vector<uint8_t>>& considered = considered_[lsystem_];
+  if (considered) fail(c.loc(), "'consider:' is given twice");
+  for (uint8_t ignored : ignored_here())
     if (ignored) fail(c.loc(), "'consider:' and 'ignore:' cannot both be given");
-  consider_ = true;
+  considered.emplace();
   for (const ParsedModule& m : ms) {
     if (!m.args.empty()) fail(m.loc, "the consider list takes module names without parameters");
-    if (considered_.size() <= m.symbol) considered_.resize(m.symbol + 1u, 0);
-    considered_[m.symbol] = 1;
+    if (considered->size() <= m.symbol) considered->resize(m.symbol + 1u, 0);
+    (*considered)[m.symbol] = 1;
   }
 }
 
@@ -1636,9 +1708,7 @@ void Parser::parse_statement(Cursor& c, ExprBuild& b, Scope* scope) {
     probe.skip_spaces();
     if (probe.peek() == '[') {
       // "a[i] = expr;" (or += -= *= /=): the element's index, then the value, stored.
-      auto a = array_index_.find(name);
-      if (a == array_index_.end()) fail(loc, "'" + name + "' is not an array (CPFG manual 2.2.2: 'define: { array " + name + "[n]; }')");
-      parse_array_element(probe, b, scope, a->second, loc);
+      parse_array_element(probe, b, scope, name, loc);
       probe.skip_spaces();
       const char op = compound_assignment(probe);
       if (probe.peek() != '=' || probe.peek(1) == '=')
@@ -1793,7 +1863,11 @@ void Parser::define_arrays(Cursor c) {
 
 // `[i, j]` or `[i][j]` after array `array`'s name: its indices, one per dimension, then
 // kArrayIndex (the element's global index on the stack).
-void Parser::parse_array_element(Cursor& c, ExprBuild& b, const Scope* scope, uint32_t array, SourceLoc loc) {
+void Parser::parse_array_element(Cursor& c, ExprBuild& b, const Scope* scope, const std::string& name, SourceLoc loc) {
+  auto found = array_index_.find(name);
+  if (found == array_index_.end())
+    fail(loc, "'" + name + "' is not an array (CPFG manual 2.2.2: 'define: { array " + name + "[n]; }')");
+  const uint32_t array = found->second;
   const ArrayInfo& a = g_.program.arrays[array];
   const size_t rank = a.dims.size();
   size_t given = 0;
@@ -1853,10 +1927,15 @@ void Parser::collect_globals(const std::vector<LogicalLine>& lines) {
       if (!is_ident_start(t[i]) || (i > 0 && (is_ident_char(t[i - 1]) || t[i - 1] == '.'))) continue;
       size_t e = i;
       while (e < t.size() && is_ident_char(t[e])) ++e;
+      // fscanf's target "&name" assigns it too (not "a && b").
+      size_t amp = i;
+      while (amp > 0 && is_space(t[amp - 1])) --amp;
+      const bool address = amp > 0 && t[amp - 1] == '&' && (amp < 2 || t[amp - 2] != '&');
       size_t p = e;
       while (p < t.size() && is_space(t[p])) ++p;
       if (p < t.size() && (t[p] == '+' || t[p] == '-' || t[p] == '*' || t[p] == '/') && p + 1 < t.size() && t[p + 1] == '=') ++p;
-      if (p < t.size() && t[p] == '=' && (p + 1 >= t.size() || t[p + 1] != '=')) {
+      const bool indexed = p < t.size() && t[p] == '[';  // &a[i]: an array's element, no new global
+      if ((address && !indexed) || (p < t.size() && t[p] == '=' && (p + 1 >= t.size() || t[p + 1] != '='))) {
         const std::string name = t.substr(i, e - i);
         if (!define_values_.count(name) && !global_index_.count(name)) {
           global_index_.emplace(name, static_cast<uint32_t>(g_.global_names.size()));
@@ -2069,10 +2148,14 @@ void Parser::parse(const std::string& text) {
 
   // Index productions by predecessor symbol; size per-symbol tables.
   const size_t nsym = g_.symbols.size();
-  g_.ignored.resize(nsym, 0);
-  if (consider_) {  // every module that 'consider:' does not name is ignored; brackets never are
-    considered_.resize(nsym, 0);
-    for (size_t k = 0; k < nsym; ++k) g_.ignored[k] = k != kSymPush && k != kSymPop && !considered_[k];
+  g_.resize_symbol_tables(nsym);
+  for (uint32_t l = 0; l < considered_.size(); ++l) {
+    std::optional<std::vector<uint8_t>>& considered = considered_[l];
+    if (!considered) continue;
+    // Every module that 'consider:' does not name is ignored; brackets never are.
+    considered->resize(nsym, 0);
+    std::vector<uint8_t>& ignored = l ? g_.sub_lsystems[l - 1].ignored : g_.ignored;
+    for (size_t k = 0; k < nsym; ++k) ignored[k] = k != kSymPush && k != kSymPop && !(*considered)[k];
   }
   if (explicit_pass_ && !pass_has_productions_)
     fail(g_.passes.back().loc, "this pass has no productions");
@@ -2187,7 +2270,7 @@ Expected<Word> parse_word(std::string_view text, Grammar& grammar) {
     Parser parser(grammar, none);
     Word w = parser.parse_word_line(line);
     const size_t nsym = grammar.symbols.size();  // the word may name new modules
-    grammar.ignored.resize(nsym, 0);
+    grammar.resize_symbol_tables(nsym);
     for (Grammar::Pass& pass : grammar.passes) pass.by_symbol.resize(nsym);
     grammar.homomorphism_by_symbol.resize(nsym);
     grammar.decomposition_by_symbol.resize(nsym);

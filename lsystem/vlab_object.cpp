@@ -458,18 +458,30 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
         return fail_here(values[0].column + value_column - 1,
                          "the sides around a contour are a whole number up to " + std::to_string(lsys::kMaxContourSides));
       t.contour_sides = std::max(3, static_cast<int>(sides));
-    } else if (name == "tsurface") {
-      // Triangulated surfaces (cpfg's tsurfaces.c) would change the plant: said, not skipped.
-      return fail_here(1, "'tsurface:' (a surface of triangles for ~) is not supported yet (docs/cpfg.md)");
-    } else if (name == "surface") {
+    } else if (name == "surface" || name == "tsurface") {
       // "surface: id file size [s t [texture]]" (CPFG manual 8.1.5): the id is one character,
       // a size not above 0 is 1 (as cpfg's reader), s and t the cells a patch is cut into.
-      if (values.size() < 3) return fail_here(value_column, "a surface needs 'surface: id file.s size [s t]'");
+      // "tsurface: id file.ray size" (8.1.5, 8.4): triangles, the size mandatory. Both are
+      // drawn by ~id, so an id names one of them.
+      const bool triangles = name == "tsurface";
+      if (values.size() < 3)
+        return fail_here(value_column, triangles ? "a tsurface needs 'tsurface: id file.ray size'"
+                                                 : "a surface needs 'surface: id file.s size [s t]'");
       if (values[0].text.size() != 1)
-        return fail_here(values[0].column + value_column - 1, "a surface's id is one character ('~" + values[0].text.substr(0, 1) + "' draws it)");
+        return fail_here(values[0].column + value_column - 1, "a " + name + "'s id is one character ('~" + values[0].text.substr(0, 1) + "' draws it)");
+      for (const lsys::CpfgSurface& other : grammar.surfaces)
+        if (other.id == values[0].text[0])
+          return fail_here(values[0].column + value_column - 1,
+                           "a second surface with the id '" + values[0].text + "' (~" + values[0].text + " draws one)");
       double size = 0, cells[2] = {0, 0};
-      if (!number(values[2].text, &size)) return fail_here(values[2].column + value_column - 1, "a surface's size is a number");
+      if (!number(values[2].text, &size)) return fail_here(values[2].column + value_column - 1, "a " + name + "'s size is a number");
       if (!(size > 0)) size = 1;
+      if (triangles) {
+        auto surface = read_cpfg_tsurface(beside(values[1]), values[0].text[0], size);
+        if (!surface) return fail_file(values[1], "tsurface", std::move(surface.error()));
+        grammar.surfaces.push_back(std::move(*surface));
+        return;
+      }
       for (size_t k = 0; k < 2 && 3 + k < values.size(); ++k)
         if (!number(values[3 + k].text, &cells[k]) || cells[k] != std::floor(cells[k]) || cells[k] < 0 || cells[k] > 1e6)
           return fail_here(values[3 + k].column + value_column - 1, "a surface's cells across and along are whole numbers");

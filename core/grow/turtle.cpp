@@ -556,13 +556,15 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   // up (sylva's −U) and y along −L, the frame carried along the curve from a's by the least
   // rotation between the tangents — and polygon leaves between neighbouring rings.
   // One cell of a surface or a swept contour (quad: its corners in order) as polygon leaves:
-  // the quad where it is flat, else its two triangles, each kept only where it has area.
+  // the quad where it is flat, else its two triangles, each kept only where it has area; a
+  // triangle (three corners: a tsurface's) where it has area.
   auto add_cell = [&](const std::optional<ChainParent>& at, uint32_t material, std::vector<std::array<double, 3>> quad) {
     if (leaves.size() + 2 >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
     if (!leaf_polygon_problem(quad)) {
       leaves.push_back(Leaf{at, material, std::move(quad)});
       return;
     }
+    if (quad.size() == 3) return;  // a degenerate triangle: nothing to draw
     for (std::vector<std::array<double, 3>> tri :
          {std::vector{quad[0], quad[1], quad[2]}, std::vector{quad[0], quad[2], quad[3]}})
       if (!leaf_polygon_problem(tri)) leaves.push_back(Leaf{at, material, std::move(tri)});
@@ -1001,7 +1003,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
             // ~X(s) or ~X(sx, sy, sz) (CPFG manual 6.7.1): the view file's surface X at the
             // turtle, its x along L, y along H, z along cpfg's up, scaled by s and
             // the turtle's scale; one polygon leaf per grid cell (two triangles where the
-            // cell is not flat). The module after `~` names the surface and carries the
+            // cell is not flat), or per triangle of a tsurface. The module after `~` names the surface and carries the
             // scale; a surface the view file does not define draws nothing, as in cpfg.
             if (i + 1 >= n) continue;
             const Module& id_module = word.modules[++i];
@@ -1027,6 +1029,8 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
               return std::array<double, 3>{w.x, w.y, w.z};
             };
             const std::optional<ChainParent> at = standing_on(t);
+            for (const auto& tri : surface->triangles)  // a tsurface: one leaf a triangle
+              add_cell(at, t.material, {place(tri[0]), place(tri[1]), place(tri[2])});
             const int columns = surface->t_cells + 1;
             for (const auto& grid : surface->patches)
               for (int a = 0; a < surface->s_cells; ++a)

@@ -1138,7 +1138,7 @@ double polygon_area(const Leaf& leaf) {
 }
 
 // `~l(s)` draws the view file's surface `l` where the turtle stands: the file's SIZE made the
-// view file's size, times s; its x along cpfg's left (H × U: +x for the first turtle), y along
+// view file's size, times s; its x along cpfg's left (H × U: −x for the first turtle), y along
 // H, z along U; one leaf per cell of the s × t grid a patch is cut into.
 TEST(TurtleCpfg, TildeDrawsTheViewFilesSurfaceAsLeavesWhereTheTurtleStands) {
   auto grown = grow_with_surface("F(1);(3)~l(1.5)", "surface: l leaf.s 2 4 3\n");
@@ -1182,6 +1182,59 @@ TEST(TurtleCpfg, TildeDrawsTheViewFilesSurfaceAsLeavesWhereTheTurtleStands) {
   EXPECT_EQ(missing.error().loc.line, 2u);
   EXPECT_NE(missing.error().message.find("surface file 'nothing.s'"), std::string::npos) << missing.error().format();
   EXPECT_FALSE(missing.error().notes.empty());
+}
+
+// A tsurface (CPFG manual 8.1.5 `tsurface: id file size`, 8.4; cpfg's tsurfaces.c): the file's
+// triangles, their points times the size (no contact point), drawn by ~id as surfaces are
+// (x along L, y along H, z along cpfg's up, sylva's −U), one leaf a triangle. The manual's
+// two triangles make a unit diamond; a third stands in the plane of L and U.
+TEST(TurtleCpfg, TildeDrawsATsurfacesTrianglesScaledByItsSize) {
+  const std::string diamond =
+      "name leaf grid 20 20 20\ntriangle\n-0.5 1 0 0 0 1\n 0.0 2 0 0 0 1\n 0.5 1 0 0 0 1\n"
+      "triangle\n0.5,1,0, 0,0,1, 0.5,1.0\n0.0 0 0 0 0 1 0 0.5 7 8\n-0.5 1 0 0 0 1 0.5 0.0\n"
+      "triangle 0 0 0\n1 0 0\n0 0 0.5\n";
+  auto grown = grow_object("F(1);(3)~l(1.5)", "tsurface: l leaf.ray 2\n", {{"leaf.ray", diamond}});
+  ASSERT_TRUE(grown.ok()) << grown.error().format();
+  const Skeleton& sk = grown->skeleton;
+  ASSERT_EQ(sk.leaves.size(), 3u);
+  double area = 0, lo[3] = {1e9, 1e9, 1e9}, hi[3] = {-1e9, -1e9, -1e9};
+  for (const Leaf& leaf : sk.leaves) {
+    EXPECT_EQ(leaf.material, 3u);
+    EXPECT_EQ(leaf.vertices_m.size(), 3u);
+    area += polygon_area(leaf);
+    for (const auto& v : leaf.vertices_m)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
+  }
+  // Scaled by 2 × 1.5: the diamond 9, the third triangle 3 × 1.5 / 2; from the turtle at (0, 1, 0).
+  EXPECT_NEAR(area, 9 + 2.25, 1e-9);
+  EXPECT_NEAR(lo[0], -3, 1e-9);  // the file's +x is cpfg's left: −x for the first turtle
+  EXPECT_NEAR(hi[0], 1.5, 1e-9);
+  EXPECT_NEAR(lo[1], 1, 1e-9);
+  EXPECT_NEAR(hi[1], 7, 1e-9);
+  EXPECT_NEAR(lo[2], -1.5, 1e-9);
+  EXPECT_NEAR(hi[2], 0, 1e-9);
+  // A word where a number belongs, an unfinished triangle, none at all: errors at their place
+  // in the file, under the view file's line; an id a surface has already.
+  auto bad = [&](const std::string& file, const std::string& view = "tsurface: l leaf.ray 1\n") {
+    return grow_object("~l", view, {{"leaf.ray", file}});
+  };
+  auto word = bad("triangle\n1 2 3\n1 x 3\n");
+  ASSERT_FALSE(word.ok());
+  EXPECT_EQ(word.error().loc.line, 1u);
+  ASSERT_FALSE(word.error().notes.empty());
+  EXPECT_EQ(word.error().notes[0].loc.line, 3u);
+  EXPECT_EQ(word.error().notes[0].loc.column, 3u);
+  EXPECT_NE(word.error().notes[0].message.find("expected a number"), std::string::npos);
+  auto short_one = bad("triangle\n1 2 3\n1 2 3\n");
+  ASSERT_FALSE(short_one.ok());
+  EXPECT_NE(short_one.error().notes[0].message.find("fewer than three vertices"), std::string::npos);
+  auto none = bad("name leaf\n");
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.error().notes[0].message.find("at least one 'triangle'"), std::string::npos);
+  auto twice = bad("triangle 0 0 0\n1 0 0\n0 1 0\n", "tsurface: l leaf.ray 1\ntsurface: l leaf.ray 2\n");
+  ASSERT_FALSE(twice.ok());
+  EXPECT_EQ(twice.error().loc.line, 2u);
+  EXPECT_NE(twice.error().message.find("a second surface with the id 'l'"), std::string::npos);
 }
 
 // A generalized cylinder with a contour (CPFG manual 6.7.3 @#(id), 8.1.5 `contour:`; cpfg's

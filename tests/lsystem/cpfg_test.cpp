@@ -371,14 +371,57 @@ TEST(CpfgModel, SubLSystemsRewriteTheModulesBetweenTheirCallAndItsEnd) {
                              [] { DeriveOptions o; o.steps = 1; return o; }());
   EXPECT_NE(unknown.find("?(7, ...) calls an L-system the file does not define (its labels: 1, 2)"), std::string::npos)
       << unknown;
-  expect_located({"Lsystem: 1\nAxiom: A\nendlsystem\nLsystem: 2\nAxiom: B\nignore: F\nendlsystem\n", 6, 1,
-                  "'ignore:' in a sub-L-system is not supported yet"});
   expect_located({"Lsystem: 1\nAxiom: A\nendlsystem\nLsystem: 1\nAxiom: B\nendlsystem\n", 4, 10,
                   "a second L-system with the label 1"});
   expect_located({"Lsystem: 1\nAxiom: A\nendlsystem\nF --> G\n", 4, 1, "expected a sub-L-system's 'Lsystem:' line"});
   expect_located({"Lsystem: 1\nAxiom: A\nLsystem: 2\nendlsystem\n", 3, 1, "'endlsystem' first"});
-  expect_located({"Lsystem: 1\nAxiom: A\nhomomorphism\nmaximum depth: 3\nendlsystem\nLsystem: 2\nAxiom: B\n"
-                  "homomorphism\nmaximum depth: 2\nendlsystem\n", 9, 16, "must be the main L-system's (3)"});
+}
+
+// Each L-system of a cpfg file has its own ignore or consider list, ring and maximum depths
+// (cpfg keeps them per LSYSDATA; its RconDiff/LconDiff read the current L-system's): a
+// sub-L-system without a list passes over nothing, whatever the main one ignores.
+TEST(CpfgModel, EachSubLSystemHasItsOwnContextListRingAndMaximumDepths) {
+  const std::string two = "Lsystem: 1\nderivation length: 1\n%sAxiom: %s\n%s\nendlsystem\nLsystem: 2\n%sAxiom: B\n%s\n"
+                          "endlsystem\n";
+  auto file = [&](const std::string& main_head, const std::string& axiom, const std::string& main_rules,
+                  const std::string& sub_head, const std::string& sub_rules) {
+    std::string t;
+    size_t k = 0;
+    for (const std::string* part : {&main_head, &axiom, &main_rules, &sub_head, &sub_rules}) {
+      const size_t at = two.find("%s", k);
+      t += two.substr(k, at - k) + *part;
+      k = at + 2;
+    }
+    return t + two.substr(k);
+  };
+  // The main L-system ignores +, the sub-L-system does not: only the main one's B sees its A.
+  EXPECT_EQ(derive_text(file("ignore: +\n", "A+B?(2)A+B$", "A < B --> C", "", "A < B --> D")), "A+C?(2)A+B$");
+  EXPECT_EQ(derive_text(file("", "A+B?(2)A+B$", "A < B --> C", "ignore: +\n", "A < B --> D")), "A+B?(2)A+D$");
+  // consider: in the sub-L-system only (X is passed over there, not in the main one).
+  EXPECT_EQ(derive_text(file("", "AXB?(2)AXB$", "A < B --> C", "consider: A B\n", "A < B --> E")), "AXB?(2)AXE$");
+  // A ring sub-L-system: its B, the word's last module, has the word's first as right context.
+  EXPECT_EQ(derive_text(file("", "A?(2)B", "", "ring lsystem\n", "B > A --> X")), "A?(2)X");
+  EXPECT_EQ(derive_text(file("", "A?(2)B", "", "", "B > A --> X")), "A?(2)B");
+  // Maximum depths: the homomorphism's (main 1, sub 3), the decomposition's (main 2, sub 1).
+  const std::string chain = "X --> Y\nY --> Z\nZ --> W";
+  auto g = parse_grammar(file("", "X?(2)X$", "homomorphism\nmaximum depth: 1\n" + chain, "",
+                              "homomorphism\nmaximum depth: 3\n" + chain),
+                         "s.l");
+  ASSERT_TRUE(g.ok()) << g.error().format();
+  EXPECT_EQ(drawn_text(*g), "Y?(2)W$");
+  EXPECT_EQ(derive_text(file("", "X?(2)X$", "decomposition\nmaximum depth: 2\n" + chain, "",
+                             "decomposition\nmaximum depth: 1\n" + chain),
+                        [] { DeriveOptions o; o.steps = 0; return o; }()),
+            "Z?(2)Y$");
+  // With context, the decomposition goes pass by pass: pass 2 leaves the main one's Y.
+  const std::string with_context = "B < X --> Y\nY --> Z";
+  EXPECT_EQ(derive_text(file("", "BX?(2)BX$", "decomposition\nmaximum depth: 1\n" + with_context, "",
+                             "decomposition\nmaximum depth: 2\n" + with_context),
+                        [] { DeriveOptions o; o.steps = 0; return o; }()),
+            "BY?(2)BZ$");
+  // Each list once per L-system, as in the main one.
+  const std::string both = file("", "A", "", "ignore: F\nconsider: G\n", "");
+  expect_located({both.c_str(), 8, 10, "cannot both be given"});
 }
 
 // cpfg's cut (generate.c's ApplyProd): a % a production writes stays in the word, and cuts
@@ -403,8 +446,8 @@ TEST(CpfgModel, APercentCutsTheRestOfItsBranchWhenTheNextStepReadsIt) {
 
 // Output files (CPFG manual 5.4; vlab's canalization-file): fopen(name, "w") in the model's
 // folder, fprintf appends, fflush and fclose write the whole file atomically, and a file left
-// open is written when the derivation ends. Outside the folder, reading, an unknown id and a
-// model of no file are errors at their place.
+// open is written when the derivation ends. Outside the folder, an unknown id and a model of
+// no file are errors at their place.
 TEST(CpfgStatements, FopenAndFprintfWriteFilesBesideTheModel) {
   ModelFolder folder;
   const std::string model = folder.write(
@@ -424,9 +467,6 @@ TEST(CpfgStatements, FopenAndFprintfWriteFilesBesideTheModel) {
   const std::string outside = derive_file((folder.dir() / "bad.l").string());
   EXPECT_NE(outside.find("outside the model's folder"), std::string::npos) << outside;
   EXPECT_FALSE(std::filesystem::exists(folder.dir().parent_path() / "escape.txt"));
-  expect_located({"Lsystem: 1\nStart: {f = fopen(\"in.txt\", \"r\");}\nAxiom: A\nendlsystem\n", 2, 29,
-                  "reading files (fopen \"r\", fscan) is not supported yet"});
-  expect_located({"Lsystem: 1\nStart: {fscan(1, \"%f\", x);}\nAxiom: A\nendlsystem\n", 2, 9, "not supported yet"});
   // A model read from no file (Python's Grammar(text), "<string>") has no folder to write in.
   auto from_text = [](const std::string& text) {
     auto g = parse_grammar(text, "<string>");
@@ -438,6 +478,48 @@ TEST(CpfgStatements, FopenAndFprintfWriteFilesBesideTheModel) {
   EXPECT_NE(unknown.find("3 is no open file"), std::string::npos) << unknown;
   const std::string nofile = from_text("Lsystem: 1\nStart: {f = fopen(\"x.txt\", \"w\");}\nAxiom: A\nendlsystem\n");
   EXPECT_NE(nofile.find("read from no file"), std::string::npos) << nofile;
+}
+
+// Reading files (CPFG manual 5.4): fopen(name, "r") in the model's folder, and fscanf (the
+// manual's fscan) reads numbers into globals, array elements, a production's parameters and
+// locals, with C's result: how many were read, 0 at a mismatch, -1 at the file's end.
+TEST(CpfgStatements, FscanfReadsNumbersFromAFileBesideTheModel) {
+  ModelFolder folder;
+  folder.write("data.txt", "3 0.5\nlength: 2.25\n7e-1 x");
+  folder.write("one.txt", " +1\n");
+  folder.write("nums.txt", "10 20\n30");
+  const std::string model = folder.write(
+      "plant.l",
+      "Lsystem: 1\ndefine: { array a[2]; }\nderivation length: 1\n"
+      "Start: {f = fopen(\"data.txt\", \"r\"); r1 = fscanf(f, \"%f %f\", &n, &w); r2 = fscanf(f, \" length: %g\", &len);\n"
+      "  r3 = fscanf(f, \"%f %f\", &a[0], &a[1]); r4 = fscanf(f, \"%f\", &z); fclose(f);\n"
+      "  g = fopen(\"one.txt\", \"r\"); r5 = fscanf(g, \"%lf\", &z); r6 = fscanf(g, \"%f\", &z);\n"
+      "  h = fopen(\"nums.txt\", \"r\");}\n"
+      "Axiom: S(n, w, len, a[0], a[1], r1, r2, r3, r4, r5, r6, z) A(0) A(0) A(0) A(0)\n"
+      "A(x) : {k = fscanf(h, \"%f\", &x);} --> B(x, k)\nendlsystem\n");
+  EXPECT_EQ(derive_file(model), "S(3,0.5,2.25,0.7,0,2,1,1,0,1,-1,1)B(10,1)B(20,1)B(30,1)B(0,-1)");
+  // What fscanf cannot read, and targets that are no variables, are errors at their place.
+  expect_located({"Lsystem: 1\nStart: {f = fopen(\"a\", \"r\"); fscanf(f, \"%d\", &x);}\nAxiom: A\nendlsystem\n", 2,
+                  40, "fscanf's %d: every cpfg variable is a number"});
+  expect_located({"Lsystem: 1\nStart: {fscanf(1, \"%f\", x);}\nAxiom: A\nendlsystem\n", 2, 25, "write '&'"});
+  expect_located({"Lsystem: 1\nStart: {fscanf(1, \"%f %f\", &x);}\nAxiom: A\nendlsystem\n", 2, 9,
+                  "reads 2 values, it was given 1 variable"});
+  expect_located({"Lsystem: 1\nAxiom: A(1)\nA(x) : {fscanf(1, \"%f\", &y);} --> B\nendlsystem\n", 3, 26,
+                  "'y' is no parameter, local assigned before, or global"});
+  expect_located({"Lsystem: 1\nStart: {f = fopen(\"a\", \"rw\");}\nAxiom: A\nendlsystem\n", 2, 24,
+                  "fopen's mode is \"w\" (writing) or \"r\" (reading)"});
+  // At run time: a missing file, one outside the folder, writing to one read, reading one written.
+  auto run = [&](const std::string& start) {
+    return derive_file(folder.write("bad.l", "Lsystem: 1\nStart: {" + start + "}\nAxiom: A\nendlsystem\n"));
+  };
+  const std::string missing = run("f = fopen(\"none.txt\", \"r\");");
+  EXPECT_NE(missing.find("none.txt"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("No such file"), std::string::npos) << missing;
+  EXPECT_NE(run("f = fopen(\"../data.txt\", \"r\");").find("outside the model's folder"), std::string::npos);
+  EXPECT_NE(run("f = fopen(\"one.txt\", \"r\"); fprintf(f, \"x\");").find("opened for reading"), std::string::npos);
+  EXPECT_NE(run("f = fopen(\"o.txt\", \"w\"); fscanf(f, \"%f\", &x);").find("opened for writing"), std::string::npos);
+  EXPECT_NE(run("f = fopen(\"one.txt\", \"r\"); fclose(f); fscanf(f, \"%f\", &x);").find("is no open file"),
+            std::string::npos);
 }
 
 // stop(n) (CPFG manual 5.6) ends the derivation after the step that calls it: the word is
@@ -536,17 +618,6 @@ TEST(CpfgModel, AnEqualsSignInARightContextIsTheRestOfTheBranch) {
   EXPECT_EQ(derive_text("Lsystem: 1\nderivation length: 1\nAxiom: I(1) [I(2)] I(3) [I(4) X]\n"
                         "I(a) > [I(b)=]I(c) --> I(a + b + c)\nendlsystem\n"),
             "I(6)[I(2)]I(3)[I(4)X]");
-}
-
-TEST(CpfgModel, WhatSylvaCannotReadYetIsAnErrorAtItsPlaceNamingTheFeature) {
-  const LocatedError cases[] = {
-      {"Lsystem: 1\nAxiom: F\nendlsystem\nLsystem: 2\nAxiom: G\nconsider: G\nendlsystem\n", 6, 1,
-       "'consider:' in a sub-L-system"},
-  };
-  for (const LocatedError& c : cases) {
-    expect_located(c);
-    EXPECT_NE(parse_error(c.text).message.find("not supported yet"), std::string::npos) << c.text;
-  }
 }
 
 // ---- ring L-systems (CPFG manual 3.1.1) ----
@@ -1082,11 +1153,6 @@ TEST(VlabObject, TheViewFileIsReadAsCpfgReadsIt) {
     ASSERT_TRUE(w.ok()) << w.error().format();
     EXPECT_DOUBLE_EQ(w->turtle.width, 0.1) << view;
   }
-  folder.write("plant.v", "angle factor: 4\ntsurface: l leaf.tsurface 1\n");
-  auto triangles = load_grammar(folder.dir().string());
-  ASSERT_FALSE(triangles.ok());
-  EXPECT_EQ(triangles.error().loc.line, 2u);
-  EXPECT_NE(triangles.error().message.find("not supported yet"), std::string::npos) << triangles.error().message;
   // cpfg's double-sided surfaces (a back colour) are not drawn yet: said at the place.
   folder.write("plant.v", "initial color: 3 7\n");
   auto sides = load_grammar(folder.dir().string());
