@@ -102,6 +102,12 @@ struct TurtleDefaults {
   double width_increment = 0;
   uint32_t color_increment = 1;
   uint32_t initial_color = 0;  // the material index the turtle starts with (a view file's)
+  // cpfg's double-sided surfaces (CPFG manual 6.3, 8.1.1: `initial color: front back`, drawn
+  // so by cpfg with a material file): every leaf gets the turtle's back colour as its back
+  // material (docs/cpfg.md "Two-sided surfaces"); @; and @, step it by color_increment_back.
+  bool double_sided = false;
+  uint32_t initial_back_color = 128;  // cpfg's default (interpret.c)
+  uint32_t color_increment_back = 1;
   // The turtle's scale (CPFG manual 6.3, 8.1.1): `initial scale:` and `scale multiplier:`,
   // which @D, @Di and @Dd change; lengths and set widths are multiplied by it.
   double initial_scale = 1;

@@ -423,21 +423,20 @@ Status apply_view_file(const std::string& path, Grammar& grammar) {
       // as cpfg does ("Invalid line style ... Default used!", interpret.c).
       if (style == "pixel" || style == "1") world_units = false;
       else if (style == "polygon" || style == "cylinder" || style == "2" || style == "3") world_units = true;
-    } else if (name == "initial color") {
-      double back = 0;
-      // A second number turns cpfg's double-sided surfaces on: a back side with its own colour.
-      if (values.size() >= 2 && number(values[1].text, &back))
-        return fail_here(values[1].column + value_column - 1,
-                         "a back side's colour ('initial color: front back', double-sided surfaces) is not supported "
-                         "yet (docs/cpfg.md)");
-      if (value(0, &v)) {
-        if (v < 0 || v != std::floor(v)) return fail_here(values[0].column + value_column - 1, "a colour index is a whole number from 0");
-        t.initial_color = static_cast<uint32_t>(v);
-      }
-    } else if (name == "color increment") {
-      if (value(0, &v)) {
-        if (v < 0 || v != std::floor(v)) return fail_here(values[0].column + value_column - 1, "a colour increment is a whole number from 0");
-        t.color_increment = static_cast<uint32_t>(v);
+    } else if (name == "initial color" || name == "color increment") {
+      // "initial color: front [back]" (CPFG manual 8.1.1): a second number turns cpfg's
+      // double-sided surfaces on, the back side in its own colour (interpret.c);
+      // "color increment: front [back]": the steps of ; , and of @; @,.
+      const bool initial = name == "initial color";
+      for (size_t k = 0; k < 2 && k < values.size(); ++k) {
+        if (k == 1 && !number(values[1].text, &v)) break;  // not a number: one colour, as cpfg's fscanf
+        if (!value(k, &v)) return;
+        if (v < 0 || v != std::floor(v) || v > 4294967295.0)
+          return fail_here(values[k].column + value_column - 1,
+                           initial ? "a colour index is a whole number from 0" : "a colour increment is a whole number from 0");
+        (initial ? (k ? t.initial_back_color : t.initial_color) : (k ? t.color_increment_back : t.color_increment)) =
+            static_cast<uint32_t>(v);
+        if (initial && k == 1) t.double_sided = true;
       }
     } else if (name == "contour") {
       // "contour: id file.con" (CPFG manual 8.1.5): @#(id) selects it.
@@ -641,6 +640,9 @@ Expected<Grammar> read_vlab_object(const std::string& folder, const ParseOptions
     }
     g->colours = std::move(*colours);
   }
+  // cpfg gives a back side its own colour with a material file only (my_color: GL_BACK's
+  // material); with a colour map both sides take the front's (docs/cpfg.md).
+  if (!colour_file) g->turtle.double_sided = false;
   return g;
 }
 

@@ -27,6 +27,16 @@ in vec2 v_uv;
 flat in uvec4 v_ids;
 #endif
 
+#if defined(GBUFFER_PASS) || defined(LEAF_IMAGES)
+// The material a ray along `ray_direction` sees here: a double-sided leaf's back material
+// (ids.w − 1, gl_mesh.cpp; 0 none) where the ray runs along its normal, as LeafRef::
+// material_seen_along; otherwise the ids' own.
+uint side_material(vec3 ray_direction) {
+  bool back = v_ids.y == LEAF_CHAIN && v_ids.w != 0u && dot(ray_direction, v_normal) > 0.0;
+  return back ? v_ids.w - 1u : v_ids.x >> PLANT_INDEX_BITS;
+}
+#endif
+
 // LEAF_IMAGES (the leaves, both passes; leaf_images.h): material m's layer u_leaf_layer[m]
 // of the 2D array (RGB sRGB-encoded albedo, A the cut-out; GL_LINEAR, clamped, no MIP
 // levels: LeafImages::sample's filter), its flags u_leaf_flags[m]: 1 albedo image, 2
@@ -72,12 +82,15 @@ uniform float u_footprint_scale;  // 1 / sqrt(spp): the ray differentials' step
 
 void main() {
 #if defined(SHADOW_PASS) && defined(LEAF_IMAGES)
-  if (leaf_missing(v_ids.x >> PLANT_INDEX_BITS, leaf_texel(v_ids.x >> PLANT_INDEX_BITS), -u_light_dir)) discard;
+  // The light meets the side its rays (along −u_light_dir) arrive at.
+  uint shadow_material = side_material(-u_light_dir);
+  if (leaf_missing(shadow_material, leaf_texel(shadow_material), -u_light_dir)) discard;
 #endif
 #ifdef GBUFFER_PASS
+  uint material = side_material(v_rel_eye);
 #ifdef LEAF_IMAGES
   // Sampled in uniform control flow (before any discard), so the helper pixels agree.
-  uint leaf_material = v_ids.x >> PLANT_INDEX_BITS;
+  uint leaf_material = material;
   vec4 leaf = leaf_texel(leaf_material);
   if (leaf_missing(leaf_material, leaf, v_rel_eye)) discard;
 #endif
@@ -100,7 +113,8 @@ void main() {
   float u = v_ids.y == LEAF_CHAIN ? clamp(v_uv.x, 0.0, 1.0) : v_uv.x - floor(v_uv.x);
   g_normal_distance = vec4(n_shading, length(v_rel_eye));
   g_geometric_u = vec4(n_geometric, u);
-  g_ids = uvec4(v_ids.xyz, floatBitsToUint(v_ids.y == LEAF_CHAIN ? clamp(v_uv.y, 0.0, 1.0) : v_uv.y));
+  g_ids = uvec4((v_ids.x & PLANT_INDEX_MASK) | (material << PLANT_INDEX_BITS), v_ids.yz,
+                floatBitsToUint(v_ids.y == LEAF_CHAIN ? clamp(v_uv.y, 0.0, 1.0) : v_uv.y));
 #ifdef BARK_TEXTURE_UNITS
   // Derivatives first, in uniform control flow; the image rows run downward (texture.h's y).
   vec2 duv_dx = dFdx(v_uv) * u_footprint_scale, duv_dy = -dFdy(v_uv) * u_footprint_scale;
@@ -108,7 +122,7 @@ void main() {
   UvFootprint footprint = cap ? UvFootprint(0.0, 0.0, 0.0, 0.0)
                               : UvFootprint(duv_dx.x, duv_dx.y, duv_dy.x, duv_dy.y);
   // The bark covers the wood only (material 0), the table's images their materials.
-  g_albedo = segment_albedo(v_ids.x & PLANT_INDEX_MASK, v_ids.x >> PLANT_INDEX_BITS, u, v_uv.y, footprint);
+  g_albedo = segment_albedo(v_ids.x & PLANT_INDEX_MASK, material, u, v_uv.y, footprint);
 #elif defined(LEAF_IMAGES)
   // A leaf image's albedo, decoded after filtering as LeafImages::albedo (and bark.glsl).
   bool image = (leaf_flags(leaf_material) & 1u) != 0u;

@@ -34,7 +34,7 @@ out vec3 v_rel_eye;         // position − eye: the distance, and the ray it li
 out vec3 v_local;           // position − origin_hi: the triangle's plane (geometric normal)
 out vec3 v_normal;
 out vec2 v_uv;
-flat out uvec4 v_ids;       // plant | material << 24, chain, segment, 0
+flat out uvec4 v_ids;       // plant | material << 24, chain, segment, a leaf's back material + 1 (0: none)
 #endif
 
 void main() {

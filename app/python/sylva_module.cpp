@@ -357,7 +357,8 @@ struct LeafRecord {
   int32_t vertex_count;
   int32_t chain;         // the joint it hangs from; -1: none
   int32_t joint;
-  uint32_t material;
+  uint32_t material;       // its front's where it has a back of its own
+  uint32_t back_material;  // seen from behind (a cpfg double-sided surface's); else `material`
 };
 
 int32_t checked_index(uint64_t value, const char* what) {
@@ -447,6 +448,7 @@ py::array_t<LeafRecord> skeleton_leaves(const Skeleton& sk) {
     r.chain = leaf.joint ? static_cast<int32_t>(leaf.joint->chain) : -1;
     r.joint = leaf.joint ? static_cast<int32_t>(leaf.joint->joint) : -1;
     r.material = leaf.material;
+    r.back_material = leaf.back_material.value_or(leaf.material);
     first += leaf.vertices_m.size();
   }
   return leaves;
@@ -700,7 +702,7 @@ Growing, deriving, exporting and rendering release the GIL, so threads run in pa
 void bind_module(py::module_& m) {
   m.doc() = kModuleDoc;
   PYBIND11_NUMPY_DTYPE(ChainRecord, first_joint, joint_count, parent_chain, parent_joint);
-  PYBIND11_NUMPY_DTYPE(LeafRecord, first_vertex, vertex_count, chain, joint, material);
+  PYBIND11_NUMPY_DTYPE(LeafRecord, first_vertex, vertex_count, chain, joint, material, back_material);
   m.attr("__version__") = "0.1.0";
 
   // --- exceptions -----------------------------------------------------------------------
@@ -877,8 +879,9 @@ and where no light arrived). A grammar without ?E gives an empty (0, 7) array.)d
       .def_property_readonly(
           "leaves", &skeleton_leaves,
           "(L,) numpy structured array, fields first_vertex, vertex_count, chain, joint (int32;\n"
-          "-1 for a leaf on no joint) and material (uint32): the leaves (docs/spec/skeleton.md), one per\n"
-          "polygon of the grammar. A new array on every access.")
+          "-1 for a leaf on no joint), material and back_material (uint32; the material seen from\n"
+          "behind, the same as material unless a cpfg double-sided surface gives it its own, docs/leaves.md):\n"
+          "the leaves (docs/spec/skeleton.md), one per polygon of the grammar. A new array on every access.")
       .def_property_readonly("leaf_vertices", &skeleton_leaf_vertices,
                              "(V, 3) float64 every leaf's vertices in metres, leaf after leaf. A new array.")
       .def_property_readonly("leaf_count", [](const Skeleton& sk) { return sk.leaves.size(); }, "Number of leaves L.")

@@ -44,10 +44,13 @@ void leaf_filter(const RTCFilterFunctionNArguments* args) {
     if (keep && q->images) {
       const LeafRef& leaf = m.leaves[m.triangle_leaf[prim]];
       const double along_normal = glm::dot(q->triangles.ray.direction, leaf.normal);
-      if (q->images->one_sided(leaf.material) && (q->toward_light ? along_normal < 0 : along_normal > 0)) keep = false;
-      if (keep && q->images->has_cutout(leaf.material)) {
+      // The side the ray meets (a shadow ray runs against the light: the light meets the other).
+      const uint32_t material =
+          leaf.material_seen_along(q->toward_light ? -q->triangles.ray.direction : q->triangles.ray.direction);
+      if (q->images->one_sided(material) && (q->toward_light ? along_normal < 0 : along_normal > 0)) keep = false;
+      if (keep && q->images->has_cutout(material)) {
         const glm::dvec2 uv = uv_at(m, tri, c);
-        keep = q->images->opaque(leaf.material, uv.x, uv.y);
+        keep = q->images->opaque(material, uv.x, uv.y);
       }
     }
     if (!keep) args->valid[i] = 0;
@@ -106,7 +109,7 @@ SurfaceHit LeafTracer::nearest_leaf(const Ray& ray, double t_min, double t_max) 
   s.u = std::clamp(uv.x, 0.0, 1.0);
   s.v_m = std::clamp(uv.y, 0.0, 1.0);
   s.plant = leaf.plant;
-  s.material = leaf.material;
+  s.material = leaf.material_seen_along(ray.direction);  // a double-sided leaf's back from behind
   s.leaf = leaf.leaf;
   return s;
 }

@@ -298,7 +298,7 @@ void append_leaves(LeafMesh& mesh, const Skeleton& placed, uint32_t plant) {
     for (uint32_t i : triangles) mesh.indices.push_back(first + i);
     mesh.triangle_leaf.insert(mesh.triangle_leaf.end(), triangles.size() / 3, index);
     mesh.vertex_leaf.insert(mesh.vertex_leaf.end(), leaf.vertices_m.size(), index);
-    mesh.leaves.push_back({plant, l, leaf.material, normal});
+    mesh.leaves.push_back({plant, l, leaf.material, leaf.back_material.value_or(leaf.material), normal});
   }
 }
 

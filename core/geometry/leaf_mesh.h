@@ -12,6 +12,7 @@
 #include <array>
 #include <cstdint>
 #include <glm/vec2.hpp>
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include <span>
 #include <vector>
@@ -53,8 +54,14 @@ std::vector<glm::dvec2> leaf_uvs(std::span<const std::array<double, 3>> vertices
 struct LeafRef {
   uint32_t plant = 0;     // index into Scene::plants
   uint32_t leaf = 0;      // index into that plant's Skeleton::leaves
-  uint32_t material = 0;  // the leaf's material index
+  uint32_t material = 0;  // the leaf's material index (its front's, when it has a back)
+  uint32_t back_material = 0;  // the material seen from behind (Leaf::back_material, else `material`)
   glm::dvec3 normal{0, 0, 1};  // unit Newell normal
+  // The material a ray along `direction` sees: the back's when it runs along the normal
+  // (it meets the side the normal points away from).
+  uint32_t material_seen_along(const glm::dvec3& direction) const {
+    return back_material != material && glm::dot(direction, normal) > 0 ? back_material : material;
+  }
 };
 
 // The leaves of a scene (or of one plant) as one triangle soup.

@@ -428,7 +428,7 @@ bool SkeletonReader::read_leaf(size_t index, const JsonValue& value, const Skele
     return fail(value, prefix + " must be an object {\"joint\": ..., \"material\": ..., \"vertices\": [...]}, got " +
                            describe(value));
   }
-  if (!check_keys(value, {"joint", "material", "vertices"}, prefix)) return false;
+  if (!check_keys(value, {"joint", "material", "back_material", "vertices"}, prefix)) return false;
   const JsonValue* joint = require(value, "joint", prefix);
   const JsonValue* material = joint ? require(value, "material", prefix) : nullptr;
   const JsonValue* vertices = material ? require(value, "vertices", prefix) : nullptr;
@@ -446,6 +446,12 @@ bool SkeletonReader::read_leaf(size_t index, const JsonValue& value, const Skele
   if (!m || *m > kMaxCount)
     return fail(*material, prefix + ": material must be an integer from 0 to 4294967295, got " + describe(*material));
   leaf.material = static_cast<uint32_t>(*m);
+  if (const JsonValue* back = value.find("back_material")) {  // a double-sided leaf's (docs/leaves.md)
+    const std::optional<uint64_t> b = back->as_uint64();
+    if (!b || *b > kMaxCount)
+      return fail(*back, prefix + ": back_material must be an integer from 0 to 4294967295, got " + describe(*back));
+    leaf.back_material = static_cast<uint32_t>(*b);
+  }
   if (!vertices->is_array())
     return fail(*vertices, prefix + ": vertices must be an array of [x, y, z], got " + describe(*vertices));
   for (size_t v = 0; v < vertices->elements.size(); ++v) {
@@ -646,6 +652,7 @@ void write_skeleton_members(JsonWriter& w, const Skeleton& skeleton, const Skele
     w.begin_object(inline_layout);
     write_joint_ref("joint", leaf.joint);
     w.key("material").integer(leaf.material);
+    if (leaf.back_material) w.key("back_material").integer(*leaf.back_material);
     w.key("vertices").begin_array();
     for (const auto& p : leaf.vertices_m) w.begin_array().number(p[0]).number(p[1]).number(p[2]).end_array();
     w.end_array();

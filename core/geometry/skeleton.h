@@ -59,6 +59,10 @@ struct Leaf {
   std::optional<ChainParent> joint;               // (chain, joint index); none: before the first F
   uint32_t material = 0;                          // the material index in force at `}`
   std::vector<std::array<double, 3>> vertices_m;  // metres, Y up, in the order recorded
+  // A double-sided leaf's back (docs/leaves.md "Two colours"): the material seen from behind,
+  // the side its Newell normal points away from; `material` is then its front's. None: one
+  // material on both sides. A cpfg double-sided surface's (docs/cpfg.md).
+  std::optional<uint32_t> back_material;
   bool operator==(const Leaf&) const = default;
 };
 

@@ -108,7 +108,8 @@ void append_plant(MeshArrays& out, const TriangleMesh& part, const SkinnedSkelet
 }
 
 // Appends plant `plant`'s leaves `part` (leaf_mesh.h: one plant's) to `out`: a record
-// per leaf (ids plant | material << 24, kLeafChain, the leaf's index), its flat normal at
+// per leaf (ids plant | material << 24, kLeafChain, the leaf's index, its back material + 1
+// when it has one of its own, else 0: mesh.frag.glsl's side_material), its flat normal at
 // every vertex, its leaf_uvs, and a sphere per leaf to *spheres.
 void append_leaves(MeshArrays& out, const LeafMesh& part, std::vector<GlMeshSphere>* spheres) {
   if (part.empty()) return;
@@ -121,7 +122,7 @@ void append_leaves(MeshArrays& out, const LeafMesh& part, std::vector<GlMeshSphe
   for (const LeafRef& leaf : part.leaves)
     out.frusta.push_back({{origin_hi.x, origin_hi.y, origin_hi.z, 0.0f},
                           {leaf.plant | (std::min(leaf.material, 255u) << gl::kPlantIndexBits), gl::kLeafChain,
-                           leaf.leaf, 0u}});
+                           leaf.leaf, leaf.back_material != leaf.material ? std::min(leaf.back_material, 255u) + 1 : 0u}});
   const std::vector<uint32_t>& vertex_leaf = part.vertex_leaf;
   const uint32_t first_vertex = static_cast<uint32_t>(out.vertices.size());
   for (size_t v = 0; v < part.positions.size(); ++v) {

@@ -96,7 +96,7 @@ class GlMesh {
   // The leaves of `scene` (leaf_mesh.h; docs/spec/skeleton.md "Leaves") drawn the same way, with the
   // same programs (without bark: a leaf is never bark, materials.md): one record per leaf
   // with ids plant | material << 24, gl::kLeafChain, the leaf's index in its plant's
-  // leaves; its flat Newell normal as every vertex's shading normal (mesh.frag.glsl turns
+  // leaves, its back material + 1 (0: none; mesh.frag.glsl picks the side's); its flat Newell normal as every vertex's shading normal (mesh.frag.glsl turns
   // it toward the eye: two-sided), its leaf_uvs (leaf_mesh.h); a sphere per leaf. Null when no plant has leaves.
   // The frusta's renderer draws it after the frusta into the same G-buffer and shadow map.
   // `images` (leaf_images.h; null: plain leaves): the table's leaf images, cut-outs and

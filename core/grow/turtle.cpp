@@ -30,6 +30,7 @@ struct TurtleState {
   dvec3 up{0, 0, 1};
   double radius = 0.05;
   uint32_t material = 0;
+  uint32_t back_material = 0;  // cpfg's back colour (@; @,), drawn where surfaces are double-sided
   double tropism_e = 0;
   dvec3 tropism{0, 0, 0};      // T (the header's, or @Tp's for the rest of the branch)
   int64_t chain = -1;          // chain the turtle stands on, or -1
@@ -365,7 +366,7 @@ enum class CpfgKind : uint8_t {
   kNone, kDraw, kMove, kColorUp, kColorDown, kWidthUp, kWidthDown, kLevel, kSetPosition, kSetHeading, kCircle, kSphere,
   kScaleSet, kScaleUp, kScaleDown, kForceTwist, kElasticityUp, kElasticityDown, kElasticitySet,
   kCylinderStart, kCylinderPoint, kCylinderEnd, kCylinderTangents, kCylinderSides, kCylinderContour, kSurface, kRadiusTangents,
-  kSubCall, kSubEnd, kPatchInit, kPatchPoint, kPatchDraw, kRing, kBackColour
+  kSubCall, kSubEnd, kPatchInit, kPatchPoint, kPatchDraw, kRing, kBackColorUp, kBackColorDown
 };
 
 struct CpfgSymbols {
@@ -415,8 +416,8 @@ CpfgSymbols cpfg_symbols(const lsys::Grammar& g) {
   set("@PD", CpfgKind::kPatchDraw);
   set("@bc", CpfgKind::kRing);
   set("@bo", CpfgKind::kRing);  // a boundary facing the screen: drawn in the HL plane (docs/cpfg.md)
-  set("@;", CpfgKind::kBackColour);
-  set("@,", CpfgKind::kBackColour);
+  set("@;", CpfgKind::kBackColorUp);
+  set("@,", CpfgKind::kBackColorDown);
   return out;
 }
 
@@ -468,6 +469,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   t.tropism = dvec3(d.tropism[0], d.tropism[1], d.tropism[2]);
   t.radius = d.width;
   t.material = d.initial_color;
+  t.back_material = d.initial_back_color;
   t.scale = d.initial_scale;
   t.tropism_e = d.has_tropism ? d.tropism_e : 0.0;
   // A cpfg file's tropisms: its view file's, else sylva's `tropism:` header as one
@@ -558,16 +560,25 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
   // One cell of a surface or a swept contour (quad: its corners in order) as polygon leaves:
   // the quad where it is flat, else its two triangles, each kept only where it has area; a
   // triangle (three corners: a tsurface's) where it has area.
-  auto add_cell = [&](const std::optional<ChainParent>& at, uint32_t material, std::vector<std::array<double, 3>> quad) {
-    if (leaves.size() + 2 >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
-    if (!leaf_polygon_problem(quad)) {
-      leaves.push_back(Leaf{at, material, std::move(quad)});
-      return;
+  // A leaf in `material` (the front's) hung from `at`. Where a cpfg view file makes surfaces
+  // double-sided (TurtleDefaults::double_sided, docs/cpfg.md), its outline is turned round
+  // (vertex 0 kept) so that its normal points to cpfg's front — the side cpfg's GL draws
+  // clockwise, glFrontFace(GL_CW) — and the turtle's back colour is its back material.
+  auto add_leaf = [&](const std::optional<ChainParent>& at, uint32_t material, std::vector<std::array<double, 3>> vertices) {
+    if (leaves.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
+    Leaf leaf{at, material, std::move(vertices), std::nullopt};
+    if (d.double_sided) {
+      std::reverse(leaf.vertices_m.begin() + 1, leaf.vertices_m.end());
+      if (t.back_material != material) leaf.back_material = t.back_material;
     }
+    leaves.push_back(std::move(leaf));
+  };
+  auto add_cell = [&](const std::optional<ChainParent>& at, uint32_t material, std::vector<std::array<double, 3>> quad) {
+    if (!leaf_polygon_problem(quad)) return add_leaf(at, material, std::move(quad));
     if (quad.size() == 3) return;  // a degenerate triangle: nothing to draw
     for (std::vector<std::array<double, 3>> tri :
          {std::vector{quad[0], quad[1], quad[2]}, std::vector{quad[0], quad[2], quad[3]}})
-      if (!leaf_polygon_problem(tri)) leaves.push_back(Leaf{at, material, std::move(tri)});
+      if (!leaf_polygon_problem(tri)) add_leaf(at, material, std::move(tri));
   };
   // A view-file contour's id, checked (0 is cpfg's default circle).
   auto check_contour = [&](int id) {
@@ -806,8 +817,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
         OpenPolygon& polygon = polygons.back();
         std::vector<std::array<double, 3>> vertices = closed_polygon(polygon);
         if (auto problem = leaf_polygon_problem(vertices)) throw TurtleFailure{"bad leaf: " + *problem};
-        if (leaves.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
-        leaves.push_back(Leaf{polygon.joint, t.material, std::move(vertices)});
+        add_leaf(polygon.joint, t.material, std::move(vertices));
         polygons.pop_back();
         continue;
       }
@@ -822,16 +832,24 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
           case CpfgKind::kDraw: symbol = kSymF; break;   // G: move and draw, no polygon vertex
           case CpfgKind::kMove: symbol = kSymf; break;   // g: move without drawing, no vertex
           case CpfgKind::kColorUp:
-          case CpfgKind::kColorDown: {
+          case CpfgKind::kColorDown:
+          case CpfgKind::kBackColorUp:
+          case CpfgKind::kBackColorDown: {
             // A parameter is truncated toward zero, as cpfg's (int) cast; an index that steps
-            // past either end of the 256-entry colour map comes round once (interpret.c).
-            double next = has ? std::trunc(p[0]) : static_cast<double>(t.material) +
-                                           (cpfg.kind[symbol] == CpfgKind::kColorUp ? 1.0 : -1.0) * d.color_increment;
-            if (cpfg.kind[symbol] == CpfgKind::kColorUp && next > 255) next -= 256;
-            else if (cpfg.kind[symbol] == CpfgKind::kColorDown && next < 0) next += 256;
+            // past either end of the 256-entry colour map comes round once (interpret.c). @;
+            // and @, step the back's by the view file's second colour increment (blackbox.c).
+            const CpfgKind kind = cpfg.kind[symbol];
+            const bool back = kind == CpfgKind::kBackColorUp || kind == CpfgKind::kBackColorDown;
+            const bool up = kind == CpfgKind::kColorUp || kind == CpfgKind::kBackColorUp;
+            uint32_t& index = back ? t.back_material : t.material;
+            double next = has ? std::trunc(p[0])
+                              : static_cast<double>(index) +
+                                    (up ? 1.0 : -1.0) * (back ? d.color_increment_back : d.color_increment);
+            if (up && next > 255) next -= 256;
+            else if (!up && next < 0) next += 256;
             if (!(next >= 0) || next != std::floor(next) || next > 4294967295.0)
               throw TurtleFailure{"a colour index must be an integer from 0 to 4294967295"};
-            t.material = static_cast<uint32_t>(next);
+            index = static_cast<uint32_t>(next);
             continue;
           }
           case CpfgKind::kWidthUp:
@@ -932,8 +950,7 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
                 check_position(v);
                 vertices.push_back({v.x, v.y, v.z});
               }
-              if (leaves.size() >= 0xFFFFFFFFu) throw TurtleFailure{"too many leaves"};
-              leaves.push_back(Leaf{at, t.material, std::move(vertices)});
+              add_leaf(at, t.material, std::move(vertices));
               continue;
             }
             // A chain of its own, hung from the joint the turtle stands on: kSphereSegments
@@ -1040,11 +1057,6 @@ Expected<Skeleton> build_skeleton(const lsys::Word& word, const lsys::Grammar& g
                 }
             continue;
           }
-          case CpfgKind::kBackColour:
-            // @; and @, step the back side's colour, which cpfg draws only on double-sided
-            // surfaces (a view file's `initial color: front back`, which sylva refuses at its
-            // place); otherwise the front's colour shows on both sides, as here.
-            continue;
           case CpfgKind::kPatchInit:
           case CpfgKind::kPatchPoint:
           case CpfgKind::kPatchDraw: {

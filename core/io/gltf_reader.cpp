@@ -461,6 +461,14 @@ Status read_compact_skeleton(const std::string& path, const JsonValue& sylva, co
   if (!leaf_joints) return std::move(leaf_joints.error());
   auto leaf_materials = compact_array<uint32_t>(views, path, *leaves, "material", *l, lwhere);
   if (!leaf_materials) return std::move(leaf_materials.error());
+  // Double-sided leaves' backs (docs/leaves.md), where the writer had any: one the same as
+  // its front is none.
+  std::optional<std::vector<uint32_t>> back_materials;
+  if (leaves->find("back_material")) {
+    auto backs = compact_array<uint32_t>(views, path, *leaves, "back_material", *l, lwhere);
+    if (!backs) return std::move(backs.error());
+    back_materials = std::move(*backs);
+  }
   uint64_t vertex_total = 0;
   for (uint32_t n : *vertex_counts) vertex_total += n;
   auto vertices = compact_array<double>(views, path, *leaves, "vertices", 3 * vertex_total, lwhere);
@@ -470,6 +478,7 @@ Status read_compact_skeleton(const std::string& path, const JsonValue& sylva, co
     Leaf leaf;
     leaf.joint = joint_ref((*leaf_joints)[2 * k], (*leaf_joints)[2 * k + 1]);
     leaf.material = (*leaf_materials)[k];
+    if (back_materials && (*back_materials)[k] != leaf.material) leaf.back_material = (*back_materials)[k];
     leaf.vertices_m.resize((*vertex_counts)[k]);
     for (auto& v : leaf.vertices_m) {
       for (double& x : v) x = (*vertices)[next++];

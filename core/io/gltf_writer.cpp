@@ -276,18 +276,22 @@ void write_compact_skeleton(JsonWriter& w, const Skeleton& sk, BufferBuilder& bu
   write_view(w, "material", materials, buffer);
   w.end_object();
   if (sk.leaves.empty()) return;
-  std::vector<uint32_t> vertex_counts, leaf_joints, leaf_materials;
+  std::vector<uint32_t> vertex_counts, leaf_joints, leaf_materials, back_materials;
   std::vector<double> vertices;
+  const bool backs = std::any_of(sk.leaves.begin(), sk.leaves.end(), [](const Leaf& l) { return l.back_material.has_value(); });
   for (const Leaf& leaf : sk.leaves) {
     vertex_counts.push_back(static_cast<uint32_t>(leaf.vertices_m.size()));
     push_ref(leaf_joints, leaf.joint);
     leaf_materials.push_back(leaf.material);
+    // A double-sided leaf's back (docs/leaves.md), the front's where a leaf has none.
+    if (backs) back_materials.push_back(leaf.back_material.value_or(leaf.material));
     for (const auto& v : leaf.vertices_m) vertices.insert(vertices.end(), v.begin(), v.end());
   }
   w.key("leaves").begin_object().key("count").integer(sk.leaves.size());
   write_view(w, "vertex_count", vertex_counts, buffer);
   write_view(w, "joint", leaf_joints, buffer);
   write_view(w, "material", leaf_materials, buffer);
+  if (backs) write_view(w, "back_material", back_materials, buffer);
   write_view(w, "vertices", vertices, buffer);
   w.end_object();
 }
@@ -505,13 +509,15 @@ std::string material_json(uint32_t material, const Bark& bark, const std::map<ui
 // baseColorTexture (its RGB white where the entry has only an alpha image: the colour is
 // then the factor), alphaMode MASK at kLeafAlphaCutoff for a cut-out, doubleSided unless
 // the entry is one-sided.
+// `one_side`: a side of a double-sided leaf with two materials (docs/leaves.md), drawn as
+// its own single-sided triangles.
 std::string leaf_material_json(uint32_t material, const std::map<uint32_t, SceneMaterial>& materials,
-                               const LeafImages* images, std::optional<size_t> texture) {
+                               const LeafImages* images, std::optional<size_t> texture, bool one_side = false) {
   const MaterialLook look = material_look(materials, nullptr, material);
   const bool image_albedo = images && images->has_albedo(material);
   JsonWriter w;
   w.begin_object();
-  w.key("name").string("sylva_leaf_material_" + std::to_string(material));
+  w.key("name").string("sylva_leaf_material_" + std::to_string(material) + (one_side ? "_one_side" : ""));
   w.key("pbrMetallicRoughness").begin_object();
   const double factor[4] = {image_albedo ? 1 : look.albedo.x, image_albedo ? 1 : look.albedo.y,
                             image_albedo ? 1 : look.albedo.z, 1};
@@ -524,10 +530,11 @@ std::string leaf_material_json(uint32_t material, const std::map<uint32_t, Scene
     w.key("alphaMode").string("MASK");
     w.key("alphaCutoff").number(kLeafAlphaCutoff);
   }
-  w.key("doubleSided").boolean(!(images && images->one_sided(material)));
+  w.key("doubleSided").boolean(!one_side && !(images && images->one_sided(material)));
   w.key("extras").begin_object().key("sylva").begin_object();
   w.key("material_index").integer(material);
   w.key("leaf").boolean(true);
+  if (one_side) w.key("one_side_of_two").boolean(true);
   if (materials.count(material)) w.key("specular").number(look.specular);
   w.end_object().end_object();
   w.end_object();
@@ -1028,19 +1035,47 @@ Status add_segment_mesh(const SkinnedSkeleton& skinned, const Bark& bark, const 
 // The leaves (leaf_mesh.h): flat triangles with their leaf's normal at each vertex, one
 // primitive per material index in increasing order, double-sided materials;
 // TEXCOORD_0 = (u, 1 − v) of leaf_uvs (glTF's t runs down the image: an image drawn
-// upright, petiole at its bottom row, covers the leaf as the renderers map it).
+// upright, petiole at its bottom row, covers the leaf as the renderers map it). A leaf with
+// a back material of its own (docs/leaves.md "Two colours") is two single-sided sheets: its
+// triangles in its front's material, and copies of its vertices with the normal reversed,
+// wound the other way, in its back's; after the double-sided primitives.
 Status add_leaf_mesh(const Skeleton& sk, const GltfExportOptions& options, const PlantRig* rig,
                      const WindSource* wind, GltfDocument& doc, MeshPrimitives& primitives) {
   LeafMesh leaves;
   append_leaves(leaves, sk, 0);
+  // (material, one side of two) → its triangles; the back sheets' vertices appended.
+  std::map<std::pair<bool, uint32_t>, std::vector<uint32_t>> triangles_of;
+  std::vector<uint8_t> reversed(leaves.positions.size(), 0);
+  std::vector<uint32_t> copy_of(leaves.positions.size(), UINT32_MAX);
+  for (size_t t = 0; t < leaves.triangle_count(); ++t) {
+    const LeafRef& leaf = leaves.leaves[leaves.triangle_leaf[t]];
+    const uint32_t* tri = &leaves.indices[3 * t];
+    const bool two = leaf.back_material != leaf.material;
+    std::vector<uint32_t>& front = triangles_of[{two, leaf.material}];
+    front.insert(front.end(), tri, tri + 3);
+    if (!two) continue;
+    std::vector<uint32_t>& back = triangles_of[{true, leaf.back_material}];
+    for (int k = 3; k-- > 0;) {
+      uint32_t& c = copy_of[tri[k]];
+      if (c == UINT32_MAX) {
+        c = static_cast<uint32_t>(leaves.positions.size());
+        leaves.positions.push_back(leaves.positions[tri[k]]);
+        leaves.uvs.push_back(leaves.uvs[tri[k]]);
+        leaves.vertex_leaf.push_back(leaves.vertex_leaf[tri[k]]);
+        reversed.push_back(1);
+      }
+      back.push_back(c);
+    }
+  }
+  if (triangles_of.empty()) return {};
   std::vector<float> positions, normals, texcoords;
   for (const glm::dvec2& t : leaves.uvs)
     texcoords.insert(texcoords.end(), {static_cast<float>(t.x), static_cast<float>(1 - t.y)});
   for (const glm::dvec3& q : leaves.positions) append_float3(positions, q);
-  for (uint32_t l : leaves.vertex_leaf) append_unit_float3(normals, leaves.leaves[l].normal);
-  const std::map<uint32_t, std::vector<uint32_t>> triangles_of = triangles_by_material(
-      leaves.indices, leaves.triangle_count(), [&](size_t t) { return leaves.leaves[leaves.triangle_leaf[t]].material; });
-  if (triangles_of.empty()) return {};
+  for (size_t v = 0; v < leaves.vertex_leaf.size(); ++v) {
+    const glm::dvec3& n = leaves.leaves[leaves.vertex_leaf[v]].normal;
+    append_unit_float3(normals, reversed[v] ? -n : n);
+  }
   size_t texcoord_0 = 0;
   std::string attribute_text = open_flat_attributes(positions, normals, texcoords, doc.buffer, &texcoord_0);
   if (wind) {  // each leaf pivots about its joint, one level above its chain
@@ -1065,15 +1100,16 @@ Status add_leaf_mesh(const Skeleton& sk, const GltfExportOptions& options, const
     attribute_text += skin_attributes(weights, rig->rig.joints.size(), doc.buffer);
   }
   attribute_text += "}";
-  for (const auto& [material, indices] : triangles_of) {
+  for (const auto& [key, indices] : triangles_of) {
+    const auto [one_side, material] = key;
     JsonWriter& json = primitives.json;
     json.begin_object();
     json.key("attributes").raw(attribute_text);
     json.key("indices").integer(doc.buffer.add_indices(indices));
     Expected<std::optional<size_t>> texture = doc.table.leaf_texture(material);
     if (!texture) return std::move(texture.error());
-    json.key("material").integer(
-        doc.table.material(leaf_material_json(material, options.materials, doc.table.leaf_images(), *texture)));
+    json.key("material").integer(doc.table.material(
+        leaf_material_json(material, options.materials, doc.table.leaf_images(), *texture, one_side)));
     json.key("mode").integer(kModeTriangles);
     json.end_object();
     ++primitives.count;

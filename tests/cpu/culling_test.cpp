@@ -69,7 +69,7 @@ TEST(Culling, APlantOutsideTheViewWhoseLeafReachesIntoItIsKept) {
   // stay outside; a leaf from its top reaching 5 m to the left does not.
   Scene s = scene_with({{8, 0, 0}}, {0, 1, 0});
   ASSERT_TRUE(culled(s, 0));
-  s.plants[0].skeleton->leaves = {Leaf{ChainParent{0, 2}, 1, {{0, 2.5, 0}, {-5, 2.5, 0}, {-5, 3, 0}}}};
+  s.plants[0].skeleton->leaves = {Leaf{ChainParent{0, 2}, 1, {{0, 2.5, 0}, {-5, 2.5, 0}, {-5, 3, 0}}, std::nullopt}};
   EXPECT_FALSE(culled(s, 0));
   RenderOptions o;
   o.aovs = kAovId;

@@ -30,6 +30,10 @@ TEST(RenderCpuLeaves, ALeafIsTwoSided) {
   test::expect_the_leaf_where_projected(s, render_with_aovs(s), 1e-5, 1e-5, 1e-6);
 }
 
+TEST(RenderCpuLeaves, ADoubleSidedLeafShowsEachSidesMaterial) {
+  test::expect_each_side_in_its_material([](const Scene& s) { return render_cpu(s, {}).image; }, 1e-6);
+}
+
 TEST(RenderCpuLeaves, ALeafSeenAgainstTheSunShowsTheSkyAmbientOnly) {
   // The sun behind the leaf: its near side gets no sunlight (a leaf is opaque).
   const Scene s = test::one_leaf_scene({-0.5, 1.5, 5}, {0.2, 0.5, -1});

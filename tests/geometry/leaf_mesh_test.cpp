@@ -65,7 +65,7 @@ TEST(LeafMesh, ALeafsUvRunFromPetioleToTipAndAcrossOverItsBox) {
   EXPECT_NEAR(mirrored[2].y, 1, 1e-12);
   // append_leaves stores one uv per position, the same.
   Skeleton sk;
-  sk.leaves.push_back({std::nullopt, 1, kite});
+  sk.leaves.push_back({std::nullopt, 1, kite, std::nullopt});
   LeafMesh mesh;
   append_leaves(mesh, sk, 0);
   ASSERT_EQ(mesh.uvs.size(), mesh.positions.size());

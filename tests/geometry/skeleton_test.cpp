@@ -629,8 +629,8 @@ TEST_F(SkeletonFileTest, ErrorsInAFileNameTheFileAndPlace) {
 // documented_skeleton with two leaves: a triangle on joint [1, 1] and a square on none.
 Skeleton skeleton_with_leaves() {
   Skeleton sk = documented_skeleton();
-  sk.leaves = {Leaf{ChainParent{1, 1}, 1, {{0.7, 1.7, 0}, {0.9, 1.8, 0.1}, {0.75, 2.0, -0.05}}},
-               Leaf{std::nullopt, 3, {{0, 0, 0}, {0.1, 0, 0}, {0.1, 0.1, 0}, {0, 0.1, 0}}}};
+  sk.leaves = {Leaf{ChainParent{1, 1}, 1, {{0.7, 1.7, 0}, {0.9, 1.8, 0.1}, {0.75, 2.0, -0.05}}, std::nullopt},
+               Leaf{std::nullopt, 3, {{0, 0, 0}, {0.1, 0, 0}, {0.1, 0.1, 0}, {0, 0.1, 0}}, std::nullopt}};
   return sk;
 }
 
@@ -644,6 +644,19 @@ TEST(SkeletonLeaves, WithLeavesTheFileIsVersion2WithOneLeafPerLineAndReadsBackEq
       << text;
   EXPECT_EQ(read_ok(text), sk);
   EXPECT_EQ(write_skeleton_json(read_ok(text)), text);
+}
+
+// A double-sided leaf's back material (docs/leaves.md "Two colours") is written after its
+// material, only where it has one, and reads back equal.
+TEST(SkeletonLeaves, ABackMaterialIsWrittenWhereALeafHasOneAndReadsBackEqual) {
+  Skeleton sk = skeleton_with_leaves();
+  sk.leaves[1].back_material = 7;
+  const std::string text = write_skeleton_json(sk);
+  EXPECT_NE(text.find("{\"joint\": null, \"material\": 3, \"back_material\": 7, \"vertices\": "), std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("back_material"), text.rfind("back_material")) << "the first leaf has none";
+  EXPECT_EQ(read_ok(text), sk);
+  EXPECT_NE(read_ok(text), skeleton_with_leaves());
 }
 
 TEST(SkeletonLeaves, WithoutLeavesTheFileIsStillVersion1) {
@@ -682,6 +695,8 @@ TEST(SkeletonLeaves, BadLeavesAreLocatedAndNamed) {
       {R"({"joint": null, "material": -1, "vertices": []})", "leaf 0: material must be an integer"},
       {R"({"joint": null, "vertices": []})", "leaf 0: missing required key \"material\""},
       {R"({"joint": null, "material": 0, "vertices": [], "colour": 1})", "unknown key \"colour\""},
+      {R"({"joint": null, "material": 0, "back_material": 1.5, "vertices": []})",
+       "leaf 0: back_material must be an integer from 0 to 4294967295, got 1.5"},
   };
   for (const Bad& b : bad) EXPECT_NE(read_error(file(b.leaf)).find(b.says), std::string::npos) << read_error(file(b.leaf));
 }

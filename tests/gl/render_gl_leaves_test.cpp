@@ -38,6 +38,11 @@ TEST(RenderGlLeaves, ALeafIsTwoSided) {
   test::expect_the_leaf_where_projected(s, render_gl_with_aovs(s), kDepthRel, kRadianceAbs, 2e-3);
 }
 
+TEST(RenderGlLeaves, ADoubleSidedLeafShowsEachSidesMaterial) {
+  SYLVA_REQUIRE_GL();
+  test::expect_each_side_in_its_material([](const Scene& s) { return gl_test::gl_render(s, {}).image; }, kRadianceAbs);
+}
+
 TEST(RenderGlLeaves, ALeafShadowsTheGroundThroughTheShadowMap) {
   SYLVA_REQUIRE_GL();
   const Scene s = test::leaf_shadow_scene();

@@ -5,6 +5,7 @@
 // worked out by hand from that frame; sin/cos of multiples of 90° are exact in sylva, so
 // right-angle turns give exact coordinates and are compared with EXPECT_EQ. Anything that
 // involves other angles is compared with a tolerance of 1e-12.
+#include "core/geometry/leaf_mesh.h"
 #include "core/grow/turtle.h"
 #include "core/grow/grow.h"
 #include "lsystem/vlab_object.h"
@@ -1235,6 +1236,42 @@ TEST(TurtleCpfg, TildeDrawsATsurfacesTrianglesScaledByItsSize) {
   ASSERT_FALSE(twice.ok());
   EXPECT_EQ(twice.error().loc.line, 2u);
   EXPECT_NE(twice.error().message.find("a second surface with the id 'l'"), std::string::npos);
+}
+
+// cpfg's double-sided surfaces (CPFG manual 6.3, 8.1.1; docs/cpfg.md "Two-sided surfaces"):
+// with `initial color: front back` and a material file, each leaf keeps the turtle's colour
+// as its (front) material and the back colour as its back material, its outline turned round
+// (vertex 0 kept) so that its normal points to cpfg's front — the side cpfg's GL, which
+// draws clockwise faces as front (glFrontFace(GL_CW)), shows the front colour on: for the
+// first turtle's square in the plane of H and L, the side of cpfg's up (sylva's −U, −z). @;
+// and @, step the back colour by the second colour increment, or set it.
+TEST(TurtleCpfg, DoubleSidedSurfacesGiveEachLeafTheBackColourAsItsBackMaterial) {
+  const std::string axiom = "{.f.+f.+f.}@;{.f.+f.+f.}@,(20)@,;(4){.f.+f.+f.}";
+  const std::string view = "angle factor: 4\ninitial color: 3 7\ncolor increment: 1 2\n";
+  const std::vector<std::pair<std::string, std::string>> material_file = {
+      {"specifications", "generate:\n\tcpfg -M plant.mat plant.l plant.v\n"}, {"plant.mat", std::string(15, '\0')}};
+  auto two = grow_object(axiom, view, material_file);
+  ASSERT_TRUE(two.ok()) << two.error().format();
+  auto plain = grow_object(axiom, view, {});  // no material file: one colour on both sides, as cpfg
+  ASSERT_TRUE(plain.ok()) << plain.error().format();
+  const auto& leaves = two->skeleton.leaves;
+  ASSERT_EQ(leaves.size(), 3u);
+  ASSERT_EQ(plain->skeleton.leaves.size(), 3u);
+  const uint32_t front[3] = {3, 3, 4}, back[3] = {7, 9, 18};
+  for (size_t l = 0; l < 3; ++l) {
+    EXPECT_EQ(leaves[l].material, front[l]) << l;
+    ASSERT_TRUE(leaves[l].back_material) << l;
+    EXPECT_EQ(*leaves[l].back_material, back[l]) << l;
+    const Leaf& one = plain->skeleton.leaves[l];
+    EXPECT_EQ(one.material, front[l]);
+    EXPECT_FALSE(one.back_material);
+    // The same outline from the same vertex 0, the other way round.
+    auto turned = one.vertices_m;
+    std::reverse(turned.begin() + 1, turned.end());
+    EXPECT_EQ(leaves[l].vertices_m, turned) << l;
+    EXPECT_LT(polygon_newell_normal(leaves[l].vertices_m).z, 0) << "the normal toward cpfg's up";
+    EXPECT_GT(polygon_newell_normal(one.vertices_m).z, 0);
+  }
 }
 
 // A generalized cylinder with a contour (CPFG manual 6.7.3 @#(id), 8.1.5 `contour:`; cpfg's

@@ -401,6 +401,56 @@ TEST(GltfExport, LeavesGetOneDoubleSidedPrimitivePerMaterialWithUnitNormals) {
   EXPECT_EQ(leaf_triangles, 4u + 2u);  // a hexagon and a quadrilateral
 }
 
+// A leaf with a back material of its own (docs/leaves.md "Two colours"): two single-sided
+// sheets, its front in its material and its back — copies of its vertices, normals reversed,
+// wound the other way — in the back's; every leaf triangle wound counter-clockwise about its
+// normals, so each sheet faces where its normals point. The back material round-trips
+// through the extras, full and compact.
+TEST(GltfExport, ADoubleSidedLeafIsTwoSingleSidedSheetsAndItsBackRoundTrips) {
+  TempFolder dir;
+  Skeleton sk = grow_text("angle: 60\naxiom: F(2)[&F{.+f.-f.-f.+|+f.-f.}]F'(1){.+f.-f.-f.}\n");
+  ASSERT_EQ(sk.leaves.size(), 2u);
+  sk.leaves[0].back_material = 5;
+  GltfExportOptions o;
+  o.mesh = true;
+  ASSERT_TRUE(export_gltf({{"leafy", sk}}, dir.file("p.glb"), o).ok());
+  const Glb glb = read_glb(dir.file("p.glb"));
+  const JsonValue& accessors = at(glb.json, "accessors");
+  std::map<std::string, std::pair<bool, size_t>> sheets;  // name → (double-sided, triangles)
+  for (const JsonValue& p : at(at(glb.json, "meshes").elements[0], "primitives").elements) {
+    const JsonValue* m = p.find("material");
+    if (!m) continue;
+    const JsonValue& material = at(glb.json, "materials").elements[static_cast<size_t>(m->number)];
+    if (!material.find("doubleSided")) continue;  // the frusta's
+    const size_t count = static_cast<size_t>(at(accessors.elements[static_cast<size_t>(at(p, "indices").number)], "count").number);
+    sheets[at(material, "name").text] = {at(material, "doubleSided").boolean, count / 3};
+    const std::vector<double> index = accessor_values(glb, static_cast<size_t>(at(p, "indices").number));
+    const std::vector<double> pos = accessor_values(glb, static_cast<size_t>(at(at(p, "attributes"), "POSITION").number));
+    const std::vector<double> nrm = accessor_values(glb, static_cast<size_t>(at(at(p, "attributes"), "NORMAL").number));
+    for (size_t t = 0; t + 2 < count; t += 3) {
+      glm::dvec3 v[3];
+      for (int k = 0; k < 3; ++k) {
+        const size_t i = static_cast<size_t>(index[t + static_cast<size_t>(k)]);
+        v[k] = {pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]};
+      }
+      const size_t i0 = static_cast<size_t>(index[t]);
+      EXPECT_GT(glm::dot(glm::cross(v[1] - v[0], v[2] - v[0]), glm::dvec3(nrm[3 * i0], nrm[3 * i0 + 1], nrm[3 * i0 + 2])), 0)
+          << at(material, "name").text << " triangle " << t / 3;
+    }
+  }
+  const std::map<std::string, std::pair<bool, size_t>> want = {{"sylva_leaf_material_0_one_side", {false, 4}},
+                                                                {"sylva_leaf_material_5_one_side", {false, 4}},
+                                                                {"sylva_leaf_material_1", {true, 2}}};
+  EXPECT_EQ(sheets, want);
+  for (const GltfExtras extras : {GltfExtras::full, GltfExtras::compact}) {
+    o.extras = extras;
+    ASSERT_TRUE(export_gltf({{"leafy", sk}}, dir.file("q.glb"), o).ok());
+    Expected<std::vector<GltfPlant>> r = import_gltf_skeletons(dir.file("q.glb"));
+    ASSERT_TRUE(r.ok()) << r.error().format();
+    EXPECT_EQ((*r)[0].skeleton, sk);
+  }
+}
+
 TEST(GltfExport, SameInputGivesByteIdenticalFiles) {
   TempFolder dir;
   const Skeleton sk = grow_text(kGrammar);

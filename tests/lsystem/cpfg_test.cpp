@@ -1153,12 +1153,29 @@ TEST(VlabObject, TheViewFileIsReadAsCpfgReadsIt) {
     ASSERT_TRUE(w.ok()) << w.error().format();
     EXPECT_DOUBLE_EQ(w->turtle.width, 0.1) << view;
   }
-  // cpfg's double-sided surfaces (a back colour) are not drawn yet: said at the place.
-  folder.write("plant.v", "initial color: 3 7\n");
+  // cpfg's double-sided surfaces: a second initial colour (the back's) and colour increment
+  // (@; and @,'s); a back side in its own colour only with a material file, as cpfg draws it.
+  folder.write("plant.v", "initial color: 3 7\ncolor increment: 2 5\n");
   auto sides = load_grammar(folder.dir().string());
-  ASSERT_FALSE(sides.ok());
-  EXPECT_EQ(sides.error().loc.column, 18u);
-  EXPECT_NE(sides.error().message.find("back side"), std::string::npos) << sides.error().message;
+  ASSERT_TRUE(sides.ok()) << sides.error().format();
+  EXPECT_EQ(sides->turtle.initial_color, 3u);
+  EXPECT_EQ(sides->turtle.initial_back_color, 7u);
+  EXPECT_EQ(sides->turtle.color_increment, 2u);
+  EXPECT_EQ(sides->turtle.color_increment_back, 5u);
+  EXPECT_FALSE(sides->turtle.double_sided) << "no material file: both sides in the front's colour";
+  folder.write("plant.mat", std::string(15, '\0'));
+  folder.write("specifications", "generate:\n\tcpfg -M plant.mat plant.l plant.v\n");
+  auto with_materials = load_grammar(folder.dir().string());
+  ASSERT_TRUE(with_materials.ok()) << with_materials.error().format();
+  EXPECT_TRUE(with_materials->turtle.double_sided);
+  folder.write("plant.v", "initial color: 3 x\n");  // not a number: one colour, as cpfg's fscanf
+  auto one = load_grammar(folder.dir().string());
+  ASSERT_TRUE(one.ok()) << one.error().format();
+  EXPECT_FALSE(one->turtle.double_sided);
+  folder.write("plant.v", "initial color: 3 -7\n");
+  auto negative = load_grammar(folder.dir().string());
+  ASSERT_FALSE(negative.ok());
+  EXPECT_EQ(negative.error().loc.column, 18u);
   folder.write("plant.v", "angle factor: 4\n");
   auto none = load_grammar(folder.dir().string());
   ASSERT_TRUE(none.ok()) << none.error().format();

@@ -201,8 +201,8 @@ TEST(Animate, ScenePlantsSwayOutOfStepAndStartAtRest) {
 // small_tree with a leaf on the first branch's tip (chain 1, joint 2) and one on no joint.
 Skeleton leafy_tree() {
   Skeleton sk = small_tree();
-  sk.leaves = {Leaf{ChainParent{1, 2}, 1, {{1.3, 3.1, 0.3}, {1.5, 3.2, 0.3}, {1.4, 3.4, 0.35}}},
-               Leaf{std::nullopt, 1, {{2, 0, 0}, {2.2, 0, 0}, {2.1, 0.1, 0}}}};
+  sk.leaves = {Leaf{ChainParent{1, 2}, 1, {{1.3, 3.1, 0.3}, {1.5, 3.2, 0.3}, {1.4, 3.4, 0.35}}, std::nullopt},
+               Leaf{std::nullopt, 1, {{2, 0, 0}, {2.2, 0, 0}, {2.1, 0.1, 0}}, std::nullopt}};
   return sk;
 }
 

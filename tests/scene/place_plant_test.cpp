@@ -14,7 +14,7 @@ TEST(LeafMesh, APlacedPlantsLeavesMoveRotateAndScaleWithIt) {
   Skeleton sk;
   sk.joints = {{{0, 0, 0}, 0.1, 0}, {{0, 1, 0}, 0.1, 0}};
   sk.chains = {{0, 2, std::nullopt}};
-  sk.leaves = {Leaf{ChainParent{0, 1}, 1, {{0, 1, 0}, {1, 1, 0}, {1, 2, 0}}}};
+  sk.leaves = {Leaf{ChainParent{0, 1}, 1, {{0, 1, 0}, {1, 1, 0}, {1, 2, 0}}, std::nullopt}};
   ScenePlant plant;
   plant.skeleton = sk;
   plant.position = {10, 0, 0};

@@ -89,7 +89,7 @@ TEST_F(Viewports, AFastRendererShowsNewPlantsInFullAtOnce) {
 TEST_F(Viewports, APlantOfLeavesAloneIsDrawnAndAnEmptyOneSaysWhy) {
   GlViewport viewport({}, /*preview_above_ms=*/1e9);
   Skeleton leaf;
-  leaf.leaves = {Leaf{std::nullopt, 1, {{0, 0, 0}, {0.1, 0.1, 0}, {0, 0.3, 0}, {-0.1, 0.1, 0}}}};
+  leaf.leaves = {Leaf{std::nullopt, 1, {{0, 0, 0}, {0.1, 0.1, 0}, {0, 0.3, 0}, {-0.1, 0.1, 0}}, std::nullopt}};
   Scene scene = default_scene_for(leaf, 64, 48);
   viewport.set_plants(scene, RenderOptions{});
   const ViewImage image = settle(viewport, scene);

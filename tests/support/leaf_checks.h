@@ -80,6 +80,37 @@ inline void expect_the_leaf_where_projected(const Scene& s, const RenderResult& 
   EXPECT_GT(clear_pixels, 2000);
 }
 
+// A double-sided leaf with two materials (docs/leaves.md "Two colours"): one_leaf_scene's
+// square (its Newell normal −z) given back material 9, a blue of its own, is seen from −z
+// (its front) as the square of material 2 alone, and from +z (its back) as the square drawn
+// in material 9 alone — every pixel within radiance_abs — and there unlike material 2's.
+// `render` draws a scene (the beauty).
+template <class Render>
+void expect_each_side_in_its_material(Render render, double radiance_abs) {
+  constexpr uint32_t kBack = 9;
+  for (const double side : {-5.0, 5.0}) {
+    Scene two = one_leaf_scene({-0.5, 1.5, side}, {0.2, 0.5, side / 5});
+    SceneMaterial blue = two.materials.at(kOneLeafMaterial);
+    blue.albedo_rgb = {0.1, 0.2, 0.8};
+    two.materials[kBack] = blue;
+    Scene one = two, other = two;
+    two.plants[0].skeleton->leaves.at(0).back_material = kBack;
+    other.plants[0].skeleton->leaves.at(0).material = kBack;  // the back's material on both sides
+    const RenderImage a = render(two), b = render(side < 0 ? one : other), c = render(side < 0 ? other : one);
+    int leaf_pixels = 0, differing = 0;
+    for (uint32_t y = 0; y < two.height; ++y)
+      for (uint32_t x = 0; x < two.width; ++x) {
+        if (!one_leaf_pixel(two, x, y)) continue;
+        ++leaf_pixels;
+        const glm::dvec3 got = beauty_at(a, x, y), want = beauty_at(b, x, y), unlike = beauty_at(c, x, y);
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], want[k], radiance_abs) << x << "," << y << " side " << side;
+        if (std::abs(got[2] - unlike[2]) > 10 * radiance_abs) ++differing;
+      }
+    EXPECT_GT(leaf_pixels, 200);
+    EXPECT_EQ(differing, leaf_pixels) << "side " << side << ": the other side's material would look different";
+  }
+}
+
 // leaf_shadow_scene (test_scenes.h): points well inside the leaf's shadow show the ground's sky
 // ambient alone (within radiance_abs) where the same scene without the leaf is lit; a
 // point beside it is the same with and without the leaf.

@@ -129,13 +129,15 @@ def test_leaves_are_arrays_matching_the_json():
     # docs/spec/grammar.md's polygons become leaves (docs/spec/skeleton.md "Leaves", version 2).
     sk = sylva.Grammar("angle: 60\naxiom: F[&F'(1){.+f.-f.-f.}]F{.+f.-f.-f.+|+f.-f.}\n").grow()
     assert sk.leaf_count == 2
-    assert sk.leaves.dtype.names == ("first_vertex", "vertex_count", "chain", "joint", "material")
+    assert sk.leaves.dtype.names == ("first_vertex", "vertex_count", "chain", "joint", "material", "back_material")
     assert sk.leaves.dtype["material"] == np.uint32
     doc = json.loads(sk.to_json())
     assert doc["version"] == 2
     np.testing.assert_array_equal(sk.leaves["vertex_count"], [len(leaf["vertices"]) for leaf in doc["leaves"]])
     np.testing.assert_array_equal(sk.leaves["first_vertex"], [0, len(doc["leaves"][0]["vertices"])])
     np.testing.assert_array_equal(sk.leaves["material"], [leaf["material"] for leaf in doc["leaves"]])
+    # One material on both sides: the back's is the front's (a cpfg double-sided leaf's differs).
+    np.testing.assert_array_equal(sk.leaves["back_material"], sk.leaves["material"])
     joints = [leaf["joint"] or [-1, -1] for leaf in doc["leaves"]]
     np.testing.assert_array_equal(np.stack([sk.leaves["chain"], sk.leaves["joint"]], 1), joints)
     np.testing.assert_array_equal(sk.leaf_vertices, [v for leaf in doc["leaves"] for v in leaf["vertices"]])
