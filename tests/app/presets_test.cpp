@@ -181,6 +181,7 @@ TEST(CpfgPresets, EachGrowsTheSkeletonOfItsLsysTwinExactly) {
     const bool object = fs::is_directory(presets_dir() / "cpfg" / name) && name.ends_with("_object");
     if (fs::path(name).extension() != ".l" && !object) continue;
     const std::string stem = object ? name.substr(0, name.size() - 7) : fs::path(name).stem().string();
+    if (object && !fs::exists(presets_dir() / (stem + ".lsys"))) continue;  // no twin: its own test below
     ++checked;
     TempDir dir;
     std::optional<sylva::Skeleton> grown[2];
@@ -206,6 +207,40 @@ TEST(CpfgPresets, EachGrowsTheSkeletonOfItsLsysTwinExactly) {
     }
   }
   EXPECT_GE(checked, 3u);  // two model files and a vlab object
+}
+
+// presets/cpfg/rosette_object (docs/cpfg.md "A two-coloured rosette"): twelve leaves whose
+// lengths it reads from leaves.txt with fscanf, each two-sided (dark green material 1 above,
+// pale material 2 beneath: its view file's "initial color: 1 2" with its material file), and
+// a flower of the view file's tsurface (ten triangles of material 3 on both sides).
+TEST(CpfgPresets, TheRosetteObjectReadsItsLeafLengthsAndHasTwoSidedLeaves) {
+  TempDir dir;
+  const std::string output = dir.file("rosette.skel.json");
+  ProcessResult r = run_sylva({"grow", "presets/cpfg/rosette_object", "-o", output}, SYLVA_SOURCE_DIR, 120);
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  sylva::Expected<sylva::Skeleton> sk = sylva::read_skeleton_file(output);
+  ASSERT_TRUE(sk.ok()) << sk.error().format();
+  ASSERT_EQ(sk->leaves.size(), 12u + 10u);
+  // leaves.txt's lengths: a leaf's outline is a rhombus of sides l/2 with a 40-degree tip,
+  // so its length from base to tip is l·cos(20°).
+  const double lengths[12] = {0.16, 0.17, 0.18, 0.185, 0.19, 0.185, 0.18, 0.17, 0.155, 0.14, 0.12, 0.10};
+  for (size_t l = 0; l < 12; ++l) {
+    const sylva::Leaf& leaf = sk->leaves[l];
+    EXPECT_EQ(leaf.material, 1u) << l;
+    ASSERT_TRUE(leaf.back_material) << l;
+    EXPECT_EQ(*leaf.back_material, 2u) << l;
+    ASSERT_EQ(leaf.vertices_m.size(), 4u) << l;
+    double longest = 0;
+    for (const auto& v : leaf.vertices_m)
+      longest = std::max(longest, std::hypot(v[0] - leaf.vertices_m[0][0], v[1] - leaf.vertices_m[0][1],
+                                             v[2] - leaf.vertices_m[0][2]));
+    EXPECT_NEAR(longest, lengths[l] * std::cos(20 * 3.14159265358979323846 / 180), 1e-9) << l;
+  }
+  for (size_t l = 12; l < sk->leaves.size(); ++l) {
+    EXPECT_EQ(sk->leaves[l].material, 3u);
+    EXPECT_FALSE(sk->leaves[l].back_material) << "the flower's both sides are material 3";
+    EXPECT_EQ(sk->leaves[l].vertices_m.size(), 3u);
+  }
 }
 
 // A cpfg model file is a grammar for every command: render and export take it as they take
