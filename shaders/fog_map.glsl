@@ -25,24 +25,55 @@ layout(std430, binding = FOG_MAP_RANGES_BINDING) readonly buffer FogMapRanges { 
 layout(std430, binding = FOG_MAP_TEXELS_BINDING) readonly buffer FogMapTexels { float fog_map_texels[]; };
 
 // The lit pieces of one walk as one open run (sun_map.cpp's LitRun), each closed piece
-// integrated at once: the optical depth of the dark gap before it, then its sunlit in-scatter.
+// integrated at once by one closed form along the ray (docs/fog-map.md "One formula a
+// piece"). Below the fog's top the camera's optical depth τ from the stretch's start `lo`
+// and the sun's optical depth at the same point are tied linearly: along the ray
+// dσ/dτ = −k·d_y, so τ_sun falls by (d_y/s_y)·τ and T·T_sun = T_sun(lo)·e^{−κτ} (κ fog.glsl's
+// sun rate) — however dark the gaps before a piece, which shadow the sun, not the camera.
+// A piece [t0, t1] then adds albedo·T(τ_sun(lo) + κ·τ_anchor)·exp_integral(Δτ, |κ|) (one
+// exponent: τ + τ_sun at the anchor, never negative), the anchor its start (κ >= 0) or end
+// (κ < 0) as fog_lit_segment's, τ(lo, t0) and Δτ = τ(t0, t1) each
+// from the density at its lower end (fog_clipped_optical_depth's form, so that a ray from
+// where the density underflows still sees the fog below): the value fog_lit_segment gives
+// after fog_optical_depth over the gaps, in six exponentials, with no clipping and no depth
+// carried from piece to piece. In float the exponent τ_sun(lo) + κ·τ is good to a few ulps
+// of its larger term: a relative error of about 1e-7·τ_sun(lo), which only a sun grazing a
+// dense fog makes visible.
 struct FogMapRun {
   bool open;
   float start, end;  // the open piece
-  float t;           // where the integration stands (the last closed piece's end, or a)
-  float depth;       // optical depth from a to t
   float sun;         // the in-scatter of the closed pieces
+  // The ray, set once: its stretch [lo, hi] inside the fog (lit: there is one, the sun is
+  // up and the fog scatters), its heights, κ, τ_sun(lo).
+  bool lit;
+  float lo, hi, kappa, sun_depth_lo;
+  FogHeights heights;
 };
+
+FogMapRun fog_map_run(FogMedium m, vec3 o, vec3 d, vec3 s, float a, float b) {
+  FogHeights h = fog_heights_of(m, o.y);
+  FogMapRun run = FogMapRun(false, 0.0, 0.0, 0.0, false, 0.0, 0.0, 0.0, 0.0, h);
+  FogClip clip = fog_clip_heights(h, d.y, a, b);
+  run.lit = !clip.empty && s.y > kFogMinSunY && m.albedo > 0.0;
+  if (!run.lit) return run;
+  run.lo = clip.t0;
+  run.hi = min(clip.t1, kFogFar);
+  run.kappa = fog_sun_rate(d.y, s.y);
+  run.sun_depth_lo = fog_sun_optical_depth_at(m, fog_height_at(h, d.y, run.lo), h.top, s.y);
+  return run;
+}
 
 void fog_map_close(inout FogMapRun run, FogMedium m, vec3 o, vec3 d, vec3 s) {
   if (!run.open) return;
   run.open = false;
-  if (run.start > run.t) run.depth += fog_optical_depth(m, o, d, run.t, run.start);
-  if (run.depth > kFogMaxDepth) return;  // nothing further can add
-  FogSegment lit = fog_lit_segment(m, o, d, s, run.start, run.end, run.depth);
-  run.sun += lit.sun;
-  run.depth += lit.depth;
-  run.t = run.end;
+  float t0 = max(run.start, run.lo), t1 = min(run.end, run.hi);
+  if (!run.lit || !(t1 > t0)) return;
+  float tau0 = fog_clipped_optical_depth(m, run.heights, d.y, run.lo, t0);
+  float dtau = fog_clipped_optical_depth(m, run.heights, d.y, t0, t1);
+  if (dtau == 0.0) return;
+  float anchor = run.kappa >= 0.0 ? tau0 : tau0 + dtau;
+  run.sun += fog_flush_tiny(m.albedo * fog_transmittance_of_depth(run.sun_depth_lo + run.kappa * anchor) *
+                            fog_exp_integral(dtau, abs(run.kappa)));
 }
 
 void fog_map_add(inout FogMapRun run, FogMedium m, vec3 o, vec3 d, vec3 s, float a, float b) {
@@ -93,7 +124,7 @@ float fog_map_sun(FogMedium m, vec3 o, vec3 d, vec3 s, float a, float b, vec3 ey
   float h0 = dot(p, to_sun), hd = dot(d, to_sun);
   bool climbs = hd >= 0.0;
   float inv_hd = 1.0 / (hd != 0.0 ? hd : 1e-30);
-  FogMapRun run = FogMapRun(false, 0.0, 0.0, a, 0.0, 0.0);
+  FogMapRun run = fog_map_run(m, o, d, s, a, b);
   float g0 = a, g1 = b;
   if (!fog_map_clip(ax, bx, ay, by, size, g0, g1)) {
     fog_map_add(run, m, o, d, s, a, b);
