@@ -1,7 +1,7 @@
 // document_files.h — what the studio does with files (docs/spec/studio.md "Never blocking, never
 // losing work"): saves are atomic (write_file_atomically, docs/spec/cli.md), an edited document is
-// autosaved beside itself as `.NAME.autosave`, and a file's identity on disk (mtime,
-// size) is remembered so a change by another program is noticed.
+// autosaved beside itself as `.NAME.autosave`, and a file's identity on disk (inode,
+// mtime, ctime, size) is remembered so a change by another program is noticed.
 #pragma once
 
 #include <cstdint>
@@ -14,9 +14,15 @@ namespace sylva::studio {
 // fallback name, e.g. "untitled.lsys" in the working folder).
 std::string autosave_path(const std::string& path);
 
-// What a file looked like on disk, to notice changes made by others.
+// What a file looked like on disk, to notice changes made by others. The times alone are
+// not enough: a file system's clock may tick every few milliseconds (or every second), so
+// two same-sized writes within one tick look alike. An atomic replacement (an editor's
+// save, write_file_atomically, `git checkout`) always brings a new inode — the old one is
+// still in use until the rename — so the device and inode catch those; ctime catches a
+// change of the file's status by chmod or an in-place write in a later tick.
 struct FileStamp {
-  int64_t mtime_ns = 0;
+  uint64_t device = 0, inode = 0;
+  int64_t mtime_ns = 0, ctime_ns = 0;
   int64_t size = -1;  // -1: no such file
   bool operator==(const FileStamp&) const = default;
 };

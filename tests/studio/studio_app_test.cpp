@@ -376,14 +376,35 @@ TEST_F(Fixture, ReloadsAFileChangedOnDisk) {
   changed.replace(changed.find("#define N 4"), 11, "#define N 2");
   std::this_thread::sleep_for(std::chrono::milliseconds(20));
   ASSERT_TRUE(write_file_atomically(path, changed).ok());
+  const auto first_write = std::filesystem::last_write_time(path);
   ASSERT_TRUE(ui.until(*app, [&] { return app->text() == changed && viewport.segments == 3u; }));
   EXPECT_FALSE(app->dirty());
-  // With unsaved edits the user is asked instead.
+  // With unsaved edits the user is asked instead — even when the second write is the same
+  // size and lands in the same tick of the file system's clock (as on CI's file system,
+  // where this once went unnoticed): the replacement is a new file.
   click_line_end(*app, 8);
   ui.type(*app, "F");
   ASSERT_TRUE(write_file_atomically(path, kTree).ok());
+  std::filesystem::last_write_time(path, first_write);
   ASSERT_TRUE(ui.until(*app, [&] { return app->external_change_prompt_open(); }));
   EXPECT_NE(app->text(), kTree);
+}
+
+// The stamp tells two same-sized replacements apart even with equal times (a coarse clock).
+TEST(FileStamps, ASameSizedReplacementInTheSameClockTickIsAChange) {
+  const std::string file = (std::filesystem::temp_directory_path() / "sylva_stamp_test.txt").string();
+  ASSERT_TRUE(write_file_atomically(file, "abc").ok());
+  const FileStamp before = stamp_of(file);
+  const auto t = std::filesystem::last_write_time(file);
+  ASSERT_TRUE(write_file_atomically(file, "xyz").ok());
+  std::filesystem::last_write_time(file, t);
+  const FileStamp after = stamp_of(file);
+  EXPECT_EQ(after.size, before.size);
+  EXPECT_EQ(after.mtime_ns, before.mtime_ns);
+  EXPECT_NE(after, before);
+  EXPECT_EQ(stamp_of(file), after) << "an unchanged file keeps its stamp";
+  std::filesystem::remove(file);
+  EXPECT_EQ(stamp_of(file).size, -1);
 }
 
 TEST_F(Fixture, CameraAndSunReRenderWithoutRegrowing) {
