@@ -506,8 +506,8 @@ struct Attachment {
   double continuation_cos = 0;      // cos of that child's angle to this chain's end
 };
 
-// Unit direction of a chain at joint `k`: the mean of the directions into and out of it
-// (coincident joints skipped); nullopt for a chain of one point.
+}  // namespace
+
 std::optional<dvec3> chain_direction_at(const Skeleton& sk, const Chain& ch, uint32_t k) {
   dvec3 p = joint_position(sk.joints[ch.first_joint + k]);
   dvec3 sum(0);
@@ -522,6 +522,8 @@ std::optional<dvec3> chain_direction_at(const Skeleton& sk, const Chain& ch, uin
   if (!(glm::length(sum) > 1e-12)) return std::nullopt;
   return glm::normalize(sum);
 }
+
+namespace {
 
 std::vector<Attachment> attachments(const Skeleton& sk) {
   std::vector<Attachment> at(sk.chains.size());

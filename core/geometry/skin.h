@@ -161,6 +161,10 @@ SkinnedSkeleton skin_skeleton(const Skeleton& skeleton, const SkinOptions& optio
 Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& skeleton, const SkinOptions& options,
                                         const Progress& progress);
 
+// Unit direction of chain `ch` at its joint `k`: the mean of the directions into and out
+// of it (coincident joints skipped); none for a chain of one point.
+std::optional<glm::dvec3> chain_direction_at(const Skeleton& skeleton, const Chain& ch, uint32_t k);
+
 // For each chain, the child chain that carries its axis on (docs/joints.md
 // "Continuations"): of the children attached at its last joint (which must have a radius),
 // the one most in line with it, within 45°; -1 where there is none. skin_skeleton's smooth

@@ -1,0 +1,119 @@
+// crotch.h — the blended crotch where a lateral leaves its parent (docs/joints.md
+// "Crotches"): the region, the field whose zero set is the blended surface, and the ray
+// march through it. Geometry only: the renderers and the mesh are to draw it (not yet
+// wired; docs/joints.md says what is built).
+//
+// Units and frames: world space, metres, Y up, doubles, as skin.h.
+//
+// The blend is extra material, never less. Each frustum's solid has a signed bound
+// `frustum_bound` (1-Lipschitz, <= 0 exactly on the solid, at most the distance to the
+// solid outside it); a group's bound is the least of its frusta's (their union). A crotch
+// holds two groups — the parent's (the parent chain, its continuation and the lateral's
+// siblings from the same joint) and the lateral's — and inside its ball the smooth union
+//     F(p) = smin(P(p), C(p), k(p)),  smin(a, b, k) = min(a, b) − max(k − |a − b|, 0)² / (4k)
+// (the quadratic smooth minimum), with k(p) falling smoothly to 0 at the ball's rim and
+// where the lateral's cross-section is wholly under the parent's surface (else the start
+// of a thick lateral would swell the parent all round the joint). Since smin <= min, the
+// blended solid {F <= 0} holds the exact union, and equals it wherever k = 0 and wherever
+// |P − C| >= k: it only fills the crease. F >= min(P, C) − k/4: the bulge is at most k/4.
+//
+// Preconditions: the frusta are skin_skeleton's for the skeleton (indices as there).
+#pragma once
+
+#include <cstdint>
+#include <glm/vec3.hpp>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "core/geometry/ray_frustum.h"  // Ray
+#include "core/geometry/skin.h"
+
+namespace sylva {
+
+// Signed bound of a frustum's solid at `p`: max of the cone's apex-free distance
+// (ρ − r(y)) / sqrt(1 + slope²) and the two planes' (dot(n, p) − offset outward). It is
+// 1-Lipschitz, <= 0 exactly where p is in the solid (between the planes, ρ <= r(y)), and
+// outside the solid at most the distance to it (so a sphere tracer's step never passes
+// the surface). Inside, it is at least minus the distance to the boundary... only where
+// the cone term is the largest; no claim is made there.
+double frustum_bound(const FrustumShape& shape, const glm::dvec3& p);
+
+struct CrotchOptions {
+  double blend = 0.5;        // k at the crotch's centre, as a share of the lateral's radius
+  double min_ratio = 0.25;   // no crotch for a lateral under this share of its parent's
+                             // radius (the collars' rule: a needle's crotch is too small to see)
+};
+
+// One blended crotch.
+struct Crotch {
+  uint32_t lateral = 0;         // the lateral chain
+  glm::dvec3 start{0};          // the lateral's first joint (on its parent's axis)
+  glm::dvec3 direction{0, 1, 0};// unit, along its first segment
+  glm::dvec3 centre{0};         // where its axis leaves the parent's surface
+  double radius = 0;            // the ball: F = min(P, C) outside it
+  double k = 0;                 // blend width at the centre, metres
+  double lateral_radius = 0;    // the lateral's radius at its start
+  std::vector<uint32_t> parent_frusta;   // indices into the frusta: the parent group
+  std::vector<uint32_t> lateral_frusta;  // ... the lateral group (within the ball)
+  // The parent group's depth below its surface (−P) of the lateral's axis point at
+  // s = (i + 0.5) · depth_step along `direction` from `start`, i < depth.size();
+  // linear in between, clamped at the ends.
+  std::vector<double> depth;
+  double depth_step = 0;
+};
+
+// Every crotch of a skinned skeleton: one per lateral (a child chain that is not its
+// parent's continuation, continuation_children) of at least min_ratio of its parent's
+// radius at the joint, whose first segment leaves the parent. Deterministic, in chain order.
+std::vector<Crotch> find_crotches(const Skeleton& skeleton, std::span<const Frustum> frusta,
+                                  const CrotchOptions& options = {});
+
+// The two groups' bounds and the blend at a point.
+struct CrotchSample {
+  double value = 0;    // F(p)
+  double parent = 0;   // P(p)
+  double lateral = 0;  // C(p)
+  double k = 0;        // k(p)
+  double h = 0;        // weight of the parent's surface in the shading mix, [0, 1]:
+                       // 1 where P is far below C, 0 where C is, 0.5 on the crease
+};
+CrotchSample crotch_field(const Crotch& crotch, std::span<const Frustum> frusta, const glm::dvec3& p);
+
+// How a point of the blended surface is shaded (docs/joints.md "Crotches"): in each group
+// the frustum whose slab (between its two planes) holds the point — of those, the least
+// bound; the least bound where none does — not simply the least bound, which switches
+// between the two frusta of a mitre off their shared plane, where eq. 8's normals and
+// (u, v) differ. The normal is normalize(mix(n_lateral, n_parent, h)) of the two eq. 8
+// normals (the fillet's bounds have kinks, so a gradient of F would not be smooth), the
+// colour is to be the same mix of the two textures at their own (u, v_m), and the relief
+// is scaled by 1 − 4h(1 − h), 0 on the crease. Where h is 0 or 1 all of it is the exact
+// surface's, so nothing jumps at the fillet's edge.
+struct CrotchShade {
+  uint32_t parent_frustum = 0;   // index into the frusta
+  uint32_t lateral_frustum = 0;
+  glm::dvec3 normal{0, 1, 0};    // unit, outward
+  SurfaceUV parent_uv, lateral_uv;
+  double h = 0;                  // the parent's weight
+  double relief_scale = 1;       // 1 − 4h(1 − h)
+};
+CrotchShade crotch_shade(const Crotch& crotch, std::span<const Frustum> frusta, const glm::dvec3& p);
+
+// Largest |∇F| the step is divided by: 1 for the bounds, plus what the fading k adds
+// (docs/joints.md: the ball's fade ≤ 1.54·k/R·(1/4), the depth fade ≤ 1.5·(1/4)).
+inline constexpr double kCrotchLipschitz = 1.6;
+
+// The first point of the ray inside the ball where F crosses 0 from outside, with
+// t_min < t < t_max; none when the ray misses the ball, never reaches F = 0 inside it, or
+// enters the ball already inside the blended solid (the exact frusta's surface is then
+// in front). Sphere tracing with steps F / kCrotchLipschitz (at least 1e-3/4 of the
+// ball's radius, for grazing rays), a step that lands inside bisected back to a bracket
+// of 1e-7 of the radius.
+struct CrotchHit {
+  double t = 0;
+  int steps = 0;  // field evaluations
+};
+std::optional<CrotchHit> march_crotch(const Crotch& crotch, std::span<const Frustum> frusta, const Ray& ray,
+                                      double t_min, double t_max);
+
+}  // namespace sylva
