@@ -1,0 +1,68 @@
+// crotch_mesh.h — a crotch's fillet (crotch.h, docs/joints.md "Crotches") as triangles, for
+// the paths that draw meshes (glTF, the polygon baseline), beside the frusta's own mesh.
+//
+// Units and frames: world space, metres, Y up, doubles, as crotch.h; the mesh's
+// conventions are tessellate.h's (normals unit, uv = (u turns, v_m metres), triangles
+// counter-clockwise seen from outside, triangle_frustum an index into the frusta).
+//
+// Naive surface nets on a cubic grid of `cell_m` over the ball: one vertex a cell the
+// field changes sign in (the mean of its edges' crossings, moved onto F = 0 by Newton
+// steps), one quad of the four cells round each edge the field changes sign along. Of
+// those quads only the ones on the fillet are kept: with a vertex off the exact union
+// (more than 1e-6 of the ball's radius outside both groups, where the blend acts, k > 0),
+// or with vertices on both groups' surfaces where the blend acts (the quad across the
+// crease: where the fillet is narrower than a cell no vertex need lie on it, and without
+// that quad the crease would show through a gap). The frusta's mesh already draws the
+// rest, so the fillet adds nothing where the blend changes nothing, and where it is kept
+// it overlaps the frusta's mesh by about a cell (the renderers compose the two by depth,
+// as they do the exact frusta and the marched blend).
+//
+// A cell should be at most about k/2: the vertices sit on the surface but the facets
+// chamfer what is curved within a cell, and the acute side of a crotch is curved within
+// k (crotch_mesh_test: the marched fillet within 5.7 mm of the mesh at cells of k/3 =
+// 25 mm, within 22 mm at k/2 = 37.5 mm).
+//
+// Guarantees:
+// - Every vertex is on F = 0 to 1e-7 of the ball's radius, except where Newton steps do
+//   not settle within a cell of the crossings' mean (kinks of the bounds): that vertex is
+//   the mean, within about a cell's linear-interpolation error of the surface.
+// - Every vertex is within the ball and a cell or two beyond it, and at most k/4 (plus the
+//   above) outside the exact union, since the blend adds no more (crotch.h).
+// - Triangles are wound outward (toward F > 0), each quad split along its shorter diagonal;
+//   exactly degenerate ones are dropped.
+// - Normals are crotch_shade's mixed normal at the vertex (not the facets'; the bounds
+//   have kinks). A triangle takes the group that is heavier at its centroid (h >= 0.5:
+//   the parent's): triangle_frustum is that group's shading frustum there, and each of its
+//   corners has that group's (u, v_m) — a vertex used by triangles of both groups, or by
+//   one whose u crosses the seam (u then taken past 1), is repeated with the other uv, so
+//   no triangle interpolates between the two groups' coordinates or across the seam. The
+//   texture jumps where h crosses 0.5 (the renderers mix both textures; one uv cannot).
+// - Deterministic (grid order); empty when the crotch has no blend (k = 0).
+//
+// Cost: the 45° limb (r = 0.15 m) on a 0.3 m trunk of crotch_mesh_test makes 268
+// triangles at cells of k/3 and 148 at k/2; the field is sampled at (2⌈R/cell⌉ + 4)³
+// grid corners (R the ball's radius), and a few dozen times more at each vertex.
+#pragma once
+
+#include <span>
+#include <stdexcept>
+
+#include "core/geometry/crotch.h"
+#include "core/geometry/tessellate.h"
+
+namespace sylva {
+
+// The most cells a side of the grid may have (memory: one double a corner, one index a
+// cell); a smaller cell is refused.
+inline constexpr int kMaxCrotchGridCells = 256;
+
+// The fillet of one crotch as triangles, for the mesh paths (glTF, the polygon baseline):
+// only the part of the blended surface the exact frusta do not already have — where the
+// smooth union lies outside the exact union — so it overlaps the frusta's own mesh a
+// little and adds no triangle where the blend changes nothing. Throws
+// std::invalid_argument when cell_m is not > 0 or the grid would pass
+// kMaxCrotchGridCells a side. Preconditions: crotch.h's (the crotch is find_crotches'
+// for these frusta).
+TriangleMesh crotch_fillet_mesh(const Crotch& crotch, std::span<const Frustum> frusta, double cell_m);
+
+}  // namespace sylva
