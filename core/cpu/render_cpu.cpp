@@ -9,6 +9,7 @@
 #include "core/cpu/instance_tracer.h"
 #include "core/scene/instances.h"
 #include "core/scene/leaf_images.h"
+#include "core/cpu/crotch_tracer.h"
 #include "core/cpu/leaf_tracer.h"
 #include "core/cpu/mesh_accel.h"
 #include "core/cpu/photons.h"
@@ -233,10 +234,21 @@ class Renderer {
       return lit(albedo, n, ng, s.position, view, look.specular, rng, shadow_rays);
     }
     // A texture on the segments: the bark's (wood only), or the table's (scene.h segment_texture).
+    const auto footprint = [&] {
+      return uv_footprint(s, {h.ray.origin, h.ray.direction + direction_dx_},
+                          {h.ray.origin, h.ray.direction + direction_dy_});
+    };
     if (textures_ && textures_->has_albedo(s.plant, s.material)) {
-      const UvFootprint footprint = uv_footprint(s, {h.ray.origin, h.ray.direction + direction_dx_},
-                                                 {h.ray.origin, h.ray.direction + direction_dy_});
-      albedo = textures_->albedo(s.plant, s.material, s.u, s.v_m, footprint);
+      albedo = textures_->albedo(s.plant, s.material, s.u, s.v_m, footprint());
+    }
+    // A crotch's fillet (crotch_tracer.h): the other group's colour mixed in, sampled with
+    // this hit's footprint (the two frusta's texel sizes differ by their radii at most).
+    if (s.blend < 1) {
+      glm::dvec3 other = segment_look(scene_.materials, &plant.bark, s.material_other, leaf_images_).albedo;
+      if (textures_ && textures_->has_albedo(s.plant, s.material_other)) {
+        other = textures_->albedo(s.plant, s.material_other, s.u_other, s.v_m_other, footprint());
+      }
+      albedo = s.blend * albedo + (1 - s.blend) * other;
     }
     // A relief hit's shadow ray starts a pixel footprint above it (render_cpu.h).
     const bool relief = s.material == 0 && textures_ && options_.geometry.relief && textures_->has_height(s.plant) &&
@@ -368,6 +380,7 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
   uint32_t culled = 0, displaced = 0;
   TriangleMesh triangles;
   LeafMesh leaves;
+  std::vector<Crotch> crotches;
   for (uint32_t p = 0; p < scene.plants.size(); ++p) {
     if (progress.cancelled()) {  // between plants
       g.cancelled = true;
@@ -402,6 +415,13 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     const SkinnedSkeleton& skinned = *skinned_or;
     append_leaves(leaves, placed, p);
     const uint32_t first_frustum = static_cast<uint32_t>(g.frusta.size());
+    if (plant_skin.blend_crotches) {
+      for (Crotch& c : find_crotches(placed, skinned.frusta)) {
+        for (uint32_t& i : c.parent_frusta) i += first_frustum;
+        for (uint32_t& i : c.lateral_frusta) i += first_frustum;
+        crotches.push_back(std::move(c));
+      }
+    }
     g.frusta.insert(g.frusta.end(), skinned.frusta.begin(), skinned.frusta.end());
     g.plant_of_frustum.insert(g.plant_of_frustum.end(), skinned.frusta.size(), p);
     skin_s += seconds_since(start);
@@ -446,6 +466,10 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
       g.tracer = std::make_unique<MeshTracer>(std::move(triangles), g.frusta, g.plant_of_frustum, options.mesh_level,
                                               displaced > 0);
       break;
+  }
+  // Blended crotches (crotch_tracer.h) beside the frusta or mesh.
+  if (!crotches.empty()) {
+    g.tracer = std::make_unique<CrotchTracer>(std::move(crotches), g.frusta, g.plant_of_frustum, std::move(g.tracer));
   }
   // Leaves (leaf_tracer.h): their own triangles beside the frusta or mesh; a scene
   // without leaves keeps its tracer as it is.

@@ -104,7 +104,9 @@ std::vector<Crotch> find_crotches(const Skeleton& sk, std::span<const Frustum> f
     cr.centre = start + t_exit * *dir;
     cr.k = options.blend * r_l;
     cr.lateral_radius = r_l;
-    cr.radius = r_l / std::max(sin_t, 0.5) + cr.k;
+    // The crease lies within r / sin θ of the centre (for a parent much wider than the
+    // lateral): the ball holds it with room for the fade, which is still 0.84 there.
+    cr.radius = 1.5 * r_l / std::max(sin_t, 0.5) + cr.k;
     // The parent's group: the parent chain, its continuation, the lateral's siblings.
     std::vector<uint32_t> group_chains{pc};
     if (continuation[pc] >= 0 && continuation[pc] != int64_t(c)) group_chains.push_back(uint32_t(continuation[pc]));
@@ -137,7 +139,7 @@ CrotchSample crotch_field(const Crotch& c, std::span<const Frustum> frusta, cons
   s.lateral = group_bound(frusta, c.lateral_frusta, p);
   const double x2 = glm::dot(p - c.centre, p - c.centre) / (c.radius * c.radius);
   if (x2 < 1 && c.k > 0) {
-    const double ball = (1 - x2) * (1 - x2);
+    const double ball = (1 - x2 * x2) * (1 - x2 * x2);  // flat inside, C1 to 0 at the rim
     // Wholly under the parent's surface where the axis is deeper than the section's radius.
     const double d = depth_at(c, glm::dot(p - c.start, c.direction));
     const double u = std::clamp((d - c.lateral_radius) / c.k, 0.0, 1.0);

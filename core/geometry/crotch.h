@@ -40,7 +40,7 @@ namespace sylva {
 double frustum_bound(const FrustumShape& shape, const glm::dvec3& p);
 
 struct CrotchOptions {
-  double blend = 0.5;        // k at the crotch's centre, as a share of the lateral's radius
+  double blend = 0.8;        // k at the crotch's centre, as a share of the lateral's radius
   double min_ratio = 0.25;   // no crotch for a lateral under this share of its parent's
                              // radius (the collars' rule: a needle's crotch is too small to see)
 };

@@ -111,6 +111,10 @@ struct SkinOptions {
   double collar_flare = 1.3;        // >= 1: collar radius / branch radius at the surface
   double round_bends_over_deg = 20; // bends sharper than this are rounded by an arc ...
   double round_piece_deg = 10;      // ... of pieces that each turn at most this much
+  // Blended crotches (crotch.h, docs/joints.md "Crotches"): a fillet where each lateral
+  // leaves its parent, drawn by the CPU ray caster. Off by default until GL and the mesh
+  // draw it too (the backends must agree); the frusta are the same either way.
+  bool blend_crotches = false;
 
   // These options with the joints of `style`: smooth keeps them; paper (sec. 2 as
   // published: laterals start with a plain capped cylinder, chain ends are flat caps and
@@ -122,6 +126,7 @@ struct SkinOptions {
       o.collars = false;
       o.round_bends_over_deg = 180;
       o.round_piece_deg = 180;
+      o.blend_crotches = false;
     }
     return o;
   }

@@ -36,6 +36,12 @@ struct SurfaceHit {
   uint32_t material = 0;                 // material index of the segment
   uint32_t frustum = 0;                  // index into SceneGeometry::frusta (a leaf: none, 0)
   uint32_t leaf = kNoLeaf;               // a leaf hit: index into the plant's Skeleton::leaves
+  // A crotch fillet's hit (crotch.h, docs/joints.md): its colour is the mix of two
+  // textures, this hit's (material, u, v_m) with weight `blend` and the other group's
+  // (material_other, u_other, v_m_other) with 1 − blend. 1 on every other surface.
+  double blend = 1;
+  double u_other = 0, v_m_other = 0;
+  uint32_t material_other = 0;
 
   static constexpr uint32_t kNoLeaf = 0xFFFFFFFFu;
   bool is_leaf() const { return leaf != kNoLeaf; }

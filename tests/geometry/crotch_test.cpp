@@ -102,7 +102,7 @@ TEST(Crotch, OneCrotchWhereTheLimbLeavesTheTrunkOnItsSurfaceAndNoneForTheTwig) {
   const Crotch& c = crotches[0];
   EXPECT_EQ(c.lateral, 1u);
   EXPECT_NEAR(std::hypot(c.centre.x, c.centre.z), 0.3, 1e-9) << "on the trunk's surface";
-  EXPECT_NEAR(c.k, 0.075, 1e-15);
+  EXPECT_NEAR(c.k, 0.12, 1e-15);
   for (uint32_t i : c.parent_frusta) EXPECT_NE(skinned.frusta[i].chain, 1u) << "the trunk's and the twig's";
   for (uint32_t i : c.lateral_frusta) EXPECT_EQ(skinned.frusta[i].chain, 1u);
   EXPECT_FALSE(c.parent_frusta.empty());

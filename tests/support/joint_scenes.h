@@ -111,6 +111,9 @@ struct SurfaceDefects {
   double convex_crease_deg = 0;  // from the depth field's normals
   double convex_normal_jump_deg = 0;  // from the normal AOV
   uint64_t pairs = 0;            // pixel pairs measured
+  double concave_crease_deg = 0; // the same measure for concave pairs (a crotch's crease)
+  uint64_t concave_pairs = 0;
+  int concave_x = -1, concave_y = -1;   // where the largest concave crease begins
   int x = -1, y = -1;            // the pixel where the largest crease (depth) begins
   std::string describe() const {
     return "largest convex crease " + std::to_string(convex_crease_deg) + "° (depth, at pixel " +
@@ -194,6 +197,14 @@ inline SurfaceDefects surface_defects(const Scene& scene, const RenderImage& ima
         const glm::dvec3 a = p[idx(x, y)], c = p[idx(cx, cy)];
         const glm::dvec3 na = *n[idx(x, y)], nc = *n[idx(cx, cy)];
         const double tiny = 1e-3 * footprint[idx(x, y)];
+        if (glm::dot(na, c - a) > tiny && glm::dot(nc, a - c) > tiny) {  // concave
+          ++d.concave_pairs;
+          if (angle_deg(na, nc) > d.concave_crease_deg) {
+            d.concave_crease_deg = angle_deg(na, nc);
+            d.concave_x = x, d.concave_y = y;
+          }
+          continue;
+        }
         if (!(glm::dot(na, c - a) < -tiny && glm::dot(nc, a - c) < -tiny)) continue;  // not convex
         ++d.pairs;
         if (angle_deg(na, nc) > d.convex_crease_deg) {
