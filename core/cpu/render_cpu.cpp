@@ -1,5 +1,6 @@
 // render_cpu.cpp — the CPU reference ray caster (see render_cpu.h for the shading model).
 #include "core/cpu/render_cpu.h"
+#include "core/geometry/crotch_mesh.h"
 #include "core/geometry/plant_mesh.h"
 
 #include "core/scene/culling.h"
@@ -415,7 +416,7 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     const SkinnedSkeleton& skinned = *skinned_or;
     append_leaves(leaves, placed, p);
     const uint32_t first_frustum = static_cast<uint32_t>(g.frusta.size());
-    if (plant_skin.blend_crotches) {
+    if (plant_skin.blend_crotches && !mesh) {  // a mesh has its fillets' triangles
       for (Crotch& c : find_crotches(placed, skinned.frusta)) {
         for (uint32_t& i : c.parent_frusta) i += first_frustum;
         for (uint32_t& i : c.lateral_frusta) i += first_frustum;
@@ -430,6 +431,7 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     const HeightFn height = options.displace && textures ? height_function_for(*textures, p) : HeightFn{};
     TriangleMesh part = plant_mesh(skinned, tessellation, height, plant.bark.relief_depth_m,
                                    options.relief_options.max_depth_per_radius, &tessellate_s, &displace_s);
+    if (plant_skin.blend_crotches) append_mesh(part, skeleton_fillets(placed, skinned.frusta), 0);
     if (height) ++displaced;
     start = Clock::now();
     if (triangles.positions.empty()) {  // the first plant's mesh is taken, not copied

@@ -203,4 +203,13 @@ TriangleMesh crotch_fillet_mesh(const Crotch& crotch, std::span<const Frustum> f
   return mesh;
 }
 
+TriangleMesh skeleton_fillets(const Skeleton& skeleton, std::span<const Frustum> frusta) {
+  TriangleMesh out;
+  for (const Crotch& c : find_crotches(skeleton, frusta)) {
+    if (!(c.k > 0)) continue;
+    append_mesh(out, crotch_fillet_mesh(c, frusta, c.k / 2), 0);
+  }
+  return out;
+}
+
 }  // namespace sylva

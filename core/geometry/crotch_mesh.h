@@ -65,4 +65,10 @@ inline constexpr int kMaxCrotchGridCells = 256;
 // for these frusta).
 TriangleMesh crotch_fillet_mesh(const Crotch& crotch, std::span<const Frustum> frusta, double cell_m);
 
+// Every crotch of a skinned skeleton (find_crotches with the default options) as one mesh,
+// each at cells of k/2 (within about 8 mm of the marched fillet on the test limb, about
+// 370 triangles a crotch), triangle_frustum indexing `frusta`: what the mesh paths and GL
+// append beside the frusta's own mesh where SkinOptions::blend_crotches is on.
+TriangleMesh skeleton_fillets(const Skeleton& skeleton, std::span<const Frustum> frusta);
+
 }  // namespace sylva

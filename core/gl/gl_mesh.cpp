@@ -3,6 +3,8 @@
 // displace), uploaded once and rasterised into the ray caster's G-buffer. See gl_mesh.h.
 #include "core/gl/gl_mesh.h"
 
+#include "core/geometry/crotch_mesh.h"
+
 #include <algorithm>
 #include <climits>
 #include <cstddef>
@@ -168,6 +170,7 @@ struct MeshDraw {
 struct GlMesh::State {
   RenderOptions options;
   bool leaves = false;  // leaves_of: the scene's leaves instead of its tessellated frusta
+  bool fillets = false;  // fillets_of: the crotches' fillets instead of the tessellated frusta
   std::vector<RenderPass> setup_passes;
   std::vector<GlMeshSphere> spheres;
   uint64_t triangles = 0, drawn_triangles = 0, frusta = 0, gpu_bytes = 0;
@@ -266,16 +269,26 @@ struct GlMesh::State {
     const auto append = [&](uint32_t p, const Skeleton& skeleton, std::vector<GlMeshSphere>* out) -> size_t {
       const ScenePlant& plant = scene.plants[p];
       Clock::time_point start = Clock::now();
-      const SkinnedSkeleton skinned = skin_skeleton(skeleton, options.skin.styled(plant.skin));
+      const SkinOptions skin = options.skin.styled(plant.skin);
+      const SkinnedSkeleton skinned = skin_skeleton(skeleton, skin);
       skinned_frusta += skinned.frusta.size();
       skin_s += seconds_since(start);
-      // build_scene_geometry's mesh path: the same plant_mesh, within the same limit.
-      check_mesh_fits(tessellation_size(skinned.frusta.size(), tessellation),
-                      arrays.vertices.size() * sizeof(MeshVertex) + arrays.indices.size() * sizeof(uint32_t));
-      const HeightFn height = heights ? (*heights)[p] : HeightFn{};
-      const TriangleMesh part = plant_mesh(skinned, tessellation, height, plant.bark.relief_depth_m,
-                                           geometry.relief_options.max_depth_per_radius, &tessellate_s, &displace_s);
-      if (height) ++arrays.displaced_plants;
+      TriangleMesh part;
+      if (fillets) {
+        start = Clock::now();
+        if (skin.blend_crotches) part = skeleton_fillets(skeleton, skinned.frusta);
+        tessellate_s += seconds_since(start);
+      } else {
+        // build_scene_geometry's mesh path: the same plant_mesh, within the same limit,
+        // and the same fillets.
+        check_mesh_fits(tessellation_size(skinned.frusta.size(), tessellation),
+                        arrays.vertices.size() * sizeof(MeshVertex) + arrays.indices.size() * sizeof(uint32_t));
+        const HeightFn height = heights ? (*heights)[p] : HeightFn{};
+        part = plant_mesh(skinned, tessellation, height, plant.bark.relief_depth_m,
+                          geometry.relief_options.max_depth_per_radius, &tessellate_s, &displace_s);
+        if (skin.blend_crotches) append_mesh(part, skeleton_fillets(skeleton, skinned.frusta), 0);
+        if (height) ++arrays.displaced_plants;
+      }
       start = Clock::now();
       append_plant(arrays, part, skinned, p, out);
       tessellate_s += seconds_since(start);
@@ -304,6 +317,10 @@ struct GlMesh::State {
     if (displaced)
       setup_passes.push_back({"displace", displace_s,
                               std::to_string(arrays.displaced_plants) + " plants by their height maps"});
+    if (arrays.indices.empty()) {  // fillets_of with no crotch: nothing to upload or draw
+      gpu_bytes = 0;
+      return 0;
+    }
     return upload(arrays);
   }
 
@@ -470,9 +487,31 @@ struct GlMesh::State {
 
 GlMesh::GlMesh(const Scene& scene, const RenderOptions& options, int bark_texture_units)
     : state_(std::make_unique<State>()) {
+  state_->options = options;
+  state_->bark_texture_units = std::max(0, bark_texture_units);
+  finish_construction(scene);
+}
+
+GlMesh::GlMesh(const Scene& scene, const RenderOptions& options, int bark_texture_units, FilletsTag)
+    : state_(std::make_unique<State>()) {
+  state_->options = options;
+  state_->bark_texture_units = std::max(0, bark_texture_units);
+  state_->fillets = true;
+  finish_construction(scene);
+}
+
+std::unique_ptr<GlMesh> GlMesh::fillets_of(const Scene& scene, const RenderOptions& options, int bark_texture_units) {
+  const bool any = std::any_of(scene.plants.begin(), scene.plants.end(), [&](const ScenePlant& p) {
+    return p.skeleton && options.skin.styled(p.skin).blend_crotches;
+  });
+  if (!any) return nullptr;
+  auto mesh = std::unique_ptr<GlMesh>(new GlMesh(scene, options, bark_texture_units, FilletsTag{}));
+  if (mesh->triangles() == 0) return nullptr;
+  return mesh;
+}
+
+void GlMesh::finish_construction(const Scene& scene) {
   State& st = *state_;
-  st.options = options;
-  st.bark_texture_units = std::max(0, bark_texture_units);
   st.build(scene);
   double compile_s = 0;
   std::string names = st.variant(MeshPass::gbuffer).name;
@@ -513,6 +552,7 @@ uint64_t GlMesh::update(const Scene& scene) { return state_->build(scene); }
 
 void GlMesh::draw_gbuffer(const GlCameraView& camera, double footprint_scale) {
   State& st = *state_;
+  if (st.triangles == 0) return;
   const GLuint p = st.program(MeshPass::gbuffer, nullptr);
   set_camera_uniforms(p, camera);
   if (st.bark_texture_units > 0) set_uniform(p, "u_footprint_scale", footprint_scale);
@@ -522,6 +562,7 @@ void GlMesh::draw_gbuffer(const GlCameraView& camera, double footprint_scale) {
 
 void GlMesh::draw_shadow(const GlSunView& view) {
   State& st = *state_;
+  if (st.triangles == 0) return;
   const GLuint p = st.program(MeshPass::shadow, nullptr);
   set_sun_view_uniforms(p, view);
   st.draw(p);

@@ -104,6 +104,13 @@ class GlMesh {
   // applied in both passes (mesh_program's LEAF_IMAGES).
   static std::unique_ptr<GlMesh> leaves_of(const Scene& scene, const RenderOptions& options,
                                            std::shared_ptr<const LeafImages> images = nullptr);
+  // The blended crotches' fillets (crotch_mesh.h skeleton_fillets, docs/joints.md
+  // "Crotches") of the plants whose skin has SkinOptions::blend_crotches, drawn the same
+  // way with the bark, after the ray-cast frusta into the same G-buffer and shadow map (the
+  // CPU marches the same fillet; the mesh's facets are within about 8 mm of it on the test
+  // limb). Null when no plant has a fillet.
+  static std::unique_ptr<GlMesh> fillets_of(const Scene& scene, const RenderOptions& options,
+                                            int bark_texture_units = 0);
   ~GlMesh();
   GlMesh(const GlMesh&) = delete;
   GlMesh& operator=(const GlMesh&) = delete;
@@ -139,6 +146,9 @@ class GlMesh {
 
  private:
   struct LeavesTag {};
+  struct FilletsTag {};
+  GlMesh(const Scene& scene, const RenderOptions& options, int bark_texture_units, FilletsTag);
+  void finish_construction(const Scene& scene);
   GlMesh(const Scene& scene, const RenderOptions& options, std::shared_ptr<const LeafImages> images, LeavesTag);
   struct State;
   std::unique_ptr<State> state_;

@@ -221,6 +221,7 @@ struct GlRenderer::State {
   std::unique_ptr<GlBarkMaps> bark_maps;
   std::unique_ptr<GlMesh> mesh;      // GeometryKind::mesh: the polygon baseline, drawn instead of the frusta
   std::unique_ptr<GlMesh> leaves;    // the plants' leaves (GlMesh::leaves_of), drawn after either; null: none
+  std::unique_ptr<GlMesh> fillets;   // the crotches' fillets beside the frusta (GlMesh::fillets_of); null: none
   std::shared_ptr<const LeafImages> leaf_images;  // the table's leaf materials (leaf_images.h); null: none
 
   GlVertexArray vao;  // empty: the frusta pull their vertices from the records
@@ -622,6 +623,18 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options, std::sh
                                    (instances.empty() ? std::string()
                                                       : " + " + std::to_string(instances.size()) + " instances (48 B)")});
   }
+  // The crotches' fillets beside the ray-cast frusta (gl_mesh.h fillets_of; the mesh has
+  // its own in its triangles).
+  if (!st.mesh) {
+    st.fillets = GlMesh::fillets_of(scene, options, st.bark_maps->albedo() ? st.features.texture_units : 0);
+    if (st.fillets) {
+      st.uploaded_bytes += st.fillets->gpu_bytes();
+      for (RenderPass pass : st.fillets->setup_passes()) {
+        pass.name = "fillets " + pass.name;
+        st.setup_passes.push_back(std::move(pass));
+      }
+    }
+  }
   // The leaves (gl_mesh.h leaves_of): their own upload and programs.
   st.leaf_images = scene_leaf_images(scene);
   st.leaves = GlMesh::leaves_of(scene, options, st.leaf_images);
@@ -686,7 +699,7 @@ uint64_t GlRenderer::update_plants(const Scene& scene) {
     throw std::invalid_argument("GlRenderer::update_plants: the scene has " + std::to_string(scene.plants.size()) +
                                 " plants, the renderer " + std::to_string(st.plant_count));
   // The leaves are uploaded again whole (they move with their joints: animate.h).
-  const uint64_t leaf_bytes = st.leaves ? st.leaves->update(scene) : 0;
+  const uint64_t leaf_bytes = (st.leaves ? st.leaves->update(scene) : 0) + (st.fillets ? st.fillets->update(scene) : 0);
   if (st.mesh) {  // the polygon baseline is re-tessellated and uploaded whole
     const uint64_t uploaded = st.mesh->update(scene) + leaf_bytes;
     st.take_mesh_spheres();
@@ -716,7 +729,8 @@ uint64_t GlRenderer::update_plants(const Scene& scene) {
     st.instance_buffer = make_gl_buffer(instances.data(), instance_bytes);
     uploaded += ids.size() * sizeof(uint32_t) + instance_bytes;
     st.uploaded_bytes =
-        record_bytes + ids.size() * sizeof(uint32_t) + instance_bytes + (st.leaves ? st.leaves->gpu_bytes() : 0);
+        record_bytes + ids.size() * sizeof(uint32_t) + instance_bytes + (st.leaves ? st.leaves->gpu_bytes() : 0) +
+        (st.fillets ? st.fillets->gpu_bytes() : 0);
   }
   check_gl("update_plants");
   st.pending_plant_bytes += uploaded;
@@ -873,6 +887,7 @@ void GlRenderer::shadow_pass(Frame& f, const glm::dvec3& l) {
     glUseProgram(f.shadow_program);
     st.draw_frusta(f.shadow_program);
   }
+  if (st.fillets) st.fillets->draw_shadow(view);
   if (st.leaves) st.leaves->draw_shadow(view);
   st.timers.end();
 }
@@ -911,6 +926,7 @@ void GlRenderer::geometry_pass(Frame& f, double jitter_x, double jitter_y) {
       glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(f.eye_inside_frusta * gl::kPyramidVertices));
     }
   }
+  if (st.fillets) st.fillets->draw_gbuffer(f.camera_view, f.differential_step);
   if (st.leaves) st.leaves->draw_gbuffer(f.camera_view, f.differential_step);
   st.timers.end();
 }
