@@ -216,17 +216,29 @@ std::optional<CrotchHit> march_crotch(const Crotch& c, std::span<const Frustum> 
   const double speed = std::sqrt(a);
   const double min_step = 2.5e-4 * c.radius / speed;
   const double eps = 1e-7 * c.radius;
-  auto field = [&](double t) { return crotch_field(c, frusta, ray.origin + t * ray.direction).value; };
+  auto sample = [&](double t) { return crotch_field(c, frusta, ray.origin + t * ray.direction); };
+  auto field = [&](double t) { return sample(t).value; };
+  // How far the solid {F <= 0} is at least: its exact part (min(P, C) <= 0) is at least
+  // min(P, C) away, and its fillet (F <= 0 < min(P, C)) needs |P − C| < k and
+  // min(P, C) <= k/4, so max(P, C) < 5k/4, at least max(P, C) − 5k/4 away (P and C are
+  // 1-Lipschitz). That is often far more than F / kCrotchLipschitz: beside one group's
+  // surface, away from the other's, and where the march closes in on the exact surface.
+  auto clearance = [&](const CrotchSample& s) {
+    return std::max(s.value / kCrotchLipschitz,
+                    std::min(std::min(s.parent, s.lateral), std::max(s.parent, s.lateral) - 1.25 * c.k));
+  };
   CrotchHit hit;
-  double t = lo, f = field(t);
+  double t = lo;
+  CrotchSample s = sample(t);
   hit.steps = 1;
-  if (!(f > 0)) return std::nullopt;  // inside at entry: the exact surface is in front
+  if (!(s.value > 0)) return std::nullopt;  // inside at entry: the exact surface is in front
   constexpr int kMaxSteps = 4096;
   while (hit.steps < kMaxSteps) {
-    const double step = std::max(f / (kCrotchLipschitz * speed), min_step);
+    const double step = std::max(clearance(s) / speed, min_step);
     const double t_next = t + step;
     if (t_next >= hi) return std::nullopt;
-    const double f_next = field(t_next);
+    const CrotchSample s_next = sample(t_next);
+    const double f_next = s_next.value;
     ++hit.steps;
     if (f_next <= eps) {
       if (f_next >= 0) {
@@ -244,7 +256,7 @@ std::optional<CrotchHit> march_crotch(const Crotch& c, std::span<const Frustum> 
       return hit;
     }
     t = t_next;
-    f = f_next;
+    s = s_next;
   }
   return std::nullopt;
 }

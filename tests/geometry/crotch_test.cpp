@@ -172,7 +172,7 @@ TEST(Crotch, TheMarchFindsTheFirstCrossingThatAFineWalkFinds) {
   const Crotch& c = limb.crotch;
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(-1, 1);
-  int hits = 0, grazing = 0, max_steps = 0;
+  int hits = 0, grazing = 0, max_steps = 0, fillet_hits = 0;
   for (int i = 0; i < 400; ++i) {
     const dvec3 target = c.centre + 0.9 * c.radius * std::abs(u(rng)) * random_unit(rng);
     const dvec3 origin = c.centre + 3 * c.radius * random_unit(rng);
@@ -189,6 +189,12 @@ TEST(Crotch, TheMarchFindsTheFirstCrossingThatAFineWalkFinds) {
     const std::optional<double> want = fine_walk(c, skinned.frusta, ray, lo, hi, 1e-4 * c.radius / speed);
     ASSERT_EQ(got.has_value(), want.has_value()) << "ray " << i;
     if (got) {
+      const CrotchSample at = crotch_field(c, skinned.frusta, ray.origin + got->t * ray.direction);
+      if (std::min(at.parent, at.lateral) > 1e-6 * c.radius) {
+        ++fillet_hits;
+      }
+    }
+    if (got) {
       ++hits;
       EXPECT_NEAR(got->t * speed, *want * speed, 2e-5 * c.radius) << "ray " << i;
       max_steps = std::max(max_steps, got->steps);
@@ -196,7 +202,9 @@ TEST(Crotch, TheMarchFindsTheFirstCrossingThatAFineWalkFinds) {
     }
   }
   EXPECT_GT(hits, 100);
-  std::printf("march: %d hits of 400 rays, at most %d field evaluations, %d over 100\n", hits, max_steps, grazing);
+  EXPECT_GT(fillet_hits, 20);
+  std::printf("march: %d hits of 400 rays (%d on the fillet), at most %d field evaluations, %d over 100\n", hits,
+              fillet_hits, max_steps, grazing);
 }
 
 // Along a fan of rays across the crease, the shading normal of the blended surface turns
