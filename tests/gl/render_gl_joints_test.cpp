@@ -61,6 +61,25 @@ TEST(RenderGlJoints, TheBlendedCrotchesFilletMeshMatchesTheCpusMarchedFillet) {
   }
 }
 
+TEST(RenderGlJoints, NoPixelSeesInsideAnotherSolidWithTheBlend) {
+  // tests/cpu/render_joints_test.cpp's measure on GL's depth AOV, the fillets drawn as
+  // triangles (their vertices outside the exact union, their chords too): nothing seen
+  // lies inside a solid by more than the depth's float rounding (measured at most 4.7e-7 m;
+  // the crown's crack of the exact joints is covered by its fillets here too).
+  SYLVA_REQUIRE_GL();
+  RenderOptions o;
+  o.aovs = kAovDepth;
+  o.spp = 1;
+  o.skin.blend_crotches = true;
+  for (const test::JointCloseUp& c : test::joint_close_ups()) {
+    const test::InsideView v = test::deepest_inside_view(c.scene, gl_test::gl_render(c.scene, o).image, o.skin);
+    std::printf("[ joints ] %-12s GL blend: deepest inside another solid %.2e m (pixel %d, %d)\n", c.name.c_str(),
+                v.deepest_m, v.x, v.y);
+    EXPECT_GT(v.pixels, 1000u) << c.name;
+    EXPECT_LT(v.deepest_m, 1e-5) << c.name;
+  }
+}
+
 TEST(RenderGlJoints, ThePapersSkinByTheScenesKeyMatchesTheCpu) {
   // The `skin` key reaches the GL skinning too (render_gl.cpp skin_one): the paper's
   // mitred close-ups agree with the CPU's, and differ from the smooth ones.

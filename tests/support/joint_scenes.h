@@ -12,6 +12,8 @@
 // facet) and, separately, from the normal AOV (what shading sees).
 #pragma once
 
+#include "core/geometry/crotch.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -298,6 +300,41 @@ inline UvContinuity uv_continuity(const Scene& scene, const RenderImage& image) 
     }
   }
   return out;
+}
+
+// How deep the surface a pixel sees lies inside a solid it should not show: for every hit
+// pixel (depth AOV), the point seen and, over every frustum of every plant (skinned with
+// `skin`), the most negative frustum_bound (crotch.h) other than those of the frusta whose
+// surface it is on — i.e. the largest depth inside another solid. A union of solids drawn by
+// nearest hit, with or without fillets (which lie outside the exact union), shows none.
+struct InsideView {
+  double deepest_m = 0;  // the deepest a seen point lies inside a solid, metres (0: none)
+  uint64_t pixels = 0;   // hit pixels measured
+  int x = -1, y = -1;
+};
+inline InsideView deepest_inside_view(const Scene& scene, const RenderImage& image, const SkinOptions& skin) {
+  std::vector<Frustum> frusta;
+  for (const ScenePlant& plant : scene.plants) {
+    const SkinnedSkeleton s = skin_skeleton(place_plant(plant), skin.styled(plant.skin));
+    frusta.insert(frusta.end(), s.frusta.begin(), s.frusta.end());
+  }
+  const render_common::CameraFrame f = render_common::camera_frame(scene);
+  InsideView v;
+  for (uint32_t y = 0; y < image.height; ++y) {
+    for (uint32_t x = 0; x < image.width; ++x) {
+      const double z = image.depth[static_cast<size_t>(y) * image.width + x];
+      if (!std::isfinite(z)) continue;
+      const Ray r = render_common::frame_ray(f, x + 0.5, y + 0.5);
+      const glm::dvec3 p = r.origin + z * glm::normalize(r.direction);
+      ++v.pixels;
+      // The point is on (or, by rounding, just inside) the solids it bounds: its own
+      // frusta's bounds are ~0; another solid's interior is what is measured.
+      double deepest = 0;
+      for (const Frustum& fr : frusta) deepest = std::min(deepest, frustum_bound(fr.shape, p));
+      if (-deepest > v.deepest_m) v.deepest_m = -deepest, v.x = static_cast<int>(x), v.y = static_cast<int>(y);
+    }
+  }
+  return v;
 }
 
 }  // namespace sylva::test
