@@ -144,6 +144,18 @@ def test_leaves_are_arrays_matching_the_json():
     assert sk.leaf_vertices.shape == (sum(sk.leaves["vertex_count"]), 3)
 
 
+def test_a_double_sided_leafs_back_material_is_its_own():
+    # docs/leaves.md "Two colours": a leaf with a `back_material` (a cpfg double-sided
+    # surface's) shows it in the records; the leaf without one keeps its front's.
+    sk = sylva.Grammar("angle: 60\naxiom: F[&F'(1){.+f.-f.-f.}]F{.+f.-f.-f.+|+f.-f.}\n").grow()
+    doc = json.loads(sk.to_json())
+    doc["leaves"][1]["back_material"] = 5
+    two = sylva.Skeleton.from_json(json.dumps(doc), "two.skel.json")
+    np.testing.assert_array_equal(two.leaves["material"], sk.leaves["material"])
+    np.testing.assert_array_equal(two.leaves["back_material"], [sk.leaves["material"][0], 5])
+    assert json.loads(two.to_json())["leaves"][1]["back_material"] == 5
+
+
 def test_a_skeleton_without_leaves_has_empty_leaf_arrays(elm):
     assert elm.leaf_count == 0
     assert elm.leaves.shape == (0,) and elm.leaf_vertices.shape == (0, 3)
