@@ -15,6 +15,7 @@
 
 #include "core/cpu/frustum_accel.h"
 #include "core/cpu/leaf_tracer.h"
+#include "core/geometry/closest_point.h"
 #include "core/geometry/leaf_mesh.h"
 #include "core/geometry/relief.h"
 #include "core/geometry/skin.h"
@@ -111,35 +112,6 @@ PrimitiveHit nearest_primitive(const LightScene& s, const Ray& ray, double t_min
     h.t_after = exit + 1e-9 * (1 + std::abs(exit));
   }
   return h;
-}
-
-double point_segment_distance(const dvec3& p, const dvec3& a, const dvec3& b) {
-  const dvec3 ab = b - a;
-  const double len2 = glm::dot(ab, ab);
-  const double t = len2 > 0 ? std::clamp(glm::dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
-  return glm::length(p - (a + t * ab));
-}
-
-// Distance from p to triangle abc (Ericson, Real-Time Collision Detection, 5.1.5).
-double point_triangle_distance(const dvec3& p, const dvec3& a, const dvec3& b, const dvec3& c) {
-  const dvec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return glm::length(p - a);
-  const dvec3 bp = p - b;
-  const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return glm::length(p - b);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return glm::length(p - (a + d1 / (d1 - d3) * ab));
-  const dvec3 cp = p - c;
-  const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return glm::length(p - c);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return glm::length(p - (a + d2 / (d2 - d6) * ac));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return glm::length(p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b)));
-  const double denom = 1 / (va + vb + vc);
-  return glm::length(p - (a + ab * (vb * denom) + ac * (vc * denom)));
 }
 
 // ---- Sensors -------------------------------------------------------------------------

@@ -12,64 +12,16 @@
 #include <limits>
 #include <random>
 
+#include "core/geometry/closest_point.h"
+#include "tests/support/limb_crotch.h"
+
 namespace sylva {
 namespace {
 
 using glm::dvec3;
 
-Joint joint_at(dvec3 p, double radius) { return Joint{{p.x, p.y, p.z}, radius, 0}; }
-
-void add_chain(Skeleton& sk, const std::vector<dvec3>& points, const std::vector<double>& radii,
-               std::optional<ChainParent> parent) {
-  Chain ch{static_cast<uint32_t>(sk.joints.size()), static_cast<uint32_t>(points.size()), parent};
-  for (size_t i = 0; i < points.size(); ++i) sk.joints.push_back(joint_at(points[i], radii[i]));
-  sk.chains.push_back(ch);
-}
-
-// crotch_test's: a trunk of radius 0.3 with, from its middle joint, a limb at 45° (radius
-// 0.15) and a twig at 60° on the other side (under a quarter of the trunk's: no crotch).
-Skeleton limb_on_trunk() {
-  Skeleton sk;
-  add_chain(sk, {{0, 0, 0}, {0, 1, 0}, {0, 2, 0}}, {0.3, 0.3, 0.28}, std::nullopt);
-  const double s = std::sqrt(0.5);
-  add_chain(sk, {{0, 1, 0}, {1.2 * s, 1 + 1.2 * s, 0}}, {0.15, 0.12}, ChainParent{0, 1});
-  add_chain(sk, {{0, 1, 0}, {-0.8 * std::sin(1.047), 1 + 0.8 * std::cos(1.047), 0}}, {0.05, 0.04}, ChainParent{0, 1});
-  return sk;
-}
-
-struct LimbCrotch {
-  Skeleton skeleton = limb_on_trunk();
-  SkinnedSkeleton skinned = skin_skeleton(skeleton);
-  Crotch crotch = find_crotches(skeleton, skinned.frusta).at(0);
-};
-
-dvec3 random_unit(std::mt19937_64& rng) {
-  std::normal_distribution<double> n;
-  return glm::normalize(dvec3(n(rng), n(rng), n(rng)));
-}
-
-// Distance from p to the triangle abc (Ericson, Real-Time Collision Detection 5.1.5).
-double point_triangle_distance(const dvec3& p, const dvec3& a, const dvec3& b, const dvec3& c) {
-  const dvec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return glm::length(p - a);
-  const dvec3 bp = p - b;
-  const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return glm::length(p - b);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return glm::length(p - (a + d1 / (d1 - d3) * ab));
-  const dvec3 cp = p - c;
-  const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return glm::length(p - c);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return glm::length(p - (a + d2 / (d2 - d6) * ac));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
-    return glm::length(p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b)));
-  }
-  const double denom = 1 / (va + vb + vc);
-  return glm::length(p - (a + ab * (vb * denom) + ac * (vc * denom)));
-}
+using test::LimbCrotch;
+using test::random_unit;
 
 double distance_to_mesh(const TriangleMesh& mesh, const dvec3& p) {
   double best = std::numeric_limits<double>::infinity();
@@ -78,15 +30,6 @@ double distance_to_mesh(const TriangleMesh& mesh, const dvec3& p) {
     best = std::min(best, point_triangle_distance(p, mesh.positions[i[0]], mesh.positions[i[1]], mesh.positions[i[2]]));
   }
   return best;
-}
-
-TEST(CrotchMesh, PointTriangleDistanceOfTheTestIsRight) {
-  const dvec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
-  EXPECT_NEAR(point_triangle_distance({0.2, 0.2, 0.5}, a, b, c), 0.5, 1e-15);  // over the face
-  EXPECT_NEAR(point_triangle_distance({-1, -1, 0}, a, b, c), std::sqrt(2.0), 1e-15);  // vertex a
-  EXPECT_NEAR(point_triangle_distance({0.5, -2, 0}, a, b, c), 2, 1e-15);  // edge ab
-  EXPECT_NEAR(point_triangle_distance({1, 1, 0}, a, b, c), std::sqrt(0.5), 1e-15);  // edge bc
-  EXPECT_NEAR(point_triangle_distance({3, 0, 0}, a, b, c), 2, 1e-15);  // vertex b
 }
 
 // At cells of k/3 and k/2: every vertex on the blended surface within the ball, off the
@@ -172,7 +115,7 @@ TEST(CrotchMesh, TheMeshCoversTheFilletTheMarcherSees) {
 }
 
 TEST(CrotchMesh, NoBlendNoTriangles) {
-  const Skeleton sk = limb_on_trunk();
+  const Skeleton sk = test::limb_on_trunk();
   const SkinnedSkeleton skinned = skin_skeleton(sk);
   const std::vector<Crotch> crotches = find_crotches(sk, skinned.frusta, CrotchOptions{0.0, 0.25});
   ASSERT_EQ(crotches.size(), 1u);

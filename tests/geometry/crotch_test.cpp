@@ -8,37 +8,15 @@
 #include <glm/geometric.hpp>
 #include <random>
 
+#include "tests/support/limb_crotch.h"
+
 namespace sylva {
 namespace {
 
 using glm::dvec3;
 
-Joint joint_at(dvec3 p, double radius) { return Joint{{p.x, p.y, p.z}, radius, 0}; }
-
-void add_chain(Skeleton& sk, const std::vector<dvec3>& points, const std::vector<double>& radii,
-               std::optional<ChainParent> parent) {
-  Chain ch{static_cast<uint32_t>(sk.joints.size()), static_cast<uint32_t>(points.size()), parent};
-  for (size_t i = 0; i < points.size(); ++i) sk.joints.push_back(joint_at(points[i], radii[i]));
-  sk.chains.push_back(ch);
-}
-
-// A trunk of radius 0.3 with, from its middle joint, a limb at 45° (radius 0.15) and a
-// twig at 60° on the other side (radius 0.05, under a quarter of the trunk's).
-Skeleton limb_on_trunk() {
-  Skeleton sk;
-  add_chain(sk, {{0, 0, 0}, {0, 1, 0}, {0, 2, 0}}, {0.3, 0.3, 0.28}, std::nullopt);
-  const double s = std::sqrt(0.5);
-  add_chain(sk, {{0, 1, 0}, {1.2 * s, 1 + 1.2 * s, 0}}, {0.15, 0.12}, ChainParent{0, 1});
-  add_chain(sk, {{0, 1, 0}, {-0.8 * std::sin(1.047), 1 + 0.8 * std::cos(1.047), 0}}, {0.05, 0.04}, ChainParent{0, 1});
-  return sk;
-}
-
-// The limb's crotch, skinned smooth.
-struct LimbCrotch {
-  Skeleton skeleton = limb_on_trunk();
-  SkinnedSkeleton skinned = skin_skeleton(skeleton);
-  Crotch crotch = find_crotches(skeleton, skinned.frusta).at(0);
-};
+using test::LimbCrotch;
+using test::random_unit;
 
 bool inside(const FrustumShape& f, const dvec3& p) {
   const double y = glm::dot(p - f.base, f.axis);
@@ -46,11 +24,6 @@ bool inside(const FrustumShape& f, const dvec3& p) {
   const double r = f.radius_at(y);
   return glm::dot(f.lower.normal, p) >= f.lower.offset && glm::dot(f.upper.normal, p) <= f.upper.offset && r >= 0 &&
          rho <= r;
-}
-
-dvec3 random_unit(std::mt19937_64& rng) {
-  std::normal_distribution<double> n;
-  return glm::normalize(dvec3(n(rng), n(rng), n(rng)));
 }
 
 TEST(Crotch, TheFrustumBoundIsNegativeExactlyInsideAndOneLipschitz) {
@@ -95,7 +68,7 @@ TEST(Crotch, TheFrustumBoundIsNegativeExactlyInsideAndOneLipschitz) {
 }
 
 TEST(Crotch, OneCrotchWhereTheLimbLeavesTheTrunkOnItsSurfaceAndNoneForTheTwig) {
-  const Skeleton sk = limb_on_trunk();
+  const Skeleton sk = test::limb_on_trunk();
   const SkinnedSkeleton skinned = skin_skeleton(sk);
   const std::vector<Crotch> crotches = find_crotches(sk, skinned.frusta);
   ASSERT_EQ(crotches.size(), 1u);

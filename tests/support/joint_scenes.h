@@ -25,22 +25,13 @@
 #include <vector>
 
 #include "core/geometry/skin.h"
+#include "tests/support/skeleton_builder.h"
 #include "core/scene/render_common.h"
 #include "core/scene/render_types.h"
 #include "core/scene/scene.h"
 #include "core/util/math.h"
 
 namespace sylva::test {
-
-inline Joint joint_at(glm::dvec3 p, double radius) { return Joint{{p.x, p.y, p.z}, radius, 0}; }
-
-// Appends a chain through `points` with `radii`, attached to `parent`.
-inline void add_chain(Skeleton& sk, const std::vector<glm::dvec3>& points, const std::vector<double>& radii,
-                      std::optional<ChainParent> parent) {
-  const auto first = static_cast<uint32_t>(sk.joints.size());
-  for (size_t i = 0; i < points.size(); ++i) sk.joints.push_back(joint_at(points[i], radii[i]));
-  sk.chains.push_back(Chain{first, static_cast<uint32_t>(points.size()), parent});
-}
 
 struct JointCloseUp {
   std::string name;
