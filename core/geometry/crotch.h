@@ -1,7 +1,8 @@
 // crotch.h — the blended crotch where a lateral leaves its parent (docs/joints.md
 // "Crotches"): the region, the field whose zero set is the blended surface, and the ray
-// march through it. Geometry only: the renderers and the mesh are to draw it (not yet
-// wired; docs/joints.md says what is built).
+// march through it. Geometry only: the CPU ray caster marches it (core/cpu/crotch_tracer.h),
+// GL and the mesh paths draw its triangles (crotch_mesh.h), where SkinOptions::blend_crotches
+// asks (off by default; docs/joints.md says what is left).
 //
 // Units and frames: world space, metres, Y up, doubles, as skin.h.
 //

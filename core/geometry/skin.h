@@ -112,8 +112,9 @@ struct SkinOptions {
   double round_bends_over_deg = 20; // bends sharper than this are rounded by an arc ...
   double round_piece_deg = 10;      // ... of pieces that each turn at most this much
   // Blended crotches (crotch.h, docs/joints.md "Crotches"): a fillet where each lateral
-  // leaves its parent, drawn by the CPU ray caster. Off by default until GL and the mesh
-  // draw it too (the backends must agree); the frusta are the same either way.
+  // leaves its parent, marched by the CPU ray caster, drawn as triangles by GL and the
+  // mesh paths. Off by default until its cost is paid and it becomes the smooth skin's
+  // (docs/joints.md says what is left); the frusta are the same either way.
   bool blend_crotches = false;
 
   // These options with the joints of `style`: smooth keeps them; paper (sec. 2 as
