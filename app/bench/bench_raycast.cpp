@@ -237,27 +237,31 @@ int run_bench_raycast(const std::vector<std::string>& args) {
     r.bytes_per_segment = static_cast<double>(accel.memory_bytes()) / static_cast<double>(segments);
     results.push_back(r);
   }
-  {
-    // The blended crotches (docs/joints.md "Crotches", crotch_tracer.h) beside the frusta:
-    // what the fillets cost a primary ray, and how far they move the depth (they fill the
-    // creases: a change, not an error, measured against the exact frusta).
-    SkinOptions blended;
-    blended.blend_crotches = true;
-    const SceneGeometry with_fillets = build_scene_geometry(scene, blended);
-    MethodResult r{"crotch-blend"};
+  // The renderer's own tracer (SceneTracer::nearest: the hit shaded, its normal, uv and
+  // tangents) over the exact frusta, and with the blended crotches (docs/joints.md
+  // "Crotches", crotch_tracer.h) beside them: what the fillets cost a primary ray against
+  // its peer, and how far they move the depth (they fill the creases: a change, not an
+  // error, measured against the exact frusta).
+  auto run_scene_tracer = [&](const std::string& name, const SkinOptions& skin) {
+    const SceneGeometry traced = build_scene_geometry(scene, skin);
+    MethodResult r{name};
     auto trace = [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
-        const SurfaceHit h = with_fillets.tracer->nearest(rays[i], 0, std::numeric_limits<double>::infinity());
+        const SurfaceHit h = traced.tracer->nearest(rays[i], 0, std::numeric_limits<double>::infinity());
         depth[i] = h.hit() ? h.t * glm::length(rays[i].direction) : std::numeric_limits<double>::infinity();
       }
     };
     r.rays_per_s_1 = static_cast<double>(rays.size()) / time_trace(rays.size(), 1, repeats, trace);
     r.rays_per_s_all = static_cast<double>(rays.size()) / time_trace(rays.size(), all, repeats, trace);
     compare(reference, depth, scale, r);
-    r.bytes_per_segment = static_cast<double>(with_fillets.tracer->memory_bytes()) / static_cast<double>(segments);
-    std::printf("crotch-blend: %s\n", with_fillets.tracer->describe().c_str());
+    r.bytes_per_segment = static_cast<double>(traced.tracer->memory_bytes()) / static_cast<double>(segments);
+    std::printf("%s: %s\n", name.c_str(), traced.tracer->describe().c_str());
     results.push_back(r);
-  }
+  };
+  SkinOptions blended;
+  blended.blend_crotches = true;
+  run_scene_tracer("scene-tracer", SkinOptions{});
+  run_scene_tracer("crotch-blend", blended);
   run_embree("embree-curves", [&](RTCScene s) {
     // One vertex per joint (x, y, z, r); one index per segment (its first vertex). A
     // branch chain starts at its parent joint's position, so chains stay connected.

@@ -197,7 +197,7 @@ CrotchShade crotch_shade(const Crotch& c, std::span<const Frustum> frusta, const
 }
 
 std::optional<CrotchHit> march_crotch(const Crotch& c, std::span<const Frustum> frusta, const Ray& ray,
-                                      double t_min, double t_max) {
+                                      double t_min, double t_max, bool fillet_only) {
   // The ball, as a stable quadratic in t re-centred at the ball's centre.
   const dvec3 o = ray.origin - c.centre;
   const double a = glm::dot(ray.direction, ray.direction);
@@ -234,6 +234,7 @@ std::optional<CrotchHit> march_crotch(const Crotch& c, std::span<const Frustum> 
   if (!(s.value > 0)) return std::nullopt;  // inside at entry: the exact surface is in front
   constexpr int kMaxSteps = 4096;
   while (hit.steps < kMaxSteps) {
+    if (fillet_only && std::abs(s.parent - s.lateral) - 2 * (hi - t) * speed >= c.k) return std::nullopt;
     const double step = std::max(clearance(s) / speed, min_step);
     const double t_next = t + step;
     if (t_next >= hi) return std::nullopt;

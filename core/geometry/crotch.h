@@ -110,11 +110,17 @@ inline constexpr double kCrotchLipschitz = 1.6;
 // in front). Sphere tracing with steps F / kCrotchLipschitz (at least 1e-3/4 of the
 // ball's radius, for grazing rays), a step that lands inside bisected back to a bracket
 // of 1e-7 of the radius.
+//
+// With `fillet_only` (what a tracer that has the exact frusta's hit already asks) the march
+// also gives up as soon as no point of the rest of the ray can be on the fillet: there
+// |P − C| < k (else F = min(P, C)), and |P − C| is 2-Lipschitz, so once
+// |P − C| − 2·(distance left to t_max or the ball's exit) >= k only the exact surface is
+// ahead. A crossing it does return may still be the exact surface's.
 struct CrotchHit {
   double t = 0;
   int steps = 0;  // field evaluations
 };
 std::optional<CrotchHit> march_crotch(const Crotch& crotch, std::span<const Frustum> frusta, const Ray& ray,
-                                      double t_min, double t_max);
+                                      double t_min, double t_max, bool fillet_only = false);
 
 }  // namespace sylva

@@ -122,6 +122,7 @@
 #include "core/scene/animate.h"
 #include "core/scene/scene.h"
 #include "core/geometry/skeleton.h"
+#include "core/geometry/skin.h"
 #include "core/io/gltf_lod.h"
 #include "core/io/gltf_rig.h"
 #include "core/util/diagnostic.h"
@@ -238,6 +239,11 @@ struct GltfExportOptions {
   uint32_t card_pixels = 256;
   CardRenderer card_renderer = {};
   GltfCompression compress = GltfCompression::none;
+  // The skin options each plant's style is applied to (SkinOptions::styled) for its mesh
+  // and its levels of detail. With blend_crotches the full mesh (and NAME_LOD0) carries
+  // each crotch's fillet (crotch_mesh.h skeleton_fillets, docs/gltf.md "Crotches"); the
+  // coarser levels leave them out. Extras' "skinning" stays the default options' frusta.
+  SkinOptions skin = {};
 };
 
 // Writes `plants` to `path` (.glb or .gltf by extension). An error is a Diagnostic naming

@@ -38,6 +38,7 @@
 #include "core/scene/leaf_images.h"
 #include "core/scene/materials.h"
 #include "core/io/normal_map.h"
+#include "core/geometry/crotch_mesh.h"
 #include "core/geometry/skin.h"
 #include "core/geometry/tessellate.h"
 
@@ -964,12 +965,17 @@ std::string open_segment_attributes(const TriangleMesh& tm, const SkinnedSkeleto
 }
 
 // The segments of `skinned` tessellated (tessellate.h), one primitive per material index
-// in increasing order, with the bark's textures on the wood.
-Status add_segment_mesh(const SkinnedSkeleton& skinned, const Bark& bark, const GltfExportOptions& options,
-                        const PlantRig* rig, const WindSource* wind, GltfDocument& doc, MeshPrimitives& primitives) {
+// in increasing order, with the bark's textures on the wood; with `fillets_of` (the
+// skeleton `skinned` is of) each crotch's fillet too (crotch_mesh.h): its triangles are in
+// the material of their heavier group's frustum, and its vertices are weighted, carry wind
+// data and tangents as that frustum's own (each fillet vertex belongs to one group).
+Status add_segment_mesh(const SkinnedSkeleton& skinned, const Skeleton* fillets_of, const Bark& bark,
+                        const GltfExportOptions& options, const PlantRig* rig, const WindSource* wind,
+                        GltfDocument& doc, MeshPrimitives& primitives) {
   TessellateOptions to;
   to.segments_around = options.segments_around;
-  const TriangleMesh tm = tessellate(skinned, to);
+  TriangleMesh tm = tessellate(skinned, to);
+  if (fillets_of) append_mesh(tm, skeleton_fillets(*fillets_of, skinned.frusta), 0);
   if (tm.indices.empty()) return {};
   const std::map<uint32_t, std::vector<uint32_t>> triangles_of = triangles_by_material(
       tm.indices, tm.triangle_count(), [&](size_t t) { return skinned.frusta[tm.triangle_frustum[t]].material; });
@@ -1297,12 +1303,15 @@ void add_rig_nodes(GltfDocument& doc, const GltfPlant& plant, const Rig& rig,
 }
 
 // The surface of one skeleton (the plant, or a level of detail of it: its chains and
-// joints indexed as the plant's): the tessellated segments and the leaves.
-Status add_surface(const Skeleton& sk, const SkinnedSkeleton& skinned, const Bark& bark,
+// joints indexed as the plant's): the tessellated segments, with `fillets` the crotches'
+// fillets, and the leaves.
+Status add_surface(const Skeleton& sk, const SkinnedSkeleton& skinned, bool fillets, const Bark& bark,
                    const GltfExportOptions& options, const PlantRig* rig, const WindSource* wind, GltfDocument& doc,
                    MeshPrimitives& primitives) {
   if (options.mesh && !skinned.frusta.empty())
-    if (Status added = add_segment_mesh(skinned, bark, options, rig, wind, doc, primitives); !added) return added;
+    if (Status added = add_segment_mesh(skinned, fillets ? &sk : nullptr, bark, options, rig, wind, doc, primitives);
+        !added)
+      return added;
   if (options.mesh && !sk.leaves.empty())
     if (Status added = add_leaf_mesh(sk, options, rig, wind, doc, primitives); !added) return added;
   return {};
@@ -1375,8 +1384,9 @@ Status add_plant_group(GltfDocument& doc, const std::vector<GltfPlant>& plants, 
   const size_t plant_index = group.plants.front();
   const GltfPlant& plant = plants[plant_index];
   const Skeleton& sk = plant.skeleton;
-  const SkinOptions skin_options = SkinOptions{}.styled(plant.skin);
+  const SkinOptions skin_options = options.skin.styled(plant.skin);
   const SkinnedSkeleton skinned = skin_skeleton(sk, skin_options);
+  const bool fillets = skin_options.blend_crotches;  // the crotches' fillets, on the full mesh only
   const std::optional<PlantRig> plant_rig = rig ? std::optional<PlantRig>(PlantRig{*rig, sk}) : std::nullopt;
   const PlantRig* weights = plant_rig ? &*plant_rig : nullptr;
   const std::optional<WindSource> wind_source =
@@ -1402,14 +1412,15 @@ Status add_plant_group(GltfDocument& doc, const std::vector<GltfPlant>& plants, 
             !added)
           return added;
       } else if (level == 0) {
-        if (Status added = add_surface(sk, skinned, plant.bark, options, weights, wind, doc, level_primitives); !added)
+        if (Status added = add_surface(sk, skinned, fillets, plant.bark, options, weights, wind, doc, level_primitives);
+            !added)
           return added;
       } else {
         GltfExportOptions level_options = options;
         level_options.segments_around = lod_columns(options.segments_around, level);
         const Skeleton& coarse = coarse_levels[level - 1];
-        if (Status added = add_surface(coarse, skin_skeleton(coarse, skin_options), plant.bark, level_options, weights,
-                                       wind, doc, level_primitives);
+        if (Status added = add_surface(coarse, skin_skeleton(coarse, skin_options), false, plant.bark, level_options,
+                                       weights, wind, doc, level_primitives);
             !added)
           return added;
       }
@@ -1418,11 +1429,12 @@ Status add_plant_group(GltfDocument& doc, const std::vector<GltfPlant>& plants, 
   } else if (rig) {
     MeshPrimitives& skinned_primitives = surfaces.emplace_back(plant.name + "_skin", MeshPrimitives{}).second;
     skinned_primitives.json.begin_array();
-    if (Status added = add_surface(sk, skinned, plant.bark, options, weights, wind, doc, skinned_primitives); !added)
+    if (Status added = add_surface(sk, skinned, fillets, plant.bark, options, weights, wind, doc, skinned_primitives);
+        !added)
       return added;
     skinned_primitives.json.end_array();
   } else {
-    if (Status added = add_surface(sk, skinned, plant.bark, options, weights, wind, doc, primitives); !added)
+    if (Status added = add_surface(sk, skinned, fillets, plant.bark, options, weights, wind, doc, primitives); !added)
       return added;
   }
   primitives.json.end_array();

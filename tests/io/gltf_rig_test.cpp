@@ -15,11 +15,14 @@
 #include <map>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "core/io/gltf.h"
 #include "core/scene/animate.h"
 #include "tests/io/tinygltf_read.h"
+#include "core/geometry/crotch_mesh.h"
+#include "tests/support/limb_crotch.h"
 #include "tests/support/plants.h"
 
 namespace sylva {
@@ -373,6 +376,66 @@ TEST(GltfWindData, PivotLevelAndPhaseOfEveryVertexAreItsChainsAndLeaves) {
   fs::remove(path);
   EXPECT_FALSE(export_gltf({plant}, path, {.wind_data = true}));
   EXPECT_FALSE(fs::exists(path));
+}
+
+// With SkinOptions::blend_crotches the mesh carries each crotch's fillet (crotch_mesh.h):
+// its triangles besides the frusta's, every fillet vertex written, riding on the trunk's or
+// the limb's chain in the wind data; the coarser levels of detail leave them out.
+TEST(GltfCrotches, TheMeshCarriesTheFilletsWithTheirChainsWindData) {
+  GltfPlant plant;
+  plant.name = "limb";
+  plant.skeleton = test::limb_on_trunk();
+  const Skeleton& sk = plant.skeleton;
+  SkinOptions blended;
+  blended.blend_crotches = true;
+  const TriangleMesh fillets = skeleton_fillets(sk, skin_skeleton(sk).frusta);
+  ASSERT_GT(fillets.triangle_count(), 100u);
+  auto triangles_and_positions = [&](const GltfExportOptions& options, const std::string& name) {
+    const std::string path = temp_path(name);
+    EXPECT_TRUE(export_gltf({plant}, path, options));
+    tinygltf::Model model;
+    EXPECT_TRUE(load_with_tinygltf(path, &model));
+    size_t triangles = 0;
+    std::vector<glm::dvec3> positions;
+    std::vector<glm::dvec3> pivots;
+    for (const tinygltf::Primitive& prim : model.meshes.at(0).primitives) {
+      if (prim.mode != TINYGLTF_MODE_TRIANGLES) continue;
+      triangles += model.accessors.at(static_cast<size_t>(prim.indices)).count / 3;
+      const std::vector<float> p = floats_of(model, prim.attributes.at("POSITION"));
+      const std::vector<float> xy = floats_of(model, prim.attributes.at("TEXCOORD_2"));
+      const std::vector<float> zl = floats_of(model, prim.attributes.at("TEXCOORD_3"));
+      for (size_t v = 0; v < p.size() / 3; ++v) {
+        positions.emplace_back(p[3 * v], p[3 * v + 1], p[3 * v + 2]);
+        pivots.emplace_back(xy[2 * v], xy[2 * v + 1], zl[2 * v]);
+      }
+    }
+    fs::remove(path);
+    return std::make_tuple(triangles, positions, pivots);
+  };
+  const GltfExportOptions plain_options{.mesh = true, .wind_data = true};
+  GltfExportOptions blended_options = plain_options;
+  blended_options.skin = blended;
+  const auto [plain, plain_positions, plain_pivots] = triangles_and_positions(plain_options, "plain.glb");
+  const auto [with, positions, pivots] = triangles_and_positions(blended_options, "blended.glb");
+  EXPECT_EQ(with, plain + fillets.triangle_count());
+  // Every fillet vertex is written, pivoting about the first joint of the trunk or the limb.
+  size_t on_trunk = 0, on_limb = 0;
+  for (const glm::dvec3& want : fillets.positions) {
+    size_t found = positions.size();
+    for (size_t v = 0; v < positions.size() && found == positions.size(); ++v)
+      if (glm::length(positions[v] - want) < 1e-5) found = v;
+    ASSERT_LT(found, positions.size()) << want.x << ", " << want.y << ", " << want.z;
+    if (glm::length(pivots[found] - joint_position(sk, sk.chains[0].first_joint)) < 1e-5) ++on_trunk;
+    if (glm::length(pivots[found] - joint_position(sk, sk.chains[1].first_joint)) < 1e-5) ++on_limb;
+  }
+  EXPECT_GT(on_trunk, 10u);
+  EXPECT_GT(on_limb, 10u);
+  EXPECT_EQ(on_trunk + on_limb, fillets.positions.size());
+  // The paper's skin has no fillets, whatever the options ask.
+  plant.skin = SkinStyle::paper;
+  const auto [paper, paper_positions, paper_pivots] = triangles_and_positions(blended_options, "paper.glb");
+  const auto [paper_plain, pp, pq] = triangles_and_positions(plain_options, "paper_plain.glb");
+  EXPECT_EQ(paper, paper_plain);
 }
 
 TEST(SwayLoop, ALoopPeriodRoundsEveryFrequencySoTheSwayRepeats) {
