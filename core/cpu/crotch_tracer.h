@@ -1,56 +1,67 @@
 // crotch_tracer.h — the blended crotches (core/geometry/crotch.h, docs/joints.md
-// "Crotches") in the CPU ray caster: an Embree user geometry over their balls beside the
-// scene's other geometry, one SceneTracer over both, so that primary rays, shadow rays and
-// the fog's shadow rays see the fillets wherever they see wood.
+// "Crotches") in the CPU ray caster: their balls as extra primitives of the frusta's own
+// Embree scene (frustum_accel.h ExtraPrimitives; FrustumTracer takes them), so that a ray
+// walks one BVH, and primary rays, shadow rays and the fog's shadow rays see the fillets
+// wherever they see wood.
 //
 // A fillet is extra material in front of the exact frusta, never behind them (F <= the
-// union's bound), so a nearest query asks the other geometry first and the crotches only
-// up to its hit; a crotch hit counts only where it is in front of the exact surface by more
-// than 10⁻⁶ of its ball's radius — where the blend changes nothing, the march converges on
-// the exact surface and the exact hit (its relief, its caps) is kept.
+// union's bound). A ball's march asks for the fillet only (march_crotch's fillet_only) up
+// to the nearer of the frusta's hit so far and the fillets' so far; a crossing counts
+// (in_front) only where it is in front of the frusta's final hit by more than 10⁻⁶ of its
+// ball's radius — where the blend changes nothing, the march converges on the exact
+// surface and the exact hit (its relief, its caps) is kept.
 //
-// What a fillet hit reports (SurfaceHit): t and position in double; geometric_normal =
+// What a fillet hit reports (describe): t and position in double; geometric_normal =
 // shading_normal = crotch_shade's mixed eq. 8 normal; the heavier group's frustum (h >= ½:
 // the parent's) for plant, chain, segment, material, frustum, u, v_m and the tangents, and
 // the other group's (u, v_m, material) as `*_other` with `blend` = max(h, 1 − h).
 //
-// A shadow ray (`any`) is marched from 10⁻³ of a ball's radius past its start, so that a
-// ray leaving a fillet does not find the fillet it left along the field's kinks.
+// A shadow ray (occludes) is marched from 10⁻³ of a ball's radius past its start, so that
+// a ray leaving a fillet does not find the fillet it left along the field's kinks.
 //
-// Not seen by: the sun photons (photons.cpp traces frusta directly) and the `?E` light —
-// docs/joints.md says so. Preconditions: `frusta` and `plant_of_frustum` are the scene's,
-// with the crotches' indices into them, and outlive the tracer. Thread-safe for concurrent
-// queries.
+// The sun photons (photons.cpp) trace the same balls beside their frusta. Not seen by the
+// `?E` light — docs/joints.md says so. Preconditions: `frusta` (and the plant indices given to
+// describe) are the scene's, with the crotches' indices into them, and outlive this object.
+// Thread-safe for concurrent queries.
 #pragma once
 
-#include <memory>
 #include <span>
-#include <string>
 #include <vector>
 
+#include "core/cpu/frustum_accel.h"
 #include "core/geometry/crotch.h"
 #include "core/geometry/surface.h"
 
 namespace sylva {
 
-class CrotchTracer final : public SceneTracer {
+class CrotchBalls final : public ExtraPrimitives {
  public:
-  CrotchTracer(std::vector<Crotch> crotches, std::span<const Frustum> frusta,
-               std::span<const uint32_t> plant_of_frustum, std::unique_ptr<SceneTracer> other);
-  ~CrotchTracer() override;
-  CrotchTracer(const CrotchTracer&) = delete;
-  CrotchTracer& operator=(const CrotchTracer&) = delete;
+  CrotchBalls(std::vector<Crotch> crotches, std::span<const Frustum> frusta);
 
-  SurfaceHit nearest(const Ray& ray, double t_min, double t_max) const override;
-  bool any(const Ray& ray, double t_min, double t_max) const override;
-  Aabb bounds() const override;
-  size_t memory_bytes() const override;
-  // The other geometry's line, then ", N blended crotches".
-  std::string describe() const override;
+  uint32_t count() const override { return static_cast<uint32_t>(crotches_.size()); }
+  Aabb bounds(uint32_t index) const override;
+  std::optional<double> intersect(uint32_t index, const Ray& ray, double t_min, double t_max) const override;
+  bool occludes(uint32_t index, const Ray& ray, double t_min, double t_max) const override;
+
+  // Whether crotch `index`'s crossing at t is its fillet: in front of the frusta's hit at
+  // t_exact (infinity: none) by more than the march's tolerance.
+  bool in_front(uint32_t index, const Ray& ray, double t, double t_exact) const;
+  // The fillet hit at t of crotch `index`, described for shading (above); plant from
+  // `plant_of_frustum`.
+  SurfaceHit describe(uint32_t index, const Ray& ray, double t, std::span<const uint32_t> plant_of_frustum) const;
+  // The frustum that describe() names for the point p of crotch `index`'s fillet (the
+  // heavier group's shading frustum).
+  uint32_t frustum_at(uint32_t index, const glm::dvec3& p) const;
+  // Each ball's centre and radius (a caller's own bounds: the photons' mask).
+  const Crotch& crotch(uint32_t index) const { return crotches_[index]; }
+
+  // Every ball's box, grown together (empty when there are none).
+  Aabb all_bounds() const;
+  size_t memory_bytes() const;
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  std::vector<Crotch> crotches_;
+  std::span<const Frustum> frusta_;
 };
 
 }  // namespace sylva

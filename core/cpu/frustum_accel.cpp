@@ -33,6 +33,8 @@ struct QueryContext {
   double t_min;
   double t_best;
   BvhHit best;
+  const ExtraPrimitives* extra;  // null: none
+  ExtraHit extra_best;           // the nearest extra crossing before t_best
 };
 
 struct GeometryData {
@@ -42,6 +44,7 @@ struct GeometryData {
   const CustomFrustumIntersector* custom;
   glm::dvec3 centre;
   double pad;
+  const ExtraPrimitives* extra;  // null: none
 };
 
 // A fresh query for `ray` in (t_min, t_max).
@@ -57,6 +60,7 @@ QueryContext start_query(const GeometryData& data, const Ray& ray, double t_min,
   q.ray = ray;
   q.t_min = t_min;
   q.t_best = t_max;
+  q.extra = data.extra;
   return q;
 }
 
@@ -99,6 +103,29 @@ void occluded_callback(const RTCOccludedFunctionNArguments* args) {
   reinterpret_cast<RTCRay*>(args->ray)->tfar = -kInfF;  // Embree's "occluded" mark
 }
 
+// The extra primitives' callbacks (frustum_accel.h): their crossings are kept in the
+// query, never written to Embree's ray, so they never cull a frustum.
+void extra_bounds_callback(const RTCBoundsFunctionArguments* args) {
+  const auto* data = static_cast<const GeometryData*>(args->geometryUserPtr);
+  EmbreeScene::write_bounds(args->bounds_o, data->extra->bounds(args->primID), data->centre, data->pad);
+}
+
+void extra_intersect_callback(const RTCIntersectFunctionNArguments* args) {
+  if (!args->valid[0]) return;
+  auto* q = reinterpret_cast<QueryContext*>(args->context);
+  const double t_max = q->extra_best.hit() ? std::min(q->t_best, q->extra_best.t) : q->t_best;
+  const std::optional<double> t = q->extra->intersect(args->primID, q->ray, q->t_min, t_max);
+  if (t && *t < t_max) q->extra_best = {args->primID, *t};
+}
+
+void extra_occluded_callback(const RTCOccludedFunctionNArguments* args) {
+  if (!args->valid[0]) return;
+  auto* q = reinterpret_cast<QueryContext*>(args->context);
+  if (!q->extra->occludes(args->primID, q->ray, q->t_min, q->t_best)) return;
+  q->extra_best = {args->primID, q->t_min};
+  reinterpret_cast<RTCRay*>(args->ray)->tfar = -kInfF;  // Embree's "occluded" mark
+}
+
 }  // namespace
 
 struct FrustumAccel::Impl {
@@ -107,7 +134,7 @@ struct FrustumAccel::Impl {
   std::vector<double> reach;
 };
 
-FrustumAccel::FrustumAccel(std::span<const Frustum> frusta, CustomFrusta custom)
+FrustumAccel::FrustumAccel(std::span<const Frustum> frusta, CustomFrusta custom, const ExtraPrimitives* extra)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   // Centre and a padding that covers float rounding of rays far across the scene.
@@ -130,25 +157,36 @@ FrustumAccel::FrustumAccel(std::span<const Frustum> frusta, CustomFrusta custom)
   });
   glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
   for (const Aabb& b : chunk_box) lo = glm::min(lo, b.lo), hi = glm::max(hi, b.hi);
+  const uint32_t extras = extra ? extra->count() : 0;
+  for (uint32_t i = 0; i < extras; ++i) {
+    const Aabb b = extra->bounds(i);
+    lo = glm::min(lo, b.lo), hi = glm::max(hi, b.hi);
+  }
   m.data.frusta = frusta.data();
   m.data.reach = m.reach.data();
   m.data.custom_shell = has_custom ? custom.shell_m.data() : nullptr;
   m.data.custom = has_custom ? custom.intersector : nullptr;
-  m.data.centre = frusta.empty() ? glm::dvec3(0) : 0.5 * (lo + hi);
-  m.data.pad = frusta.empty() ? 0 : 1e-6 * glm::length(hi - lo);
+  const bool any = !frusta.empty() || extras > 0;
+  m.data.centre = any ? 0.5 * (lo + hi) : glm::dvec3(0);
+  m.data.pad = any ? 1e-6 * glm::length(hi - lo) : 0;
+  m.data.extra = extras > 0 ? extra : nullptr;
   m.embree.attach_user_geometry(static_cast<unsigned>(frusta.size()), &m.data, bounds_callback, intersect_callback,
                                 occluded_callback);
+  m.embree.attach_user_geometry(extras, &m.data, extra_bounds_callback, extra_intersect_callback,
+                                extra_occluded_callback);
   m.embree.commit();
 }
 
 FrustumAccel::~FrustumAccel() = default;
 
-BvhHit FrustumAccel::nearest(const Ray& ray, double t_min, double t_max, CustomHitDetail* detail) const {
+BvhHit FrustumAccel::nearest(const Ray& ray, double t_min, double t_max, CustomHitDetail* detail,
+                             ExtraHit* extra) const {
   QueryContext q = start_query(impl_->data, ray, t_min, t_max, detail);
   RTCRayHit rh{};
   rh.ray = EmbreeScene::embree_ray(ray, impl_->data.centre, t_min, t_max);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(impl_->embree.scene(), &q.embree, &rh);
+  if (extra) *extra = q.extra_best.hit() && q.extra_best.t < q.t_best ? q.extra_best : ExtraHit{};
   return q.best;
 }
 
@@ -156,7 +194,7 @@ bool FrustumAccel::any(const Ray& ray, double t_min, double t_max) const {
   QueryContext q = start_query(impl_->data, ray, t_min, t_max, nullptr);
   RTCRay r = EmbreeScene::embree_ray(ray, impl_->data.centre, t_min, t_max);
   rtcOccluded1(impl_->embree.scene(), &q.embree, &r);
-  return q.best.hit_any();
+  return q.best.hit_any() || q.extra_best.hit();
 }
 
 size_t FrustumAccel::memory_bytes() const {

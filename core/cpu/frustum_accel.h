@@ -16,10 +16,20 @@
 // shell_m[i], and every candidate ray goes to custom.intersector instead of
 // intersect_frustum. Other frusta take exactly the path they take without custom frusta
 // (one predictable branch per candidate more).
+//
+// Extra primitives (the blended crotches' balls, crotch_tracer.h): other shapes traced in
+// the same Embree scene as the frusta, so that a ray walks one BVH, not two. Their hits
+// are kept apart from the frusta's: nearest() reports the nearest frustum hit as always
+// and, in *extra, the nearest extra crossing (each extra is asked only up to the nearer of
+// the frusta's hit and the extras' so far: its own t_max), and the caller decides which to
+// keep. The frusta's hit is exactly the one without extras (an extra never shortens the
+// ray the frusta are culled with). A shadow ray (any()) is occluded by either.
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 
 #include "core/cpu/bvh.h"
@@ -53,20 +63,48 @@ struct CustomFrusta {
   const CustomFrustumIntersector* intersector = nullptr;
 };
 
+// Extra primitives traced beside the frusta (see the header comment). Called concurrently
+// from every querying thread.
+class ExtraPrimitives {
+ public:
+  virtual ~ExtraPrimitives() = default;
+  virtual uint32_t count() const = 0;
+  // A box holding primitive `index` (world space).
+  virtual Aabb bounds(uint32_t index) const = 0;
+  // The first t in (t_min, t_max) where `ray` meets primitive `index`, if any.
+  virtual std::optional<double> intersect(uint32_t index, const Ray& ray, double t_min, double t_max) const = 0;
+  // Whether a shadow ray meets it in (t_min, t_max).
+  virtual bool occludes(uint32_t index, const Ray& ray, double t_min, double t_max) const = 0;
+};
+
+// The nearest extra crossing of a query.
+struct ExtraHit {
+  static constexpr uint32_t kNone = 0xFFFFFFFFu;
+  uint32_t index = kNone;
+  double t = 0;
+  bool hit() const { return index != kNone; }
+};
+
 class FrustumAccel {
  public:
-  // Builds over `frusta`, which must outlive this object and stay unchanged.
-  explicit FrustumAccel(std::span<const Frustum> frusta, CustomFrusta custom = {});
+  // Builds over `frusta`, which must outlive this object and stay unchanged, and the
+  // `extra` primitives (null: none), which must outlive it too.
+  explicit FrustumAccel(std::span<const Frustum> frusta, CustomFrusta custom = {},
+                        const ExtraPrimitives* extra = nullptr);
   ~FrustumAccel();
   FrustumAccel(const FrustumAccel&) = delete;
   FrustumAccel& operator=(const FrustumAccel&) = delete;
 
   // The nearest hit with t_min < t < t_max (frustum index valid on a hit). When the hit is
   // on a custom frustum and `detail` is non-null, *detail is the intersector's detail.
-  BvhHit nearest(const Ray& ray, double t_min, double t_max, CustomHitDetail* detail = nullptr) const;
+  // With extra primitives and a non-null `extra`, *extra is their nearest crossing with
+  // t_min < t < t_max that lies before the frustum hit (if any).
+  BvhHit nearest(const Ray& ray, double t_min, double t_max, CustomHitDetail* detail = nullptr,
+                 ExtraHit* extra = nullptr) const;
   // Whether anything is hit with t_min < t < t_max (shadow rays).
   bool any(const Ray& ray, double t_min, double t_max) const;
-  // Bytes of the structure: Embree's allocations and each frustum's reach.
+  // Bytes of the structure: Embree's allocations and each frustum's reach (not what the
+  // extra primitives hold themselves).
   size_t memory_bytes() const;
 
  private:

@@ -4,6 +4,7 @@
 #include "core/cpu/bvh.h"  // frustum_bounds
 
 #include <glm/geometric.hpp>
+#include <limits>
 #include <numbers>
 #include <utility>
 
@@ -74,7 +75,7 @@ bool has_relief(const ReliefMap& map) { return map.field && map.depth_m > 0; }
 }  // namespace
 
 FrustumTracer::FrustumTracer(std::span<const Frustum> frusta, std::span<const uint32_t> plant_of_frustum,
-                             SceneRelief relief)
+                             SceneRelief relief, std::shared_ptr<const CrotchBalls> crotches)
     : frusta_(frusta),
       plant_of_frustum_(plant_of_frustum),
       relief_(std::move(relief)),
@@ -97,7 +98,8 @@ FrustumTracer::FrustumTracer(std::span<const Frustum> frusta, std::span<const ui
         return shell;
       }()),
       intersector_(*this),
-      accel_(frusta, CustomFrusta{shell_m_, &intersector_}) {
+      crotches_(crotches && crotches->count() > 0 ? std::move(crotches) : nullptr),
+      accel_(frusta, CustomFrusta{shell_m_, &intersector_}, crotches_.get()) {
   std::vector<char> plant_has_relief(relief_.plants.size(), 0);
   for (size_t i = 0; i < shell_m_.size(); ++i)
     if (shell_m_[i] > 0) ++relief_frusta_, plant_has_relief[plant_of_frustum_[i]] = 1;
@@ -108,11 +110,16 @@ FrustumTracer::FrustumTracer(std::span<const Frustum> frusta, std::span<const ui
     b.lo -= glm::dvec3(shell), b.hi += glm::dvec3(shell);
     grow(bounds_, b);
   }
+  if (crotches_) grow(bounds_, crotches_->all_bounds());
 }
 
 SurfaceHit FrustumTracer::nearest(const Ray& ray, double t_min, double t_max) const {
   CustomHitDetail detail;
-  const BvhHit hit = accel_.nearest(ray, t_min, t_max, &detail);
+  ExtraHit fillet;
+  const BvhHit hit = accel_.nearest(ray, t_min, t_max, &detail, crotches_ ? &fillet : nullptr);
+  const double t_exact = hit.hit_any() ? hit.hit.t : std::numeric_limits<double>::infinity();
+  if (fillet.hit() && crotches_->in_front(fillet.index, ray, fillet.t, t_exact))
+    return crotches_->describe(fillet.index, ray, fillet.t, plant_of_frustum_);
   if (!hit.hit_any()) return {};
   const Frustum& f = frusta_[hit.frustum];
   SurfaceHit s = !shell_m_.empty() && shell_m_[hit.frustum] > 0 ? describe_relief_hit(ray, f, hit.hit, detail)
@@ -128,12 +135,13 @@ bool FrustumTracer::any(const Ray& ray, double t_min, double t_max) const {
 
 size_t FrustumTracer::memory_bytes() const {
   return accel_.memory_bytes() + frusta_.size_bytes() + plant_of_frustum_.size_bytes() +
-         shell_m_.size() * sizeof(double);
+         shell_m_.size() * sizeof(double) + (crotches_ ? crotches_->memory_bytes() : 0);
 }
 
 std::string FrustumTracer::describe() const {
   std::string d = "Embree user geometry, " + std::to_string(frusta_.size()) + " analytic frusta";
   if (relief_frusta_) d += " (" + std::to_string(relief_frusta_) + " relief-mapped)";
+  if (crotches_) d += ", " + std::to_string(crotches_->count()) + " blended crotches";
   return d;
 }
 

@@ -12,6 +12,9 @@
 // mostly hides; the relief may protrude up to the depth beyond it at the rim. Plants
 // without relief take the exact path, at the exact path's speed.
 //
+// Blended crotches (crotch_tracer.h): given the crotches, their balls are extra primitives
+// of the same Embree scene, and a fillet in front of the frusta's hit is the hit.
+//
 // Preconditions: `frusta` and `plant_of_frustum` have equal sizes and outlive the tracer
 // unchanged; every ReliefMap's field outlives it. Thread-safe for concurrent queries.
 #pragma once
@@ -20,6 +23,7 @@
 #include <span>
 #include <vector>
 
+#include "core/cpu/crotch_tracer.h"
 #include "core/cpu/frustum_accel.h"
 #include "core/geometry/relief.h"
 #include "core/geometry/skin.h"
@@ -35,8 +39,10 @@ struct SceneRelief {
 
 class FrustumTracer final : public SceneTracer {
  public:
+  // With `crotches` (over these frusta) the blended crotches' fillets are traced too, in
+  // the same Embree scene (crotch_tracer.h).
   FrustumTracer(std::span<const Frustum> frusta, std::span<const uint32_t> plant_of_frustum,
-                SceneRelief relief = {});
+                SceneRelief relief = {}, std::shared_ptr<const CrotchBalls> crotches = nullptr);
 
   SurfaceHit nearest(const Ray& ray, double t_min, double t_max) const override;
   bool any(const Ray& ray, double t_min, double t_max) const override;
@@ -64,8 +70,9 @@ class FrustumTracer final : public SceneTracer {
   SceneRelief relief_;
   std::vector<double> shell_m_;  // per frustum: relief depth, 0 for exact frusta
   size_t relief_plants_ = 0, relief_frusta_ = 0;
-  Aabb bounds_ = empty_box();  // the frusta's boxes, each grown by its relief shell
+  Aabb bounds_ = empty_box();  // the frusta's boxes, each grown by its relief shell, and the crotches' balls
   ReliefIntersector intersector_;
+  std::shared_ptr<const CrotchBalls> crotches_;  // null: no blended crotches
   FrustumAccel accel_;
 };
 

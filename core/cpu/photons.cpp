@@ -17,6 +17,7 @@
 #include <time.h>
 
 #include "core/cpu/bvh.h"  // frustum_bounds
+#include "core/cpu/crotch_tracer.h"
 #include "core/cpu/frustum_accel.h"
 #include "core/cpu/instance_tracer.h"
 #include "core/cpu/leaf_tracer.h"
@@ -101,12 +102,15 @@ struct PlacedPlants {
   std::span<const TracedInstance> instances;
 
   // f(shape) for every instance's frustum placed in the world, g(a, b, c) for every
-  // instance's leaf triangle.
-  template <class F, class G>
-  void for_each(F&& f, G&& g) const {
+  // instance's leaf triangle, b(centre, radius) for every instance's crotch ball.
+  template <class F, class G, class B>
+  void for_each(F&& f, G&& g, B&& b) const {
     for (const TracedInstance& inst : instances) {
       const SceneGeometry::Prototype& proto = prototypes[inst.prototype];
       for (const Frustum& frustum : proto.frusta) f(placed_shape(frustum.shape, inst.transform));
+      for (uint32_t i = 0; proto.crotches && i < proto.crotches->count(); ++i)
+        b(inst.transform.to_world(proto.crotches->crotch(i).centre),
+          proto.crotches->crotch(i).radius * inst.transform.scale);
       if (!proto.leaves) continue;
       const LeafMesh& leaves = proto.leaves->leaves();
       for (size_t t = 0; t < leaves.triangle_count(); ++t)
@@ -164,8 +168,8 @@ class SunMask {
   // first edge as wide as its third vertex is far: the triangle lies within it), and the
   // instances of `placed` (their capsules made again from the prototypes for each band of
   // the rasterisation, never stored: a scatter's placed frusta would not fit).
-  SunMask(std::span<const Frustum> frusta, const LeafMesh* leaves, const SunEmitter& e, unsigned threads,
-          const PlacedPlants* placed = nullptr)
+  SunMask(std::span<const Frustum> frusta, const LeafMesh* leaves, const CrotchBalls* crotches, const SunEmitter& e,
+          unsigned threads, const PlacedPlants* placed = nullptr)
       : frame_(axis_frame(e.to_sun)), e_(e) {
     std::vector<Capsule> capsules;
     capsules.reserve(frusta.size());
@@ -181,6 +185,10 @@ class SunMask {
       capsules.push_back(frustum_capsule(f.shape));
       extend(capsules.back());
     }
+    for (uint32_t i = 0; crotches && i < crotches->count(); ++i) {
+      capsules.push_back(ball_capsule(crotches->crotch(i).centre, crotches->crotch(i).radius));
+      extend(capsules.back());
+    }
     for (size_t t = 0; leaves && t < leaves->triangle_count(); ++t) {
       const glm::dvec3* v[3];
       for (int k = 0; k < 3; ++k) v[k] = &leaves->positions[leaves->indices[3 * t + static_cast<size_t>(k)]];
@@ -193,7 +201,8 @@ class SunMask {
         placed->for_each([&](const FrustumShape& shape) { visit(frustum_capsule(shape)); },
                          [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
                            visit(triangle_capsule(a, b, c));
-                         });
+                         },
+                         [&](const glm::dvec3& centre, double radius) { visit(ball_capsule(centre, radius)); });
     };
     for_each_placed([&](const Capsule& c) { extend(c), any_placed = true; });
     if (capsules.empty() && !any_placed) return;
@@ -310,6 +319,15 @@ class SunMask {
       c.z1 = std::max(c.z1, depth(v));
     }
     c.radius = c.radius * (1 + 1e-9) + 1e-9;
+    return c;
+  }
+  // A blended crotch's ball (crotch_tracer.h): a capsule of no length.
+  Capsule ball_capsule(const glm::dvec3& centre, double radius) const {
+    Capsule c;
+    c.a = c.b = lateral(centre);
+    c.radius = radius * (1 + 1e-9) + 1e-9;
+    c.z0 = depth(centre) - c.radius;
+    c.z1 = depth(centre) + c.radius;
     return c;
   }
   Capsule triangle_capsule(const glm::dvec3& v0, const glm::dvec3& v1, const glm::dvec3& v2) const {
@@ -460,20 +478,40 @@ void leave_at_exit(const FrustumShape& shape, double t_hit, uint32_t frustum, co
   local.push_back({glm::vec3(exit - e.centre), glm::vec3(ray.direction), frustum});
 }
 
+// The first wood a photon meets in (0, t_max): the frusta's nearest hit, or a blended
+// crotch's fillet in front of it (crotch_tracer.h), named by the fillet's heavier group's
+// frustum. hit_any() false: none.
+BvhHit first_wood(const FrustumAccel& accel, const CrotchBalls* crotches, const Ray& ray, double t_max) {
+  ExtraHit fillet;
+  BvhHit hit = accel.nearest(ray, 0, t_max, nullptr, crotches ? &fillet : nullptr);
+  if (fillet.hit() && crotches->in_front(fillet.index, ray, fillet.t, hit.hit_any() ? hit.hit.t : kInf)) {
+    hit.hit.kind = FrustumHitKind::side;
+    hit.hit.t = fillet.t;
+    hit.frustum = crotches->frustum_at(fillet.index, ray.origin + fillet.t * ray.direction);
+  }
+  return hit;
+}
+
 // One prototype of the instanced photon tracer: exact frusta (no relief) and leaves in one
 // frame, hit as the non-instanced photons hit them — the nearest frustum, unless a leaf
-// comes first (then the leaf hit, is_leaf()). Its hits' plant: plant_of_frustum's, or 0
-// (an instance's hits take the instance's plant).
+// comes first (then the leaf hit, is_leaf()), with the blended crotches' fillets (first_wood).
+// Its hits' plant: plant_of_frustum's, or 0 (an instance's hits take the instance's plant).
 class PhotonPrototype final : public SceneTracer {
  public:
-  PhotonPrototype(std::span<const Frustum> frusta, const LeafTracer* leaves, std::span<const uint32_t> plant_of_frustum)
-      : frusta_(frusta), leaves_(leaves && !leaves->leaves().empty() ? leaves : nullptr), plants_(plant_of_frustum) {
-    if (!frusta.empty()) accel_.emplace(frusta);
+  PhotonPrototype(std::span<const Frustum> frusta, const LeafTracer* leaves, std::span<const uint32_t> plant_of_frustum,
+                  const CrotchBalls* crotches)
+      : frusta_(frusta),
+        leaves_(leaves && !leaves->leaves().empty() ? leaves : nullptr),
+        plants_(plant_of_frustum),
+        crotches_(crotches && crotches->count() > 0 ? crotches : nullptr) {
+    if (!frusta.empty()) accel_.emplace(frusta, CustomFrusta{}, crotches_);
     for (const Frustum& f : frusta) grow(bounds_, frustum_bounds(f.shape));
     if (leaves_) grow(bounds_, leaves_->leaves().bounds());
+    if (crotches_) grow(bounds_, crotches_->all_bounds());
   }
   SurfaceHit nearest(const Ray& ray, double t_min, double t_max) const override {
-    const BvhHit hit = accel_ ? accel_->nearest(ray, t_min, t_max) : BvhHit{};
+    // t_min is 0 for every photon query (the instance tracer passes it on).
+    const BvhHit hit = accel_ ? first_wood(*accel_, crotches_, ray, t_max) : BvhHit{};
     if (leaves_) {
       const SurfaceHit leaf = leaves_->nearest_leaf(ray, t_min, hit.hit_any() ? hit.hit.t : t_max);
       if (leaf.hit()) return leaf;
@@ -497,6 +535,7 @@ class PhotonPrototype final : public SceneTracer {
   std::span<const Frustum> frusta_;
   const LeafTracer* leaves_;
   std::span<const uint32_t> plants_;
+  const CrotchBalls* crotches_;
   std::optional<FrustumAccel> accel_;
   Aabb bounds_ = empty_box();
 };
@@ -507,6 +546,7 @@ struct SunPhotonTracer::Impl {
   std::span<const Frustum> frusta;
   std::span<const uint32_t> plant_of_frustum;
   PhotonLeaves leaves;
+  const CrotchBalls* crotches = nullptr;  // the blended crotches' balls (null: none)
   SunEmitter emitter;
   std::optional<FrustumAccel> accel;  // none without frusta
   std::optional<SunMask> mask;
@@ -538,7 +578,8 @@ std::vector<uint32_t> first_frustum_of_plants(std::span<const uint32_t> plant_of
 }  // namespace
 
 SunPhotonTracer::SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun, unsigned threads,
-                                 const LeafTracer* leaves, std::span<const uint32_t> plant_of_frustum)
+                                 const LeafTracer* leaves, std::span<const uint32_t> plant_of_frustum,
+                                 const CrotchBalls* crotches)
     : impl_(std::make_unique<Impl>()) {
   const Clock::time_point start = Clock::now();
   impl_->frusta = frusta;
@@ -549,10 +590,13 @@ SunPhotonTracer::SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun
     impl_->leaves.first_frustum_of_plant = first_frustum_of_plants(plant_of_frustum);
   }
   impl_->any_frusta = !frusta.empty();
-  impl_->emitter = sun_emitter(frusta, sun, leaf_mesh ? leaf_mesh->bounds() : empty_box());
+  impl_->crotches = crotches && crotches->count() > 0 && !frusta.empty() ? crotches : nullptr;
+  Aabb beside = leaf_mesh ? leaf_mesh->bounds() : empty_box();  // what the frusta's box leaves out
+  if (impl_->crotches) grow(beside, impl_->crotches->all_bounds());
+  impl_->emitter = sun_emitter(frusta, sun, beside);
   if (!frusta.empty()) {
-    impl_->accel.emplace(frusta);
-    impl_->mask.emplace(frusta, leaf_mesh, impl_->emitter, worker_count(threads));
+    impl_->accel.emplace(frusta, CustomFrusta{}, impl_->crotches);
+    impl_->mask.emplace(frusta, leaf_mesh, impl_->crotches, impl_->emitter, worker_count(threads));
   }
   impl_->build_seconds = seconds_since(start);
 }
@@ -561,7 +605,8 @@ SunPhotonTracer::SunPhotonTracer(const SceneGeometry& geometry, const Sun& sun, 
     : SunPhotonTracer(geometry.instances.empty() ? std::span<const Frustum>(geometry.frusta) : std::span<const Frustum>{},
                       sun, threads, geometry.instances.empty() ? geometry.leaves : nullptr,
                       geometry.instances.empty() ? std::span<const uint32_t>(geometry.plant_of_frustum)
-                                                 : std::span<const uint32_t>{}) {
+                                                 : std::span<const uint32_t>{},
+                      geometry.instances.empty() ? geometry.crotches.get() : nullptr) {
   if (geometry.instances.empty()) return;
   const Clock::time_point start = Clock::now();
   Impl& m = *impl_;
@@ -587,10 +632,12 @@ SunPhotonTracer::SunPhotonTracer(const SceneGeometry& geometry, const Sun& sun, 
   // The tracer: a photon prototype per skeleton, the world's plants one more at the identity.
   std::vector<std::unique_ptr<SceneTracer>> prototypes;
   for (const SceneGeometry::Prototype& p : m.prototypes)
-    prototypes.push_back(std::make_unique<PhotonPrototype>(p.frusta, p.leaves, std::span<const uint32_t>{}));
+    prototypes.push_back(
+        std::make_unique<PhotonPrototype>(p.frusta, p.leaves, std::span<const uint32_t>{}, p.crotches));
   std::vector<TracedInstance> instances = m.instances;
   instances.push_back({static_cast<uint32_t>(prototypes.size()), TracedInstance::kOwnPlant, PlantTransform{}});
-  prototypes.push_back(std::make_unique<PhotonPrototype>(geometry.frusta, geometry.world_leaves, geometry.plant_of_frustum));
+  prototypes.push_back(std::make_unique<PhotonPrototype>(geometry.frusta, geometry.world_leaves,
+                                                         geometry.plant_of_frustum, geometry.crotches.get()));
   m.placed = std::make_unique<InstanceTracer>(std::move(prototypes), std::move(instances));
   // The emitter over every placed frustum and leaf, as sun_emitter over the world's.
   const PlacedPlants placed{m.prototypes, m.instances};
@@ -608,6 +655,9 @@ SunPhotonTracer::SunPhotonTracer(const SceneGeometry& geometry, const Sun& sun, 
       [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
         leaf_lo = glm::min(glm::min(leaf_lo, a), glm::min(b, c));
         leaf_hi = glm::max(glm::max(leaf_hi, a), glm::max(b, c));
+      },
+      [&](const glm::dvec3& centre, double radius) {  // a crotch's ball: beside the frusta, as the leaves
+        leaf_lo = glm::min(leaf_lo, centre - radius), leaf_hi = glm::max(leaf_hi, centre + radius);
       });
   const LeafMesh* world_leaves =
       geometry.world_leaves && !geometry.world_leaves->leaves().empty() ? &geometry.world_leaves->leaves() : nullptr;
@@ -615,10 +665,16 @@ SunPhotonTracer::SunPhotonTracer(const SceneGeometry& geometry, const Sun& sun, 
     const Aabb b = world_leaves->bounds();
     leaf_lo = glm::min(leaf_lo, b.lo), leaf_hi = glm::max(leaf_hi, b.hi);
   }
+  const CrotchBalls* world_crotches = geometry.crotches && !geometry.frusta.empty() ? geometry.crotches.get() : nullptr;
+  if (world_crotches) {
+    const Aabb b = world_crotches->all_bounds();
+    leaf_lo = glm::min(leaf_lo, b.lo), leaf_hi = glm::max(leaf_hi, b.hi);
+  }
   if (any_frusta && leaf_lo.x <= leaf_hi.x) lo = glm::min(lo, leaf_lo), hi = glm::max(hi, leaf_hi);
   m.any_frusta = any_frusta;
   m.emitter = sun_emitter_of_box(lo, hi, any_frusta, sun);
-  if (any_frusta) m.mask.emplace(geometry.frusta, world_leaves, m.emitter, worker_count(threads), &placed);
+  if (any_frusta)
+    m.mask.emplace(geometry.frusta, world_leaves, world_crotches, m.emitter, worker_count(threads), &placed);
   m.build_seconds += seconds_since(start);
 }
 
@@ -653,7 +709,7 @@ SunPhotons SunPhotonTracer::trace(const SunPhotonOptions& options) const {
                     m.first_of_instance[i] + hit.frustum, ray, e, local);
     });
   return trace_photons(*m.mask, e, options, [&](const Ray& ray, std::vector<ShadowVector>& local) {
-    const BvhHit hit = m.accel->nearest(ray, 0, kInf);
+    const BvhHit hit = first_wood(*m.accel, m.crotches, ray, kInf);
     // A leaf before the first frustum (or instead of one) stops the photon, naming the
     // first frustum of the leaf's plant.
     if (m.leaves.tracer) {
@@ -681,7 +737,7 @@ double SunPhotonTracer::first_hit(const Ray& ray) const {
     const SurfaceHit hit = m.placed->nearest(ray, 0, kInf);
     return hit.hit() ? hit.t : kInf;
   }
-  const BvhHit hit = m.accel->nearest(ray, 0, kInf);
+  const BvhHit hit = first_wood(*m.accel, m.crotches, ray, kInf);
   double t = hit.hit_any() ? hit.hit.t : kInf;
   if (m.leaves.tracer) {
     const SurfaceHit leaf = m.leaves.tracer->nearest_leaf(ray, 0, t);

@@ -22,6 +22,11 @@
 // Leaves (docs/leaves.md) stop photons too: a photon whose first hit is a leaf leaves its
 // vector at the hit point (a leaf has no thickness, so its far side is where the photon
 // meets it), naming the first frustum of the leaf's plant.
+// Blended crotches (SceneGeometry::crotches, crotch_tracer.h) stop photons as the frusta
+// do: their balls are extra primitives of the same Embree scene, and a fillet in front of
+// the frusta's hit is the photon's first hit, named by the fillet's heavier group's
+// frustum, the vector where the photon leaves that frustum's solid (at the fillet's hit
+// where it misses it). The occupancy mask and the emitter cover the balls.
 //
 // Instances (SceneGeometry::instances, build_instanced_geometry): the photons go through
 // the same InstanceTracer construction the renderer uses (instance_tracer.h), over
@@ -59,7 +64,8 @@
 
 namespace sylva {
 
-class LeafTracer;  // leaf_tracer.h
+class LeafTracer;   // leaf_tracer.h
+class CrotchBalls;  // crotch_tracer.h
 
 struct SunPhotonOptions {
   uint64_t photons = 1'000'000;             // photons emitted, >= 0
@@ -105,8 +111,13 @@ class SunPhotonTracer {
   // `leaves` (optional, outliving the tracer): the scene's leaves, which stop photons too
   // (see the header comment); `plant_of_frustum` names each frustum's plant (a leaf's
   // vectors carry the first frustum of its plant; a plant without frusta leaves none).
+  // `crotches` (optional, over `frusta`, outliving the tracer): the blended crotches'
+  // fillets, which stop photons as the frusta do (a vector where the photon leaves the
+  // solid of the frustum the fillet hit names, crotch_tracer.h, or at the hit where the
+  // photon misses that solid).
   SunPhotonTracer(std::span<const Frustum> frusta, const Sun& sun, unsigned threads = 0,
-                  const LeafTracer* leaves = nullptr, std::span<const uint32_t> plant_of_frustum = {});
+                  const LeafTracer* leaves = nullptr, std::span<const uint32_t> plant_of_frustum = {},
+                  const CrotchBalls* crotches = nullptr);
   // Over everything `geometry` holds (outliving the tracer, unchanged): its frusta and
   // leaves, and its instances when build_instanced_geometry made it (see the header
   // comment). Throws std::runtime_error when Embree fails.

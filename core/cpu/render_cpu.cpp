@@ -416,7 +416,7 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     const SkinnedSkeleton& skinned = *skinned_or;
     append_leaves(leaves, placed, p);
     const uint32_t first_frustum = static_cast<uint32_t>(g.frusta.size());
-    if (plant_skin.blend_crotches && !mesh) {  // a mesh has its fillets' triangles
+    if (plant_skin.blend_crotches) {  // a mesh has its fillets' triangles too (below)
       for (Crotch& c : find_crotches(placed, skinned.frusta)) {
         for (uint32_t& i : c.parent_frusta) i += first_frustum;
         for (uint32_t& i : c.lateral_frusta) i += first_frustum;
@@ -459,19 +459,16 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
   if (passes && displaced > 0)
     passes->push_back({"displace", displace_s, std::to_string(displaced) + " plants by their height maps"});
   Clock::time_point start = Clock::now();
+  if (!crotches.empty()) g.crotches = std::make_shared<const CrotchBalls>(std::move(crotches), g.frusta);
   switch (options.kind) {
     case GeometryKind::frusta:
       g.tracer = std::make_unique<FrustumTracer>(g.frusta, g.plant_of_frustum,
-                                                 scene_relief(scene, options, textures, g, passes));
+                                                 scene_relief(scene, options, textures, g, passes), g.crotches);
       break;
     case GeometryKind::mesh:
       g.tracer = std::make_unique<MeshTracer>(std::move(triangles), g.frusta, g.plant_of_frustum, options.mesh_level,
                                               displaced > 0);
       break;
-  }
-  // Blended crotches (crotch_tracer.h) beside the frusta or mesh.
-  if (!crotches.empty()) {
-    g.tracer = std::make_unique<CrotchTracer>(std::move(crotches), g.frusta, g.plant_of_frustum, std::move(g.tracer));
   }
   // Leaves (leaf_tracer.h): their own triangles beside the frusta or mesh; a scene
   // without leaves keeps its tracer as it is.
@@ -604,7 +601,7 @@ SceneGeometry build_instanced_geometry(const Scene& scene, const SkinOptions& sk
       frusta_of_prototype.push_back(pg.frusta.size());
       prototype_frusta += pg.frusta.size();
       // The vector's buffer and the leaf tracer move with pg into the tracer unchanged.
-      g.prototypes.push_back({std::span<const Frustum>(pg.frusta), pg.leaves});
+      g.prototypes.push_back({std::span<const Frustum>(pg.frusta), pg.leaves, pg.crotches.get()});
       prototypes.push_back(std::make_unique<OwningTracer>(std::move(pg)));
     }
     const uint32_t index = static_cast<uint32_t>(prototype_index[k]);

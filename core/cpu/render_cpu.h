@@ -70,6 +70,7 @@ namespace sylva {
 
 class SceneTextures;  // texture.h
 class LeafTracer;     // leaf_tracer.h
+class CrotchBalls;    // crotch_tracer.h
 class LeafImages;     // leaf_images.h
 
 // World-space geometry of a scene: every plant's skeleton transformed (position,
@@ -82,6 +83,10 @@ struct SceneGeometry {
                                                       // none and the relief needs them
   std::unique_ptr<SceneTracer> tracer;     // over `frusta` (or a mesh made from them) and the leaves
   const LeafTracer* leaves = nullptr;      // `tracer` when the scene has leaves (leaf_tracer.h), else null
+  // The blended crotches (crotch_tracer.h) of the plants whose skin blends them, over
+  // `frusta` (null: none): traced by `tracer` when it is the frusta's (a mesh has the
+  // fillets' triangles), and by the sun photons either way.
+  std::shared_ptr<const CrotchBalls> crotches;
   // The scene's leaf materials (leaf_images.h: images, cut-outs, one-sidedness) every leaf
   // tracer of `tracer` applies; null when the table has none.
   std::shared_ptr<const LeafImages> leaf_images;
@@ -100,6 +105,7 @@ struct SceneGeometry {
   struct Prototype {
     std::span<const Frustum> frusta;
     const LeafTracer* leaves = nullptr;
+    const CrotchBalls* crotches = nullptr;  // its blended crotches (null: none)
   };
   std::vector<Prototype> prototypes;
   std::vector<TracedInstance> instances;

@@ -8,6 +8,7 @@
 #include <functional>
 #include <glm/geometric.hpp>
 #include <limits>
+#include <optional>
 #include <random>
 
 namespace sylva {
@@ -108,6 +109,77 @@ TEST(FrustumAccel, EmbreeFindsExactlyWhatTestingEveryFrustumFinds) {
 
 TEST(FrustumAccel, EmbreeStaysExactFarFromTheOrigin) {
   expect_accel_matches_brute_force(random_skeleton(8, 40, 6, 1e6), 12, 1e6);
+}
+
+// Balls as extra primitives (frustum_accel.h): the blended crotches' role, a plain ray-sphere
+// test here.
+class Balls final : public ExtraPrimitives {
+ public:
+  std::vector<glm::dvec3> centres;
+  std::vector<double> radii;
+  uint32_t count() const override { return static_cast<uint32_t>(centres.size()); }
+  Aabb bounds(uint32_t i) const override {
+    return {centres[i] - glm::dvec3(radii[i]), centres[i] + glm::dvec3(radii[i])};
+  }
+  std::optional<double> intersect(uint32_t i, const Ray& ray, double t_min, double t_max) const override {
+    const glm::dvec3 o = ray.origin - centres[i];
+    const double a = glm::dot(ray.direction, ray.direction), b = glm::dot(o, ray.direction);
+    const double disc = b * b - a * (glm::dot(o, o) - radii[i] * radii[i]);
+    if (!(disc > 0)) return std::nullopt;
+    for (double t : {(-b - std::sqrt(disc)) / a, (-b + std::sqrt(disc)) / a})
+      if (t > t_min && t < t_max) return t;
+    return std::nullopt;
+  }
+  bool occludes(uint32_t i, const Ray& ray, double t_min, double t_max) const override {
+    return intersect(i, ray, t_min, t_max).has_value();
+  }
+};
+
+TEST(FrustumAccel, ExtraPrimitivesLeaveTheFrustaHitAndFindTheNearestExtraInFrontOfIt) {
+  const SkinnedSkeleton skinned = skin_skeleton(random_skeleton(9, 40, 6, 0));
+  std::span<const Frustum> frusta(skinned.frusta);
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Balls balls;
+  for (int i = 0; i < 60; ++i) {
+    balls.centres.emplace_back(4 * u(rng), 4 * u(rng), 4 * u(rng));
+    balls.radii.push_back(0.1 + 0.2 * (u(rng) + 1));
+  }
+  const FrustumAccel plain(frusta);
+  const FrustumAccel with(frusta, {}, &balls);
+  const double inf = std::numeric_limits<double>::infinity();
+  int extra_hits = 0, frusta_hits = 0;
+  for (int r = 0; r < 4000; ++r) {
+    Ray ray;
+    ray.origin = glm::dvec3(9 * u(rng), 9 * u(rng), 9 * u(rng));
+    ray.direction = glm::dvec3(4 * u(rng), 4 * u(rng), 4 * u(rng)) - ray.origin;
+    ExtraHit extra;
+    const BvhHit want = plain.nearest(ray, 0, inf);
+    const BvhHit got = with.nearest(ray, 0, inf, nullptr, &extra);
+    ASSERT_EQ(got.hit_any(), want.hit_any()) << "ray " << r;
+    if (want.hit_any()) {
+      EXPECT_EQ(got.hit.t, want.hit.t) << "ray " << r;
+      EXPECT_EQ(got.frustum, want.frustum) << "ray " << r;
+      ++frusta_hits;
+    }
+    // The nearest ball crossing before the frusta's hit, by testing every ball.
+    const double t_frusta = want.hit_any() ? want.hit.t : inf;
+    std::optional<double> best;
+    uint32_t best_index = 0;
+    for (uint32_t b = 0; b < balls.count(); ++b) {
+      const std::optional<double> t = balls.intersect(b, ray, 0, t_frusta);
+      if (t && (!best || *t < *best)) best = t, best_index = b;
+    }
+    ASSERT_EQ(extra.hit(), best.has_value()) << "ray " << r;
+    if (best) {
+      EXPECT_EQ(extra.t, *best) << "ray " << r;
+      EXPECT_EQ(extra.index, best_index) << "ray " << r;
+      ++extra_hits;
+    }
+    EXPECT_EQ(with.any(ray, 0, inf), want.hit_any() || best.has_value()) << "ray " << r;
+  }
+  EXPECT_GT(extra_hits, 200);
+  EXPECT_GT(frusta_hits, 400);
 }
 
 TEST(FrustumAccel, AnEmptySceneHitsNothing) {

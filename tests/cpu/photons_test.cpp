@@ -14,6 +14,9 @@
 #include "core/cpu/render_cpu.h"
 #include "core/util/math.h"
 #include "tests/support/plants.h"
+#include "core/cpu/crotch_tracer.h"
+#include "core/geometry/crotch_mesh.h"
+#include "tests/support/limb_crotch.h"
 
 namespace sylva {
 namespace {
@@ -312,6 +315,48 @@ TEST(SunPhotonsLeaves, ALeafStopsPhotonsAtItsHitPoint) {
   const SunPhotonTracer tracer(g.frusta, s.sun, 0, g.leaves, g.plant_of_frustum);
   EXPECT_TRUE(tracer.toward_sun_blocked({-0.5, 0, -1.5}));
   EXPECT_FALSE(SunPhotonTracer(g.frusta, s.sun, 0).toward_sun_blocked({-0.5, 0, -1.5}));
+}
+
+// The blended crotches' fillets (crotch_tracer.h) stop photons as the frusta do: a photon
+// aimed at a point of a fillet outside the exact frusta stops there (first_hit, trace's own
+// test), where the exact frusta let it pass; the mask covers the balls (it changes no
+// vector); every vector names a frustum of the plant.
+TEST(SunPhotonsCrotches, TheFilletsStopPhotonsWhereTheExactFrustaLetThemPass) {
+  Scene s = test::scene_around(test::limb_on_trunk(), {4, 1.5, 3}, {0, 1.2, 0}, 64, 48);
+  s.sun.direction = glm::normalize(glm::dvec3(0.5, 1, 0.3));
+  s.sun.angular_radius_deg = kSunRadiusDeg;
+  GeometryOptions no_cull;
+  no_cull.cull = false;
+  SkinOptions blended;
+  blended.blend_crotches = true;
+  const SceneGeometry g = build_scene_geometry(s, blended, no_cull);
+  ASSERT_NE(g.crotches, nullptr);
+  ASSERT_EQ(g.crotches->count(), 1u);
+  const SunPhotonTracer with(g.frusta, s.sun, 0, nullptr, g.plant_of_frustum, g.crotches.get());
+  const SunPhotonTracer without(g.frusta, s.sun, 0, nullptr, g.plant_of_frustum);
+  const glm::dvec3 to_sun = glm::normalize(s.sun.direction);
+  // Points of the fillet (its mesh's vertices lie on the blended surface) at least 5 mm
+  // outside every frustum.
+  int passed_exact = 0;
+  for (const glm::dvec3& q : skeleton_fillets(test::limb_on_trunk(), g.frusta).positions) {
+    double outside = 1e300;
+    for (const Frustum& f : g.frusta) outside = std::min(outside, frustum_bound(f.shape, q));
+    if (outside < 5e-3) continue;
+    const Ray ray{q + 3.0 * to_sun, -to_sun};
+    if (without.first_hit(ray) < 3 + 1e-3) continue;  // something exact in front of it
+    ++passed_exact;
+    EXPECT_LE(with.first_hit(ray), 3 + 1e-6) << q.x << ", " << q.y << ", " << q.z;
+  }
+  EXPECT_GT(passed_exact, 20);
+  SunPhotonOptions o;
+  o.photons = 200'000;
+  o.seed = 5;
+  const SunPhotons masked = with.trace(o);
+  o.occupancy_mask = false;
+  const SunPhotons all = with.trace(o);
+  ASSERT_GT(all.vectors.vectors.size(), 1000u);
+  expect_same_vectors(all.vectors, masked.vectors, "mask, fillets");
+  for (const ShadowVector& v : all.vectors.vectors) ASSERT_LT(v.frustum, g.frusta.size());
 }
 
 }  // namespace
