@@ -5,7 +5,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -205,9 +207,17 @@ TriangleMesh crotch_fillet_mesh(const Crotch& crotch, std::span<const Frustum> f
 
 TriangleMesh skeleton_fillets(const Skeleton& skeleton, std::span<const Frustum> frusta) {
   TriangleMesh out;
-  for (const Crotch& c : find_crotches(skeleton, frusta)) {
+  const std::vector<Crotch> crotches = find_crotches(skeleton, frusta);
+  if (crotches.empty()) return out;
+  dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+  for (const Joint& j : skeleton.joints) {
+    const dvec3 p(j.position_m[0], j.position_m[1], j.position_m[2]);
+    lo = glm::min(lo, p), hi = glm::max(hi, p);
+  }
+  const double min_cell = kFilletMinCellPerExtent * glm::length(hi - lo);
+  for (const Crotch& c : crotches) {
     if (!(c.k > 0)) continue;
-    append_mesh(out, crotch_fillet_mesh(c, frusta, c.k / 2), 0);
+    append_mesh(out, crotch_fillet_mesh(c, frusta, std::max(c.k / 2, min_cell)), 0);
   }
   return out;
 }

@@ -65,10 +65,18 @@ inline constexpr int kMaxCrotchGridCells = 256;
 // for these frusta).
 TriangleMesh crotch_fillet_mesh(const Crotch& crotch, std::span<const Frustum> frusta, double cell_m);
 
+// The smallest cell skeleton_fillets meshes a crotch with, as a share of the skeleton's
+// extent (the diagonal of its joints' box): in a view of the whole plant 1000 pixels
+// across, a facet is at least about a pixel.
+inline constexpr double kFilletMinCellPerExtent = 1e-3;
+
 // Every crotch of a skinned skeleton (find_crotches with the default options) as one mesh,
 // each at cells of k/2 (within about 8 mm of the marched fillet on the test limb, about
-// 370 triangles a crotch), triangle_frustum indexing `frusta`: what the mesh paths and GL
-// append beside the frusta's own mesh where SkinOptions::blend_crotches is on.
+// 370 triangles a crotch) but no smaller than kFilletMinCellPerExtent of the skeleton's
+// extent (docs/joints.md: the elm's 529 crotches make 81,000 triangles in 0.25 s instead
+// of 197,000 in 0.64 s; only its crotches of under about 3 cm are coarser),
+// triangle_frustum indexing `frusta`: what the mesh paths and GL append beside the
+// frusta's own mesh where SkinOptions::blend_crotches is on.
 TriangleMesh skeleton_fillets(const Skeleton& skeleton, std::span<const Frustum> frusta);
 
 }  // namespace sylva

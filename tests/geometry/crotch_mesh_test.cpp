@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/common.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -123,6 +125,32 @@ TEST(CrotchMesh, NoBlendNoTriangles) {
   const TriangleMesh mesh = crotch_fillet_mesh(crotches[0], skinned.frusta, 0.025);
   EXPECT_EQ(mesh.triangle_count(), 0u);
   EXPECT_TRUE(mesh.positions.empty());
+}
+
+// skeleton_fillets meshes each crotch at cells of k/2, but no finer than
+// kFilletMinCellPerExtent of the skeleton's extent: the limb alone (extent ~2.4 m, k/2 =
+// 60 mm) at k/2; with a far stem widening the extent to ~200 m, at 0.2 m.
+TEST(CrotchMesh, TheSkeletonsFilletsAreNoFinerThanAThousandthOfItsExtent) {
+  const LimbCrotch limb;
+  const TriangleMesh fine = skeleton_fillets(limb.skeleton, limb.skinned.frusta);
+  EXPECT_EQ(fine.triangle_count(),
+            crotch_fillet_mesh(limb.crotch, limb.skinned.frusta, limb.crotch.k / 2).triangle_count());
+  Skeleton wide = limb.skeleton;
+  test::add_chain(wide, {{200, 0, 0}, {200, 1, 0}}, {0.1, 0.1}, std::nullopt);
+  const SkinnedSkeleton skinned = skin_skeleton(wide);
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (const Joint& j : wide.joints) {
+    const glm::dvec3 p(j.position_m[0], j.position_m[1], j.position_m[2]);
+    lo = glm::min(lo, p), hi = glm::max(hi, p);
+  }
+  const double cell = kFilletMinCellPerExtent * glm::length(hi - lo);
+  ASSERT_GT(cell, limb.crotch.k / 2);
+  const TriangleMesh coarse = skeleton_fillets(wide, skinned.frusta);
+  const std::vector<Crotch> crotches = find_crotches(wide, skinned.frusta);
+  ASSERT_EQ(crotches.size(), 1u);
+  EXPECT_EQ(coarse.triangle_count(), crotch_fillet_mesh(crotches[0], skinned.frusta, cell).triangle_count());
+  EXPECT_LT(coarse.triangle_count(), fine.triangle_count() / 4);
+  EXPECT_GT(coarse.triangle_count(), 0u);  // the crease is still covered
 }
 
 TEST(CrotchMesh, ACellTooSmallOrNotPositiveIsRefused) {
