@@ -24,6 +24,8 @@
 #define FOG_MAP_SLOTS_BINDING 15  // fog_map.glsl FogMapSlots: per tile of every map, its slot
 #define FOG_MAP_RANGES_BINDING 16 // fog_map.glsl FogMapRanges: per slot, its smallest and largest height
 #define FOG_MAP_TEXELS_BINDING 17 // fog_map.glsl FogMapTexels: per texel of every slot, its height
+#define CROTCHES_BINDING 18       // crotch.glsl Crotches: a GpuCrotch per blended crotch (CROTCH_FADE)
+#define CROTCH_LISTS_BINDING 19   // crotch.glsl CrotchLists: per record its crotches, the groups' records
 
 // Texture units. Bark images take units BARK_TEXTURES_UNIT .. + MAX_BARK_IMAGES − 1; the
 // G-buffer, the shadow map and the accumulated beauty sit above them, so no pass rebinds
@@ -50,6 +52,7 @@
 #define FOG_MAP_NO_SLOT 0xFFFFFFFFu  // a sun map's tile that is not allocated (fog_map.glsl)
 #define FOG_MAP_TILE 32           // texels a side of a sun map's tile (fog_map.glsl)
 #define FOG_MAX_MAPS 64           // sun maps the fog resolve walks (fog.frag.glsl FOG_MAP)
+#define CROTCH_DEPTH_SAMPLES 16   // a crotch's depth table (crotch.h kCrotchDepthSamples)
 
 // Uniform blocks (std140): none. The views (views.glsl's camera and sun uniforms) and the
 // shading parameters are default-block uniforms set by name (core/gl/gl_views.h,

@@ -18,6 +18,8 @@
 // RELIEF: frusta of a plant with a relief (bark.glsl's plant_maps[].relief_depth_m > 0)
 // are intersected by relief.glsl's intersect_relief_f inside their shell (the pyramid
 // bounds the shell, frusta.vert.glsl); knuckles keep their exact surface, as on the CPU.
+// CROTCH_FADE (with RELIEF): the relief of a blended crotch's frusta fades into its fillet
+// (crotch.glsl), as on the CPU.
 // BARK: the albedo texture is looked up here, where the hit is known (bark.glsl), over
 // the footprint of the ray differentials, into g_albedo (a = 1); a = 0 leaves the albedo
 // to shade.frag.glsl (material table, bark colour).
@@ -75,7 +77,7 @@ void main() {
   }
 #endif
 #ifdef RELIEF
-  ReliefMapF map = ReliefMapF(plant_maps[plant], plant_maps[plant].relief_depth_m);
+  ReliefMapF map = ReliefMapF(plant_maps[plant], plant_maps[plant].relief_depth_m, v_segment_info.x);
   bool relief = map.depth_m > 0.0 && !fr.knuckle && fr.material == 0u;  // bark: wood only
 #ifdef SHADOW_PASS
   const bool describe = false;

@@ -204,6 +204,7 @@ SolidInterval frustum_solid_interval(RayF ray, FrustumShapeF shape, float t_min,
 struct ReliefMapF {
   PlantMaps maps;
   float depth_m;
+  uint record;  // the frustum's record (CROTCH_FADE: its crotches' fade, crotch.glsl)
 };
 
 // Everything the marcher needs about one frustum, in its local frame.
@@ -291,7 +292,14 @@ bool marcher_inside(Marcher m, float t_local, bool on_shell) {
   if (w < 0.0) return true;
   if (w > 1.0) return false;
   float v_m = v_m_at(m, q, t_local);
+#ifdef CROTCH_FADE
+  // relief.h ReliefFade: the height scaled by the crotches' fade at the sample.
+  float scale = clamp(relief_fade(m.map.record, m.frustum.shape.base + q.p), 0.0, 1.0);
+  if (w > scale) return false;
+  return w <= scale * marcher_height(m, u_at(m, q, v_m), v_m);
+#else
   return w <= marcher_height(m, u_at(m, q, v_m), v_m);
+#endif
 }
 
 // A hit on the relief of a frustum (relief.h's ReliefHit).
@@ -349,6 +357,21 @@ void describe_relief_hit_f(Marcher m, RayF ray, float t, float hit_local, uint b
   vec3 tangent_u = cross(m.axis, e);
   float slope_w = m.slope + clamp(point_w(q), 0.0, 1.0) * m.depth_slope;
   vec3 tangent_v = normalize(m.axis + slope_w * e);
+#ifdef CROTCH_FADE
+  // The displacement is d·f·H: H's differences scaled by f, and H times f's gradient.
+  {
+    vec3 p = m.frustum.shape.base + q.p;
+    float step = relief_fade_step(m.map.record);
+    float f = clamp(relief_fade(m.map.record, p), 0.0, 1.0);
+    float df_da = (clamp(relief_fade(m.map.record, p + step * tangent_u), 0.0, 1.0) -
+                   clamp(relief_fade(m.map.record, p - step * tangent_u), 0.0, 1.0)) / (2.0 * step);
+    float df_db = (clamp(relief_fade(m.map.record, p + step * tangent_v), 0.0, 1.0) -
+                   clamp(relief_fade(m.map.record, p - step * tangent_v), 0.0, 1.0)) / (2.0 * step);
+    float h0 = filtered ? height_field_filtered(maps, s0, t0, ws, wt) : height_field(maps, s0, t0);
+    around = f * around + depth * h0 * df_da;
+    along = f * along + depth * h0 * df_db;
+  }
+#endif
   vec3 offset = around * tangent_u + along * tangent_v;
   // perturb(n0): normalize(n0 − offset), n0 where that is degenerate.
   vec3 n0 = normalize(e - slope_w * m.axis);

@@ -8,7 +8,6 @@
 // file's bytes, its triangles per level, the rig's joints. Growing the plants is not timed.
 #include <chrono>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -22,6 +21,7 @@
 #include "core/geometry/skin.h"
 #include "core/geometry/tessellate.h"
 #include "core/grow/grow.h"
+#include "core/util/clock.h"
 #include "core/io/gltf.h"
 #include "core/io/gltf_lod.h"
 #include "core/io/gltf_rig.h"
@@ -66,12 +66,6 @@ struct Row {
   size_t joints = 0;
 };
 
-double process_cpu_s() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
 // Triangles of a plant's levels as the export writes them (the cards: 2 a card).
 std::string level_triangles(const Skeleton& sk, uint32_t lod) {
   auto count = [](const Skeleton& s, int columns) {
@@ -92,10 +86,10 @@ std::string level_triangles(const Skeleton& sk, uint32_t lod) {
 // One export of `plants` timed; false (the error printed) when it fails.
 bool timed_export(const std::vector<GltfPlant>& plants, const GltfExportOptions& options, const std::string& path,
                   Row& row) {
-  const double cpu = process_cpu_s();
+  const double cpu = process_cpu_seconds();
   const auto wall = std::chrono::steady_clock::now();
   Status exported = export_gltf(plants, path, options);
-  row.cpu_s = process_cpu_s() - cpu;
+  row.cpu_s = process_cpu_seconds() - cpu;
   row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall).count();
   if (!exported) {
     std::cerr << exported.error().format();

@@ -39,9 +39,11 @@
 #include "core/cpu/mesh_accel.h"
 #include "core/cpu/render_cpu.h"
 #include "core/scene/scene.h"
+#include "core/geometry/crotch_mesh.h"
 #include "core/geometry/tessellate.h"
 #include "core/grow/turtle.h"
 #include "core/grow/grow.h"
+#include "core/util/clock.h"
 #include "core/util/parallel.h"
 
 namespace sylva::cli {
@@ -262,6 +264,19 @@ int run_bench_raycast(const std::vector<std::string>& args) {
   blended.blend_crotches = true;
   run_scene_tracer("scene-tracer", SkinOptions{});
   run_scene_tracer("crotch-blend", blended);
+  {
+    // What the mesh paths pay for the same fillets (GL, the polygon baseline and glTF build
+    // skeleton_fillets when they load a plant; crotch_mesh.h): triangles and CPU seconds.
+    const SkinnedSkeleton skin = skin_skeleton(grown->skeleton, blended);
+    const double cpu_start = process_cpu_seconds();
+    const TriangleMesh fillets = skeleton_fillets(grown->skeleton, skin.frusta, 1);
+    const double cpu_s = process_cpu_seconds() - cpu_start;
+    const Clock::time_point wall_start = Clock::now();
+    (void)skeleton_fillets(grown->skeleton, skin.frusta, all);
+    std::printf("fillet-mesh: %zu crotches, %zu triangles in %.3f CPU-s on one thread, %.3f s on %u\n",
+                find_crotches(grown->skeleton, skin.frusta).size(), fillets.triangle_count(), cpu_s,
+                seconds_since(wall_start), all);
+  }
   run_embree("embree-curves", [&](RTCScene s) {
     // One vertex per joint (x, y, z, r); one index per segment (its first vertex). A
     // branch chain starts at its parent joint's position, so chains stay connected.

@@ -2,6 +2,7 @@
 #include "core/cpu/crotch_tracer.h"
 
 #include <algorithm>
+#include <cmath>
 #include <glm/geometric.hpp>
 #include <limits>
 #include <numbers>
@@ -23,7 +24,7 @@ void set_tangents(SurfaceHit& s, const FrustumShape& f) {
 }  // namespace
 
 CrotchBalls::CrotchBalls(std::vector<Crotch> crotches, std::span<const Frustum> frusta)
-    : crotches_(std::move(crotches)), frusta_(frusta) {}
+    : crotches_(std::move(crotches)), frusta_(frusta), of_frustum_(crotches_of_frusta(crotches_, frusta.size())) {}
 
 Aabb CrotchBalls::bounds(uint32_t index) const {
   const Crotch& c = crotches_[index];
@@ -53,7 +54,8 @@ SurfaceHit CrotchBalls::describe(uint32_t index, const Ray& ray, double t,
   s.position = ray.origin + s.t * ray.direction;
   const CrotchShade shade = crotch_shade(c, frusta_, s.position);
   const bool parent = shade.h >= 0.5;
-  const Frustum& f = frusta_[parent ? shade.parent_frustum : shade.lateral_frustum];  // frustum_at's
+  s.frustum = heavier_frustum(shade);
+  const Frustum& f = frusta_[s.frustum];
   const Frustum& other = frusta_[parent ? shade.lateral_frustum : shade.parent_frustum];
   s.geometric_normal = s.shading_normal = shade.normal;
   s.u = parent ? shade.parent_uv.u : shade.lateral_uv.u;
@@ -63,7 +65,6 @@ SurfaceHit CrotchBalls::describe(uint32_t index, const Ray& ray, double t,
   s.blend = std::max(shade.h, 1 - shade.h);
   s.material_other = other.material;
   set_tangents(s, f.shape);
-  s.frustum = parent ? shade.parent_frustum : shade.lateral_frustum;
   s.plant = plant_of_frustum[s.frustum];
   s.chain = f.chain;
   s.segment = f.segment;
@@ -72,8 +73,19 @@ SurfaceHit CrotchBalls::describe(uint32_t index, const Ray& ray, double t,
 }
 
 uint32_t CrotchBalls::frustum_at(uint32_t index, const glm::dvec3& p) const {
-  const CrotchShade shade = crotch_shade(crotches_[index], frusta_, p);
-  return shade.h >= 0.5 ? shade.parent_frustum : shade.lateral_frustum;
+  return heavier_frustum(crotch_shade(crotches_[index], frusta_, p));
+}
+
+bool CrotchBalls::fades(uint32_t frustum) const { return !of_frustum_.of(frustum).empty(); }
+
+double CrotchBalls::relief_fade(uint32_t frustum, const glm::dvec3& p) const {
+  return relief_fade_at(crotches_, of_frustum_.of(frustum), frusta_, p);
+}
+
+double CrotchBalls::fade_step_m(uint32_t frustum) const {
+  double k = std::numeric_limits<double>::infinity();
+  for (uint32_t i : of_frustum_.of(frustum)) k = std::min(k, crotches_[i].k);
+  return std::isfinite(k) ? 1e-3 * k : 1e-6;
 }
 
 Aabb CrotchBalls::all_bounds() const {
@@ -87,7 +99,20 @@ size_t CrotchBalls::memory_bytes() const {
   for (const Crotch& c : crotches_)
     bytes += (c.parent_frusta.capacity() + c.lateral_frusta.capacity()) * sizeof(uint32_t) +
              c.depth.capacity() * sizeof(double);
-  return bytes;
+  return bytes + of_frustum_.bytes();
+}
+
+BvhHit nearest_wood(const FrustumAccel& accel, const CrotchBalls* crotches, const Ray& ray, double t_min,
+                    double t_max) {
+  ExtraHit fillet;
+  BvhHit hit = accel.nearest(ray, t_min, t_max, nullptr, crotches ? &fillet : nullptr);
+  const double t_exact = hit.hit_any() ? hit.hit.t : std::numeric_limits<double>::infinity();
+  if (fillet.hit() && crotches->in_front(fillet.index, ray, fillet.t, t_exact)) {
+    hit.hit.kind = FrustumHitKind::side;
+    hit.hit.t = fillet.t;
+    hit.frustum = crotches->frustum_at(fillet.index, ray.origin + fillet.t * ray.direction);
+  }
+  return hit;
 }
 
 }  // namespace sylva

@@ -19,6 +19,9 @@
 // A shadow ray (occludes) is marched from 10⁻³ of a ball's radius past its start, so that
 // a ray leaving a fillet does not find the fillet it left along the field's kinks.
 //
+// Relief (relief.h) on a crotch's frusta fades into its fillet (crotch.h
+// crotch_relief_fade): FrustumTracer marches those frusta with a CrotchReliefFade.
+//
 // The sun photons (photons.cpp) trace the same balls beside their frusta. Not seen by the
 // `?E` light — docs/joints.md says so. Preconditions: `frusta` (and the plant indices given to
 // describe) are the scene's, with the crotches' indices into them, and outlive this object.
@@ -30,6 +33,7 @@
 
 #include "core/cpu/frustum_accel.h"
 #include "core/geometry/crotch.h"
+#include "core/geometry/relief.h"
 #include "core/geometry/surface.h"
 
 namespace sylva {
@@ -59,9 +63,36 @@ class CrotchBalls final : public ExtraPrimitives {
   Aabb all_bounds() const;
   size_t memory_bytes() const;
 
+  // Whether `frustum` belongs to a crotch's group (its relief fades there).
+  bool fades(uint32_t frustum) const;
+  // The least crotch_relief_fade at p over the crotches that hold `frustum` (1: none).
+  double relief_fade(uint32_t frustum, const glm::dvec3& p) const;
+  // A difference step for the fade's gradient: 10⁻³ of the least k of those crotches.
+  double fade_step_m(uint32_t frustum) const;
+
  private:
   std::vector<Crotch> crotches_;
   std::span<const Frustum> frusta_;
+  CrotchesOfFrusta of_frustum_;  // each frustum's crotches (its relief's fade)
+};
+
+// The first wood along `ray` in (t_min, t_max) for a tracer that names what it meets by
+// frustum (the sun photons, the `?E` light): the frusta's nearest hit, or a fillet in front
+// of it (kind side, t the fillet's), named by its heavier group's frustum (frustum_at).
+// `accel` holds `crotches` as its extra primitives, or crotches is null. hit_any() false: none.
+BvhHit nearest_wood(const FrustumAccel& accel, const CrotchBalls* crotches, const Ray& ray, double t_min,
+                    double t_max);
+
+// The relief fade of one frustum (relief.h ReliefFade) over a scene's crotches.
+class CrotchReliefFade final : public ReliefFade {
+ public:
+  CrotchReliefFade(const CrotchBalls& balls, uint32_t frustum) : balls_(balls), frustum_(frustum) {}
+  double scale(const glm::dvec3& world) const override { return balls_.relief_fade(frustum_, world); }
+  double fade_step_m() const override { return balls_.fade_step_m(frustum_); }
+
+ private:
+  const CrotchBalls& balls_;
+  uint32_t frustum_;
 };
 
 }  // namespace sylva

@@ -114,8 +114,9 @@ void extra_intersect_callback(const RTCIntersectFunctionNArguments* args) {
   if (!args->valid[0]) return;
   auto* q = reinterpret_cast<QueryContext*>(args->context);
   const double t_max = q->extra_best.hit() ? std::min(q->t_best, q->extra_best.t) : q->t_best;
-  const std::optional<double> t = q->extra->intersect(args->primID, q->ray, q->t_min, t_max);
-  if (t && *t < t_max) q->extra_best = {args->primID, *t};
+  // ExtraPrimitives::intersect keeps its crossing inside (t_min, t_max): nearer than both.
+  if (const std::optional<double> t = q->extra->intersect(args->primID, q->ray, q->t_min, t_max))
+    q->extra_best = {args->primID, *t};
 }
 
 void extra_occluded_callback(const RTCOccludedFunctionNArguments* args) {

@@ -5,6 +5,7 @@
 
 #include <glm/geometric.hpp>
 #include <limits>
+#include <optional>
 #include <numbers>
 #include <utility>
 
@@ -63,7 +64,12 @@ FrustumHit FrustumTracer::ReliefIntersector::intersect(uint32_t index, const Ray
                                                        double t_max, CustomHitDetail* detail) const {
   const Frustum& f = tracer_.frusta_[index];
   const ReliefMap& map = tracer_.relief_.plants[tracer_.plant_of_frustum_[index]];
-  const ReliefHit h = intersect_relief(ray, f, map, tracer_.relief_.options, t_min, t_max, detail != nullptr);
+  // On a crotch's frusta the relief fades into the fillet (crotch_tracer.h).
+  const CrotchBalls* balls = tracer_.crotches_.get();
+  const std::optional<CrotchReliefFade> fade =
+      balls && balls->fades(index) ? std::optional<CrotchReliefFade>(std::in_place, *balls, index) : std::nullopt;
+  const ReliefHit h = intersect_relief(ray, f, map, tracer_.relief_.options, t_min, t_max, detail != nullptr,
+                                       fade ? &*fade : nullptr);
   if (detail && h.hit.hit()) *detail = {h.u, h.v_m, h.shading_normal};
   return h.hit;
 }

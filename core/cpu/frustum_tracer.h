@@ -13,7 +13,8 @@
 // without relief take the exact path, at the exact path's speed.
 //
 // Blended crotches (crotch_tracer.h): given the crotches, their balls are extra primitives
-// of the same Embree scene, and a fillet in front of the frusta's hit is the hit.
+// of the same Embree scene, and a fillet in front of the frusta's hit is the hit; the
+// relief of a crotch's frusta fades into its fillet (crotch.h crotch_relief_fade).
 //
 // Preconditions: `frusta` and `plant_of_frustum` have equal sizes and outlive the tracer
 // unchanged; every ReliefMap's field outlives it. Thread-safe for concurrent queries.

@@ -13,6 +13,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "core/cpu/crotch_tracer.h"
 #include "core/cpu/frustum_accel.h"
 #include "core/cpu/leaf_tracer.h"
 #include "core/geometry/closest_point.h"
@@ -41,18 +42,30 @@ struct LightScene {
   std::vector<uint32_t> leaf_base;  // per plant
   uint32_t primitives = 0;
   std::vector<Aabb> boxes;  // per primitive
-  std::optional<FrustumAccel> accel;
+  std::unique_ptr<const CrotchBalls> crotches;  // the blended crotches' fillets (null: none)
+  std::optional<FrustumAccel> accel;            // the frusta, the fillets beside them
   std::unique_ptr<LeafTracer> leaves;
   Aabb bounds = empty_box();
 };
 
-std::unique_ptr<LightScene> build_light_scene(std::span<const Skeleton> plants) {
+std::unique_ptr<LightScene> build_light_scene(std::span<const Skeleton> plants, const SkinOptions& skin) {
   auto s = std::make_unique<LightScene>();
   LeafMesh mesh;
   uint64_t leaf_count = 0;
   std::vector<SkinnedSkeleton> skinned(plants.size());
-  parallel_for(plants.size(), 0, nullptr, [&](size_t p, unsigned) { skinned[p] = skin_skeleton(plants[p]); });
+  std::vector<std::vector<Crotch>> crotches(plants.size());
+  parallel_for(plants.size(), 0, nullptr, [&](size_t p, unsigned) {
+    skinned[p] = skin_skeleton(plants[p], skin);
+    if (skin.blend_crotches) crotches[p] = find_crotches(plants[p], skinned[p].frusta);
+  });
+  std::vector<Crotch> all_crotches;
   for (uint32_t p = 0; p < plants.size(); ++p) {
+    const uint32_t first = static_cast<uint32_t>(s->frusta.size());
+    for (Crotch& c : crotches[p]) {  // by the scene's frustum index
+      for (uint32_t& i : c.parent_frusta) i += first;
+      for (uint32_t& i : c.lateral_frusta) i += first;
+      all_crotches.push_back(std::move(c));
+    }
     s->frusta.insert(s->frusta.end(), skinned[p].frusta.begin(), skinned[p].frusta.end());
     skinned[p] = {};
     append_leaves(mesh, plants[p], p);
@@ -77,7 +90,11 @@ std::unique_ptr<LightScene> build_light_scene(std::span<const Skeleton> plants) 
   if (!mesh.empty()) {
     s->leaves = std::make_unique<LeafTracer>(std::move(mesh), nullptr);
   }
-  if (!s->frusta.empty()) s->accel.emplace(s->frusta);
+  if (!all_crotches.empty()) {
+    s->crotches = std::make_unique<CrotchBalls>(std::move(all_crotches), s->frusta);
+    grow(s->bounds, s->crotches->all_bounds());
+  }
+  if (!s->frusta.empty()) s->accel.emplace(s->frusta, CustomFrusta{}, s->crotches.get());
   return s;
 }
 
@@ -91,7 +108,10 @@ struct PrimitiveHit {
 PrimitiveHit nearest_primitive(const LightScene& s, const Ray& ray, double t_min, double t_max) {
   PrimitiveHit h;
   if (s.accel) {
-    const BvhHit b = s.accel->nearest(ray, t_min, t_max);
+    // A fillet in front of the frusta is named by its heavier group's frustum (a sensor
+    // ignores it as it ignores that frustum); past it the photon resumes where the ray
+    // leaves that frustum's solid, or just past the fillet.
+    const BvhHit b = nearest_wood(*s.accel, s.crotches.get(), ray, t_min, t_max);
     if (b.hit_any()) {
       h.t = b.hit.t;
       h.primitive = b.frustum;
@@ -373,7 +393,7 @@ Expected<std::vector<LightAnswer>> PhotonLightOracle::answer(std::span<const Ske
   if (sensors.empty()) return out;
   const double r = env.sensor_radius_m;
   const LightSource src = light_source(scene);
-  const std::unique_ptr<LightScene> geometry = build_light_scene(plants);
+  const std::unique_ptr<LightScene> geometry = build_light_scene(plants, skin_.styled(scene.skin));
   Aabb box = geometry->bounds;
   for (const dvec3& p : sensors) grow(box, p);
   box.lo -= dvec3(r), box.hi += dvec3(r);
@@ -501,13 +521,14 @@ Expected<std::vector<LightAnswer>> PhotonLightOracle::answer(std::span<const Ske
 }
 
 Expected<std::vector<LightAnswer>> gather_light(std::span<const Skeleton> plants, std::span<const dvec3> sensors,
-                                                const Scene& scene, int64_t step, uint64_t rays) {
+                                                const Scene& scene, int64_t step, uint64_t rays,
+                                                const SkinOptions& skin) {
   const LightEnvironment env = scene.environment.value_or(LightEnvironment{});
   std::vector<LightAnswer> out(sensors.size());
   if (sensors.empty() || rays == 0) return out;
   const double r = env.sensor_radius_m;
   const LightSource src = light_source(scene);
-  const std::unique_ptr<LightScene> geometry = build_light_scene(plants);
+  const std::unique_ptr<LightScene> geometry = build_light_scene(plants, skin.styled(scene.skin));
   const SensorGrid grid = build_sensor_grid(sensors, r);
   const Ignored ignored = crossing_primitives(*geometry, plants, sensors, grid, r);
   const bool any_light = src.sun_share > 0 || env.sky != LightSky::sun;

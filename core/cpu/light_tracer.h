@@ -26,6 +26,12 @@
 // photon is traced on (at most kMaxLightHitsPerPhoton surfaces), from the far side of a
 // frustum's solid or just past a leaf.
 //
+// The plants are skinned with the oracle's SkinOptions styled by the scene's skin (the
+// defaults: the frusta every renderer draws); where they blend their crotches
+// (SkinOptions::blend_crotches, docs/joints.md) a photon meets the fillets too, each named
+// by its heavier group's frustum (crotch_tracer.h nearest_wood), so a sensor ignores a
+// fillet of the twig it sits on as it ignores the twig.
+//
 // Sums are kept in fixed point (integers), so the answers do not depend on how photons
 // are split over threads: the same inputs give the same answers on any thread count.
 // Cost: O(N·(sensors per cell + log P per photon that crosses one) + K·sensors) for P
@@ -35,6 +41,7 @@
 #include <span>
 #include <vector>
 
+#include "core/geometry/skin.h"
 #include "core/scene/light_queries.h"
 
 namespace sylva {
@@ -43,13 +50,14 @@ inline constexpr int kMaxLightHitsPerPhoton = 64;
 
 class PhotonLightOracle final : public LightOracle {
  public:
-  explicit PhotonLightOracle(unsigned threads = 0) : threads_(threads) {}
+  explicit PhotonLightOracle(unsigned threads = 0, SkinOptions skin = {}) : threads_(threads), skin_(skin) {}
   Expected<std::vector<LightAnswer>> answer(std::span<const Skeleton> plants, std::span<const glm::dvec3> sensors,
                                             const Scene& scene, int64_t step,
                                             LightAnswerStats* stats = nullptr) const override;
 
  private:
   unsigned threads_;
+  SkinOptions skin_;
 };
 
 // The backward estimate of the same q (tests cross-check the photons with it): from each
@@ -57,6 +65,7 @@ class PhotonLightOracle final : public LightOracle {
 // counting 1 when it leaves the plants' bounding sphere without meeting a surface the
 // sensor does not ignore, nor the ground. Its std_error is the binomial one.
 Expected<std::vector<LightAnswer>> gather_light(std::span<const Skeleton> plants, std::span<const glm::dvec3> sensors,
-                                                const Scene& scene, int64_t step, uint64_t rays);
+                                                const Scene& scene, int64_t step, uint64_t rays,
+                                                const SkinOptions& skin = {});
 
 }  // namespace sylva

@@ -478,23 +478,9 @@ void leave_at_exit(const FrustumShape& shape, double t_hit, uint32_t frustum, co
   local.push_back({glm::vec3(exit - e.centre), glm::vec3(ray.direction), frustum});
 }
 
-// The first wood a photon meets in (0, t_max): the frusta's nearest hit, or a blended
-// crotch's fillet in front of it (crotch_tracer.h), named by the fillet's heavier group's
-// frustum. hit_any() false: none.
-BvhHit first_wood(const FrustumAccel& accel, const CrotchBalls* crotches, const Ray& ray, double t_max) {
-  ExtraHit fillet;
-  BvhHit hit = accel.nearest(ray, 0, t_max, nullptr, crotches ? &fillet : nullptr);
-  if (fillet.hit() && crotches->in_front(fillet.index, ray, fillet.t, hit.hit_any() ? hit.hit.t : kInf)) {
-    hit.hit.kind = FrustumHitKind::side;
-    hit.hit.t = fillet.t;
-    hit.frustum = crotches->frustum_at(fillet.index, ray.origin + fillet.t * ray.direction);
-  }
-  return hit;
-}
-
 // One prototype of the instanced photon tracer: exact frusta (no relief) and leaves in one
 // frame, hit as the non-instanced photons hit them — the nearest frustum, unless a leaf
-// comes first (then the leaf hit, is_leaf()), with the blended crotches' fillets (first_wood).
+// comes first (then the leaf hit, is_leaf()), with the blended crotches' fillets (nearest_wood).
 // Its hits' plant: plant_of_frustum's, or 0 (an instance's hits take the instance's plant).
 class PhotonPrototype final : public SceneTracer {
  public:
@@ -511,7 +497,7 @@ class PhotonPrototype final : public SceneTracer {
   }
   SurfaceHit nearest(const Ray& ray, double t_min, double t_max) const override {
     // t_min is 0 for every photon query (the instance tracer passes it on).
-    const BvhHit hit = accel_ ? first_wood(*accel_, crotches_, ray, t_max) : BvhHit{};
+    const BvhHit hit = accel_ ? nearest_wood(*accel_, crotches_, ray, 0, t_max) : BvhHit{};
     if (leaves_) {
       const SurfaceHit leaf = leaves_->nearest_leaf(ray, t_min, hit.hit_any() ? hit.hit.t : t_max);
       if (leaf.hit()) return leaf;
@@ -709,7 +695,7 @@ SunPhotons SunPhotonTracer::trace(const SunPhotonOptions& options) const {
                     m.first_of_instance[i] + hit.frustum, ray, e, local);
     });
   return trace_photons(*m.mask, e, options, [&](const Ray& ray, std::vector<ShadowVector>& local) {
-    const BvhHit hit = first_wood(*m.accel, m.crotches, ray, kInf);
+    const BvhHit hit = nearest_wood(*m.accel, m.crotches, ray, 0, kInf);
     // A leaf before the first frustum (or instead of one) stops the photon, naming the
     // first frustum of the leaf's plant.
     if (m.leaves.tracer) {
@@ -737,7 +723,7 @@ double SunPhotonTracer::first_hit(const Ray& ray) const {
     const SurfaceHit hit = m.placed->nearest(ray, 0, kInf);
     return hit.hit() ? hit.t : kInf;
   }
-  const BvhHit hit = first_wood(*m.accel, m.crotches, ray, kInf);
+  const BvhHit hit = nearest_wood(*m.accel, m.crotches, ray, 0, kInf);
   double t = hit.hit_any() ? hit.hit.t : kInf;
   if (m.leaves.tracer) {
     const SurfaceHit leaf = m.leaves.tracer->nearest_leaf(ray, 0, t);

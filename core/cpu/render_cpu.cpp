@@ -416,12 +416,14 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     const SkinnedSkeleton& skinned = *skinned_or;
     append_leaves(leaves, placed, p);
     const uint32_t first_frustum = static_cast<uint32_t>(g.frusta.size());
-    if (plant_skin.blend_crotches) {  // a mesh has its fillets' triangles too (below)
-      for (Crotch& c : find_crotches(placed, skinned.frusta)) {
-        for (uint32_t& i : c.parent_frusta) i += first_frustum;
-        for (uint32_t& i : c.lateral_frusta) i += first_frustum;
-        crotches.push_back(std::move(c));
-      }
+    // The plant's crotches (a mesh has its fillets' triangles too, below, and its relief
+    // fades into them), then the scene's, by scene frustum.
+    const std::vector<Crotch> plant_crotches =
+        plant_skin.blend_crotches ? find_crotches(placed, skinned.frusta) : std::vector<Crotch>{};
+    for (Crotch c : plant_crotches) {
+      for (uint32_t& i : c.parent_frusta) i += first_frustum;
+      for (uint32_t& i : c.lateral_frusta) i += first_frustum;
+      crotches.push_back(std::move(c));
     }
     g.frusta.insert(g.frusta.end(), skinned.frusta.begin(), skinned.frusta.end());
     g.plant_of_frustum.insert(g.plant_of_frustum.end(), skinned.frusta.size(), p);
@@ -430,7 +432,8 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     check_mesh_fits(tessellation_size(skinned.frusta.size(), tessellation), triangles.memory_bytes());
     const HeightFn height = options.displace && textures ? height_function_for(*textures, p) : HeightFn{};
     TriangleMesh part = plant_mesh(skinned, tessellation, height, plant.bark.relief_depth_m,
-                                   options.relief_options.max_depth_per_radius, &tessellate_s, &displace_s);
+                                   options.relief_options.max_depth_per_radius, &tessellate_s, &displace_s,
+                                   plant_crotches);
     if (plant_skin.blend_crotches) append_mesh(part, skeleton_fillets(placed, skinned.frusta), 0);
     if (height) ++displaced;
     start = Clock::now();

@@ -49,8 +49,6 @@ double depth_at(const Crotch& c, double s) {
   return c.depth[i] + f * (c.depth[i + 1] - c.depth[i]);
 }
 
-constexpr int kDepthSamples = 16;
-
 }  // namespace
 
 double frustum_bound(const FrustumShape& shape, const dvec3& p) {
@@ -123,8 +121,8 @@ std::vector<Crotch> find_crotches(const Skeleton& sk, std::span<const Frustum> f
       if (touches(frusta[i].shape, cr.centre, cr.radius)) cr.lateral_frusta.push_back(i);
     }
     if (cr.parent_frusta.empty() || cr.lateral_frusta.empty()) continue;
-    cr.depth_step = (t_exit + cr.radius) / kDepthSamples;
-    for (int i = 0; i < kDepthSamples; ++i) {
+    cr.depth_step = (t_exit + cr.radius) / static_cast<int>(kCrotchDepthSamples);
+    for (int i = 0; i < static_cast<int>(kCrotchDepthSamples); ++i) {
       const dvec3 q = start + (i + 0.5) * cr.depth_step * *dir;
       cr.depth.push_back(-group_bound(frusta, cr.parent_frusta, q));
     }
@@ -192,8 +190,41 @@ CrotchShade crotch_shade(const Crotch& c, std::span<const Frustum> frusta, const
   s.normal = glm::length(n) > 1e-6 ? glm::normalize(n) : (s.h >= 0.5 ? np : nl);
   s.parent_uv = surface_uv(fp, p);
   s.lateral_uv = surface_uv(fl, p);
-  s.relief_scale = 1 - 4 * s.h * (1 - s.h);
   return s;
+}
+
+double crotch_relief_fade(const CrotchSample& s) {
+  if (!(s.k > 0)) return 1;
+  const double x = std::clamp((std::abs(s.parent - s.lateral) - s.k) / s.k, 0.0, 1.0);
+  return x * x * (3 - 2 * x);
+}
+
+CrotchesOfFrusta crotches_of_frusta(std::span<const Crotch> crotches, size_t frustum_count) {
+  CrotchesOfFrusta out;
+  out.begin.assign(frustum_count + 1, 0);
+  for (const Crotch& c : crotches) {
+    for (uint32_t f : c.parent_frusta) ++out.begin[f + 1];
+    for (uint32_t f : c.lateral_frusta) ++out.begin[f + 1];
+  }
+  for (size_t i = 1; i < out.begin.size(); ++i) out.begin[i] += out.begin[i - 1];
+  out.crotches.resize(out.begin.back());
+  std::vector<uint32_t> next(out.begin.begin(), out.begin.end() - 1);
+  for (uint32_t c = 0; c < crotches.size(); ++c) {
+    for (uint32_t f : crotches[c].parent_frusta) out.crotches[next[f]++] = c;
+    for (uint32_t f : crotches[c].lateral_frusta) out.crotches[next[f]++] = c;
+  }
+  return out;
+}
+
+double relief_fade_at(std::span<const Crotch> crotches, std::span<const uint32_t> which,
+                      std::span<const Frustum> frusta, const dvec3& p) {
+  double fade = 1;
+  for (uint32_t i : which) {
+    const Crotch& c = crotches[i];
+    if (glm::dot(p - c.centre, p - c.centre) >= c.radius * c.radius) continue;  // k = 0 there
+    fade = std::min(fade, crotch_relief_fade(crotch_field(c, frusta, p)));
+  }
+  return fade;
 }
 
 std::optional<CrotchHit> march_crotch(const Crotch& c, std::span<const Frustum> frusta, const Ray& ray,

@@ -46,6 +46,9 @@ struct CrotchOptions {
                              // radius (the collars' rule: a needle's crotch is too small to see)
 };
 
+// Samples of a crotch's depth table (Crotch::depth).
+inline constexpr uint32_t kCrotchDepthSamples = 16;
+
 // One blended crotch.
 struct Crotch {
   uint32_t lateral = 0;         // the lateral chain
@@ -87,18 +90,49 @@ CrotchSample crotch_field(const Crotch& crotch, std::span<const Frustum> frusta,
 // between the two frusta of a mitre off their shared plane, where eq. 8's normals and
 // (u, v) differ. The normal is normalize(mix(n_lateral, n_parent, h)) of the two eq. 8
 // normals (the fillet's bounds have kinks, so a gradient of F would not be smooth), the
-// colour is to be the same mix of the two textures at their own (u, v_m), and the relief
-// is scaled by 1 − 4h(1 − h), 0 on the crease. Where h is 0 or 1 all of it is the exact
-// surface's, so nothing jumps at the fillet's edge.
+// colour is the same mix of the two textures at their own (u, v_m). The fillet has no
+// relief: the frusta's relief fades out before it (crotch_relief_fade). Where h is 0 or 1
+// all of it is the exact surface's, so nothing jumps at the fillet's edge.
 struct CrotchShade {
   uint32_t parent_frustum = 0;   // index into the frusta
   uint32_t lateral_frustum = 0;
   glm::dvec3 normal{0, 1, 0};    // unit, outward
   SurfaceUV parent_uv, lateral_uv;
   double h = 0;                  // the parent's weight
-  double relief_scale = 1;       // 1 − 4h(1 − h)
 };
 CrotchShade crotch_shade(const Crotch& crotch, std::span<const Frustum> frusta, const glm::dvec3& p);
+
+// The frustum that names a fillet point (ids, material, texture, the sensors' and the
+// photons' frustum): the heavier group's shading frustum, the parent's where h >= 1/2.
+inline uint32_t heavier_frustum(const CrotchShade& shade) {
+  return shade.h >= 0.5 ? shade.parent_frustum : shade.lateral_frustum;
+}
+
+// How much of a relief (relief.h ReliefFade) is left at p on the crotch's frusta, from the
+// field's sample there: 0 wherever the blend adds material (|P − C| < k(p)), rising as a
+// smoothstep of (|P − C| − k)/k to 1 at |P − C| = 2k(p), and 1 wherever k(p) = 0 (outside
+// the ball, where the lateral is deep under the parent). So the ribs of both groups sink
+// into the relief-free fillet before it begins: the fillet meets relief-free frusta along
+// its edge, as without relief, and no rib of one group stands out of the other's surface
+// within the blend. Continuous wherever k > 0 or |P − C| > 0.
+double crotch_relief_fade(const CrotchSample& sample);
+
+// Which crotches hold each frustum in one of their groups: frustum f's are
+// crotches[begin[f] .. begin[f + 1]), in crotch order (CSR over `frustum_count` frusta).
+struct CrotchesOfFrusta {
+  std::vector<uint32_t> begin{0};
+  std::vector<uint32_t> crotches;
+  std::span<const uint32_t> of(uint32_t frustum) const {
+    return {crotches.data() + begin[frustum], crotches.data() + begin[frustum + 1]};
+  }
+  size_t bytes() const { return (begin.capacity() + crotches.capacity()) * sizeof(uint32_t); }
+};
+CrotchesOfFrusta crotches_of_frusta(std::span<const Crotch> crotches, size_t frustum_count);
+
+// The relief left at p on a frustum held by the crotches `which` (indices into crotches):
+// the least crotch_relief_fade over those whose ball holds p, 1 where none does.
+double relief_fade_at(std::span<const Crotch> crotches, std::span<const uint32_t> which,
+                      std::span<const Frustum> frusta, const glm::dvec3& p);
 
 // Largest |∇F| the step is divided by: 1 for the bounds, plus what the fading k adds
 // (docs/joints.md: the ball's fade ≤ 1.54·k/R·(1/4), the depth fade ≤ 1.5·(1/4)).

@@ -1,5 +1,7 @@
 // crotch_mesh.cpp — see crotch_mesh.h.
 #include "core/geometry/crotch_mesh.h"
+#include "core/geometry/skeleton_bounds.h"
+#include "core/util/parallel.h"
 
 #include <algorithm>
 #include <array>
@@ -205,20 +207,18 @@ TriangleMesh crotch_fillet_mesh(const Crotch& crotch, std::span<const Frustum> f
   return mesh;
 }
 
-TriangleMesh skeleton_fillets(const Skeleton& skeleton, std::span<const Frustum> frusta) {
+TriangleMesh skeleton_fillets(const Skeleton& skeleton, std::span<const Frustum> frusta, unsigned threads) {
   TriangleMesh out;
   const std::vector<Crotch> crotches = find_crotches(skeleton, frusta);
   if (crotches.empty()) return out;
-  dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
-  for (const Joint& j : skeleton.joints) {
-    const dvec3 p(j.position_m[0], j.position_m[1], j.position_m[2]);
-    lo = glm::min(lo, p), hi = glm::max(hi, p);
-  }
-  const double min_cell = kFilletMinCellPerExtent * glm::length(hi - lo);
-  for (const Crotch& c : crotches) {
-    if (!(c.k > 0)) continue;
-    append_mesh(out, crotch_fillet_mesh(c, frusta, std::max(c.k / 2, min_cell)), 0);
-  }
+  const SkeletonBounds box = skeleton_bounds(skeleton);
+  const double min_cell = kFilletMinCellPerExtent * glm::length(box.hi - box.lo);
+  std::vector<TriangleMesh> meshes(crotches.size());
+  parallel_for(crotches.size(), threads, nullptr, [&](size_t i, unsigned) {
+    const Crotch& c = crotches[i];
+    if (c.k > 0) meshes[i] = crotch_fillet_mesh(c, frusta, std::max(c.k / 2, min_cell));
+  });
+  for (const TriangleMesh& m : meshes) append_mesh(out, m, 0);
   return out;
 }
 

@@ -66,8 +66,8 @@ inline constexpr int kMaxCrotchGridCells = 256;
 TriangleMesh crotch_fillet_mesh(const Crotch& crotch, std::span<const Frustum> frusta, double cell_m);
 
 // The smallest cell skeleton_fillets meshes a crotch with, as a share of the skeleton's
-// extent (the diagonal of its joints' box): in a view of the whole plant 1000 pixels
-// across, a facet is at least about a pixel.
+// extent (the diagonal of skeleton_bounds: joints with their radii, leaves): in a view of
+// the whole plant 1000 pixels across, a facet is at least about a pixel.
 inline constexpr double kFilletMinCellPerExtent = 1e-3;
 
 // Every crotch of a skinned skeleton (find_crotches with the default options) as one mesh,
@@ -76,7 +76,9 @@ inline constexpr double kFilletMinCellPerExtent = 1e-3;
 // extent (docs/joints.md: the elm's 529 crotches make 81,000 triangles in 0.25 s instead
 // of 197,000 in 0.64 s; only its crotches of under about 3 cm are coarser),
 // triangle_frustum indexing `frusta`: what the mesh paths and GL append beside the
-// frusta's own mesh where SkinOptions::blend_crotches is on.
-TriangleMesh skeleton_fillets(const Skeleton& skeleton, std::span<const Frustum> frusta);
+// frusta's own mesh where SkinOptions::blend_crotches is on. The crotches are meshed on
+// `threads` threads (0: every hardware thread; parallel.h) and appended in crotch order:
+// the same mesh on any thread count.
+TriangleMesh skeleton_fillets(const Skeleton& skeleton, std::span<const Frustum> frusta, unsigned threads = 0);
 
 }  // namespace sylva

@@ -3,6 +3,9 @@
 // GL's GlMesh (core/gl/).
 #pragma once
 
+#include <span>
+
+#include "core/geometry/crotch.h"
 #include "core/geometry/skin.h"
 #include "core/geometry/tessellate.h"
 
@@ -14,8 +17,12 @@ namespace sylva {
 // relief.h's min(relief_depth_m, max_depth_per_radius·r) at each end of a vertex's
 // frustum, linear between — so that GS+R lifts a twig or needle no more than the relief
 // marcher's shell does. The bark is the wood's (material 0): vertices of other materials'
-// frusta are not displaced. Adds the seconds spent to *tessellate_s and *displace_s.
+// frusta are not displaced. `crotches` (find_crotches of `skinned`, where its skin blends
+// them): the displacement fades into the fillets as the marcher's relief does (crotch.h
+// crotch_relief_fade at each vertex of a crotch's frusta, before it moves). Adds the
+// seconds spent to *tessellate_s and *displace_s.
 TriangleMesh plant_mesh(const SkinnedSkeleton& skinned, const TessellateOptions& tessellation, const HeightFn& height,
-                        double relief_depth_m, double max_depth_per_radius, double* tessellate_s, double* displace_s);
+                        double relief_depth_m, double max_depth_per_radius, double* tessellate_s, double* displace_s,
+                        std::span<const Crotch> crotches = {});
 
 }  // namespace sylva

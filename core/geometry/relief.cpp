@@ -107,6 +107,7 @@ struct Marcher {
   const Frustum& frustum;
   const ReliefMap& map;
   const ReliefOptions& options;
+  const ReliefFade* fade;  // null: none
   LocalRay ray;
   glm::dvec3 axis, e0, e1;
   double slope, radius0, length;
@@ -175,7 +176,9 @@ struct Marcher {
     if (w < 0) return true;   // below the inner cone: H >= 0 >= w, no lookup
     if (w > 1) return false;  // above the shell (rounding): H <= 1 < w
     const double v_m = v_m_at(q, t_local);
-    return w <= height(u_at(q, v_m), v_m);
+    const double scale = fade ? std::clamp(fade->scale(frustum.shape.base + q.p), 0.0, 1.0) : 1.0;
+    if (w > scale) return false;  // above the faded relief's top: no lookup
+    return w <= scale * height(u_at(q, v_m), v_m);
   }
 };
 
@@ -205,7 +208,7 @@ SolidInterval frustum_solid_interval(const Ray& ray, const FrustumShape& shape, 
 
 ReliefHit intersect_relief(const Ray& ray, const Frustum& frustum, const ReliefMap& map,
                            const ReliefOptions& options, double t_min, double t_max,
-                           bool describe) {
+                           bool describe, const ReliefFade* fade) {
   assert(map.field && map.depth_m > 0 && "intersect_relief needs a height field and a depth > 0");
   assert(options.max_depth_per_radius > 0 && "a zero shell has no relief");
   ReliefHit result;
@@ -215,6 +218,7 @@ ReliefHit intersect_relief(const Ray& ray, const Frustum& frustum, const ReliefM
   Marcher m{frustum,
             map,
             options,
+            fade,
             local_ray(ray, shell),
             shell.axis,
             {},
@@ -334,13 +338,25 @@ ReliefHit intersect_relief(const Ray& ray, const Frustum& frustum, const ReliefM
     const double dh_ds = resolved ? (h_at(s0 + 0.5 * ws, t0) - h_at(s0 - 0.5 * ws, t0)) / ws : 0.0;
     const double dh_dt = resolved ? (h_at(s0, t0 + 0.5 * wt) - h_at(s0, t0 - 0.5 * wt)) / wt : 0.0;
     const double depth = std::max(q.depth, 0.0);
-    const double around = q.rho > 0 ? depth * dh_ds * map.u_repeat / (2 * kPi * q.rho) : 0.0;
-    const double along = depth * (dh_dt * map.v_per_metre +
-                                    dh_ds * map.u_repeat * frustum.twist_rad_per_m / (2 * kPi));
     const glm::dvec3 tangent_u = glm::cross(m.axis, e);
     // The constant-w cone through the hit (slope k + w·d'(y); k where d is constant).
     const double slope_w = m.slope + std::clamp(q.w(), 0.0, 1.0) * m.depth_slope;
     const glm::dvec3 tangent_v = glm::normalize(m.axis + slope_w * e);
+    // The displacement is d·f·H: H's differences scaled by f, and H times f's gradient.
+    double f = 1, df_da = 0, df_db = 0;
+    if (fade) {
+      const glm::dvec3 p = frustum.shape.base + q.p;
+      const double step = fade->fade_step_m();
+      auto scale_at = [&](const glm::dvec3& x) { return std::clamp(fade->scale(x), 0.0, 1.0); };
+      f = scale_at(p);
+      df_da = (scale_at(p + step * tangent_u) - scale_at(p - step * tangent_u)) / (2 * step);
+      df_db = (scale_at(p + step * tangent_v) - scale_at(p - step * tangent_v)) / (2 * step);
+    }
+    const double h0 = fade ? h_at(s0, t0) : 0.0;  // where f changes, H lifts by f's slope
+    const double around = depth * (f * (q.rho > 0 ? dh_ds * map.u_repeat / (2 * kPi * q.rho) : 0.0) + h0 * df_da);
+    const double along = depth * (f * (dh_dt * map.v_per_metre +
+                                       dh_ds * map.u_repeat * frustum.twist_rad_per_m / (2 * kPi)) +
+                                  h0 * df_db);
     auto perturb = [&](const glm::dvec3& n0) {
       const glm::dvec3 n = n0 - around * tangent_u - along * tangent_v;
       const double length = glm::length(n);

@@ -66,6 +66,13 @@
 // a pixel does not sparkle (as a MIP-mapped normal map would not), while the ribs and
 // furrows a pixel resolves keep their slope.
 //
+// Fading (ReliefFade, optional): a smooth factor f(p) in [0, 1] of the world point scales
+// the height field, so the solid is { ρ <= r(y) + d(y)·f(p)·H } inside the same shell: 1
+// leaves the relief as it is, 0 is the inner frustum. The blended crotches fade the relief
+// into their fillets with it (crotch.h crotch_relief_fade). The normal's perturbation is
+// that of the displacement d·f·H: the differences of H above scaled by f, plus H times
+// f's own gradient along the two tangents (central differences of f over fade_step_m).
+//
 // Units: metres, t in units of the ray's direction. Thread-safe (pure functions; the
 // HeightField must be safe for concurrent calls).
 #pragma once
@@ -137,6 +144,16 @@ inline double HeightTexels::at(double s, double t) const {
   return top + fy * (bottom - top);
 }
 
+// A factor in [0, 1] the height field is multiplied by at a world point (see the header
+// comment); continuous in p, smooth where the normal is taken. Must be thread-safe.
+class ReliefFade {
+ public:
+  virtual ~ReliefFade() = default;
+  virtual double scale(const glm::dvec3& world) const = 0;
+  // Step of the central differences that give the fade's gradient for the normal, metres.
+  virtual double fade_step_m() const = 0;
+};
+
 // What the relief of one frustum needs besides its shape.
 struct ReliefMap {
   const HeightField* field = nullptr;  // H; not owned
@@ -191,10 +208,10 @@ struct ReliefHit {
 };
 
 // The nearest hit of `ray` with t_min < t < t_max on the relief solid of `frustum` under
-// `map` (map.field non-null, map.depth_m > 0). With describe false only hit.kind and
-// hit.t are set (shadow rays).
+// `map` (map.field non-null, map.depth_m > 0), its height scaled by `fade` where one is
+// given. With describe false only hit.kind and hit.t are set (shadow rays).
 ReliefHit intersect_relief(const Ray& ray, const Frustum& frustum, const ReliefMap& map,
                            const ReliefOptions& options, double t_min, double t_max,
-                           bool describe = true);
+                           bool describe = true, const ReliefFade* fade = nullptr);
 
 }  // namespace sylva

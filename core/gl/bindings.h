@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "core/scene/materials.h"
+#include "core/geometry/crotch.h"
 #include "core/geometry/skin.h"
 
 namespace sylva::gl {
@@ -34,6 +35,8 @@ inline constexpr uint32_t kFogMapsBinding = 14;      // GpuSunMapRecord per sun 
 inline constexpr uint32_t kFogMapSlotsBinding = 15;  // uint32 per tile of every map: its slot (global)
 inline constexpr uint32_t kFogMapRangesBinding = 16; // vec2 per slot: its smallest and largest height
 inline constexpr uint32_t kFogMapTexelsBinding = 17; // float per texel of every slot (32 × 32 a slot)
+inline constexpr uint32_t kCrotchesBinding = 18;     // GpuCrotchRecord per blended crotch (CROTCH_FADE)
+inline constexpr uint32_t kCrotchListsBinding = 19;  // uint32: per record its crotches, the groups' records
 
 // Texture units.
 inline constexpr uint32_t kBarkTexturesUnit = 0;  // bark image i at kBarkTexturesUnit + i
@@ -104,6 +107,9 @@ inline constexpr GlslConstant kGlslConstants[] = {
     {"FOG_MAP_SLOTS_BINDING", kFogMapSlotsBinding},
     {"FOG_MAP_RANGES_BINDING", kFogMapRangesBinding},
     {"FOG_MAP_TEXELS_BINDING", kFogMapTexelsBinding},
+    {"CROTCHES_BINDING", kCrotchesBinding},
+    {"CROTCH_LISTS_BINDING", kCrotchListsBinding},
+    {"CROTCH_DEPTH_SAMPLES", kCrotchDepthSamples},
     {"FOG_MAP_NO_SLOT", kFogMapNoSlot},
     {"FOG_MAP_TILE", kFogMapTile},
     {"FOG_MAX_MAPS", kFogMaxMaps},
@@ -178,6 +184,22 @@ struct GpuSunMapRecord {
   uint32_t first_tile[4]; // the map's first entry in the slots array, 0, 0, 0
 };
 static_assert(sizeof(GpuSunMapRecord) == 80 && offsetof(GpuSunMapRecord, first_tile) == 64);
+
+// crotch.glsl's GpuCrotch: one blended crotch (core/geometry/crotch.h Crotch) of a plant
+// with a relief, for the relief's fade into its fillet (gl_crotch_fade.h). Positions are
+// relative to origin_hi (the origin_hi of its first parent record, float-exact); the
+// groups' record indices lie in CrotchLists from parent_first / lateral_first.
+struct GpuCrotchRecord {
+  float origin_hi[3];
+  float centre[3];
+  float start[3];
+  float direction[3];
+  float radius, k, lateral_radius, depth_step;
+  uint32_t parent_first, parent_count, lateral_first, lateral_count, depth_count;
+  float depth[kCrotchDepthSamples];
+};
+static_assert(sizeof(GpuCrotchRecord) == 4 * (21 + kCrotchDepthSamples) && offsetof(GpuCrotchRecord, radius) == 48 &&
+              offsetof(GpuCrotchRecord, parent_first) == 64 && offsetof(GpuCrotchRecord, depth) == 84);
 
 // fog_lists.glsl's FogNode (12 bytes) and FogCounters.
 struct FogNodeRecord {

@@ -284,8 +284,10 @@ struct GlMesh::State {
         check_mesh_fits(tessellation_size(skinned.frusta.size(), tessellation),
                         arrays.vertices.size() * sizeof(MeshVertex) + arrays.indices.size() * sizeof(uint32_t));
         const HeightFn height = heights ? (*heights)[p] : HeightFn{};
+        const std::vector<Crotch> crotches =
+            skin.blend_crotches && height ? find_crotches(skeleton, skinned.frusta) : std::vector<Crotch>{};
         part = plant_mesh(skinned, tessellation, height, plant.bark.relief_depth_m,
-                          geometry.relief_options.max_depth_per_radius, &tessellate_s, &displace_s);
+                          geometry.relief_options.max_depth_per_radius, &tessellate_s, &displace_s, crotches);
         if (skin.blend_crotches) append_mesh(part, skeleton_fillets(skeleton, skinned.frusta), 0);
         if (height) ++arrays.displaced_plants;
       }

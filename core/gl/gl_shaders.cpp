@@ -96,6 +96,7 @@ ShaderProgramSource frusta_program(FrustaPass pass, const FrustaFeatures& featur
   const int units = (bark || (features.relief && !shadow)) ? std::max(1, features.texture_units) : 0;
   if (features.want_uv && !shadow) defines.push_back("WANT_UV");
   if (features.relief) defines.push_back("RELIEF");
+  if (features.relief && features.crotch_fade) defines.push_back("CROTCH_FADE");
   if (bark) defines.push_back("BARK");
   if (units > 0) defines.push_back("BARK_TEXTURE_UNITS " + std::to_string(units));
   if (!features.conservative_depth) defines.push_back("NO_CONSERVATIVE_DEPTH");
@@ -109,6 +110,7 @@ ShaderProgramSource frusta_program(FrustaPass pass, const FrustaFeatures& featur
   p.name += "]";
   std::vector<std::string> files = kFrustaCommon;
   if (features.relief || bark) files.insert(files.end(), {"srgb.glsl", "bark.glsl"});
+  if (features.relief && features.crotch_fade) files.push_back("crotch.glsl");
   if (features.relief) files.push_back("relief.glsl");
   p.vertex = {ShaderStage::vertex, with(files, "frusta.vert.glsl"), defines};
   p.fragment = {ShaderStage::fragment, with(files, "frusta.frag.glsl"), defines};
@@ -245,6 +247,13 @@ std::vector<ShaderProgramSource> all_shader_programs() {
     all.push_back(frusta_program(pass, features));
     if (pass == FrustaPass::shadow) continue;
     features.want_uv = features.bark = true;
+    features.texture_units = 1;
+    all.push_back(frusta_program(pass, features));
+  }
+  // Relief fading into blended crotches (CROTCH_FADE), each pass.
+  for (FrustaPass pass : {FrustaPass::gbuffer, FrustaPass::gbuffer_eye_inside, FrustaPass::shadow}) {
+    FrustaFeatures features;
+    features.relief = features.crotch_fade = true;
     features.texture_units = 1;
     all.push_back(frusta_program(pass, features));
   }

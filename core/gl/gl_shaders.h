@@ -67,6 +67,8 @@ struct FrustaFeatures {
   bool want_uv = false;            // WANT_UV: u and v_m into the G-buffer (the UV AOV)
   bool relief = false;             // RELIEF: relief marching for plants with a relief
                                    // (relief.glsl), in the pyramid of the shell
+  bool crotch_fade = false;        // CROTCH_FADE (with relief): a blended crotch's relief
+                                   // fades into its fillet (crotch.glsl, gl_crotch_fade.h)
   bool bark = false;               // BARK: albedo textures looked up into g_albedo (bark.glsl)
   int texture_units = 0;           // BARK_TEXTURE_UNITS: distinct bark images bound (albedo
                                    // and height maps); at least 1 with relief or bark

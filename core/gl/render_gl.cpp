@@ -17,6 +17,7 @@
 #include "core/gl/bindings.h"
 #include "core/gl/gl_api.h"
 #include "core/gl/gl_bark_maps.h"
+#include "core/gl/gl_crotch_fade.h"
 #include "core/gl/gl_fog.h"
 #include "core/gl/gl_frame_targets.h"
 #include "core/gl/gl_mesh.h"
@@ -226,6 +227,10 @@ struct GlRenderer::State {
 
   GlVertexArray vao;  // empty: the frusta pull their vertices from the records
   GlBuffer segment_buffer, id_buffer, list_buffer, instance_buffer;
+  // The blended crotches of the plants with a relief, their frusta as record indices
+  // (skin_plants), and their tables on the GPU (CROTCH_FADE, gl_crotch_fade.h).
+  std::vector<Crotch> fade_crotches;
+  GlBuffer crotch_buffer, crotch_list_buffer;
   // The context's programs (shared with other renderers on it, or this renderer's own) and
   // this renderer's variants in them by name: the cache assembles a variant's sources to
   // find it, done once per variant here rather than per frame.
@@ -256,10 +261,21 @@ struct GlRenderer::State {
   // Skins one skeleton (placed: in the world) into records and id quadruples (plant, chain,
   // segment, 0), and its frusta's bounding spheres into *out.
   void skin_one(const Skeleton& skeleton, uint32_t plant, SkinStyle style, const Progress& progress,
-                std::vector<GpuSegment>* records, std::vector<uint32_t>* ids, std::vector<Sphere>* out) const {
+                std::vector<GpuSegment>* records, std::vector<uint32_t>* ids, std::vector<Sphere>* out,
+                std::vector<Crotch>* crotches) const {
     Expected<SkinnedSkeleton> skinned_or = skin_skeleton(skeleton, options.skin.styled(style), progress);
     if (!skinned_or) throw GlCancelled();  // the only error skin_skeleton returns
     const SkinnedSkeleton& skinned = *skinned_or;
+    const float plant_relief_m = bark_maps->plants().empty() ? 0.0f : bark_maps->plants()[plant].relief_depth_m;
+    if (plant_relief_m > 0 && options.skin.styled(style).blend_crotches) {
+      // The relief fades into the fillets (crotch.glsl): the crotches, by record index.
+      const uint32_t first = static_cast<uint32_t>(records->size());
+      for (Crotch c : find_crotches(skeleton, skinned.frusta)) {
+        for (uint32_t& i : c.parent_frusta) i += first;
+        for (uint32_t& i : c.lateral_frusta) i += first;
+        crotches->push_back(std::move(c));
+      }
+    }
     for (const Frustum& f : skinned.frusta) {
       records->push_back(pack_gpu_segment(f));
       ids->insert(ids->end(), {plant, f.chain, f.segment, 0u});
@@ -305,11 +321,12 @@ struct GlRenderer::State {
     std::vector<InstancedDraw> fresh_draws;
     std::vector<InstanceSphere> fresh_instance_spheres;
     std::vector<std::vector<Sphere>> fresh_draw_spheres;
+    std::vector<Crotch> fresh_crotches;
     const double share = 1.0 / std::max(1u, n);
     for (uint32_t p : split.world) {
       if (options.progress.cancelled()) throw GlCancelled();  // between plants
       skin_one(place_plant(scene.plants[p]), p, scene.plants[p].skin, options.progress.part(p * share, (p + 1) * share),
-               records, ids, &fresh);
+               records, ids, &fresh, &fresh_crotches);
     }
     const uint32_t world_records = static_cast<uint32_t>(records->size());
     uint64_t drawn = world_records;
@@ -329,7 +346,8 @@ struct GlRenderer::State {
         // plant may be one skinned in the world, with a relief none of these has).
         const uint32_t prototype = group.front();
         std::vector<Sphere> local;
-        skin_one(*scene.plants[prototype].skeleton, prototype, scene.plants[prototype].skin, {}, records, ids, &local);
+        skin_one(*scene.plants[prototype].skeleton, prototype, scene.plants[prototype].skin, {}, records, ids, &local,
+                 &fresh_crotches);
         const Sphere bound = enclosing_sphere(local);
         const uint32_t draw_index = static_cast<uint32_t>(fresh_draws.size());
         InstancedDraw draw{first, static_cast<uint32_t>(records->size()) - first,
@@ -356,8 +374,18 @@ struct GlRenderer::State {
     instance_spheres = std::move(fresh_instance_spheres);
     draw_spheres = std::move(fresh_draw_spheres);
     features.instanced = !draws.empty();
+    fade_crotches = std::move(fresh_crotches);
+    features.crotch_fade = !fade_crotches.empty();
     frusta = drawn;
     record_count = records->size();
+  }
+
+  // Uploads the crotches' fade tables for `records` (none: no buffers); their bytes.
+  uint64_t upload_crotch_fade(std::span<const GpuSegment> records) {
+    const GlCrotchFadeTables tables = pack_crotch_fade(fade_crotches, records);
+    crotch_buffer = tables.empty() ? GlBuffer() : make_gl_buffer(tables.crotches.data(), tables.crotches.size() * sizeof(gl::GpuCrotchRecord));
+    crotch_list_buffer = tables.empty() ? GlBuffer() : make_gl_buffer(tables.lists.data(), tables.lists.size() * sizeof(uint32_t));
+    return tables.bytes();
   }
 
   // Draws the frusta's pyramids with `program` (in use): every record once, or (instanced)
@@ -533,6 +561,8 @@ struct GlRenderer::State {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kSegmentIdsBinding, id_buffer.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kSegmentListBinding, list_buffer.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kInstancesBinding, instance_buffer.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kCrotchesBinding, crotch_buffer.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, gl::kCrotchListsBinding, crotch_list_buffer.id());
     bark_maps->bind();
     glBindTextureUnit(gl::kGNormalDistanceUnit, targets.gbuffer[0].id());
     glBindTextureUnit(gl::kGGeometricUUnit, targets.gbuffer[1].id());
@@ -608,6 +638,7 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options, std::sh
   st.segment_buffer = make_gl_buffer(records.data(), records.size() * sizeof(GpuSegment), GL_DYNAMIC_STORAGE_BIT);
   st.id_buffer = make_gl_buffer(ids.data(), ids.size() * sizeof(uint32_t));
   st.instance_buffer = make_gl_buffer(instances.data(), instances.size() * sizeof(GpuInstance));
+  const uint64_t crotch_bytes = st.upload_crotch_fade(records);
   GLuint list = 0;
   glCreateBuffers(1, &list);  // mutable storage: a new list each frame that needs one
   st.list_buffer.reset(list);
@@ -616,12 +647,15 @@ GlRenderer::GlRenderer(const Scene& scene, const RenderOptions& options, std::sh
     st.uploaded_bytes = st.mesh->gpu_bytes();  // its "upload" pass is in already
   } else {
     st.uploaded_bytes = records.size() * sizeof(GpuSegment) + ids.size() * sizeof(uint32_t) +
-                        instances.size() * sizeof(GpuInstance);
+                        instances.size() * sizeof(GpuInstance) + crotch_bytes;
     st.setup_passes.push_back({"upload", seconds_since(start),
                                std::to_string(st.uploaded_bytes / 1024) + " KiB: " + std::to_string(records.size()) +
                                    " GpuSegment records (64 B) + ids (16 B)" +
                                    (instances.empty() ? std::string()
-                                                      : " + " + std::to_string(instances.size()) + " instances (48 B)")});
+                                                      : " + " + std::to_string(instances.size()) + " instances (48 B)") +
+                                   (crotch_bytes == 0 ? std::string()
+                                                      : " + " + std::to_string(st.fade_crotches.size()) +
+                                                            " crotches' relief fade")});
   }
   // The crotches' fillets beside the ray-cast frusta (gl_mesh.h fillets_of; the mesh has
   // its own in its triangles).
@@ -717,7 +751,8 @@ uint64_t GlRenderer::update_plants(const Scene& scene) {
   st.skin_plants(scene, &records, &ids, &instances);
   st.add_leaf_spheres();
   const size_t record_bytes = records.size() * sizeof(GpuSegment);
-  uint64_t uploaded = record_bytes + leaf_bytes;
+  const uint64_t crotch_bytes = st.upload_crotch_fade(records);  // the crotches move with the frusta
+  uint64_t uploaded = record_bytes + leaf_bytes + crotch_bytes;
   if (!was_instanced && st.draws.empty() && records.size() == old_records) {
     update_gl_buffer(st.segment_buffer, records.data(), record_bytes);
   } else {
@@ -730,7 +765,7 @@ uint64_t GlRenderer::update_plants(const Scene& scene) {
     uploaded += ids.size() * sizeof(uint32_t) + instance_bytes;
     st.uploaded_bytes =
         record_bytes + ids.size() * sizeof(uint32_t) + instance_bytes + (st.leaves ? st.leaves->gpu_bytes() : 0) +
-        (st.fillets ? st.fillets->gpu_bytes() : 0);
+        (st.fillets ? st.fillets->gpu_bytes() : 0) + crotch_bytes;
   }
   check_gl("update_plants");
   st.pending_plant_bytes += uploaded;

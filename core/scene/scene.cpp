@@ -55,21 +55,6 @@ std::optional<LightSky> light_sky_from_name(std::string_view name) {
   return std::nullopt;
 }
 
-SkeletonBounds skeleton_bounds(const Skeleton& skeleton) {
-  SkeletonBounds b;
-  if (skeleton.joints.empty() && skeleton.leaves.empty()) return b;
-  const double inf = std::numeric_limits<double>::infinity();
-  b.lo = glm::dvec3(inf);
-  b.hi = glm::dvec3(-inf);
-  for (const Joint& j : skeleton.joints) {
-    glm::dvec3 p(j.position_m[0], j.position_m[1], j.position_m[2]);
-    b.lo = glm::min(b.lo, p - glm::dvec3(j.radius_m));
-    b.hi = glm::max(b.hi, p + glm::dvec3(j.radius_m));
-  }
-  grow(b, leaf_bounds(skeleton));  // empty without leaves
-  return b;
-}
-
 std::optional<std::string> camera_problem(const Camera& camera) {
   for (const auto& [key, p] : {std::pair{"eye", camera.eye}, std::pair{"target", camera.target}})
     for (int k = 0; k < 3; ++k)

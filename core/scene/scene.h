@@ -21,6 +21,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/geometry/skeleton.h"
+#include "core/geometry/skeleton_bounds.h"  // skeleton_bounds, which framing_camera's callers take
 #include "core/geometry/skin.h"
 #include "core/util/bounds.h"
 #include "core/util/diagnostic.h"
@@ -314,10 +315,6 @@ void override_skin(Scene& scene, SkinStyle style);
 Skeleton place_plant(const ScenePlant& plant);
 // One point of the plant's frame placed the same way.
 glm::dvec3 place_point(const ScenePlant& plant, const glm::dvec3& p);
-
-// Axis-aligned bounds of a skeleton's joints grown by their radii, and of its leaves' vertices (metres).
-using SkeletonBounds = Aabb;
-SkeletonBounds skeleton_bounds(const Skeleton& skeleton);
 
 // Camera framing a box for an image of width × height: a 3/4 view from the front right,
 // 12° above the box centre's horizon (azimuth 35° from +Z toward +X), fov_y 35°, far

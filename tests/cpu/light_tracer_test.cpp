@@ -8,9 +8,13 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 
+#include "core/cpu/crotch_tracer.h"
+#include "core/geometry/crotch_mesh.h"
 #include "core/light/sky.h"
 #include "core/scene/light_cases.h"
+#include "tests/support/limb_crotch.h"
 #include "tests/support/test_scenes.h"
 
 namespace sylva {
@@ -117,6 +121,75 @@ TEST(LightTracer, UnderASlabOfRandomLeavesBeerLambertHolds) {
       EXPECT_NEAR(mean, expected, 3 * se) << "LAI " << lai << ", sun at " << theta_deg << "°, se " << se;
       EXPECT_LT(se, 0.03);
     }
+}
+
+// docs/joints.md "Crotches": where the plants' skin blends its crotches, the `?E` light
+// meets the fillets too. Lines through fillet points at least 1 cm outside the exact
+// frusta that graze through the crease without meeting either solid (found with the
+// accelerator: none of the frusta's boxes, the fillet in front); a sensor 1 m down such a
+// line under a point sun along it: where the exact frusta let the whole sensor (its centre
+// and four points of its rim) see the sun and the fillet hides all of it, the gather is 1
+// without the blend and 0 with it, and the photons agree.
+TEST(LightTracer, TheBlendedCrotchesFilletsShadeWhereTheExactFrustaDoNot) {
+  const std::vector<Skeleton> plants = {test::limb_on_trunk()};
+  const double r = 0.003;
+  SkinOptions blended;
+  blended.blend_crotches = true;
+  const SkinnedSkeleton skinned = skin_skeleton(plants[0], blended);
+  const CrotchBalls balls(find_crotches(plants[0], skinned.frusta), skinned.frusta);
+  const FrustumAccel exact_accel(skinned.frusta), blended_accel(skinned.frusta, CustomFrusta{}, &balls);
+  std::mt19937_64 rng(17);
+  std::vector<glm::dvec3> directions;
+  while (directions.size() < 300) {
+    const glm::dvec3 d = test::random_unit(rng);
+    if (d.y > 0.2) directions.push_back(d);
+  }
+  struct Candidate {
+    glm::dvec3 sensor, to_sun;
+  };
+  std::vector<Candidate> found;
+  int lines = 0;
+  for (const glm::dvec3& q : skeleton_fillets(plants[0], skinned.frusta).positions) {
+    double outside = 1e300;
+    for (const Frustum& f : skinned.frusta) outside = std::min(outside, frustum_bound(f.shape, q));
+    if (outside < 0.01) continue;
+    for (const glm::dvec3& to_sun : directions) {
+      const Ray line{q - 1.0 * to_sun, to_sun};
+      if (exact_accel.any(line, 0, 10)) continue;  // the exact solids are in the way
+      if (!nearest_wood(blended_accel, &balls, line, 0, 10).hit_any()) continue;
+      ++lines;
+      Scene s = light_scene(LightSky::sun, to_sun, 4'000'000, r);
+      s.sun.angular_radius_deg = 0;
+      s.ground.height = -10;
+      const glm::dvec3 e0 = glm::normalize(glm::cross(to_sun, glm::dvec3(0, 0, 1)));
+      const glm::dvec3 e1 = glm::cross(to_sun, e0);
+      std::vector<glm::dvec3> points = {line.origin};
+      for (const glm::dvec3& d : {e0, -e0, e1, -e1}) points.push_back(line.origin + r * d);
+      auto exact = gather_light(plants, points, s, 0, 4);
+      auto blend = gather_light(plants, points, s, 0, 4, blended);
+      ASSERT_TRUE(exact && blend);
+      bool all = true;
+      for (size_t i = 0; i < points.size(); ++i) all = all && (*exact)[i].q == 1 && (*blend)[i].q == 0;
+      if (all) found.push_back({line.origin, to_sun});
+      break;  // one direction a point
+    }
+    if (found.size() == 3) break;
+  }
+  std::printf("[ light ] %d grazing lines through fillet points, %zu sensors shaded whole by the fillet\n", lines,
+              found.size());
+  ASSERT_EQ(found.size(), 3u);
+  for (const Candidate& c : found) {
+    Scene s = light_scene(LightSky::sun, c.to_sun, 4'000'000, r);
+    s.sun.angular_radius_deg = 0;
+    s.ground.height = -10;
+    const std::vector<glm::dvec3> sensor = {c.sensor};
+    auto exact = PhotonLightOracle(2).answer(plants, sensor, s, 0);
+    auto blend = PhotonLightOracle(2, blended).answer(plants, sensor, s, 0);
+    ASSERT_TRUE(exact && blend);
+    EXPECT_GT((*exact)[0].q, 0);
+    EXPECT_NEAR((*exact)[0].q, 1, 3 * (*exact)[0].std_error);
+    EXPECT_EQ((*blend)[0].q, 0);
+  }
 }
 
 TEST(LightTracer, OneFrustumInterceptsTheSunsIrradianceTimesItsProjectedArea) {

@@ -99,6 +99,40 @@ TEST(RenderCpuJoints, NoPixelSeesInsideAnotherSolidWithOrWithoutTheBlend) {
   }
 }
 
+// Issue 31 §1: the relief's ribs fade into the blend (crotch.h crotch_relief_fade; the
+// saguaro's arms). The fork close-up with ribbed bark 4 cm deep: where the blend adds
+// material every pixel sees the smooth blended surface, no rib anywhere in the ball stands
+// higher than the fade allows, and away from the crotch the ribs keep their full height.
+TEST(RenderCpuJoints, TheReliefsRibsFadeIntoTheBlendedCrotch) {
+  test::TempFolder dir;
+  const double depth = 0.04;
+  const Scene scene = test::ribbed_fork(dir.file("ribs.exr"), depth);
+  RenderOptions o;
+  o.aovs = kAovDepth;
+  o.skin.blend_crotches = true;
+  const RenderResult r = render_cpu(scene, o);
+  const test::ReliefAtCrotches m = test::relief_at_crotches(scene, r.image, o.skin, depth);
+  std::printf("[ joints ] fork relief: %s\n", m.describe().c_str());
+  EXPECT_GT(m.faded_pixels, 300u);
+  EXPECT_LT(m.faded_height_m, 1e-4);
+  EXPECT_LT(m.excess_m, 1e-4);
+  EXPECT_GT(m.ribbed_pixels, 5000u);
+  EXPECT_GT(m.ribbed_height_m, 0.9 * depth);  // the measure is not blind: full ribs elsewhere
+
+  // The polygon baseline (GS+R): the displacement fades at the vertices (plant_mesh.h), so
+  // it follows the fade only as finely as the mesh samples it — near a ball's rim, where
+  // k(p) and the fade's width go to 0, a triangle spans the whole fade (measured: up to
+  // 2.5 cm above the blend at levels 2–5). Its median in the fillet's region is the
+  // fillet's facets' (6 mm at most without any relief); the ribs stand 4 cm without the fade.
+  o.geometry.kind = GeometryKind::mesh;
+  o.geometry.mesh_level = 3;
+  const test::ReliefAtCrotches mesh = test::relief_at_crotches(scene, render_cpu(scene, o).image, o.skin, depth);
+  std::printf("[ joints ] fork relief, mesh: %s\n", mesh.describe().c_str());
+  EXPECT_GT(mesh.faded_pixels, 300u);
+  EXPECT_LT(mesh.faded_median_m, 5e-3);
+  EXPECT_GT(mesh.ribbed_height_m, 0.8 * depth);
+}
+
 // The polygon baseline (GeometryKind::mesh) carries the fillets as triangles
 // (crotch_mesh.h): its crease is filled too, and it agrees with the marched fillet.
 TEST(RenderCpuJoints, TheMeshPathCarriesTheFilletsTriangles) {

@@ -15,6 +15,7 @@
 #include <random>
 
 #include "core/geometry/closest_point.h"
+#include "core/geometry/skeleton_bounds.h"
 #include "tests/support/limb_crotch.h"
 
 namespace sylva {
@@ -138,12 +139,8 @@ TEST(CrotchMesh, TheSkeletonsFilletsAreNoFinerThanAThousandthOfItsExtent) {
   Skeleton wide = limb.skeleton;
   test::add_chain(wide, {{200, 0, 0}, {200, 1, 0}}, {0.1, 0.1}, std::nullopt);
   const SkinnedSkeleton skinned = skin_skeleton(wide);
-  glm::dvec3 lo(1e300), hi(-1e300);
-  for (const Joint& j : wide.joints) {
-    const glm::dvec3 p(j.position_m[0], j.position_m[1], j.position_m[2]);
-    lo = glm::min(lo, p), hi = glm::max(hi, p);
-  }
-  const double cell = kFilletMinCellPerExtent * glm::length(hi - lo);
+  const SkeletonBounds box = skeleton_bounds(wide);
+  const double cell = kFilletMinCellPerExtent * glm::length(box.hi - box.lo);
   ASSERT_GT(cell, limb.crotch.k / 2);
   const TriangleMesh coarse = skeleton_fillets(wide, skinned.frusta);
   const std::vector<Crotch> crotches = find_crotches(wide, skinned.frusta);
@@ -151,6 +148,25 @@ TEST(CrotchMesh, TheSkeletonsFilletsAreNoFinerThanAThousandthOfItsExtent) {
   EXPECT_EQ(coarse.triangle_count(), crotch_fillet_mesh(crotches[0], skinned.frusta, cell).triangle_count());
   EXPECT_LT(coarse.triangle_count(), fine.triangle_count() / 4);
   EXPECT_GT(coarse.triangle_count(), 0u);  // the crease is still covered
+}
+
+TEST(CrotchMesh, TheSkeletonsFilletsAreTheSameOnAnyThreadCount) {
+  // A trunk with four limbs around it: four crotches, meshed in parallel, appended in order.
+  Skeleton sk;
+  test::add_chain(sk, {{0, 0, 0}, {0, 1, 0}, {0, 2, 0}, {0, 3, 0}}, {0.3, 0.29, 0.28, 0.26}, std::nullopt);
+  for (int i = 0; i < 4; ++i) {
+    const double a = 1.7 * i, y = 0.8 + 0.5 * i;
+    test::add_chain(sk, {{0, y, 0}, {0.9 * std::cos(a), y + 0.7, 0.9 * std::sin(a)}}, {0.12, 0.1},
+                    ChainParent{0, static_cast<uint32_t>(1 + i / 2)});
+  }
+  const SkinnedSkeleton skinned = skin_skeleton(sk);
+  ASSERT_EQ(find_crotches(sk, skinned.frusta).size(), 4u);
+  const TriangleMesh one = skeleton_fillets(sk, skinned.frusta, 1);
+  const TriangleMesh three = skeleton_fillets(sk, skinned.frusta, 3);
+  ASSERT_GT(one.triangle_count(), 400u);
+  EXPECT_EQ(one.positions, three.positions);
+  EXPECT_EQ(one.indices, three.indices);
+  EXPECT_EQ(one.triangle_frustum, three.triangle_frustum);
 }
 
 TEST(CrotchMesh, ACellTooSmallOrNotPositiveIsRefused) {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <functional>
 #include <glm/geometric.hpp>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -403,6 +404,21 @@ TEST(Relief, RayThroughTheShellThatMissesTheReliefHasNoHit) {
   EXPECT_FALSE(h.hit.from_inside);
 }
 
+// Where a ray meets the relief of unit_cylinder() at t: the point, its radial direction and
+// distance from the axis, its angle about the axis in `frame` and the height field's s there.
+struct CylinderPoint {
+  glm::dvec3 p, e;
+  double rho, theta, s;
+};
+CylinderPoint cylinder_point(const Ray& ray, double t, const AxisFrame& frame, double u_repeat) {
+  const glm::dvec3 p = ray.origin + t * ray.direction;
+  const glm::dvec3 perp(p.x, 0, p.z);
+  const double rho = glm::length(perp);
+  const glm::dvec3 e = perp / rho;
+  const double theta = std::atan2(glm::dot(e, frame.e1), glm::dot(e, frame.e0));
+  return {p, e, rho, theta, u_repeat * theta / (2 * kPi)};
+}
+
 TEST(Relief, NormalFollowsTheAnalyticGradient) {
   // ρ(θ) = 1 + d·H(u_repeat·θ/2π), H = 0.5 + 0.4 sin(2π s): the displaced cylinder's
   // normal is ∝ ê − (ρ'(θ)/ρ)·T_u with ρ' = d·0.4·u_repeat·cos(2π s).
@@ -418,12 +434,7 @@ TEST(Relief, NormalFollowsTheAnalyticGradient) {
     const Ray ray{{x, 1, -5}, {0, 0, 1}};
     const ReliefHit h = intersect_relief(ray, f, map, o, 0, 1e30);
     ASSERT_TRUE(h.hit.hit()) << x;
-    const glm::dvec3 p = ray.origin + h.hit.t * ray.direction;
-    const glm::dvec3 perp(p.x, 0, p.z);
-    const double rho = glm::length(perp);
-    const glm::dvec3 e = perp / rho;
-    const double theta = std::atan2(glm::dot(e, frame.e1), glm::dot(e, frame.e0));
-    const double s_coord = u_repeat * theta / (2 * kPi);
+    const auto [p, e, rho, theta, s_coord] = cylinder_point(ray, h.hit.t, frame, u_repeat);
     EXPECT_NEAR(rho, 1 + d * field.height(s_coord, 0), 1e-7);
     const double rho_prime = d * 0.4 * u_repeat * std::cos(2 * kPi * s_coord);
     const glm::dvec3 expected = glm::normalize(e - (rho_prime / rho) * glm::cross(s.axis, e));
@@ -432,6 +443,78 @@ TEST(Relief, NormalFollowsTheAnalyticGradient) {
     EXPECT_NEAR(h.u, theta / (2 * kPi) - std::floor(theta / (2 * kPi)), 1e-12);
     EXPECT_NEAR(h.v_m, 1.0, 1e-12);
   }
+}
+
+// A fade f(y) = a + b·y along the axis (relief.h ReliefFade).
+class AxialFade final : public ReliefFade {
+ public:
+  AxialFade(double a, double b) : a_(a), b_(b) {}
+  double scale(const glm::dvec3& p) const override { return a_ + b_ * p.y; }
+  double fade_step_m() const override { return 1e-5; }
+
+ private:
+  double a_, b_;
+};
+
+TEST(Relief, AFadeScalesTheHeightAndTiltsTheNormalByItsGradient) {
+  // ρ(θ, y) = 1 + d·f(y)·H(θ): the normal is ∝ ê − (∂ρ/∂θ / ρ)·T_u − ∂ρ/∂y·axis, the
+  // second term from the fade alone (H does not change along the axis here).
+  const double d = 0.1, u_repeat = 3;
+  const FunctionField field([](double s, double) { return 0.5 + 0.4 * std::sin(2 * kPi * s); }, 1e-6);
+  const FrustumShape s = unit_cylinder();
+  const Frustum f = frustum_of(s);
+  const ReliefMap map{&field, d, u_repeat, 1};
+  ReliefOptions o;
+  o.bisection_steps = 30;
+  const AxialFade fade(0.2, 0.35);  // 0.2 at the base, 0.9 at the top
+  const AxisFrame frame = axis_frame(s.axis);
+  int tilted = 0;
+  for (double y : {0.3, 1.0, 1.7})
+    for (double x : {-0.9, -0.5, -0.1, 0.2, 0.6, 0.95}) {
+      const Ray ray{{x, y, -5}, {0, 0, 1}};
+      const ReliefHit h = intersect_relief(ray, f, map, o, 0, 1e30, true, &fade);
+      ASSERT_TRUE(h.hit.hit()) << x;
+      const auto [p, e, rho, theta, s_coord] = cylinder_point(ray, h.hit.t, frame, u_repeat);
+      const double scale = fade.scale(p);
+      EXPECT_NEAR(rho, 1 + d * scale * field.height(s_coord, 0), 1e-7);
+      const double d_theta = d * scale * 0.4 * u_repeat * std::cos(2 * kPi * s_coord);
+      const double d_y = d * 0.35 * field.height(s_coord, 0);
+      const glm::dvec3 expected = glm::normalize(e - (d_theta / rho) * glm::cross(s.axis, e) - d_y * s.axis);
+      EXPECT_NEAR(glm::dot(h.hit.normal, expected), 1.0, 1e-8) << x << " " << y;
+      EXPECT_NEAR(glm::dot(h.shading_normal, expected), 1.0, 1e-8) << x << " " << y;
+      tilted += std::abs(h.shading_normal.y) > 0.003;
+    }
+  EXPECT_EQ(tilted, 18);  // every normal leans with the fade: −∂ρ/∂y = −d·0.35·H <= −0.0035
+}
+
+TEST(Relief, AConstantFadeIsAShallowerRelief) {
+  // Inside iff (ρ − r)/d <= f·H: with f constant that is the relief of depth f·d, marched
+  // over a thicker shell (so found within both marches' bisection brackets). H depends on
+  // s only: exact v follows each sample's constant-w cone, which differs between the two.
+  const FunctionField field([](double s, double) { return 0.5 + 0.45 * std::sin(2 * kPi * s); });
+  const AxialFade half(0.5, 0);
+  int compared = 0, differ = 0;
+  for (const ReliefCase& c : relief_cases(23, 2000, true)) {
+    const ReliefMap deep{&field, 0.06, 3, 2}, shallow{&field, 0.03, 3, 2};
+    ReliefOptions o;
+    o.linear_steps = 64;
+    o.bisection_steps = 20;
+    o.max_depth_per_radius = std::numeric_limits<double>::infinity();  // both shells of constant depth
+    const ReliefHit faded = intersect_relief(c.ray, c.frustum, deep, o, 0, 1e30, true, &half);
+    const ReliefHit plain = intersect_relief(c.ray, c.frustum, shallow, o, 0, 1e30);
+    if (faded.hit.hit() != plain.hit.hit() || faded.hit.from_inside || plain.hit.from_inside) {
+      ++differ;  // a thin grazing chord one march's uniform steps jumped over
+      continue;
+    }
+    if (!plain.hit.hit()) continue;
+    EXPECT_NEAR(faded.hit.t, plain.hit.t, 1e-5 * plain.hit.t);
+    if (faded.hit.kind == FrustumHitKind::side && std::abs(faded.hit.t - plain.hit.t) < 1e-7 * plain.hit.t) {
+      EXPECT_NEAR(glm::dot(faded.shading_normal, plain.shading_normal), 1.0, 1e-6);
+    }
+    ++compared;
+  }
+  EXPECT_GT(compared, 1000);
+  EXPECT_LT(differ, compared / 50);
 }
 
 TEST(Relief, EnteringThroughACapIsAHitOnTheCapWithItsNormal) {

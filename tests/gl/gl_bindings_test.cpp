@@ -175,6 +175,30 @@ TEST(GlBindings, TheDriverLaysEveryRecordOutAsItsCppMirror) {
   EXPECT_EQ(block_binding(m, "FogMapSlots"), static_cast<GLint>(gl::kFogMapSlotsBinding));
   EXPECT_EQ(block_binding(m, "FogMapRanges"), static_cast<GLint>(gl::kFogMapRangesBinding));
   EXPECT_EQ(block_binding(m, "FogMapTexels"), static_cast<GLint>(gl::kFogMapTexelsBinding));
+
+  // crotch.glsl's blended crotches (CROTCH_FADE: the relief's fade into the fillets).
+  FrustaFeatures fade;
+  fade.relief = fade.crotch_fade = true;
+  fade.texture_units = 1;
+  const GlProgramObject faded = build(frusta_program(FrustaPass::gbuffer, fade));
+  const GLuint c = faded.id();
+  EXPECT_EQ(stride(c, "crotches[0].origin_hi[0]"), static_cast<GLint>(sizeof(gl::GpuCrotchRecord)));
+  EXPECT_EQ(offset(c, "crotches[0].centre[0]"), static_cast<GLint>(offsetof(gl::GpuCrotchRecord, centre)));
+  EXPECT_EQ(offset(c, "crotches[0].start[0]"), static_cast<GLint>(offsetof(gl::GpuCrotchRecord, start)));
+  EXPECT_EQ(offset(c, "crotches[0].direction[0]"), static_cast<GLint>(offsetof(gl::GpuCrotchRecord, direction)));
+  EXPECT_EQ(offset(c, "crotches[0].radius"), static_cast<GLint>(offsetof(gl::GpuCrotchRecord, radius)));
+  EXPECT_EQ(offset(c, "crotches[0].k"), static_cast<GLint>(offsetof(gl::GpuCrotchRecord, k)));
+  EXPECT_EQ(offset(c, "crotches[0].lateral_radius"), static_cast<GLint>(offsetof(gl::GpuCrotchRecord, lateral_radius)));
+  EXPECT_EQ(offset(c, "crotches[0].depth_step"), static_cast<GLint>(offsetof(gl::GpuCrotchRecord, depth_step)));
+  EXPECT_EQ(offset(c, "crotches[0].parent_first"), static_cast<GLint>(offsetof(gl::GpuCrotchRecord, parent_first)));
+  EXPECT_EQ(offset(c, "crotches[0].parent_count"), static_cast<GLint>(offsetof(gl::GpuCrotchRecord, parent_count)));
+  EXPECT_EQ(offset(c, "crotches[0].lateral_first"), static_cast<GLint>(offsetof(gl::GpuCrotchRecord, lateral_first)));
+  EXPECT_EQ(offset(c, "crotches[0].lateral_count"), static_cast<GLint>(offsetof(gl::GpuCrotchRecord, lateral_count)));
+  EXPECT_EQ(offset(c, "crotches[0].depth_count"), static_cast<GLint>(offsetof(gl::GpuCrotchRecord, depth_count)));
+  EXPECT_EQ(offset(c, "crotches[0].depth[0]"), static_cast<GLint>(offsetof(gl::GpuCrotchRecord, depth)));
+  EXPECT_EQ(stride(c, "crotch_lists[0]"), static_cast<GLint>(sizeof(uint32_t)));
+  EXPECT_EQ(block_binding(c, "Crotches"), static_cast<GLint>(gl::kCrotchesBinding));
+  EXPECT_EQ(block_binding(c, "CrotchLists"), static_cast<GLint>(gl::kCrotchListsBinding));
 }
 
 TEST(GlObjects, AHandleOwnsItsObjectUntilResetAndMovesIt) {

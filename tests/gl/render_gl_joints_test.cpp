@@ -80,6 +80,32 @@ TEST(RenderGlJoints, NoPixelSeesInsideAnotherSolidWithTheBlend) {
   }
 }
 
+TEST(RenderGlJoints, TheReliefsRibsFadeIntoTheBlendedCrotchAsOnTheCpu) {
+  // tests/cpu/render_joints_test.cpp's measure on GL (crotch.glsl's fade in the relief
+  // marcher): no rib stands out of the fillet's region. GL's fillet is a mesh whose facets
+  // lie within millimetres of the CPU's marched field, so the region's height above the
+  // field is held to 1 cm here (the unfaded ribs stand 4 cm); the frusta's relief agrees
+  // with the CPU's as the relief close-ups do.
+  SYLVA_REQUIRE_GL();
+  test::TempFolder dir;
+  const double depth = 0.04;
+  const Scene scene = test::ribbed_fork(dir.file("ribs.exr"), depth);
+  RenderOptions o;
+  o.aovs = kAovDepth;
+  o.spp = 1;
+  o.skin.blend_crotches = true;
+  const RenderResult gl = gl_test::gl_render(scene, o), cpu = gl_test::cpu_render(scene, o);
+  const gl_test::Agreement a = gl_test::compare(gl.image, cpu.image);
+  const test::ReliefAtCrotches m = test::relief_at_crotches(scene, gl.image, o.skin, depth);
+  std::printf("[ joints ] fork relief GL vs CPU %s; GL %s\n", a.describe().c_str(), m.describe().c_str());
+  EXPECT_GE(a.hit_miss, 0.99) << a.describe();
+  EXPECT_LE(a.depth_median_rel, 1e-3) << a.describe();
+  EXPECT_GT(m.faded_pixels, 300u);
+  EXPECT_LT(m.faded_height_m, 1e-2);
+  EXPECT_LT(m.excess_m, 1e-2);
+  EXPECT_GT(m.ribbed_height_m, 0.9 * depth);
+}
+
 TEST(RenderGlJoints, ThePapersSkinByTheScenesKeyMatchesTheCpu) {
   // The `skin` key reaches the GL skinning too (render_gl.cpp skin_one): the paper's
   // mitred close-ups agree with the CPU's, and differ from the smooth ones.

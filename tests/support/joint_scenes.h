@@ -17,8 +17,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -26,6 +28,7 @@
 
 #include "core/geometry/skin.h"
 #include "tests/support/skeleton_builder.h"
+#include "tests/support/test_textures.h"
 #include "core/scene/render_common.h"
 #include "core/scene/render_types.h"
 #include "core/scene/scene.h"
@@ -293,6 +296,21 @@ inline UvContinuity uv_continuity(const Scene& scene, const RenderImage& image) 
   return out;
 }
 
+// Calls seen(x, y, p) for every hit pixel of `image` (its depth AOV) with the point p the
+// pixel's centre ray sees.
+template <class Seen>
+void for_each_seen_point(const Scene& scene, const RenderImage& image, Seen&& seen) {
+  const render_common::CameraFrame f = render_common::camera_frame(scene);
+  for (uint32_t y = 0; y < image.height; ++y) {
+    for (uint32_t x = 0; x < image.width; ++x) {
+      const double z = image.depth[static_cast<size_t>(y) * image.width + x];
+      if (!std::isfinite(z)) continue;
+      const Ray r = render_common::frame_ray(f, x + 0.5, y + 0.5);
+      seen(x, y, r.origin + z * glm::normalize(r.direction));
+    }
+  }
+}
+
 // How deep the surface a pixel sees lies inside a solid it should not show: for every hit
 // pixel (depth AOV), the point seen and, over every frustum of every plant (skinned with
 // `skin`), the most negative frustum_bound (crotch.h) other than those of the frusta whose
@@ -309,23 +327,89 @@ inline InsideView deepest_inside_view(const Scene& scene, const RenderImage& ima
     const SkinnedSkeleton s = skin_skeleton(place_plant(plant), skin.styled(plant.skin));
     frusta.insert(frusta.end(), s.frusta.begin(), s.frusta.end());
   }
-  const render_common::CameraFrame f = render_common::camera_frame(scene);
   InsideView v;
-  for (uint32_t y = 0; y < image.height; ++y) {
-    for (uint32_t x = 0; x < image.width; ++x) {
-      const double z = image.depth[static_cast<size_t>(y) * image.width + x];
-      if (!std::isfinite(z)) continue;
-      const Ray r = render_common::frame_ray(f, x + 0.5, y + 0.5);
-      const glm::dvec3 p = r.origin + z * glm::normalize(r.direction);
-      ++v.pixels;
-      // The point is on (or, by rounding, just inside) the solids it bounds: its own
-      // frusta's bounds are ~0; another solid's interior is what is measured.
-      double deepest = 0;
-      for (const Frustum& fr : frusta) deepest = std::min(deepest, frustum_bound(fr.shape, p));
-      if (-deepest > v.deepest_m) v.deepest_m = -deepest, v.x = static_cast<int>(x), v.y = static_cast<int>(y);
-    }
-  }
+  for_each_seen_point(scene, image, [&](uint32_t x, uint32_t y, const glm::dvec3& p) {
+    ++v.pixels;
+    // The point is on (or, by rounding, just inside) the solids it bounds: its own
+    // frusta's bounds are ~0; another solid's interior is what is measured.
+    double deepest = 0;
+    for (const Frustum& fr : frusta) deepest = std::min(deepest, frustum_bound(fr.shape, p));
+    if (-deepest > v.deepest_m) v.deepest_m = -deepest, v.x = static_cast<int>(x), v.y = static_cast<int>(y);
+  });
   return v;
+}
+
+// The fork close-up with ribbed bark `depth_m` deep (vertical ribs, 8 around, from a
+// 32 × 8 height map written to `height_path`): the saguaro's arm in small.
+inline Scene ribbed_fork(const std::string& height_path, double depth_m) {
+  write_gray_float(height_path, 32, 8, [](uint32_t x, uint32_t) {
+    return static_cast<float>(0.5 + 0.5 * std::sin(2 * kPi * (x + 0.5) / 32));
+  });
+  for (JointCloseUp& c : joint_close_ups()) {
+    if (c.name != "fork") continue;
+    ScenePlant& plant = c.scene.plants[0];
+    plant.bark.height_texture = height_path;
+    plant.bark.relief_depth_m = depth_m;
+    plant.bark.u_repeat = 8;
+    return c.scene;
+  }
+  return {};
+}
+
+// The relief on a blended crotch (crotch.h crotch_relief_fade): for every hit pixel
+// inside a crotch's ball, the seen point's field sample; where the blend adds material
+// (fade 0) the seen surface must be the smooth blended one (F ~ 0), and every seen point
+// must lie on the blended surface or no higher above the exact union (min(P, C)) than
+// depth·fade allows (the fillet itself stands up to k/4 off the union, relief-free).
+struct ReliefAtCrotches {
+  uint64_t faded_pixels = 0;       // pixels whose point has fade 0 (the fillet's region)
+  double faded_height_m = 0;       // the largest F there: the height above the blended solid
+  double faded_median_m = 0;       // the median F there
+  double excess_m = 0;             // the largest min(F, min(P, C) − depth·fade), any pixel in a ball
+  uint64_t ribbed_pixels = 0;      // pixels in no ball, or with fade 1
+  double ribbed_height_m = 0;      // the largest min(P, C) there: the ribs, undimmed
+  int x = -1, y = -1;              // where excess_m was found
+  std::string describe() const {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "%llu pixels in the fillet's region, at most %.2e m above the blend (median %.2e); excess over the fade %.2e m "
+                  "(pixel %d, %d); ribs %.4f m high in %llu pixels",
+                  static_cast<unsigned long long>(faded_pixels), faded_height_m, faded_median_m, excess_m, x, y,
+                  ribbed_height_m,
+                  static_cast<unsigned long long>(ribbed_pixels));
+    return text;
+  }
+};
+inline ReliefAtCrotches relief_at_crotches(const Scene& scene, const RenderImage& image, const SkinOptions& skin,
+                                          double depth_m) {
+  const ScenePlant& plant = scene.plants.at(0);
+  const Skeleton placed = place_plant(plant);
+  const SkinnedSkeleton skinned = skin_skeleton(placed, skin.styled(plant.skin));
+  const std::vector<Crotch> crotches = find_crotches(placed, skinned.frusta);
+  ReliefAtCrotches out;
+  std::vector<double> faded;
+  for_each_seen_point(scene, image, [&](uint32_t x, uint32_t y, const glm::dvec3& p) {
+    double fade = 1, union_bound = std::numeric_limits<double>::infinity(), blended = union_bound;
+    for (const Crotch& c : crotches) {
+      if (glm::length(p - c.centre) >= c.radius) continue;
+      const CrotchSample sample = crotch_field(c, skinned.frusta, p);
+      fade = std::min(fade, crotch_relief_fade(sample));
+      union_bound = std::min(union_bound, std::min(sample.parent, sample.lateral));
+      blended = std::min(blended, sample.value);
+    }
+    if (!std::isfinite(union_bound)) {  // in no ball: the frusta's own relief
+      for (const Frustum& fr : skinned.frusta) union_bound = std::min(union_bound, frustum_bound(fr.shape, p));
+    } else if (const double excess = std::min(blended, union_bound - depth_m * fade); excess > out.excess_m) {
+      out.excess_m = excess, out.x = static_cast<int>(x), out.y = static_cast<int>(y);
+    }
+    if (fade == 0) ++out.faded_pixels, out.faded_height_m = std::max(out.faded_height_m, blended), faded.push_back(blended);
+    if (fade == 1) ++out.ribbed_pixels, out.ribbed_height_m = std::max(out.ribbed_height_m, union_bound);
+  });
+  if (!faded.empty()) {
+    std::nth_element(faded.begin(), faded.begin() + faded.size() / 2, faded.end());
+    out.faded_median_m = faded[faded.size() / 2];
+  }
+  return out;
 }
 
 }  // namespace sylva::test
