@@ -63,7 +63,7 @@ FogMapRun fog_map_run(FogMedium m, vec3 o, vec3 d, vec3 s, float a, float b) {
   return run;
 }
 
-void fog_map_close(inout FogMapRun run, FogMedium m, vec3 o, vec3 d, vec3 s) {
+void fog_map_close(inout FogMapRun run, FogMedium m, vec3 d) {
   if (!run.open) return;
   run.open = false;
   float t0 = max(run.start, run.lo), t1 = min(run.end, run.hi);
@@ -76,13 +76,13 @@ void fog_map_close(inout FogMapRun run, FogMedium m, vec3 o, vec3 d, vec3 s) {
                             fog_exp_integral(dtau, abs(run.kappa)));
 }
 
-void fog_map_add(inout FogMapRun run, FogMedium m, vec3 o, vec3 d, vec3 s, float a, float b) {
+void fog_map_add(inout FogMapRun run, FogMedium m, vec3 d, float a, float b) {
   if (!(b > a)) return;
   if (run.open && a <= run.end) {
     run.end = max(run.end, b);
     return;
   }
-  fog_map_close(run, m, o, d, s);
+  fog_map_close(run, m, d);
   run.open = true;
   run.start = a;
   run.end = b;
@@ -127,11 +127,11 @@ float fog_map_sun(FogMedium m, vec3 o, vec3 d, vec3 s, float a, float b, vec3 ey
   FogMapRun run = fog_map_run(m, o, d, s, a, b);
   float g0 = a, g1 = b;
   if (!fog_map_clip(ax, bx, ay, by, size, g0, g1)) {
-    fog_map_add(run, m, o, d, s, a, b);
-    fog_map_close(run, m, o, d, s);
+    fog_map_add(run, m, d, a, b);
+    fog_map_close(run, m, d);
     return run.sun;
   }
-  fog_map_add(run, m, o, d, s, a, g0);
+  fog_map_add(run, m, d, a, g0);
   // The tiles the ray crosses over [g0, g1], in order.
   const float kTile = float(FOG_MAP_TILE);
   float tax = ax / kTile, tbx = bx / kTile, tay = ay / kTile, tby = by / kTile;
@@ -151,7 +151,7 @@ float fog_map_sun(FogMedium m, vec3 o, vec3 d, vec3 s, float a, float b, vec3 ey
       float ha = h0 + ta * hd, hb = h0 + tb * hd;
       vec2 range = slot == FOG_MAP_NO_SLOT ? vec2(0.0) : fog_map_ranges[slot];
       if (slot == FOG_MAP_NO_SLOT || min(ha, hb) > range.y) {
-        fog_map_add(run, m, o, d, s, ta, tb);  // no plant here, or above every plant
+        fog_map_add(run, m, d, ta, tb);  // no plant here, or above every plant
       } else if (!(max(ha, hb) <= range.x)) {   // not below every plant with no gap: the texels
         float lax = ax - float(ix * FOG_MAP_TILE), lay = ay - float(iy * FOG_MAP_TILE);
         const int n = FOG_MAP_TILE;
@@ -171,9 +171,9 @@ float fog_map_sun(FogMedium m, vec3 o, vec3 d, vec3 s, float a, float b, vec3 ey
           // before it when it descends (w = −inf: the crossing at ∓inf, lit whole).
           float cross = (fog_map_texels[base + uint(jy * n + jx)] - h0) * inv_hd;
           if (climbs)
-            fog_map_add(run, m, o, d, s, max(cross, u), stop);
+            fog_map_add(run, m, d, max(cross, u), stop);
           else
-            fog_map_add(run, m, o, d, s, u, min(cross, stop));
+            fog_map_add(run, m, d, u, min(cross, stop));
           u = max(u, stop);
           if (!(stop < tb)) break;
           if (tx < ty) {
@@ -203,9 +203,9 @@ float fog_map_sun(FogMedium m, vec3 o, vec3 d, vec3 s, float a, float b, vec3 ey
   }
   if (!done) {
     capped = true;
-    fog_map_add(run, m, o, d, s, t, g1);
+    fog_map_add(run, m, d, t, g1);
   }
-  fog_map_add(run, m, o, d, s, g1, b);
-  fog_map_close(run, m, o, d, s);
+  fog_map_add(run, m, d, g1, b);
+  fog_map_close(run, m, d);
   return run.sun;
 }
