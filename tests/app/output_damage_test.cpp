@@ -126,8 +126,10 @@ TEST(OutputDamage, ASignalDuringTheVideoStopsFfmpegAndLeavesNoTemporary) {
 // Ctrl-C while a grammar derives (issue 32, item 12): the derivation polls render's SIGINT
 // flag, so render stops within a step, says so and writes nothing, with status 130. The
 // grammar derives ~10^6 modules for 100,000 steps — hours. (Before: the derivation ran
-// to its end before the render saw the flag.) SIGINT is sent until sylva ends: a
-// background job starts with SIGINT ignored until render sets its handler.
+// to its end before the render saw the flag.) SIGINT is sent once sylva has spent two
+// CPU-seconds (it is deriving by then, render's handler set: a fixed second was not always
+// enough for an ASan build on a loaded machine, whose start-up a SIGINT then ended silently
+// through the temporaries' handler), and again until sylva ends.
 TEST(OutputDamage, CtrlCWhileTheGrammarDerivesStopsTheRenderWithinAStep) {
   TempDir dir;
   const std::string grammar = dir.write("long.lsys",
@@ -135,7 +137,10 @@ TEST(OutputDamage, CtrlCWhileTheGrammarDerivesStopsTheRenderWithinAStep) {
                                         "p1: A(n) : n < 20 -> A(n+1)A(n+1)\np2: A(n) : n >= 20 -> A(n)\n");
   const std::string script =
       "\"$0\" render \"$1/long.lsys\" -o \"$1/x.png\" --width 32 --height 24 --spp 1 --backend cpu 2>\"$1/err\" & "
-      "sylva=$!\nsleep 1\nwhile kill -INT $sylva 2>/dev/null; do sleep 0.5; done\nwait $sylva; echo \"status $?\"\n";
+      "sylva=$!\nticks=$((2 * $(getconf CLK_TCK)))\n"
+      "for _ in $(seq 1200); do t=$(awk '{print $14 + $15}' /proc/$sylva/stat 2>/dev/null || echo 0); "
+      "[ \"$t\" -ge \"$ticks\" ] && break; sleep 0.1; done\n"
+      "while kill -INT $sylva 2>/dev/null; do sleep 0.5; done\nwait $sylva; echo \"status $?\"\n";
   ProcessResult r = run_process({"bash", "-c", script, SYLVA_BINARY, dir.path().string()});
   const std::string err = read_file(dir.file("err"));
   EXPECT_NE(r.out.find("status 130"), std::string::npos) << describe(r) << err;
