@@ -89,6 +89,7 @@ TriangleMesh crotch_fillet_mesh(const Crotch& crotch, std::span<const Frustum> f
   // One vertex a sign-changing cell; whether it is off the exact union (on the fillet
   // proper), and, where the blend acts, which group's surface it is nearer.
   std::vector<uint32_t> cell_vertex(size_t(n) * size_t(n) * size_t(n), kNone);
+  std::vector<std::array<int, 3>> active;  // the sign-changing cells, in grid order
   std::vector<dvec3> points;
   std::vector<char> on_fillet, blended_parent, blended_lateral;
   const double off_union = 1e-6 * crotch.radius;
@@ -99,16 +100,16 @@ TriangleMesh crotch_fillet_mesh(const Crotch& crotch, std::span<const Frustum> f
   for (int l = 0; l < n; ++l) {
     for (int j = 0; j < n; ++j) {
       for (int i = 0; i < n; ++i) {
+        int outsides = 0;
+        for (const auto& d : kCorner) outsides += outside(i + d[0], j + d[1], l + d[2]);
+        if (outsides == 0 || outsides == 8) continue;
         std::array<double, 8> f;
         std::array<dvec3, 8> p;
-        int outsides = 0;
         for (int v = 0; v < 8; ++v) {
           const auto& d = kCorner[v];
           f[v] = value[grid.corner(i + d[0], j + d[1], l + d[2])];
           p[v] = grid.at(i + d[0], j + d[1], l + d[2]);
-          outsides += f[v] > 0;
         }
-        if (outsides == 0 || outsides == 8) continue;
         dvec3 sum(0);
         int crossings = 0;
         for (const auto& e : kEdge) {
@@ -121,6 +122,7 @@ TriangleMesh crotch_fillet_mesh(const Crotch& crotch, std::span<const Frustum> f
         const dvec3 q = project(crotch, frusta, mean, cell_m).value_or(mean);
         const CrotchSample s = crotch_field(crotch, frusta, q);
         cell_vertex[grid.cell_index(i, j, l)] = static_cast<uint32_t>(points.size());
+        active.push_back({i, j, l});
         points.push_back(q);
         on_fillet.push_back(s.k > 0 && std::min(s.parent, s.lateral) > off_union);
         blended_parent.push_back(s.k > 0 && s.parent <= s.lateral);
@@ -131,45 +133,43 @@ TriangleMesh crotch_fillet_mesh(const Crotch& crotch, std::span<const Frustum> f
 
   // Quads round sign-changing edges, wound so that their normal points along the edge
   // toward F > 0: the four cells in counter-clockwise order about the edge's axis.
+  // A sign-changing edge from corner x along an axis lies in the cell whose lower corner is
+  // x: the active cells, in grid order, list every such edge in the order of a walk over
+  // all corners.
   std::vector<std::array<uint32_t, 3>> triangles;
   for (int axis = 0; axis < 3; ++axis) {
     const int b = (axis + 1) % 3, c = (axis + 2) % 3;  // (b, c, axis) right-handed
-    for (int l = 0; l <= n; ++l) {
-      for (int j = 0; j <= n; ++j) {
-        for (int i = 0; i <= n; ++i) {
-          std::array<int, 3> x{i, j, l};
-          if (x[axis] >= n || x[b] < 1 || x[b] >= n || x[c] < 1 || x[c] >= n) continue;
-          std::array<int, 3> y = x;
-          ++y[axis];
-          const bool lo_out = outside(x[0], x[1], x[2]), hi_out = outside(y[0], y[1], y[2]);
-          if (lo_out == hi_out) continue;
-          std::array<uint32_t, 4> quad;
-          static constexpr std::array<std::array<int, 2>, 4> kAround{{{-1, -1}, {0, -1}, {0, 0}, {-1, 0}}};
-          // Kept where the fillet is: a vertex off the exact union, or vertices on both
-          // groups' surfaces where the blend acts — a fillet narrower than a cell can have
-          // no vertex of its own, and dropping the quad across it would leave the crease.
-          bool off = false, parent_side = false, lateral_side = false;
-          for (int q = 0; q < 4; ++q) {
-            std::array<int, 3> cc = x;
-            cc[b] += kAround[q][0];
-            cc[c] += kAround[q][1];
-            quad[q] = cell_vertex[grid.cell_index(cc[0], cc[1], cc[2])];
-            off = off || on_fillet[quad[q]];
-            parent_side = parent_side || blended_parent[quad[q]];
-            lateral_side = lateral_side || blended_lateral[quad[q]];
-          }
-          if (!off && !(parent_side && lateral_side)) continue;
-          if (lo_out) std::swap(quad[1], quad[3]);  // outside lies toward −axis
-          const bool split02 = glm::length(points[quad[0]] - points[quad[2]]) <=
-                               glm::length(points[quad[1]] - points[quad[3]]);
-          const std::array<std::array<uint32_t, 3>, 2> pair =
-              split02 ? std::array<std::array<uint32_t, 3>, 2>{{{quad[0], quad[1], quad[2]}, {quad[0], quad[2], quad[3]}}}
-                      : std::array<std::array<uint32_t, 3>, 2>{{{quad[0], quad[1], quad[3]}, {quad[1], quad[2], quad[3]}}};
-          for (const auto& t : pair) {
-            const dvec3 cross = glm::cross(points[t[1]] - points[t[0]], points[t[2]] - points[t[0]]);
-            if (glm::dot(cross, cross) > 0) triangles.push_back(t);
-          }
-        }
+    for (const std::array<int, 3>& x : active) {
+      if (x[b] < 1 || x[c] < 1) continue;
+      std::array<int, 3> y = x;
+      ++y[axis];
+      const bool lo_out = outside(x[0], x[1], x[2]), hi_out = outside(y[0], y[1], y[2]);
+      if (lo_out == hi_out) continue;
+      std::array<uint32_t, 4> quad;
+      static constexpr std::array<std::array<int, 2>, 4> kAround{{{-1, -1}, {0, -1}, {0, 0}, {-1, 0}}};
+      // Kept where the fillet is: a vertex off the exact union, or vertices on both
+      // groups' surfaces where the blend acts — a fillet narrower than a cell can have
+      // no vertex of its own, and dropping the quad across it would leave the crease.
+      bool off = false, parent_side = false, lateral_side = false;
+      for (int q = 0; q < 4; ++q) {
+        std::array<int, 3> cc = x;
+        cc[b] += kAround[q][0];
+        cc[c] += kAround[q][1];
+        quad[q] = cell_vertex[grid.cell_index(cc[0], cc[1], cc[2])];
+        off = off || on_fillet[quad[q]];
+        parent_side = parent_side || blended_parent[quad[q]];
+        lateral_side = lateral_side || blended_lateral[quad[q]];
+      }
+      if (!off && !(parent_side && lateral_side)) continue;
+      if (lo_out) std::swap(quad[1], quad[3]);  // outside lies toward −axis
+      const bool split02 = glm::length(points[quad[0]] - points[quad[2]]) <=
+                           glm::length(points[quad[1]] - points[quad[3]]);
+      const std::array<std::array<uint32_t, 3>, 2> pair =
+          split02 ? std::array<std::array<uint32_t, 3>, 2>{{{quad[0], quad[1], quad[2]}, {quad[0], quad[2], quad[3]}}}
+                  : std::array<std::array<uint32_t, 3>, 2>{{{quad[0], quad[1], quad[3]}, {quad[1], quad[2], quad[3]}}};
+      for (const auto& t : pair) {
+        const dvec3 cross = glm::cross(points[t[1]] - points[t[0]], points[t[2]] - points[t[0]]);
+        if (glm::dot(cross, cross) > 0) triangles.push_back(t);
       }
     }
   }
