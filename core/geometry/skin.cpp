@@ -170,6 +170,62 @@ double minor_semi_axis(const dvec3& base, const dvec3& axis, double r0, double s
   return std::sqrt(std::max(0.0, r * r - glm::dot(radial, radial)));
 }
 
+// Sec. 2.2's fit at a mitred joint between segment 1 (from base1 along m1, base radius
+// r1_base, radius r1_joint at `joint`, length1) and segment 2 (from `joint` along m2, base
+// radius r2_base, far radius r2_far, length2): the new cone's base radius r (within
+// [0.5, 2] of r1_joint) whose cut's minor semi-axis matches the old cone's, so that both
+// elliptical cuts share both axes and coincide; secant steps on f(r) = b2(r) − b1 from
+// r2_base. The plain cut with r2_base, not `matched`, where the construction is not
+// regular, clamped, split, or does not settle within max_iterations to tolerance · r1_joint
+// (the cuts then share at most their major axis: a crack between them, G3).
+struct FittedCut {
+  JointCut cut;
+  double radius = 0;      // segment 2's base radius
+  bool matched = false;   // the minor axes agree: the two cuts coincide
+};
+FittedCut fit_minor_axis(const dvec3& joint, const dvec3& base1, const dvec3& m1, double r1_base,
+                         double r1_joint, double length1, const dvec3& m2, double r2_base, double r2_far,
+                         double length2, double max_tilt_rad, double tolerance, int max_iterations) {
+  const JointSide below{r1_base, r1_joint, length1};
+  auto make_cut = [&](double r) {
+    return cutting_plane_at_joint(joint, m1, below, m2, JointSide{r2_far, r, length2}, max_tilt_rad);
+  };
+  FittedCut out{make_cut(r2_base), r2_base};
+  if (!out.cut.regular || out.cut.clamped || out.cut.split || !(r1_joint > 0) || !(r2_base > 0)) return out;
+  auto mismatch = [&](double r, JointCut& c_out) -> std::optional<double> {
+    c_out = make_cut(r);
+    if (c_out.split || !c_out.regular || c_out.clamped) return std::nullopt;
+    const dvec3 mid = 0.5 * (c_out.a_point + c_out.b_point);
+    const double k1 = (r1_joint - r1_base) / length1;
+    const double k2 = (r2_far - r) / length2;
+    return minor_semi_axis(joint, m2, r, k2, mid) - minor_semi_axis(base1, m1, r1_base, k1, mid);
+  };
+  double x0 = r2_base, x1 = r2_base * (1 + 1e-3);
+  JointCut c0, c1;
+  std::optional<double> f0 = mismatch(x0, c0);
+  // Matched already (equal slopes; or collinear segments, where every radius gives a
+  // perpendicular cut on which both circles agree, so the secant's second point would be
+  // taken for a fit): the base radius stays.
+  if (!f0) return out;
+  if (std::abs(*f0) <= tolerance * r1_joint) {
+    out.matched = true;
+    return out;
+  }
+  std::optional<double> f1 = mismatch(x1, c1);
+  for (int it = 0; f1 && it < max_iterations; ++it) {
+    if (std::abs(*f1) <= tolerance * r1_joint) {
+      if (x1 >= 0.5 * r1_joint && x1 <= 2.0 * r1_joint) out = {c1, x1, true};
+      break;
+    }
+    if (*f1 == *f0) break;
+    const double x2 = x1 - *f1 * (x1 - x0) / (*f1 - *f0);
+    if (!(x2 > 0.25 * r1_joint && x2 < 4.0 * r1_joint)) break;
+    x0 = x1, f0 = f1, c0 = c1;
+    x1 = x2, f1 = mismatch(x1, c1);
+  }
+  return out;
+}
+
 // Rotates v about unit axis k by angle (Rodrigues).
 dvec3 rotate(const dvec3& v, const dvec3& k, double angle) {
   double c = std::cos(angle), s = std::sin(angle);
@@ -636,20 +692,43 @@ ChainPath prepared_path(const Skeleton& sk, uint32_t c, const SkinOptions& optio
   return path;
 }
 
-// The plane in which a continuation (its prepared `child` path) meets `last`, its parent's
-// last frustum: the interior joint's construction, where it needs no split and keeps
-// `last` proper and the child's first segment proper under it even with a perpendicular
-// cut at its far end (which the child then falls back to); none otherwise.
-std::optional<Plane> continuation_mitre(const FrustumShape& last, const ChainPath& child, double max_tilt_deg) {
+// Where a continuation (its prepared `child` path) meets `last`, its parent's last
+// frustum: the interior joint's construction (with sec. 2.2's fit of the child's base
+// radius where options.fit_minor_axis, which must then make the cuts coincide), where it
+// needs no split and keeps `last` proper and
+// the child's first segment proper under it even with a perpendicular cut at its far end
+// (which the child then falls back to); none otherwise.
+struct ContinuationStart {
+  Plane plane;
+  double radius = 0;  // the child's base radius
+};
+std::optional<ContinuationStart> continuation_mitre(const FrustumShape& last, const ChainPath& child,
+                                                    const SkinOptions& options) {
   if (child.points.size() < 2) return std::nullopt;
   const dvec3 end = last.base + last.length * last.axis;
   if (!(glm::length(child.points[0] - end) <= 1e-9 * (1 + glm::length(end)))) return std::nullopt;
   const dvec3 d = child.points[1] - child.points[0];
   const double length = glm::length(d);
   const dvec3 axis = d / length;
-  JointSide below{last.radius0, last.radius1, last.length};
-  JointSide above{child.radii[1], child.radii[0], length};
-  JointCut cut = cutting_plane_at_joint(child.points[0], last.axis, below, axis, above, deg_to_rad(max_tilt_deg));
+  const double max_tilt_rad = deg_to_rad(options.max_tilt_deg);
+  ContinuationStart start;
+  start.radius = child.radii[0];
+  JointCut cut;
+  if (options.fit_minor_axis) {
+    const FittedCut fitted = fit_minor_axis(child.points[0], last.base, last.axis, last.radius0, last.radius1,
+                                            last.length, axis, child.radii[0], child.radii[1], length,
+                                            max_tilt_rad, options.fit_tolerance, options.fit_max_iterations);
+    // A mitre whose cuts would not coincide leaves a crack as wide as the mismatch: on the
+    // elm up to 5 cm, where a twig tip goes on from its branch's end at the end's radius
+    // and tapers to a third of it within 8 cm, the plane clamped to the tilt limit. There
+    // the two keep their flat caps under the dome.
+    if (!fitted.matched) return std::nullopt;
+    cut = fitted.cut;
+    start.radius = fitted.radius;
+  } else {
+    cut = cutting_plane_at_joint(child.points[0], last.axis, JointSide{last.radius0, last.radius1, last.length},
+                                 axis, JointSide{child.radii[1], child.radii[0], length}, max_tilt_rad);
+  }
   if (cut.split) return std::nullopt;
   FrustumShape parent = last;
   parent.upper = cut.plane;
@@ -658,12 +737,15 @@ std::optional<Plane> continuation_mitre(const FrustumShape& last, const ChainPat
   first.base = child.points[0];
   first.axis = axis;
   first.length = length;
-  first.radius0 = child.radii[0];
+  first.radius0 = start.radius;
   first.radius1 = child.radii[1];
   first.lower = cut.plane;
   first.upper = plane_through(child.points[1], axis);
-  if (!cuts_are_proper(parent, max_tilt_deg) || !cuts_are_proper(first, max_tilt_deg)) return std::nullopt;
-  return cut.plane;
+  if (!cuts_are_proper(parent, options.max_tilt_deg) || !cuts_are_proper(first, options.max_tilt_deg)) {
+    return std::nullopt;
+  }
+  start.plane = cut.plane;
+  return start;
 }
 
 // The frustum a continuation goes on from: its parent's last segment frustum, when chain
@@ -709,7 +791,7 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
   std::vector<int64_t> first_frustum_of_chain(sk.chains.size(), -1);
   std::vector<std::vector<uint32_t>> segment_lower_joint(sk.chains.size());
   const std::vector<Attachment> joins = options.collars ? attachments(sk) : std::vector<Attachment>(sk.chains.size());
-  std::vector<std::optional<Plane>> mitre_below(sk.chains.size());  // a continuation's first plane
+  std::vector<std::optional<ContinuationStart>> mitre_below(sk.chains.size());  // a continuation's start
   uint64_t lookahead_skipped = 0;  // counted again when the continuation is skinned
 
   for (uint32_t c = 0; c < sk.chains.size(); ++c) {
@@ -738,11 +820,12 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
     // meets the parent's last frustum in the mitred plane its parent chose (if it did).
     const int64_t continued = continued_from(sk, c, joins, first_frustum_of_chain,
                                              segment_lower_joint, out, path.points[0]);
-    const std::optional<Plane> inherited_lower = continued >= 0 ? mitre_below[c] : std::nullopt;
+    const std::optional<ContinuationStart> inherited_lower = continued >= 0 ? mitre_below[c] : std::nullopt;
     for (int pass = 0;; ++pass) {
       assert(pass <= int(n) + 1);
       for (size_t s = 0; s < n; ++s) radius_lower[s] = path.radii[s];
-      planes[0] = inherited_lower ? *inherited_lower : plane_through(path.points[0], axis[0]);
+      if (inherited_lower) radius_lower[0] = inherited_lower->radius;
+      planes[0] = inherited_lower ? inherited_lower->plane : plane_through(path.points[0], axis[0]);
       planes[n] = plane_through(path.points[n], axis[n - 1]);
       for (size_t i = 1; i < n; ++i) {
         clamped[i] = false;
@@ -756,38 +839,13 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
         bend_normal[i] = cut.medial_normal;
         if (!split[i] && cut.split) split[i] = true;
         if (split[i]) continue;
-        if (options.fit_minor_axis && cut.regular && !cut.clamped && path.radii[i] > 0) {
-          // Sec. 2.2: adjust the new cone's base radius until the minor axes match
-          // (secant iterations on f(r) = b_above(r) − b_below(r)).
-          auto mismatch = [&](double r, JointCut& c_out) -> std::optional<double> {
-            c_out = make_cut(r);
-            if (c_out.split || !c_out.regular || c_out.clamped) return std::nullopt;
-            dvec3 mid = 0.5 * (c_out.a_point + c_out.b_point);
-            double k_below = (path.radii[i] - radius_lower[i - 1]) / length[i - 1];
-            double k_above = (path.radii[i + 1] - r) / length[i];
-            double b_below = minor_semi_axis(path.points[i - 1], axis[i - 1],
-                                             radius_lower[i - 1], k_below, mid);
-            double b_above = minor_semi_axis(path.points[i], axis[i], r, k_above, mid);
-            return b_above - b_below;
-          };
-          double rj = path.radii[i];
-          double x0 = rj, x1 = rj * (1 + 1e-3);
-          JointCut c0, c1;
-          std::optional<double> f0 = mismatch(x0, c0), f1 = mismatch(x1, c1);
-          for (int it = 0; f0 && f1 && it < options.fit_max_iterations; ++it) {
-            if (std::abs(*f1) <= options.fit_tolerance * rj) {
-              if (x1 >= 0.5 * rj && x1 <= 2.0 * rj) {
-                cut = c1;
-                radius_lower[i] = x1;
-              }
-              break;
-            }
-            if (*f1 == *f0) break;
-            double x2 = x1 - *f1 * (x1 - x0) / (*f1 - *f0);
-            if (!(x2 > 0.25 * rj && x2 < 4.0 * rj)) break;
-            x0 = x1, f0 = f1, c0 = c1;
-            x1 = x2, f1 = mismatch(x1, c1);
-          }
+        if (options.fit_minor_axis) {
+          const FittedCut fitted =
+              fit_minor_axis(path.points[i], path.points[i - 1], axis[i - 1], radius_lower[i - 1], path.radii[i],
+                             length[i - 1], axis[i], path.radii[i], path.radii[i + 1], length[i], max_tilt_rad,
+                             options.fit_tolerance, options.fit_max_iterations);
+          cut = fitted.cut;
+          radius_lower[i] = fitted.radius;
         }
         planes[i] = cut.plane;
         clamped[i] = cut.clamped;
@@ -884,11 +942,11 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
         bool mitred = false;
         if (joins[c].continuation >= 0) {
           Frustum& last = out.frusta[segment_frustum[n - 1]];
-          std::optional<Plane> mitre = continuation_mitre(
+          std::optional<ContinuationStart> mitre = continuation_mitre(
               last.shape, prepared_path(sk, uint32_t(joins[c].continuation), options, joins, lookahead_skipped),
-              options.max_tilt_deg);
+              options);
           if (mitre) {
-            last.shape.upper = *mitre;
+            last.shape.upper = mitre->plane;
             last.shape.cap_upper = false;
             mitre_below[size_t(joins[c].continuation)] = mitre;
             mitred = true;

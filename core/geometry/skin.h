@@ -20,8 +20,9 @@
 //       contains the cuts, so it holds for the cone a fortiori);
 //   G3  at a mitred interior joint both frusta use the identical Plane, so their cut
 //       curves lie in one plane and share the major axis A–B of eq. 3–5; they coincide
-//       exactly for equal slopes and within seam_error otherwise (the minor-axis fit makes
-//       them coincide);
+//       exactly for equal slopes and within seam_error otherwise; the minor-axis fit
+//       (fit_minor_axis, the smooth skin's) makes them coincide where it finds a radius,
+//       and a continuation is mitred onto its parent's end only where it does;
 //   G4  no NaN or infinity for any joint angle, antiparallel segments included.
 //
 // Sharp bends (the paper leaves intersecting caps unhandled). Each interior joint is
@@ -94,7 +95,13 @@ std::optional<SkinStyle> parse_skin_style(std::string_view text);
 
 // Options of skin_skeleton.
 struct SkinOptions {
-  bool fit_minor_axis = false;    // sec. 2.2 iterative fit of the new cone's base radius
+  // Sec. 2.2's iterative fit of the new cone's base radius at a mitre (within a chain and
+  // where a continuation meets its parent's end), so that the two elliptical cuts share
+  // their minor axis as well as their major one and coincide (G3). The smooth skin fits:
+  // without it a mitre between unequal slopes leaves a crack of up to a millimetre on a
+  // trunk, through which a collar inside can be seen (docs/joints.md); the paper's skin does
+  // not ("in practice we found this extra fitting step to be unnecessary").
+  bool fit_minor_axis = true;
   double fit_tolerance = 1e-12;   // fit stops when |b2 − b1| <= tolerance · joint radius
   int fit_max_iterations = 50;    // secant steps before the fit gives up (keeps radius)
   double max_tilt_deg = 60;       // (0, 80]: largest angle between a plane normal and axis
@@ -120,13 +127,15 @@ struct SkinOptions {
   // These options with the joints of `style`: smooth keeps them; paper (sec. 2 as
   // published: laterals start with a plain capped cylinder, chain ends are flat caps and
   // every bend is a mitre or a split joint, what the paper's figures show) turns collars,
-  // domes and rounded bends off. The other knobs (tilt, knuckles, twist, fit) are kept.
+  // domes, rounded bends, the minor-axis fit and the crotch blend off. The other knobs
+  // (tilt, knuckles, twist) are kept.
   SkinOptions styled(SkinStyle style) const {
     SkinOptions o = *this;
     if (style == SkinStyle::paper) {
       o.collars = false;
       o.round_bends_over_deg = 180;
       o.round_piece_deg = 180;
+      o.fit_minor_axis = false;
       o.blend_crotches = false;
     }
     return o;

@@ -53,9 +53,12 @@ TEST(RenderCpuJoints, ThePapersPlainSkinningShowsTheRimTheStepAndTheFacet) {
 // docs/joints.md "Crotches": with the blend, where a lateral leaves its parent the
 // concave crease of the two solids is filled — the surface turns by much less between
 // pixels 4 apart — and nothing turns convex by more than the smooth limit. Measured
-// (200×150, blend 0.8 r): crown 42.0° → 28.1°, fork 93.1° → 39.7°, y_fork 83.2° → 26.9°;
-// the largest convex turn 41.5° / 19.0° / 42.1° (depth; the swollen parent's offset of
-// its bounds' kinks, docs/joints.md) and at most 20.4° in the normal AOV.
+// (200×150, blend 0.8 r): fork 93.1° → 39.7°, y_fork 83.1° → 26.4°; the largest convex
+// turn 19.0° / 42.0° (depth; the swollen parent's offset of its bounds' kinks,
+// docs/joints.md) and at most 20.4° in the normal AOV. The crown's 42.0° was the crack at
+// the trunk's mitred end (closed by the minor-axis fit, skin.h): its exact skin turns by
+// 21.5° at most, and its blend by 28.1°, where two limbs' fillets cross (each blends with
+// its own k; one field per joint would not) — held under the smooth limit.
 TEST(RenderCpuJoints, TheBlendFillsTheCrotchesConcaveCrease) {
   SkinOptions blended;
   blended.blend_crotches = true;
@@ -66,8 +69,13 @@ TEST(RenderCpuJoints, TheBlendFillsTheCrotchesConcaveCrease) {
     std::printf("[ joints ] %-12s concave crease %.1f° exact (at %d, %d), %.1f° blended (at %d, %d); convex %.1f° blended\n",
                 c.name.c_str(), exact.concave_crease_deg, exact.concave_x, exact.concave_y, blend.concave_crease_deg,
                 blend.concave_x, blend.concave_y, blend.convex_crease_deg);
-    EXPECT_GT(exact.concave_crease_deg, 40) << c.name << ": the crease the blend is for";
-    EXPECT_LT(blend.concave_crease_deg, 0.75 * exact.concave_crease_deg) << c.name;
+    if (c.name == "crown") {
+      EXPECT_LT(exact.concave_crease_deg, kLargestSmoothTurnDeg) << "the crack is closed";
+      EXPECT_LT(blend.concave_crease_deg, kLargestSmoothTurnDeg) << c.name;
+    } else {
+      EXPECT_GT(exact.concave_crease_deg, 40) << c.name << ": the crease the blend is for";
+      EXPECT_LT(blend.concave_crease_deg, 0.75 * exact.concave_crease_deg) << c.name;
+    }
     EXPECT_LT(blend.convex_crease_deg, kLargestSmoothTurnDeg) << c.name << ": " << blend.describe();
     EXPECT_LT(blend.convex_normal_jump_deg, kLargestSmoothTurnDeg) << c.name << ": " << blend.describe();
   }
@@ -75,11 +83,7 @@ TEST(RenderCpuJoints, TheBlendFillsTheCrotchesConcaveCrease) {
 
 // Issue 31 §1: no pixel of a crotch sees the inside of the other solid — with the exact
 // joints and with the blend (the fillets lie outside the exact union). Measured: at most
-// 0.12 µm (the depth AOV's float rounding), except the crown's exact joints: at the
-// trunk's mitred end a pixel sees a limb's collar 6.2 mm inside the trunk (docs/joints.md
-// "Crotches": a crack between the trunk's last frustum and its tilted continuation, whose
-// slopes differ; the blend's fillets cover it). That one is measured, not passed over: it
-// must stay under 1 cm until it is mended, then join the others.
+// 0.12 µm (the depth AOV's float rounding) on every close-up.
 TEST(RenderCpuJoints, NoPixelSeesInsideAnotherSolidWithOrWithoutTheBlend) {
   SkinOptions blended;
   blended.blend_crotches = true;
@@ -93,8 +97,10 @@ TEST(RenderCpuJoints, NoPixelSeesInsideAnotherSolidWithOrWithoutTheBlend) {
                   c.name.c_str(), skin.blend_crotches ? "blend" : "exact", v.deepest_m, v.x, v.y,
                   static_cast<unsigned long long>(v.pixels));
       EXPECT_GT(v.pixels, 1000u) << c.name;
-      const bool known_crack = c.name == "crown" && !skin.blend_crotches;
-      EXPECT_LT(v.deepest_m, known_crack ? 1e-2 : 1e-4) << c.name;
+      // The crown's exact skin saw a collar 6.2 mm inside the trunk through a 0.71 mm crack
+      // where the trunk's end met its tilted, faster-tapering continuation, before the
+      // smooth skin fitted the continuation's base radius (skin.h fit_minor_axis).
+      EXPECT_LT(v.deepest_m, 1e-4) << c.name;
     }
   }
 }

@@ -184,14 +184,26 @@ TEST(SkinJoints, AnEndIsMitredOntoItsContinuationWhichGoesOnAtItsRadiusWithItsUA
   const Frustum& goes_on = skin.frusta[1];
   EXPECT_EQ(goes_on.chain, 1u);
   EXPECT_EQ(goes_on.parent, 0);
-  EXPECT_EQ(goes_on.shape.radius0, 0.3);  // no radius step
+  // It starts at the end's radius, moved by sec. 2.2's fit only as far as the two cuts'
+  // minor axes need (the end is a cylinder, the continuation tapers: unequal slopes).
+  EXPECT_NEAR(goes_on.shape.radius0, 0.3, 0.01 * 0.3);
+  EXPECT_NE(goes_on.shape.radius0, 0.3);
   EXPECT_EQ(goes_on.shape.radius1, 0.18);
   EXPECT_EQ(end.shape.upper.normal, goes_on.shape.lower.normal);  // one plane
   EXPECT_EQ(end.shape.upper.offset, goes_on.shape.lower.offset);
   EXPECT_LT(glm::dot(end.shape.upper.normal, end.shape.axis), 1.0);  // tilted: a mitre
   EXPECT_FALSE(end.shape.cap_upper);
   EXPECT_FALSE(goes_on.shape.cap_lower);
-  EXPECT_LT(seam_error(end, goes_on), 0.01 * 0.3);  // the cut curves meet
+  EXPECT_LT(seam_error(end, goes_on), 1e-9);  // the cut curves coincide
+  {  // without the fit: no radius step, and the cuts share only their major axis
+    SkinOptions unfitted;
+    unfitted.fit_minor_axis = false;
+    const SkinnedSkeleton plain = skin_skeleton(sk, unfitted);
+    EXPECT_EQ(plain.frusta[1].shape.radius0, 0.3);
+    const double crack = seam_error(plain.frusta[0], plain.frusta[1]);
+    EXPECT_GT(crack, 1e-4);
+    EXPECT_LT(crack, 0.01 * 0.3);
+  }
   EXPECT_DOUBLE_EQ(goes_on.v_lower_m, end.v_upper_m);  // v goes on
   for (int i = 0; i < 16; ++i) {  // u goes on: the same u on both sides of the cut
     const dvec3 p = cut_point(end.shape, end.shape.upper, i / 16.0);
@@ -204,6 +216,31 @@ TEST(SkinJoints, AnEndIsMitredOntoItsContinuationWhichGoesOnAtItsRadiusWithItsUA
   SkinnedSkeleton paper = skin_skeleton(sk, SkinOptions::paper());
   EXPECT_TRUE(paper.frusta[0].shape.cap_upper);
   EXPECT_EQ(paper.frusta[1].v_lower_m, 0.0);
+}
+
+TEST(SkinJoints, AContinuationWhoseCutsCannotBeFittedKeepsItsCapUnderTheDome) {
+  // The elm's twig tips: a continuation goes on from its branch's end at the end's radius
+  // and tapers to a third of it within 8 cm, 30.5° off the branch's axis. The interior
+  // joint's plane is clamped to the tilt limit there, so no base radius makes the two cuts
+  // coincide: a mitre would leave a crack of 5 cm. The smooth skin keeps both caps and
+  // the dome instead (closed solids).
+  Skeleton sk;
+  const double a = 30.5 * kPi / 180;
+  sk.joints = {joint({0, 0, 0}, 0.1038), joint({0, 0.795, 0}, 0.0913), joint({0, 0.795, 0}, 0.0913),
+               joint({0.08 * std::sin(a), 0.795 + 0.08 * std::cos(a), 0}, 0.035)};
+  sk.chains = {Chain{0, 2, std::nullopt}, Chain{2, 2, ChainParent{0, 1}}};
+  ASSERT_EQ(continuation_children(sk), (std::vector<int64_t>{1, -1}));
+  const SkinnedSkeleton skin = skin_skeleton(sk);
+  EXPECT_TRUE(skin.frusta[0].shape.cap_upper);
+  EXPECT_EQ(skin.frusta[1].kind, FrustumKind::knuckle);  // the dome's first frustum
+  EXPECT_TRUE(skin.frusta.back().shape.cap_lower);
+  EXPECT_EQ(skin.frusta.back().chain, 1u);
+  SkinOptions unfitted;
+  unfitted.fit_minor_axis = false;
+  const SkinnedSkeleton mitred = skin_skeleton(sk, unfitted);
+  ASSERT_EQ(mitred.frusta.size(), 2u);
+  EXPECT_FALSE(mitred.frusta[0].shape.cap_upper);
+  EXPECT_GT(seam_error(mitred.frusta[0], mitred.frusta[1]), 0.04);  // what the fit's check prevents
 }
 
 TEST(SkinJoints, AnEndWithChildrenAndNoContinuationIsADomeThatCarriesItsUAndV) {
@@ -378,6 +415,19 @@ TEST(SkinSeam, MinorAxisFitMakesTheTwoEllipticalCutsCoincide) {
     EXPECT_GT(error_plain, 1e-4);
     EXPECT_LT(error_fit, 1e-9);
   }
+}
+
+TEST(SkinSeam, TheSmoothSkinFitsItsMitresAndThePapersDoesNot) {
+  // The smooth skin's mitres coincide (skin.h fit_minor_axis, on); the paper's skin keeps
+  // sec. 2's plain construction ("in practice ... unnecessary"), the seam G3 allows.
+  const Skeleton sk = bent_chain(15, 0.2, 0.2, 0.05);  // under the smooth skin's 20° rounding
+  const SkinnedSkeleton smooth = skin_skeleton(sk), paper = skin_skeleton(sk, SkinOptions::paper());
+  ASSERT_EQ(smooth.frusta.size(), 2u);
+  ASSERT_EQ(paper.frusta.size(), 2u);
+  EXPECT_TRUE(SkinOptions{}.fit_minor_axis);
+  EXPECT_FALSE(SkinOptions::paper().fit_minor_axis);
+  EXPECT_LT(seam_error(smooth.frusta[0], smooth.frusta[1]), 1e-9);
+  EXPECT_GT(seam_error(paper.frusta[0], paper.frusta[1]), 1e-4);
 }
 
 // ---- parametrization -----------------------------------------------------------------

