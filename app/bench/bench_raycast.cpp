@@ -243,9 +243,13 @@ int run_bench_raycast(const std::vector<std::string>& args) {
   // tangents) over the exact frusta, and with the blended crotches (docs/joints.md
   // "Crotches", crotch_tracer.h) beside them: what the fillets cost a primary ray against
   // its peer, and how far they move the depth (they fill the creases: a change, not an
-  // error, measured against the exact frusta).
-  auto run_scene_tracer = [&](const std::string& name, const SkinOptions& skin) {
-    const SceneGeometry traced = build_scene_geometry(scene, skin);
+  // error, measured against the exact frusta): every crotch's fillet (crotch-blend-all: a
+  // build for no view in particular) and those this view needs (crotch-blend: the fillets
+  // of kFilletMinPixels or more, crotch.h crotch_seen).
+  auto run_scene_tracer = [&](const std::string& name, const SkinOptions& skin, bool view = true) {
+    GeometryOptions geometry_options;
+    geometry_options.cull = view;
+    const SceneGeometry traced = build_scene_geometry(scene, skin, geometry_options);
     MethodResult r{name};
     auto trace = [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
@@ -263,6 +267,7 @@ int run_bench_raycast(const std::vector<std::string>& args) {
   SkinOptions blended;
   blended.blend_crotches = true;
   run_scene_tracer("scene-tracer", SkinOptions{});
+  run_scene_tracer("crotch-blend-all", blended, false);
   run_scene_tracer("crotch-blend", blended);
   {
     // What the mesh paths pay for the same fillets (GL, the polygon baseline and glTF build

@@ -377,6 +377,8 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     textures = own_textures.get();
   }
   const ViewFrustum view = view_frustum(scene);
+  const double view_pixels_per_radian = pixels_per_radian(scene);
+  size_t crotches_found = 0;
   double cull_s = 0, skin_s = 0, tessellate_s = 0, displace_s = 0;
   uint32_t culled = 0, displaced = 0;
   TriangleMesh triangles;
@@ -417,10 +419,13 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     append_leaves(leaves, placed, p);
     const uint32_t first_frustum = static_cast<uint32_t>(g.frusta.size());
     // The plant's crotches (a mesh has its fillets' triangles too, below, and its relief
-    // fades into them), then the scene's, by scene frustum.
+    // fades into them), then the scene's, by scene frustum: in a view (culling on), only
+    // those whose fillet spans kFilletMinPixels or more (crotch.h crotch_seen).
     const std::vector<Crotch> plant_crotches =
         plant_skin.blend_crotches ? find_crotches(placed, skinned.frusta) : std::vector<Crotch>{};
+    crotches_found += plant_crotches.size();
     for (Crotch c : plant_crotches) {
+      if (options.cull && !crotch_seen(c, scene.camera.eye, view_pixels_per_radian)) continue;
       for (uint32_t& i : c.parent_frusta) i += first_frustum;
       for (uint32_t& i : c.lateral_frusta) i += first_frustum;
       crotches.push_back(std::move(c));
@@ -453,7 +458,14 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
   if (passes)
     passes->push_back({"skin", skin_s,
                        std::to_string(scene.plants.size() - culled) + " plants, " + std::to_string(g.frusta.size()) +
-                           " frusta"});
+                           " frusta" +
+                           (crotches_found ? ", " + std::to_string(crotches.size()) + " of " +
+                                                 std::to_string(crotches_found) + " crotches blended" +
+                                                 (crotches.size() < crotches_found
+                                                      ? " (the rest under " + std::to_string(int(kFilletMinPixels)) +
+                                                            " px)"
+                                                      : std::string())
+                                           : std::string())});
   if (passes && mesh)
     passes->push_back({"tessellate", tessellate_s,
                        std::to_string(triangles.triangle_count()) + " triangles, GS " +

@@ -131,6 +131,11 @@ std::vector<Crotch> find_crotches(const Skeleton& sk, std::span<const Frustum> f
   return out;
 }
 
+bool crotch_seen(const Crotch& c, const dvec3& eye, double pixels_per_radian, double min_pixels) {
+  const double distance = glm::length(c.centre - eye) - c.radius;
+  return !(distance > 0) || c.k * pixels_per_radian >= min_pixels * distance;
+}
+
 CrotchSample crotch_field(const Crotch& c, std::span<const Frustum> frusta, const dvec3& p) {
   CrotchSample s;
   s.parent = group_bound(frusta, c.parent_frusta, p);

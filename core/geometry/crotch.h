@@ -73,6 +73,17 @@ struct Crotch {
 std::vector<Crotch> find_crotches(const Skeleton& skeleton, std::span<const Frustum> frusta,
                                   const CrotchOptions& options = {});
 
+// What a view needs of the fillets (docs/joints.md "Fillets by their size on screen"): a
+// fillet is about k wide and moves the surface off the exact union by at most k/4, so one
+// whose k spans fewer than kFilletMinPixels pixels where its ball is nearest the eye moves
+// no surface by more than half a pixel; a renderer that knows its view leaves it out.
+inline constexpr double kFilletMinPixels = 2;
+// Whether crotch `c`'s fillet spans at least min_pixels seen from `eye` by a view of
+// pixels_per_radian (culling.h): k / (distance to the ball) · pixels_per_radian; always
+// where the eye is inside the ball.
+bool crotch_seen(const Crotch& c, const glm::dvec3& eye, double pixels_per_radian,
+                 double min_pixels = kFilletMinPixels);
+
 // The two groups' bounds and the blend at a point.
 struct CrotchSample {
   double value = 0;    // F(p)

@@ -50,6 +50,12 @@ ViewFrustum view_frustum(const Scene& scene) {
   return v;
 }
 
+double pixels_per_radian(const Scene& scene) {
+  const double w = scene.width, h = scene.height;
+  const double focal = 0.5 * h / std::tan(0.5 * scene.camera.fov_y_deg * kRadPerDeg);
+  return focal + 0.25 * (w * w + h * h) / focal;  // f·(1 + tan²θ), tan θ = half-diagonal / f
+}
+
 Aabb plant_box(const Skeleton& placed, const SkinOptions& skin, double relief_m) {
   const double inf = std::numeric_limits<double>::infinity();
   Aabb box{glm::dvec3(inf), glm::dvec3(-inf)};

@@ -53,6 +53,12 @@ Aabb plant_box(const Skeleton& placed, const SkinOptions& skin, double relief_m 
 // sun is off.
 std::optional<Aabb> shadow_box(const Scene& scene, const Aabb& box);
 
+// The most pixels a radian of view spans anywhere in `scene`'s image (at its corners, where
+// a pinhole's pixels subtend the least angle): f·(1 + tan²θ) for the focal length
+// f = (height / 2) / tan(fov_y / 2) in pixels and θ the corner's angle off the axis. A
+// feature of angular size a covers at most a times this many pixels.
+double pixels_per_radian(const Scene& scene);
+
 // Whether `box` lies outside `view` (one plane separates it from the view).
 bool outside_view(const ViewFrustum& view, const Aabb& box);
 

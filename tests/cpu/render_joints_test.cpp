@@ -6,10 +6,13 @@
 // axis goes on into a child, u and v go on with it (no ring in the bark).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include "core/cpu/render_cpu.h"
+#include "core/geometry/crotch.h"
+#include "core/scene/culling.h"
 #include "tests/support/joint_scenes.h"
 
 namespace sylva {
@@ -79,6 +82,51 @@ TEST(RenderCpuJoints, TheBlendFillsTheCrotchesConcaveCrease) {
     EXPECT_LT(blend.convex_crease_deg, kLargestSmoothTurnDeg) << c.name << ": " << blend.describe();
     EXPECT_LT(blend.convex_normal_jump_deg, kLargestSmoothTurnDeg) << c.name << ": " << blend.describe();
   }
+}
+
+// docs/joints.md "Fillets by their size on screen": a view leaves out the fillets whose
+// width k spans under kFilletMinPixels (they move no surface by more than half a pixel),
+// and says so in the skin pass. The fork seen from 40 times as far: its one crotch is left
+// out and the picture is the exact skin's, pixel for pixel; from its close-up it is
+// blended. Without culling (a view-independent build) every crotch is kept.
+TEST(RenderCpuJoints, AViewLeavesOutTheFilletsUnderTwoPixels) {
+  const test::JointCloseUp fork = test::joint_close_ups().at(2);
+  ASSERT_EQ(fork.name, "fork");
+  Scene far = fork.scene;
+  far.camera.eye = far.camera.target + 20.0 * (far.camera.eye - far.camera.target);
+  const Skeleton& sk = *far.plants.at(0).skeleton;
+  const std::vector<Crotch> crotches = find_crotches(sk, skin_skeleton(sk).frusta);
+  ASSERT_EQ(crotches.size(), 1u);
+  EXPECT_FALSE(crotch_seen(crotches[0], far.camera.eye, pixels_per_radian(far)));
+  EXPECT_TRUE(crotch_seen(crotches[0], fork.scene.camera.eye, pixels_per_radian(fork.scene)));
+  auto k_pixels = [&](const Scene& s) {
+    return crotches[0].k * pixels_per_radian(s) / (glm::length(crotches[0].centre - s.camera.eye) - crotches[0].radius);
+  };
+  std::printf("[ joints ] fork's fillet k spans %.2f px in its close-up, %.2f px from 20 times as far\n",
+              k_pixels(fork.scene), k_pixels(far));
+
+  RenderOptions exact;
+  exact.aovs = kAovDepth | kAovNormal;
+  RenderOptions blended = exact;
+  blended.skin.blend_crotches = true;
+  auto skin_detail = [](const RenderResult& r) {
+    for (const RenderPass& p : r.passes)
+      if (p.name == "skin") return p.detail;
+    return std::string();
+  };
+  const RenderResult far_blended = render_cpu(far, blended), far_exact = render_cpu(far, exact);
+  EXPECT_NE(skin_detail(far_blended).find("0 of 1 crotches blended (the rest under 2 px)"), std::string::npos)
+      << skin_detail(far_blended);
+  const size_t seen = std::count_if(far_exact.image.depth.begin(), far_exact.image.depth.end(),
+                                    [](float z) { return std::isfinite(z); });
+  EXPECT_GT(seen, 10u) << "the far view still sees the fork";
+  EXPECT_EQ(far_blended.image.depth, far_exact.image.depth);
+  EXPECT_EQ(far_blended.image.normal, far_exact.image.normal);
+  EXPECT_EQ(far_blended.image.beauty, far_exact.image.beauty);
+
+  const RenderResult near = render_cpu(fork.scene, blended);
+  EXPECT_NE(skin_detail(near).find("1 of 1 crotches blended"), std::string::npos) << skin_detail(near);
+  EXPECT_EQ(skin_detail(near).find("under 2 px"), std::string::npos) << skin_detail(near);
 }
 
 // Issue 31 §1: no pixel of a crotch sees the inside of the other solid — with the exact

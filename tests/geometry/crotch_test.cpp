@@ -87,6 +87,19 @@ TEST(Crotch, OneCrotchWhereTheLimbLeavesTheTrunkOnItsSurfaceAndNoneForTheTwig) {
   EXPECT_EQ(find_crotches(sk, skin_skeleton(sk, SkinOptions::paper()).frusta).size(), 1u);
 }
 
+TEST(Crotch, AViewSeesAFilletOnlyWhereItsWidthSpansTwoPixels) {
+  // k = 0.12 m: at 1000 pixels a radian it spans 2 pixels 60 m beyond the ball's surface.
+  const Skeleton sk = test::limb_on_trunk();
+  const Crotch c = find_crotches(sk, skin_skeleton(sk).frusta).at(0);
+  const dvec3 away = glm::normalize(dvec3(1, 0.5, 2));
+  auto eye_at = [&](double beyond_ball_m) { return c.centre + (c.radius + beyond_ball_m) * away; };
+  EXPECT_TRUE(crotch_seen(c, eye_at(59.0), 1000));
+  EXPECT_FALSE(crotch_seen(c, eye_at(61.0), 1000));
+  EXPECT_TRUE(crotch_seen(c, eye_at(61.0), 2000));              // a finer view
+  EXPECT_TRUE(crotch_seen(c, eye_at(61.0), 1000, 1.0));         // a lower bar
+  EXPECT_TRUE(crotch_seen(c, c.centre + 0.5 * c.radius * away, 1e-6));  // the eye in the ball
+}
+
 TEST(Crotch, TheBlendOnlyFillsTheCreaseByAtMostAQuarterOfKAndNothingOutsideItsBall) {
   const LimbCrotch limb;
   const SkinnedSkeleton& skinned = limb.skinned;
