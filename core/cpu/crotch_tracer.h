@@ -22,8 +22,10 @@
 // Relief (relief.h) on a crotch's frusta fades into its fillet (crotch.h
 // crotch_relief_fade): FrustumTracer marches those frusta with a CrotchReliefFade.
 //
-// The sun photons (photons.cpp) trace the same balls beside their frusta. Not seen by the
-// `?E` light — docs/joints.md says so. Preconditions: `frusta` (and the plant indices given to
+// The sun photons (photons.cpp) and the `?E` light (light_tracer.h) trace the same balls
+// beside their frusta (nearest_wood, below). A renderer's geometry for one view holds the
+// balls of the fillets that view can see only (crotch.h crotch_seen; render_cpu.cpp).
+// Preconditions: `frusta` (and the plant indices given to
 // describe) are the scene's, with the crotches' indices into them, and outlive this object.
 // Thread-safe for concurrent queries.
 #pragma once
