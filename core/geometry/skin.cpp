@@ -172,45 +172,47 @@ double minor_semi_axis(const dvec3& base, const dvec3& axis, double r0, double s
 
 // Sec. 2.2's fit at a mitred joint between segment 1 (from base1 along m1, base radius
 // r1_base, radius r1_joint at `joint`, length1) and segment 2 (from `joint` along m2, base
-// radius r2_base, far radius r2_far, length2): the new cone's base radius r (within
-// [0.5, 2] of r1_joint) whose cut's minor semi-axis matches the old cone's, so that both
-// elliptical cuts share both axes and coincide; secant steps on f(r) = b2(r) − b1 from
-// r2_base. The plain cut with r2_base, not `matched`, where the construction is not
-// regular, clamped, split, or does not settle within max_iterations to tolerance · r1_joint
-// (the cuts then share at most their major axis: a crack between them, G3).
+// radius r2_base, far radius r2_far, length2), given `plain`, the construction's cut with
+// r2_base: the new cone's base radius r (within [0.5, 2] of r1_joint) whose cut's minor
+// semi-axis matches the old cone's, so that both elliptical cuts share both axes and
+// coincide; secant steps on f(r) = b2(r) − b1 from r2_base. `plain` and r2_base, not
+// `matched`, where the construction is not regular, clamped, split, or does not settle
+// within max_iterations to tolerance · r1_joint (the cuts then share at most their major
+// axis: a crack between them, G3).
 struct FittedCut {
   JointCut cut;
   double radius = 0;      // segment 2's base radius
   bool matched = false;   // the minor axes agree: the two cuts coincide
 };
-FittedCut fit_minor_axis(const dvec3& joint, const dvec3& base1, const dvec3& m1, double r1_base,
-                         double r1_joint, double length1, const dvec3& m2, double r2_base, double r2_far,
-                         double length2, double max_tilt_rad, double tolerance, int max_iterations) {
-  const JointSide below{r1_base, r1_joint, length1};
-  auto make_cut = [&](double r) {
-    return cutting_plane_at_joint(joint, m1, below, m2, JointSide{r2_far, r, length2}, max_tilt_rad);
-  };
-  FittedCut out{make_cut(r2_base), r2_base};
-  if (!out.cut.regular || out.cut.clamped || out.cut.split || !(r1_joint > 0) || !(r2_base > 0)) return out;
-  auto mismatch = [&](double r, JointCut& c_out) -> std::optional<double> {
-    c_out = make_cut(r);
-    if (c_out.split || !c_out.regular || c_out.clamped) return std::nullopt;
-    const dvec3 mid = 0.5 * (c_out.a_point + c_out.b_point);
+FittedCut fit_minor_axis(const JointCut& plain, const dvec3& joint, const dvec3& base1, const dvec3& m1,
+                         double r1_base, double r1_joint, double length1, const dvec3& m2, double r2_base,
+                         double r2_far, double length2, double max_tilt_rad, double tolerance, int max_iterations) {
+  FittedCut out{plain, r2_base};
+  // b2(r) − b1 on r's cut; none where that cut is no regular mitre.
+  auto mismatch = [&](double r, const JointCut& c) -> std::optional<double> {
+    if (c.split || !c.regular || c.clamped) return std::nullopt;
+    const dvec3 mid = 0.5 * (c.a_point + c.b_point);
     const double k1 = (r1_joint - r1_base) / length1;
     const double k2 = (r2_far - r) / length2;
     return minor_semi_axis(joint, m2, r, k2, mid) - minor_semi_axis(base1, m1, r1_base, k1, mid);
   };
-  double x0 = r2_base, x1 = r2_base * (1 + 1e-3);
-  JointCut c0, c1;
-  std::optional<double> f0 = mismatch(x0, c0);
+  auto cut_with = [&](double r) {
+    return cutting_plane_at_joint(joint, m1, JointSide{r1_base, r1_joint, length1}, m2,
+                                  JointSide{r2_far, r, length2}, max_tilt_rad);
+  };
+  if (!(r1_joint > 0) || !(r2_base > 0)) return out;
+  double x0 = r2_base;
+  std::optional<double> f0 = mismatch(x0, plain);
+  if (!f0) return out;
   // Matched already (equal slopes; or collinear segments, where every radius gives a
   // perpendicular cut on which both circles agree, so the secant's second point would be
   // taken for a fit): the base radius stays.
-  if (!f0) return out;
   if (std::abs(*f0) <= tolerance * r1_joint) {
     out.matched = true;
     return out;
   }
+  double x1 = r2_base * (1 + 1e-3);
+  JointCut c1 = cut_with(x1);
   std::optional<double> f1 = mismatch(x1, c1);
   for (int it = 0; f1 && it < max_iterations; ++it) {
     if (std::abs(*f1) <= tolerance * r1_joint) {
@@ -220,8 +222,8 @@ FittedCut fit_minor_axis(const dvec3& joint, const dvec3& base1, const dvec3& m1
     if (*f1 == *f0) break;
     const double x2 = x1 - *f1 * (x1 - x0) / (*f1 - *f0);
     if (!(x2 > 0.25 * r1_joint && x2 < 4.0 * r1_joint)) break;
-    x0 = x1, f0 = f1, c0 = c1;
-    x1 = x2, f1 = mismatch(x1, c1);
+    x0 = x1, f0 = f1;
+    x1 = x2, c1 = cut_with(x1), f1 = mismatch(x1, c1);
   }
   return out;
 }
@@ -695,9 +697,9 @@ ChainPath prepared_path(const Skeleton& sk, uint32_t c, const SkinOptions& optio
 // Where a continuation (its prepared `child` path) meets `last`, its parent's last
 // frustum: the interior joint's construction (with sec. 2.2's fit of the child's base
 // radius where options.fit_minor_axis, which must then make the cuts coincide), where it
-// needs no split and keeps `last` proper and
-// the child's first segment proper under it even with a perpendicular cut at its far end
-// (which the child then falls back to); none otherwise.
+// needs no split and keeps `last` proper and the child's first segment proper under it
+// even with a perpendicular cut at its far end (which the child then falls back to); none
+// otherwise.
 struct ContinuationStart {
   Plane plane;
   double radius = 0;  // the child's base radius
@@ -713,11 +715,13 @@ std::optional<ContinuationStart> continuation_mitre(const FrustumShape& last, co
   const double max_tilt_rad = deg_to_rad(options.max_tilt_deg);
   ContinuationStart start;
   start.radius = child.radii[0];
-  JointCut cut;
-  if (options.fit_minor_axis) {
-    const FittedCut fitted = fit_minor_axis(child.points[0], last.base, last.axis, last.radius0, last.radius1,
-                                            last.length, axis, child.radii[0], child.radii[1], length,
-                                            max_tilt_rad, options.fit_tolerance, options.fit_max_iterations);
+  JointCut cut = cutting_plane_at_joint(child.points[0], last.axis, JointSide{last.radius0, last.radius1, last.length},
+                                        axis, JointSide{child.radii[1], child.radii[0], length}, max_tilt_rad);
+  if (options.fit_minor_axis && !cut.split) {
+    const FittedCut fitted =
+        fit_minor_axis(cut, child.points[0], last.base, last.axis, last.radius0, last.radius1, last.length, axis,
+                       child.radii[0], child.radii[1], length, max_tilt_rad, options.fit_tolerance,
+                       options.fit_max_iterations);
     // A mitre whose cuts would not coincide leaves a crack as wide as the mismatch: on the
     // elm up to 5 cm, where a twig tip goes on from its branch's end at the end's radius
     // and tapers to a third of it within 8 cm, the plane clamped to the tilt limit. There
@@ -725,9 +729,6 @@ std::optional<ContinuationStart> continuation_mitre(const FrustumShape& last, co
     if (!fitted.matched) return std::nullopt;
     cut = fitted.cut;
     start.radius = fitted.radius;
-  } else {
-    cut = cutting_plane_at_joint(child.points[0], last.axis, JointSide{last.radius0, last.radius1, last.length},
-                                 axis, JointSide{child.radii[1], child.radii[0], length}, max_tilt_rad);
   }
   if (cut.split) return std::nullopt;
   FrustumShape parent = last;
@@ -841,9 +842,9 @@ Expected<SkinnedSkeleton> skin_skeleton(const Skeleton& sk, const SkinOptions& o
         if (split[i]) continue;
         if (options.fit_minor_axis) {
           const FittedCut fitted =
-              fit_minor_axis(path.points[i], path.points[i - 1], axis[i - 1], radius_lower[i - 1], path.radii[i],
-                             length[i - 1], axis[i], path.radii[i], path.radii[i + 1], length[i], max_tilt_rad,
-                             options.fit_tolerance, options.fit_max_iterations);
+              fit_minor_axis(cut, path.points[i], path.points[i - 1], axis[i - 1], radius_lower[i - 1],
+                             path.radii[i], length[i - 1], axis[i], path.radii[i], path.radii[i + 1], length[i],
+                             max_tilt_rad, options.fit_tolerance, options.fit_max_iterations);
           cut = fitted.cut;
           radius_lower[i] = fitted.radius;
         }

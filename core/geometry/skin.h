@@ -98,9 +98,10 @@ struct SkinOptions {
   // Sec. 2.2's iterative fit of the new cone's base radius at a mitre (within a chain and
   // where a continuation meets its parent's end), so that the two elliptical cuts share
   // their minor axis as well as their major one and coincide (G3). The smooth skin fits:
-  // without it a mitre between unequal slopes leaves a crack of up to a millimetre on a
-  // trunk, through which a collar inside can be seen (docs/joints.md); the paper's skin does
-  // not ("in practice we found this extra fitting step to be unnecessary").
+  // without it a mitre between unequal slopes leaves a crack (0.71 mm at the crown
+  // close-up's trunk end, through which a collar inside was seen; up to 5 cm at the elm's
+  // twig tips, docs/joints.md); the paper's skin does not ("in practice we found this
+  // extra fitting step to be unnecessary").
   bool fit_minor_axis = true;
   double fit_tolerance = 1e-12;   // fit stops when |b2 − b1| <= tolerance · joint radius
   int fit_max_iterations = 50;    // secant steps before the fit gives up (keeps radius)
