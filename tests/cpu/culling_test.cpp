@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <glm/geometric.hpp>
 
 #include "core/cpu/render_cpu.h"
@@ -200,6 +201,36 @@ TEST(Culling, TheViewFrustumPassesThroughTheImageCorners) {
   // Just inside and just outside a box's reach.
   EXPECT_FALSE(outside_view(view, Aabb{{-0.1, 1, -0.1}, {0.1, 2, 0.1}}));
   EXPECT_TRUE(outside_view(view, Aabb{{-0.1, 1, 10.5}, {0.1, 2, 11}}));  // behind the eye
+}
+
+// pixels_per_radian (crotch.h crotch_seen's view): the most pixels a radian spans anywhere
+// in the image, measured as the angle between the rays of neighbouring pixel positions —
+// nowhere more than it says (a feature it calls under 2 pixels is), and as much at the
+// corners, along the diagonal (where a pinhole's pixels subtend the least angle).
+TEST(Culling, PixelsPerRadianIsTheMostAnyPixelOfTheImageSpans) {
+  for (const auto& [w, h, fov] : {std::tuple{64u, 48u, 40.0}, {1024u, 768u, 35.0}, {200u, 150u, 90.0}}) {
+    Scene s = scene_with({}, {0, 1, 0});
+    s.width = w;
+    s.height = h;
+    s.camera.fov_y_deg = fov;
+    const double said = pixels_per_radian(s);
+    auto angle = [&](double x0, double y0, double x1, double y1) {
+      const glm::dvec3 a = glm::normalize(camera_ray(s, x0, y0).direction);
+      const glm::dvec3 b = glm::normalize(camera_ray(s, x1, y1).direction);
+      return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+    };
+    double most = 0;
+    for (int i = 0; i <= 8; ++i) {
+      for (int j = 0; j <= 8; ++j) {
+        const double x = std::clamp(w * i / 8.0, 0.5, w - 0.5), y = std::clamp(h * j / 8.0, 0.5, h - 0.5);
+        most = std::max({most, 0.01 / angle(x - 0.005, y, x + 0.005, y), 0.01 / angle(x, y - 0.005, x, y + 0.005)});
+      }
+    }
+    const double diagonal = std::hypot(double(w), double(h));  // from the corner toward the centre
+    const double corner = 0.01 / angle(0, 0, 0.01 * w / diagonal, 0.01 * h / diagonal);
+    EXPECT_LE(most, said * (1 + 1e-6)) << w << "x" << h << " fov " << fov;
+    EXPECT_NEAR(corner, said, 1e-3 * said) << w << "x" << h << " fov " << fov;
+  }
 }
 
 }  // namespace
