@@ -165,7 +165,9 @@ int run_bench_raycast(const std::vector<std::string>& args) {
     return kInputError;
   }
   Scene scene = default_scene_for(grown->skeleton, width, height);
-  SceneGeometry geometry = build_scene_geometry(scene, SkinOptions{});
+  SkinOptions exact;  // the frusta alone (the smooth skin blends its crotches: rows crotch-blend below)
+  exact.blend_crotches = false;
+  SceneGeometry geometry = build_scene_geometry(scene, exact);
   const Bvh bvh = build_bvh(geometry.frusta);  // sylva's own BVH, the measured alternative
   const size_t segments = grown->skeleton.segment_count();
   std::vector<Ray> rays;
@@ -264,9 +266,8 @@ int run_bench_raycast(const std::vector<std::string>& args) {
     std::printf("%s: %s\n", name.c_str(), traced.tracer->describe().c_str());
     results.push_back(r);
   };
-  SkinOptions blended;
-  blended.blend_crotches = true;
-  run_scene_tracer("scene-tracer", SkinOptions{});
+  const SkinOptions blended;
+  run_scene_tracer("scene-tracer", exact);
   run_scene_tracer("crotch-blend-all", blended, false);
   run_scene_tracer("crotch-blend", blended);
   {

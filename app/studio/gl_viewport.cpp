@@ -168,6 +168,7 @@ void GlViewport::run() {
       const auto start = Clock::now();
       renderer.reset();
       options = plants->options;
+      options.geometry.cull = false;  // the camera moves: keep every crotch's fillet (gl_mesh.cpp)
       options.progress = Progress(&sh.cancel_build);
       version = plants->version;
       bool any = false;

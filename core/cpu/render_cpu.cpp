@@ -360,7 +360,9 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
                                     std::vector<RenderPass>* passes, const SceneTextures* textures,
                                     std::shared_ptr<const LeafImages> images, const Progress& progress,
                                     const std::vector<char>* only,
-                                    uint32_t* culled_out = nullptr, double* cull_s_out = nullptr) {
+                                    uint32_t* culled_out = nullptr, double* cull_s_out = nullptr,
+                                    std::span<const glm::dvec3> fillet_eyes = {},
+                                    double fillet_pixels_per_radian = 0) {
   SceneGeometry g;
   g.leaf_images = images;
   const bool mesh = options.kind == GeometryKind::mesh;
@@ -377,7 +379,13 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     textures = own_textures.get();
   }
   const ViewFrustum view = view_frustum(scene);
-  const double view_pixels_per_radian = pixels_per_radian(scene);
+  // The fillets a view needs (crotch.h crotch_seen): seen from the scene's camera with
+  // culling on; from `fillet_eyes` at fillet_pixels_per_radian where the caller gives them
+  // (an instanced prototype: the eye in its frame, one per instance).
+  const glm::dvec3 camera_eye = scene.camera.eye;
+  const bool fillets_by_view = options.cull || !fillet_eyes.empty();
+  const std::span<const glm::dvec3> eyes = fillet_eyes.empty() ? std::span<const glm::dvec3>(&camera_eye, 1) : fillet_eyes;
+  const double view_pixels_per_radian = fillet_eyes.empty() ? pixels_per_radian(scene) : fillet_pixels_per_radian;
   size_t crotches_found = 0;
   double cull_s = 0, skin_s = 0, tessellate_s = 0, displace_s = 0;
   uint32_t culled = 0, displaced = 0;
@@ -424,8 +432,10 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     const std::vector<Crotch> plant_crotches =
         plant_skin.blend_crotches ? find_crotches(placed, skinned.frusta) : std::vector<Crotch>{};
     crotches_found += plant_crotches.size();
-    for (Crotch c : plant_crotches) {
-      if (options.cull && !crotch_seen(c, scene.camera.eye, view_pixels_per_radian)) continue;
+    std::vector<Crotch> seen;  // in the plant's frusta
+    for (const Crotch& c : plant_crotches)
+      if (!fillets_by_view || crotch_seen_from_any(c, eyes, view_pixels_per_radian)) seen.push_back(c);
+    for (Crotch c : seen) {
       for (uint32_t& i : c.parent_frusta) i += first_frustum;
       for (uint32_t& i : c.lateral_frusta) i += first_frustum;
       crotches.push_back(std::move(c));
@@ -439,7 +449,7 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     TriangleMesh part = plant_mesh(skinned, tessellation, height, plant.bark.relief_depth_m,
                                    options.relief_options.max_depth_per_radius, &tessellate_s, &displace_s,
                                    plant_crotches);
-    if (plant_skin.blend_crotches) append_mesh(part, skeleton_fillets(placed, skinned.frusta), 0);
+    if (plant_skin.blend_crotches) append_mesh(part, crotch_fillets(seen, placed, skinned.frusta), 0);
     if (height) ++displaced;
     start = Clock::now();
     if (triangles.positions.empty()) {  // the first plant's mesh is taken, not copied
@@ -575,6 +585,15 @@ SceneGeometry build_instanced_geometry(const Scene& scene, const SkinOptions& sk
   const uint32_t world_culled = culled;
   uint64_t prototype_frusta = 0;
   std::vector<uint64_t> frusta_of_prototype;
+  // With culling on, each prototype keeps the fillets any of its instances needs: the eye
+  // in its frame, one per instance (crotch.h crotch_seen_from_any).
+  std::vector<std::vector<glm::dvec3>> eyes_of_prototype(groups.distinct());
+  if (options.cull)
+    for (uint32_t p = 0; p < scene.plants.size(); ++p)
+      if (!in_world[p])
+        eyes_of_prototype[groups.prototype_of_plant[p]].push_back(
+            PlantTransform::of(scene.plants[p]).to_local(scene.camera.eye));
+  const double view_pixels_per_radian = pixels_per_radian(scene);
   const Progress instance_progress = progress.part(kWorldShare, 1);
   for (uint32_t p = 0; p < scene.plants.size(); ++p) {
     if (in_world[p]) continue;
@@ -611,7 +630,8 @@ SceneGeometry build_instanced_geometry(const Scene& scene, const SkinOptions& sk
       one.plants[0].bark = Bark{};
       GeometryOptions local = options;
       local.cull = false;
-      SceneGeometry pg = build_plants_geometry(one, skin, local, nullptr, nullptr, images, {}, nullptr);
+      SceneGeometry pg = build_plants_geometry(one, skin, local, nullptr, nullptr, images, {}, nullptr, nullptr,
+                                               nullptr, eyes_of_prototype[k], view_pixels_per_radian);
       prototype_index[k] = static_cast<int64_t>(prototypes.size());
       frusta_of_prototype.push_back(pg.frusta.size());
       prototype_frusta += pg.frusta.size();

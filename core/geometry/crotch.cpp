@@ -136,6 +136,11 @@ bool crotch_seen(const Crotch& c, const dvec3& eye, double pixels_per_radian, do
   return !(distance > 0) || c.k * pixels_per_radian >= min_pixels * distance;
 }
 
+bool crotch_seen_from_any(const Crotch& c, std::span<const dvec3> eyes, double pixels_per_radian, double min_pixels) {
+  return std::any_of(eyes.begin(), eyes.end(),
+                     [&](const dvec3& eye) { return crotch_seen(c, eye, pixels_per_radian, min_pixels); });
+}
+
 CrotchSample crotch_field(const Crotch& c, std::span<const Frustum> frusta, const dvec3& p) {
   CrotchSample s;
   s.parent = group_bound(frusta, c.parent_frusta, p);

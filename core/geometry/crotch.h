@@ -83,6 +83,12 @@ inline constexpr double kFilletMinPixels = 2;
 // where the eye is inside the ball.
 bool crotch_seen(const Crotch& c, const glm::dvec3& eye, double pixels_per_radian,
                  double min_pixels = kFilletMinPixels);
+// A skeleton drawn at several places (instances sharing one skinning): whether any of
+// `eyes` — the view's eye in the skeleton's frame, one per place (the width-to-distance
+// ratio does not change with a placement's scale) — sees c's fillet so wide. The
+// instances share the fillets any of them needs.
+bool crotch_seen_from_any(const Crotch& c, std::span<const glm::dvec3> eyes, double pixels_per_radian,
+                          double min_pixels = kFilletMinPixels);
 
 // The two groups' bounds and the blend at a point.
 struct CrotchSample {

@@ -208,15 +208,27 @@ TriangleMesh crotch_fillet_mesh(const Crotch& crotch, std::span<const Frustum> f
 }
 
 TriangleMesh skeleton_fillets(const Skeleton& skeleton, std::span<const Frustum> frusta, unsigned threads) {
+  return crotch_fillets(find_crotches(skeleton, frusta), skeleton, frusta, threads);
+}
+
+TriangleMesh asset_fillets(const Skeleton& skeleton, std::span<const Frustum> frusta, unsigned threads) {
+  std::vector<Crotch> crotches = find_crotches(skeleton, frusta);
+  const SkeletonBounds box = skeleton_bounds(skeleton);
+  const double least_k = kFilletMinPixels / kFilletAssetPixels * glm::length(box.hi - box.lo);
+  std::erase_if(crotches, [&](const Crotch& c) { return !(c.k >= least_k); });
+  return crotch_fillets(crotches, skeleton, frusta, threads, 1.0);
+}
+
+TriangleMesh crotch_fillets(std::span<const Crotch> crotches, const Skeleton& skeleton,
+                            std::span<const Frustum> frusta, unsigned threads, double cell_per_k) {
   TriangleMesh out;
-  const std::vector<Crotch> crotches = find_crotches(skeleton, frusta);
   if (crotches.empty()) return out;
   const SkeletonBounds box = skeleton_bounds(skeleton);
   const double min_cell = kFilletMinCellPerExtent * glm::length(box.hi - box.lo);
   std::vector<TriangleMesh> meshes(crotches.size());
   parallel_for(crotches.size(), threads, nullptr, [&](size_t i, unsigned) {
     const Crotch& c = crotches[i];
-    if (c.k > 0) meshes[i] = crotch_fillet_mesh(c, frusta, std::max(c.k / 2, min_cell));
+    if (c.k > 0) meshes[i] = crotch_fillet_mesh(c, frusta, std::max(c.k * cell_per_k, min_cell));
   });
   for (const TriangleMesh& m : meshes) append_mesh(out, m, 0);
   return out;

@@ -70,8 +70,9 @@ TriangleMesh crotch_fillet_mesh(const Crotch& crotch, std::span<const Frustum> f
 // the whole plant 1000 pixels across, a facet is at least about a pixel.
 inline constexpr double kFilletMinCellPerExtent = 1e-3;
 
-// Every crotch of a skinned skeleton (find_crotches with the default options) as one mesh,
-// each at cells of k/2 (within about 8 mm of the marched fillet on the test limb, about
+// The fillets of `crotches` (find_crotches' for these frusta, all or some of them: a
+// renderer that knows its view meshes only those crotch_seen keeps) as one mesh, each at
+// cells of k/2 (within about 8 mm of the marched fillet on the test limb, about
 // 370 triangles a crotch) but no smaller than kFilletMinCellPerExtent of the skeleton's
 // extent (docs/joints.md: the elm's 529 crotches make 81,000 triangles in 0.25 s instead
 // of 197,000 in 0.64 s; only its crotches of under about 3 cm are coarser),
@@ -79,6 +80,20 @@ inline constexpr double kFilletMinCellPerExtent = 1e-3;
 // frusta's own mesh where SkinOptions::blend_crotches is on. The crotches are meshed on
 // `threads` threads (0: every hardware thread; parallel.h) and appended in crotch order:
 // the same mesh on any thread count.
+// `cell_per_k`: the cell as a share of k (asset_fillets meshes coarser).
+TriangleMesh crotch_fillets(std::span<const Crotch> crotches, const Skeleton& skeleton,
+                            std::span<const Frustum> frusta, unsigned threads = 0, double cell_per_k = 0.5);
+// Every crotch's fillet: crotch_fillets of find_crotches with the default options.
 TriangleMesh skeleton_fillets(const Skeleton& skeleton, std::span<const Frustum> frusta, unsigned threads = 0);
+
+// The plant's size on screen an asset's fillets are chosen for: seen whole this many pixels
+// across (the extent kFilletMinCellPerExtent's facets are sized for).
+inline constexpr double kFilletAssetPixels = 1000;
+// The fillets an asset carries (the glTF mesh, docs/gltf.md "Crotches"), for no view in
+// particular: those at least kFilletMinPixels wide when the whole plant spans
+// kFilletAssetPixels, k >= 2/1000 of the skeleton's extent; the rest move no surface by more than half a pixel in such a view. Each at
+// cells of k, nearer the export's 8 facets around a stem than k/2: the elm's add 4,998
+// triangles to its 33,648 (16,324 at k/2).
+TriangleMesh asset_fillets(const Skeleton& skeleton, std::span<const Frustum> frusta, unsigned threads = 0);
 
 }  // namespace sylva

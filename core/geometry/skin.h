@@ -121,9 +121,9 @@ struct SkinOptions {
   double round_piece_deg = 10;      // ... of pieces that each turn at most this much
   // Blended crotches (crotch.h, docs/joints.md "Crotches"): a fillet where each lateral
   // leaves its parent, marched by the CPU ray caster, drawn as triangles by GL and the
-  // mesh paths. Off by default until its cost is paid and it becomes the smooth skin's
-  // (docs/joints.md says what is left); the frusta are the same either way.
-  bool blend_crotches = false;
+  // mesh paths — in a view, only those at least kFilletMinPixels wide (GeometryOptions::
+  // cull). The smooth skin's; the frusta are the same either way.
+  bool blend_crotches = true;
 
   // These options with the joints of `style`: smooth keeps them; paper (sec. 2 as
   // published: laterals start with a plain capped cylinder, chain ends are flat caps and

@@ -18,6 +18,7 @@
 #include "core/gl/gl_objects.h"
 #include "core/gl/gl_program.h"
 #include "core/gl/gl_views.h"
+#include "core/scene/culling.h"
 #include "core/scene/render_common.h"
 #include "core/scene/height_maps.h"
 #include "core/scene/leaf_images.h"
@@ -265,8 +266,24 @@ struct GlMesh::State {
     double skin_s = 0, tessellate_s = 0, displace_s = 0;
     uint64_t skinned_frusta = 0, placed_frusta = 0;
     std::vector<GlMeshSphere> world_spheres;
+    // The crotches whose fillets a plant needs (crotch.h crotch_seen): with culling on, the
+    // renderer draws the scene's camera (the CLI, the benchmarks; the studio, whose camera
+    // moves, turns it off), so only those at least kFilletMinPixels wide there, as on the
+    // CPU. `eyes`: the camera's eye in the skeleton's frame (a placed plant's: the world's;
+    // an instanced skeleton's: one per instance, which share the fillets any of them needs).
+    const double view_pixels_per_radian = pixels_per_radian(scene);
+    size_t crotches_found = 0, crotches_meshed = 0;
+    const auto seen = [&](std::vector<Crotch> crotches, std::span<const glm::dvec3> eyes) {
+      crotches_found += crotches.size();
+      if (geometry.cull)
+        std::erase_if(crotches,
+                      [&](const Crotch& c) { return !crotch_seen_from_any(c, eyes, view_pixels_per_radian); });
+      crotches_meshed += crotches.size();
+      return crotches;
+    };
     // Plant p's skeleton (placed in the world, or in its own frame) tessellated into arrays.
-    const auto append = [&](uint32_t p, const Skeleton& skeleton, std::vector<GlMeshSphere>* out) -> size_t {
+    const auto append = [&](uint32_t p, const Skeleton& skeleton, std::span<const glm::dvec3> eyes,
+                            std::vector<GlMeshSphere>* out) -> size_t {
       const ScenePlant& plant = scene.plants[p];
       Clock::time_point start = Clock::now();
       const SkinOptions skin = options.skin.styled(plant.skin);
@@ -276,7 +293,8 @@ struct GlMesh::State {
       TriangleMesh part;
       if (fillets) {
         start = Clock::now();
-        if (skin.blend_crotches) part = skeleton_fillets(skeleton, skinned.frusta);
+        if (skin.blend_crotches)
+          part = crotch_fillets(seen(find_crotches(skeleton, skinned.frusta), eyes), skeleton, skinned.frusta);
         tessellate_s += seconds_since(start);
       } else {
         // build_scene_geometry's mesh path: the same plant_mesh, within the same limit,
@@ -285,10 +303,11 @@ struct GlMesh::State {
                         arrays.vertices.size() * sizeof(MeshVertex) + arrays.indices.size() * sizeof(uint32_t));
         const HeightFn height = heights ? (*heights)[p] : HeightFn{};
         const std::vector<Crotch> crotches =
-            skin.blend_crotches && height ? find_crotches(skeleton, skinned.frusta) : std::vector<Crotch>{};
+            skin.blend_crotches ? find_crotches(skeleton, skinned.frusta) : std::vector<Crotch>{};
         part = plant_mesh(skinned, tessellation, height, plant.bark.relief_depth_m,
-                          geometry.relief_options.max_depth_per_radius, &tessellate_s, &displace_s, crotches);
-        if (skin.blend_crotches) append_mesh(part, skeleton_fillets(skeleton, skinned.frusta), 0);
+                          geometry.relief_options.max_depth_per_radius, &tessellate_s, &displace_s,
+                          height ? std::span<const Crotch>(crotches) : std::span<const Crotch>{});
+        if (skin.blend_crotches) append_mesh(part, crotch_fillets(seen(crotches, eyes), skeleton, skinned.frusta), 0);
         if (height) ++arrays.displaced_plants;
       }
       start = Clock::now();
@@ -296,11 +315,16 @@ struct GlMesh::State {
       tessellate_s += seconds_since(start);
       return skinned.frusta.size();
     };
-    for (uint32_t p : split.world) placed_frusta += append(p, place_plant(scene.plants[p]), &world_spheres);
+    const glm::dvec3 world_eye = scene.camera.eye;
+    for (uint32_t p : split.world)
+      placed_frusta += append(p, place_plant(scene.plants[p]), {&world_eye, 1}, &world_spheres);
     append_instanced(scene, split, arrays, world_spheres,
                      [&](const std::vector<uint32_t>& group, std::vector<GlMeshSphere>* local) {
                        const uint32_t p = group.front();
-                       placed_frusta += append(p, *scene.plants[p].skeleton, local) * group.size();
+                       std::vector<glm::dvec3> eyes;
+                       eyes.reserve(group.size());
+                       for (uint32_t q : group) eyes.push_back(PlantTransform::of(scene.plants[q]).to_local(world_eye));
+                       placed_frusta += append(p, *scene.plants[p].skeleton, eyes, local) * group.size();
                      });
     if (arrays.indices.size() > static_cast<size_t>(INT_MAX))
       throw GlError("the GL mesh draws at most 2^31 indices in one call (lower --mesh-level)");
@@ -315,7 +339,8 @@ struct GlMesh::State {
     setup_passes.push_back({"skin", skin_s, skin_detail});
     setup_passes.push_back({"tessellate", tessellate_s,
                             std::to_string(triangles) + " triangles, GS " + std::to_string(geometry.mesh_level) + ", " +
-                                std::to_string(arrays.vertices.size()) + " vertices" + drawn_detail()});
+                                std::to_string(arrays.vertices.size()) + " vertices" + drawn_detail() +
+                                fillet_detail(crotches_meshed, crotches_found)});
     if (displaced)
       setup_passes.push_back({"displace", displace_s,
                               std::to_string(arrays.displaced_plants) + " plants by their height maps"});
@@ -324,6 +349,13 @@ struct GlMesh::State {
       return 0;
     }
     return upload(arrays);
+  }
+
+  // ", N of M crotches' fillets (the rest under 2 px)" when a view left some out.
+  static std::string fillet_detail(size_t meshed, size_t found) {
+    if (meshed == found) return {};
+    return ", " + std::to_string(meshed) + " of " + std::to_string(found) + " crotches' fillets (the rest under " +
+           std::to_string(static_cast<int>(kFilletMinPixels)) + " px)";
   }
 
   // ", N drawn" when instances draw more triangles than were uploaded.

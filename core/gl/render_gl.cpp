@@ -28,7 +28,9 @@
 #include "core/gl/gl_views.h"
 #include "core/gl/gl_instances.h"
 #include "core/scene/instances.h"
+#include "core/geometry/crotch.h"
 #include "core/geometry/relief.h"
+#include "core/scene/culling.h"
 #include "core/scene/render_common.h"
 #include "core/util/math.h"
 #include "core/util/clock.h"
@@ -258,6 +260,10 @@ struct GlRenderer::State {
     return id;
   }
 
+  // The view the fillets' relief fade is for (skin_plants sets it; options.geometry.cull).
+  glm::dvec3 fillet_eye{0};
+  double fillet_pixels_per_radian = 0;
+
   // Skins one skeleton (placed: in the world) into records and id quadruples (plant, chain,
   // segment, 0), and its frusta's bounding spheres into *out.
   void skin_one(const Skeleton& skeleton, uint32_t plant, SkinStyle style, const Progress& progress,
@@ -268,9 +274,12 @@ struct GlRenderer::State {
     const SkinnedSkeleton& skinned = *skinned_or;
     const float plant_relief_m = bark_maps->plants().empty() ? 0.0f : bark_maps->plants()[plant].relief_depth_m;
     if (plant_relief_m > 0 && options.skin.styled(style).blend_crotches) {
-      // The relief fades into the fillets (crotch.glsl): the crotches, by record index.
+      // The relief fades into the fillets (crotch.glsl): the crotches, by record index —
+      // with culling on, those whose fillets the view draws (gl_mesh.cpp, crotch.h
+      // crotch_seen; the fade of a fillet left out would only flatten the relief).
       const uint32_t first = static_cast<uint32_t>(records->size());
       for (Crotch c : find_crotches(skeleton, skinned.frusta)) {
+        if (options.geometry.cull && !crotch_seen(c, fillet_eye, fillet_pixels_per_radian)) continue;
         for (uint32_t& i : c.parent_frusta) i += first;
         for (uint32_t& i : c.lateral_frusta) i += first;
         crotches->push_back(std::move(c));
@@ -322,6 +331,8 @@ struct GlRenderer::State {
     std::vector<InstanceSphere> fresh_instance_spheres;
     std::vector<std::vector<Sphere>> fresh_draw_spheres;
     std::vector<Crotch> fresh_crotches;
+    fillet_eye = scene.camera.eye;
+    fillet_pixels_per_radian = pixels_per_radian(scene);
     const double share = 1.0 / std::max(1u, n);
     for (uint32_t p : split.world) {
       if (options.progress.cancelled()) throw GlCancelled();  // between plants

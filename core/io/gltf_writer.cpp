@@ -966,16 +966,17 @@ std::string open_segment_attributes(const TriangleMesh& tm, const SkinnedSkeleto
 
 // The segments of `skinned` tessellated (tessellate.h), one primitive per material index
 // in increasing order, with the bark's textures on the wood; with `fillets_of` (the
-// skeleton `skinned` is of) each crotch's fillet too (crotch_mesh.h): its triangles are in
-// the material of their heavier group's frustum, and its vertices are weighted, carry wind
-// data and tangents as that frustum's own (each fillet vertex belongs to one group).
+// skeleton `skinned` is of) the crotches' fillets an asset carries too (crotch_mesh.h
+// asset_fillets): their triangles are in the material of their heavier group's frustum,
+// and their vertices are weighted, carry wind data and tangents as that frustum's own
+// (each fillet vertex belongs to one group).
 Status add_segment_mesh(const SkinnedSkeleton& skinned, const Skeleton* fillets_of, const Bark& bark,
                         const GltfExportOptions& options, const PlantRig* rig, const WindSource* wind,
                         GltfDocument& doc, MeshPrimitives& primitives) {
   TessellateOptions to;
   to.segments_around = options.segments_around;
   TriangleMesh tm = tessellate(skinned, to);
-  if (fillets_of) append_mesh(tm, skeleton_fillets(*fillets_of, skinned.frusta), 0);
+  if (fillets_of) append_mesh(tm, asset_fillets(*fillets_of, skinned.frusta), 0);
   if (tm.indices.empty()) return {};
   const std::map<uint32_t, std::vector<uint32_t>> triangles_of = triangles_by_material(
       tm.indices, tm.triangle_count(), [&](size_t t) { return skinned.frusta[tm.triangle_frustum[t]].material; });

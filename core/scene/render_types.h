@@ -45,8 +45,11 @@ enum class GeometryKind : uint8_t {
 struct GeometryOptions {
   GeometryKind kind = GeometryKind::frusta;
   int mesh_level = 2;   // m: 16·4^m triangles per segment
-  bool cull = true;     // leave out plants that can affect no pixel (outside the view
-                        // frustum and casting no shadow into it; culling.h)
+  bool cull = true;     // CPU: leave out plants that can affect no pixel (outside the view
+                        // frustum and casting no shadow into it; culling.h). Both: leave out
+                        // the crotches' fillets under kFilletMinPixels wide in the view
+                        // (crotch.h crotch_seen; GL: seen from the scene's camera when the
+                        // renderer is made, so a renderer whose camera moves turns it off)
   bool instance = true; // plants that share a skeleton (instances.h) skinned and uploaded
                         // once, drawn through each plant's transform (docs/scatter.md,
                         // "Instancing"); false: every plant skinned where it stands. The

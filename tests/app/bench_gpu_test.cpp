@@ -172,9 +172,11 @@ TEST(BenchGpu, QuickRunOnAGrammarMeasuresEveryMethodTheGlBackendDraws) {
     EXPECT_EQ(row.at("status"), "ok") << "the GL backend draws a bare grammar's frusta and meshes";
     if (row.at("family").rfind("RC", 0) == 0) {
       // Bare frusta against the CPU's: the GL tests' agreement (99.5 % of pixels), depth
-      // to float precision.
+      // to float precision but where the view keeps a crotch's fillet: GL draws its facets,
+      // within millimetres of the fillet the CPU marches (docs/joints.md; measured 6.2e-4 m
+      // and 7.0e-4 m RMS over the saguaro at 160x120).
       EXPECT_LE(number(row, "hit_mismatch"), 0.005);
-      EXPECT_LT(number(row, "depth_rmse_m"), 1e-4);
+      EXPECT_LT(number(row, "depth_rmse_m"), 1.5e-3);
     }
   }
   const CsvRow& anim = rows->back();

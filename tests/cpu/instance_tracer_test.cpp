@@ -16,8 +16,14 @@
 namespace sylva {
 namespace {
 
+// The frusta through instances against the plants skinned in the world. Without the
+// crotches' fillets: in a view, instances share the fillets any of them needs and a plant
+// skinned in the world keeps its own (render_cpu.cpp; under 2 px, they move no surface by
+// half a pixel), so the two pictures differ there by design; the fillets through instances
+// are tested below with every fillet kept.
 RenderResult render(const Scene& s, bool instance) {
   RenderOptions o;
+  o.skin.blend_crotches = false;
   o.aovs = kAovDepth | kAovNormal | kAovUv | kAovId;
   o.geometry.instance = instance;
   return render_cpu(s, o);
@@ -141,7 +147,9 @@ void expect_instanced_photons_as_flat(const SkinOptions& skin, bool exact) {
 }
 
 TEST(InstanceTracer, SunPhotonsThroughInstancesLeaveTheVectorsOfEveryPlantSkinnedInTheWorld) {
-  expect_instanced_photons_as_flat({}, true);
+  SkinOptions unblended;  // the frusta alone
+  unblended.blend_crotches = false;
+  expect_instanced_photons_as_flat(unblended, true);
 }
 
 TEST(InstanceTracer, SunPhotonsThroughInstancedFilletsLeaveTheVectorsOfEveryPlantSkinnedInTheWorld) {
@@ -156,6 +164,7 @@ TEST(InstanceTracer, AFogRenderWithShadowConesIsTheSameThroughInstances) {
     RenderOptions o;
     o.aovs = kAovId | kAovFog;
     o.threads = 2;
+    o.skin.blend_crotches = false;  // as render() above
     o.fog.cone_params = std::array<uint32_t, 4>{81, 8, 16, 16};
     o.geometry.instance = false;
     const RenderResult flat = render_cpu(s, o);

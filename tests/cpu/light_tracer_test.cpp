@@ -135,6 +135,8 @@ TEST(LightTracer, TheBlendedCrotchesFilletsShadeWhereTheExactFrustaDoNot) {
   const double r = 0.003;
   SkinOptions blended;
   blended.blend_crotches = true;
+  SkinOptions unblended;
+  unblended.blend_crotches = false;
   const SkinnedSkeleton skinned = skin_skeleton(plants[0], blended);
   const CrotchBalls balls(find_crotches(plants[0], skinned.frusta), skinned.frusta);
   const FrustumAccel exact_accel(skinned.frusta), blended_accel(skinned.frusta, CustomFrusta{}, &balls);
@@ -165,7 +167,7 @@ TEST(LightTracer, TheBlendedCrotchesFilletsShadeWhereTheExactFrustaDoNot) {
       const glm::dvec3 e1 = glm::cross(to_sun, e0);
       std::vector<glm::dvec3> points = {line.origin};
       for (const glm::dvec3& d : {e0, -e0, e1, -e1}) points.push_back(line.origin + r * d);
-      auto exact = gather_light(plants, points, s, 0, 4);
+      auto exact = gather_light(plants, points, s, 0, 4, unblended);
       auto blend = gather_light(plants, points, s, 0, 4, blended);
       ASSERT_TRUE(exact && blend);
       bool all = true;
@@ -183,7 +185,7 @@ TEST(LightTracer, TheBlendedCrotchesFilletsShadeWhereTheExactFrustaDoNot) {
     s.sun.angular_radius_deg = 0;
     s.ground.height = -10;
     const std::vector<glm::dvec3> sensor = {c.sensor};
-    auto exact = PhotonLightOracle(2).answer(plants, sensor, s, 0);
+    auto exact = PhotonLightOracle(2, unblended).answer(plants, sensor, s, 0);
     auto blend = PhotonLightOracle(2, blended).answer(plants, sensor, s, 0);
     ASSERT_TRUE(exact && blend);
     EXPECT_GT((*exact)[0].q, 0);

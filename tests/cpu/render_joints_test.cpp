@@ -14,6 +14,7 @@
 #include "core/geometry/crotch.h"
 #include "core/scene/culling.h"
 #include "tests/support/joint_scenes.h"
+#include "tests/support/test_scenes.h"
 
 namespace sylva {
 namespace {
@@ -65,9 +66,11 @@ TEST(RenderCpuJoints, ThePapersPlainSkinningShowsTheRimTheStepAndTheFacet) {
 TEST(RenderCpuJoints, TheBlendFillsTheCrotchesConcaveCrease) {
   SkinOptions blended;
   blended.blend_crotches = true;
+  SkinOptions exact_skin;
+  exact_skin.blend_crotches = false;
   for (const test::JointCloseUp& c : test::joint_close_ups()) {
     if (c.name != "fork" && c.name != "crown" && c.name != "y_fork") continue;
-    const test::SurfaceDefects exact = defects(c, SkinOptions{});
+    const test::SurfaceDefects exact = defects(c, exact_skin);
     const test::SurfaceDefects blend = defects(c, blended);
     std::printf("[ joints ] %-12s concave crease %.1f° exact (at %d, %d), %.1f° blended (at %d, %d); convex %.1f° blended\n",
                 c.name.c_str(), exact.concave_crease_deg, exact.concave_x, exact.concave_y, blend.concave_crease_deg,
@@ -107,6 +110,7 @@ TEST(RenderCpuJoints, AViewLeavesOutTheFilletsUnderTwoPixels) {
 
   RenderOptions exact;
   exact.aovs = kAovDepth | kAovNormal;
+  exact.skin.blend_crotches = false;
   RenderOptions blended = exact;
   blended.skin.blend_crotches = true;
   auto skin_detail = [](const RenderResult& r) {
@@ -129,14 +133,40 @@ TEST(RenderCpuJoints, AViewLeavesOutTheFilletsUnderTwoPixels) {
   EXPECT_EQ(skin_detail(near).find("under 2 px"), std::string::npos) << skin_detail(near);
 }
 
+// The smooth skin (the default) blends its crotches; the paper's (--skin paper, the scene's
+// key) does not: the fork's close-up, as a user renders it.
+TEST(RenderCpuJoints, TheSmoothSkinBlendsItsCrotchesAndThePapersDoesNot) {
+  const test::JointCloseUp fork = test::joint_close_ups().at(2);
+  ASSERT_EQ(fork.name, "fork");
+  RenderOptions o;
+  o.aovs = kAovDepth;
+  const RenderResult smooth = render_cpu(fork.scene, o);
+  const RenderPass* skin = test::find_pass(smooth, "skin");
+  ASSERT_NE(skin, nullptr);
+  EXPECT_NE(skin->detail.find("1 of 1 crotches blended"), std::string::npos) << skin->detail;
+  Scene paper = fork.scene;
+  override_skin(paper, SkinStyle::paper);
+  const RenderPass* paper_skin = test::find_pass(render_cpu(paper, o), "skin");
+  ASSERT_NE(paper_skin, nullptr);
+  EXPECT_EQ(paper_skin->detail.find("crotches blended"), std::string::npos) << paper_skin->detail;
+  RenderOptions exact = o;
+  exact.skin.blend_crotches = false;
+  const RenderResult unblended = render_cpu(fork.scene, exact);
+  const size_t filled = test::differing_pixels(smooth.image.depth, unblended.image.depth, 1, 1e-6);
+  std::printf("[ joints ] fork: the default skin's fillet moves %zu pixels' depth\n", filled);
+  EXPECT_GT(filled, 50u) << "the fillet fills the fork's crease";
+}
+
 // Issue 31 §1: no pixel of a crotch sees the inside of the other solid — with the exact
 // joints and with the blend (the fillets lie outside the exact union). Measured: at most
 // 0.12 µm (the depth AOV's float rounding) on every close-up.
 TEST(RenderCpuJoints, NoPixelSeesInsideAnotherSolidWithOrWithoutTheBlend) {
   SkinOptions blended;
   blended.blend_crotches = true;
+  SkinOptions exact;
+  exact.blend_crotches = false;
   for (const test::JointCloseUp& c : test::joint_close_ups()) {
-    for (const SkinOptions& skin : {SkinOptions{}, blended}) {
+    for (const SkinOptions& skin : {exact, blended}) {
       RenderOptions o;
       o.aovs = kAovDepth;
       o.skin = skin;
@@ -196,6 +226,7 @@ TEST(RenderCpuJoints, TheMeshPathCarriesTheFilletsTriangles) {
     o.aovs = kAovDepth | kAovNormal;
     o.geometry.kind = GeometryKind::mesh;
     o.geometry.mesh_level = 2;
+    o.skin.blend_crotches = false;
     const RenderResult exact = render_cpu(c.scene, o);
     o.skin.blend_crotches = true;
     const RenderResult mesh = render_cpu(c.scene, o);

@@ -6,10 +6,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "tests/support/joint_scenes.h"
 #include "tests/support/gl_checks.h"
+#include "tests/support/test_scenes.h"
 
 namespace sylva {
 namespace {
@@ -45,6 +48,7 @@ TEST(RenderGlJoints, TheBlendedCrotchesFilletMeshMatchesTheCpusMarchedFillet) {
   SYLVA_REQUIRE_GL();
   RenderOptions o;
   o.aovs = kAovDepth | kAovNormal;
+  o.skin.blend_crotches = false;  // the exact frusta
   RenderOptions blended = o;
   blended.skin.blend_crotches = true;
   for (const test::JointCloseUp& c : test::joint_close_ups()) {
@@ -67,6 +71,41 @@ TEST(RenderGlJoints, TheBlendedCrotchesFilletMeshMatchesTheCpusMarchedFillet) {
   }
 }
 
+// The CPU's AViewLeavesOutTheFilletsUnderTwoPixels on GL (gl_mesh.cpp): a renderer made for
+// the scene's camera meshes only the fillets at least kFilletMinPixels wide there — the
+// fork from 20 times its close-up's distance draws as its exact skin, pixel for pixel, and
+// meshes no fillet; with culling off (the studio's renderer, whose camera moves) and in
+// the close-up the fillet is meshed.
+TEST(RenderGlJoints, AViewLeavesOutTheFilletsUnderTwoPixels) {
+  SYLVA_REQUIRE_GL();
+  const test::JointCloseUp fork = test::joint_close_ups().at(2);
+  ASSERT_EQ(fork.name, "fork");
+  Scene far = fork.scene;
+  far.camera.eye = far.camera.target + 20.0 * (far.camera.eye - far.camera.target);
+  RenderOptions exact;
+  exact.aovs = kAovDepth | kAovNormal;
+  exact.skin.blend_crotches = false;
+  RenderOptions blended = exact;
+  blended.skin.blend_crotches = true;
+  auto fillet_pass = [](const RenderResult& r) { return test::find_pass(r, "fillets tessellate"); };
+  const RenderResult far_blended = gl_test::gl_render(far, blended), far_exact = gl_test::gl_render(far, exact);
+  EXPECT_EQ(fillet_pass(far_blended), nullptr) << "a fillet under 2 px was meshed";
+  const size_t seen = std::count_if(far_exact.image.depth.begin(), far_exact.image.depth.end(),
+                                    [](float z) { return std::isfinite(z); });
+  EXPECT_GT(seen, 10u) << "the far view still sees the fork";
+  EXPECT_EQ(far_blended.image.depth, far_exact.image.depth);
+  EXPECT_EQ(far_blended.image.beauty, far_exact.image.beauty);
+
+  RenderOptions every = blended;
+  every.geometry.cull = false;
+  const RenderPass* all = fillet_pass(gl_test::gl_render(far, every));
+  ASSERT_NE(all, nullptr) << "culling off keeps every fillet";
+  EXPECT_EQ(all->detail.find("under 2 px"), std::string::npos) << all->detail;
+  const RenderPass* near = fillet_pass(gl_test::gl_render(fork.scene, blended));
+  ASSERT_NE(near, nullptr) << "the close-up meshes its fillet";
+  EXPECT_EQ(near->detail.find("under 2 px"), std::string::npos) << near->detail;
+}
+
 TEST(RenderGlJoints, NoPixelSeesInsideAnotherSolidWithOrWithoutTheBlend) {
   // tests/cpu/render_joints_test.cpp's measure on GL's depth AOV, with the exact joints and
   // with the fillets drawn as triangles (their vertices outside the exact union, their
@@ -75,7 +114,9 @@ TEST(RenderGlJoints, NoPixelSeesInsideAnotherSolidWithOrWithoutTheBlend) {
   SYLVA_REQUIRE_GL();
   SkinOptions blended;
   blended.blend_crotches = true;
-  for (const SkinOptions& skin : {SkinOptions{}, blended}) {
+  SkinOptions exact;
+  exact.blend_crotches = false;
+  for (const SkinOptions& skin : {exact, blended}) {
     RenderOptions o;
     o.aovs = kAovDepth;
     o.spp = 1;
