@@ -2,7 +2,7 @@
 // "Crotches"): the region, the field whose zero set is the blended surface, and the ray
 // march through it. Geometry only: the CPU ray caster marches it (core/cpu/crotch_tracer.h),
 // GL and the mesh paths draw its triangles (crotch_mesh.h), where SkinOptions::blend_crotches
-// asks (off by default; docs/joints.md says what is left).
+// asks (the smooth skin; docs/joints.md says what is left).
 //
 // Units and frames: world space, metres, Y up, doubles, as skin.h.
 //
