@@ -146,7 +146,8 @@ TEST(RenderCpuJoints, TheSmoothSkinBlendsItsCrotchesAndThePapersDoesNot) {
   EXPECT_NE(skin->detail.find("1 of 1 crotches blended"), std::string::npos) << skin->detail;
   Scene paper = fork.scene;
   override_skin(paper, SkinStyle::paper);
-  const RenderPass* paper_skin = test::find_pass(render_cpu(paper, o), "skin");
+  const RenderResult paper_render = render_cpu(paper, o);
+  const RenderPass* paper_skin = test::find_pass(paper_render, "skin");
   ASSERT_NE(paper_skin, nullptr);
   EXPECT_EQ(paper_skin->detail.find("crotches blended"), std::string::npos) << paper_skin->detail;
   RenderOptions exact = o;
