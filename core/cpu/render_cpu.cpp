@@ -384,7 +384,8 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
   // (an instanced prototype: the eye in its frame, one per instance).
   const glm::dvec3 camera_eye = scene.camera.eye;
   const bool fillets_by_view = options.cull || !fillet_eyes.empty();
-  const std::span<const glm::dvec3> eyes = fillet_eyes.empty() ? std::span<const glm::dvec3>(&camera_eye, 1) : fillet_eyes;
+  const std::span<const glm::dvec3> eyes =
+      fillet_eyes.empty() ? std::span<const glm::dvec3>(&camera_eye, 1) : fillet_eyes;
   const double view_pixels_per_radian = fillet_eyes.empty() ? pixels_per_radian(scene) : fillet_pixels_per_radian;
   size_t crotches_found = 0;
   double cull_s = 0, skin_s = 0, tessellate_s = 0, displace_s = 0;
@@ -432,9 +433,8 @@ SceneGeometry build_plants_geometry(const Scene& scene, const SkinOptions& skin,
     const std::vector<Crotch> plant_crotches =
         plant_skin.blend_crotches ? find_crotches(placed, skinned.frusta) : std::vector<Crotch>{};
     crotches_found += plant_crotches.size();
-    std::vector<Crotch> seen;  // in the plant's frusta
-    for (const Crotch& c : plant_crotches)
-      if (!fillets_by_view || crotch_seen_from_any(c, eyes, view_pixels_per_radian)) seen.push_back(c);
+    const std::vector<Crotch> seen =  // in the plant's frusta
+        fillets_by_view ? crotches_seen(plant_crotches, eyes, view_pixels_per_radian) : plant_crotches;
     for (Crotch c : seen) {
       for (uint32_t& i : c.parent_frusta) i += first_frustum;
       for (uint32_t& i : c.lateral_frusta) i += first_frustum;

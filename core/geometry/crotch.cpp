@@ -141,6 +141,12 @@ bool crotch_seen_from_any(const Crotch& c, std::span<const dvec3> eyes, double p
                      [&](const dvec3& eye) { return crotch_seen(c, eye, pixels_per_radian, min_pixels); });
 }
 
+std::vector<Crotch> crotches_seen(std::vector<Crotch> crotches, std::span<const dvec3> eyes,
+                                  double pixels_per_radian) {
+  std::erase_if(crotches, [&](const Crotch& c) { return !crotch_seen_from_any(c, eyes, pixels_per_radian); });
+  return crotches;
+}
+
 CrotchSample crotch_field(const Crotch& c, std::span<const Frustum> frusta, const dvec3& p) {
   CrotchSample s;
   s.parent = group_bound(frusta, c.parent_frusta, p);

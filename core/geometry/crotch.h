@@ -89,6 +89,10 @@ bool crotch_seen(const Crotch& c, const glm::dvec3& eye, double pixels_per_radia
 // instances share the fillets any of them needs.
 bool crotch_seen_from_any(const Crotch& c, std::span<const glm::dvec3> eyes, double pixels_per_radian,
                           double min_pixels = kFilletMinPixels);
+// `crotches` less those no eye of `eyes` sees kFilletMinPixels wide (crotch_seen_from_any):
+// the fillets a view needs, in the order given.
+std::vector<Crotch> crotches_seen(std::vector<Crotch> crotches, std::span<const glm::dvec3> eyes,
+                                  double pixels_per_radian);
 
 // The two groups' bounds and the blend at a point.
 struct CrotchSample {

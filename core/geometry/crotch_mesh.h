@@ -91,9 +91,9 @@ TriangleMesh skeleton_fillets(const Skeleton& skeleton, std::span<const Frustum>
 inline constexpr double kFilletAssetPixels = 1000;
 // The fillets an asset carries (the glTF mesh, docs/gltf.md "Crotches"), for no view in
 // particular: those at least kFilletMinPixels wide when the whole plant spans
-// kFilletAssetPixels, k >= 2/1000 of the skeleton's extent; the rest move no surface by more than half a pixel in such a view. Each at
-// cells of k, nearer the export's 8 facets around a stem than k/2: the elm's add 4,998
-// triangles to its 33,648 (16,324 at k/2).
+// kFilletAssetPixels, k >= 2/1000 of the skeleton's extent; the rest move no surface by
+// more than half a pixel in such a view. Each at cells of k, nearer the export's 8 facets
+// around a stem than k/2: the elm's add 4,998 triangles to its 33,648 (16,324 at k/2).
 TriangleMesh asset_fillets(const Skeleton& skeleton, std::span<const Frustum> frusta, unsigned threads = 0);
 
 }  // namespace sylva

@@ -275,9 +275,7 @@ struct GlMesh::State {
     size_t crotches_found = 0, crotches_meshed = 0;
     const auto seen = [&](std::vector<Crotch> crotches, std::span<const glm::dvec3> eyes) {
       crotches_found += crotches.size();
-      if (geometry.cull)
-        std::erase_if(crotches,
-                      [&](const Crotch& c) { return !crotch_seen_from_any(c, eyes, view_pixels_per_radian); });
+      if (geometry.cull) crotches = crotches_seen(std::move(crotches), eyes, view_pixels_per_radian);
       crotches_meshed += crotches.size();
       return crotches;
     };
